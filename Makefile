@@ -1,0 +1,40 @@
+# cube5 — the README's two commands are `make demo` and `make test`; both run `setup` first.
+CARGO ?= cargo
+DEMO_DIR ?= out
+
+.PHONY: setup demo test sim lint synth bench fmt clippy clean
+
+setup:
+	@scripts/setup.sh
+
+## The main job on the embedded default scene (no download).
+demo: setup
+	@mkdir -p $(DEMO_DIR)
+	$(CARGO) run --release -q -p cube5-cli -- render -o $(DEMO_DIR)/cube5-demo.png
+
+## Every test: golden model, co-simulation (RTL and gate-level netlists), command line.
+test: setup
+	$(CARGO) test --release --workspace
+
+## The RTL regression alone: every co-simulation test.
+sim: setup
+	$(CARGO) test --release -p cube5-tb
+
+lint:
+	@scripts/lint.sh
+
+synth:
+	@scripts/synth.sh
+
+bench: setup
+	$(CARGO) run --release -q -p cube5-cli -- bench
+
+fmt:
+	$(CARGO) fmt --all
+
+clippy:
+	$(CARGO) clippy --workspace --all-targets --release -- -D warnings
+
+clean:
+	$(CARGO) clean
+	rm -rf $(DEMO_DIR)

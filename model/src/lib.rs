@@ -1,0 +1,14 @@
+//! cube5 golden model: a bit-accurate Rust model of every cube5 RTL unit, written from the numeric
+//! contract in `docs/numerics.md`, plus f64 reference renderers to measure error against.
+//!
+//! Pure Rust: builds and tests with no Verilator and no C++ compiler.
+
+pub mod bits;
+pub mod error;
+pub mod phantom;
+pub mod render;
+pub mod scene;
+pub mod trilin;
+pub mod unit;
+
+pub use error::{ModelError, Result};

@@ -1,0 +1,202 @@
+//! Volumes and the embedded procedural phantoms (no download needed for the default scene).
+
+use crate::error::{ModelError, Result};
+use rayon::prelude::*;
+
+/// A scalar volume of unsigned voxels, x fastest. Samples outside the volume read as 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Volume {
+    pub dims: [usize; 3],
+    /// Physical size of a voxel along each axis (anisotropic CT, say); 1.0 when isotropic.
+    pub spacing: [f64; 3],
+    /// Voxel width in bits (values are `0 ..= 2^bits - 1`).
+    pub bits: u32,
+    pub data: Vec<u16>,
+}
+
+/// Largest edge accepted anywhere (memory: 1024^3 voxels of 16 bits is 2 GiB).
+pub const MAX_EDGE: usize = 1024;
+
+impl Volume {
+    pub fn new(dims: [usize; 3], spacing: [f64; 3], bits: u32, data: Vec<u16>) -> Result<Self> {
+        if dims.iter().any(|&d| d == 0 || d > MAX_EDGE) {
+            return Err(ModelError::Volume(format!(
+                "dimensions {dims:?}: each edge must be 1..={MAX_EDGE}"
+            )));
+        }
+        if !(1..=16).contains(&bits) {
+            return Err(ModelError::Volume(format!(
+                "voxel width {bits} bits: must be 1..=16"
+            )));
+        }
+        if spacing.iter().any(|s| !s.is_finite() || *s <= 0.0) {
+            return Err(ModelError::Volume(format!(
+                "spacing {spacing:?}: must be finite and > 0"
+            )));
+        }
+        let n = dims[0] * dims[1] * dims[2];
+        if data.len() != n {
+            return Err(ModelError::Volume(format!(
+                "{} voxels given for dimensions {dims:?} ({n} expected)",
+                data.len()
+            )));
+        }
+        let max = ((1u32 << bits) - 1) as u16;
+        if let Some(i) = data.iter().position(|&v| v > max) {
+            return Err(ModelError::Volume(format!(
+                "voxel {i} is {} but {bits}-bit voxels stop at {max}",
+                data[i]
+            )));
+        }
+        Ok(Self {
+            dims,
+            spacing,
+            bits,
+            data,
+        })
+    }
+
+    pub fn max_value(&self) -> u32 {
+        (1u32 << self.bits) - 1
+    }
+
+    pub fn len(&self) -> usize {
+        self.data.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+
+    /// Voxel at integer coordinates; 0 outside the volume (the contract's rule for outside samples).
+    pub fn get(&self, x: i64, y: i64, z: i64) -> u32 {
+        let [nx, ny, nz] = self.dims.map(|d| d as i64);
+        if x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz {
+            return 0;
+        }
+        u32::from(self.data[(x + nx * (y + ny * z)) as usize])
+    }
+
+    /// Tri-linear interpolation in f64 at continuous voxel coordinates (voxel centres at integers).
+    pub fn sample_f64(&self, p: [f64; 3]) -> f64 {
+        let f = p.map(f64::floor);
+        let t = [p[0] - f[0], p[1] - f[1], p[2] - f[2]];
+        let [x, y, z] = f.map(|v| v as i64);
+        let mut acc = 0.0;
+        for c in 0..8 {
+            let (dx, dy, dz) = (c & 1, (c >> 1) & 1, (c >> 2) & 1);
+            let w = (if dx == 1 { t[0] } else { 1.0 - t[0] })
+                * (if dy == 1 { t[1] } else { 1.0 - t[1] })
+                * (if dz == 1 { t[2] } else { 1.0 - t[2] });
+            if w != 0.0 {
+                acc += w * f64::from(self.get(x + dx, y + dy, z + dz));
+            }
+        }
+        acc
+    }
+}
+
+/// One ellipsoid of constant density in normalized coordinates ([-1, 1] across the volume).
+struct Blob {
+    centre: [f64; 3],
+    radii: [f64; 3],
+    density: f64,
+}
+
+impl Blob {
+    fn inside(&self, p: [f64; 3]) -> bool {
+        (0..3)
+            .map(|a| ((p[a] - self.centre[a]) / self.radii[a]).powi(2))
+            .sum::<f64>()
+            <= 1.0
+    }
+}
+
+/// A CT-like head: skin, skull shell, brain, two ventricles and lesions of different densities.
+/// Later blobs overwrite earlier ones, so the list reads from the outside in.
+fn head_blobs() -> Vec<Blob> {
+    let b = |centre, radii, density| Blob {
+        centre,
+        radii,
+        density,
+    };
+    vec![
+        b([0.0, 0.0, 0.0], [0.80, 0.90, 0.95], 0.22), // skin and scalp
+        b([0.0, 0.0, 0.0], [0.76, 0.86, 0.91], 0.86), // skull
+        b([0.0, 0.0, 0.02], [0.69, 0.79, 0.84], 0.36), // brain
+        b([-0.3, -0.8, -0.25], [0.16, 0.16, 0.14], 0.0), // left eye orbit
+        b([0.3, -0.8, -0.25], [0.16, 0.16, 0.14], 0.0), // right eye orbit
+        b([-0.16, 0.05, 0.1], [0.08, 0.28, 0.12], 0.12), // left ventricle
+        b([0.16, 0.05, 0.1], [0.08, 0.28, 0.12], 0.12), // right ventricle
+        b([0.32, -0.25, 0.28], [0.15, 0.15, 0.15], 0.50), // lesion
+        b([-0.35, -0.2, -0.15], [0.12, 0.12, 0.12], 0.61), // lesion
+        b([0.05, 0.42, -0.35], [0.11, 0.11, 0.11], 0.75), // calcification
+        b([0.0, -0.5, 0.45], [0.05, 0.05, 0.05], 1.00), // metal marker
+    ]
+}
+
+/// The embedded head phantom, `n^3` voxels of `bits` bits, edges anti-aliased by 2x2x2 supersampling.
+pub fn head_phantom(n: usize, bits: u32) -> Result<Volume> {
+    if !(4..=MAX_EDGE).contains(&n) {
+        return Err(ModelError::Volume(format!(
+            "phantom size {n}: must be 4..={MAX_EDGE}"
+        )));
+    }
+    if !(1..=16).contains(&bits) {
+        return Err(ModelError::Volume(format!(
+            "voxel width {bits} bits: must be 1..=16"
+        )));
+    }
+    let blobs = head_blobs();
+    let max = f64::from((1u32 << bits) - 1);
+    let to_norm = |i: f64| (i + 0.5) / n as f64 * 2.0 - 1.0;
+    let data: Vec<u16> = (0..n * n * n)
+        .into_par_iter()
+        .map(|idx| {
+            let (x, y, z) = (idx % n, (idx / n) % n, idx / (n * n));
+            let mut acc = 0.0;
+            for s in 0..8 {
+                let off = |bit: usize| if (s >> bit) & 1 == 1 { 0.25 } else { -0.25 };
+                let p = [
+                    to_norm(x as f64 + off(0)),
+                    to_norm(y as f64 + off(1)),
+                    to_norm(z as f64 + off(2)),
+                ];
+                let d = blobs
+                    .iter()
+                    .rev()
+                    .find(|b| b.inside(p))
+                    .map_or(0.0, |b| b.density);
+                acc += d / 8.0;
+            }
+            (acc * max).round() as u16
+        })
+        .collect();
+    Volume::new([n; 3], [1.0; 3], bits, data)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn phantom_has_structure() {
+        let v = head_phantom(32, 12).unwrap();
+        assert_eq!(v.len(), 32 * 32 * 32);
+        assert_eq!(v.get(0, 0, 0), 0, "corners are air");
+        assert!(
+            v.data.iter().any(|&d| u32::from(d) > 3000),
+            "skull is dense"
+        );
+        assert_eq!(v.get(-1, 5, 5), 0, "outside reads zero");
+    }
+
+    #[test]
+    fn bad_volumes_refused() {
+        assert!(Volume::new([0, 4, 4], [1.0; 3], 8, vec![]).is_err());
+        assert!(Volume::new([2, 2, 2], [1.0; 3], 8, vec![0; 7]).is_err());
+        assert!(Volume::new([2, 2, 2], [1.0; 3], 8, vec![256; 8]).is_err());
+        assert!(Volume::new([2, 2, 2], [f64::NAN, 1.0, 1.0], 8, vec![0; 8]).is_err());
+        assert!(head_phantom(2, 12).is_err());
+    }
+}

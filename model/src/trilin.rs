@@ -1,0 +1,311 @@
+//! Tri-linear interpolation (`cube5_trilin`), written from `docs/numerics.md` § Tri-linear
+//! interpolation: seven linear interpolations, x then y then z, each rounded half up.
+
+use crate::bits::{BitReader, BitWriter};
+use crate::error::{ModelError, Result};
+use crate::unit::{StreamCodec, StreamUnit};
+
+/// Widths of one `cube5_trilin` configuration (the RTL parameters of the same names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrilinConfig {
+    pub voxel_w: u32,
+    pub weight_w: u32,
+    pub frac_w: u32,
+}
+
+impl TrilinConfig {
+    pub const NARROW: Self = Self {
+        voxel_w: 8,
+        weight_w: 6,
+        frac_w: 2,
+    };
+    pub const DEFAULT: Self = Self {
+        voxel_w: 12,
+        weight_w: 8,
+        frac_w: 4,
+    };
+    pub const WIDE: Self = Self {
+        voxel_w: 16,
+        weight_w: 10,
+        frac_w: 6,
+    };
+
+    pub fn new(voxel_w: u32, weight_w: u32, frac_w: u32) -> Result<Self> {
+        let cfg = Self {
+            voxel_w,
+            weight_w,
+            frac_w,
+        };
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        let bad = |what: &str| Err(ModelError::Config(format!("trilin: {what}")));
+        if !(4..=16).contains(&self.voxel_w) {
+            return bad(&format!("VoxelW {} outside 4..=16", self.voxel_w));
+        }
+        if !(1..=12).contains(&self.weight_w) {
+            return bad(&format!("WeightW {} outside 1..=12", self.weight_w));
+        }
+        if self.frac_w > 8 {
+            return bad(&format!("FracW {} outside 0..=8", self.frac_w));
+        }
+        Ok(())
+    }
+
+    /// Width of the output sample, `U(VoxelW.FracW)`.
+    pub fn sample_w(&self) -> u32 {
+        self.voxel_w + self.frac_w
+    }
+
+    pub fn voxel_max(&self) -> u32 {
+        (1 << self.voxel_w) - 1
+    }
+
+    pub fn weight_max(&self) -> u32 {
+        (1 << self.weight_w) - 1
+    }
+}
+
+/// The weight modes of `docs/numerics.md` (the 2-bit `mode` field).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrilinMode {
+    Lerp = 0,
+    Half = 1,
+    Select = 2,
+    /// Reserved encoding; behaves as `Lerp` by contract.
+    Reserved = 3,
+}
+
+impl TrilinMode {
+    pub fn from_bits(bits: u32) -> Self {
+        match bits & 3 {
+            0 => Self::Lerp,
+            1 => Self::Half,
+            2 => Self::Select,
+            _ => Self::Reserved,
+        }
+    }
+}
+
+/// One input item: corner voxels indexed `x + 2y + 4z`, weights `U(0.WeightW)`, mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrilinIn {
+    pub voxels: [u32; 8],
+    pub weights: [u32; 3],
+    pub mode: TrilinMode,
+}
+
+/// The golden model of `cube5_trilin`.
+#[derive(Debug, Clone)]
+pub struct Trilin {
+    cfg: TrilinConfig,
+}
+
+impl Trilin {
+    pub fn new(cfg: TrilinConfig) -> Result<Self> {
+        cfg.validate()?;
+        Ok(Self { cfg })
+    }
+
+    pub fn config(&self) -> TrilinConfig {
+        self.cfg
+    }
+
+    /// The effective weight on the scale `2^WeightW` = 1.0 (table in the contract).
+    fn effective_weight(&self, w: u32, mode: TrilinMode) -> u64 {
+        let one = 1u64 << self.cfg.weight_w;
+        match mode {
+            TrilinMode::Lerp | TrilinMode::Reserved => u64::from(w),
+            TrilinMode::Half => one / 2,
+            TrilinMode::Select => {
+                if u64::from(w) < one / 2 {
+                    0
+                } else {
+                    one
+                }
+            }
+        }
+    }
+
+    /// `lerp(a, b, e) = rnd(a * (2^WeightW - e) + b * e, WeightW)`.
+    fn lerp(&self, a: u64, b: u64, e: u64) -> u64 {
+        let one = 1u64 << self.cfg.weight_w;
+        round_half_up(a * (one - e) + b * e, self.cfg.weight_w)
+    }
+
+    /// One sample, `U(VoxelW.FracW)`.
+    pub fn sample(&self, item: &TrilinIn) -> u32 {
+        let wide = |c: usize| u64::from(item.voxels[c]) << self.cfg.frac_w;
+        let [ex, ey, ez] = item.weights.map(|w| self.effective_weight(w, item.mode));
+        let p = [
+            self.lerp(wide(0), wide(1), ex),
+            self.lerp(wide(2), wide(3), ex),
+            self.lerp(wide(4), wide(5), ex),
+            self.lerp(wide(6), wide(7), ex),
+        ];
+        let q = [self.lerp(p[0], p[1], ey), self.lerp(p[2], p[3], ey)];
+        self.lerp(q[0], q[1], ez) as u32
+    }
+
+    /// The f64 ideal with the same effective weights, in voxel units.
+    pub fn reference(&self, item: &TrilinIn) -> f64 {
+        let one = f64::from(1u32 << self.cfg.weight_w);
+        let e = item
+            .weights
+            .map(|w| self.effective_weight(w, item.mode) as f64 / one);
+        (0..8)
+            .map(|c| {
+                let f = |axis: usize| {
+                    if (c >> axis) & 1 == 1 {
+                        e[axis]
+                    } else {
+                        1.0 - e[axis]
+                    }
+                };
+                f64::from(item.voxels[c]) * f(0) * f(1) * f(2)
+            })
+            .sum()
+    }
+}
+
+/// `rnd(x, s)`: round half up of `x / 2^s`.
+pub fn round_half_up(x: u64, s: u32) -> u64 {
+    if s == 0 {
+        x
+    } else {
+        (x + (1 << (s - 1))) >> s
+    }
+}
+
+impl StreamUnit for Trilin {
+    type In = TrilinIn;
+    type Out = u32;
+
+    fn run(&mut self, inputs: &[TrilinIn]) -> Vec<u32> {
+        inputs.iter().map(|item| self.sample(item)).collect()
+    }
+}
+
+impl StreamCodec for TrilinConfig {
+    type In = TrilinIn;
+    type Out = u32;
+
+    fn in_width(&self) -> u32 {
+        8 * self.voxel_w + 3 * self.weight_w + 2
+    }
+
+    fn out_width(&self) -> u32 {
+        self.sample_w()
+    }
+
+    fn pack_in(&self, item: &TrilinIn) -> Vec<u32> {
+        let mut w = BitWriter::new();
+        for v in item.voxels {
+            w.put(u64::from(v), self.voxel_w);
+        }
+        for x in item.weights {
+            w.put(u64::from(x), self.weight_w);
+        }
+        w.put(item.mode as u64, 2);
+        w.finish(self.in_width())
+    }
+
+    fn unpack_out(&self, words: &[u32]) -> u32 {
+        BitReader::new(words).get(self.sample_w()) as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_item(rng: &mut ChaCha8Rng, cfg: &TrilinConfig) -> TrilinIn {
+        TrilinIn {
+            voxels: std::array::from_fn(|_| rng.random_range(0..=cfg.voxel_max())),
+            weights: std::array::from_fn(|_| rng.random_range(0..=cfg.weight_max())),
+            mode: TrilinMode::from_bits(rng.random_range(0..4)),
+        }
+    }
+
+    #[test]
+    fn error_within_contract_bound() {
+        for cfg in [
+            TrilinConfig::NARROW,
+            TrilinConfig::DEFAULT,
+            TrilinConfig::WIDE,
+        ] {
+            let unit = Trilin::new(cfg).unwrap();
+            let mut rng = ChaCha8Rng::seed_from_u64(7);
+            let lsb = 1.0 / f64::from(1u32 << cfg.frac_w);
+            for _ in 0..100_000 {
+                let item = random_item(&mut rng, &cfg);
+                let got = f64::from(unit.sample(&item)) * lsb;
+                let err = (got - unit.reference(&item)).abs();
+                let bound = if item.mode == TrilinMode::Select {
+                    0.0
+                } else {
+                    1.5 * lsb
+                };
+                assert!(
+                    err <= bound + 1e-9,
+                    "{cfg:?} {item:?}: error {err} > {bound}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn extremes() {
+        let cfg = TrilinConfig::DEFAULT;
+        let unit = Trilin::new(cfg).unwrap();
+        let max = cfg.voxel_max();
+        for mode in [TrilinMode::Lerp, TrilinMode::Half, TrilinMode::Select] {
+            for w in [0, cfg.weight_max()] {
+                let all = |v| TrilinIn {
+                    voxels: [v; 8],
+                    weights: [w; 3],
+                    mode,
+                };
+                assert_eq!(unit.sample(&all(0)), 0);
+                assert_eq!(unit.sample(&all(max)), max << cfg.frac_w);
+            }
+        }
+        // Weight 0 selects corner 0, Select with max weight selects corner 7.
+        let ramp = TrilinIn {
+            voxels: [1, 2, 3, 4, 5, 6, 7, 8],
+            weights: [0; 3],
+            mode: TrilinMode::Lerp,
+        };
+        assert_eq!(unit.sample(&ramp), 1 << cfg.frac_w);
+        let sel = TrilinIn {
+            weights: [cfg.weight_max(); 3],
+            mode: TrilinMode::Select,
+            ..ramp
+        };
+        assert_eq!(unit.sample(&sel), 8 << cfg.frac_w);
+        let half = TrilinIn {
+            mode: TrilinMode::Half,
+            ..ramp
+        };
+        assert_eq!(unit.sample(&half), (9 << cfg.frac_w) / 2);
+    }
+
+    #[test]
+    fn config_validation() {
+        assert!(TrilinConfig::new(3, 8, 4).is_err());
+        assert!(TrilinConfig::new(12, 0, 4).is_err());
+        assert!(TrilinConfig::new(12, 8, 9).is_err());
+        assert!(TrilinConfig::new(12, 8, 4).is_ok());
+    }
+
+    #[test]
+    fn packing_width_matches_contract_table() {
+        assert_eq!(TrilinConfig::NARROW.in_width(), 84);
+        assert_eq!(TrilinConfig::DEFAULT.in_width(), 122);
+        assert_eq!(TrilinConfig::WIDE.in_width(), 160);
+    }
+}

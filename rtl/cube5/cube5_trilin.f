@@ -1,0 +1,3 @@
+rtl/cube5_pkg.sv
+rtl/cube5/cube5_lerp.sv
+rtl/cube5/cube5_trilin.sv

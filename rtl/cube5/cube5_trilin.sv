@@ -1,0 +1,181 @@
+// cube5_trilin: tri-linear interpolation of one sample from eight voxels (patent [44], [48], [202];
+// cube3-paper §3), as seven rounded linear interpolations: four along x, two along y, one along z.
+//
+// Modes (docs/numerics.md): Lerp uses the weights, Half forces 0.5 (level-of-detail filtering),
+// Select forces 0 or 1 from each weight's MSB (nearest voxel). Three register stages, one per axis;
+// each stage holds its item while the next is full, so the unit accepts one item per cycle when the
+// output is never stalled and never drops or duplicates an item.
+module cube5_trilin #(
+  /// Voxel width, U(VoxelW.0).
+  parameter int unsigned VoxelW  = 12,
+  /// Weight fraction bits, U(0.WeightW).
+  parameter int unsigned WeightW = 8,
+  /// Fraction bits kept in intermediates and in the sample.
+  parameter int unsigned FracW   = 4
+) (
+  input  logic clk_i,
+  input  logic rst_ni,
+
+  /// Input item valid.
+  input  logic in_valid_i,
+  /// Unit can take an input item this cycle.
+  output logic in_ready_o,
+  /// v[0..7] (VoxelW each, corner x + 2y + 4z), wx, wy, wz (WeightW each), mode (2), LSB first.
+  input  logic [cube5_pkg::trilin_in_w(VoxelW, WeightW)-1:0] in_data_i,
+
+  /// Output sample valid.
+  output logic out_valid_o,
+  /// Consumer takes the sample this cycle.
+  input  logic out_ready_i,
+  /// Sample, U(VoxelW.FracW).
+  output logic [cube5_pkg::sample_w(VoxelW, FracW)-1:0] out_data_o
+);
+
+  localparam int unsigned SampleW = cube5_pkg::sample_w(VoxelW, FracW);
+  localparam int unsigned EffW    = WeightW + 1;  // effective weight, 2^WeightW = 1.0
+
+  // Elaboration checks mirror TrilinConfig::validate in the model.
+  if (VoxelW < 4 || VoxelW > 16) begin : gen_bad_voxel_w
+    $fatal(1, "cube5_trilin: VoxelW must be 4..16");
+  end
+  if (WeightW < 1 || WeightW > 12) begin : gen_bad_weight_w
+    $fatal(1, "cube5_trilin: WeightW must be 1..12");
+  end
+  if (FracW > 8) begin : gen_bad_frac_w
+    $fatal(1, "cube5_trilin: FracW must be 0..8");
+  end
+
+  // ---------------------------------------------------------------------------
+  // Input decode: voxels widened to U(VoxelW.FracW), effective weights per mode
+  // ---------------------------------------------------------------------------
+  localparam int unsigned WeightsLsb = 8 * VoxelW;
+  localparam int unsigned ModeLsb    = WeightsLsb + 3 * WeightW;
+
+  logic [1:0]          mode;
+  logic [8*SampleW-1:0] corners;   // corner c at [c*SampleW +: SampleW]
+  logic [3*EffW-1:0]    eff;       // axis a at [a*EffW +: EffW]
+
+  always_comb begin
+    mode = in_data_i[ModeLsb +: 2];
+    for (int unsigned c = 0; c < 8; c++) begin
+      corners[c*SampleW +: SampleW] = {in_data_i[c*VoxelW +: VoxelW], {FracW{1'b0}}};
+    end
+    for (int unsigned a = 0; a < 3; a++) begin
+      logic [WeightW-1:0] w;
+      w = in_data_i[WeightsLsb + a*WeightW +: WeightW];
+      unique case (mode)
+        cube5_pkg::TrilinModeHalf:   eff[a*EffW +: EffW] = EffW'(1) << (WeightW - 1);
+        cube5_pkg::TrilinModeSelect: eff[a*EffW +: EffW] = w[WeightW-1] ? (EffW'(1) << WeightW)
+                                                                         : '0;
+        default:                     eff[a*EffW +: EffW] = {1'b0, w};
+      endcase
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stage handshakes: a stage takes a new item when it is empty or its item moves on
+  // ---------------------------------------------------------------------------
+  logic valid_x_q, valid_y_q, valid_z_q;
+  logic ready_x, ready_y, ready_z;
+
+  assign ready_z    = !valid_z_q || out_ready_i;
+  assign ready_y    = !valid_y_q || ready_z;
+  assign ready_x    = !valid_x_q || ready_y;
+  assign in_ready_o = ready_x;
+
+  // ---------------------------------------------------------------------------
+  // Stage x: four interpolations along x (pairs of corners differing in x)
+  // ---------------------------------------------------------------------------
+  logic [4*SampleW-1:0] along_x_d, along_x_q;
+  logic [2*EffW-1:0]    eff_yz_q;
+
+  for (genvar i = 0; i < 4; i++) begin : gen_lerp_x
+    cube5_lerp #(
+      .ValW    (SampleW),
+      .WeightW (WeightW)
+    ) u_lerp (
+      .a_i (corners[(2*i)*SampleW +: SampleW]),
+      .b_i (corners[(2*i+1)*SampleW +: SampleW]),
+      .e_i (eff[0 +: EffW]),
+      .y_o (along_x_d[i*SampleW +: SampleW])
+    );
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stage y: two interpolations along y
+  // ---------------------------------------------------------------------------
+  logic [2*SampleW-1:0] along_y_d, along_y_q;
+  logic [EffW-1:0]      eff_z_q;
+
+  for (genvar i = 0; i < 2; i++) begin : gen_lerp_y
+    cube5_lerp #(
+      .ValW    (SampleW),
+      .WeightW (WeightW)
+    ) u_lerp (
+      .a_i (along_x_q[(2*i)*SampleW +: SampleW]),
+      .b_i (along_x_q[(2*i+1)*SampleW +: SampleW]),
+      .e_i (eff_yz_q[0 +: EffW]),
+      .y_o (along_y_d[i*SampleW +: SampleW])
+    );
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stage z: the sample
+  // ---------------------------------------------------------------------------
+  logic [SampleW-1:0] sample_d, sample_q;
+
+  cube5_lerp #(
+    .ValW    (SampleW),
+    .WeightW (WeightW)
+  ) u_lerp_z (
+    .a_i (along_y_q[0 +: SampleW]),
+    .b_i (along_y_q[SampleW +: SampleW]),
+    .e_i (eff_z_q),
+    .y_o (sample_d)
+  );
+
+  // ---------------------------------------------------------------------------
+  // Registers: valids reset (synchronously, as FPGA flows prefer), datapath not
+  // ---------------------------------------------------------------------------
+  logic valid_x_d, valid_y_d, valid_z_d;
+  assign valid_x_d = ready_x ? in_valid_i : valid_x_q;
+  assign valid_y_d = ready_y ? valid_x_q  : valid_y_q;
+  assign valid_z_d = ready_z ? valid_y_q  : valid_z_q;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      valid_x_q <= 1'b0;
+      valid_y_q <= 1'b0;
+      valid_z_q <= 1'b0;
+    end else begin
+      valid_x_q <= valid_x_d;
+      valid_y_q <= valid_y_d;
+      valid_z_q <= valid_z_d;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (ready_x) begin
+      along_x_q <= along_x_d;
+      eff_yz_q  <= eff[EffW +: 2*EffW];
+    end
+    if (ready_y) begin
+      along_y_q <= along_y_d;
+      eff_z_q   <= eff_yz_q[EffW +: EffW];
+    end
+    if (ready_z) begin
+      sample_q <= sample_d;
+    end
+  end
+
+  assign out_valid_o = valid_z_q;
+  assign out_data_o  = sample_q;
+
+`ifndef SYNTHESIS
+  // A stalled output holds its item (STYLE.md rule 3).
+  OutputHoldsWhileStalled: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
+    else $error("cube5_trilin: output changed while stalled");
+`endif
+
+endmodule

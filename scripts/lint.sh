@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# verilator --lint-only -Wall (with assertions elaborated) on every top at every verified
+# configuration. Waivers live only in rtl/lint/verilator.vlt.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+fail=0
+count=0
+while read -r top flist name flags params; do
+  gflags=()
+  for p in $params; do gflags+=("-G$p"); done
+  if ! verilator --lint-only -Wall --assert rtl/lint/verilator.vlt --top-module "$top" "${gflags[@]}" -f "$flist"; then
+    echo "lint FAILED: $top $name ($params)"
+    fail=1
+  fi
+  count=$((count + 1))
+done < <(scripts/variants.sh)
+if [ "$fail" -ne 0 ]; then exit 1; fi
+echo "lint clean: $count configurations (verilator $(verilator --version | cut -d' ' -f2) -Wall)"

@@ -1,0 +1,222 @@
+//! A Verilated streaming top behind the same `StreamUnit` trait as the golden model.
+
+use crate::ffi::bridge::{self, RunResult, StreamDut};
+use cube5_model::bits::words_for;
+use cube5_model::unit::{StreamCodec, StreamUnit};
+use cxx::UniquePtr;
+use std::path::Path;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum RtlError {
+    #[error("RTL variant `{name}` is not built into this test bench (built: {built}); check rtl/**/*.variants and CUBE5_TOPS")]
+    NotBuilt { name: String, built: String },
+    #[error("RTL variant `{name}`: {port} is {rtl} bits in the RTL but {model} bits in the model's codec")]
+    WidthMismatch {
+        name: String,
+        port: &'static str,
+        rtl: u32,
+        model: u32,
+    },
+    #[error("RTL variant `{name}`: {what}")]
+    Run { name: String, what: String },
+}
+
+/// Per-cycle input idling and output back-pressure, as repeating patterns (nonzero = idle/stall).
+#[derive(Debug, Clone, Default)]
+pub struct Traffic {
+    pub idle: Vec<u8>,
+    pub stall: Vec<u8>,
+}
+
+impl Traffic {
+    /// Input always offered, output always taken: the throughput case.
+    pub fn full_speed() -> Self {
+        Self::default()
+    }
+
+    /// Random idle with probability `idle` and back-pressure with probability `stall`, over
+    /// patterns of 4099 and 4111 cycles (coprime, so the two never fall into lock-step).
+    pub fn random(rng: &mut impl rand::Rng, idle: f64, stall: f64) -> Self {
+        let pattern = |rng: &mut dyn rand::RngCore, p: f64, n: usize| -> Vec<u8> {
+            (0..n)
+                .map(|_| u8::from(rand::Rng::random_bool(rng, p)))
+                .collect()
+        };
+        Self {
+            idle: pattern(rng, idle, 4099),
+            stall: pattern(rng, stall, 4111),
+        }
+    }
+}
+
+/// One output as it left the RTL: the cycle it was taken and its value.
+#[derive(Debug, Clone)]
+pub struct Taken<T> {
+    pub cycle: u64,
+    pub value: T,
+    pub words: Vec<u32>,
+}
+
+/// Result of driving a batch.
+#[derive(Debug, Clone)]
+pub struct Driven<T> {
+    pub outputs: Vec<Taken<T>>,
+    pub stats: RunResult,
+}
+
+pub struct RtlStream<C: StreamCodec> {
+    dut: UniquePtr<StreamDut>,
+    codec: C,
+    name: String,
+}
+
+/// Names of every RTL variant built into this test bench.
+pub fn built_variants() -> Vec<String> {
+    bridge::built_variants()
+}
+
+impl<C: StreamCodec> RtlStream<C> {
+    /// Instantiates variant `name` (e.g. `cube5_trilin_v12`) with Verilator's random-reset seed
+    /// `seed`, resets it, and checks its port widths against `codec`.
+    pub fn new(name: &str, codec: C, seed: u32) -> Result<Self, RtlError> {
+        let dut = bridge::new_stream_dut(name, seed);
+        if dut.is_null() {
+            return Err(RtlError::NotBuilt {
+                name: name.into(),
+                built: built_variants().join(", "),
+            });
+        }
+        let mut s = Self {
+            dut,
+            codec,
+            name: name.into(),
+        };
+        for (port, rtl, model) in [
+            ("in_data_i", s.dut.in_bits(), s.codec.in_width()),
+            ("out_data_o", s.dut.out_bits(), s.codec.out_width()),
+        ] {
+            if rtl != model {
+                return Err(RtlError::WidthMismatch {
+                    name: name.into(),
+                    port,
+                    rtl,
+                    model,
+                });
+            }
+        }
+        s.reset();
+        Ok(s)
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn codec(&self) -> &C {
+        &self.codec
+    }
+
+    /// Four cycles of reset with idle inputs.
+    pub fn reset(&mut self) {
+        self.dut.pin_mut().reset(4);
+    }
+
+    pub fn cycle(&self) -> u64 {
+        self.dut.cycle()
+    }
+
+    /// Records cycles `[from, to]` into a VCD file.
+    pub fn trace_window(&mut self, path: &Path, from: u64, to: u64) -> bool {
+        self.dut
+            .pin_mut()
+            .trace_window(&path.to_string_lossy(), from, to)
+    }
+
+    /// Drives `items` under `traffic` until all are consumed and `expect_out` outputs were taken,
+    /// or `max_cycles` pass.
+    pub fn drive(
+        &mut self,
+        items: &[C::In],
+        traffic: &Traffic,
+        expect_out: u64,
+        max_cycles: u64,
+    ) -> Result<Driven<C::Out>, RtlError> {
+        let flat = self.pack(items);
+        self.drive_packed(&flat, traffic, expect_out, max_cycles)
+    }
+
+    /// Items packed as the RTL's `in_data_i` words, back to back.
+    pub fn pack(&self, items: &[C::In]) -> Vec<u32> {
+        let mut flat = Vec::with_capacity(items.len() * words_for(self.codec.in_width()));
+        for it in items {
+            flat.extend(self.codec.pack_in(it));
+        }
+        flat
+    }
+
+    /// `drive` for items already packed by `pack` (benchmarks time the simulation alone).
+    pub fn drive_packed(
+        &mut self,
+        flat: &[u32],
+        traffic: &Traffic,
+        expect_out: u64,
+        max_cycles: u64,
+    ) -> Result<Driven<C::Out>, RtlError> {
+        let in_words = words_for(self.codec.in_width());
+        let out_words = words_for(self.codec.out_width());
+        let mut raw = Vec::new();
+        let stats = self.dut.pin_mut().run(
+            flat,
+            in_words as u32,
+            &traffic.idle,
+            &traffic.stall,
+            expect_out,
+            max_cycles,
+            &mut raw,
+            out_words as u32,
+        );
+        if stats.finished {
+            return Err(RtlError::Run {
+                name: self.name.clone(),
+                what: "the RTL stopped the simulation ($finish or a failed assertion)".into(),
+            });
+        }
+        let outputs = raw
+            .chunks_exact(2 + out_words)
+            .map(|rec| Taken {
+                cycle: u64::from(rec[0]) | u64::from(rec[1]) << 32,
+                value: self.codec.unpack_out(&rec[2..]),
+                words: rec[2..].to_vec(),
+            })
+            .collect();
+        Ok(Driven { outputs, stats })
+    }
+}
+
+impl<C: StreamCodec> StreamUnit for RtlStream<C>
+where
+    C::In: Clone + std::fmt::Debug,
+    C::Out: Clone + std::fmt::Debug + PartialEq,
+{
+    type In = C::In;
+    type Out = C::Out;
+
+    /// Full speed, no stalls; panics only if the RTL deadlocks (a bug in the RTL, not user input).
+    fn run(&mut self, inputs: &[C::In]) -> Vec<C::Out> {
+        let n = inputs.len() as u64;
+        let driven = self
+            .drive(inputs, &Traffic::full_speed(), n, 1000 + 100 * n)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            driven.stats.produced, n,
+            "{}: RTL did not produce every output",
+            self.name
+        );
+        driven.outputs.into_iter().map(|t| t.value).collect()
+    }
+
+    fn reset(&mut self) {
+        RtlStream::reset(self);
+    }
+}

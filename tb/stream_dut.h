@@ -1,0 +1,35 @@
+// stream_dut.h: the cxx-bridged wrapper around a DutCore (see tb-rs/src/ffi.rs).
+#pragma once
+
+#include <memory>
+
+#include "dut_core.h"
+#include "rust/cxx.h"
+
+namespace cube5 {
+
+struct RunResult;
+
+class StreamDut {
+ public:
+  explicit StreamDut(std::unique_ptr<DutCore> core) : core_(std::move(core)) {}
+
+  void reset(uint32_t cycles);
+  RunResult run(rust::Slice<const uint32_t> items, uint32_t in_words, rust::Slice<const uint8_t> idle,
+                rust::Slice<const uint8_t> stall, uint64_t expect_out, uint64_t max_cycles,
+                rust::Vec<uint32_t>& out, uint32_t out_words);
+  bool trace_window(rust::Str path, uint64_t from_cycle, uint64_t to_cycle);
+  uint64_t cycle() const;
+  uint32_t in_bits() const;
+  uint32_t out_bits() const;
+
+ private:
+  std::unique_ptr<DutCore> core_;
+};
+
+/// The variant named `name` (e.g. "cube5_trilin_v12"), or null if it was not built.
+std::unique_ptr<StreamDut> new_stream_dut(rust::Str name, uint32_t seed);
+/// Names of every variant compiled into this test bench.
+rust::Vec<rust::String> built_variants();
+
+}  // namespace cube5
