@@ -44,6 +44,10 @@ class DutCore {
                        size_t idle_len, const uint8_t* stall, size_t stall_len, uint64_t expect_out,
                        uint64_t max_cycles, std::vector<uint32_t>& out, uint32_t out_words) = 0;
 
+  /// One write on the optional configuration port (cfg_valid_i, cfg_addr_i, cfg_data_i) that loads
+  /// LUTs and registers: one clock with the stream idle. False if the top has no such port.
+  virtual bool write_config(uint32_t addr, const uint32_t* words, uint32_t n_words) = 0;
+
   /// Starts a VCD trace to `path` that records cycles [from_cycle, to_cycle]; false if tracing
   /// was not compiled in.
   virtual bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) = 0;

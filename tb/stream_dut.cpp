@@ -25,6 +25,10 @@ RunResult StreamDut::run(rust::Slice<const uint32_t> items, uint32_t in_words,
                    st.first_protocol_error_cycle, st.finished};
 }
 
+bool StreamDut::write_config(uint32_t addr, rust::Slice<const uint32_t> data) {
+  return core_->write_config(addr, data.data(), static_cast<uint32_t>(data.size()));
+}
+
 bool StreamDut::trace_window(rust::Str path, uint64_t from_cycle, uint64_t to_cycle) {
   return core_->trace_window(std::string(path), from_cycle, to_cycle);
 }

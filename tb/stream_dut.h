@@ -18,6 +18,7 @@ class StreamDut {
   RunResult run(rust::Slice<const uint32_t> items, uint32_t in_words, rust::Slice<const uint8_t> idle,
                 rust::Slice<const uint8_t> stall, uint64_t expect_out, uint64_t max_cycles,
                 rust::Vec<uint32_t>& out, uint32_t out_words);
+  bool write_config(uint32_t addr, rust::Slice<const uint32_t> data);
   bool trace_window(rust::Str path, uint64_t from_cycle, uint64_t to_cycle);
   uint64_t cycle() const;
   uint32_t in_bits() const;

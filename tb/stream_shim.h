@@ -4,6 +4,7 @@
 
 #include <cstring>
 #include <type_traits>
+#include <utility>
 
 #include "dut_core.h"
 #include "verilated.h"
@@ -46,6 +47,14 @@ inline bool port_equal(const T& a, const T& b) {
   }
 }
 
+// Detects the optional configuration port (cfg_valid_i, cfg_addr_i, cfg_data_i).
+template <class V, class = void>
+struct HasConfigPort : std::false_type {};
+template <class V>
+struct HasConfigPort<V, std::void_t<decltype(std::declval<V&>().cfg_valid_i),
+                                    decltype(std::declval<V&>().cfg_addr_i),
+                                    decltype(std::declval<V&>().cfg_data_i)>> : std::true_type {};
+
 template <class V>
 class StreamShim final : public DutCore {
  public:
@@ -60,6 +69,7 @@ class StreamShim final : public DutCore {
     top_->rst_ni = 1;
     top_->in_valid_i = 0;
     top_->out_ready_i = 0;
+    if constexpr (HasConfigPort<V>::value) top_->cfg_valid_i = 0;
     top_->eval();
   }
 
@@ -122,6 +132,25 @@ class StreamShim final : public DutCore {
     top_->out_ready_i = 0;
     top_->eval();
     return st;
+  }
+
+  bool write_config(uint32_t addr, const uint32_t* words, uint32_t n_words) override {
+    if constexpr (HasConfigPort<V>::value) {
+      top_->in_valid_i = 0;
+      top_->out_ready_i = 0;
+      top_->cfg_valid_i = 1;
+      top_->cfg_addr_i = addr;
+      write_port(top_->cfg_data_i, words, n_words);
+      tick();
+      top_->cfg_valid_i = 0;
+      top_->eval();
+      return true;
+    } else {
+      (void)addr;
+      (void)words;
+      (void)n_words;
+      return false;
+    }
   }
 
   bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) override {

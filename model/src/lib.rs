@@ -4,11 +4,19 @@
 //! Pure Rust: builds and tests with no Verilator and no C++ compiler.
 
 pub mod bits;
+pub mod blocking;
+pub mod compos;
 pub mod error;
+pub mod gicube;
+pub mod gradient;
 pub mod phantom;
 pub mod render;
 pub mod scene;
+pub mod shader;
+pub mod skewed;
+pub mod tradeoff;
 pub mod trilin;
 pub mod unit;
+pub mod volume_io;
 
 pub use error::{ModelError, Result};

@@ -34,6 +34,7 @@ pub mod bridge {
             out: &mut Vec<u32>,
             out_words: u32,
         ) -> RunResult;
+        fn write_config(self: Pin<&mut StreamDut>, addr: u32, data: &[u32]) -> bool;
         fn trace_window(
             self: Pin<&mut StreamDut>,
             path: &str,

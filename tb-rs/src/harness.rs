@@ -35,6 +35,9 @@ pub struct StreamCheck {
     pub corrupt: Option<(u64, u32)>,
     /// Write a VCD of the window around the first mismatch (re-runs the case with tracing on).
     pub waveform_on_mismatch: bool,
+    /// Configuration-port writes (address, data words) applied after construction, before any
+    /// item: LUT contents that the test loaded into the model as well. They survive resets.
+    pub config_writes: Vec<(u32, Vec<u32>)>,
 }
 
 impl StreamCheck {
@@ -48,7 +51,13 @@ impl StreamCheck {
             reset_in_batch: None,
             corrupt: None,
             waveform_on_mismatch: std::env::var_os("CUBE5_NO_WAVES").is_none(),
+            config_writes: Vec::new(),
         }
+    }
+
+    pub fn with_config_writes(mut self, writes: Vec<(u32, Vec<u32>)>) -> Self {
+        self.config_writes = writes;
+        self
     }
 
     pub fn with_traffic(mut self, idle: f64, stall: f64) -> Self {
@@ -230,6 +239,10 @@ where
             ..fail(u64::MAX, 0, e.to_string())
         })
     })?;
+    for (addr, data) in &check.config_writes {
+        dut.write_config(*addr, data)
+            .map_err(|e| Box::new(fail(u64::MAX, 0, e.to_string())))?;
+    }
     if let Some((path, (from, to))) = &trace {
         dut.trace_window(path, *from, *to);
     }

@@ -126,6 +126,19 @@ impl<C: StreamCodec> RtlStream<C> {
         self.dut.cycle()
     }
 
+    /// One write on the configuration port (LUT and register loads; see the unit's contract).
+    pub fn write_config(&mut self, addr: u32, data: &[u32]) -> Result<(), RtlError> {
+        if self.dut.pin_mut().write_config(addr, data) {
+            Ok(())
+        } else {
+            Err(RtlError::Run {
+                name: self.name.clone(),
+                what: "this top has no configuration port (cfg_valid_i, cfg_addr_i, cfg_data_i)"
+                    .into(),
+            })
+        }
+    }
+
     /// Records cycles `[from, to]` into a VCD file.
     pub fn trace_window(&mut self, path: &Path, from: u64, to: u64) -> bool {
         self.dut

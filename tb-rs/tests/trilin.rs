@@ -206,6 +206,11 @@ fn codec_and_variant_are_checked_against_the_rtl() {
         }
         other => panic!("expected a width mismatch, got {:?}", other.err()),
     }
+    let mut dut = RtlStream::new("cube5_trilin_v8", TrilinConfig::NARROW, 1).unwrap();
+    assert!(
+        dut.write_config(0, &[1]).is_err(),
+        "trilin has no configuration port"
+    );
     assert!(matches!(
         RtlStream::new("cube5_trilin_nonexistent", TrilinConfig::DEFAULT, 1),
         Err(RtlError::NotBuilt { .. })

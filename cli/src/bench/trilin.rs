@@ -1,20 +1,12 @@
-//! `cube5 bench`: speed as figures, never as pass/fail. Simulated RTL cycles per second (Verilator,
-//! driven in batches from Rust), items per clock, and golden-model items per second.
+//! Benchmark of cube5_trilin: speed, and error against the f64 reference.
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use cube5_model::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use cube5_model::unit::StreamUnit;
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
-
-#[derive(Debug, clap::Args)]
-pub struct BenchArgs {
-    /// Items per measurement.
-    #[arg(long, default_value_t = 1_000_000)]
-    items: usize,
-}
 
 fn trilin_items(cfg: &TrilinConfig, n: usize, seed: u64) -> Vec<TrilinIn> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -27,10 +19,8 @@ fn trilin_items(cfg: &TrilinConfig, n: usize, seed: u64) -> Vec<TrilinIn> {
         .collect()
 }
 
-pub fn run(args: BenchArgs) -> Result<()> {
-    if args.items == 0 {
-        return Err(anyhow!("--items must be at least 1"));
-    }
+pub fn run(n_items: usize) -> Result<()> {
+    println!("## cube5_trilin\n");
     println!("| unit | config | RTL cycles | items/clock | sim cycles/s | model items/s | model/sim speed |");
     println!("|------|--------|-----------:|------------:|-------------:|--------------:|----------------:|");
     for (name, cfg) in [
@@ -38,7 +28,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         ("v12", TrilinConfig::DEFAULT),
         ("v16", TrilinConfig::WIDE),
     ] {
-        let items = trilin_items(&cfg, args.items, 1);
+        let items = trilin_items(&cfg, n_items, 1);
         let variant = format!("cube5_trilin_{name}");
         let mut dut = RtlStream::new(&variant, cfg, 1)?;
         let n = items.len() as u64;
@@ -65,7 +55,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         );
     }
     println!();
-    println!("Error of cube5_trilin against its f64 reference ({} random items, all weights, mode Lerp),", args.items);
+    println!("Error of cube5_trilin against its f64 reference ({} random items, all weights, mode Lerp),", n_items);
     println!("in output LSBs (2^-FracW voxel units); the contract bound is 1.5 LSB:");
     println!();
     println!("| config | max abs error (LSB) | RMS error (LSB) | mean error (LSB) |");
@@ -78,7 +68,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         let model = Trilin::new(cfg)?;
         let lsb = f64::from(1u32 << cfg.frac_w);
         let (mut max, mut sq, mut sum) = (0.0f64, 0.0, 0.0);
-        let items = trilin_items(&cfg, args.items, 2);
+        let items = trilin_items(&cfg, n_items, 2);
         for it in &items {
             let e = f64::from(model.sample(it)) - model.reference(it) * lsb;
             max = max.max(e.abs());
