@@ -4,9 +4,11 @@
 //! Pure Rust: builds and tests with no Verilator and no C++ compiler.
 
 pub mod bits;
+pub mod camera;
 pub mod blocking;
 pub mod compos;
 pub mod error;
+pub mod frame;
 pub mod gicube;
 pub mod gradient;
 pub mod phantom;

@@ -1,0 +1,491 @@
+//! The slice-order frame (`docs/numerics/frame.md`): host set-up of a parallel view in f64,
+//! quantized frame parameters, per-slice constants in integers, the samples of every ray in slice
+//! order, the base-plane image, and the (model-only) warp onto the final image.
+
+use crate::camera::Camera;
+use crate::error::{ModelError, Result};
+use crate::phantom::Volume;
+use crate::render::ImageF64;
+use crate::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use glam::DVec3;
+
+/// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
+pub const STEP_W: u32 = 16;
+
+/// Largest volume edge the frame supports (the RTL's `MaxDim` default).
+pub const MAX_DIM: usize = 512;
+
+/// The quantized parameters of one frame: everything the RTL is told about the view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FrameParams {
+    /// Volume axis (0 = x, 1 = y, 2 = z) of the slice axis `k`, beam axis `i`, row axis `j`.
+    pub axis_k: usize,
+    pub axis_i: usize,
+    pub axis_j: usize,
+    /// Edges along `i`, `j`, `k`.
+    pub ni: usize,
+    pub nj: usize,
+    pub nk: usize,
+    /// True when slice `s` is `k = nk - 1 - s` (the view runs toward -k).
+    pub k_reversed: bool,
+    /// Per-slice ray steps, `S(2.StepW)`.
+    pub dx: i32,
+    pub dy: i32,
+}
+
+/// Host set-up: the frame parameters plus the f64 figures derived from the same view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameSetup {
+    pub params: FrameParams,
+    /// Opacity-correction ratio: sample spacing along the ray over the transfer function's unit.
+    pub opacity_ratio: f64,
+    /// The view direction in voxel space (not normalized).
+    pub voxel_dir: DVec3,
+}
+
+/// Constants of one slice (integers only).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SliceConst {
+    /// Slice number in processing order.
+    pub s: usize,
+    /// Volume index along `k` of this slice.
+    pub k: usize,
+    pub shift_x: i64,
+    pub shift_y: i64,
+    /// Fractions, `U(0.StepW)`.
+    pub frac_x: u32,
+    pub frac_y: u32,
+}
+
+impl FrameSetup {
+    /// Quantizes a parallel view of a volume of `dims` voxels with `spacing`, for `p` pipelines.
+    pub fn new(dims: [usize; 3], spacing: [f64; 3], view: DVec3, p: usize) -> Result<Self> {
+        if !(view.is_finite() && view.length_squared() > 0.0) {
+            return Err(ModelError::View(format!(
+                "view vector {view:?} is zero or not finite"
+            )));
+        }
+        if p == 0 || !p.is_power_of_two() || p > 64 {
+            return Err(ModelError::Config(format!(
+                "pipelines {p}: must be a power of two 1..=64"
+            )));
+        }
+        for (a, &n) in dims.iter().enumerate() {
+            if n == 0 || n > MAX_DIM || n % p != 0 {
+                return Err(ModelError::Volume(format!(
+                    "dimension {} along {} must be 1..={MAX_DIM} and a multiple of {p} pipelines",
+                    n,
+                    ["x", "y", "z"][a]
+                )));
+            }
+        }
+        if spacing.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(ModelError::Volume(format!(
+                "spacing {spacing:?} must be finite and > 0"
+            )));
+        }
+        let d = DVec3::new(
+            view.x / spacing[0],
+            view.y / spacing[1],
+            view.z / spacing[2],
+        );
+        let mag = d.abs().to_array();
+        // Ties go to the later axis: z over y over x.
+        let mut axis_k = 2;
+        for a in [1, 0] {
+            if mag[a] > mag[axis_k] {
+                axis_k = a;
+            }
+        }
+        if axis_k == 0 && mag[1] >= mag[0] {
+            axis_k = 1;
+        }
+        if mag[2] >= mag[axis_k] {
+            axis_k = 2;
+        }
+        let (axis_i, axis_j) = match axis_k {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        let dk = d[axis_k];
+        let quant = |x: f64| (x * f64::from(1u32 << STEP_W)).round() as i32;
+        let (fdx, fdy) = (d[axis_i] / dk.abs(), d[axis_j] / dk.abs());
+        let params = FrameParams {
+            axis_k,
+            axis_i,
+            axis_j,
+            ni: dims[axis_i],
+            nj: dims[axis_j],
+            nk: dims[axis_k],
+            k_reversed: dk < 0.0,
+            dx: quant(fdx),
+            dy: quant(fdy),
+        };
+        let along = DVec3::new(
+            fdx * spacing[axis_i],
+            fdy * spacing[axis_j],
+            spacing[axis_k],
+        );
+        let min_spacing = spacing.iter().copied().fold(f64::INFINITY, f64::min);
+        Ok(Self {
+            params,
+            opacity_ratio: along.length() / min_spacing,
+            voxel_dir: d,
+        })
+    }
+}
+
+impl FrameParams {
+    pub fn slice(&self, s: usize) -> SliceConst {
+        let mask = (1i64 << STEP_W) - 1;
+        let tx = s as i64 * i64::from(self.dx);
+        let ty = s as i64 * i64::from(self.dy);
+        SliceConst {
+            s,
+            k: if self.k_reversed { self.nk - 1 - s } else { s },
+            shift_x: tx >> STEP_W,
+            shift_y: ty >> STEP_W,
+            frac_x: (tx & mask) as u32,
+            frac_y: (ty & mask) as u32,
+        }
+    }
+
+    /// Range of shifts over all slices: (min, max) for x and y.
+    pub fn shift_range(&self) -> ((i64, i64), (i64, i64)) {
+        let first = self.slice(0);
+        let last = self.slice(self.nk - 1);
+        let mm = |a: i64, b: i64| (a.min(b), a.max(b));
+        (
+            mm(first.shift_x, last.shift_x),
+            mm(first.shift_y, last.shift_y),
+        )
+    }
+
+    /// Base-plane width and height in rays.
+    pub fn base_plane_size(&self) -> (usize, usize) {
+        let ((x0, x1), (y0, y1)) = self.shift_range();
+        (self.ni + (x1 - x0) as usize, self.nj + (y1 - y0) as usize)
+    }
+
+    /// Base-plane pixel of the sample at anchor `(a, b)` in slice `c`.
+    pub fn pixel_of(&self, c: &SliceConst, a: usize, b: usize) -> (usize, usize) {
+        let ((_, x1), (_, y1)) = self.shift_range();
+        (
+            (a as i64 - c.shift_x + x1) as usize,
+            (b as i64 - c.shift_y + y1) as usize,
+        )
+    }
+
+    /// The voxel at `(i, j, k)` in frame axes.
+    pub fn voxel(&self, vol: &Volume, i: usize, j: usize, k: usize) -> u32 {
+        if i >= self.ni || j >= self.nj {
+            return 0;
+        }
+        let mut pos = [0i64; 3];
+        pos[self.axis_i] = i as i64;
+        pos[self.axis_j] = j as i64;
+        pos[self.axis_k] = k as i64;
+        vol.get(pos[0], pos[1], pos[2])
+    }
+
+    /// Total samples (anchors) in a frame: one per voxel.
+    pub fn samples(&self) -> usize {
+        self.ni * self.nj * self.nk
+    }
+}
+
+/// The interpolation input of the sample at anchor `(a, b)` of slice `c` (frame contract).
+pub fn sample_input(
+    params: &FrameParams,
+    vol: &Volume,
+    c: &SliceConst,
+    a: usize,
+    b: usize,
+    cfg: &TrilinConfig,
+) -> TrilinIn {
+    let v = |da: usize, db: usize| params.voxel(vol, a + da, b + db, c.k);
+    let w = |f: u32| f >> (STEP_W - cfg.weight_w);
+    TrilinIn {
+        voxels: [v(0, 0), v(1, 0), v(0, 1), v(1, 1), 0, 0, 0, 0],
+        weights: [w(c.frac_x), w(c.frac_y), 0],
+        mode: TrilinMode::Lerp,
+    }
+}
+
+/// The bilinear sample of slice number `t` (processing order; zero outside `0..nk`) at anchor
+/// `(a, b)` (zero outside the face) with the weights of slice `c`: `S'(t)` of the contract.
+pub fn sample_at(
+    params: &FrameParams,
+    vol: &Volume,
+    c: &SliceConst,
+    t: i64,
+    a: i64,
+    b: i64,
+    trilin: &Trilin,
+) -> u32 {
+    if t < 0
+        || t >= params.nk as i64
+        || a < 0
+        || b < 0
+        || a >= params.ni as i64
+        || b >= params.nj as i64
+    {
+        return 0;
+    }
+    let other = params.slice(t as usize);
+    let at = SliceConst { k: other.k, ..*c };
+    trilin.sample(&sample_input(
+        params,
+        vol,
+        &at,
+        a as usize,
+        b as usize,
+        &trilin.config(),
+    ))
+}
+
+/// The gradient neighbourhood of the contract: `[C, x-, x+, y-, y+, B (slice before), A (after)]`.
+pub fn neighbourhood(
+    params: &FrameParams,
+    vol: &Volume,
+    c: &SliceConst,
+    a: usize,
+    b: usize,
+    trilin: &Trilin,
+) -> [u32; 7] {
+    let (a, b, s) = (a as i64, b as i64, c.s as i64);
+    let at = |t, da, db| sample_at(params, vol, c, t, a + da, b + db, trilin);
+    [
+        at(s, 0, 0),
+        at(s, -1, 0),
+        at(s, 1, 0),
+        at(s, 0, -1),
+        at(s, 0, 1),
+        at(s - 1, 0, 0),
+        at(s + 1, 0, 0),
+    ]
+}
+
+/// One plane of samples in anchor order (`b` outer, `a` inner), for slice `s`.
+pub fn sample_plane(params: &FrameParams, vol: &Volume, s: usize, trilin: &Trilin) -> Vec<u32> {
+    let c = params.slice(s);
+    let cfg = trilin.config();
+    let mut out = Vec::with_capacity(params.ni * params.nj);
+    for b in 0..params.nj {
+        for a in 0..params.ni {
+            out.push(trilin.sample(&sample_input(params, vol, &c, a, b, &cfg)));
+        }
+    }
+    out
+}
+
+/// Folds every sample of every ray, in slice order, into a per-ray accumulator: the model's view of
+/// the compositing buffer. `init` is the coxel of a ray with no sample yet; `step(coxel, slice,
+/// anchor (a, b), sample)` returns the updated coxel.
+pub fn fold_rays<T: Clone>(
+    params: &FrameParams,
+    vol: &Volume,
+    trilin: &Trilin,
+    init: T,
+    mut step: impl FnMut(&T, &SliceConst, (usize, usize), u32) -> T,
+) -> (usize, usize, Vec<T>) {
+    let (w, h) = params.base_plane_size();
+    let mut coxels = vec![init; w * h];
+    for s in 0..params.nk {
+        let c = params.slice(s);
+        let plane = sample_plane(params, vol, s, trilin);
+        for b in 0..params.nj {
+            for a in 0..params.ni {
+                let (r, q) = params.pixel_of(&c, a, b);
+                let idx = q * w + r;
+                coxels[idx] = step(&coxels[idx], &c, (a, b), plane[b * params.ni + a]);
+            }
+        }
+    }
+    (w, h, coxels)
+}
+
+/// Warps a base-plane image (`w` x `h` rays, RGB in 0..1) onto the final image seen by `camera`
+/// (model only; bilinear, zero outside the base plane). Each output pixel's ray is followed to the
+/// front slice; the ray through front-slice point `(i, j)` is base-plane ray `(i, j)`.
+pub fn warp(
+    params: &FrameParams,
+    spacing: [f64; 3],
+    base: &[[f64; 3]],
+    (w, h): (usize, usize),
+    camera: &Camera,
+) -> ImageF64 {
+    let ((_, max_sx), (_, max_sy)) = params.shift_range();
+    let k0 = params.slice(0).k as f64;
+    let sp = DVec3::from_array(spacing);
+    let dir_v = camera.dir / sp;
+    let texel = |x: i64, y: i64| -> [f64; 3] {
+        if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
+            [0.0; 3]
+        } else {
+            base[y as usize * w + x as usize]
+        }
+    };
+    let mut rgb = Vec::with_capacity((camera.width * camera.height) as usize);
+    for py in 0..camera.height {
+        for px in 0..camera.width {
+            let o = camera.ray_origin(px, py) / sp;
+            let t = (k0 - o[params.axis_k]) / dir_v[params.axis_k];
+            let p = o + dir_v * t;
+            let (x, y) = (
+                p[params.axis_i] + max_sx as f64,
+                p[params.axis_j] + max_sy as f64,
+            );
+            let (x0, y0) = (x.floor(), y.floor());
+            let (fx, fy) = (x - x0, y - y0);
+            let (x0, y0) = (x0 as i64, y0 as i64);
+            let mut c = [0.0; 3];
+            for (dx, dy, wgt) in [
+                (0, 0, (1.0 - fx) * (1.0 - fy)),
+                (1, 0, fx * (1.0 - fy)),
+                (0, 1, (1.0 - fx) * fy),
+                (1, 1, fx * fy),
+            ] {
+                let t = texel(x0 + dx, y0 + dy);
+                for ch in 0..3 {
+                    c[ch] += wgt * t[ch];
+                }
+            }
+            rgb.push(c);
+        }
+    }
+    ImageF64 {
+        width: camera.width,
+        height: camera.height,
+        rgb,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn major_axis_and_ties() {
+        let p = |v: DVec3| FrameSetup::new([16; 3], [1.0; 3], v, 4).unwrap().params;
+        assert_eq!(p(DVec3::new(0.0, 0.0, 1.0)).axis_k, 2);
+        assert_eq!(p(DVec3::new(1.0, 0.2, 0.1)).axis_k, 0);
+        assert_eq!(p(DVec3::new(0.1, -1.0, 0.3)).axis_k, 1);
+        // Exactly 45 degrees: the later axis wins.
+        assert_eq!(p(DVec3::new(1.0, 1.0, 0.0)).axis_k, 1);
+        assert_eq!(p(DVec3::new(1.0, 0.0, 1.0)).axis_k, 2);
+        assert_eq!(p(DVec3::new(0.0, -1.0, 1.0)).axis_k, 2);
+        assert_eq!(p(DVec3::new(1.0, 1.0, 1.0)).axis_k, 2);
+        // 45 degrees +- a little.
+        assert_eq!(p(DVec3::new(1.0 + 1e-3, 1.0, 0.0)).axis_k, 0);
+        let q = p(DVec3::new(-1.0, 0.0, -1.0));
+        assert!(q.k_reversed && q.dx == -(1 << STEP_W));
+    }
+
+    #[test]
+    fn bad_views_refused() {
+        assert!(FrameSetup::new([16; 3], [1.0; 3], DVec3::ZERO, 4).is_err());
+        assert!(FrameSetup::new([16; 3], [1.0; 3], DVec3::new(f64::NAN, 0.0, 1.0), 4).is_err());
+        assert!(FrameSetup::new([18, 16, 16], [1.0; 3], DVec3::Z, 4).is_err());
+        assert!(FrameSetup::new([16; 3], [1.0; 3], DVec3::Z, 3).is_err());
+    }
+
+    #[test]
+    fn slice_constants_match_f64_positions() {
+        let setup = FrameSetup::new([32; 3], [1.0; 3], DVec3::new(0.37, -0.81, 1.0), 4).unwrap();
+        let p = setup.params;
+        let (fdx, fdy) = (0.37, -0.81);
+        for s in 0..p.nk {
+            let c = p.slice(s);
+            let x = c.shift_x as f64 + f64::from(c.frac_x) / 65536.0;
+            let y = c.shift_y as f64 + f64::from(c.frac_y) / 65536.0;
+            // Quantized step error accumulates at most half an LSB per slice.
+            let tol = (s as f64 + 1.0) * 0.5 / 65536.0;
+            assert!((x - s as f64 * fdx).abs() <= tol && (y - s as f64 * fdy).abs() <= tol);
+        }
+        let (w, h) = p.base_plane_size();
+        let ((x0, x1), (y0, y1)) = p.shift_range();
+        assert_eq!((w, h), (32 + (x1 - x0) as usize, 32 + (y1 - y0) as usize));
+    }
+
+    #[test]
+    fn neighbourhood_is_zero_outside_and_matches_the_plane_inside() {
+        let vol = crate::phantom::head_phantom(16, 12).unwrap();
+        let p = FrameSetup::new([16; 3], [1.0; 3], DVec3::new(0.2, 0.7, 1.0), 4)
+            .unwrap()
+            .params;
+        let trilin = Trilin::new(TrilinConfig::DEFAULT).unwrap();
+        let c = p.slice(5);
+        let plane = sample_plane(&p, &vol, 5, &trilin);
+        let n = neighbourhood(&p, &vol, &c, 7, 8, &trilin);
+        assert_eq!(n[0], plane[8 * 16 + 7]);
+        assert_eq!(n[1], plane[8 * 16 + 6]);
+        assert_eq!(n[4], plane[9 * 16 + 7]);
+        let edge = neighbourhood(&p, &vol, &p.slice(0), 0, 15, &trilin);
+        assert_eq!(
+            (edge[1], edge[4], edge[5]),
+            (0, 0, 0),
+            "outside the face and before slice 0"
+        );
+    }
+
+    #[test]
+    fn warped_mip_of_the_phantom_matches_the_reference_mip() {
+        // Unquantized MIP of the frame's samples, warped, against the f64 image-order MIP: the
+        // same framing and close values prove the geometry of set-up, base plane and warp.
+        use crate::render::{
+            render_reference, CompositeMode, RenderParams, TransferFunction, View,
+        };
+        let vol = crate::phantom::head_phantom(32, 12).unwrap();
+        let view = View {
+            azimuth: 35.0,
+            elevation: 25.0,
+        };
+        let dir = view.direction().unwrap();
+        let setup = FrameSetup::new([32; 3], [1.0; 3], dir, 4).unwrap();
+        let trilin = Trilin::new(TrilinConfig::DEFAULT).unwrap();
+        let (w, h, peaks) = fold_rays(&setup.params, &vol, &trilin, 0u32, |m, _, _, x| (*m).max(x));
+        let scale = f64::from(vol.max_value() << 4);
+        let base: Vec<[f64; 3]> = peaks.iter().map(|&m| [f64::from(m) / scale; 3]).collect();
+        let cam = Camera::new(dir, vol.dims, vol.spacing, 48, 48);
+        let warped = warp(&setup.params, vol.spacing, &base, (w, h), &cam);
+        let params = RenderParams {
+            width: 48,
+            height: 48,
+            view,
+            mode: CompositeMode::Mip,
+            ..Default::default()
+        };
+        let reference = render_reference(&vol, &TransferFunction::head_default(), &params).unwrap();
+        let err: f64 = warped
+            .rgb
+            .iter()
+            .zip(&reference.rgb)
+            .map(|(a, b)| (a[0] - b[0]).abs())
+            .sum::<f64>()
+            / warped.rgb.len() as f64;
+        eprintln!("mean absolute MIP difference {err}");
+        assert!(err < 0.015, "mean absolute MIP difference {err}");
+    }
+
+    #[test]
+    fn every_ray_gets_its_samples_in_slice_order() {
+        let vol = crate::phantom::head_phantom(16, 12).unwrap();
+        let setup = FrameSetup::new([16; 3], [1.0; 3], DVec3::new(0.6, 0.3, -1.0), 4).unwrap();
+        let trilin = Trilin::new(TrilinConfig::DEFAULT).unwrap();
+        let (_, _, trails) = fold_rays(&setup.params, &vol, &trilin, Vec::new(), |t, c, _, _| {
+            let mut t = t.clone();
+            t.push(c.s);
+            t
+        });
+        let total: usize = trails.iter().map(Vec::len).sum();
+        assert_eq!(total, 16 * 16 * 16, "one sample per anchor");
+        for t in &trails {
+            assert!(
+                t.windows(2).all(|w| w[1] == w[0] + 1),
+                "consecutive slices: {t:?}"
+            );
+        }
+    }
+}
