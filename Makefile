@@ -2,7 +2,7 @@
 CARGO ?= cargo
 DEMO_DIR ?= out
 
-.PHONY: setup demo test sim lint synth bench fmt clippy clean
+.PHONY: setup demo test sim lint synth bench tradeoff fmt clippy clean
 
 setup:
 	@scripts/setup.sh
@@ -28,6 +28,10 @@ synth:
 
 bench: setup
 	$(CARGO) run --release -q -p cube5-cli -- bench
+
+## Regenerates docs/tradeoffs.md and its plots (speed/area against accuracy sweeps).
+tradeoff: setup
+	$(CARGO) run --release -q -p cube5-cli -- tradeoff --write-docs
 
 fmt:
 	$(CARGO) fmt --all

@@ -75,7 +75,11 @@ class StreamShim final : public DutCore {
 
   ~StreamShim() override {
     if (trace_) trace_->close();
+    // Verilator 5.006 erases a model's scopes through the *thread's* current context, which is
+    // whichever model was built last: point it at ours, or the erase locks a dead context's mutex.
+    Verilated::threadContextp(ctx_.get());
     top_->final();
+    top_.reset();
   }
 
   void reset(uint32_t cycles) override {

@@ -1,0 +1,3 @@
+rtl/cube5/cube5_compos_pkg.sv
+rtl/cube5/cube5_compos_unorm.sv
+rtl/cube5/cube5_compos.sv
