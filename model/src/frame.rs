@@ -3,11 +3,19 @@
 //! order, the base-plane image, and the (model-only) warp onto the final image.
 
 use crate::camera::Camera;
+use crate::compos::{Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample};
 use crate::error::{ModelError, Result};
+use crate::gradient::{block_index, Gradient, GradientConfig, GradientIn, GradientMode};
 use crate::phantom::Volume;
 use crate::render::ImageF64;
+use crate::render::TransferFunction;
+use crate::shader::{
+    ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn,
+    ShaderMode, ShaderTables,
+};
 use crate::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;
@@ -359,6 +367,199 @@ pub fn warp(
         width: camera.width,
         height: camera.height,
         rgb,
+    }
+}
+
+/// What the frame composites (docs/numerics/frame.md, "The pipeline of one sample").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameMode {
+    /// Maximum intensity projection: density ramp LUT, unlit, compositing `Max`.
+    Mip,
+    /// Front-to-back `over` with classification and reflectance-map shading.
+    Composite,
+}
+
+/// The four unit models of one pipeline, with their tables loaded.
+#[derive(Debug, Clone)]
+pub struct FrameUnits {
+    pub trilin: Trilin,
+    pub gradient: Gradient,
+    pub shader: Shader,
+    pub compos: Compos,
+    pub mode: FrameMode,
+}
+
+/// The base-plane image: the final coxel of every ray, row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BasePlane {
+    pub width: usize,
+    pub height: usize,
+    pub coxels: Vec<Coxel>,
+}
+
+/// Directions (volume axes) expressed in frame axes `(i, j, s)`, `s` along the sweep.
+pub fn to_frame_axes(params: &FrameParams, v: [f64; 3]) -> [f64; 3] {
+    let sk = if params.k_reversed { -1.0 } else { 1.0 };
+    [v[params.axis_i], v[params.axis_j], sk * v[params.axis_k]]
+}
+
+/// The lighting of a frame in frame axes: the viewer looks along +s, rays step `(dx, dy, 1)`.
+/// `lights` are given in volume axes (direction towards the light); none means a headlight.
+pub fn frame_phong(params: &FrameParams, lights: &[DistantLight]) -> Phong {
+    let unit = f64::from(1u32 << STEP_W);
+    let to_viewer = [
+        -f64::from(params.dx) / unit,
+        -f64::from(params.dy) / unit,
+        -1.0,
+    ];
+    let lights = if lights.is_empty() {
+        vec![DistantLight {
+            direction: to_viewer,
+            intensity: 1.0,
+        }]
+    } else {
+        lights
+            .iter()
+            .map(|l| DistantLight {
+                direction: to_frame_axes(params, l.direction),
+                ..*l
+            })
+            .collect()
+    };
+    Phong {
+        view: to_viewer,
+        lights,
+        ..Phong::two_lights()
+    }
+}
+
+impl FrameUnits {
+    /// The default widths (trilin v12, gradient v12, shader v12, compos c12) with the tables of
+    /// `mode`: for `Composite` the transfer function, the reflectance map of `phong` and the
+    /// opacity correction of the set-up; for `Mip` the density ramp and no correction.
+    pub fn new(
+        mode: FrameMode,
+        setup: &FrameSetup,
+        tf: &TransferFunction,
+        phong: &Phong,
+    ) -> Result<Self> {
+        let shader_cfg = ShaderConfig::DEFAULT;
+        let compos_cfg = ComposConfig::DEFAULT;
+        let (class, rmap, lut, regs) = match mode {
+            FrameMode::Mip => {
+                let top = (shader_cfg.class_entries() - 1) as u64;
+                let scale = |idx: usize, max: u32| ((idx as u64 * u64::from(max)) / top) as u32;
+                let class = ClassLut::from_fn(&shader_cfg, |idx| Rgba {
+                    r: scale(idx, shader_cfg.color_max()),
+                    g: scale(idx, shader_cfg.color_max()),
+                    b: scale(idx, shader_cfg.color_max()),
+                    a: scale(idx, shader_cfg.alpha_max()),
+                })?;
+                let rmap = ReflectanceMap::from_lights(&shader_cfg, phong)?;
+                let regs = ComposRegs {
+                    lut_bypass: true,
+                    ..ComposRegs::without_termination(&compos_cfg)
+                };
+                (class, rmap, OpacityLut::new(1.0, &compos_cfg)?, regs)
+            }
+            FrameMode::Composite => (
+                ClassLut::from_transfer(&shader_cfg, tf)?,
+                ReflectanceMap::from_lights(&shader_cfg, phong)?,
+                OpacityLut::new(setup.opacity_ratio, &compos_cfg)?,
+                ComposRegs::without_termination(&compos_cfg),
+            ),
+        };
+        Ok(Self {
+            trilin: Trilin::new(TrilinConfig::DEFAULT)?,
+            gradient: Gradient::new(GradientConfig::DEFAULT)?,
+            shader: Shader::new(shader_cfg, ShaderTables { class, rmap })?,
+            compos: Compos::new(compos_cfg, lut, regs)?,
+            mode,
+        })
+    }
+
+    /// The shaded sample of anchor `(a, b)` in slice `c` (steps 1-4 of the contract).
+    pub fn shaded_sample(
+        &self,
+        params: &FrameParams,
+        vol: &Volume,
+        c: &SliceConst,
+        a: usize,
+        b: usize,
+    ) -> Sample {
+        let n = neighbourhood(params, vol, c, a, b, &self.trilin);
+        let mut block = [0u32; 27];
+        for (v, (di, dj, dk)) in n.iter().zip([
+            (0, 0, 0),
+            (-1, 0, 0),
+            (1, 0, 0),
+            (0, -1, 0),
+            (0, 1, 0),
+            (0, 0, -1),
+            (0, 0, 1),
+        ]) {
+            block[block_index(di, dj, dk)] = *v;
+        }
+        let g = self.gradient.gradient(&GradientIn {
+            samples: block,
+            dx: 0,
+            dy: 0,
+            mode: GradientMode::N6,
+        });
+        let shaded = self.shader.shade(&ShaderIn {
+            sample: n[0],
+            grad: [g.gx >> 4, g.gy >> 4, g.gz >> 4],
+            mag: g.mag >> 4,
+            mode: ShaderMode {
+                tf2d: false,
+                unlit: self.mode == FrameMode::Mip,
+            },
+        });
+        Sample {
+            rgb: [shaded.r, shaded.g, shaded.b],
+            alpha: shaded.a,
+            depth: c.s as u32,
+            mode: match self.mode {
+                FrameMode::Mip => ComposMode::Max,
+                FrameMode::Composite => ComposMode::FrontToBack,
+            },
+        }
+    }
+}
+
+/// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md).
+pub fn render_base_plane(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
+    let (w, h) = params.base_plane_size();
+    let init = Coxel::empty(&units.compos.config());
+    let mut coxels = vec![init; w * h];
+    for s in 0..params.nk {
+        let c = params.slice(s);
+        // Samples of one plane are independent: shade them in parallel, composite in order.
+        let plane: Vec<Sample> = (0..params.ni * params.nj)
+            .into_par_iter()
+            .map(|idx| units.shaded_sample(params, vol, &c, idx % params.ni, idx / params.ni))
+            .collect();
+        for (idx, sample) in plane.iter().enumerate() {
+            let (r, q) = params.pixel_of(&c, idx % params.ni, idx / params.ni);
+            let at = q * w + r;
+            coxels[at] = units.compos.step(&coxels[at], sample);
+        }
+    }
+    BasePlane {
+        width: w,
+        height: h,
+        coxels,
+    }
+}
+
+impl BasePlane {
+    /// Colour of each ray in 0..1 (the coxel's R, G, B on its `2^AccW` scale, clamped).
+    pub fn rgb(&self, cfg: &ComposConfig) -> Vec<[f64; 3]> {
+        let one = cfg.one() as f64;
+        self.coxels
+            .iter()
+            .map(|c| std::array::from_fn(|i| (c.rgba[i] as f64 / one).min(1.0)))
+            .collect()
     }
 }
 

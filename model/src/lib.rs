@@ -4,8 +4,8 @@
 //! Pure Rust: builds and tests with no Verilator and no C++ compiler.
 
 pub mod bits;
-pub mod camera;
 pub mod blocking;
+pub mod camera;
 pub mod compos;
 pub mod error;
 pub mod frame;

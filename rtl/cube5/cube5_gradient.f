@@ -1,0 +1,4 @@
+rtl/cube5_pkg.sv
+rtl/cube5/cube5_gradient_pkg.sv
+rtl/cube5/cube5_gradient_lerp.sv
+rtl/cube5/cube5_gradient.sv

@@ -1,0 +1,2 @@
+rtl/cube5/cube5_gradient_pkg.sv
+rtl/cube5/cube5_sepconv.sv

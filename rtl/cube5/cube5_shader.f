@@ -1,0 +1,4 @@
+rtl/cube5/cube5_shader_pkg.sv
+rtl/cube5/cube5_shader_ram.sv
+rtl/cube5/cube5_shader_lerp.sv
+rtl/cube5/cube5_shader.sv

@@ -1,0 +1,2 @@
+rtl/gicube/gicube_pkg.sv
+rtl/gicube/gicube_sorter.sv

@@ -1,0 +1,296 @@
+//! Co-simulation of cube5_sepconv against the golden model (docs/numerics/sepconv.md).
+
+mod support;
+
+use cube5_model::gradient::{Sepconv, SepconvConfig, SepconvIn, SepconvKernel};
+use cube5_model::unit::StreamUnit;
+use cube5_tb::harness::{check_stream, StreamCheck};
+use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+use support::{must_match, seed, MILLION};
+
+const CONFIGS: [(&str, SepconvConfig); 3] = [
+    ("cube5_sepconv_v8", SepconvConfig::NARROW),
+    ("cube5_sepconv_v12", SepconvConfig::DEFAULT),
+    ("cube5_sepconv_v16", SepconvConfig::WIDE),
+];
+
+const LATENCY: u64 = 2;
+
+/// Random items: taps uniform over the whole two's complement range, or (one in four) drawn from
+/// the extremes, or (one in four) small around zero where the rounding ties of small values lie.
+fn random_item(cfg: SepconvConfig) -> impl FnMut(&mut ChaCha8Rng) -> SepconvIn {
+    move |rng| {
+        let (lo, hi) = (cfg.tap_min(), cfg.tap_max());
+        let class = rng.random_range(0..4);
+        let taps = std::array::from_fn(|_| match class {
+            0 => [lo, lo + 1, -1, 0, 1, hi - 1, hi][rng.random_range(0..7)],
+            1 => rng.random_range(-8..=8),
+            _ => rng.random_range(lo..=hi),
+        });
+        SepconvIn {
+            taps,
+            kernel: SepconvKernel::from_bits(rng.random_range(0..2)),
+        }
+    }
+}
+
+/// Weights exercised: 0, one LSB, 1.0, 2.0 (Sobel, binomial), a Gaussian, the largest.
+fn weights(cfg: SepconvConfig) -> Vec<u32> {
+    vec![
+        0,
+        1,
+        cfg.weight_from_f64(1.0),
+        cfg.weight_from_f64(2.0),
+        cfg.weight_from_f64(std::f64::consts::E.sqrt()), // sigma = 1
+        cfg.weight_max(),
+    ]
+}
+
+/// Every combination of extreme taps with both kernels.
+fn directed_items(cfg: SepconvConfig) -> Vec<SepconvIn> {
+    let (lo, hi) = (cfg.tap_min(), cfg.tap_max());
+    let values = [lo, lo + 1, -2, -1, 0, 1, 2, hi - 1, hi];
+    let mut items = Vec::new();
+    for &a in &values {
+        for &b in &values {
+            for &c in &values {
+                for kernel in [SepconvKernel::Smooth, SepconvKernel::Diff] {
+                    items.push(SepconvIn {
+                        taps: [a, b, c],
+                        kernel,
+                    });
+                }
+            }
+        }
+    }
+    items
+}
+
+#[test]
+fn million_random_items_per_config_with_idle_backpressure_and_reset() {
+    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
+        let mut rng: ChaCha8Rng = rand::SeedableRng::seed_from_u64(seed(400 + i as u64));
+        let w = rng.random_range(0..=cfg.weight_max());
+        let mut gold = Sepconv::new(*cfg, w).unwrap();
+        // The weight is written once, before the first item; it must survive the reset.
+        let check = StreamCheck::new(seed(410 + i as u64), MILLION)
+            .with_traffic(0.2, 0.3)
+            .with_reset_in_batch(5)
+            .with_config_writes(gold.config_writes());
+        let r = must_match(variant, *cfg, &mut gold, &mut random_item(*cfg), &check);
+        assert_eq!(r.resets, 1);
+        assert!(
+            r.compared as usize >= MILLION - 1000,
+            "a reset drops at most the items in flight"
+        );
+    }
+}
+
+#[test]
+fn directed_extremes_at_every_weight() {
+    for (variant, cfg) in CONFIGS {
+        for w in weights(cfg) {
+            let items = directed_items(cfg);
+            let n = items.len();
+            let mut it = items.into_iter().cycle();
+            let mut gold = Sepconv::new(cfg, w).unwrap();
+            let check = StreamCheck::new(seed(41), n)
+                .with_traffic(0.3, 0.3)
+                .with_config_writes(gold.config_writes());
+            must_match(variant, cfg, &mut gold, &mut |_| it.next().unwrap(), &check);
+        }
+    }
+}
+
+#[test]
+fn one_item_per_cycle_when_never_stalled() {
+    for (variant, cfg) in CONFIGS {
+        let gold = Sepconv::new(cfg, cfg.weight_from_f64(2.0)).unwrap();
+        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
+        for (addr, data) in gold.config_writes() {
+            dut.write_config(addr, &data).unwrap();
+        }
+        let mut rng = rand::SeedableRng::seed_from_u64(seed(42));
+        let mut gen = random_item(cfg);
+        let items: Vec<SepconvIn> = (0..100_000).map(|_| gen(&mut rng)).collect();
+        let n = items.len() as u64;
+        let driven = dut
+            .drive(&items, &Traffic::full_speed(), n, 10 * n)
+            .unwrap();
+        assert_eq!(driven.stats.consumed, n);
+        assert_eq!(
+            driven.stats.cycles,
+            n + LATENCY,
+            "{variant}: one item per clock plus the pipeline fill"
+        );
+        let first = driven.outputs.first().unwrap().cycle;
+        let last = driven.outputs.last().unwrap().cycle;
+        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
+        let want = gold.clone().run(&items);
+        assert!(driven.outputs.iter().zip(&want).all(|(t, g)| t.value == *g));
+    }
+}
+
+#[test]
+fn a_weight_write_applies_to_items_accepted_after_it() {
+    // Items still in flight when w changes keep the w they were accepted with: drive a batch but
+    // stop waiting for its last outputs, write a new w, then drive a second batch.
+    for (variant, cfg) in CONFIGS {
+        let (w1, w2) = (cfg.weight_from_f64(2.0), cfg.weight_max());
+        let mut gold = Sepconv::new(cfg, w1).unwrap();
+        let mut dut = RtlStream::new(variant, cfg, 7).unwrap();
+        for (addr, data) in gold.config_writes() {
+            dut.write_config(addr, &data).unwrap();
+        }
+        let mut rng = rand::SeedableRng::seed_from_u64(seed(43));
+        let mut gen = random_item(cfg);
+        let first: Vec<SepconvIn> = (0..1000).map(|_| gen(&mut rng)).collect();
+        let second: Vec<SepconvIn> = (0..1000).map(|_| gen(&mut rng)).collect();
+        let mut want = gold.run(&first);
+        gold.set_weight(w2).unwrap();
+        want.extend(gold.run(&second));
+
+        let full = Traffic::full_speed();
+        let a = dut.drive(&first, &full, 0, 10_000).unwrap();
+        let in_flight = first.len() - a.outputs.len();
+        assert!(
+            in_flight >= 1,
+            "{variant}: items are in flight at the write"
+        );
+        for (addr, data) in gold.config_writes() {
+            dut.write_config(addr, &data).unwrap();
+        }
+        // Address 1 is ignored.
+        dut.write_config(1, &[0]).unwrap();
+        let b = dut
+            .drive(&second, &full, (in_flight + second.len()) as u64, 10_000)
+            .unwrap();
+        let got: Vec<i64> = a
+            .outputs
+            .iter()
+            .chain(&b.outputs)
+            .map(|t| t.value)
+            .collect();
+        assert_eq!(got.len(), want.len());
+        if let Some(k) = (0..got.len()).find(|&k| got[k] != want[k]) {
+            panic!(
+                "{variant}: item {k} ({:?}): rtl {} model {}",
+                first.iter().chain(&second).nth(k),
+                got[k],
+                want[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn gate_level_netlist_smoke() {
+    let cfg = SepconvConfig::NARROW;
+    let mut gold = Sepconv::new(cfg, cfg.weight_from_f64(2.0)).unwrap();
+    let check = StreamCheck::new(seed(44), 30_000)
+        .with_traffic(0.2, 0.2)
+        .with_batch(10_000)
+        .with_reset_in_batch(1)
+        .with_config_writes(gold.config_writes());
+    must_match(
+        "cube5_sepconv_v8_gate",
+        cfg,
+        &mut gold,
+        &mut random_item(cfg),
+        &check,
+    );
+    for w in weights(cfg) {
+        let items = directed_items(cfg);
+        let n = items.len();
+        let mut it = items.into_iter().cycle();
+        let mut gold = Sepconv::new(cfg, w).unwrap();
+        let check = StreamCheck::new(seed(45), n)
+            .with_traffic(0.3, 0.3)
+            .with_config_writes(gold.config_writes());
+        must_match(
+            "cube5_sepconv_v8_gate",
+            cfg,
+            &mut gold,
+            &mut |_| it.next().unwrap(),
+            &check,
+        );
+    }
+}
+
+/// A golden model that rounds ties down instead of up.
+struct TiesDown(Sepconv);
+
+impl StreamUnit for TiesDown {
+    type In = SepconvIn;
+    type Out = i64;
+
+    fn run(&mut self, inputs: &[SepconvIn]) -> Vec<i64> {
+        let s = self.0.config().out_shift;
+        inputs
+            .iter()
+            .map(|it| (self.0.exact(it) + (1 << (s - 1)) - 1) >> s)
+            .collect()
+    }
+}
+
+#[test]
+fn the_weight_register_and_the_rounding_are_checked() {
+    let (variant, cfg) = CONFIGS[0];
+    // 2.25: an odd raw weight, so y = 4a + 9b + 4c reaches every residue of the shift by 2 (with
+    // w = 2.0 every y is a multiple of 4 and the rounding never sees a tie).
+    let w = cfg.weight_from_f64(2.25);
+    assert_eq!(w % 2, 1);
+    let mut check = StreamCheck::new(seed(46), 20_000).with_traffic(0.1, 0.1);
+    check.waveform_on_mismatch = false;
+
+    // The RTL loaded with w one LSB off the model's: the configuration port reaches the datapath.
+    let off_by_one = check.clone().with_config_writes(vec![(0, vec![w + 1])]);
+    let err = check_stream(
+        variant,
+        cfg,
+        &mut Sepconv::new(cfg, w).unwrap(),
+        &mut random_item(cfg),
+        &off_by_one,
+    )
+    .expect_err("a different w must be caught");
+    assert_eq!(err.what, "output differs");
+
+    // A write to any other address leaves w alone.
+    let other_address =
+        check
+            .clone()
+            .with_config_writes(vec![(0, vec![w]), (1, vec![w + 1]), (15, vec![0])]);
+    must_match(
+        variant,
+        cfg,
+        &mut Sepconv::new(cfg, w).unwrap(),
+        &mut random_item(cfg),
+        &other_address,
+    );
+
+    // Round half down instead of up.
+    let loaded = check.with_config_writes(vec![(0, vec![w])]);
+    let err = check_stream(
+        variant,
+        cfg,
+        &mut TiesDown(Sepconv::new(cfg, w).unwrap()),
+        &mut random_item(cfg),
+        &loaded,
+    )
+    .expect_err("the rounding direction of ties must be caught");
+    assert_eq!(err.what, "output differs");
+}
+
+#[test]
+fn codec_and_variant_are_checked_against_the_rtl() {
+    match RtlStream::new("cube5_sepconv_v8", SepconvConfig::DEFAULT, 1) {
+        Err(RtlError::WidthMismatch {
+            port, rtl, model, ..
+        }) => {
+            assert_eq!((port, rtl, model), ("in_data_i", 34, 52));
+        }
+        other => panic!("expected a width mismatch, got {:?}", other.err()),
+    }
+}
