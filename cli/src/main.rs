@@ -1,11 +1,24 @@
 //! `cube5`: render scenes with the golden model, co-simulate the RTL against it, and measure.
 
+/// `println!` that never panics: a closed stdout (`cube5 render | head -1`) loses the text, not the
+/// run.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod bench;
+mod tradeoff;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
-use cube5_model::render::render_reference;
-use cube5_model::scene::Scene;
+use cube5_model::phantom::{phantom_by_name, PHANTOMS};
+use cube5_model::render::{render_pipeline, render_reference, ImageF64};
+use cube5_model::scene::{Plan, Renderer, Scene};
+use cube5_model::tradeoff::image_error;
+use cube5_model::volume_io::{self, Endian, NrrdEncoding};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -24,6 +37,10 @@ struct Cli {
 enum Command {
     /// Render a scene with the golden model to a PNG (the embedded default scene when none given).
     Render(RenderArgs),
+    /// Measure the speed/accuracy trade: sweep the quality knobs against the f64 reference.
+    Tradeoff(tradeoff::TradeoffArgs),
+    /// Write an embedded phantom as a volume file (.nrrd, .nii, .nii.gz or .raw).
+    Phantom(PhantomArgs),
     /// Print speed figures: simulated RTL cycles per second and model samples per second.
     Bench(bench::BenchArgs),
 }
@@ -47,6 +64,27 @@ struct RenderArgs {
     /// Override the image height in pixels.
     #[arg(long)]
     height: Option<u32>,
+    /// Render with the f64 image-order reference instead of the pipeline model.
+    #[arg(long)]
+    reference: bool,
+    /// Also render the f64 reference and print the pipeline's error against it.
+    #[arg(long)]
+    compare: bool,
+}
+
+#[derive(Debug, clap::Args)]
+struct PhantomArgs {
+    /// Phantom name (head, sphere, bubbles).
+    name: String,
+    /// Output file: .nrrd (gzip-encoded), .nii, .nii.gz or .raw (u8/u16, little endian).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Edge in voxels.
+    #[arg(long, default_value_t = 64)]
+    size: usize,
+    /// Voxel width in bits (at most 8 stores u8, else u16).
+    #[arg(long, default_value_t = 8)]
+    bits: u32,
 }
 
 fn main() -> ExitCode {
@@ -70,7 +108,8 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            // One line, whatever the chain holds.
+            eprintln!("error: {}", format!("{e:#}").replace('\n', " "));
             ExitCode::FAILURE
         }
     }
@@ -79,6 +118,8 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Render(args) => render(args),
+        Command::Tradeoff(args) => tradeoff::run(args),
+        Command::Phantom(args) => phantom(args),
         Command::Bench(args) => bench::run(args),
     }
 }
@@ -88,6 +129,31 @@ fn load_scene(path: Option<&Path>) -> Result<Scene> {
         Some(p) => Scene::load(p)?,
         None => Scene::default(),
     })
+}
+
+/// Refuses an output name that is not `.png` or whose directory does not exist, before any work.
+fn check_png_path(path: &Path) -> Result<()> {
+    if path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+        != Some("png")
+    {
+        bail!("output {}: the file name must end in .png", path.display());
+    }
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !dir.is_dir() {
+        bail!(
+            "output {}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 fn render(args: RenderArgs) -> Result<()> {
@@ -104,54 +170,123 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(h) = args.height {
         scene.image.height = h;
     }
+    if args.reference {
+        scene.run.renderer = Renderer::Reference;
+    }
     scene.validate("command line")?;
-    if args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-        != Some("png")
-    {
+    check_png_path(&args.output)?;
+    let vol = scene.build_volume()?;
+    let plan = Plan::new(&scene, &vol)?;
+    say!("plan: {plan}");
+    if scene.run.target.uses_rtl() {
         bail!(
-            "output {}: the file name must end in .png",
-            args.output.display()
+            "run.target = \"{}\": the RTL scene runner is not wired into this build yet (the plan above lists the units it needs); use target = \"model\"",
+            scene.run.target.name()
         );
     }
-    let vol = scene.build_volume()?;
     let params = scene.render_params();
+    let tf = scene.transfer_function();
     let start = std::time::Instant::now();
-    let img = render_reference(&vol, &scene.transfer_function(), &params)?;
+    let (img, what): (ImageF64, String) = match scene.run.renderer {
+        Renderer::Reference => (
+            render_reference(&vol, &tf, &params)?,
+            format!("f64 reference renderer, step {}", params.step),
+        ),
+        Renderer::Pipeline => {
+            let q = scene.quality();
+            let out = render_pipeline(&vol, &tf, &params, &q)?;
+            let s = out.stats;
+            (
+                out.image,
+                format!(
+                    "pipeline model: {} interpolation, {}-neighbourhood gradient, base plane {}x{}, {} samples",
+                    q.interpolation.name(),
+                    u32::from(q.gradient),
+                    s.base_plane[0],
+                    s.base_plane[1],
+                    s.samples
+                ),
+            )
+        }
+    };
     let secs = start.elapsed().as_secs_f64();
+    if args.compare && scene.run.renderer == Renderer::Pipeline {
+        let reference = render_reference(&vol, &tf, &params)?;
+        let e = image_error(&img, &reference);
+        say!(
+            "error against the f64 reference: PSNR {:.1} dB, max abs {:.1}/255, relative Euclidean {:.3}%",
+            e.psnr_db,
+            e.max_abs * 255.0,
+            e.rel_euclid
+        );
+    }
     write_png_atomically(&img.to_rgb8(), &args.output)?;
-    println!(
-        "rendered {}x{}x{} volume, view azimuth {} elevation {}, {}x{} pixels in {:.2} s (f64 reference renderer)",
+    let view = match params.direction {
+        Some(d) => format!("view direction {d:?}"),
+        None => format!(
+            "view azimuth {} elevation {}",
+            params.view.azimuth, params.view.elevation
+        ),
+    };
+    say!(
+        "rendered {}x{}x{} volume, {view}, {}x{} pixels in {:.2} s ({what})",
         vol.dims[0],
         vol.dims[1],
         vol.dims[2],
-        params.view.azimuth,
-        params.view.elevation,
         params.width,
         params.height,
         secs
     );
-    println!("wrote {}", args.output.display());
+    say!("wrote {}", args.output.display());
+    Ok(())
+}
+
+fn phantom(args: PhantomArgs) -> Result<()> {
+    if !PHANTOMS.contains(&args.name.as_str()) {
+        bail!(
+            "phantom `{}`: unknown (known: {})",
+            args.name,
+            PHANTOMS.join(", ")
+        );
+    }
+    let vol = phantom_by_name(&args.name, args.size, args.bits)?;
+    let name = args
+        .output
+        .file_name()
+        .map(|n| n.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let what = format!(
+        "cube5 {} phantom, {}^3 voxels of {} bits (cube5 phantom {} --size {} --bits {})",
+        args.name, args.size, args.bits, args.name, args.size, args.bits
+    );
+    if name.ends_with(".nrrd") {
+        volume_io::write_nrrd(&args.output, &vol, NrrdEncoding::Gzip, &what)?;
+    } else if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+        volume_io::write_nifti(&args.output, &vol, &what)?;
+    } else if name.ends_with(".raw") {
+        let t = volume_io::write_raw(&args.output, &vol, Endian::Little)?;
+        say!(
+            "raw: dims = [{0}, {0}, {0}], type = \"{1}\", endian = \"little\"",
+            args.size,
+            t.name()
+        );
+    } else {
+        bail!(
+            "output {}: the name must end in .nrrd, .nii, .nii.gz or .raw",
+            args.output.display()
+        );
+    }
+    say!("wrote {} ({what})", args.output.display());
     Ok(())
 }
 
 /// Writes to a temporary name beside the target and renames, so a failure leaves no partial file.
 fn write_png_atomically(img: &image::RgbImage, path: &Path) -> Result<()> {
+    check_png_path(path)?;
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    if !dir.is_dir() {
-        bail!(
-            "output {}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
     let tmp = dir.join(format!(
         ".{}.tmp",
         path.file_name()

@@ -1,11 +1,27 @@
-//! Scene files (TOML). A scene names the volume, the view, the image and the rendering mode; the
-//! embedded default scene needs no file at all.
+//! Scene files (TOML): the volume (an embedded phantom or a raw, NRRD or NIfTI file), the view and
+//! projection, the image, the projection mode, the transfer function (points or a named preset),
+//! shading and distant lights, the quality knobs of the pipeline model, and what to run. The
+//! embedded default scene needs no file at all. `docs/scenes.md` documents every field.
+//!
+//! A scene also decides what is modelled: [`Plan::new`] works out which units the scene needs
+//! (no gradient or shader for MIP or X-ray, no depth test without geometry, no opacity correction
+//! at a step of exactly one voxel, ...) and why the others are left out.
 
 use crate::error::{ModelError, Result};
-use crate::phantom::{head_phantom, Volume};
-use crate::render::{CompositeMode, RenderParams, TransferFunction, View};
+use crate::phantom::{phantom_by_name, Volume, MAX_EDGE, PHANTOMS};
+use crate::render::{
+    CompositeMode, GradientScheme, Interpolation, Light, Material, Projection, Quality,
+    RenderParams, SliceSetup, TfPoint, TransferFunction, View, TF_PRESETS,
+};
+use crate::volume_io::{self, Endian, Format, RawSpec, VoxelType};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Largest volume edge the configured slice-order RTL supports (the frame's `MaxDim`,
+/// `docs/numerics/frame.md`); scenes that run on the RTL (`run.target = "rtl"` or `"both"`) are
+/// refused beyond it.
+pub const RTL_MAX_EDGE: usize = crate::frame::MAX_DIM;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
@@ -15,18 +31,66 @@ pub struct Scene {
     pub image: ImageSpec,
     pub render: RenderSpec,
     /// Transfer function; the phantom's default when absent.
-    pub transfer: Option<TransferFunction>,
+    pub transfer: Option<TransferSpec>,
+    /// Phong coefficients.
+    pub shading: Material,
+    /// Distant lights (`[[light]]` tables); none means one white headlight.
+    #[serde(rename = "light")]
+    pub lights: Vec<Light>,
+    pub quality: QualitySpec,
+    pub run: RunSpec,
+    /// The file the scene was loaded from (relative volume paths start from its directory).
+    #[serde(skip)]
+    pub source: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct VolumeSpec {
-    /// Embedded procedural phantom: `head`.
-    pub phantom: String,
+    /// Embedded procedural phantom (`head`, `sphere`, `bubbles`); `head` when no file is given.
+    pub phantom: Option<String>,
     /// Edge of the cubic phantom in voxels.
     pub size: usize,
-    /// Voxel width in bits.
-    pub bits: u32,
+    /// Voxel width in bits: the phantom's width; for files, the width asked for (unsigned 8- and
+    /// 16-bit data must fit it; other types are mapped onto it).
+    pub bits: Option<u32>,
+    /// A volume file, relative to the scene file's directory.
+    pub file: Option<PathBuf>,
+    /// `raw`, `nrrd` or `nifti`; from the file name when absent.
+    pub format: Option<FormatSpec>,
+    /// Raw files: voxels along x, y, z.
+    pub dims: Option<[usize; 3]>,
+    /// Raw files: `u8` or `u16`.
+    #[serde(rename = "type")]
+    pub voxel_type: Option<RawType>,
+    /// Raw files: byte order of `u16` voxels.
+    pub endian: Option<EndianSpec>,
+    /// Physical voxel size; overrides the file's.
+    pub spacing: Option<[f64; 3]>,
+    /// Raw files: header bytes to skip.
+    pub offset: u64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FormatSpec {
+    Raw,
+    Nrrd,
+    Nifti,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawType {
+    U8,
+    U16,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EndianSpec {
+    Little,
+    Big,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -34,6 +98,12 @@ pub struct VolumeSpec {
 pub struct ViewSpec {
     pub azimuth: f64,
     pub elevation: f64,
+    /// View vector from the eye into the scene; overrides azimuth and elevation.
+    pub direction: Option<[f64; 3]>,
+    pub projection: Projection,
+    /// Perspective: full field of view across the shorter image side, degrees.
+    pub fov: f64,
+    pub zoom: f64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -48,17 +118,78 @@ pub struct ImageSpec {
 pub struct RenderSpec {
     pub mode: CompositeMode,
     pub shading: bool,
-    /// Samples per voxel of path is 1/step.
+    /// Reference renderer: sample spacing along the ray in voxels (samples per voxel = 1/step).
     pub step: f64,
     pub early_termination: f64,
+    /// First-opaque: the opacity per voxel that counts as opaque.
+    pub threshold: f64,
+}
+
+/// A transfer function: a named preset or explicit points.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct TransferSpec {
+    pub preset: Option<String>,
+    pub points: Option<Vec<TfPoint>>,
+}
+
+/// The pipeline model's knobs (`render::Quality`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct QualitySpec {
+    pub voxel_bits: Option<u32>,
+    pub weight_bits: u32,
+    pub frac_bits: u32,
+    #[serde(alias = "color_bits")]
+    pub colour_bits: u32,
+    pub alpha_bits: u32,
+    pub acc_bits: u32,
+    pub samples_per_slice: u32,
+    pub supersampling: u32,
+    pub interpolation: Interpolation,
+    pub gradient: GradientScheme,
+}
+
+/// What to run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct RunSpec {
+    pub target: Target,
+    pub renderer: Renderer,
+}
+
+/// Where the scene runs: the golden model, the RTL (co-simulated), or both compared.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Target {
+    #[default]
+    Model,
+    Rtl,
+    Both,
+}
+
+/// Which model renders: the slice-order pipeline at the quality knobs, or the f64 reference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Renderer {
+    #[default]
+    Pipeline,
+    Reference,
 }
 
 impl Default for VolumeSpec {
     fn default() -> Self {
         Self {
-            phantom: "head".into(),
+            phantom: None,
             size: 96,
-            bits: 12,
+            bits: None,
+            file: None,
+            format: None,
+            dims: None,
+            voxel_type: None,
+            endian: None,
+            spacing: None,
+            offset: 0,
         }
     }
 }
@@ -68,6 +199,10 @@ impl Default for ViewSpec {
         Self {
             azimuth: 30.0,
             elevation: 20.0,
+            direction: None,
+            projection: Projection::Parallel,
+            fov: 30.0,
+            zoom: 1.0,
         }
     }
 }
@@ -89,7 +224,51 @@ impl Default for RenderSpec {
             shading: p.shading,
             step: p.step,
             early_termination: p.early_termination,
+            threshold: p.threshold,
         }
+    }
+}
+
+impl Default for QualitySpec {
+    fn default() -> Self {
+        let q = Quality::default();
+        Self {
+            voxel_bits: q.voxel_bits,
+            weight_bits: q.weight_bits,
+            frac_bits: q.frac_bits,
+            colour_bits: q.colour_bits,
+            alpha_bits: q.alpha_bits,
+            acc_bits: q.acc_bits,
+            samples_per_slice: q.samples_per_slice,
+            supersampling: q.supersampling,
+            interpolation: q.interpolation,
+            gradient: q.gradient,
+        }
+    }
+}
+
+impl Target {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Model => "model",
+            Self::Rtl => "rtl",
+            Self::Both => "both",
+        }
+    }
+
+    pub fn uses_rtl(self) -> bool {
+        self != Self::Model
+    }
+}
+
+/// Strips the error kind's prefix (`configuration: `, ...) from a model error's text.
+fn inner(e: &ModelError) -> String {
+    match e {
+        ModelError::Config(m)
+        | ModelError::View(m)
+        | ModelError::Image(m)
+        | ModelError::Volume(m) => m.clone(),
+        other => other.to_string(),
     }
 }
 
@@ -101,7 +280,9 @@ impl Scene {
             path: name.clone(),
             source,
         })?;
-        Self::parse(&text, &name)
+        let mut scene = Self::parse(&text, &name)?;
+        scene.source = Some(path.to_path_buf());
+        Ok(scene)
     }
 
     /// Parses scene text; `origin` names it in error messages.
@@ -122,75 +303,378 @@ impl Scene {
         Ok(scene)
     }
 
+    /// The name errors use for this scene: its file, or `origin`.
+    fn origin_or(&self, origin: &str) -> String {
+        self.source
+            .as_ref()
+            .map_or(origin.to_string(), |p| p.display().to_string())
+    }
+
+    /// Checks every field that can be checked without reading the volume; the error names the
+    /// field (`view.direction`, `transfer.points[2].density`, `quality.weight_bits`, ...).
     pub fn validate(&self, origin: &str) -> Result<()> {
+        let origin = self.origin_or(origin);
         let bad = |field: &str, m: String| {
             Err(ModelError::Scene {
-                path: origin.to_string(),
+                path: origin.clone(),
                 message: format!("{field}: {m}"),
             })
         };
-        if self.volume.phantom != "head" {
-            return bad(
-                "volume.phantom",
-                format!("unknown phantom `{}` (known: head)", self.volume.phantom),
-            );
+        let v = &self.volume;
+        match (&v.phantom, &v.file) {
+            (Some(_), Some(_)) => {
+                return bad("volume", "give either `phantom` or `file`, not both".into())
+            }
+            (_, None) => {
+                let name = v.phantom.as_deref().unwrap_or("head");
+                if !PHANTOMS.contains(&name) {
+                    return bad(
+                        "volume.phantom",
+                        format!("unknown phantom `{name}` (known: {})", PHANTOMS.join(", ")),
+                    );
+                }
+                if !(4..=MAX_EDGE).contains(&v.size) {
+                    return bad(
+                        "volume.size",
+                        format!("{} is outside 4..={MAX_EDGE}", v.size),
+                    );
+                }
+                for (field, set) in [
+                    ("volume.dims", v.dims.is_some()),
+                    ("volume.type", v.voxel_type.is_some()),
+                    ("volume.endian", v.endian.is_some()),
+                    ("volume.format", v.format.is_some()),
+                ] {
+                    if set {
+                        return bad(field, "only applies to a volume `file`".into());
+                    }
+                }
+            }
+            (None, Some(file)) => {
+                let format = match v.format {
+                    Some(FormatSpec::Raw) => Format::Raw,
+                    Some(FormatSpec::Nrrd) => Format::Nrrd,
+                    Some(FormatSpec::Nifti) => Format::Nifti,
+                    None => match Format::from_path(file) {
+                        Some(f) => f,
+                        None => {
+                            return bad(
+                                "volume.format",
+                                format!(
+                                    "cannot tell the format of `{}` from its name; say `format = \"raw\"`, `\"nrrd\"` or `\"nifti\"`",
+                                    file.display()
+                                ),
+                            )
+                        }
+                    },
+                };
+                if format == Format::Raw {
+                    let Some(dims) = v.dims else {
+                        return bad(
+                            "volume.dims",
+                            "a raw file needs `dims = [nx, ny, nz]`".into(),
+                        );
+                    };
+                    if dims.iter().any(|&d| d == 0 || d > MAX_EDGE) {
+                        return bad(
+                            "volume.dims",
+                            format!("{dims:?}: each edge must be 1..={MAX_EDGE}"),
+                        );
+                    }
+                    if v.voxel_type.is_none() {
+                        return bad(
+                            "volume.type",
+                            "a raw file needs `type = \"u8\"` or `\"u16\"`".into(),
+                        );
+                    }
+                } else {
+                    for (field, set) in [
+                        ("volume.dims", v.dims.is_some()),
+                        ("volume.type", v.voxel_type.is_some()),
+                        ("volume.endian", v.endian.is_some()),
+                        ("volume.offset", v.offset != 0),
+                    ] {
+                        if set {
+                            return bad(
+                                field,
+                                "only applies to raw files (the header says it)".into(),
+                            );
+                        }
+                    }
+                }
+            }
         }
-        if !(4..=512).contains(&self.volume.size) {
-            return bad(
-                "volume.size",
-                format!("{} is outside 4..=512", self.volume.size),
-            );
+        if let Some(b) = v.bits {
+            if !(1..=16).contains(&b) {
+                return bad("volume.bits", format!("{b} is outside 1..=16"));
+            }
         }
-        if !(4..=16).contains(&self.volume.bits) {
-            return bad(
-                "volume.bits",
-                format!("{} is outside 4..=16", self.volume.bits),
-            );
+        if let Some(s) = v.spacing {
+            if s.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+                return bad(
+                    "volume.spacing",
+                    format!("{s:?}: each must be finite and > 0"),
+                );
+            }
         }
-        for (field, v) in [
+        for (field, x) in [
             ("view.azimuth", self.view.azimuth),
             ("view.elevation", self.view.elevation),
         ] {
-            if !v.is_finite() {
-                return bad(field, format!("{v} is not a finite number"));
+            if !x.is_finite() {
+                return bad(field, format!("{x} is not a finite number"));
             }
         }
-        for (field, v) in [
+        if let Some(d) = self.view.direction {
+            if d.iter().any(|x| !x.is_finite()) {
+                return bad("view.direction", format!("{d:?} is not finite"));
+            }
+            if d.iter().map(|x| x * x).sum::<f64>() < 1e-24 {
+                return bad("view.direction", format!("{d:?} is the zero vector"));
+            }
+        }
+        if !(self.view.fov.is_finite() && self.view.fov > 0.0 && self.view.fov < 170.0) {
+            return bad(
+                "view.fov",
+                format!("{} is outside (0, 170) degrees", self.view.fov),
+            );
+        }
+        if !(self.view.zoom.is_finite() && self.view.zoom > 0.0 && self.view.zoom <= 100.0) {
+            return bad(
+                "view.zoom",
+                format!("{} is outside (0, 100]", self.view.zoom),
+            );
+        }
+        for (field, x) in [
             ("image.width", self.image.width),
             ("image.height", self.image.height),
         ] {
-            if !(1..=8192).contains(&v) {
-                return bad(field, format!("{v} is outside 1..=8192"));
+            if !(1..=8192).contains(&x) {
+                return bad(field, format!("{x} is outside 1..=8192"));
             }
         }
-        if !(self.render.step.is_finite() && self.render.step > 0.0 && self.render.step <= 4.0) {
-            return bad(
-                "render.step",
-                format!("{} is outside (0, 4]", self.render.step),
-            );
+        let r = &self.render;
+        if !(r.step.is_finite() && r.step > 0.0 && r.step <= 4.0) {
+            return bad("render.step", format!("{} is outside (0, 4]", r.step));
         }
-        if !(self.render.early_termination > 0.0 && self.render.early_termination <= 1.0) {
+        if !(r.early_termination > 0.0 && r.early_termination <= 1.0) {
             return bad(
                 "render.early_termination",
-                format!("{} is outside (0, 1]", self.render.early_termination),
+                format!("{} is outside (0, 1]", r.early_termination),
             );
         }
-        if let Some(tf) = &self.transfer {
-            if let Err(e) = tf.validate() {
-                return bad("transfer", e.to_string());
+        if !(r.threshold > 0.0 && r.threshold <= 1.0) {
+            return bad(
+                "render.threshold",
+                format!("{} is outside (0, 1]", r.threshold),
+            );
+        }
+        if let Some(t) = &self.transfer {
+            match (&t.preset, &t.points) {
+                (Some(_), Some(_)) => {
+                    return bad(
+                        "transfer",
+                        "give either `preset` or `points`, not both".into(),
+                    )
+                }
+                (None, None) => return bad("transfer", "give `preset` or `points`".into()),
+                (Some(p), None) => {
+                    if !TF_PRESETS.contains(&p.as_str()) {
+                        return bad(
+                            "transfer.preset",
+                            format!("unknown preset `{p}` (known: {})", TF_PRESETS.join(", ")),
+                        );
+                    }
+                }
+                (None, Some(points)) => {
+                    let tf = TransferFunction {
+                        points: points.clone(),
+                    };
+                    if let Err(e) = tf.validate() {
+                        let m = inner(&e);
+                        let m = m.strip_prefix("transfer function: ").unwrap_or(&m);
+                        let (field, rest) = m.split_once(": ").unwrap_or(("points", m));
+                        return bad(&format!("transfer.{field}"), rest.to_string());
+                    }
+                }
             }
+        }
+        let m = &self.shading;
+        for (name, x, hi) in [
+            ("ambient", m.ambient, 4.0),
+            ("diffuse", m.diffuse, 4.0),
+            ("specular", m.specular, 4.0),
+            ("shininess", m.shininess, 1024.0),
+        ] {
+            if !(0.0..=hi).contains(&x) {
+                return bad(
+                    &format!("shading.{name}"),
+                    format!("{x} is outside 0..={hi}"),
+                );
+            }
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            if l.direction.iter().any(|x| !x.is_finite())
+                || l.direction.iter().map(|x| x * x).sum::<f64>() < 1e-24
+            {
+                return bad(
+                    &format!("light[{i}].direction"),
+                    format!("{:?} is zero or not finite", l.direction),
+                );
+            }
+            if l.colour.iter().any(|c| !(0.0..=4.0).contains(c)) {
+                return bad(
+                    &format!("light[{i}].colour"),
+                    format!("{:?}: each channel must be in 0..=4", l.colour),
+                );
+            }
+        }
+        if let Err(e) = self.quality().validate() {
+            let m = inner(&e);
+            let (field, rest) = m.split_once(' ').unwrap_or((&m, ""));
+            return bad(field, rest.to_string());
+        }
+        if self.run.renderer == Renderer::Pipeline
+            && self.view.projection == Projection::Perspective
+        {
+            return bad(
+                "view.projection",
+                "perspective is rendered by the reference renderer only (the slice-order pipeline model is parallel); set `run.renderer = \"reference\"`".into(),
+            );
+        }
+        if self.run.target.uses_rtl() && self.run.renderer == Renderer::Reference {
+            return bad(
+                "run.renderer",
+                format!(
+                    "target `{}` runs the RTL pipeline, which the f64 reference renderer is not; use `renderer = \"pipeline\"`",
+                    self.run.target.name()
+                ),
+            );
+        }
+        if self.run.target.uses_rtl() && v.file.is_none() && v.size > RTL_MAX_EDGE {
+            return bad(
+                "volume.size",
+                format!(
+                    "{} exceeds the configured RTL's {RTL_MAX_EDGE} voxels per edge (run.target = \"{}\")",
+                    v.size,
+                    self.run.target.name()
+                ),
+            );
         }
         Ok(())
     }
 
+    /// The volume file's path, resolved against the scene file's directory.
+    pub fn volume_path(&self) -> Option<PathBuf> {
+        let file = self.volume.file.as_ref()?;
+        Some(match &self.source {
+            Some(src) if file.is_relative() => src
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .map_or(file.clone(), |d| d.join(file)),
+            _ => file.clone(),
+        })
+    }
+
+    /// Builds (phantom) or reads (file) the volume and checks it: not constant, and within the RTL's
+    /// limit when the scene runs on the RTL. Errors name the scene file and the field.
     pub fn build_volume(&self) -> Result<Volume> {
-        head_phantom(self.volume.size, self.volume.bits)
+        let origin = self.origin_or("scene");
+        let scene_err = |field: &str, m: String| ModelError::Scene {
+            path: origin.clone(),
+            message: format!("{field}: {m}"),
+        };
+        let v = &self.volume;
+        let mut vol = match self.volume_path() {
+            None => {
+                let name = v.phantom.as_deref().unwrap_or("head");
+                phantom_by_name(name, v.size, v.bits.unwrap_or(12))
+                    .map_err(|e| scene_err("volume.phantom", inner(&e)))?
+            }
+            Some(path) => {
+                let format = match v.format {
+                    Some(FormatSpec::Raw) => Format::Raw,
+                    Some(FormatSpec::Nrrd) => Format::Nrrd,
+                    Some(FormatSpec::Nifti) => Format::Nifti,
+                    None => Format::from_path(&path).unwrap_or(Format::Raw),
+                };
+                let read = match format {
+                    Format::Raw => volume_io::read_raw(
+                        &path,
+                        &RawSpec {
+                            dims: v.dims.unwrap_or([0; 3]),
+                            voxel_type: match v.voxel_type {
+                                Some(RawType::U16) => VoxelType::U16,
+                                _ => VoxelType::U8,
+                            },
+                            endian: match v.endian {
+                                Some(EndianSpec::Big) => Endian::Big,
+                                _ => Endian::Little,
+                            },
+                            spacing: v.spacing.unwrap_or([1.0; 3]),
+                            offset: v.offset,
+                        },
+                        v.bits,
+                    ),
+                    Format::Nrrd => volume_io::read_nrrd(&path, v.bits),
+                    Format::Nifti => volume_io::read_nifti(&path, v.bits),
+                };
+                read.map_err(|e| scene_err("volume.file", inner(&e)))?
+            }
+        };
+        if let Some(s) = v.spacing {
+            vol.spacing = s;
+        }
+        let first = vol.data.first().copied();
+        if vol.is_empty() {
+            return Err(scene_err("volume", "the volume has no voxels".into()));
+        }
+        if let Some(c) = first {
+            if vol.data.iter().all(|&x| x == c) {
+                return Err(scene_err(
+                    "volume",
+                    format!(
+                        "every voxel is {c}: a constant volume renders as a flat image (nothing to see)"
+                    ),
+                ));
+            }
+        }
+        if self.run.target.uses_rtl() && vol.dims.iter().any(|&d| d > RTL_MAX_EDGE) {
+            return Err(scene_err(
+                if v.file.is_some() { "volume.file" } else { "volume.size" },
+                format!(
+                    "{} x {} x {} exceeds the configured RTL's {RTL_MAX_EDGE} voxels per edge (run.target = \"{}\")",
+                    vol.dims[0],
+                    vol.dims[1],
+                    vol.dims[2],
+                    self.run.target.name()
+                ),
+            ));
+        }
+        Ok(vol)
     }
 
     pub fn transfer_function(&self) -> TransferFunction {
-        self.transfer
-            .clone()
-            .unwrap_or_else(TransferFunction::head_default)
+        match &self.transfer {
+            Some(TransferSpec {
+                points: Some(points),
+                ..
+            }) => TransferFunction {
+                points: points.clone(),
+            },
+            Some(TransferSpec {
+                preset: Some(p), ..
+            }) => TransferFunction::preset(p).unwrap_or_else(|_| TransferFunction::head_default()),
+            _ => match (self.volume.file.is_some(), self.volume.phantom.as_deref()) {
+                (false, Some("sphere")) => {
+                    TransferFunction::preset("iso").expect("built-in preset")
+                }
+                (false, Some("bubbles")) => {
+                    TransferFunction::preset("grey").expect("built-in preset")
+                }
+                _ => TransferFunction::head_default(),
+            },
+        }
     }
 
     pub fn render_params(&self) -> RenderParams {
@@ -201,17 +685,302 @@ impl Scene {
                 azimuth: self.view.azimuth,
                 elevation: self.view.elevation,
             },
+            direction: self.view.direction,
+            projection: self.view.projection,
+            fov: self.view.fov,
+            zoom: self.view.zoom,
             step: self.render.step,
             mode: self.render.mode,
             shading: self.render.shading,
             early_termination: self.render.early_termination,
+            threshold: self.render.threshold,
+            supersampling: self.quality.supersampling.clamp(1, 8),
+            lights: self.lights.clone(),
+            material: self.shading,
         }
     }
+
+    pub fn quality(&self) -> Quality {
+        let q = &self.quality;
+        Quality {
+            voxel_bits: q.voxel_bits,
+            weight_bits: q.weight_bits,
+            frac_bits: q.frac_bits,
+            colour_bits: q.colour_bits,
+            alpha_bits: q.alpha_bits,
+            acc_bits: q.acc_bits,
+            samples_per_slice: q.samples_per_slice,
+            supersampling: q.supersampling,
+            interpolation: q.interpolation,
+            gradient: q.gradient,
+        }
+    }
+}
+
+// =================================================================================================
+// The plan: which units a scene needs
+// =================================================================================================
+
+/// A unit of the pipeline, as the plan names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Unit {
+    /// `cube5_trilin`: interpolation of every sample.
+    Trilin,
+    /// `cube5_gradient`: ABC gradients, for shading.
+    Gradient,
+    /// `cube5_shader`: classification LUT and reflectance map.
+    Shader,
+    /// `cube5_compos`: the projection mode.
+    Compos,
+    /// Opacity correction `1 - (1 - a)^ratio` in the compositing unit's LUT.
+    OpacityCorrection,
+    /// Rays stop once opaque.
+    EarlyTermination,
+    /// Depth test against opaque geometry in the compositing buffer.
+    DepthTest,
+    /// More base-plane rays per voxel.
+    Supersampling,
+    /// Skipping blocks the transfer function makes transparent.
+    EmptySpaceSkip,
+    /// Warp of the base-plane image onto the image.
+    Warp,
+    /// ER-perspective (exponential regions).
+    Perspective,
+}
+
+impl Unit {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Trilin => "trilin",
+            Self::Gradient => "gradient",
+            Self::Shader => "shader",
+            Self::Compos => "compos",
+            Self::OpacityCorrection => "opacity correction",
+            Self::EarlyTermination => "early termination",
+            Self::DepthTest => "depth test",
+            Self::Supersampling => "supersampling",
+            Self::EmptySpaceSkip => "empty-space skip",
+            Self::Warp => "warp",
+            Self::Perspective => "perspective",
+        }
+    }
+}
+
+/// One line of a plan: a unit, whether the scene needs it, and its setting or the reason it is
+/// left out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanEntry {
+    pub unit: Unit,
+    pub needed: bool,
+    pub detail: String,
+}
+
+/// What a scene needs modelled (and, later, built and simulated on the RTL side).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    pub entries: Vec<PlanEntry>,
+    pub renderer: Renderer,
+    pub target: Target,
+}
+
+/// Edge of the blocks the empty-space count uses.
+pub const SKIP_BLOCK: usize = 8;
+
+impl Plan {
+    /// Works out the plan of `scene` for `vol` (the volume decides empty-space skipping).
+    pub fn new(scene: &Scene, vol: &Volume) -> Result<Self> {
+        let params = scene.render_params();
+        let q = scene.quality();
+        let mode = params.mode;
+        let tf = scene.transfer_function();
+        let dir = params.direction()?;
+        let setup = SliceSetup::new(vol, dir)?;
+        let ratio = setup.ratio / f64::from(q.samples_per_slice);
+        let mut entries = Vec::new();
+        let mut add = |unit, needed, detail: String| {
+            entries.push(PlanEntry {
+                unit,
+                needed,
+                detail,
+            })
+        };
+        let mname = mode.name().to_uppercase();
+        let vb = q.voxel_width(vol.bits);
+        let offset = setup.offset(q.interpolation, q.weight_bits);
+        add(
+            Unit::Trilin,
+            true,
+            format!(
+                "{}{}, U({vb}.{}) samples, {}-bit weights{}",
+                q.interpolation.name(),
+                if offset > 0.0 {
+                    format!(" (offset {offset})")
+                } else {
+                    String::new()
+                },
+                q.frac_bits,
+                q.weight_bits,
+                if q.samples_per_slice > 1 {
+                    format!(", {} samples per slice", q.samples_per_slice)
+                } else {
+                    String::new()
+                }
+            ),
+        );
+        let shaded = mode.classifies() && params.shading;
+        add(
+            Unit::Gradient,
+            shaded,
+            if shaded {
+                format!("{}-neighbourhood", u32::from(q.gradient))
+            } else if mode.classifies() {
+                "shading is off".into()
+            } else {
+                format!("{mname} needs no shading")
+            },
+        );
+        add(
+            Unit::Shader,
+            mode.classifies(),
+            if !mode.classifies() {
+                format!("{mname} projects densities, nothing to classify or light")
+            } else if params.shading {
+                format!(
+                    "classification + {}",
+                    match params.lights.len() {
+                        0 => "headlight".to_string(),
+                        1 => "1 light".to_string(),
+                        n => format!("{n} lights"),
+                    }
+                )
+            } else {
+                "classification only (shading off)".into()
+            },
+        );
+        add(Unit::Compos, true, mode.name().into());
+        let blends = mode == CompositeMode::Composite;
+        let unit_step = (ratio - 1.0).abs() < 1e-12;
+        add(
+            Unit::OpacityCorrection,
+            blends && !unit_step,
+            if !blends {
+                format!("{mname} does not blend opacities")
+            } else if unit_step {
+                "the step is exactly one voxel".into()
+            } else {
+                format!("exponent {ratio:.3}")
+            },
+        );
+        let (et, et_detail) = match mode {
+            CompositeMode::Composite if params.early_termination < 1.0 => {
+                (true, format!("at opacity {}", params.early_termination))
+            }
+            CompositeMode::Composite => (false, "threshold 1.0 (off)".into()),
+            CompositeMode::FirstOpaque => (true, "the first opaque sample ends the ray".into()),
+            _ => (false, format!("{mname} must see every sample")),
+        };
+        add(Unit::EarlyTermination, et, et_detail);
+        add(Unit::DepthTest, false, "no geometry in the scene".into());
+        add(
+            Unit::Supersampling,
+            q.supersampling > 1,
+            if q.supersampling > 1 {
+                format!("{0}x{0} rays per voxel", q.supersampling)
+            } else {
+                "1 ray per voxel".into()
+            },
+        );
+        let (skip, skip_detail) = if mode.classifies() {
+            let empty = empty_block_fraction(vol, &tf);
+            if empty > 0.0 {
+                (
+                    true,
+                    format!(
+                        "{:.0}% of {SKIP_BLOCK}^3 blocks are transparent",
+                        100.0 * empty
+                    ),
+                )
+            } else {
+                (false, "no block is transparent".into())
+            }
+        } else {
+            (false, format!("{mname} reads every sample"))
+        };
+        add(Unit::EmptySpaceSkip, skip, skip_detail);
+        add(Unit::Warp, true, "base plane to image, bilinear".into());
+        add(
+            Unit::Perspective,
+            params.projection == Projection::Perspective,
+            if params.projection == Projection::Perspective {
+                "reference renderer only".into()
+            } else {
+                "parallel projection".into()
+            },
+        );
+        Ok(Self {
+            entries,
+            renderer: scene.run.renderer,
+            target: scene.run.target,
+        })
+    }
+
+    /// True when the scene needs `unit`.
+    pub fn needs(&self, unit: Unit) -> bool {
+        self.entries.iter().any(|e| e.unit == unit && e.needed)
+    }
+}
+
+impl fmt::Display for Plan {
+    /// One line: `modelled: trilin (...), ...; left out: gradient (MIP needs no shading), ...`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let list = |needed: bool| {
+            self.entries
+                .iter()
+                .filter(|e| e.needed == needed)
+                .map(|e| format!("{} ({})", e.unit.name(), e.detail))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        write!(f, "modelled: {}; left out: {}", list(true), list(false))
+    }
+}
+
+/// Fraction of `SKIP_BLOCK`^3 blocks (with a one-voxel apron, as interpolation reads it) whose
+/// density range the transfer function maps to zero opacity.
+pub fn empty_block_fraction(vol: &Volume, tf: &TransferFunction) -> f64 {
+    let nb = vol.dims.map(|d| d.div_ceil(SKIP_BLOCK));
+    let max = f64::from(vol.max_value());
+    let mut empty = 0usize;
+    for bz in 0..nb[2] {
+        for by in 0..nb[1] {
+            for bx in 0..nb[0] {
+                let (mut lo, mut hi) = (u32::MAX, 0u32);
+                let b = [bx, by, bz].map(|v| (v * SKIP_BLOCK) as i64);
+                for z in b[2] - 1..=b[2] + SKIP_BLOCK as i64 {
+                    for y in b[1] - 1..=b[1] + SKIP_BLOCK as i64 {
+                        for x in b[0] - 1..=b[0] + SKIP_BLOCK as i64 {
+                            let v = vol.get(x, y, z);
+                            lo = lo.min(v);
+                            hi = hi.max(v);
+                        }
+                    }
+                }
+                if tf.transparent_between(f64::from(lo) / max, f64::from(hi) / max) {
+                    empty += 1;
+                }
+            }
+        }
+    }
+    empty as f64 / (nb[0] * nb[1] * nb[2]) as f64
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn err(text: &str) -> String {
+        Scene::parse(text, "s.toml").unwrap_err().to_string()
+    }
 
     #[test]
     fn empty_text_is_the_default_scene() {
@@ -220,21 +989,52 @@ mod tests {
 
     #[test]
     fn errors_name_file_line_and_field() {
-        let e = Scene::parse("[view]\nazimuth = \"left\"\n", "s.toml")
-            .unwrap_err()
-            .to_string();
+        let e = err("[view]\nazimuth = \"left\"\n");
         assert!(e.starts_with("s.toml:2"), "{e}");
-        let e = Scene::parse("[image]\nwidth = 0\n", "s.toml")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("image.width"), "{e}");
-        let e = Scene::parse("[volume]\nsise = 3\n", "s.toml")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("sise"), "{e}");
-        let e = Scene::parse("[view]\nazimuth = nan\n", "s.toml")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("view.azimuth"), "{e}");
+        assert!(err("[image]\nwidth = 0\n").contains("image.width"));
+        assert!(err("[volume]\nsise = 3\n").contains("sise"));
+        assert!(err("[view]\nazimuth = nan\n").contains("view.azimuth"));
+        assert!(err("[view]\ndirection = [0.0, 0.0, 0.0]\n").contains("view.direction"));
+        assert!(err("[view]\ndirection = [nan, 0.0, 1.0]\n").contains("view.direction"));
+        let e = err("[transfer]\npoints = [{ density = 0.5, rgba = [0,0,0,0] }, { density = 0.2, rgba = [0,0,0,0] }]\n");
+        assert!(e.contains("s.toml: transfer.points[1].density"), "{e}");
+        assert!(err("[transfer]\npreset = \"glow\"\n").contains("transfer.preset"));
+        assert!(err("[quality]\nweight_bits = 13\n").contains("quality.weight_bits"));
+        assert!(err("[quality]\ngradient = 8\n").contains("gradient"));
+        assert!(err("[quality]\ninterpolation = \"cubic\"\n").contains("cubic"));
+        assert!(err("[volume]\nfile = \"a.raw\"\n").contains("volume.dims"));
+        assert!(err("[volume]\nfile = \"a.raw\"\ndims = [2, 2, 2]\n").contains("volume.type"));
+        assert!(err("[volume]\nfile = \"a.dat\"\n").contains("volume.format"));
+        assert!(err("[volume]\nfile = \"a.nrrd\"\nphantom = \"head\"\n").contains("not both"));
+        assert!(err("[[light]]\ndirection = [0, 0, 0]\n").contains("light[0].direction"));
+        assert!(err("[view]\nprojection = \"perspective\"\n").contains("view.projection"));
+        assert!(err("[run]\ntarget = \"rtl\"\n[volume]\nsize = 600\n").contains("configured RTL"));
+    }
+
+    #[test]
+    fn plans_follow_the_mode() {
+        let vol = crate::phantom::head_phantom(32, 12).unwrap();
+        let scene = Scene::parse("[render]\nmode = \"mip\"\n", "s").unwrap();
+        let plan = Plan::new(&scene, &vol).unwrap();
+        assert!(plan.needs(Unit::Trilin) && plan.needs(Unit::Compos));
+        assert!(!plan.needs(Unit::Gradient) && !plan.needs(Unit::Shader));
+        let text = plan.to_string();
+        assert!(text.contains("gradient (MIP needs no shading)"), "{text}");
+        assert!(
+            text.contains("depth test (no geometry in the scene)"),
+            "{text}"
+        );
+        // Axis-aligned composite at one sample per slice: no opacity correction.
+        let scene = Scene::parse("[view]\ndirection = [0, 0, 1]\n", "s").unwrap();
+        let plan = Plan::new(&scene, &vol).unwrap();
+        assert!(plan.needs(Unit::Gradient) && !plan.needs(Unit::OpacityCorrection));
+        let sphere = crate::phantom::sphere_phantom(32, 12).unwrap();
+        let scene = Scene::parse("[volume]\nphantom = \"sphere\"\nsize = 32\n", "s").unwrap();
+        let plan = Plan::new(&scene, &sphere).unwrap();
+        assert!(plan.needs(Unit::EmptySpaceSkip), "{plan}");
+        let scene = Scene::parse("[view]\ndirection = [1, 0.5, 0.2]\n", "s").unwrap();
+        assert!(Plan::new(&scene, &vol)
+            .unwrap()
+            .needs(Unit::OpacityCorrection));
     }
 }

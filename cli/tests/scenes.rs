@@ -1,0 +1,351 @@
+//! Scene files as a user meets them: every example in `scenes/` renders; every kind of bad input
+//! (docs/scenes.md § Bad input) gets one line naming the file and the field, a non-zero exit code
+//! and no output; `cube5 tradeoff` runs a tiny sweep end to end.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn cube5(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cube5"))
+        .args(args)
+        .output()
+        .expect("run cube5")
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("scene-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A refusal: non-zero exit, exactly one line on stderr containing every needle, no panic.
+fn assert_refused(out: &Output, needles: &[&str]) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected failure; stderr: {err}");
+    assert!(!err.contains("panicked"), "panic on user input: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "one-line error expected:\n{err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "error should mention `{n}`: {err}");
+    }
+}
+
+/// Writes `scene` as NAME.toml in the scratch directory and renders it; returns the output and
+/// the PNG path (removed first).
+fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
+    let toml = scratch(&format!("{name}.toml"));
+    std::fs::write(&toml, scene).unwrap();
+    let png = scratch(&format!("{name}.png"));
+    let _ = std::fs::remove_file(&png);
+    let out = cube5(&[
+        "render",
+        s(&toml),
+        "-o",
+        s(&png),
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ]);
+    (out, png)
+}
+
+#[test]
+fn every_example_scene_renders() {
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(repo().join("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 10, "{scenes:?}");
+    for scene in scenes {
+        let name = scene.file_stem().unwrap().to_string_lossy().to_string();
+        let png = scratch(&format!("example-{name}.png"));
+        let _ = std::fs::remove_file(&png);
+        let out = cube5(&[
+            "render",
+            s(&scene),
+            "-o",
+            s(&png),
+            "--width",
+            "64",
+            "--height",
+            "64",
+        ]);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            stdout.contains("plan: modelled: trilin"),
+            "{name}: {stdout}"
+        );
+        let img = image::open(&png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (64, 64));
+        assert!(
+            img.pixels().any(|p| p.0.iter().any(|&c| c > 20)),
+            "{name}: the image is black"
+        );
+    }
+}
+
+#[test]
+fn missing_volume_file() {
+    let (out, png) = render_scene("missing-volume", "[volume]\nfile = \"no/such.nrrd\"\n");
+    assert_refused(
+        &out,
+        &["missing-volume.toml", "volume.file", "no/such.nrrd"],
+    );
+    assert!(!png.exists());
+}
+
+#[test]
+fn unreadable_volume_file() {
+    // A directory where a file should be (root can read any file, so permissions cannot show it).
+    let dir = scratch("a-directory.nii");
+    std::fs::create_dir_all(&dir).unwrap();
+    let (out, png) = render_scene("unreadable", &format!("[volume]\nfile = \"{}\"\n", s(&dir)));
+    assert_refused(&out, &["unreadable.toml", "volume.file", "a-directory.nii"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn raw_size_must_equal_dims_times_type() {
+    let raw = scratch("short.raw");
+    std::fs::write(&raw, vec![7u8; 1000]).unwrap();
+    let (out, png) = render_scene(
+        "raw-size",
+        &format!(
+            "[volume]\nfile = \"{}\"\ndims = [10, 10, 6]\ntype = \"u16\"\n",
+            s(&raw)
+        ),
+    );
+    assert_refused(
+        &out,
+        &[
+            "raw-size.toml",
+            "volume.file",
+            "short.raw",
+            "file size",
+            "1000 bytes",
+        ],
+    );
+    assert!(!png.exists());
+}
+
+#[test]
+fn dims_beyond_the_configured_rtl() {
+    let (out, png) = render_scene(
+        "rtl-limit",
+        "[volume]\nsize = 600\n[run]\ntarget = \"rtl\"\n",
+    );
+    assert_refused(
+        &out,
+        &["rtl-limit.toml", "volume.size", "configured RTL", "512"],
+    );
+    assert!(!png.exists());
+    // A file whose header says more than the model takes at all.
+    let big = scratch("big.nrrd");
+    std::fs::write(
+        &big,
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2000 4 4\nencoding: raw\n\n",
+    )
+    .unwrap();
+    let (out, png) = render_scene("too-big", &format!("[volume]\nfile = \"{}\"\n", s(&big)));
+    assert_refused(&out, &["too-big.toml", "volume.file", "big.nrrd", "sizes"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn nan_or_zero_view_vector() {
+    let (out, png) = render_scene("nan-view", "[view]\ndirection = [nan, 0.0, 1.0]\n");
+    assert_refused(&out, &["nan-view.toml", "view.direction"]);
+    assert!(!png.exists());
+    let (out, png) = render_scene("zero-view", "[view]\ndirection = [0, 0, 0]\n");
+    assert_refused(&out, &["zero-view.toml", "view.direction", "zero"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn empty_or_constant_volume() {
+    let empty = scratch("empty.nrrd");
+    std::fs::write(&empty, b"").unwrap();
+    let (out, png) = render_scene("empty", &format!("[volume]\nfile = \"{}\"\n", s(&empty)));
+    assert_refused(&out, &["empty.toml", "volume.file", "empty.nrrd", "magic"]);
+    assert!(!png.exists());
+    let flat = scratch("flat.raw");
+    std::fs::write(&flat, vec![0u8; 8 * 8 * 8]).unwrap();
+    let (out, png) = render_scene(
+        "constant",
+        &format!(
+            "[volume]\nfile = \"{}\"\ndims = [8, 8, 8]\ntype = \"u8\"\n",
+            s(&flat)
+        ),
+    );
+    assert_refused(&out, &["constant.toml", "volume", "every voxel is 0"]);
+    assert!(!png.exists());
+}
+
+#[test]
+fn unsorted_transfer_function_points() {
+    let (out, png) = render_scene(
+        "unsorted",
+        "[transfer]\npoints = [\n  { density = 0.0, rgba = [0, 0, 0, 0] },\n  { density = 0.6, rgba = [1, 1, 1, 0.5] },\n  { density = 0.4, rgba = [1, 1, 1, 1] },\n]\n",
+    );
+    assert_refused(
+        &out,
+        &["unsorted.toml", "transfer.points[2].density", "sorted"],
+    );
+    assert!(!png.exists());
+}
+
+#[test]
+fn malformed_headers_name_the_field() {
+    let bad = scratch("bad-header.nrrd");
+    std::fs::write(
+        &bad,
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: bzip2\n\n",
+    )
+    .unwrap();
+    let (out, _) = render_scene("bad-nrrd", &format!("[volume]\nfile = \"{}\"\n", s(&bad)));
+    assert_refused(&out, &["bad-nrrd.toml", "bad-header.nrrd", "encoding"]);
+    let nii = scratch("bad.nii");
+    let mut h = vec![0u8; 352];
+    h[0..4].copy_from_slice(&348i32.to_le_bytes());
+    h[344..348].copy_from_slice(b"n+1\0");
+    std::fs::write(&nii, &h).unwrap();
+    let (out, _) = render_scene("bad-nifti", &format!("[volume]\nfile = \"{}\"\n", s(&nii)));
+    assert_refused(&out, &["bad-nifti.toml", "bad.nii", "dim[0]"]);
+}
+
+#[test]
+fn bad_knobs_and_combinations() {
+    let (out, _) = render_scene("knob", "[quality]\nweight_bits = 20\n");
+    assert_refused(&out, &["knob.toml", "quality.weight_bits"]);
+    let (out, _) = render_scene("persp", "[view]\nprojection = \"perspective\"\n");
+    assert_refused(&out, &["persp.toml", "view.projection", "reference"]);
+    let (out, _) = render_scene("both", "[volume]\nphantom = \"head\"\nfile = \"x.nrrd\"\n");
+    assert_refused(&out, &["both.toml", "volume", "not both"]);
+}
+
+#[test]
+fn rtl_target_prints_the_plan_then_stops() {
+    let (out, png) = render_scene(
+        "rtl",
+        "[volume]\nsize = 16\n[render]\nmode = \"mip\"\n[run]\ntarget = \"both\"\n",
+    );
+    assert_refused(&out, &["run.target", "not wired"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("gradient (MIP needs no shading)"),
+        "{stdout}"
+    );
+    assert!(!png.exists());
+}
+
+#[test]
+fn phantom_files_round_trip_through_render() {
+    // The phantom written as NIfTI and NRRD renders exactly as the embedded phantom.
+    let mut images = Vec::new();
+    for (name, volume) in [
+        (
+            "embedded",
+            "phantom = \"head\"\nsize = 24\nbits = 8\n".to_string(),
+        ),
+        ("nifti", String::new()),
+        ("nrrd", String::new()),
+    ] {
+        let volume = match name {
+            "nifti" | "nrrd" => {
+                let file = scratch(&format!(
+                    "rt-head.{}",
+                    if name == "nifti" { "nii.gz" } else { "nrrd" }
+                ));
+                let out = cube5(&[
+                    "phantom",
+                    "head",
+                    "--size",
+                    "24",
+                    "--bits",
+                    "8",
+                    "-o",
+                    s(&file),
+                ]);
+                assert!(
+                    out.status.success(),
+                    "{}",
+                    String::from_utf8_lossy(&out.stderr)
+                );
+                format!("file = \"{}\"\n", s(&file))
+            }
+            _ => volume,
+        };
+        let (out, png) = render_scene(
+            &format!("rt-{name}"),
+            &format!("[volume]\n{volume}[transfer]\npreset = \"head\"\n"),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        images.push(image::open(&png).unwrap().to_rgb8());
+    }
+    assert_eq!(images[0], images[1], "NIfTI");
+    assert_eq!(images[0], images[2], "NRRD");
+}
+
+#[test]
+fn tradeoff_tiny_sweep_end_to_end() {
+    let dir = scratch("tradeoff");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = cube5(&["tradeoff", "--tiny", "--out", s(&dir)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("cube3-paper 6.1"), "{stdout}");
+    for f in [
+        "tradeoff.md",
+        "tradeoff-widths.csv",
+        "tradeoff-configs.csv",
+        "tradeoff-sample-rate.csv",
+        "tradeoff-early-termination.csv",
+        "tradeoff-interpolation.csv",
+        "tradeoff-gradient.csv",
+        "tradeoff-widths.png",
+        "tradeoff-samples.png",
+        "tradeoff-interpolation.png",
+        "tradeoff-gradient.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let md = std::fs::read_to_string(dir.join("tradeoff.md")).unwrap();
+    assert!(
+        md.contains("cube3-paper §6.2") && md.contains("| 45 |"),
+        "{md}"
+    );
+    let csv = std::fs::read_to_string(dir.join("tradeoff-interpolation.csv")).unwrap();
+    assert!(csv.lines().count() == 4, "{csv}");
+    let png = image::open(dir.join("tradeoff-gradient.png")).unwrap();
+    assert!(png.width() >= 800);
+}
