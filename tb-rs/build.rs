@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// Bumped when the way a variant is built changes, to invalidate every cached object.
-const RECIPE: &str = "cube5-variant-recipe-3";
+const RECIPE: &str = "cube5-variant-recipe-4";
 
 /// Verilator flags for RTL variants (TOOLCHAIN.md; `--x-initial unique` so randReset(2) applies).
 const VERILATE_FLAGS: &[&str] = &[
