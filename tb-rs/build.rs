@@ -30,6 +30,16 @@ const VERILATE_FLAGS: &[&str] = &[
     "--assert",
 ];
 
+/// Extra Verilator flags for gate-level netlists: Verilator 5.006's DFG `REMOVE_NOT_NOT` peephole
+/// mis-simulates some flat netlists at -O3 (docs/architecture.md).
+const GATE_VERILATE_FLAGS: &[&str] = &[
+    "-Wno-fatal",
+    "-Wno-lint",
+    "-Wno-style",
+    "-Wno-UNOPTFLAT",
+    "-fno-dfg-peephole-remove-not-not",
+];
+
 /// Yosys fails on the warnings that signal a wrong netlist (TOOLCHAIN.md).
 const YOSYS_FATAL: &str = "implicitly declared|Resizing cell port|out of bounds";
 
@@ -262,6 +272,9 @@ fn variant_stamp(v: &Variant, extra: &[&str]) -> String {
     }
     h.update(VERILATE_FLAGS.join(" "));
     h.update(CXX_FLAGS.join(" "));
+    if v.gate {
+        h.update(GATE_VERILATE_FLAGS.join(" "));
+    }
     format!("{:x}", h.finalize())
 }
 
@@ -329,9 +342,7 @@ fn build_variant(
             Command::new("yosys").args(["-q", "-e", YOSYS_FATAL, "-p", &script]),
             "yosys",
         )?;
-        verilate
-            .args(["-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT"])
-            .arg(&netlist);
+        verilate.args(GATE_VERILATE_FLAGS).arg(&netlist);
     } else {
         verilate.arg("-Wall").arg(vlt);
         for (k, val) in &v.params {

@@ -10,6 +10,7 @@ macro_rules! say {
 }
 
 mod bench;
+mod cosim;
 mod tradeoff;
 
 use anyhow::{bail, Context, Result};
@@ -41,6 +42,8 @@ enum Command {
     Tradeoff(tradeoff::TradeoffArgs),
     /// Write an embedded phantom as a volume file (.nrrd, .nii, .nii.gz or .raw).
     Phantom(PhantomArgs),
+    /// Co-simulate one frame of a scene: the RTL frame against the golden model, bit for bit.
+    Cosim(cosim::CosimArgs),
     /// Print speed figures: simulated RTL cycles per second and model samples per second.
     Bench(bench::BenchArgs),
 }
@@ -121,6 +124,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Tradeoff(args) => tradeoff::run(args),
         Command::Phantom(args) => phantom(args),
         Command::Bench(args) => bench::run(args),
+        Command::Cosim(args) => cosim::run(args),
     }
 }
 
@@ -179,10 +183,26 @@ fn render(args: RenderArgs) -> Result<()> {
     let plan = Plan::new(&scene, &vol)?;
     say!("plan: {plan}");
     if scene.run.target.uses_rtl() {
-        bail!(
-            "run.target = \"{}\": the RTL scene runner is not wired into this build yet (the plan above lists the units it needs); use target = \"model\"",
-            scene.run.target.name()
-        );
+        // The RTL frame (P = 4) against the model, images beside the output.
+        let stem = args
+            .output
+            .file_stem()
+            .map_or("cube5".into(), |s| s.to_string_lossy().into_owned());
+        let dir = args.output.with_file_name(format!("{stem}-cosim"));
+        let origin = args
+            .scene
+            .as_ref()
+            .map_or("the default scene".to_string(), |p| p.display().to_string());
+        let r = cosim::cosim_scene(&scene, &origin, cube5_tb::frame::P4, &dir, 1)?;
+        if !r.matched {
+            bail!(
+                "run.target = \"{}\": the RTL frame differs from the model (report above)",
+                scene.run.target.name()
+            );
+        }
+        if scene.run.target == cube5_model::scene::Target::Rtl {
+            return Ok(());
+        }
     }
     let params = scene.render_params();
     let tf = scene.transfer_function();

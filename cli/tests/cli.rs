@@ -138,3 +138,74 @@ fn output_must_be_png_in_an_existing_directory() {
         "does not exist",
     );
 }
+
+/// `cube5 cosim`: a small scene on the RTL frame at P = 1 and 8 (the default scene at P = 4 is
+/// `make demo`), then the inputs it refuses.
+#[test]
+fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
+    let scene = scratch("cosim-small.toml");
+    std::fs::write(
+        &scene,
+        "[volume]\nphantom = \"sphere\"\nsize = 32\n[view]\nazimuth = 45.0\nelevation = 0.0\n[image]\nwidth = 64\nheight = 64\n",
+    )
+    .unwrap();
+    for p in ["1", "8"] {
+        let dir = scratch(&format!("cosim-p{p}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        let out = cube5(&[
+            "cosim",
+            scene.to_str().unwrap(),
+            "-p",
+            p,
+            "-o",
+            dir.to_str().unwrap(),
+        ]);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{stdout}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(stdout.contains("MATCH"), "{stdout}");
+        assert!(stdout.contains("samples/clock/pipeline"), "{stdout}");
+        for f in ["model.png", "rtl.png"] {
+            let img = image::open(dir.join(f)).unwrap();
+            assert_eq!((img.width(), img.height()), (64, 64));
+        }
+    }
+    let bad = |name: &str, text: &str, extra: &[&str], needle: &str| {
+        let f = scratch(name);
+        std::fs::write(&f, text).unwrap();
+        let dir = scratch(&format!("{name}-out"));
+        let _ = std::fs::remove_dir_all(&dir);
+        let mut args = vec!["cosim", f.to_str().unwrap(), "-o", dir.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let out = cube5(&args);
+        assert_refused(&out, needle);
+        assert!(!dir.join("rtl.png").exists(), "{name}: no image on refusal");
+    };
+    bad(
+        "cosim-xray.toml",
+        "[volume]\nsize = 16\n[render]\nmode = \"xray\"\n",
+        &[],
+        "renders \"composite\" and \"mip\"",
+    );
+    bad(
+        "cosim-big.toml",
+        "[volume]\nsize = 200\n",
+        &[],
+        "128 voxels per edge",
+    );
+    bad(
+        "cosim-odd.toml",
+        "[volume]\nsize = 18\n",
+        &[],
+        "multiple of P = 4",
+    );
+    bad(
+        "cosim-p3.toml",
+        "[volume]\nsize = 16\n",
+        &["-p", "3"],
+        "1, 4 or 8",
+    );
+}

@@ -158,7 +158,7 @@ fn dims_beyond_the_configured_rtl() {
     );
     assert_refused(
         &out,
-        &["rtl-limit.toml", "volume.size", "configured RTL", "512"],
+        &["rtl-limit.toml", "volume.size", "configured RTL", "128"],
     );
     assert!(!png.exists());
     // A file whose header says more than the model takes at all.
@@ -246,18 +246,35 @@ fn bad_knobs_and_combinations() {
 }
 
 #[test]
-fn rtl_target_prints_the_plan_then_stops() {
+fn rtl_target_cosimulates_the_frame() {
     let (out, png) = render_scene(
         "rtl",
         "[volume]\nsize = 16\n[render]\nmode = \"mip\"\n[run]\ntarget = \"both\"\n",
     );
-    assert_refused(&out, &["run.target", "not wired"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(
         stdout.contains("gradient (MIP needs no shading)"),
         "{stdout}"
     );
-    assert!(!png.exists());
+    assert!(stdout.contains("MATCH"), "{stdout}");
+    assert!(png.exists(), "target both also renders the model image");
+    let cosim = png.with_file_name(format!(
+        "{}-cosim",
+        png.file_stem().unwrap().to_string_lossy()
+    ));
+    for f in [
+        "model.png",
+        "rtl.png",
+        "model-base-plane.png",
+        "rtl-base-plane.png",
+    ] {
+        assert!(cosim.join(f).exists(), "{f}");
+    }
 }
 
 #[test]

@@ -13,6 +13,7 @@ use crate::shader::{
     ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn,
     ShaderMode, ShaderTables,
 };
+use crate::skewed::{module_of, Axis, SkewIn, SkewMem};
 use crate::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -201,6 +202,75 @@ impl FrameParams {
     pub fn samples(&self) -> usize {
         self.ni * self.nj * self.nk
     }
+}
+
+/// What a frame's sweep asked of the skewed memory (`docs/numerics/frame.md`, "Memory").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SweepAccesses {
+    /// Beams fetched from the modules (the RTL's `reads` counter).
+    pub beams_read: u64,
+    /// Beams whose block the LUT marks empty or masked: no module access, the beam reads as 0.
+    pub beams_skipped: u64,
+    /// Beams that touched some module twice in one cycle (must be 0).
+    pub conflicts: u64,
+    /// Module reads, per module.
+    pub module_reads: [u64; 16],
+}
+
+/// Issues every beam of a frame's sweep to the skewed-memory model in the frame's order (slice
+/// `s`, row `b`, beat `m`: `P` voxels along axis `i` from `i = P m`), so the model counts the
+/// frame's memory accesses and checks each beam for a module conflict, as the RTL's memory does.
+pub fn sweep_memory(params: &FrameParams, mem: &mut SkewMem) -> Result<SweepAccesses> {
+    let cfg = mem.config();
+    let p = cfg.p as usize;
+    if p > 16 || !params.ni.is_multiple_of(p) {
+        return Err(ModelError::Config(format!(
+            "frame: ni = {} is not a multiple of P = {p} (at most 16)",
+            params.ni
+        )));
+    }
+    let axis = Axis::ALL[params.axis_i];
+    let (read0, skipped0, conflicts0) = (mem.beams_read, mem.beams_skipped, mem.checker.conflicts);
+    let rd0: Vec<u32> = (0..p).map(|k| mem.counters(k).0).collect();
+    let mut module_reads = [0u64; 16];
+    for s in 0..params.nk {
+        let k = params.slice(s).k;
+        for b in 0..params.nj {
+            for m in 0..params.ni / p {
+                let mut pos = [0u32; 3];
+                pos[params.axis_i] = (m * p) as u32;
+                pos[params.axis_j] = b as u32;
+                pos[params.axis_k] = k as u32;
+                let out = mem.command(&SkewIn::read(pos, axis));
+                if out.outside {
+                    return Err(ModelError::Config(format!(
+                        "frame: beam at {pos:?} lies outside the memory's volume"
+                    )));
+                }
+                if !(out.empty || out.masked) {
+                    for i in 0..p {
+                        let mut c = pos;
+                        c[params.axis_i] += i as u32;
+                        module_reads[module_of(&cfg, c) as usize] += 1;
+                    }
+                }
+            }
+        }
+    }
+    // The model's own per-module counters wrap at 2^CntW: they agree modulo that width.
+    let mask = cfg.cnt_mask();
+    for (k, r0) in rd0.iter().enumerate() {
+        debug_assert_eq!(
+            (u64::from(*r0) + module_reads[k]) & mask,
+            u64::from(mem.counters(k).0)
+        );
+    }
+    Ok(SweepAccesses {
+        beams_read: mem.beams_read - read0,
+        beams_skipped: mem.beams_skipped - skipped0,
+        conflicts: mem.checker.conflicts - conflicts0,
+        module_reads,
+    })
 }
 
 /// The interpolation input of the sample at anchor `(a, b)` of slice `c` (frame contract).
@@ -566,6 +636,57 @@ impl BasePlane {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::skewed::{BlockLut, SkewConfig, SkewDims};
+
+    /// Every beam of a frame, at every view of the six faces and the 45-degree cases, at P = 1, 2,
+    /// 4, 8: no module conflict, each module read equally, one beam per P voxels; an empty block
+    /// costs no module access.
+    #[test]
+    fn every_beam_of_a_frame_is_conflict_free_at_each_p() {
+        let dims = [16, 24, 32];
+        let views = [
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [1.0, 0.0, 1.0],
+            [1.0 + 1e-3, 0.0, 1.0],
+            [-1.0, -1.0, 1.0],
+        ];
+        for p in [1u32, 2, 4, 8] {
+            let cfg = SkewConfig {
+                p,
+                voxel_w: 12,
+                max_dim_log2: 5,
+                block: 8,
+                read_latency: 1,
+                cnt_w: 16,
+            };
+            for v in views {
+                let lut = BlockLut::identity(dims, 8).unwrap();
+                let sd = SkewDims::new(&cfg, dims.map(|d| d as u32)).unwrap();
+                let mut mem = SkewMem::new(cfg, sd, lut).unwrap();
+                let params = FrameSetup::new(dims, [1.0; 3], DVec3::from(v), p as usize)
+                    .unwrap()
+                    .params;
+                let acc = sweep_memory(&params, &mut mem).unwrap();
+                let voxels = (dims[0] * dims[1] * dims[2]) as u64;
+                assert_eq!(acc.conflicts, 0, "P {p} view {v:?}");
+                assert_eq!(acc.beams_read, voxels / u64::from(p));
+                for k in 0..p as usize {
+                    assert_eq!(acc.module_reads[k], voxels / u64::from(p), "module {k}");
+                }
+                let mut sparse = BlockLut::identity(dims, 8).unwrap();
+                sparse.restrict_to([0, 0, 0], [8, 24, 32]);
+                let mut mem = SkewMem::new(cfg, sd, sparse.clone()).unwrap();
+                let acc = sweep_memory(&params, &mut mem).unwrap();
+                assert_eq!(acc.beams_read + acc.beams_skipped, voxels / u64::from(p));
+                assert_eq!(acc.beams_read, voxels / 2 / u64::from(p), "half the blocks");
+            }
+        }
+    }
 
     #[test]
     fn major_axis_and_ties() {

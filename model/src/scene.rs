@@ -18,10 +18,10 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-/// Largest volume edge the configured slice-order RTL supports (the frame's `MaxDim`,
-/// `docs/numerics/frame.md`); scenes that run on the RTL (`run.target = "rtl"` or `"both"`) are
-/// refused beyond it.
-pub const RTL_MAX_EDGE: usize = crate::frame::MAX_DIM;
+/// Largest volume edge of the built slice-order RTL configurations (`MaxDim` of `p1`, `p4`, `p8`
+/// in `rtl/cube5/cube5_frame.variants`; tb-rs checks the two agree); scenes that run on the RTL
+/// (`run.target = "rtl"` or `"both"`) are refused beyond it.
+pub const RTL_MAX_EDGE: usize = 128;
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]

@@ -165,7 +165,7 @@ impl SkewConfig {
         (1 << self.voxel_w) - 1
     }
 
-    fn cnt_mask(&self) -> u64 {
+    pub(crate) fn cnt_mask(&self) -> u64 {
         (1u64 << self.cnt_w) - 1
     }
 

@@ -2,6 +2,7 @@
 //! with the golden model (`cube5_model`).
 
 pub mod ffi;
+pub mod frame;
 pub mod harness;
 pub mod rtl;
 

@@ -3,6 +3,7 @@
 //! and where an ideal exists the error against the f64 reference. Markdown on stdout.
 
 mod compos;
+mod frame;
 mod gradient;
 mod scatter;
 mod shader;
@@ -30,5 +31,6 @@ pub fn run(args: BenchArgs) -> Result<()> {
     sorter::run(args.items)?;
     scatter::run(args.items)?;
     skewed::run(args.items)?;
+    frame::run(args.items)?;
     Ok(())
 }

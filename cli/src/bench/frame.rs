@@ -1,0 +1,153 @@
+//! Benchmark of cube5_frame, the slice-order machine: cycles per frame, samples per clock per
+//! pipeline against the one-sample-per-clock limit, where the cycles go, simulated cycles per
+//! second, and the golden model's speed on the same frames (docs/frame-rtl.md, "Cycle budget").
+//! The frames are driven and checked by `cube5_tb::frame`; 64^3 images are compared bit for bit.
+
+use anyhow::{anyhow, Result};
+use cube5_model::phantom::head_phantom;
+use cube5_model::skewed::BlockLut;
+use cube5_tb::frame::{as_seen, Expected, FrameBench, FrameRtl, Look, Render, OP_RENDER};
+use cube5_tb::rtl::Traffic;
+use std::rc::Rc;
+use std::time::Instant;
+
+/// One measured frame.
+struct Row {
+    p: usize,
+    n: usize,
+    samples: u64,
+    cycles: u64,
+    beats: u64,
+    flush: u64,
+    setup_pipe: u64,
+    readout: u64,
+    sim_secs: f64,
+    load_secs: f64,
+    model_secs: f64,
+    checked: bool,
+}
+
+fn measure(rtl: FrameRtl, n: usize, view: [f64; 3], check: bool) -> Result<Row> {
+    let vol = head_phantom(n, 12)?;
+    let lut = BlockLut::identity(vol.dims, rtl.block as usize)?;
+    let seen = Rc::new(as_seen(&vol, &lut)?);
+    let t = Instant::now();
+    let e = Expected::new(
+        &rtl,
+        &seen,
+        "oblique",
+        view,
+        Render::Composite,
+        &Look::default(),
+    )?;
+    let model_secs = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mut bench = FrameBench::new(rtl, &vol, &lut, 1)?;
+    bench.load(&e)?;
+    // After reset the compositing buffer clears its valid bits (4 MaxDim^2 / P cycles): wait for
+    // it with one refused command, so the measured frame is a steady-state frame.
+    bench.write(&[rtl.reg(cube5_tb::frame::REG_MODE, 3)])?;
+    bench.refused(OP_RENDER)?;
+    bench.load(&e)?;
+    let load_secs = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let (cycles, sweep) = if check {
+        let st = bench.render_and_compare(&e, &Traffic::full_speed(), 1)?;
+        (st.cycles, u64::from(st.sweep))
+    } else {
+        let pixels = (e.w * e.h) as u64;
+        let limit = 8 * e.params.samples() as u64 + 1_000_000;
+        let d = bench
+            .dut
+            .drive(&[OP_RENDER], &Traffic::full_speed(), pixels, limit)?;
+        if d.outputs.len() as u64 != pixels {
+            return Err(anyhow!(
+                "{}: {} of {pixels} pixels",
+                rtl.variant,
+                d.outputs.len()
+            ));
+        }
+        (d.stats.cycles, u64::from(d.outputs[0].value.cycles))
+    };
+    let sim_secs = t.elapsed().as_secs_f64();
+    let params = e.params;
+    let samples = params.samples() as u64;
+    let p = rtl.p as u64;
+    let (nbr, nbs) = (
+        (params.ni / rtl.p) as u64,
+        (params.ni * params.nj / rtl.p) as u64,
+    );
+    let beats = samples / p;
+    let flush = nbs + 2 * nbr + 2;
+    Ok(Row {
+        p: rtl.p,
+        n,
+        samples,
+        cycles,
+        beats,
+        flush,
+        setup_pipe: sweep - beats - flush,
+        readout: cycles - sweep,
+        sim_secs,
+        load_secs,
+        model_secs,
+        checked: check,
+    })
+}
+
+/// `n_items` bounds the volumes: 128^3 frames (2.1 M samples each) run when `n_items >= 100_000`.
+pub fn run(n_items: usize) -> Result<()> {
+    println!("## cube5_frame\n");
+    println!(
+        "One composite frame (head phantom, view (-0.37, 0.81, -1), all blocks present) per row, \
+         configurations p1/p4/p8 (MaxDim 128, default widths). Cycles from the command to the \
+         last pixel; samples/clock/pipeline = samples / (cycles * P), the limit is 1.0. 64^3 \
+         images are checked against the model bit for bit.\n"
+    );
+    println!(
+        "| P | volume | samples | cycles/frame | samples/clock/pipeline | without read-out | sweep beats | flush | set-up + pipeline | read-out | sim cycles/s | model samples/s | volume load (s) |"
+    );
+    println!(
+        "|--:|--------|--------:|-------------:|-----------------------:|-----------------:|------------:|------:|------------------:|---------:|-------------:|----------------:|----------------:|"
+    );
+    let sizes: Vec<usize> = if n_items >= 100_000 {
+        vec![64, 128]
+    } else {
+        vec![64]
+    };
+    let view = [-0.37, 0.81, -1.0];
+    for &n in &sizes {
+        for p in [1, 4, 8] {
+            let rtl = FrameRtl::with_pipelines(p).ok_or_else(|| anyhow!("no P = {p} frame"))?;
+            let r = measure(rtl, n, view, n <= 64)?;
+            let pp = r.p as f64;
+            println!(
+                "| {} | {}^3 | {} | {} | {:.3} | {:.3} | {} | {} | {} | {} | {:.2e} | {:.2e}{} | {:.1} |",
+                r.p,
+                r.n,
+                r.samples,
+                r.cycles,
+                r.samples as f64 / (r.cycles as f64 * pp),
+                r.samples as f64 / ((r.cycles - r.readout) as f64 * pp),
+                r.beats,
+                r.flush,
+                r.setup_pipe,
+                r.readout,
+                r.cycles as f64 / r.sim_secs,
+                r.samples as f64 / r.model_secs,
+                if r.checked { " (bit-exact)" } else { "" },
+                r.load_secs
+            );
+        }
+    }
+    println!();
+    println!(
+        "Where the cycles go: `sweep beats` = samples / P (one beam per clock: the limit), `flush` = \
+         ni nj / P + 2 ni / P + 2 (the voxel and sample windows' lag, docs/frame-rtl.md), `set-up + \
+         pipeline` = 3 + memory, trilin, gradient, shader, buffer and compos latencies, `read-out` \
+         = W H + 2 (one pixel per clock; a double-buffered compositing buffer would overlap it with \
+         the next frame's sweep)."
+    );
+    println!();
+    Ok(())
+}

@@ -1,0 +1,256 @@
+//! `cube5 cosim [SCENE]`: one frame of a scene through the RTL frame (`cube5_frame`, Verilator)
+//! and the golden model, compared pixel by pixel and channel by channel. Prints MATCH or the first
+//! mismatch (pixel, channel, both values, the model's sample trail of that ray), the cycles per
+//! frame and samples per clock per pipeline, and writes both base planes and both warped images.
+
+use crate::{load_scene, write_png_atomically};
+use anyhow::{anyhow, bail, Context, Result};
+use cube5_model::camera::Camera;
+use cube5_model::compos::{ComposConfig, Coxel};
+use cube5_model::frame::{self, BasePlane, FrameParams, FrameSetup};
+use cube5_model::phantom::Volume;
+use cube5_model::render::{CompositeMode, Projection};
+use cube5_model::scene::Scene;
+use cube5_model::shader::{DistantLight, Phong};
+use cube5_model::skewed::BlockLut;
+use cube5_tb::frame::{as_seen, Expected, FrameBench, FrameError, FrameRtl, Look, Render};
+use cube5_tb::rtl::Traffic;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::time::Instant;
+
+#[derive(Debug, clap::Args)]
+pub struct CosimArgs {
+    /// Scene file (TOML); omit for the embedded default scene.
+    scene: Option<PathBuf>,
+    /// Pipelines: 1, 4 or 8 (the cube5_frame configurations p1, p4, p8).
+    #[arg(short, long, default_value_t = 4)]
+    pipelines: usize,
+    /// Directory for the images (created if missing).
+    #[arg(short, long, default_value = "cube5-cosim")]
+    out_dir: PathBuf,
+    /// Seed of the DUT's random initial state (randReset).
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+}
+
+/// What a co-simulated frame showed.
+pub struct CosimResult {
+    pub matched: bool,
+}
+
+pub fn run(args: CosimArgs) -> Result<()> {
+    let scene = load_scene(args.scene.as_deref())?;
+    let origin = args
+        .scene
+        .as_ref()
+        .map_or("the default scene".to_string(), |p| p.display().to_string());
+    scene.validate(&origin)?;
+    let rtl = FrameRtl::with_pipelines(args.pipelines).ok_or_else(|| {
+        anyhow!(
+            "--pipelines {}: cube5_frame is built for 1, 4 or 8",
+            args.pipelines
+        )
+    })?;
+    let result = cosim_scene(&scene, &origin, rtl, &args.out_dir, args.seed)?;
+    if !result.matched {
+        bail!("the RTL frame differs from the model (report above)");
+    }
+    Ok(())
+}
+
+/// The scene's volume at the frame's voxel width: `v << (W - bits)` or `v >> (bits - W)`, the same
+/// integers for model and RTL.
+fn at_voxel_width(vol: &Volume, w: u32) -> Result<Volume> {
+    let data = vol
+        .data
+        .iter()
+        .map(|&v| {
+            if vol.bits <= w {
+                v << (w - vol.bits)
+            } else {
+                v >> (vol.bits - w)
+            }
+        })
+        .collect();
+    Ok(Volume::new(vol.dims, vol.spacing, w, data)?)
+}
+
+/// The scene's lights and material in the frame's axes (the reflectance map's input).
+fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
+    let lights: Vec<DistantLight> = scene
+        .lights
+        .iter()
+        .map(|l| DistantLight {
+            // The scene gives the direction light travels; the map wants the way to the light.
+            direction: l.direction.map(|c| -c),
+            intensity: (l.colour.iter().sum::<f64>() / 3.0).clamp(0.0, 4.0),
+        })
+        .collect();
+    let base = frame::frame_phong(params, &lights);
+    if scene.render.shading {
+        let m = scene.shading;
+        Phong {
+            ambient: m.ambient,
+            diffuse: m.diffuse,
+            specular: m.specular,
+            shininess: m.shininess,
+            ..base
+        }
+    } else {
+        // Unlit: the map is 1 everywhere.
+        Phong {
+            ambient: 1.0,
+            diffuse: 0.0,
+            specular: 0.0,
+            ..base
+        }
+    }
+}
+
+/// One frame of `scene` on `rtl` and on the model; prints the comparison and the figures and
+/// writes the images into `out_dir`.
+pub fn cosim_scene(
+    scene: &Scene,
+    origin: &str,
+    rtl: FrameRtl,
+    out_dir: &Path,
+    seed: u32,
+) -> Result<CosimResult> {
+    let render = match scene.render.mode {
+        CompositeMode::Composite => Render::Composite,
+        CompositeMode::Mip => Render::Mip,
+        m => bail!(
+            "{origin}: render.mode = \"{}\": cube5_frame renders \"composite\" and \"mip\"",
+            m.name()
+        ),
+    };
+    if scene.view.projection != Projection::Parallel {
+        bail!("{origin}: view.projection: cube5_frame renders parallel projections only");
+    }
+    let params_r = scene.render_params();
+    let dir = params_r.direction().context(origin.to_string())?;
+    std::fs::create_dir_all(out_dir)
+        .with_context(|| format!("output directory {}", out_dir.display()))?;
+
+    let raw = scene.build_volume()?;
+    let vol = at_voxel_width(&raw, rtl.trilin.voxel_w)?;
+    rtl.check_volume(&vol)
+        .map_err(|e| anyhow!("{origin}: volume: {e}"))?;
+    // Blocks whose voxels are all 0 are marked empty: the memory skips their beams.
+    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0)?;
+    let seen = Rc::new(as_seen(&vol, &lut)?);
+    let setup = FrameSetup::new(vol.dims, vol.spacing, dir, rtl.p)?;
+    let look = Look {
+        tf: scene.transfer_function(),
+        phong: scene_phong(scene, &setup.params),
+        early_termination: false,
+    };
+    say!(
+        "cosim: {} volume {}x{}x{} ({}-bit, as {}-bit), {} on {} ({} pipelines), view {:.4?}",
+        origin,
+        vol.dims[0],
+        vol.dims[1],
+        vol.dims[2],
+        raw.bits,
+        vol.bits,
+        scene.render.mode.name(),
+        rtl.variant,
+        rtl.p,
+        dir.to_array()
+    );
+
+    let t = Instant::now();
+    let e = Expected::new(&rtl, &seen, "scene", dir.to_array(), render, &look)?;
+    let model_secs = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mut bench = FrameBench::new(rtl, &vol, &lut, seed)?;
+    bench.load(&e)?;
+    let load_secs = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let got = bench.render(&e, &Traffic::full_speed())?;
+    let sim_secs = t.elapsed().as_secs_f64();
+    let verdict = bench.compare(&e, &got, u64::from(seed));
+
+    let samples = e.params.samples() as u64;
+    let matched = match &verdict {
+        Ok(st) => {
+            say!(
+                "MATCH: {} x {} base-plane pixels, every channel bit-exact; memory beats read {} (model = RTL), {} skipped (empty blocks), no module conflict",
+                e.w,
+                e.h,
+                st.accesses.beams_read,
+                st.accesses.beams_skipped
+            );
+            true
+        }
+        Err(FrameError::Mismatch(report)) => {
+            say!("{report}");
+            false
+        }
+        Err(other) => return Err(anyhow!("{other}")),
+    };
+    let cycles = got.cycles;
+    let sweep = got.pixels.first().map_or(0, |p| u64::from(p.cycles));
+    say!(
+        "cycles per frame {cycles} (sweep {sweep}, read-out {}); {samples} samples, {:.3} samples/clock/pipeline ({:.3} over the sweep alone; limit 1)",
+        cycles.saturating_sub(sweep),
+        samples as f64 / (cycles as f64 * rtl.p as f64),
+        samples as f64 / (sweep.max(1) as f64 * rtl.p as f64)
+    );
+    say!(
+        "simulated {:.2} Mcycles/s ({:.2} s); volume and tables loaded in {:.2} s; model {:.2e} samples/s ({:.2} s)",
+        cycles as f64 / sim_secs / 1e6,
+        sim_secs,
+        load_secs,
+        samples as f64 / model_secs,
+        model_secs
+    );
+
+    // The images: both base planes as they are, and both warped onto the scene's image.
+    let cfg = rtl.compos;
+    let model_bp = BasePlane {
+        width: e.w,
+        height: e.h,
+        coxels: e.want.clone(),
+    };
+    let mut rtl_coxels: Vec<Coxel> = got.pixels.iter().map(|p| p.coxel).collect();
+    rtl_coxels.resize(e.w * e.h, Coxel::empty(&cfg));
+    let rtl_bp = BasePlane {
+        width: e.w,
+        height: e.h,
+        coxels: rtl_coxels,
+    };
+    let camera = Camera::new(
+        dir,
+        vol.dims,
+        vol.spacing,
+        scene.image.width,
+        scene.image.height,
+    );
+    for (who, bp) in [("model", &model_bp), ("rtl", &rtl_bp)] {
+        let base = base_plane_png(bp, &cfg);
+        let path = out_dir.join(format!("{who}-base-plane.png"));
+        write_png_atomically(&base, &path)?;
+        let warped = frame::warp(
+            &e.params,
+            vol.spacing,
+            &bp.rgb(&cfg),
+            (bp.width, bp.height),
+            &camera,
+        );
+        let path2 = out_dir.join(format!("{who}.png"));
+        write_png_atomically(&warped.to_rgb8(), &path2)?;
+        say!("wrote {} and {}", path.display(), path2.display());
+    }
+    Ok(CosimResult { matched })
+}
+
+/// The base plane as an image, one pixel per coxel.
+fn base_plane_png(bp: &BasePlane, cfg: &ComposConfig) -> image::RgbImage {
+    let mut img = image::RgbImage::new(bp.width as u32, bp.height as u32);
+    for (p, c) in img.pixels_mut().zip(bp.rgb(cfg)) {
+        *p = image::Rgb(c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8));
+    }
+    img
+}

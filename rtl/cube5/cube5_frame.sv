@@ -1,0 +1,695 @@
+// cube5_frame: the Cube-5 slice-order rendering machine (patent [37]-[51], [165], [240];
+// cube3-paper §2, §5; docs/numerics/frame.md, docs/frame-rtl.md).
+//
+// A `render` command sweeps the volume held in the skewed memory (cube5_skewmem) slice by slice,
+// front to back, one beam of P voxels per clock, for the base plane and step (DX, DY) in the frame
+// registers. P pipelines each interpolate three samples per anchor (cube5_trilin: slices s-1, s, s+1
+// at slice s's weights), take the gradient on the orthogonal neighbourhood (cube5_gradient, N6),
+// shade (cube5_shader) and composite (cube5_compos) into the coxel of the sample's ray in the
+// compositing buffer (banked by ray mod P, rotated by the slice's shift). After the sweep the
+// base-plane image leaves as W x H coxels, q outer, r inner, one per output item. Every output item
+// also carries an error flag and two counters of the frame: memory beats read and sweep cycles.
+//
+// The volume, the frame registers and every table are written through the configuration port
+// (address map: docs/numerics/frame.md, "RTL configuration map"); writes that arrive while a frame
+// is being swept are ignored.
+module cube5_frame #(
+  /// Pipelines = memory modules = voxels per beat: 1, 2, 4 or 8.
+  parameter int unsigned P          = 4,
+  /// Largest volume edge, a power of two (the skewed memory holds MaxDim^3 voxels).
+  parameter int unsigned MaxDim     = 64,
+  /// Voxel, interpolation weight and sample fraction widths (cube5_trilin).
+  parameter int unsigned VoxelW     = 12,
+  parameter int unsigned WeightW    = 8,
+  parameter int unsigned FracW      = 4,
+  /// Skewed memory: block edge of the block LUT and module read latency (cube5_skewmem).
+  parameter int unsigned BlockDim   = 8,
+  parameter int unsigned MemLatency = 1,
+  /// Shader (cube5_shader).
+  parameter int unsigned ClassIdxW  = 12,
+  parameter int unsigned MagIdxW    = 4,
+  parameter int unsigned MagShift   = 10,
+  parameter int unsigned ColorW     = 8,
+  parameter int unsigned AlphaW     = 12,
+  parameter int unsigned RmLog2     = 3,
+  parameter int unsigned RmFracW    = 4,
+  parameter int unsigned DiffW      = 9,
+  parameter int unsigned SpecW      = 8,
+  /// Compositing (cube5_compos).
+  parameter int unsigned ExtraW     = 4,
+  parameter int unsigned AccW       = 20,
+  parameter int unsigned ZW         = 12
+) (
+  input  logic clk_i,
+  input  logic rst_ni,
+
+  /// Command valid.
+  input  logic in_valid_i,
+  /// The frame takes a command (idle, buffer cleared).
+  output logic in_ready_o,
+  /// op (2): 0 render; 1..3 reserved (answered by one error item).
+  input  logic [1:0] in_data_i,
+
+  /// Output item valid.
+  output logic out_valid_o,
+  /// Consumer takes the item.
+  input  logic out_ready_i,
+  /// coxel (compos packing), error (1), beats read (32), sweep cycles (32); LSB first.
+  output logic [cube5_frame_pkg::out_w(AccW, ZW, ColorW)-1:0] out_data_o,
+
+  /// Configuration write (frame registers, voxels, block LUT, shader and compositing tables).
+  input  logic cfg_valid_i,
+  input  logic [cube5_frame_pkg::CfgRegionW + cube5_frame_pkg::cfg_off_w(
+                  $clog2(MaxDim), cube5_skewmem_pkg::blk_w($clog2(MaxDim), BlockDim),
+                  cube5_shader_pkg::cfg_addr_w(ClassIdxW, RmLog2), AlphaW)-1:0] cfg_addr_i,
+  input  logic [cube5_frame_pkg::cfg_data_w(
+                  $clog2(MaxDim), VoxelW, cube5_skewmem_pkg::blk_w($clog2(MaxDim), BlockDim),
+                  cube5_shader_pkg::cfg_data_w(ColorW, AlphaW, DiffW, SpecW), AccW)-1:0] cfg_data_i
+);
+
+  // ---------------------------------------------------------------------------
+  // Widths
+  // ---------------------------------------------------------------------------
+  localparam int unsigned M        = $clog2(MaxDim);        // coordinate bits
+  localparam int unsigned DimW     = M + 1;                 // a dimension, 1 ..= MaxDim
+  localparam int unsigned LogP     = $clog2(P);
+  localparam int unsigned StepW    = cube5_frame_pkg::StepW;
+  localparam int unsigned DW       = StepW + 2;             // DX, DY: S(2.StepW)
+  localparam int unsigned TW       = DimW + StepW + 2;      // T_x(s) = s * DX
+  localparam int unsigned CntW     = cube5_frame_pkg::CntW;
+  localparam int unsigned SampleW  = cube5_pkg::sample_w(VoxelW, FracW);
+  localparam int unsigned RgbaW    = 3 * ColorW + AlphaW;
+  localparam int unsigned ChanW    = AccW + 1;              // coxel channel U(1.AccW)
+  localparam int unsigned StoreW   = 4 * ChanW + 1;         // R, G, B, A, terminated
+  localparam int unsigned CoxelW   = cube5_frame_pkg::coxel_w(AccW, ZW, ColorW);
+  localparam int unsigned CSampW   = 3 * ColorW + AlphaW + ZW + 3;  // compos sample
+  localparam int unsigned CInW     = CoxelW + CSampW;
+  localparam int unsigned BlkW     = cube5_skewmem_pkg::blk_w(M, BlockDim);
+  localparam int unsigned SkInW    = cube5_skewmem_pkg::in_w(P, VoxelW, M);
+  localparam int unsigned SkCntW   = 8;
+  localparam int unsigned SkOutW   = cube5_skewmem_pkg::out_w(P, VoxelW, SkCntW);
+  localparam int unsigned SkAddrW  = cube5_skewmem_pkg::cfg_addr_w(M, BlockDim);
+  localparam int unsigned SkDataW  = cube5_skewmem_pkg::cfg_data_w(M, BlockDim);
+  localparam int unsigned ShAddrW  = cube5_shader_pkg::cfg_addr_w(ClassIdxW, RmLog2);
+  localparam int unsigned ShDataW  = cube5_shader_pkg::cfg_data_w(ColorW, AlphaW, DiffW, SpecW);
+  localparam int unsigned CoAddrW  = AlphaW + 1;
+  localparam int unsigned CoDataW  = AccW + 1;
+  localparam int unsigned OffW     = cube5_frame_pkg::cfg_off_w(M, BlkW, ShAddrW, AlphaW);
+  localparam int unsigned RowLenW  = $clog2(MaxDim/P + 1);
+  localparam int unsigned SliceLenW = $clog2(MaxDim*MaxDim/P + 1);
+  localparam int unsigned LagW     = SliceLenW + 1;
+  localparam int unsigned TotW     = 3 * M + 1;             // beats of a frame, <= MaxDim^3 / P
+  localparam int unsigned PixW     = 2 * DimW + 1;          // W * H <= (2 MaxDim)^2
+  localparam int unsigned NbsW     = 2 * DimW;              // ni * nj
+  /// The coxel update loop: nbs - nbr - 1 >= ReuseMin (docs/frame-rtl.md, "Smallest volumes").
+  localparam int unsigned ReuseMin = cube5_frame_pkg::ReuseMin;
+
+  // Elaboration checks.
+  if (P != 1 && P != 2 && P != 4 && P != 8) begin : gen_bad_p
+    $fatal(1, "cube5_frame: P must be 1, 2, 4 or 8");
+  end
+  if (MaxDim < 8 || MaxDim > 256 || (1 << M) != MaxDim) begin : gen_bad_max_dim
+    $fatal(1, "cube5_frame: MaxDim must be a power of two, 8 ..= 256");
+  end
+  if (2 * P > MaxDim) begin : gen_bad_p_dim
+    $fatal(1, "cube5_frame: MaxDim must be at least 2 P (a row holds at least two beats)");
+  end
+  if (ZW < DimW) begin : gen_bad_zw
+    $fatal(1, "cube5_frame: ZW must hold every slice number below MaxDim (ZW >= log2(MaxDim) + 1)");
+  end
+  if (VoxelW + FracW < ClassIdxW) begin : gen_bad_class
+    $fatal(1, "cube5_frame: ClassIdxW must not exceed the sample width");
+  end
+  if (OffW + cube5_frame_pkg::CfgRegionW > 32) begin : gen_bad_cfg
+    $fatal(1, "cube5_frame: the configuration address must fit 32 bits");
+  end
+
+  // ---------------------------------------------------------------------------
+  // Configuration port: decode
+  // ---------------------------------------------------------------------------
+  typedef enum logic [2:0] {
+    StIdle, StSetup1, StSetup2, StSetup3, StSweep, StReadout, StError
+  } state_e;
+  state_e state_q, state_d;
+
+  logic [2:0]      cfg_region;
+  logic [OffW-1:0] cfg_off;
+  logic            cfg_on;
+  assign cfg_region = cfg_addr_i[OffW +: 3];
+  assign cfg_off    = cfg_addr_i[OffW-1:0];
+  assign cfg_on     = cfg_valid_i && state_q != StSetup1 && state_q != StSetup2
+                      && state_q != StSetup3 && state_q != StSweep;
+
+  logic cfg_frame, cfg_voxel, cfg_block, cfg_shader, cfg_compos;
+  assign cfg_frame  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionFrame;
+  assign cfg_voxel  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionVoxel;
+  assign cfg_block  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionBlock;
+  assign cfg_shader = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionShader;
+  assign cfg_compos = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionCompos;
+
+  // Frame registers (configuration: not reset).
+  logic [3*DimW-1:0]    dims_q;             // nx, ny, nz
+  logic [1:0]           axis_k_q;
+  logic                 k_rev_q;
+  logic signed [DW-1:0] dx_q, dy_q;
+  logic [1:0]           render_q;
+  logic                 tf2d_q;
+  logic                 we_dims, we_view, we_dx, we_dy, we_mode;
+
+  assign we_dims = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegDims);
+  assign we_view = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegView);
+  assign we_dx   = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegDx);
+  assign we_dy   = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegDy);
+  assign we_mode = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegMode);
+
+  always_ff @(posedge clk_i) begin
+    if (we_dims) dims_q <= cfg_data_i[0 +: 3*DimW];
+    if (we_view) {k_rev_q, axis_k_q} <= cfg_data_i[2:0];
+    if (we_dx)   dx_q <= cfg_data_i[DW-1:0];
+    if (we_dy)   dy_q <= cfg_data_i[DW-1:0];
+    if (we_mode) {tf2d_q, render_q} <= cfg_data_i[2:0];
+  end
+
+  // ---------------------------------------------------------------------------
+  // Frame set-up: frame-axis dimensions, counts, base plane, checks (three cycles)
+  // ---------------------------------------------------------------------------
+  logic [DimW-1:0] nx, ny, nz;
+  assign nx = dims_q[0 +: DimW];
+  assign ny = dims_q[DimW +: DimW];
+  assign nz = dims_q[2*DimW +: DimW];
+
+  function automatic logic dim_ok(logic [DimW-1:0] n);
+    dim_ok = (n >= DimW'(P)) && (n <= DimW'(MaxDim)) && ((n & DimW'(P - 1)) == '0);
+  endfunction
+
+  logic signed [DW-1:0] one_step;
+  assign one_step = DW'(1) <<< StepW;
+
+  // Set-up 1: frame axes ((i, j) = (y, z), (x, z), (x, y) for k = x, y, z) and the register checks.
+  logic [DimW-1:0] ni_q, nj_q, nk_q, ni_d, nj_d, nk_d;
+  logic            dims_ok_q, view_ok_q, dims_ok_d, view_ok_d;
+
+  always_comb begin
+    unique case (axis_k_q)
+      2'd0:    begin ni_d = ny; nj_d = nz; nk_d = nx; end
+      2'd1:    begin ni_d = nx; nj_d = nz; nk_d = ny; end
+      default: begin ni_d = nx; nj_d = ny; nk_d = nz; end
+    endcase
+    dims_ok_d = dim_ok(nx) && dim_ok(ny) && dim_ok(nz);
+    view_ok_d = (axis_k_q != 2'd3)
+                && (render_q == cube5_frame_pkg::RenderMip
+                    || render_q == cube5_frame_pkg::RenderComposite)
+                && (dx_q <= one_step) && (dx_q >= -one_step)
+                && (dy_q <= one_step) && (dy_q >= -one_step);
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (state_q == StSetup1) begin
+      ni_q      <= ni_d;
+      nj_q      <= nj_d;
+      nk_q      <= nk_d;
+      dims_ok_q <= dims_ok_d;
+      view_ok_q <= view_ok_d;
+    end
+  end
+
+  // Set-up 2: products.
+  logic [NbsW-1:0]      nij_q, nij_d;
+  logic signed [TW-1:0] tx_last_q, ty_last_q, tx_last_d, ty_last_d;  // (nk - 1) * DX, * DY
+
+  always_comb begin
+    nij_d     = NbsW'(ni_q) * NbsW'(nj_q);
+    tx_last_d = TW'($signed({1'b0, nk_q - DimW'(1)})) * TW'(dx_q);
+    ty_last_d = TW'($signed({1'b0, nk_q - DimW'(1)})) * TW'(dy_q);
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (state_q == StSetup2) begin
+      nij_q     <= nij_d;
+      tx_last_q <= tx_last_d;
+      ty_last_q <= ty_last_d;
+    end
+  end
+
+  // Set-up 3: beats per row and slice (wires of registers that hold until the next set-up), the
+  // base plane, the flush, the volume rule.
+  logic [DimW-1:0]      nbr, max_sx_q, max_sy_q, max_sx_d, max_sy_d;
+  logic [NbsW-1:0]      nbs;
+  logic [TotW-1:0]      total_q, total_d;
+  logic [DimW:0]        w_q, h_q, w_d, h_d;
+  logic [PixW-1:0]      pixels_q;
+  logic [LagW:0]        flush_q, flush_d;
+  logic signed [TW-1:0] sx_last, sy_last;
+  logic [DimW-1:0]      abs_sx, abs_sy;
+  logic                 frame_ok;
+
+  always_comb begin
+    nbr      = ni_q >> LogP;
+    nbs      = nij_q >> LogP;
+    sx_last  = tx_last_q >>> StepW;
+    sy_last  = ty_last_q >>> StepW;
+    abs_sx   = DimW'(sx_last < 0 ? -sx_last : sx_last);
+    abs_sy   = DimW'(sy_last < 0 ? -sy_last : sy_last);
+    // W = ni + max sx - min sx; sx(s) is monotone, so the extremes are sx(0) = 0 and sx(nk-1).
+    w_d      = {1'b0, ni_q} + {1'b0, abs_sx};
+    h_d      = {1'b0, nj_q} + {1'b0, abs_sy};
+    max_sx_d = (sx_last > 0) ? DimW'(sx_last) : '0;
+    max_sy_d = (sy_last > 0) ? DimW'(sy_last) : '0;
+    total_d  = TotW'(nbs) * TotW'(nk_q);
+    flush_d  = (LagW+1)'(nbs) + (LagW+1)'(2 * nbr) + (LagW+1)'(2);
+    // Rows of at least two beats; a coxel's reuse distance nbs - nbr - 1 of at least ReuseMin.
+    frame_ok = dims_ok_q && view_ok_q && (nbr >= DimW'(2))
+               && (nbs >= NbsW'(nbr) + NbsW'(1 + ReuseMin));
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (state_q == StSetup3) begin
+      total_q  <= total_d;
+      max_sx_q <= max_sx_d;
+      max_sy_q <= max_sy_d;
+      w_q      <= w_d;
+      h_q      <= h_d;
+      flush_q  <= flush_d;
+    end
+  end
+
+  // W * H, needed only by the read-out: multiplied from the registers during the sweep.
+  logic [PixW-1:0] pixels_d;
+  assign pixels_d = PixW'(w_q) * PixW'(h_q);
+
+  always_ff @(posedge clk_i) begin
+    if (state_q == StSweep) pixels_q <= pixels_d;
+  end
+
+  // ---------------------------------------------------------------------------
+  // Control
+  // ---------------------------------------------------------------------------
+  logic in_fire, out_fire, cbuf_clear_busy, start, ro_start;
+  logic sweep_done, ro_last;
+  logic [TotW-1:0] recvd_q, recvd_d, written_q, written_d;
+  logic [LagW:0]   flushed_q, flushed_d;
+  logic [PixW-1:0] sent_q, sent_d;
+  logic [CntW-1:0] reads_q, reads_d, cycles_q, cycles_d;
+  logic            mem_beat, mem_read, flush_beat, upd_done;
+
+  assign in_ready_o = (state_q == StIdle) && !cbuf_clear_busy;
+  assign in_fire    = in_valid_i && in_ready_o;
+  assign out_fire   = out_valid_o && out_ready_i;
+  assign start      = (state_q == StSetup3) && frame_ok;
+  assign sweep_done = (state_q == StSweep) && (written_q == total_q);
+  assign ro_start   = sweep_done;
+  assign ro_last    = (state_q == StReadout) && out_fire && (sent_q == pixels_q - PixW'(1));
+
+  always_comb begin
+    state_d  = state_q;
+    unique case (state_q)
+      StIdle: if (in_fire) begin
+        state_d = (in_data_i != cube5_frame_pkg::OpRender) ? StError : StSetup1;
+      end
+      StSetup1: state_d = StSetup2;
+      StSetup2: state_d = StSetup3;
+      StSetup3: state_d = frame_ok ? StSweep : StError;
+      StSweep:   if (sweep_done) state_d = StReadout;
+      StReadout: if (ro_last) state_d = StIdle;
+      StError:   if (out_fire) state_d = StIdle;
+      default:   state_d = StIdle;
+    endcase
+  end
+
+  // Counters of the sweep.
+  always_comb begin
+    recvd_d   = recvd_q;
+    written_d = written_q;
+    flushed_d = flushed_q;
+    sent_d    = sent_q;
+    reads_d   = reads_q;
+    cycles_d  = cycles_q;
+    if (in_fire) begin
+      reads_d  = '0;
+      cycles_d = '0;
+    end else if (state_q != StIdle && state_q != StReadout && state_q != StError) begin
+      cycles_d = cycles_q + CntW'(1);
+    end
+    if (start) begin
+      recvd_d   = '0;
+      written_d = '0;
+      flushed_d = '0;
+    end else begin
+      if (mem_beat)   recvd_d   = recvd_q + TotW'(1);
+      if (flush_beat) flushed_d = flushed_q + (LagW+1)'(1);
+      if (upd_done)   written_d = written_q + TotW'(1);
+      if (mem_read)   reads_d   = reads_q + CntW'(1);
+    end
+    if (ro_start) begin
+      sent_d = '0;
+    end else if (state_q == StReadout && out_fire) begin
+      sent_d = sent_q + PixW'(1);
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      state_q   <= StIdle;
+      recvd_q   <= '0;
+      written_q <= '0;
+      flushed_q <= '0;
+      sent_q    <= '0;
+      reads_q   <= '0;
+      cycles_q  <= '0;
+    end else begin
+      state_q   <= state_d;
+      recvd_q   <= recvd_d;
+      written_q <= written_d;
+      flushed_q <= flushed_d;
+      sent_q    <= sent_d;
+      reads_q   <= reads_d;
+      cycles_q  <= cycles_d;
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Address generation and the skewed memory
+  // ---------------------------------------------------------------------------
+  logic         cmd_valid, sk_in_ready, sk_in_valid;
+  logic [M-1:0] cmd_x, cmd_y, cmd_z;
+  logic [1:0]   cmd_axis;
+  logic [SkInW-1:0] sk_in;
+
+  cube5_frame_agen #(
+    .P          (P),
+    .MaxDimLog2 (M)
+  ) u_agen (
+    .clk_i        (clk_i),
+    .rst_ni       (rst_ni),
+    .start_i      (start),
+    .nbr_i        (nbr),
+    .nj_i         (nj_q),
+    .nk_i         (nk_q),
+    .axis_k_i     (axis_k_q),
+    .k_reversed_i (k_rev_q),
+    .cmd_valid_o  (cmd_valid),
+    .cmd_ready_i  (sk_in_ready && state_q == StSweep),
+    .cmd_x_o      (cmd_x),
+    .cmd_y_o      (cmd_y),
+    .cmd_z_o      (cmd_z),
+    .cmd_axis_o   (cmd_axis)
+  );
+
+  // A voxel write (configuration region 1) or a beam read; the two never meet (no writes while
+  // sweeping). Command: op, axis, x, y, z, data, probe.
+  always_comb begin
+    if (state_q == StSweep) begin
+      sk_in_valid = cmd_valid;
+      sk_in = {{cube5_skewmem_pkg::mod_w(P){1'b0}}, {VoxelW{1'b0}}, cmd_z, cmd_y, cmd_x, cmd_axis,
+               cube5_skewmem_pkg::OpRead};
+    end else begin
+      sk_in_valid = cfg_voxel;
+      sk_in = {{cube5_skewmem_pkg::mod_w(P){1'b0}}, cfg_data_i[VoxelW-1:0], cfg_off[2*M +: M],
+               cfg_off[M +: M], cfg_off[0 +: M], 2'd0, cube5_skewmem_pkg::OpWrite};
+    end
+  end
+
+  // Skewed memory configuration: the dimensions follow the frame register; block LUT entries.
+  logic               sk_cfg_valid;
+  logic [SkAddrW-1:0] sk_cfg_addr;
+  logic [SkDataW-1:0] sk_cfg_data;
+  always_comb begin
+    sk_cfg_valid = we_dims || cfg_block;
+    sk_cfg_addr  = cfg_block ? {1'b1, cfg_off[BlkW-1:0]} : '0;
+    sk_cfg_data  = SkDataW'(cfg_data_i);
+  end
+
+  logic              sk_out_valid;
+  logic [SkOutW-1:0] sk_out;
+
+  cube5_skewmem #(
+    .P           (P),
+    .VoxelW      (VoxelW),
+    .MaxDimLog2  (M),
+    .B           (BlockDim),
+    .ReadLatency (MemLatency),
+    .CntW        (SkCntW)
+  ) u_mem (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (sk_in_valid),
+    .in_ready_o  (sk_in_ready),
+    .in_data_i   (sk_in),
+    .out_valid_o (sk_out_valid),
+    .out_ready_i (1'b1),
+    .out_data_o  (sk_out),
+    .cfg_valid_i (sk_cfg_valid),
+    .cfg_addr_i  (sk_cfg_addr),
+    .cfg_data_i  (sk_cfg_data)
+  );
+
+  // Responses: lanes, is_beam, outside, empty, masked, conflict, rd, wr.
+  logic [P*VoxelW-1:0] mem_lanes;
+  logic                rsp_beam, rsp_outside, rsp_empty, rsp_masked;
+  assign mem_lanes   = sk_out[0 +: P*VoxelW];
+  assign rsp_beam    = sk_out[P*VoxelW];
+  assign rsp_outside = sk_out[P*VoxelW + 1];
+  assign rsp_empty   = sk_out[P*VoxelW + 2];
+  assign rsp_masked  = sk_out[P*VoxelW + 3];
+  assign mem_beat    = sk_out_valid && rsp_beam && state_q == StSweep;
+  assign mem_read    = mem_beat && !rsp_outside && !rsp_empty && !rsp_masked;
+
+  // After the last memory beat: nbs + 2 nbr + 2 beats of zeros flush the windows.
+  assign flush_beat  = (state_q == StSweep) && (recvd_q == total_q) && (flushed_q != flush_q);
+
+  logic                beat_valid;
+  logic [P*VoxelW-1:0] beat;
+  assign beat_valid = mem_beat || flush_beat;
+  assign beat       = mem_beat ? mem_lanes : '0;
+
+  // ---------------------------------------------------------------------------
+  // The P pipelines
+  // ---------------------------------------------------------------------------
+  logic                   smp_valid;
+  logic [3*P*SampleW-1:0] smp;
+  // Delay-line lengths (explicitly sized wires: Yosys ignores a narrowing cast on a port).
+  logic [RowLenW-1:0]     row_len;
+  logic [SliceLenW-1:0]   slice_len;
+  logic [LagW-1:0]        lag;
+  assign row_len   = RowLenW'(nbr - DimW'(1));
+  assign slice_len = SliceLenW'(nbs - NbsW'(1));
+  assign lag       = LagW'(nbs) + LagW'(nbr) + LagW'(1);
+
+  cube5_frame_interp #(
+    .P       (P),
+    .MaxDim  (MaxDim),
+    .VoxelW  (VoxelW),
+    .WeightW (WeightW),
+    .FracW   (FracW),
+    .DimW    (DimW),
+    .TW      (TW),
+    .DW      (DW)
+  ) u_interp (
+    .clk_i        (clk_i),
+    .rst_ni       (rst_ni),
+    .start_i      (start),
+    .nbr_i        (nbr),
+    .nj_i         (nj_q),
+    .nk_i         (nk_q),
+    .dx_i         (dx_q),
+    .dy_i         (dy_q),
+    .row_len_i    (row_len),
+    .slice_len_i  (slice_len),
+    .lag_i        (lag),
+    .beat_valid_i (beat_valid),
+    .beat_i       (beat),
+    .smp_valid_o  (smp_valid),
+    .smp_o        (smp)
+  );
+
+  logic                   nb_valid;
+  logic [7*P*SampleW-1:0] nb;
+
+  cube5_frame_swin #(
+    .P       (P),
+    .MaxDim  (MaxDim),
+    .SampleW (SampleW),
+    .DimW    (DimW)
+  ) u_swin (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .start_i     (start),
+    .nbr_i       (nbr),
+    .nj_i        (nj_q),
+    .nk_i        (nk_q),
+    .row_len_i   (row_len),
+    .smp_valid_i (smp_valid),
+    .smp_i       (smp),
+    .nb_valid_o  (nb_valid),
+    .nb_o        (nb)
+  );
+
+  logic               rgba_valid;
+  logic [P*RgbaW-1:0] rgba;
+  logic               is_mip;
+  assign is_mip = (render_q == cube5_frame_pkg::RenderMip);
+
+  cube5_frame_shade #(
+    .P          (P),
+    .VoxelW     (VoxelW),
+    .FracW      (FracW),
+    .WeightW    (WeightW),
+    .ClassIdxW  (ClassIdxW),
+    .MagIdxW    (MagIdxW),
+    .MagShift   (MagShift),
+    .ColorW     (ColorW),
+    .AlphaW     (AlphaW),
+    .RmLog2     (RmLog2),
+    .RmFracW    (RmFracW),
+    .DiffW      (DiffW),
+    .SpecW      (SpecW),
+    .ShCfgAddrW (ShAddrW),
+    .ShCfgDataW (ShDataW)
+  ) u_shade (
+    .clk_i         (clk_i),
+    .rst_ni        (rst_ni),
+    .start_i       (start),
+    .shader_mode_i ({is_mip, tf2d_q}),
+    .nb_valid_i    (nb_valid),
+    .nb_i          (nb),
+    .cfg_valid_i   (cfg_shader),
+    .cfg_addr_i    (cfg_off[ShAddrW-1:0]),
+    .cfg_data_i    (cfg_data_i[ShDataW-1:0]),
+    .rgba_valid_o  (rgba_valid),
+    .rgba_o        (rgba)
+  );
+
+  // ---------------------------------------------------------------------------
+  // Compositing buffer and the compositing units (one per bank)
+  // ---------------------------------------------------------------------------
+  logic               upd_valid, cb_out_valid, ro_busy, unused_ro_busy;
+  logic [P*StoreW-1:0] upd_cox, upd_res;
+  logic [P*RgbaW-1:0] upd_pay;
+  logic [DimW-1:0]    upd_depth;
+  logic [StoreW-1:0]  cb_out_cox;
+  logic [P-1:0]       co_ready, co_valid;
+  logic [P*CoxelW-1:0] co_out;
+
+  cube5_frame_cbuf #(
+    .P      (P),
+    .MaxDim (MaxDim),
+    .PayW   (RgbaW),
+    .CoxW   (StoreW),
+    .DimW   (DimW),
+    .TW     (TW),
+    .DW     (DW)
+  ) u_cbuf (
+    .clk_i        (clk_i),
+    .rst_ni       (rst_ni),
+    .clear_busy_o (cbuf_clear_busy),
+    .start_i      (start),
+    .nbr_i        (nbr),
+    .nj_i         (nj_q),
+    .nk_i         (nk_q),
+    .dx_i         (dx_q),
+    .dy_i         (dy_q),
+    .max_sx_i     (max_sx_q),
+    .max_sy_i     (max_sy_q),
+    .in_valid_i   (rgba_valid),
+    .in_pay_i     (rgba),
+    .upd_valid_o  (upd_valid),
+    .upd_cox_o    (upd_cox),
+    .upd_pay_o    (upd_pay),
+    .upd_depth_o  (upd_depth),
+    .upd_valid_i  (co_valid[0]),
+    .upd_cox_i    (upd_res),
+    .ro_start_i   (ro_start),
+    .w_i          (w_q),
+    .h_i          (h_q),
+    .out_valid_o  (cb_out_valid),
+    .out_ready_i  (out_ready_i && state_q == StReadout),
+    .out_cox_o    (cb_out_cox),
+    .ro_busy_o    (ro_busy)
+  );
+  assign unused_ro_busy = ro_busy;
+
+  // "No geometry" depth, all ones (written out: Yosys 0.23 reads a '1 localparam as 1).
+  localparam logic [ZW-1:0] ZNone = {ZW{1'b1}};
+  logic [2:0] co_mode;
+  assign co_mode = is_mip ? cube5_frame_pkg::ComposMax : cube5_frame_pkg::ComposFrontToBack;
+
+  // Stored coxel {terminated, A, B, G, R} <-> compos coxel {terminated, gB, gG, gR, Z, A, B, G, R}.
+  function automatic logic [CoxelW-1:0] full_coxel(logic [StoreW-1:0] st);
+    full_coxel = {st[4*ChanW], {3*ColorW{1'b0}}, ZNone, st[4*ChanW-1:0]};
+  endfunction
+
+  for (genvar j = 0; j < P; j++) begin : gen_compos
+    logic [CInW-1:0] co_in;
+    assign co_in = {co_mode, ZW'(upd_depth), upd_pay[j*RgbaW +: RgbaW],
+                    full_coxel(upd_cox[j*StoreW +: StoreW])};
+
+    cube5_compos #(
+      .ColorW (ColorW),
+      .AlphaW (AlphaW),
+      .ExtraW (ExtraW),
+      .AccW   (AccW),
+      .ZW     (ZW)
+    ) u_compos (
+      .clk_i       (clk_i),
+      .rst_ni      (rst_ni),
+      .in_valid_i  (upd_valid),
+      .in_ready_o  (co_ready[j]),
+      .in_data_i   (co_in),
+      .out_valid_o (co_valid[j]),
+      .out_ready_i (1'b1),
+      .out_data_o  (co_out[j*CoxelW +: CoxelW]),
+      .cfg_valid_i (cfg_compos),
+      .cfg_addr_i  (cfg_off[CoAddrW-1:0]),
+      .cfg_data_i  (cfg_data_i[CoDataW-1:0])
+    );
+
+    // Back to the stored fields: R, G, B, A and terminated (Z and the geometry never change).
+    assign upd_res[j*StoreW +: StoreW] = {co_out[j*CoxelW + CoxelW - 1],
+                                          co_out[j*CoxelW +: 4*ChanW]};
+  end
+
+  assign upd_done = co_valid[0];
+
+  // ---------------------------------------------------------------------------
+  // Output: the base-plane image, or one error item
+  // ---------------------------------------------------------------------------
+  logic error_item;
+  assign error_item  = (state_q == StError);
+  assign out_valid_o = error_item || (state_q == StReadout && cb_out_valid);
+  assign out_data_o  = {cycles_q, reads_q, error_item,
+                        error_item ? CoxelW'(0) : full_coxel(cb_out_cox)};
+
+  logic unused_top;
+  assign unused_top = ^{co_ready, co_valid, co_out, sk_out, cfg_data_i, cfg_off};
+
+`ifndef SYNTHESIS
+  // A stalled output holds its item (STYLE.md rule 3).
+  OutputHoldsWhileStalled: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
+    else $error("cube5_frame: output changed while stalled");
+  // Voxel writes are never lost: the memory takes a command every cycle while idle.
+  VoxelWriteTaken: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      cfg_voxel |-> sk_in_ready)
+    else $error("cube5_frame: the skewed memory refused a voxel write");
+  ComposAlwaysReady: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      upd_valid |-> &co_ready)
+    else $error("cube5_frame: a compositing unit was not ready");
+  // The smallest-volume rule assumes the compositing unit's latency: check it on every item.
+  logic [cube5_frame_pkg::ComposLatency-1:0] co_pipe_q;
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      co_pipe_q <= '0;
+    end else begin
+      co_pipe_q <= {co_pipe_q[cube5_frame_pkg::ComposLatency-2:0], upd_valid};
+    end
+  end
+  ComposLatencyAsAssumed: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      co_valid[0] == co_pipe_q[cube5_frame_pkg::ComposLatency-1])
+    else $error("cube5_frame: cube5_compos no longer has latency %0d; update ComposLatency in cube5_frame_pkg and the smallest-volume rule",
+                cube5_frame_pkg::ComposLatency);
+  MemoryBeatsInSweep: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      sk_out_valid && rsp_beam |-> state_q == StSweep)
+    else $error("cube5_frame: a memory beat outside the sweep");
+`endif
+
+endmodule

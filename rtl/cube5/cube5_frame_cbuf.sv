@@ -1,0 +1,382 @@
+// cube5_frame_cbuf: the compositing buffer of the frame (patent [46], [165], [240];
+// docs/frame-rtl.md): the coxels of the base plane in P banks by ray column r mod P, read and written
+// back once per sample, and read out in row-major order after the sweep.
+//
+// The sample of lane l at anchor beat (s, b, m) belongs to base-plane pixel
+// (R, Q) = (P*m + l + offx(s), b + offy(s)) with offx(s) = max_sx - sx(s), offy(s) = max_sy - sy(s).
+// Its bank is (l + offx) mod P, so the P lanes of a beat meet P different banks, and the lane of bank
+// j is (j - offx) mod P: the beat is rotated by offx mod P on its way in. Since sx changes by at most
+// one per slice, the rotation moves by at most one lane per slice: the rotator is the barrel form of
+// the nearest-neighbour links of [46], [165]. Bank j's word is {Q, R div P} =
+// {Q, m + (offx div P) + (j < offx mod P)}: a fixed row stride of 2 MaxDim / P words.
+//
+// Per sample beat: cycle 1 reads the P coxels (a word whose valid bit is clear reads as the empty
+// coxel) and registers the rotated samples; cycle 2 offers {coxel, sample, depth} to the update units
+// (the compositing units, outside); their results are written back at the addresses kept in a FIFO.
+// A coxel is read again only in the next slice, at least nbs - nbr - 1 beats later; the frame refuses
+// volumes where that is not longer than the update loop (docs/frame-rtl.md). The read-out streams the
+// W x H coxels (q outer, r inner) and clears each word's valid bit behind it; after reset the buffer
+// clears every valid bit once (clear_busy_o) before the first frame.
+module cube5_frame_cbuf #(
+  parameter int unsigned P      = 4,
+  parameter int unsigned MaxDim = 64,
+  /// Sample bits per lane (the shaded sample).
+  parameter int unsigned PayW   = 44,
+  /// Stored coxel bits (the fields the update changes).
+  parameter int unsigned CoxW   = 85,
+  parameter int unsigned DimW   = 7,
+  parameter int unsigned TW     = 25,
+  parameter int unsigned DW     = 18
+) (
+  input  logic clk_i,
+  input  logic rst_ni,
+
+  /// The buffer is clearing its valid bits after reset (no frame may start).
+  output logic clear_busy_o,
+
+  /// New frame: position counters to the first anchor.
+  input  logic start_i,
+  input  logic [DimW-1:0] nbr_i,
+  input  logic [DimW-1:0] nj_i,
+  input  logic [DimW-1:0] nk_i,
+  input  logic signed [DW-1:0] dx_i,
+  input  logic signed [DW-1:0] dy_i,
+  /// max over the frame of sx(s) and sy(s) (>= 0).
+  input  logic [DimW-1:0] max_sx_i,
+  input  logic [DimW-1:0] max_sy_i,
+
+  /// Samples of one anchor beat, lane l at [l*PayW +: PayW].
+  input  logic in_valid_i,
+  input  logic [P*PayW-1:0] in_pay_i,
+
+  /// To the update units, bank j at [j*... +: ...]: the coxel (0 when its word was not written in
+  /// this frame), the sample, the slice number s of the beat.
+  output logic upd_valid_o,
+  output logic [P*CoxW-1:0] upd_cox_o,
+  output logic [P*PayW-1:0] upd_pay_o,
+  output logic [DimW-1:0]   upd_depth_o,
+  /// Back from the update units, in the same order.
+  input  logic upd_valid_i,
+  input  logic [P*CoxW-1:0] upd_cox_i,
+
+  /// Read-out: start it after the last write-back; W x H pixels.
+  input  logic ro_start_i,
+  input  logic [DimW:0] w_i,
+  input  logic [DimW:0] h_i,
+  output logic out_valid_o,
+  input  logic out_ready_i,
+  /// The pixel's coxel (0 when no sample reached it).
+  output logic [CoxW-1:0] out_cox_o,
+  /// The read-out has issued its last read.
+  output logic ro_busy_o
+);
+
+  localparam int unsigned StepW = cube5_frame_pkg::StepW;
+  localparam int unsigned LogP  = $clog2(P);
+  localparam int unsigned LaneW = cube5_frame_pkg::lane_w(P);
+  localparam int unsigned QW    = DimW;                // Q <= 2 MaxDim - 2
+  localparam int unsigned ColW  = DimW - LogP;         // R div P < 2 MaxDim / P
+  localparam int unsigned AddrW = QW + ColW;
+  localparam int unsigned Depth = 1 << AddrW;
+  localparam int unsigned WordW = CoxW + 1;            // valid bit on top
+  localparam int unsigned OutDepth = 4;
+
+  if (P < 1 || (1 << LogP) != P || P > MaxDim) begin : gen_bad_p
+    $fatal(1, "cube5_frame_cbuf: P must be a power of two, at most MaxDim");
+  end
+
+  // ---------------------------------------------------------------------------
+  // Clear pass after reset
+  // ---------------------------------------------------------------------------
+  logic             clr_busy_q, clr_busy_d;
+  logic [AddrW-1:0] clr_addr_q, clr_addr_d;
+
+  always_comb begin
+    clr_busy_d = clr_busy_q;
+    clr_addr_d = clr_addr_q;
+    if (clr_busy_q) begin
+      clr_addr_d = clr_addr_q + AddrW'(1);
+      if (clr_addr_q == AddrW'(Depth - 1)) clr_busy_d = 1'b0;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      clr_busy_q <= 1'b1;
+      clr_addr_q <= '0;
+    end else begin
+      clr_busy_q <= clr_busy_d;
+      clr_addr_q <= clr_addr_d;
+    end
+  end
+
+  assign clear_busy_o = clr_busy_q;
+
+  // ---------------------------------------------------------------------------
+  // Sweep: where the beat's samples go
+  // ---------------------------------------------------------------------------
+  logic [DimW-1:0] pos_m, pos_b, pos_s;
+  logic signed [TW-1:0] tx, ty;
+  logic unused_f0, unused_f1, unused_f2, unused_f3, unused_f4, unused_f5;
+
+  cube5_frame_pos #(
+    .DimW (DimW),
+    .TW   (TW),
+    .DW   (DW)
+  ) u_pos (
+    .clk_i         (clk_i),
+    .rst_ni        (rst_ni),
+    .start_i       (start_i),
+    .step_i        (in_valid_i),
+    .nbr_i         (nbr_i),
+    .nj_i          (nj_i),
+    .nk_i          (nk_i),
+    .dx_i          (dx_i),
+    .dy_i          (dy_i),
+    .m_o           (pos_m),
+    .b_o           (pos_b),
+    .s_o           (pos_s),
+    .tx_o          (tx),
+    .ty_o          (ty),
+    .first_beat_o  (unused_f0),
+    .last_beat_o   (unused_f1),
+    .first_row_o   (unused_f2),
+    .last_row_o    (unused_f3),
+    .first_slice_o (unused_f4),
+    .last_slice_o  (unused_f5)
+  );
+
+  // offx = max_sx - floor(T_x / 2^StepW), offy likewise: 0 ..= W - ni, H - nj.
+  logic signed [TW-1:0] offx_s, offy_s;
+  logic [DimW-1:0]      offx, offy, q_row;
+  assign offx_s = TW'($signed({1'b0, max_sx_i})) - (tx >>> StepW);
+  assign offy_s = TW'($signed({1'b0, max_sy_i})) - (ty >>> StepW);
+  assign offx   = DimW'(offx_s);
+  assign offy   = DimW'(offy_s);
+  assign q_row  = pos_b + offy;
+
+  logic [LaneW-1:0] rot;        // offx mod P
+  logic [DimW-1:0]  col_base;   // m + offx div P
+  if (P > 1) begin : gen_rot
+    assign rot = offx[LogP-1:0];
+  end else begin : gen_no_rot
+    assign rot = '0;
+  end
+  assign col_base = pos_m + (offx >> LogP);
+
+  logic [P*AddrW-1:0] sw_addr;  // bank j's word for this beat
+  logic [P*PayW-1:0]  pay_rot;  // bank j's sample
+  logic               unused_col;
+
+  if (P > 1) begin : gen_rotate
+    // Bank j serves lane (j - rot) mod P; below rot it holds the next word of the row.
+    always_comb begin
+      unused_col = 1'b0;
+      for (int unsigned j = 0; j < P; j++) begin
+        logic [DimW-1:0]  col;
+        logic [LaneW-1:0] lane;
+        col  = col_base + ((LaneW'(j) < rot) ? DimW'(1) : DimW'(0));
+        lane = LaneW'(j) - rot;
+        sw_addr[j*AddrW +: AddrW] = {q_row[QW-1:0], col[ColW-1:0]};
+        pay_rot[j*PayW +: PayW]   = in_pay_i[lane*PayW +: PayW];
+        unused_col ^= ^col[DimW-1:ColW];
+      end
+    end
+  end else begin : gen_single
+    assign sw_addr    = {q_row[QW-1:0], col_base[ColW-1:0]};
+    assign pay_rot    = in_pay_i;
+    assign unused_col = ^rot;
+  end
+
+  // Write-back addresses wait for the update units' results.
+  logic [P*AddrW-1:0] wb_addr;
+  logic               unused_wb_empty, unused_wb_full;
+
+  cube5_frame_fifo #(
+    .Width (P * AddrW),
+    .Depth (8)
+  ) u_wb_addr (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .clear_i (start_i),
+    .push_i  (in_valid_i),
+    .d_i     (sw_addr),
+    .pop_i   (upd_valid_i),
+    .q_o     (wb_addr),
+    .empty_o (unused_wb_empty),
+    .full_o  (unused_wb_full)
+  );
+
+  // ---------------------------------------------------------------------------
+  // Read-out: q outer, r inner; one read per cycle while the output FIFO has room
+  // ---------------------------------------------------------------------------
+  logic             ro_busy_q, ro_busy_d;
+  logic [DimW:0]    ro_r_q, ro_r_d, ro_q_q, ro_q_d;
+  logic [2:0]       ro_cred_q, ro_cred_d;      // reads issued and not yet taken
+  logic             ro_issue, out_pop;
+  logic [AddrW-1:0] ro_addr;
+  logic [LaneW-1:0] ro_bank, ro_bank_q;
+  logic             ro_rd_q;                   // a read-out word arrives this cycle
+
+  assign ro_issue = ro_busy_q && (ro_cred_q < 3'(OutDepth));
+  assign ro_addr  = {ro_q_q[QW-1:0], ColW'(ro_r_q >> LogP)};
+  if (P > 1) begin : gen_ro_bank
+    assign ro_bank = ro_r_q[LogP-1:0];
+  end else begin : gen_ro_bank1
+    assign ro_bank = '0;
+  end
+
+  always_comb begin
+    ro_busy_d = ro_busy_q;
+    ro_r_d    = ro_r_q;
+    ro_q_d    = ro_q_q;
+    ro_cred_d = ro_cred_q + (ro_issue ? 3'd1 : 3'd0) - (out_pop ? 3'd1 : 3'd0);
+    if (ro_start_i) begin
+      ro_busy_d = 1'b1;
+      ro_r_d    = '0;
+      ro_q_d    = '0;
+    end else if (ro_issue) begin
+      if (ro_r_q + (DimW+1)'(1) < w_i) begin
+        ro_r_d = ro_r_q + (DimW+1)'(1);
+      end else begin
+        ro_r_d = '0;
+        ro_q_d = ro_q_q + (DimW+1)'(1);
+        if (ro_q_q + (DimW+1)'(1) >= h_i) ro_busy_d = 1'b0;
+      end
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      ro_busy_q <= 1'b0;
+      ro_cred_q <= '0;
+      ro_rd_q   <= 1'b0;
+      ro_r_q    <= '0;
+      ro_q_q    <= '0;
+    end else begin
+      ro_busy_q <= ro_busy_d;
+      ro_cred_q <= ro_cred_d;
+      ro_rd_q   <= ro_issue;
+      ro_r_q    <= ro_r_d;
+      ro_q_q    <= ro_q_d;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (ro_issue) ro_bank_q <= ro_bank;
+  end
+
+  assign ro_busy_o = ro_busy_q;
+
+  // ---------------------------------------------------------------------------
+  // The banks: one read and one write port each
+  // ---------------------------------------------------------------------------
+  logic [P*WordW-1:0] rd_word;
+  logic               sw_rd_q;
+  logic [P*PayW-1:0]  pay_q;
+  logic [DimW-1:0]    depth_q;
+
+  for (genvar j = 0; j < P; j++) begin : gen_bank
+    logic [WordW-1:0] mem_q [Depth];
+    logic [WordW-1:0] rd_q;
+    logic             we, re;
+    logic [AddrW-1:0] wa, ra;
+    logic [WordW-1:0] wd;
+
+    always_comb begin
+      we = 1'b0;
+      wa = clr_addr_q;
+      wd = '0;
+      if (clr_busy_q) begin
+        we = 1'b1;
+      end else if (ro_issue) begin
+        we = (ro_bank == LaneW'(j));
+        wa = ro_addr;
+      end else if (upd_valid_i) begin
+        we = 1'b1;
+        wa = wb_addr[j*AddrW +: AddrW];
+        wd = {1'b1, upd_cox_i[j*CoxW +: CoxW]};
+      end
+      re = in_valid_i || ro_issue;
+      ra = ro_issue ? ro_addr : sw_addr[j*AddrW +: AddrW];
+    end
+
+    always_ff @(posedge clk_i) begin
+      if (we) mem_q[wa] <= wd;
+    end
+
+    always_ff @(posedge clk_i) begin
+      if (re) rd_q <= mem_q[ra];
+    end
+
+    assign rd_word[j*WordW +: WordW] = rd_q;
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      sw_rd_q <= 1'b0;
+    end else begin
+      sw_rd_q <= in_valid_i;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (in_valid_i) begin
+      pay_q   <= pay_rot;
+      depth_q <= pos_s;
+    end
+  end
+
+  // A word whose valid bit is clear is the empty coxel (all stored fields 0).
+  always_comb begin
+    for (int unsigned j = 0; j < P; j++) begin
+      upd_cox_o[j*CoxW +: CoxW] = rd_word[j*WordW + CoxW] ? rd_word[j*WordW +: CoxW] : '0;
+    end
+  end
+  assign upd_valid_o = sw_rd_q;
+  assign upd_pay_o   = pay_q;
+  assign upd_depth_o = depth_q;
+
+  // ---------------------------------------------------------------------------
+  // Output FIFO of the read-out
+  // ---------------------------------------------------------------------------
+  logic [WordW-1:0] ro_word;
+  logic [CoxW-1:0]  ro_cox;
+  logic             out_empty, unused_out_full;
+
+  assign ro_word = rd_word[ro_bank_q*WordW +: WordW];
+  assign ro_cox  = ro_word[CoxW] ? ro_word[CoxW-1:0] : '0;
+
+  cube5_frame_fifo #(
+    .Width (CoxW),
+    .Depth (OutDepth)
+  ) u_out (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .clear_i (ro_start_i),
+    .push_i  (ro_rd_q),
+    .d_i     (ro_cox),
+    .pop_i   (out_pop),
+    .q_o     (out_cox_o),
+    .empty_o (out_empty),
+    .full_o  (unused_out_full)
+  );
+
+  assign out_valid_o = !out_empty;
+  assign out_pop     = out_valid_o && out_ready_i;
+
+  logic unused_cbuf;
+  assign unused_cbuf = ^{unused_f0, unused_f1, unused_f2, unused_f3, unused_f4, unused_f5,
+                         unused_wb_empty, unused_wb_full, unused_out_full, offx_s, offy_s, tx, ty,
+                         unused_col};
+
+`ifndef SYNTHESIS
+  CbufOnePhase: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      $onehot0({clr_busy_q, ro_busy_q, in_valid_i || upd_valid_i}))
+    else $error("cube5_frame_cbuf: clear, sweep and read-out overlap");
+  CbufWriteBackExpected: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      upd_valid_i |-> !unused_wb_empty)
+    else $error("cube5_frame_cbuf: a write-back without its address");
+`endif
+
+endmodule

@@ -1,0 +1,155 @@
+// gicube_scatter_norm: normalize(V) of docs/numerics/gicube_scatter.md: a vector of signed
+// integers to unit length in S(2.F), out_c = rnd(V_c y, kk + 3) with (y, kk) = rsq(sum V_c^2).
+// Seven register stages: the sum of squares, rsq (four), the products, the rounding shift.
+// The variable right shift by kk + 3 is done as a left shift by KMax - kk and a fixed rounding
+// shift by KMax + 3 (the same integer; the model shifts right directly).
+module gicube_scatter_norm #(
+  /// Bits of each input component (two's complement).
+  parameter int unsigned VW = 16,
+  /// Direction fraction bits F of the output.
+  parameter int unsigned F  = 14
+) (
+  input  logic clk_i,
+  /// Pipeline advance: every stage loads.
+  input  logic en_i,
+  /// V, component c at [c*VW +: VW].
+  input  logic [3*VW-1:0] v_i,
+
+  /// SEED table write, index and value (see gicube_scatter_rsqrt).
+  input  logic cfg_we_i,
+  input  logic [gicube_scatter_pkg::seed_idx_w(F)-1:0] cfg_idx_i,
+  input  logic [gicube_scatter_pkg::seed_frac_w(F)-1:0] cfg_seed_i,
+
+  /// normalize(V), S(2.F) components, NormLatency stages after v_i.
+  output logic [3*(F+2)-1:0] vn_o,
+  /// V was the zero vector (then vn_o is zero too).
+  output logic zero_o
+);
+
+  localparam int unsigned QW   = 2 * VW;           // sum of three squares < 2^(2 VW)
+  localparam int unsigned KMax = VW - 1;           // largest kk
+  localparam int unsigned KW   = $clog2(VW) + 1;
+  localparam int unsigned YF   = gicube_scatter_pkg::newton_frac_w(F);
+  localparam int unsigned PW   = VW + YF + 2;      // V_c * y, signed
+  localparam int unsigned SW   = PW + KMax;        // after the left shift
+  localparam int unsigned OW   = F + 2;
+
+  if (VW < 2 || VW > 32) begin : gen_bad_vw
+    $fatal(1, "gicube_scatter_norm: VW must be 2..32");
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stage 1: q = sum of squares
+  // ---------------------------------------------------------------------------
+  logic [QW-1:0] q_d;
+
+  always_comb begin
+    q_d = '0;
+    for (int unsigned c = 0; c < 3; c++) begin
+      logic signed [QW-1:0] vc;
+      vc  = {{(QW-VW){v_i[c*VW + VW-1]}}, v_i[c*VW +: VW]};
+      q_d = q_d + QW'(vc * vc);
+    end
+  end
+
+  logic [QW-1:0]   q_q;
+  logic [3*VW-1:0] v_q;
+  logic            zero_q;
+
+  always_ff @(posedge clk_i) begin
+    if (en_i) begin
+      q_q    <= q_d;
+      v_q    <= v_i;
+      zero_q <= (v_i == '0);
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stages 2-5: rsq(q); V and the zero flag wait beside it
+  // ---------------------------------------------------------------------------
+  logic [YF:0]     y;
+  logic [KW-1:0]   kk;
+  logic [YF+1:0]   m_unused;
+  logic [3*VW-1:0] v_late;
+  logic            zero_late;
+
+  gicube_scatter_rsqrt #(
+    .QW (QW),
+    .F  (F),
+    .KW (KW)
+  ) u_rsqrt (
+    .clk_i      (clk_i),
+    .en_i       (en_i),
+    .q_i        (q_q),
+    .cfg_we_i   (cfg_we_i),
+    .cfg_idx_i  (cfg_idx_i),
+    .cfg_seed_i (cfg_seed_i),
+    .y_o        (y),
+    .kk_o       (kk),
+    .m_o        (m_unused)
+  );
+
+  gicube_scatter_pipe #(
+    .W (3*VW + 1),
+    .N (gicube_scatter_pkg::RsqLatency)
+  ) u_wait (
+    .clk_i (clk_i),
+    .en_i  (en_i),
+    .d_i   ({zero_q, v_q}),
+    .q_o   ({zero_late, v_late})
+  );
+
+  // ---------------------------------------------------------------------------
+  // Stage 6: products V_c * y
+  // ---------------------------------------------------------------------------
+  logic [3*PW-1:0] prod_d, prod_q;
+  logic [KW-1:0]   kk_q;
+  logic            zero_q6;
+
+  always_comb begin
+    for (int unsigned c = 0; c < 3; c++) begin
+      logic signed [PW-1:0] vc, ys;
+      vc = {{(PW-VW){v_late[c*VW + VW-1]}}, v_late[c*VW +: VW]};
+      ys = PW'({1'b0, y});
+      prod_d[c*PW +: PW] = vc * ys;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (en_i) begin
+      prod_q  <= prod_d;
+      kk_q    <= kk;
+      zero_q6 <= zero_late;
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stage 7: out_c = rnd(prod_c, kk + 3)
+  // ---------------------------------------------------------------------------
+  logic [3*OW-1:0] out_d, out_q;
+  logic [3*SW-1:0] sum_d;  // kept whole for the unused-bit tie-off
+  logic            zero_q7;
+
+  always_comb begin
+    for (int unsigned c = 0; c < 3; c++) begin
+      logic [SW-1:0] shifted;
+      shifted = {{KMax{prod_q[c*PW + PW-1]}}, prod_q[c*PW +: PW]} << (KMax - 32'(kk_q));
+      sum_d[c*SW +: SW]  = shifted + (SW'(1) << (KMax + 2));
+      out_d[c*OW +: OW]  = sum_d[c*SW + KMax + 3 +: OW];
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (en_i) begin
+      out_q   <= out_d;
+      zero_q7 <= zero_q6;
+    end
+  end
+
+  assign vn_o   = out_q;
+  assign zero_o = zero_q7;
+
+  logic unused_norm;
+  assign unused_norm = ^{m_unused, sum_d};
+
+endmodule

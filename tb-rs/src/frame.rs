@@ -1,0 +1,887 @@
+//! Driving `cube5_frame`, the slice-order machine, against the golden model: the frame's stream
+//! and configuration formats (docs/numerics/frame.md, "RTL configuration map"), its verified
+//! configurations, the model's image of a frame, and one loaded DUT that renders a frame and
+//! compares every pixel and channel. Used by tb-rs/tests/frame.rs, `cube5 cosim` and `cube5 bench`.
+//!
+//! A stream item is a command (`render`); its outputs are the W x H coxels of the base plane, so
+//! the 1:1 `check_stream` does not apply: the volume and the tables go in through the
+//! configuration port, one command is driven with `RtlStream::drive` (expect_out = W H), and the
+//! pixels are compared with the model's image.
+
+use crate::rtl::{RtlError, RtlStream, Traffic};
+use cube5_model::bits::{BitReader, BitWriter};
+use cube5_model::compos::{self, Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut};
+use cube5_model::error::ModelError;
+use cube5_model::frame::{self, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepAccesses};
+use cube5_model::gradient::{block_index, Gradient, GradientConfig, GradientIn, GradientMode};
+use cube5_model::phantom::Volume;
+use cube5_model::render::TransferFunction;
+use cube5_model::shader::{
+    ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables,
+};
+use cube5_model::skewed::{BlockLut, SkewConfig, SkewDims, SkewMem};
+use cube5_model::trilin::{Trilin, TrilinConfig};
+use cube5_model::unit::StreamCodec;
+use std::rc::Rc;
+
+// -------------------------------------------------------------------------------------------------
+// The RTL configurations and the frame's stream and configuration formats
+// -------------------------------------------------------------------------------------------------
+
+/// One verified configuration of cube5_frame (`rtl/cube5/cube5_frame.variants`).
+#[derive(Debug, Clone, Copy)]
+pub struct FrameRtl {
+    pub variant: &'static str,
+    pub p: usize,
+    pub max_dim_log2: u32,
+    pub block: u32,
+    pub mem_latency: u32,
+    pub trilin: TrilinConfig,
+    pub gradient: GradientConfig,
+    pub shader: ShaderConfig,
+    pub compos: ComposConfig,
+}
+
+/// The shader at the narrow widths with the compositing unit's 8-bit colour.
+const SHADER_NARROW8: ShaderConfig = ShaderConfig {
+    color_w: 8,
+    ..ShaderConfig::NARROW
+};
+
+pub const P1: FrameRtl = FrameRtl {
+    variant: "cube5_frame_p1",
+    p: 1,
+    max_dim_log2: 7,
+    block: 8,
+    mem_latency: 1,
+    trilin: TrilinConfig::DEFAULT,
+    gradient: GradientConfig::DEFAULT,
+    shader: ShaderConfig::DEFAULT,
+    compos: ComposConfig::DEFAULT,
+};
+pub const P4: FrameRtl = FrameRtl {
+    variant: "cube5_frame_p4",
+    p: 4,
+    ..P1
+};
+pub const P8: FrameRtl = FrameRtl {
+    variant: "cube5_frame_p8",
+    p: 8,
+    ..P1
+};
+pub const S1: FrameRtl = FrameRtl {
+    variant: "cube5_frame_s1",
+    p: 1,
+    max_dim_log2: 3,
+    block: 4,
+    mem_latency: 1,
+    trilin: TrilinConfig::NARROW,
+    gradient: GradientConfig::NARROW,
+    shader: SHADER_NARROW8,
+    compos: ComposConfig::NARROW,
+};
+pub const S4: FrameRtl = FrameRtl {
+    variant: "cube5_frame_s4",
+    p: 4,
+    ..S1
+};
+
+/// The default-width configurations, one per pipeline count: what `cube5 cosim` can run.
+pub const BY_P: [FrameRtl; 3] = [P1, P4, P8];
+
+/// Configuration regions and frame registers.
+pub const REGION_FRAME: u32 = 0;
+pub const REGION_VOXEL: u32 = 1;
+pub const REGION_BLOCK: u32 = 2;
+pub const REGION_SHADER: u32 = 3;
+pub const REGION_COMPOS: u32 = 4;
+pub const REG_DIMS: u32 = 0;
+pub const REG_VIEW: u32 = 1;
+pub const REG_DX: u32 = 2;
+pub const REG_DY: u32 = 3;
+pub const REG_MODE: u32 = 4;
+
+/// Commands.
+pub const OP_RENDER: u32 = 0;
+
+/// Latencies of the units (trilin.md and compos.md; cube5_gradient's five register stages; the
+/// shader's and the memory's come from their model configurations). Only the cycle budget and
+/// the smallest-volume rule (compos) depend on them.
+pub const TRILIN_LATENCY: u64 = 3;
+pub const GRADIENT_LATENCY: u64 = 5;
+pub const COMPOS_LATENCY: u64 = 6;
+
+/// The frame's two renderings (docs/numerics/frame.md, "The pipeline of one sample").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Render {
+    Mip,
+    Composite,
+}
+
+impl Render {
+    fn mode(self) -> FrameMode {
+        match self {
+            Render::Mip => FrameMode::Mip,
+            Render::Composite => FrameMode::Composite,
+        }
+    }
+}
+
+/// One output item: a base-plane coxel and the frame's status.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameOut {
+    pub coxel: Coxel,
+    pub error: bool,
+    /// Memory beats the sweep read from the modules.
+    pub reads: u32,
+    /// The sweep counter: command accepted to read-out start.
+    pub cycles: u32,
+}
+
+/// Configuration-port writes: (address, data words).
+pub type ConfigWrites = Vec<(u32, Vec<u32>)>;
+
+/// What can go wrong driving a frame.
+#[derive(Debug, thiserror::Error)]
+pub enum FrameError {
+    #[error(transparent)]
+    Rtl(#[from] RtlError),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The RTL's image (or its status) differs from the model's: the full report.
+    #[error("{0}")]
+    Mismatch(String),
+}
+
+impl FrameRtl {
+    /// The default-width configuration with `p` pipelines.
+    pub fn with_pipelines(p: usize) -> Option<FrameRtl> {
+        BY_P.into_iter().find(|r| r.p == p)
+    }
+
+    pub fn max_dim(&self) -> usize {
+        1 << self.max_dim_log2
+    }
+
+    pub fn skew(&self) -> SkewConfig {
+        SkewConfig {
+            p: self.p as u32,
+            voxel_w: self.trilin.voxel_w,
+            max_dim_log2: self.max_dim_log2,
+            block: self.block,
+            read_latency: self.mem_latency,
+            cnt_w: 8,
+        }
+    }
+
+    /// Bits of a region offset: the widest region.
+    fn off_w(&self) -> u32 {
+        let m = self.max_dim_log2;
+        (3 * m)
+            .max(self.skew().blk_w())
+            .max(self.shader.cfg_addr_w())
+            .max(self.compos.alpha_w + 1)
+    }
+
+    pub fn addr(&self, region: u32, off: u32) -> u32 {
+        region << self.off_w() | off
+    }
+
+    /// One frame register, raw (tests also write values the host set-up would never produce).
+    pub fn reg(&self, r: u32, value: u32) -> (u32, Vec<u32>) {
+        (self.addr(REGION_FRAME, r), vec![value])
+    }
+
+    /// The dimensions register.
+    pub fn dims_reg(&self, dims: [u32; 3]) -> (u32, Vec<u32>) {
+        let m1 = self.max_dim_log2 + 1;
+        let mut w = BitWriter::new();
+        for d in dims {
+            w.put(u64::from(d), m1);
+        }
+        (self.addr(REGION_FRAME, REG_DIMS), w.finish(3 * m1))
+    }
+
+    /// The frame registers of one view.
+    pub fn frame_writes(
+        &self,
+        params: &FrameParams,
+        render: Render,
+        tf2d: bool,
+    ) -> Vec<(u32, Vec<u32>)> {
+        let mut dims = [0u32; 3];
+        dims[params.axis_i] = params.ni as u32;
+        dims[params.axis_j] = params.nj as u32;
+        dims[params.axis_k] = params.nk as u32;
+        let step = |d: i32| (d as u32) & ((1 << 18) - 1);
+        let render_bits = match render {
+            Render::Mip => 0,
+            Render::Composite => 1,
+        };
+        vec![
+            self.dims_reg(dims),
+            self.reg(
+                REG_VIEW,
+                params.axis_k as u32 | u32::from(params.k_reversed) << 2,
+            ),
+            self.reg(REG_DX, step(params.dx)),
+            self.reg(REG_DY, step(params.dy)),
+            self.reg(REG_MODE, render_bits | u32::from(tf2d) << 2),
+        ]
+    }
+
+    /// The skewed memory's model with this volume's dimensions and block LUT (no voxels: for
+    /// counting a sweep's accesses).
+    fn memory(&self, dims: [usize; 3], lut: &BlockLut) -> Result<SkewMem, ModelError> {
+        let skew = self.skew();
+        let sd = SkewDims::new(&skew, dims.map(|d| d as u32))?;
+        SkewMem::new(skew, sd, lut.clone())
+    }
+
+    /// The block LUT's writes (a voxel is written through its block's pointer).
+    pub fn block_writes(
+        &self,
+        dims: [usize; 3],
+        lut: &BlockLut,
+    ) -> Result<Vec<(u32, Vec<u32>)>, ModelError> {
+        let mem = self.memory(dims, lut)?;
+        let blk_mask = (1u32 << self.skew().blk_w()) - 1;
+        Ok(mem
+            .config_writes()
+            .into_iter()
+            .skip(1)
+            .map(|(a, d)| (self.addr(REGION_BLOCK, a & blk_mask), d))
+            .collect())
+    }
+
+    /// The dimensions (the memory ignores voxels outside them) and the block LUT first, then
+    /// every voxel of the volume.
+    pub fn volume_writes(
+        &self,
+        vol: &Volume,
+        lut: &BlockLut,
+    ) -> Result<Vec<(u32, Vec<u32>)>, ModelError> {
+        let m = self.max_dim_log2;
+        let [nx, ny, nz] = vol.dims;
+        let mut out = Vec::with_capacity(nx * ny * nz + 1024);
+        out.push(self.dims_reg(vol.dims.map(|d| d as u32)));
+        out.extend(self.block_writes(vol.dims, lut)?);
+        for z in 0..nz {
+            for y in 0..ny {
+                for x in 0..nx {
+                    let off = (x | y << m | z << (2 * m)) as u32;
+                    out.push((
+                        self.addr(REGION_VOXEL, off),
+                        vec![vol.get(x as i64, y as i64, z as i64)],
+                    ));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    pub fn shader_writes(&self, tables: &ShaderTables) -> Vec<(u32, Vec<u32>)> {
+        tables
+            .config_writes(&self.shader)
+            .into_iter()
+            .map(|(a, d)| (self.addr(REGION_SHADER, a), d))
+            .collect()
+    }
+
+    pub fn compos_writes(&self, lut: &OpacityLut, regs: &ComposRegs) -> Vec<(u32, Vec<u32>)> {
+        compos::config_writes(&self.compos, lut, regs)
+            .into_iter()
+            .map(|(a, d)| (self.addr(REGION_COMPOS, a), d))
+            .collect()
+    }
+
+    /// The default unit widths, the only ones `cube5_model::frame::FrameUnits` builds.
+    pub fn default_widths(&self) -> bool {
+        self.trilin == TrilinConfig::DEFAULT
+            && self.gradient == GradientConfig::DEFAULT
+            && self.shader == ShaderConfig::DEFAULT
+            && self.compos == ComposConfig::DEFAULT
+    }
+
+    /// Refuses a volume this configuration cannot hold, naming the limit.
+    pub fn check_volume(&self, vol: &Volume) -> Result<(), String> {
+        let max = self.max_dim();
+        if vol.dims.iter().any(|&d| d > max) {
+            return Err(format!(
+                "volume {:?} exceeds {}'s memory ({max} voxels per edge)",
+                vol.dims, self.variant
+            ));
+        }
+        if vol.dims.iter().any(|&d| !d.is_multiple_of(self.p)) {
+            return Err(format!(
+                "volume {:?}: every edge must be a multiple of P = {} for {}",
+                vol.dims, self.p, self.variant
+            ));
+        }
+        if vol.bits != self.trilin.voxel_w {
+            return Err(format!(
+                "volume of {}-bit voxels; {} takes {}-bit voxels",
+                vol.bits, self.variant, self.trilin.voxel_w
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl StreamCodec for FrameRtl {
+    type In = u32;
+    type Out = FrameOut;
+
+    fn in_width(&self) -> u32 {
+        2
+    }
+
+    fn out_width(&self) -> u32 {
+        self.compos.coxel_w() + 1 + 64
+    }
+
+    fn pack_in(&self, op: &u32) -> Vec<u32> {
+        let mut w = BitWriter::new();
+        w.put(u64::from(*op), 2);
+        w.finish(2)
+    }
+
+    fn unpack_out(&self, words: &[u32]) -> FrameOut {
+        let c = &self.compos;
+        let mut r = BitReader::new(words);
+        let rgba = std::array::from_fn(|_| r.get(c.acc_w + 1));
+        let z = r.get(c.z_w) as u32;
+        let geo = std::array::from_fn(|_| r.get(c.color_w) as u32);
+        let terminated = r.get_bool();
+        FrameOut {
+            coxel: Coxel {
+                rgba,
+                z,
+                geo,
+                terminated,
+            },
+            error: r.get_bool(),
+            reads: r.get(32) as u32,
+            cycles: r.get(32) as u32,
+        }
+    }
+}
+
+// -------------------------------------------------------------------------------------------------
+// The model side: the base-plane image of a frame, from the unit models along each ray
+// -------------------------------------------------------------------------------------------------
+
+/// The units of one rendering, configured as the frame contract says.
+pub struct Units {
+    pub trilin: Trilin,
+    pub gradient: Gradient,
+    pub shader: Shader,
+    pub compos: Compos,
+    pub render: Render,
+    pub tf2d: bool,
+}
+
+/// The MIP classification table of the contract: the density ramp, grey.
+pub fn density_ramp(cfg: &ShaderConfig) -> Result<ClassLut, ModelError> {
+    let top = (1u64 << cfg.class_idx_w) - 1;
+    let scale = |idx: usize, w: u32| (idx as u64 * ((1u64 << w) - 1) / top) as u32;
+    ClassLut::from_fn(cfg, |idx| {
+        let c = scale(idx, cfg.color_w);
+        Rgba {
+            r: c,
+            g: c,
+            b: c,
+            a: scale(idx, cfg.alpha_w),
+        }
+    })
+}
+
+/// The look of a rendering: transfer function and lighting (frame axes), opacity correction and
+/// early termination.
+#[derive(Debug, Clone)]
+pub struct Look {
+    pub tf: TransferFunction,
+    pub phong: Phong,
+    pub early_termination: bool,
+}
+
+impl Default for Look {
+    /// The head phantom's transfer function, two lights, no early termination.
+    fn default() -> Self {
+        Self {
+            tf: TransferFunction::head_default(),
+            phong: Phong::two_lights(),
+            early_termination: false,
+        }
+    }
+}
+
+impl Units {
+    pub fn new(
+        rtl: &FrameRtl,
+        render: Render,
+        ratio: f64,
+        look: &Look,
+    ) -> Result<Self, ModelError> {
+        let rmap = ReflectanceMap::from_lights(&rtl.shader, &look.phong)?;
+        let tables = match render {
+            Render::Mip => ShaderTables {
+                class: density_ramp(&rtl.shader)?,
+                rmap,
+            },
+            Render::Composite => ShaderTables {
+                class: ClassLut::from_transfer(&rtl.shader, &look.tf)?,
+                rmap,
+            },
+        };
+        let c = rtl.compos;
+        let (lut, regs) = match render {
+            Render::Mip => (
+                OpacityLut::new(1.0, &c)?,
+                ComposRegs {
+                    lut_bypass: true,
+                    ..ComposRegs::without_termination(&c)
+                },
+            ),
+            Render::Composite => (
+                OpacityLut::new(ratio, &c)?,
+                if look.early_termination {
+                    ComposRegs::defaults(&c)
+                } else {
+                    ComposRegs::without_termination(&c)
+                },
+            ),
+        };
+        Ok(Self {
+            trilin: Trilin::new(rtl.trilin)?,
+            gradient: Gradient::new(rtl.gradient)?,
+            shader: Shader::new(rtl.shader, tables)?,
+            compos: Compos::new(c, lut, regs)?,
+            render,
+            tf2d: false,
+        })
+    }
+
+    pub fn config_writes(&self, rtl: &FrameRtl) -> Vec<(u32, Vec<u32>)> {
+        let mut w = rtl.shader_writes(self.shader.tables());
+        w.extend(rtl.compos_writes(self.compos.lut(), &self.compos.regs()));
+        w
+    }
+
+    /// One sample's way through gradient, adapter, shader: the compositing unit's sample.
+    pub fn shaded(&self, nb: [u32; 7], s: usize) -> compos::Sample {
+        let mut samples = [0u32; 27];
+        samples[block_index(0, 0, 0)] = nb[0];
+        samples[block_index(-1, 0, 0)] = nb[1];
+        samples[block_index(1, 0, 0)] = nb[2];
+        samples[block_index(0, -1, 0)] = nb[3];
+        samples[block_index(0, 1, 0)] = nb[4];
+        samples[block_index(0, 0, -1)] = nb[5];
+        samples[block_index(0, 0, 1)] = nb[6];
+        let g = self.gradient.gradient(&GradientIn {
+            samples,
+            dx: 0,
+            dy: 0,
+            mode: GradientMode::N6,
+        });
+        let rgba = self.shader.shade(&ShaderIn {
+            sample: nb[0],
+            grad: [g.gx >> 4, g.gy >> 4, g.gz >> 4],
+            mag: g.mag >> 4,
+            mode: ShaderMode {
+                tf2d: self.tf2d,
+                unlit: self.render == Render::Mip,
+            },
+        });
+        compos::Sample {
+            rgb: [rgba.r, rgba.g, rgba.b],
+            alpha: rgba.a,
+            depth: s as u32,
+            mode: match self.render {
+                Render::Mip => ComposMode::Max,
+                Render::Composite => ComposMode::FrontToBack,
+            },
+        }
+    }
+}
+
+/// What the memory returns: the volume with the voxels of skipped blocks (empty or masked) read as
+/// 0 (docs/numerics/skewmem.md).
+pub fn as_seen(vol: &Volume, lut: &BlockLut) -> Result<Volume, ModelError> {
+    let b = lut.block as usize;
+    let [nx, ny, _] = vol.dims;
+    let mut data = vol.data.clone();
+    for (i, v) in data.iter_mut().enumerate() {
+        let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
+        let e = lut.entry([(x / b) as u32, (y / b) as u32, (z / b) as u32]);
+        if e.is_none_or(|e| e.empty || e.masked) {
+            *v = 0;
+        }
+    }
+    Volume::new(vol.dims, vol.spacing, vol.bits, data)
+}
+
+/// The base-plane image from the unit models along each ray (`frame::fold_rays`), for the widths
+/// and registers `FrameUnits` does not build (narrow widths, early termination); checked against
+/// `frame::render_base_plane` where both apply.
+pub fn model_image(
+    params: &FrameParams,
+    vol: &Volume,
+    units: &Units,
+) -> (usize, usize, Vec<Coxel>) {
+    let init = Coxel::empty(&units.compos.config());
+    frame::fold_rays(params, vol, &units.trilin, init, |cox, c, (a, b), _| {
+        let nb = frame::neighbourhood(params, vol, c, a, b, &units.trilin);
+        units.compos.step(cox, &units.shaded(nb, c.s))
+    })
+}
+
+/// The samples of ray (r, q) (base-plane pixel), for a mismatch report.
+pub fn ray_trail(params: &FrameParams, vol: &Volume, units: &Units, r: usize, q: usize) -> String {
+    let mut trail = String::new();
+    let init = Coxel::empty(&units.compos.config());
+    let _ = frame::fold_rays(params, vol, &units.trilin, init, |cox, c, (a, b), x| {
+        if params.pixel_of(c, a, b) != (r, q) {
+            return *cox;
+        }
+        let nb = frame::neighbourhood(params, vol, c, a, b, &units.trilin);
+        let smp = units.shaded(nb, c.s);
+        let next = units.compos.step(cox, &smp);
+        if trail.len() < 4000 {
+            trail.push_str(&format!(
+                "\n      slice {:3} (k {:3}) anchor ({:3}, {:3}) sample {:6} nb {:?} -> rgb {:?} a {} -> coxel {:?} a {}",
+                c.s, c.k, a, b, x, nb, smp.rgb, smp.alpha, next.rgba, next.terminated
+            ));
+        }
+        next
+    });
+    trail
+}
+
+/// One frame as the model sees it: the view, the units and the base-plane image. Independent of P.
+pub struct Expected {
+    /// The volume as the memory returns it (skipped blocks read as 0).
+    pub seen: Rc<Volume>,
+    pub view: String,
+    pub dir: [f64; 3],
+    pub params: FrameParams,
+    pub units: Units,
+    pub w: usize,
+    pub h: usize,
+    pub want: Vec<Coxel>,
+}
+
+impl Expected {
+    /// The model's image of `seen` viewed along `dir`.
+    pub fn new(
+        rtl: &FrameRtl,
+        seen: &Rc<Volume>,
+        view: &str,
+        dir: [f64; 3],
+        render: Render,
+        look: &Look,
+    ) -> Result<Self, ModelError> {
+        // The set-up is that of P = 1: the image does not depend on P (only the set-up's check
+        // that the dimensions are multiples of P does).
+        let setup = FrameSetup::new(seen.dims, seen.spacing, dir.into(), 1)?;
+        let params = setup.params;
+        let ratio = setup
+            .opacity_ratio
+            .clamp(OpacityLut::RATIO_MIN, OpacityLut::RATIO_MAX);
+        let (units, w, h, want) = if rtl.default_widths() && !look.early_termination {
+            // The model's own base plane (cube5_model::frame::render_base_plane).
+            let fu = FrameUnits::new(render.mode(), &setup, &look.tf, &look.phong)?;
+            let bp = frame::render_base_plane(&params, seen, &fu);
+            let units = Units {
+                trilin: fu.trilin,
+                gradient: fu.gradient,
+                shader: fu.shader,
+                compos: fu.compos,
+                render,
+                tf2d: false,
+            };
+            (units, bp.width, bp.height, bp.coxels)
+        } else {
+            let units = Units::new(rtl, render, ratio, look)?;
+            let (w, h, want) = model_image(&params, seen, &units);
+            (units, w, h, want)
+        };
+        Ok(Expected {
+            seen: seen.clone(),
+            view: view.to_string(),
+            dir,
+            params,
+            units,
+            w,
+            h,
+            want,
+        })
+    }
+}
+
+// -------------------------------------------------------------------------------------------------
+// Driving frames
+// -------------------------------------------------------------------------------------------------
+
+/// What one frame took.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameStats {
+    /// Cycles of the drive call: command offered to last pixel taken.
+    pub cycles: u64,
+    /// The frame's own sweep counter (set-up and sweep, command accepted to read-out start).
+    pub sweep: u32,
+    /// Cycles at which the first and the last pixel left.
+    pub first_out: u64,
+    pub last_out: u64,
+    /// The model's count of the sweep's memory accesses (equal to the RTL's, or the frame fails).
+    pub accesses: SweepAccesses,
+}
+
+/// A loaded DUT: one variant with one volume in its memory.
+pub struct FrameBench {
+    pub rtl: FrameRtl,
+    pub dut: RtlStream<FrameRtl>,
+    pub dims: [usize; 3],
+    pub lut: BlockLut,
+    /// The tables loaded last (render mode, opacity ratio, early termination): reloaded on change.
+    pub loaded: Option<(Render, u64, bool)>,
+}
+
+impl FrameBench {
+    pub fn new(
+        rtl: FrameRtl,
+        vol: &Volume,
+        lut: &BlockLut,
+        dut_seed: u32,
+    ) -> Result<Self, FrameError> {
+        let mut dut = RtlStream::new(rtl.variant, rtl, dut_seed)?;
+        for (a, d) in rtl.volume_writes(vol, lut)? {
+            dut.write_config(a, &d)?;
+        }
+        Ok(Self {
+            rtl,
+            dut,
+            dims: vol.dims,
+            lut: lut.clone(),
+            loaded: None,
+        })
+    }
+
+    pub fn write(&mut self, writes: &[(u32, Vec<u32>)]) -> Result<(), FrameError> {
+        for (a, d) in writes {
+            self.dut.write_config(*a, d)?;
+        }
+        Ok(())
+    }
+
+    /// Loads a new block LUT (same pointers: only the empty and masked flags change).
+    pub fn set_lut(&mut self, lut: &BlockLut) -> Result<(), FrameError> {
+        let writes = self.rtl.block_writes(self.dims, lut)?;
+        self.write(&writes)?;
+        self.lut = lut.clone();
+        Ok(())
+    }
+
+    /// Loads the tables and registers of a frame.
+    pub fn load(&mut self, e: &Expected) -> Result<(), FrameError> {
+        let u = &e.units;
+        let key = (
+            u.render,
+            u.compos.lut().ratio().unwrap_or(0.0).to_bits(),
+            u.compos.regs() == ComposRegs::defaults(&self.rtl.compos),
+        );
+        if self.loaded != Some(key) {
+            let w = u.config_writes(&self.rtl);
+            self.write(&w)?;
+            self.loaded = Some(key);
+        }
+        let w = self.rtl.frame_writes(&e.params, u.render, u.tf2d);
+        self.write(&w)
+    }
+
+    /// Renders one frame on the RTL and compares every pixel and channel with the model's image.
+    pub fn check(
+        &mut self,
+        e: &Expected,
+        traffic: &Traffic,
+        seed: u64,
+    ) -> Result<FrameStats, FrameError> {
+        self.load(e)?;
+        self.render_and_compare(e, traffic, seed)
+    }
+
+    /// The render command alone (frame registers already written), then the comparison.
+    pub fn render_and_compare(
+        &mut self,
+        e: &Expected,
+        traffic: &Traffic,
+        seed: u64,
+    ) -> Result<FrameStats, FrameError> {
+        let got = self.render(e, traffic)?;
+        self.compare(e, &got, seed)
+    }
+
+    /// Drives the render command until the W H pixels of `e`'s base plane are out (or a cycle
+    /// limit far beyond the frame's budget passes).
+    pub fn render(&mut self, e: &Expected, traffic: &Traffic) -> Result<Rendered, FrameError> {
+        let n = (e.w * e.h) as u64;
+        let start = self.dut.cycle();
+        let limit = 40 * (e.params.samples() as u64 + n) + 100_000;
+        let driven = self.dut.drive(&[OP_RENDER], traffic, n, limit)?;
+        Ok(Rendered {
+            pixels: driven.outputs.iter().map(|t| t.value.clone()).collect(),
+            taken_at: driven.outputs.iter().map(|t| t.cycle).collect(),
+            cycles: self.dut.cycle() - start,
+            protocol_errors: driven.stats.protocol_errors,
+            limit,
+        })
+    }
+
+    /// Compares a rendered frame with the model's: every pixel and channel, the error flag, and
+    /// the memory beats read against the model's sweep of the skewed memory (which must find no
+    /// module conflict). The first difference is reported with the ray's trail.
+    pub fn compare(
+        &self,
+        e: &Expected,
+        got: &Rendered,
+        seed: u64,
+    ) -> Result<FrameStats, FrameError> {
+        let rtl = self.rtl;
+        let mut mem = rtl.memory(self.dims, &self.lut)?;
+        let accesses = frame::sweep_memory(&e.params, &mut mem)?;
+        let ctx = || {
+            format!(
+                "{} view {} {:?}, {:?}, volume {:?}, {:?}, seed {seed}",
+                rtl.variant, e.view, e.dir, e.units.render, self.dims, e.params
+            )
+        };
+        let fail = |what: String| Err(FrameError::Mismatch(format!("{}: {what}", ctx())));
+        if accesses.conflicts != 0 {
+            return fail(format!(
+                "the model's sweep has {} beams with a module conflict",
+                accesses.conflicts
+            ));
+        }
+        if got.protocol_errors > 0 {
+            return fail("a stalled output changed".into());
+        }
+        let reads = accesses.beams_read as u32;
+        for (i, px) in got.pixels.iter().enumerate() {
+            let (r, q) = (i % e.w, i / e.w);
+            if px.error {
+                return fail(format!("pixel ({r}, {q}) carries the error flag"));
+            }
+            if px.reads != reads {
+                return fail(format!(
+                    "pixel ({r}, {q}) reports {} memory beats read, the model {reads}",
+                    px.reads
+                ));
+            }
+            if i < e.want.len() && px.coxel != e.want[i] {
+                return Err(FrameError::Mismatch(mismatch_report(
+                    &ctx(),
+                    e,
+                    PixelAt {
+                        r,
+                        q,
+                        item: i,
+                        cycle: got.taken_at[i],
+                    },
+                    &px.coxel,
+                    seed,
+                )));
+            }
+        }
+        let n = e.w * e.h;
+        if got.pixels.len() != n {
+            return fail(format!(
+                "{} of {n} pixels within {} cycles (deadlock or lost pixel)",
+                got.pixels.len(),
+                got.limit
+            ));
+        }
+        Ok(FrameStats {
+            cycles: got.cycles,
+            sweep: got.pixels[0].cycles,
+            first_out: got.taken_at[0],
+            last_out: got.taken_at[n - 1],
+            accesses,
+        })
+    }
+}
+
+/// The RTL's output of one render command.
+#[derive(Debug, Clone)]
+pub struct Rendered {
+    pub pixels: Vec<FrameOut>,
+    /// The cycle each pixel was taken.
+    pub taken_at: Vec<u64>,
+    /// Cycles from the command offered to the last pixel taken.
+    pub cycles: u64,
+    pub protocol_errors: u64,
+    pub limit: u64,
+}
+
+impl FrameBench {
+    /// Drives one command that must be refused: exactly one output item, with the error flag, and
+    /// nothing after it. (After a reset the command waits for the compositing buffer's clear
+    /// pass, 4 MaxDim^2 / P cycles.)
+    pub fn refused(&mut self, op: u32) -> Result<FrameOut, FrameError> {
+        let d = self.dut.drive(&[op], &Traffic::full_speed(), 1, 100_000)?;
+        let more = self.dut.drive(&[], &Traffic::full_speed(), 1, 200)?;
+        match (d.outputs.as_slice(), more.outputs.is_empty()) {
+            ([one], true) => Ok(one.value.clone()),
+            _ => Err(FrameError::Mismatch(format!(
+                "{}: command {op} answered {} item(s), then {} more; a refused command has one",
+                self.rtl.variant,
+                d.outputs.len(),
+                more.outputs.len()
+            ))),
+        }
+    }
+}
+
+/// Where the first differing pixel is.
+struct PixelAt {
+    r: usize,
+    q: usize,
+    item: usize,
+    cycle: u64,
+}
+
+/// The first differing pixel: where, which channel, both values, and the model's trail of the ray.
+fn mismatch_report(ctx: &str, e: &Expected, at: PixelAt, got: &Coxel, seed: u64) -> String {
+    let exp = &e.want[at.item];
+    let names = ["R", "G", "B", "A"];
+    let mut what = String::new();
+    for (ch, name) in names.iter().enumerate() {
+        if got.rgba[ch] != exp.rgba[ch] {
+            what.push_str(&format!(
+                "\n  channel {name}: rtl {} model {}",
+                got.rgba[ch], exp.rgba[ch]
+            ));
+        }
+    }
+    if got.z != exp.z || got.geo != exp.geo {
+        what.push_str(&format!(
+            "\n  Z / geometry: rtl {} {:?} model {} {:?}",
+            got.z, got.geo, exp.z, exp.geo
+        ));
+    }
+    if got.terminated != exp.terminated {
+        what.push_str(&format!(
+            "\n  terminated: rtl {} model {}",
+            got.terminated, exp.terminated
+        ));
+    }
+    format!(
+        "MISMATCH {ctx}\n  pixel (r, q) = ({}, {}) of the {} x {} base plane (output #{}, taken at cycle {}){what}\n  the model's samples of this ray (slice, anchor, sample, neighbourhood C x- x+ y- y+ B A, shaded, coxel after):{}\n  reproduce with CUBE5_SEED={seed}",
+        at.r,
+        at.q,
+        e.w,
+        e.h,
+        at.item,
+        at.cycle,
+        ray_trail(&e.params, &e.seen, &e.units, at.r, at.q)
+    )
+}

@@ -1,0 +1,688 @@
+//! Co-simulation of cube5_frame, the slice-order rendering machine (docs/numerics/frame.md,
+//! docs/frame-rtl.md), against the golden model: whole base-plane images, bit for bit. The driver
+//! (formats, configurations, the model's image, the comparison) is `cube5_tb::frame`.
+
+mod support;
+
+use cube5_model::compos::Coxel;
+use cube5_model::frame::{self, FrameMode, FrameParams, FrameSetup, FrameUnits};
+use cube5_model::phantom::{head_phantom, Volume};
+use cube5_model::render::TransferFunction;
+use cube5_model::shader::Phong;
+use cube5_model::skewed::BlockLut;
+use cube5_tb::frame::*;
+use cube5_tb::rtl::Traffic;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::rc::Rc;
+use std::time::Instant;
+use support::seed;
+
+// -------------------------------------------------------------------------------------------------
+// Volumes and views
+// -------------------------------------------------------------------------------------------------
+
+/// A non-cubic volume: two overlapping soft ellipsoids, some noise, and an empty corner (so the
+/// block LUT has empty blocks to skip).
+fn blob_volume(dims: [usize; 3], bits: u32, seed: u64) -> Volume {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let max = f64::from((1u32 << bits) - 1);
+    let [nx, ny, nz] = dims;
+    let c = [nx as f64 * 0.55, ny as f64 * 0.45, nz as f64 * 0.5];
+    let mut data = Vec::with_capacity(nx * ny * nz);
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let p = [x as f64, y as f64, z as f64];
+                let d1 = ((p[0] - c[0]) / (nx as f64 * 0.35)).powi(2)
+                    + ((p[1] - c[1]) / (ny as f64 * 0.3)).powi(2)
+                    + ((p[2] - c[2]) / (nz as f64 * 0.4)).powi(2);
+                let d2 = ((p[0] - c[0] * 0.6) / (nx as f64 * 0.15)).powi(2)
+                    + ((p[1] - c[1] * 1.4) / (ny as f64 * 0.2)).powi(2)
+                    + ((p[2] - c[2]) / (nz as f64 * 0.25)).powi(2);
+                let mut v = 0.45 * (1.0 - d1).max(0.0) + 0.6 * (1.0 - d2).max(0.0);
+                if x < nx / 4 && y < ny / 4 {
+                    v = 0.0;
+                } else if v > 0.0 {
+                    v += rng.random_range(0.0..0.08);
+                }
+                data.push((v.min(1.0) * max).round() as u16);
+            }
+        }
+    }
+    Volume::new(dims, [1.0; 3], bits, data).unwrap()
+}
+
+/// Views: the six faces, exactly 45 degrees and 45 +- 1e-3, the space diagonal, obliques.
+fn views() -> Vec<(&'static str, [f64; 3])> {
+    vec![
+        ("+z", [0.0, 0.0, 1.0]),
+        ("-z", [0.0, 0.0, -1.0]),
+        ("+x", [1.0, 0.0, 0.0]),
+        ("-x", [-1.0, 0.0, 0.0]),
+        ("+y", [0.0, 1.0, 0.0]),
+        ("-y", [0.0, -1.0, 0.0]),
+        ("45 xz", [1.0, 0.0, 1.0]),
+        ("45+1e-3 xz", [1.0 + 1e-3, 0.0, 1.0]),
+        ("45-1e-3 xz", [1.0 - 1e-3, 0.0, 1.0]),
+        ("45 -x-y", [-1.0, -1.0, 0.0]),
+        ("diagonal", [1.0, 1.0, 1.0]),
+        ("oblique z", [-0.37, 0.81, -1.0]),
+        ("oblique y", [0.6, -1.0, 0.3]),
+        ("oblique x", [0.9, 0.45, -0.2]),
+    ]
+}
+
+/// The test volumes of the acceptance list: 16^3, 32^3, 64^3 head phantoms and a 48 x 32 x 40 blob.
+fn volumes(s: u64) -> Vec<(&'static str, Volume)> {
+    vec![
+        ("head 16^3", head_phantom(16, 12).unwrap()),
+        ("head 32^3", head_phantom(32, 12).unwrap()),
+        ("head 64^3", head_phantom(64, 12).unwrap()),
+        ("blob 48x32x40", blob_volume([48, 32, 40], 12, s)),
+    ]
+}
+
+// -------------------------------------------------------------------------------------------------
+// Driving frames
+// -------------------------------------------------------------------------------------------------
+
+/// The model's image of one of the test views at the default look (head transfer function, two
+/// lights) or with early termination.
+fn expect(
+    rtl: &FrameRtl,
+    seen: &Rc<Volume>,
+    view: (&'static str, [f64; 3]),
+    render: Render,
+    et: bool,
+) -> Expected {
+    let look = Look {
+        early_termination: et,
+        ..Look::default()
+    };
+    Expected::new(rtl, seen, view.0, view.1, render, &look).unwrap()
+}
+
+/// The volume as the memory returns it.
+fn seen_of(vol: &Volume, lut: &BlockLut) -> Rc<Volume> {
+    Rc::new(as_seen(vol, lut).unwrap())
+}
+
+fn bench(rtl: FrameRtl, vol: &Volume, lut: &BlockLut, s: u64) -> FrameBench {
+    must(FrameBench::new(rtl, vol, lut, s as u32))
+}
+
+fn must<T>(r: Result<T, FrameError>) -> T {
+    r.unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Renders views of the acceptance volumes in one rendering on the configurations of `plan`
+/// (variant, volume index, view indices or all), every pixel and channel compared; back-pressure on
+/// every other frame. The model's image is computed once per volume and view and shared by the
+/// configurations (it does not depend on P).
+fn frames_bit_exact(render: Render, plan: &[(FrameRtl, usize, Option<&[usize]>)], seed_base: u64) {
+    let t0 = Instant::now();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed_base);
+    let traffic = [Traffic::full_speed(), Traffic::random(&mut rng, 0.0, 0.25)];
+    let all_views = views();
+    let all = volumes(seed_base);
+    let mut samples = 0;
+    for (vi, (vname, vol)) in all.iter().enumerate() {
+        let runs: Vec<_> = plan.iter().filter(|r| r.1 == vi).collect();
+        if runs.is_empty() {
+            continue;
+        }
+        let lut = BlockLut::from_volume(vol, runs[0].0.block as usize, 0).unwrap();
+        let seen = seen_of(vol, &lut);
+        let t = Instant::now();
+        let expected: Vec<Expected> = all_views
+            .iter()
+            .map(|v| expect(&runs[0].0, &seen, *v, render, false))
+            .collect();
+        let model_secs = t.elapsed().as_secs_f64();
+        for (rtl, _, picks) in runs {
+            let t = Instant::now();
+            let mut bench = bench(*rtl, vol, &lut, seed_base);
+            let load_secs = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let mut cycles = 0;
+            let idx: Vec<usize> =
+                picks.map_or_else(|| (0..expected.len()).collect(), |p| p.to_vec());
+            for (n, &i) in idx.iter().enumerate() {
+                let s = seed_base + 1000 * vi as u64 + i as u64;
+                let st = must(bench.check(&expected[i], &traffic[n % 2], s));
+                cycles += st.cycles;
+                samples += expected[i].params.samples();
+            }
+            let secs = t.elapsed().as_secs_f64();
+            eprintln!(
+                "{} {vname} {render:?}: {} views bit-exact, {cycles} cycles in {secs:.2} s ({:.2} Mcycles/s; volume load {load_secs:.2} s, model {model_secs:.2} s)",
+                rtl.variant,
+                idx.len(),
+                cycles as f64 / secs / 1e6
+            );
+        }
+    }
+    eprintln!(
+        "{render:?}: {samples} samples compared in {:.1} s",
+        t0.elapsed().as_secs_f64()
+    );
+}
+
+/// Views for the lighter runs: +z, exactly 45 degrees, the space diagonal, an oblique view.
+const SOME_VIEWS: &[usize] = &[0, 6, 10, 11];
+
+// -------------------------------------------------------------------------------------------------
+// Tests
+// -------------------------------------------------------------------------------------------------
+
+/// P = 1 and 4: every acceptance volume at all 14 views; P = 8: all views of the smaller volumes,
+/// four of 64^3 (MIP only), to keep the test time down.
+fn plan(render: Render) -> Vec<(FrameRtl, usize, Option<&'static [usize]>)> {
+    let mut plan = Vec::new();
+    for v in 0..4 {
+        plan.push((P1, v, None));
+        plan.push((P4, v, None));
+        if v != 2 {
+            plan.push((P8, v, None));
+        } else if render == Render::Mip {
+            plan.push((P8, v, Some(SOME_VIEWS)));
+        }
+    }
+    plan
+}
+
+#[test]
+fn mip_frames_bit_exact_p1_p4_p8() {
+    frames_bit_exact(Render::Mip, &plan(Render::Mip), seed(1));
+}
+
+#[test]
+fn composite_frames_bit_exact_p1_p4_p8() {
+    frames_bit_exact(Render::Composite, &plan(Render::Composite), seed(2));
+}
+
+/// The frame's rule for the smallest volumes (docs/frame-rtl.md): rows of two beats at least, and
+/// a coxel reuse distance of at least ComposLatency + 2 beats.
+fn accepted(p: &FrameParams, pipes: usize) -> bool {
+    p.ni >= 2 * pipes && p.ni * (p.nj - 1) / pipes >= COMPOS_LATENCY as usize + 3
+}
+
+#[test]
+fn backpressure_and_mid_frame_reset() {
+    let s = seed(3);
+    let rtl = P4;
+    let vol = blob_volume([48, 32, 40], 12, s);
+    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+    let seen = seen_of(&vol, &lut);
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let heavy = Traffic::random(&mut rng, 0.0, 0.6);
+    let mut bench = bench(rtl, &vol, &lut, s);
+    let comp = expect(
+        &rtl,
+        &seen,
+        ("oblique z", [-0.37, 0.81, -1.0]),
+        Render::Composite,
+        false,
+    );
+    let mip = expect(
+        &rtl,
+        &seen,
+        ("oblique y", [0.6, -1.0, 0.3]),
+        Render::Mip,
+        false,
+    );
+
+    // A reset in the middle of the sweep: nothing comes out, and the next frame is whole.
+    must(bench.load(&comp));
+    let cut = (comp.params.samples() / rtl.p / 2) as u64;
+    let d = bench
+        .dut
+        .drive(&[OP_RENDER], &heavy, u64::MAX, cut)
+        .unwrap();
+    assert!(d.outputs.is_empty(), "no pixel before the sweep ends");
+    bench.dut.reset();
+    must(bench.render_and_compare(&comp, &heavy, s));
+
+    // A reset in the middle of the read-out: the pixels before it were right, the next frame (a
+    // different view and rendering, so stale coxels would show) is whole.
+    let n = comp.w * comp.h;
+    let sweep = comp.params.samples() / rtl.p + comp.params.ni * comp.params.nj / rtl.p + 200;
+    let d = bench
+        .dut
+        .drive(&[OP_RENDER], &heavy, u64::MAX, (sweep + n) as u64)
+        .unwrap();
+    assert!(
+        !d.outputs.is_empty() && d.outputs.len() < n,
+        "the reset lands in the read-out ({} of {n} pixels out)",
+        d.outputs.len()
+    );
+    for (i, t) in d.outputs.iter().enumerate() {
+        assert_eq!(t.value.coxel, comp.want[i], "pixel #{i} before the reset");
+    }
+    bench.dut.reset();
+    bench.loaded = None;
+    must(bench.check(&mip, &heavy, s + 1));
+    must(bench.check(&comp, &Traffic::full_speed(), s + 2));
+    eprintln!("mid-sweep and mid-read-out resets: later frames bit-exact");
+}
+
+#[test]
+fn refused_configurations_answer_one_error_item() {
+    let s = seed(4);
+    let rtl = P4;
+    let vol = head_phantom(16, 12).unwrap();
+    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+    let seen = seen_of(&vol, &lut);
+    let mut bench = bench(rtl, &vol, &lut, s);
+    let good = expect(
+        &rtl,
+        &seen,
+        ("diagonal", [1.0, 1.0, 1.0]),
+        Render::Mip,
+        false,
+    );
+    must(bench.load(&good));
+    assert_eq!(
+        good.params.dx,
+        1 << 16,
+        "the diagonal steps exactly one voxel"
+    );
+    must(bench.render_and_compare(&good, &Traffic::full_speed(), s));
+
+    let bad: Vec<(&str, ConfigWrites)> = vec![
+        ("DX above one voxel", vec![rtl.reg(REG_DX, (1 << 16) + 1)]),
+        (
+            "DY below minus one voxel",
+            vec![rtl.reg(REG_DY, ((-(1i32 << 16) - 1) as u32) & 0x3ffff)],
+        ),
+        ("slice axis 3", vec![rtl.reg(REG_VIEW, 3)]),
+        ("render mode 2", vec![rtl.reg(REG_MODE, 2)]),
+        ("render mode 3", vec![rtl.reg(REG_MODE, 3)]),
+        (
+            "a dimension not a multiple of P",
+            vec![rtl.dims_reg([16, 18, 16])],
+        ),
+        (
+            "a dimension above MaxDim",
+            vec![rtl.dims_reg([16, 16, 132])],
+        ),
+        ("a zero dimension", vec![rtl.dims_reg([0, 16, 16])]),
+        ("rows of one beam (ni = P)", vec![rtl.dims_reg([4, 16, 16])]),
+    ];
+    for (what, writes) in &bad {
+        must(bench.load(&good));
+        must(bench.write(writes));
+        let out = must(bench.refused(OP_RENDER));
+        assert!(out.error, "{what}: refused with the error flag");
+        assert_eq!(
+            out.coxel,
+            Coxel::default(),
+            "{what}: the error item's coxel is 0"
+        );
+        eprintln!("refused: {what}");
+    }
+    for op in 1..4 {
+        must(bench.load(&good));
+        let out = must(bench.refused(op));
+        assert!(out.error, "reserved op {op} is refused");
+    }
+    // Nothing of the refusals stays behind.
+    must(bench.load(&good));
+    must(bench.render_and_compare(&good, &Traffic::full_speed(), s + 1));
+}
+
+/// A random volume of `dims` (12-bit).
+fn noise_volume(dims: [usize; 3], seed: u64) -> Volume {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let n = dims.iter().product();
+    let data = (0..n).map(|_| rng.random_range(0..4096u16)).collect();
+    Volume::new(dims, [1.0; 3], 12, data).unwrap()
+}
+
+#[test]
+fn smallest_volumes_render_and_smaller_are_refused() {
+    // The rule (docs/frame-rtl.md): ni >= 2 P and the reuse distance nbs - nbr - 1 =
+    // ni (nj - 1) / P - 1 >= ComposLatency + 2 = 8. The accepted faces below sit exactly at the
+    // bound, and DX = DY = -1 (the view (-1, -1, 1) and its mirrors) makes every coxel's reuse
+    // distance that bound.
+    let s = seed(5);
+    for (rtl, dims, ok_views, bad_views) in [
+        (
+            P1,
+            [3usize, 4, 3],
+            vec![
+                ("-1 -1 +1", [-1.0, -1.0, 1.0]),
+                ("+1 +1 -1", [1.0, 1.0, -1.0]),
+                ("diagonal", [1.0, 1.0, 1.0]),
+            ],
+            vec![("+y (ni 3, nj 3)", [0.0, 1.0, 0.0])],
+        ),
+        (
+            P1,
+            [3, 3, 3],
+            vec![],
+            vec![("-1 -1 +1", [-1.0, -1.0, 1.0]), ("+x", [1.0, 0.0, 0.0])],
+        ),
+        (
+            P4,
+            [12, 4, 4],
+            vec![("-1 -1 +1", [-1.0, -1.0, 1.0]), ("-z", [0.0, 0.0, -1.0])],
+            vec![("+x (ni 4)", [1.0, 0.0, 0.0])],
+        ),
+        (
+            P4,
+            [8, 4, 8],
+            vec![("+y (ni 8, nj 8)", [0.1, 1.0, -0.3])],
+            vec![("+z (ni 8, nj 4)", [0.0, 0.0, 1.0])],
+        ),
+    ] {
+        let vol = noise_volume(dims, s);
+        let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+        let seen = seen_of(&vol, &lut);
+        let mut bench = bench(rtl, &vol, &lut, s);
+        for render in [Render::Mip, Render::Composite] {
+            for v in &ok_views {
+                let e = expect(&rtl, &seen, *v, render, false);
+                assert!(accepted(&e.params, rtl.p));
+                must(bench.check(&e, &Traffic::full_speed(), s));
+                eprintln!(
+                    "{} {dims:?} {} {render:?}: ni {} nj {}, reuse distance {} beats: bit-exact",
+                    rtl.variant,
+                    v.0,
+                    e.params.ni,
+                    e.params.nj,
+                    e.params.ni * (e.params.nj - 1) / rtl.p - 1
+                );
+            }
+            for v in &bad_views {
+                let e = expect(&rtl, &seen, *v, render, false);
+                assert!(!accepted(&e.params, rtl.p));
+                must(bench.load(&e));
+                let out = must(bench.refused(OP_RENDER));
+                assert!(out.error, "{dims:?} {} is below the rule", v.0);
+                eprintln!(
+                    "{} {dims:?} {} {render:?}: ni {} nj {}: refused",
+                    rtl.variant, v.0, e.params.ni, e.params.nj
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn block_lut_skips_empty_blocks_and_restricts_to_a_region() {
+    let s = seed(6);
+    let rtl = P4;
+    let vol = blob_volume([48, 32, 40], 12, s);
+    let view = ("oblique x", [0.9, 0.45, -0.2]);
+    let full = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+    assert!(
+        full.skipped() > 0,
+        "the blob's empty corner makes empty blocks"
+    );
+    let mut bench = bench(rtl, &vol, &full, s);
+    let mut roi = full.clone();
+    roi.restrict_to([8, 4, 8], [40, 28, 30]);
+    let thresholded = BlockLut::from_volume(&vol, rtl.block as usize, 1200).unwrap();
+    for (what, lut) in [
+        ("empty blocks", &full),
+        ("region of interest", &roi),
+        ("threshold 1200", &thresholded),
+    ] {
+        must(bench.set_lut(lut));
+        let seen = seen_of(&vol, lut);
+        let mut accesses = None;
+        for render in [Render::Mip, Render::Composite] {
+            let e = expect(&rtl, &seen, view, render, false);
+            accesses = Some(must(bench.check(&e, &Traffic::full_speed(), s)).accesses);
+        }
+        let a = accesses.unwrap();
+        assert!(a.beams_skipped > 0, "{what}: some beams skipped");
+        eprintln!(
+            "{what}: {} of {} blocks skipped, {} of {} beats read (RTL = model); bit-exact",
+            lut.skipped(),
+            lut.entries.len(),
+            a.beams_read,
+            a.beams_read + a.beams_skipped
+        );
+    }
+}
+
+#[test]
+fn sweep_and_readout_cycles_follow_the_budget() {
+    // Set-up 3 + beats + flush (nbs + 2 nbr + 2) + the pipeline; then one pixel per clock.
+    let s = seed(7);
+    let vol = head_phantom(32, 12).unwrap();
+    for rtl in [P1, P4, P8] {
+        let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+        let seen = seen_of(&vol, &lut);
+        let mut bench = bench(rtl, &vol, &lut, s);
+        // Memory L + 2, corner register 1, trilin, window register 1, gradient, shader, buffer
+        // read 1, compos, write-back count 1.
+        let pipeline = u64::from(rtl.skew().latency())
+            + 1
+            + TRILIN_LATENCY
+            + 1
+            + GRADIENT_LATENCY
+            + rtl.shader.latency()
+            + 1
+            + COMPOS_LATENCY
+            + 1;
+        for v in [("+z", [0.0, 0.0, 1.0]), ("oblique z", [-0.37, 0.81, -1.0])] {
+            let e = expect(&rtl, &seen, v, Render::Composite, false);
+            let st = must(bench.check(&e, &Traffic::full_speed(), s));
+            let p = &e.params;
+            let (nbr, nbs) = (p.ni / rtl.p, p.ni * p.nj / rtl.p);
+            let beats = (p.samples() / rtl.p) as u64;
+            let flush = (nbs + 2 * nbr + 2) as u64;
+            assert_eq!(
+                u64::from(st.sweep) - beats - flush - 3,
+                pipeline,
+                "{} {}: sweep cycles {} = set-up 3 + beats {beats} + flush {flush} + the pipeline, \
+                 which should be the sum of the units' latencies",
+                rtl.variant,
+                v.0,
+                st.sweep
+            );
+            let n = (e.w * e.h) as u64;
+            assert_eq!(st.last_out - st.first_out + 1, n, "one pixel per clock");
+            eprintln!(
+                "{} 32^3 {}: {} cycles = set-up 3 + beats {beats} + flush {flush} + pipeline {pipeline} + read-out {n} + {}",
+                rtl.variant,
+                v.0,
+                st.cycles,
+                st.cycles - 3 - beats - flush - pipeline - n
+            );
+        }
+    }
+}
+
+#[test]
+fn narrow_configurations_s1_s4() {
+    let s = seed(8);
+    for render in [Render::Mip, Render::Composite] {
+        for (rtl, vol) in [
+            (S1, head_phantom(8, 8).unwrap()),
+            (S1, blob_volume([8, 4, 8], 8, s)),
+            (S4, head_phantom(8, 8).unwrap()),
+        ] {
+            let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+            let seen = seen_of(&vol, &lut);
+            let mut bench = bench(rtl, &vol, &lut, s);
+            let mut rng = ChaCha8Rng::seed_from_u64(s);
+            let traffic = Traffic::random(&mut rng, 0.0, 0.3);
+            let mut n = 0;
+            for v in views() {
+                let e = expect(&rtl, &seen, v, render, false);
+                if !accepted(&e.params, rtl.p) {
+                    continue; // refused by the rule; see smallest_volumes_*
+                }
+                must(bench.check(&e, &traffic, s));
+                n += 1;
+            }
+            eprintln!(
+                "{} {:?} {render:?}: {n} views bit-exact",
+                rtl.variant, vol.dims
+            );
+        }
+    }
+}
+
+#[test]
+fn gate_level_netlist_smoke() {
+    let s = seed(9);
+    let rtl = FrameRtl {
+        variant: "cube5_frame_s1_gate",
+        ..S1
+    };
+    let vol = head_phantom(8, 8).unwrap();
+    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+    let seen = seen_of(&vol, &lut);
+    let mut bench = bench(rtl, &vol, &lut, s);
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let traffic = Traffic::random(&mut rng, 0.0, 0.3);
+    for render in [Render::Mip, Render::Composite] {
+        for &i in SOME_VIEWS {
+            let e = expect(&rtl, &seen, views()[i], render, false);
+            must(bench.check(&e, &traffic, s));
+        }
+    }
+    // A reset in mid-sweep, then a whole frame.
+    let e = expect(&rtl, &seen, views()[11], Render::Composite, false);
+    must(bench.load(&e));
+    let d = bench
+        .dut
+        .drive(&[OP_RENDER], &traffic, u64::MAX, 300)
+        .unwrap();
+    assert!(d.outputs.is_empty());
+    bench.dut.reset();
+    must(bench.render_and_compare(&e, &traffic, s));
+}
+
+#[test]
+fn early_termination_flag_reaches_the_image() {
+    let s = seed(10);
+    let rtl = P4;
+    let vol = head_phantom(32, 12).unwrap();
+    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+    let seen = seen_of(&vol, &lut);
+    let mut bench = bench(rtl, &vol, &lut, s);
+    let e = expect(
+        &rtl,
+        &seen,
+        ("oblique z", [-0.37, 0.81, -1.0]),
+        Render::Composite,
+        true,
+    );
+    let terminated = e.want.iter().filter(|c| c.terminated).count();
+    assert!(terminated > 0, "some rays reach the threshold");
+    must(bench.check(&e, &Traffic::full_speed(), s));
+    eprintln!(
+        "{terminated} of {} rays terminated early; bit-exact",
+        e.want.len()
+    );
+}
+
+#[test]
+fn a_step_one_weight_lsb_off_in_the_rtl_is_reported_with_pixel_channel_and_trail() {
+    // The comparison bites on the frame's own arithmetic (slice constants, rays, rotation), not
+    // just on the units': a DY one weight LSB off in the RTL's register alone must be caught.
+    let s = seed(11);
+    let rtl = P4;
+    let vol = head_phantom(16, 12).unwrap();
+    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+    let seen = seen_of(&vol, &lut);
+    let mut bench = bench(rtl, &vol, &lut, s);
+    let e = expect(
+        &rtl,
+        &seen,
+        ("oblique z", [-0.37, 0.81, -1.0]),
+        Render::Composite,
+        false,
+    );
+    must(bench.load(&e));
+    let lsb = 1 << (16 - rtl.trilin.weight_w);
+    must(bench.write(&[rtl.reg(REG_DY, ((e.params.dy + lsb) as u32) & 0x3ffff)]));
+    let err = bench
+        .render_and_compare(&e, &Traffic::full_speed(), 4242)
+        .expect_err("a wrong step must be caught")
+        .to_string();
+    for needle in [
+        "MISMATCH",
+        "pixel (r, q)",
+        "channel",
+        "slice",
+        "anchor",
+        "CUBE5_SEED=4242",
+    ] {
+        assert!(err.contains(needle), "report lacks `{needle}`:\n{err}");
+    }
+    eprintln!("{}", &err[..err.len().min(1500)]);
+}
+
+#[test]
+fn test_side_fold_agrees_with_the_model_base_plane() {
+    // The narrow and early-termination tests compare with this file's fold of the unit models;
+    // where the model's render_base_plane applies, the two must be the same image.
+    let vol = head_phantom(32, 12).unwrap();
+    for (render, mode) in [
+        (Render::Mip, FrameMode::Mip),
+        (Render::Composite, FrameMode::Composite),
+    ] {
+        for v in [views()[6], views()[11], views()[13]] {
+            let setup = FrameSetup::new(vol.dims, vol.spacing, v.1.into(), 1).unwrap();
+            let p = setup.params;
+            let fu = FrameUnits::new(
+                mode,
+                &setup,
+                &TransferFunction::head_default(),
+                &Phong::two_lights(),
+            )
+            .unwrap();
+            let bp = frame::render_base_plane(&p, &vol, &fu);
+            let units = Units::new(&P1, render, setup.opacity_ratio, &Look::default()).unwrap();
+            let (w, h, mine) = model_image(&p, &vol, &units);
+            assert_eq!((w, h), (bp.width, bp.height));
+            assert!(mine == bp.coxels, "{render:?} {}: images differ", v.0);
+        }
+    }
+}
+
+#[test]
+fn driver_configurations_agree_with_the_variants_file() {
+    // rtl/cube5/cube5_frame.variants is the one list of configurations; the driver's constants and
+    // the scene limit restate P, MaxDim and the block edge, so they are checked against it.
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../rtl/cube5/cube5_frame.variants"
+    );
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut seen = 0;
+    for line in text.lines().filter(|l| !l.trim_start().starts_with('#')) {
+        let mut words = line.split_whitespace();
+        let Some(name) = words.next() else { continue };
+        let param = |key: &str, default: usize| {
+            line.split_whitespace()
+                .find_map(|w| w.strip_prefix(&format!("{key}=")))
+                .map_or(default, |v| v.parse::<usize>().unwrap())
+        };
+        let rtl = [P1, P4, P8, S1, S4]
+            .into_iter()
+            .find(|r| r.variant == format!("cube5_frame_{name}"))
+            .unwrap_or_else(|| panic!("variant {name} has no FrameRtl"));
+        assert_eq!(param("P", 0), rtl.p, "{name}: P");
+        assert_eq!(param("MaxDim", 0), rtl.max_dim(), "{name}: MaxDim");
+        assert_eq!(param("BlockDim", 8), rtl.block as usize, "{name}: BlockDim");
+        assert_eq!(
+            param("VoxelW", 12),
+            rtl.trilin.voxel_w as usize,
+            "{name}: VoxelW"
+        );
+        seen += 1;
+    }
+    assert_eq!(seen, 5);
+    for rtl in BY_P {
+        assert_eq!(rtl.max_dim(), cube5_model::scene::RTL_MAX_EDGE);
+    }
+}
