@@ -165,6 +165,7 @@ pub fn cosim_scene(
     let model_secs = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let mut bench = FrameBench::new(rtl, &vol, &lut, seed)?;
+    bench.skip_empty = true;
     bench.load(&e)?;
     let load_secs = t.elapsed().as_secs_f64();
     let t = Instant::now();
@@ -176,9 +177,12 @@ pub fn cosim_scene(
     let matched = match &verdict {
         Ok(st) => {
             say!(
-                "MATCH: {} x {} base-plane pixels, every channel bit-exact; memory beats read {} (model = RTL), {} skipped (empty blocks), no module conflict",
+                "MATCH: {} x {} base-plane pixels, every channel bit-exact; {} + {} of {} slices skipped (empty); memory beats read {} (model = RTL), {} not read (empty blocks), no module conflict",
                 e.w,
                 e.h,
+                st.skip.0,
+                st.skip.1,
+                e.params.nk,
                 st.accesses.beams_read,
                 st.accesses.beams_skipped
             );
@@ -192,11 +196,14 @@ pub fn cosim_scene(
     };
     let cycles = got.cycles;
     let sweep = got.pixels.first().map_or(0, |p| u64::from(p.cycles));
+    let swept = (e.params.nk - bench.skip.0 - bench.skip.1) * e.params.ni * e.params.nj;
+    let per_clock = |n: usize, c: u64| n as f64 / (c.max(1) as f64 * rtl.p as f64);
     say!(
-        "cycles per frame {cycles} (sweep {sweep}, read-out {}); {samples} samples, {:.3} samples/clock/pipeline ({:.3} over the sweep alone; limit 1)",
+        "cycles per frame {cycles} (sweep {sweep}, read-out {}); {swept} of the volume's {samples} samples swept: {:.3} samples/clock/pipeline ({:.3} over the sweep alone; limit 1); with the skipped slices, {:.3} volume samples/clock/pipeline",
         cycles.saturating_sub(sweep),
-        samples as f64 / (cycles as f64 * rtl.p as f64),
-        samples as f64 / (sweep.max(1) as f64 * rtl.p as f64)
+        per_clock(swept, cycles),
+        per_clock(swept, sweep),
+        per_clock(samples as usize, cycles)
     );
     say!(
         "simulated {:.2} Mcycles/s ({:.2} s); volume and tables loaded in {:.2} s; model {:.2e} samples/s ({:.2} s)",

@@ -13,7 +13,7 @@ use crate::shader::{
     ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn,
     ShaderMode, ShaderTables,
 };
-use crate::skewed::{module_of, Axis, SkewIn, SkewMem};
+use crate::skewed::{module_of, Axis, BlockLut, SkewIn, SkewMem};
 use crate::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -217,10 +217,45 @@ pub struct SweepAccesses {
     pub module_reads: [u64; 16],
 }
 
+/// Empty slices a sweep may skip at its front and back (`docs/numerics/frame.md`, "Skipping
+/// empty slices"): the leading and trailing slices `s` whose voxel plane `k` lies wholly in blocks
+/// the block LUT marks empty or masked (they read as 0). At least one slice is kept. Skipping them
+/// leaves every pixel unchanged when a zero sample composites as the identity (MIP; composite with
+/// a classification whose entry 0 has alpha 0): their samples are 0, and the zero rules at the
+/// ends of the sweep give the neighbouring slices the zeros they would have read.
+pub fn empty_slices(params: &FrameParams, lut: &BlockLut) -> (usize, usize) {
+    let b = lut.block as usize;
+    let empty = |s: usize| -> bool {
+        let k = params.slice(s).k;
+        let nbi = params.ni.div_ceil(b);
+        let nbj = params.nj.div_ceil(b);
+        (0..nbi).all(|bi| {
+            (0..nbj).all(|bj| {
+                let mut blk = [0u32; 3];
+                blk[params.axis_i] = bi as u32;
+                blk[params.axis_j] = bj as u32;
+                blk[params.axis_k] = (k / b) as u32;
+                lut.entry(blk).is_none_or(|e| e.empty || e.masked)
+            })
+        })
+    };
+    let front = (0..params.nk).take_while(|&s| empty(s)).count();
+    if front == params.nk {
+        return (params.nk - 1, 0);
+    }
+    let back = (0..params.nk).rev().take_while(|&s| empty(s)).count();
+    (front, back)
+}
+
 /// Issues every beam of a frame's sweep to the skewed-memory model in the frame's order (slice
 /// `s`, row `b`, beat `m`: `P` voxels along axis `i` from `i = P m`), so the model counts the
 /// frame's memory accesses and checks each beam for a module conflict, as the RTL's memory does.
-pub fn sweep_memory(params: &FrameParams, mem: &mut SkewMem) -> Result<SweepAccesses> {
+/// `skip` = (slices skipped before, after) the sweep ([`empty_slices`]; `(0, 0)` for all).
+pub fn sweep_memory(
+    params: &FrameParams,
+    skip: (usize, usize),
+    mem: &mut SkewMem,
+) -> Result<SweepAccesses> {
     let cfg = mem.config();
     let p = cfg.p as usize;
     if p > 16 || !params.ni.is_multiple_of(p) {
@@ -229,11 +264,17 @@ pub fn sweep_memory(params: &FrameParams, mem: &mut SkewMem) -> Result<SweepAcce
             params.ni
         )));
     }
+    if skip.0 + skip.1 >= params.nk {
+        return Err(ModelError::Config(format!(
+            "frame: skipping {} + {} of {} slices leaves none",
+            skip.0, skip.1, params.nk
+        )));
+    }
     let axis = Axis::ALL[params.axis_i];
     let (read0, skipped0, conflicts0) = (mem.beams_read, mem.beams_skipped, mem.checker.conflicts);
     let rd0: Vec<u32> = (0..p).map(|k| mem.counters(k).0).collect();
     let mut module_reads = [0u64; 16];
-    for s in 0..params.nk {
+    for s in skip.0..params.nk - skip.1 {
         let k = params.slice(s).k;
         for b in 0..params.nj {
             for m in 0..params.ni / p {
@@ -636,7 +677,67 @@ impl BasePlane {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::skewed::{BlockLut, SkewConfig, SkewDims};
+    use crate::skewed::{SkewConfig, SkewDims};
+
+    /// A volume whose voxels are 0 outside `lo..hi` along each axis (a noisy blob inside).
+    fn slab_volume(n: usize, lo: [usize; 3], hi: [usize; 3]) -> Volume {
+        let mut data = vec![0u16; n * n * n];
+        for z in lo[2]..hi[2] {
+            for y in lo[1]..hi[1] {
+                for x in lo[0]..hi[0] {
+                    data[x + n * (y + n * z)] = (((x * 7 + y * 13 + z * 29) % 97) * 40) as u16;
+                }
+            }
+        }
+        Volume::new([n; 3], [1.0; 3], 12, data).unwrap()
+    }
+
+    /// Skipping the empty slices before and after the sweep (leaving their samples out of the
+    /// compositing) changes no pixel, MIP and composite, at views from several faces; and the
+    /// rule counts whole empty block planes only.
+    #[test]
+    fn skipping_empty_slices_changes_no_pixel() {
+        let vol = slab_volume(32, [4, 9, 10], [27, 22, 19]);
+        let lut = BlockLut::from_volume(&vol, 8, 0).unwrap();
+        let tf = TransferFunction::head_default();
+        let mut skipped_any = false;
+        for v in [
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [0.3, -0.2, 1.0],
+            [1.0, 0.1, 0.4],
+            [-0.2, -1.0, 0.5],
+            [1.0, 0.0, 1.0],
+        ] {
+            let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), 1).unwrap();
+            let params = setup.params;
+            let (front, back) = empty_slices(&params, &lut);
+            // Block planes: z has data in 10..19 -> blocks 1, 2 (8..24): 8 slices before and after.
+            if params.axis_k == 2 {
+                assert_eq!((front, back), (8, 8), "{v:?}");
+            }
+            skipped_any |= front + back > 0;
+            for mode in [FrameMode::Mip, FrameMode::Composite] {
+                let units = FrameUnits::new(mode, &setup, &tf, &frame_phong(&params, &[])).unwrap();
+                let full = render_base_plane(&params, &vol, &units);
+                let init = Coxel::empty(&units.compos.config());
+                let (_, _, part) =
+                    fold_rays(&params, &vol, &units.trilin, init, |cox, c, (a, b), _| {
+                        if c.s < front || c.s >= params.nk - back {
+                            return *cox;
+                        }
+                        units
+                            .compos
+                            .step(cox, &units.shaded_sample(&params, &vol, c, a, b))
+                    });
+                assert!(
+                    part == full.coxels,
+                    "{mode:?} {v:?}: skipping changed the image"
+                );
+            }
+        }
+        assert!(skipped_any);
+    }
 
     /// Every beam of a frame, at every view of the six faces and the 45-degree cases, at P = 1, 2,
     /// 4, 8: no module conflict, each module read equally, one beam per P voxels; an empty block
@@ -671,7 +772,7 @@ mod tests {
                 let params = FrameSetup::new(dims, [1.0; 3], DVec3::from(v), p as usize)
                     .unwrap()
                     .params;
-                let acc = sweep_memory(&params, &mut mem).unwrap();
+                let acc = sweep_memory(&params, (0, 0), &mut mem).unwrap();
                 let voxels = (dims[0] * dims[1] * dims[2]) as u64;
                 assert_eq!(acc.conflicts, 0, "P {p} view {v:?}");
                 assert_eq!(acc.beams_read, voxels / u64::from(p));
@@ -681,7 +782,7 @@ mod tests {
                 let mut sparse = BlockLut::identity(dims, 8).unwrap();
                 sparse.restrict_to([0, 0, 0], [8, 24, 32]);
                 let mut mem = SkewMem::new(cfg, sd, sparse.clone()).unwrap();
-                let acc = sweep_memory(&params, &mut mem).unwrap();
+                let acc = sweep_memory(&params, (0, 0), &mut mem).unwrap();
                 assert_eq!(acc.beams_read + acc.beams_skipped, voxels / u64::from(p));
                 assert_eq!(acc.beams_read, voxels / 2 / u64::from(p), "half the blocks");
             }

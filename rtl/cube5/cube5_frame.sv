@@ -154,13 +154,15 @@ module cube5_frame #(
   logic signed [DW-1:0] dx_q, dy_q;
   logic [1:0]           render_q;
   logic                 tf2d_q;
-  logic                 we_dims, we_view, we_dx, we_dy, we_mode;
+  logic [2*DimW-1:0]    skip_q;             // empty slices skipped: before, after
+  logic                 we_dims, we_view, we_dx, we_dy, we_mode, we_skip;
 
   assign we_dims = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegDims);
   assign we_view = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegView);
   assign we_dx   = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegDx);
   assign we_dy   = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegDy);
   assign we_mode = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegMode);
+  assign we_skip = cfg_frame && cfg_off == OffW'(cube5_frame_pkg::RegSkip);
 
   always_ff @(posedge clk_i) begin
     if (we_dims) dims_q <= cfg_data_i[0 +: 3*DimW];
@@ -168,6 +170,7 @@ module cube5_frame #(
     if (we_dx)   dx_q <= cfg_data_i[DW-1:0];
     if (we_dy)   dy_q <= cfg_data_i[DW-1:0];
     if (we_mode) {tf2d_q, render_q} <= cfg_data_i[2:0];
+    if (we_skip) skip_q <= cfg_data_i[0 +: 2*DimW];
   end
 
   // ---------------------------------------------------------------------------
@@ -213,14 +216,30 @@ module cube5_frame #(
     end
   end
 
-  // Set-up 2: products.
+  // Set-up 2: products; the slice range of the sweep (the skipped empty slices before and after).
   logic [NbsW-1:0]      nij_q, nij_d;
   logic signed [TW-1:0] tx_last_q, ty_last_q, tx_last_d, ty_last_d;  // (nk - 1) * DX, * DY
+  logic signed [TW-1:0] tx0_q, ty0_q, tx0_d, ty0_d;                  // s_first * DX, * DY
+  logic [DimW-1:0]      skip_front, skip_back, s_first_q, s_last_q, s_first_d, s_last_d;
+  logic [DimW-1:0]      swept_q, swept_d;                          // slices swept
+  logic [DimW:0]        skipped;
+  logic                 skip_ok_q, skip_ok_d;
+
+  assign skip_front = skip_q[0 +: DimW];
+  assign skip_back  = skip_q[DimW +: DimW];
+  assign skipped    = {1'b0, skip_front} + {1'b0, skip_back};
 
   always_comb begin
     nij_d     = NbsW'(ni_q) * NbsW'(nj_q);
     tx_last_d = TW'($signed({1'b0, nk_q - DimW'(1)})) * TW'(dx_q);
     ty_last_d = TW'($signed({1'b0, nk_q - DimW'(1)})) * TW'(dy_q);
+    tx0_d     = TW'($signed({1'b0, skip_front})) * TW'(dx_q);
+    ty0_d     = TW'($signed({1'b0, skip_front})) * TW'(dy_q);
+    s_first_d = skip_front;
+    s_last_d  = nk_q - DimW'(1) - skip_back;
+    swept_d   = nk_q - skip_front - skip_back;
+    // At least one slice is swept.
+    skip_ok_d = skipped < {1'b0, nk_q};
   end
 
   always_ff @(posedge clk_i) begin
@@ -228,6 +247,12 @@ module cube5_frame #(
       nij_q     <= nij_d;
       tx_last_q <= tx_last_d;
       ty_last_q <= ty_last_d;
+      tx0_q     <= tx0_d;
+      ty0_q     <= ty0_d;
+      s_first_q <= s_first_d;
+      s_last_q  <= s_last_d;
+      swept_q   <= swept_d;
+      skip_ok_q <= skip_ok_d;
     end
   end
 
@@ -255,10 +280,10 @@ module cube5_frame #(
     h_d      = {1'b0, nj_q} + {1'b0, abs_sy};
     max_sx_d = (sx_last > 0) ? DimW'(sx_last) : '0;
     max_sy_d = (sy_last > 0) ? DimW'(sy_last) : '0;
-    total_d  = TotW'(nbs) * TotW'(nk_q);
+    total_d  = TotW'(nbs) * TotW'(swept_q);
     flush_d  = (LagW+1)'(nbs) + (LagW+1)'(2 * nbr) + (LagW+1)'(2);
     // Rows of at least two beats; a coxel's reuse distance nbs - nbr - 1 of at least ReuseMin.
-    frame_ok = dims_ok_q && view_ok_q && (nbr >= DimW'(2))
+    frame_ok = dims_ok_q && view_ok_q && skip_ok_q && (nbr >= DimW'(2))
                && (nbs >= NbsW'(nbr) + NbsW'(1 + ReuseMin));
   end
 
@@ -385,6 +410,8 @@ module cube5_frame #(
     .nbr_i        (nbr),
     .nj_i         (nj_q),
     .nk_i         (nk_q),
+    .s_first_i    (s_first_q),
+    .s_last_i     (s_last_q),
     .axis_k_i     (axis_k_q),
     .k_reversed_i (k_rev_q),
     .cmd_valid_o  (cmd_valid),
@@ -490,7 +517,10 @@ module cube5_frame #(
     .start_i      (start),
     .nbr_i        (nbr),
     .nj_i         (nj_q),
-    .nk_i         (nk_q),
+    .s_first_i    (s_first_q),
+    .s_last_i     (s_last_q),
+    .tx0_i        (tx0_q),
+    .ty0_i        (ty0_q),
     .dx_i         (dx_q),
     .dy_i         (dy_q),
     .row_len_i    (row_len),
@@ -585,7 +615,10 @@ module cube5_frame #(
     .start_i      (start),
     .nbr_i        (nbr),
     .nj_i         (nj_q),
-    .nk_i         (nk_q),
+    .s_first_i    (s_first_q),
+    .s_last_i     (s_last_q),
+    .tx0_i        (tx0_q),
+    .ty0_i        (ty0_q),
     .dx_i         (dx_q),
     .dy_i         (dy_q),
     .max_sx_i     (max_sx_q),

@@ -1,6 +1,7 @@
 // cube5_frame_agen: address generation of the sweep (patent [43]; docs/numerics/frame.md,
 // "Order of work in the RTL"): beam reads of P voxels along the beam axis i, beams in row order
-// (a = 0, P, 2P, ..), rows b = 0 .. nj-1, slices s = 0 .. nk-1 front to back, for any of the six base
+// (a = 0, P, 2P, ..), rows b = 0 .. nj-1, slices s = s_first .. s_last front to back (the empty
+// slices before and after skipped; 0 .. nk-1 for the whole volume), for any of the six base
 // planes: the volume axis of i, j, k comes from axis_k (i, j are the other two in ascending order),
 // and slice s is k = s, or k = nk-1-s when the view runs toward -k. One command per accepted cycle.
 module cube5_frame_agen #(
@@ -13,10 +14,12 @@ module cube5_frame_agen #(
 
   /// Begin a sweep (the inputs below hold until it ends).
   input  logic start_i,
-  /// Beats per row (ni / P), rows (nj) and slices (nk).
+  /// Beats per row (ni / P), rows (nj) and slices (nk); the sweep's first and last slice.
   input  logic [MaxDimLog2:0] nbr_i,
   input  logic [MaxDimLog2:0] nj_i,
   input  logic [MaxDimLog2:0] nk_i,
+  input  logic [MaxDimLog2:0] s_first_i,
+  input  logic [MaxDimLog2:0] s_last_i,
   /// Volume axis (0 x, 1 y, 2 z) of the slice axis k; the sweep runs toward -k.
   input  logic [1:0] axis_k_i,
   input  logic k_reversed_i,
@@ -39,7 +42,7 @@ module cube5_frame_agen #(
 
   assign last_beat  = (m_q == nbr_i - (M+1)'(1));
   assign last_row   = (b_q == nj_i - (M+1)'(1));
-  assign last_slice = (s_q == nk_i - (M+1)'(1));
+  assign last_slice = (s_q == s_last_i);
   assign fire       = active_q && cmd_ready_i;
 
   always_comb begin
@@ -52,8 +55,8 @@ module cube5_frame_agen #(
       active_d = 1'b1;
       m_d      = '0;
       b_d      = '0;
-      s_d      = '0;
-      k_d      = k_reversed_i ? nk_i - (M+1)'(1) : '0;
+      s_d      = s_first_i;
+      k_d      = k_reversed_i ? nk_i - (M+1)'(1) - s_first_i : s_first_i;
     end else if (fire) begin
       if (!last_beat) begin
         m_d = m_q + (M+1)'(1);

@@ -45,6 +45,7 @@ package cube5_frame_pkg;
   localparam int unsigned RegDx   = 2;  // DX, S(2.StepW)
   localparam int unsigned RegDy   = 3;  // DY, S(2.StepW)
   localparam int unsigned RegMode = 4;  // render (2), tf2d (1)
+  localparam int unsigned RegSkip = 5;  // empty slices skipped before, after the sweep (m+1 bits each)
 
   /// Render modes (the 2-bit field of RegMode); 2 and 3 are refused.
   localparam logic [1:0] RenderMip       = 2'd0;

@@ -3,7 +3,9 @@
 // it once per item, so no position travels down the pipelines: beat m of row b of slice s, and the
 // slice's ray offsets T_x(s) = s * DX, T_y(s) = s * DY accumulated exactly (no drift).
 //
-// Items past the last slice (the flush) keep counting into slice nk; the frame ignores them.
+// The sweep may cover a range of slices s_first ..= s_last (the empty slices before and after are
+// skipped): the counters start at s_first with T_x(s_first), T_y(s_first) from the set-up. Items
+// past the last slice (the flush) keep counting into slice s_last + 1; the frame ignores them.
 module cube5_frame_pos #(
   /// Bits of a dimension (MaxDimLog2 + 1).
   parameter int unsigned DimW = 7,
@@ -15,7 +17,7 @@ module cube5_frame_pos #(
   input  logic clk_i,
   input  logic rst_ni,
 
-  /// Back to the first item of a frame (beat 0, row 0, slice 0).
+  /// Back to the first item of a frame (beat 0, row 0, slice s_first).
   input  logic start_i,
   /// The current item moves on.
   input  logic step_i,
@@ -23,20 +25,24 @@ module cube5_frame_pos #(
   input  logic [DimW-1:0] nbr_i,
   /// Rows per slice, nj.
   input  logic [DimW-1:0] nj_i,
-  /// Slices, nk.
-  input  logic [DimW-1:0] nk_i,
+  /// The first and last slice of the sweep.
+  input  logic [DimW-1:0] s_first_i,
+  input  logic [DimW-1:0] s_last_i,
+  /// T_x(s_first) = s_first DX, T_y(s_first) = s_first DY.
+  input  logic signed [TW-1:0] tx0_i,
+  input  logic signed [TW-1:0] ty0_i,
   /// Per-slice ray steps, S(2.StepW).
   input  logic signed [DW-1:0] dx_i,
   input  logic signed [DW-1:0] dy_i,
 
-  /// Beat within the row, row, slice (slice counts on past nk - 1 in the flush).
+  /// Beat within the row, row, slice (slice counts on past s_last in the flush).
   output logic [DimW-1:0] m_o,
   output logic [DimW-1:0] b_o,
   output logic [DimW-1:0] s_o,
   /// T_x(s), T_y(s), S(.StepW).
   output logic signed [TW-1:0] tx_o,
   output logic signed [TW-1:0] ty_o,
-  /// m = 0, m = nbr - 1, b = 0, b = nj - 1, s = 0, s = nk - 1.
+  /// m = 0, m = nbr - 1, b = 0, b = nj - 1, s = s_first, s = s_last.
   output logic first_beat_o,
   output logic last_beat_o,
   output logic first_row_o,
@@ -52,8 +58,8 @@ module cube5_frame_pos #(
   assign last_beat_o   = (m_q == nbr_i - DimW'(1));
   assign first_row_o   = (b_q == '0);
   assign last_row_o    = (b_q == nj_i - DimW'(1));
-  assign first_slice_o = (s_q == '0);
-  assign last_slice_o  = (s_q == nk_i - DimW'(1));
+  assign first_slice_o = (s_q == s_first_i);
+  assign last_slice_o  = (s_q == s_last_i);
 
   always_comb begin
     m_d  = m_q;
@@ -64,9 +70,9 @@ module cube5_frame_pos #(
     if (start_i) begin
       m_d  = '0;
       b_d  = '0;
-      s_d  = '0;
-      tx_d = '0;
-      ty_d = '0;
+      s_d  = s_first_i;
+      tx_d = tx0_i;
+      ty_d = ty0_i;
     end else if (step_i) begin
       if (!last_beat_o) begin
         m_d = m_q + DimW'(1);

@@ -100,6 +100,7 @@ pub const REG_VIEW: u32 = 1;
 pub const REG_DX: u32 = 2;
 pub const REG_DY: u32 = 3;
 pub const REG_MODE: u32 = 4;
+pub const REG_SKIP: u32 = 5;
 
 /// Commands.
 pub const OP_RENDER: u32 = 0;
@@ -202,12 +203,13 @@ impl FrameRtl {
         (self.addr(REGION_FRAME, REG_DIMS), w.finish(3 * m1))
     }
 
-    /// The frame registers of one view.
+    /// The frame registers of one view; `skip` = empty slices left out before and after the sweep.
     pub fn frame_writes(
         &self,
         params: &FrameParams,
         render: Render,
         tf2d: bool,
+        skip: (usize, usize),
     ) -> Vec<(u32, Vec<u32>)> {
         let mut dims = [0u32; 3];
         dims[params.axis_i] = params.ni as u32;
@@ -227,6 +229,10 @@ impl FrameRtl {
             self.reg(REG_DX, step(params.dx)),
             self.reg(REG_DY, step(params.dy)),
             self.reg(REG_MODE, render_bits | u32::from(tf2d) << 2),
+            self.reg(
+                REG_SKIP,
+                (skip.0 | skip.1 << (self.max_dim_log2 + 1)) as u32,
+            ),
         ]
     }
 
@@ -505,6 +511,27 @@ impl Units {
     }
 }
 
+/// A sparse scene for the empty-space figures: an `n`^3 volume whose voxels are random (seeded)
+/// inside the box `lo..hi` and 0 elsewhere.
+pub fn sparse_box_volume(n: usize, lo: [usize; 3], hi: [usize; 3], seed: u64) -> Volume {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut data = vec![0u16; n * n * n];
+    for z in lo[2]..hi[2] {
+        for y in lo[1]..hi[1] {
+            for x in lo[0]..hi[0] {
+                data[x + n * (y + n * z)] = rng.random_range(0..4096);
+            }
+        }
+    }
+    Volume::new([n; 3], [1.0; 3], 12, data).expect("a valid volume")
+}
+
+/// The sparse scene of the tests and the benchmark: 64^3 with data in [20, 44) x [14, 50) x [22, 41).
+pub fn sparse_scene(seed: u64) -> Volume {
+    sparse_box_volume(64, [20, 14, 22], [44, 50, 41], seed)
+}
+
 /// What the memory returns: the volume with the voxels of skipped blocks (empty or masked) read as
 /// 0 (docs/numerics/skewmem.md).
 pub fn as_seen(vol: &Volume, lut: &BlockLut) -> Result<Volume, ModelError> {
@@ -635,6 +662,8 @@ pub struct FrameStats {
     pub last_out: u64,
     /// The model's count of the sweep's memory accesses (equal to the RTL's, or the frame fails).
     pub accesses: SweepAccesses,
+    /// Empty slices the sweep skipped (before, after).
+    pub skip: (usize, usize),
 }
 
 /// A loaded DUT: one variant with one volume in its memory.
@@ -645,6 +674,11 @@ pub struct FrameBench {
     pub lut: BlockLut,
     /// The tables loaded last (render mode, opacity ratio, early termination): reloaded on change.
     pub loaded: Option<(Render, u64, bool)>,
+    /// Skip the empty slices before and after each sweep (`frame::empty_slices`) when a zero
+    /// sample composites as the identity.
+    pub skip_empty: bool,
+    /// The slices the last loaded frame skips (before, after).
+    pub skip: (usize, usize),
 }
 
 impl FrameBench {
@@ -664,6 +698,8 @@ impl FrameBench {
             dims: vol.dims,
             lut: lut.clone(),
             loaded: None,
+            skip_empty: false,
+            skip: (0, 0),
         })
     }
 
@@ -695,7 +731,20 @@ impl FrameBench {
             self.write(&w)?;
             self.loaded = Some(key);
         }
-        let w = self.rtl.frame_writes(&e.params, u.render, u.tf2d);
+        // A zero sample leaves a coxel unchanged under MIP, and under `over` when density 0
+        // classifies as alpha 0: only then may empty slices be left out (docs/numerics/frame.md).
+        let zero_is_identity = match u.render {
+            Render::Mip => true,
+            Render::Composite => !u.tf2d && u.shader.tables().class.entries()[0].a == 0,
+        };
+        self.skip = if self.skip_empty && zero_is_identity {
+            frame::empty_slices(&e.params, &self.lut)
+        } else {
+            (0, 0)
+        };
+        let w = self
+            .rtl
+            .frame_writes(&e.params, u.render, u.tf2d, self.skip);
         self.write(&w)
     }
 
@@ -748,7 +797,7 @@ impl FrameBench {
     ) -> Result<FrameStats, FrameError> {
         let rtl = self.rtl;
         let mut mem = rtl.memory(self.dims, &self.lut)?;
-        let accesses = frame::sweep_memory(&e.params, &mut mem)?;
+        let accesses = frame::sweep_memory(&e.params, self.skip, &mut mem)?;
         let ctx = || {
             format!(
                 "{} view {} {:?}, {:?}, volume {:?}, {:?}, seed {seed}",
@@ -803,6 +852,7 @@ impl FrameBench {
         Ok(FrameStats {
             cycles: got.cycles,
             sweep: got.pixels[0].cycles,
+            skip: self.skip,
             first_out: got.taken_at[0],
             last_out: got.taken_at[n - 1],
             accesses,

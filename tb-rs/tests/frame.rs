@@ -297,6 +297,10 @@ fn refused_configurations_answer_one_error_item() {
             vec![rtl.reg(REG_DY, ((-(1i32 << 16) - 1) as u32) & 0x3ffff)],
         ),
         ("slice axis 3", vec![rtl.reg(REG_VIEW, 3)]),
+        (
+            "every slice skipped",
+            vec![rtl.reg(REG_SKIP, 8 | 8 << (rtl.max_dim_log2 + 1))],
+        ),
         ("render mode 2", vec![rtl.reg(REG_MODE, 2)]),
         ("render mode 3", vec![rtl.reg(REG_MODE, 3)]),
         (
@@ -684,5 +688,49 @@ fn driver_configurations_agree_with_the_variants_file() {
     assert_eq!(seen, 5);
     for rtl in BY_P {
         assert_eq!(rtl.max_dim(), cube5_model::scene::RTL_MAX_EDGE);
+    }
+}
+
+#[test]
+fn empty_slice_skipping_cuts_cycles_without_changing_a_pixel() {
+    let s = seed(12);
+    let vol = sparse_scene(s);
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let traffic = Traffic::random(&mut rng, 0.0, 0.2);
+    for rtl in [P1, P4] {
+        let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
+        let seen = seen_of(&vol, &lut);
+        let mut bench = bench(rtl, &vol, &lut, s);
+        let (mut plain, mut skipping) = (0u64, 0u64);
+        for (i, v) in views().into_iter().enumerate() {
+            for render in [Render::Mip, Render::Composite] {
+                let e = expect(&rtl, &seen, v, render, false);
+                bench.skip_empty = false;
+                let full = must(bench.check(&e, &traffic, s + i as u64));
+                bench.skip_empty = true;
+                let cut = must(bench.check(&e, &traffic, s + i as u64));
+                assert!(
+                    cut.skip.0 + cut.skip.1 > 0,
+                    "{} {}: slices skipped",
+                    rtl.variant,
+                    v.0
+                );
+                assert!(cut.sweep < full.sweep);
+                plain += u64::from(full.sweep);
+                skipping += u64::from(cut.sweep);
+                if render == Render::Composite && i % 5 == 0 {
+                    eprintln!(
+                        "{} {:>12}: skip {:?} of {} slices, sweep {} -> {} cycles ({:.3}), frame {} -> {} cycles",
+                        rtl.variant, v.0, cut.skip, e.params.nk, full.sweep, cut.sweep,
+                        f64::from(cut.sweep) / f64::from(full.sweep), full.cycles, cut.cycles
+                    );
+                }
+            }
+        }
+        eprintln!(
+            "{}: 14 views x MIP/composite bit-exact with and without skipping; sweep cycles {skipping} / {plain} = {:.3}",
+            rtl.variant,
+            skipping as f64 / plain as f64
+        );
     }
 }

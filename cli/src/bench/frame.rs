@@ -6,7 +6,9 @@
 use anyhow::{anyhow, Result};
 use cube5_model::phantom::head_phantom;
 use cube5_model::skewed::BlockLut;
-use cube5_tb::frame::{as_seen, Expected, FrameBench, FrameRtl, Look, Render, OP_RENDER};
+use cube5_tb::frame::{
+    as_seen, sparse_scene, Expected, FrameBench, FrameRtl, Look, Render, OP_RENDER,
+};
 use cube5_tb::rtl::Traffic;
 use std::rc::Rc;
 use std::time::Instant;
@@ -148,6 +150,50 @@ pub fn run(n_items: usize) -> Result<()> {
          = W H + 2 (one pixel per clock; a double-buffered compositing buffer would overlap it with \
          the next frame's sweep)."
     );
+    println!();
+    skipping()?;
+    Ok(())
+}
+
+/// Empty-slice skipping on the sparse scene (64^3, data in a box inside): sweep and frame cycles
+/// with and without it, P = 4, images compared bit for bit with the model's full sweep.
+fn skipping() -> Result<()> {
+    println!("### Empty-slice skipping (sparse scene, P = 4)\n");
+    println!(
+        "64^3 volume with data only in [20, 44) x [14, 50) x [22, 41), blocks of 8^3; composite; \
+         both frames compared with the model's full sweep, bit for bit.\n"
+    );
+    println!("| view | slices skipped (front + back of nk) | sweep cycles | with skipping | ratio | frame cycles | with skipping | ratio |");
+    println!("|------|------------------------------------|-------------:|--------------:|------:|-------------:|--------------:|------:|");
+    let rtl = FrameRtl::with_pipelines(4).ok_or_else(|| anyhow!("no P = 4 frame"))?;
+    let vol = sparse_scene(7);
+    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0)?;
+    let seen = Rc::new(as_seen(&vol, &lut)?);
+    let mut bench = FrameBench::new(rtl, &vol, &lut, 1)?;
+    for (name, view) in [
+        ("+z", [0.0, 0.0, 1.0]),
+        ("-y", [0.0, -1.0, 0.0]),
+        ("+x", [1.0, 0.0, 0.0]),
+        ("oblique", [-0.37, 0.81, -1.0]),
+    ] {
+        let e = Expected::new(&rtl, &seen, name, view, Render::Composite, &Look::default())?;
+        bench.skip_empty = false;
+        let full = bench.check(&e, &Traffic::full_speed(), 1)?;
+        bench.skip_empty = true;
+        let cut = bench.check(&e, &Traffic::full_speed(), 1)?;
+        println!(
+            "| {name} | {} + {} of {} | {} | {} | {:.3} | {} | {} | {:.3} |",
+            cut.skip.0,
+            cut.skip.1,
+            e.params.nk,
+            full.sweep,
+            cut.sweep,
+            f64::from(cut.sweep) / f64::from(full.sweep),
+            full.cycles,
+            cut.cycles,
+            cut.cycles as f64 / full.cycles as f64
+        );
+    }
     println!();
     Ok(())
 }
