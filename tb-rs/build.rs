@@ -237,7 +237,8 @@ fn parse_variants(repo: &Path, path: &Path) -> Vec<Variant> {
             match w.split_once('=') {
                 Some((k, v)) => params.push((k.to_string(), v.to_string())),
                 None if w == "gate" => gate = true,
-                None if w == "fmax" || w == "sim" => {} // read by scripts/synth.sh only
+                // Read by scripts/synth.sh only.
+                None if matches!(w, "fmax" | "fmax85" | "sim") => {}
                 None => panic!("{}: unknown flag `{w}`", path.display()),
             }
         }

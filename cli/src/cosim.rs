@@ -61,7 +61,7 @@ pub fn run(args: CosimArgs) -> Result<()> {
 
 /// The scene's volume at the frame's voxel width: `v << (W - bits)` or `v >> (bits - W)`, the same
 /// integers for model and RTL.
-fn at_voxel_width(vol: &Volume, w: u32) -> Result<Volume> {
+pub fn at_voxel_width(vol: &Volume, w: u32) -> Result<Volume> {
     let data = vol
         .data
         .iter()
@@ -77,7 +77,7 @@ fn at_voxel_width(vol: &Volume, w: u32) -> Result<Volume> {
 }
 
 /// The scene's lights and material in the frame's axes (the reflectance map's input).
-fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
+pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
     let lights: Vec<DistantLight> = scene
         .lights
         .iter()
@@ -260,4 +260,68 @@ fn base_plane_png(bp: &BasePlane, cfg: &ComposConfig) -> image::RgbImage {
         *p = image::Rgb(c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8));
     }
     img
+}
+
+/// The cost side of the trade in cycles: one frame of `scene` on `cube5_frame` at P = 1, 4, 8,
+/// measured on the RTL with and without empty-slice skipping, each image compared with the model
+/// bit for bit. A Markdown section for `cube5 tradeoff`.
+pub fn frame_cost_section(scene: &Scene) -> Result<String> {
+    let mut md = String::from("## Cycles per frame (`cube5_frame`, RTL)\n\n");
+    let render = match scene.render.mode {
+        CompositeMode::Composite => Render::Composite,
+        CompositeMode::Mip => Render::Mip,
+        m => {
+            md.push_str(&format!(
+                "cube5_frame renders composite and MIP; this scene's mode is {}.\n\n",
+                m.name()
+            ));
+            return Ok(md);
+        }
+    };
+    md.push_str(
+        "The baseline scene's volume and view on the verified frame configurations (default widths): \
+         cycles from the render command to the last base-plane pixel, measured in simulation; the \
+         limit is one sample per clock per pipeline. Independent of the width knobs above (they \
+         change area and error, not the schedule); the sample rate of the slice-order machine is \
+         one sample per voxel of every slice. Every frame's image equals the model's, bit for bit.\n\n",
+    );
+    md.push_str("| P | samples | cycles/frame | samples/clock/pipeline | skipping empty slices: cycles/frame | ratio |\n");
+    md.push_str("|--:|--------:|-------------:|-----------------------:|------------------------------------:|------:|\n");
+    let dir = scene.render_params().direction()?;
+    let raw = scene.build_volume()?;
+    for rtl in cube5_tb::frame::BY_P {
+        let vol = at_voxel_width(&raw, rtl.trilin.voxel_w)?;
+        if let Err(why) = rtl.check_volume(&vol) {
+            md.push_str(&format!("| {} | | n/a: {why} | | | |\n", rtl.p));
+            continue;
+        }
+        let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0)?;
+        let seen = Rc::new(as_seen(&vol, &lut)?);
+        let setup = FrameSetup::new(vol.dims, vol.spacing, dir, rtl.p)?;
+        let look = Look {
+            tf: scene.transfer_function(),
+            phong: scene_phong(scene, &setup.params),
+            early_termination: false,
+        };
+        let e = Expected::new(&rtl, &seen, "scene", dir.to_array(), render, &look)?;
+        let mut bench = FrameBench::new(rtl, &vol, &lut, 1)?;
+        let full = bench.check(&e, &Traffic::full_speed(), 1)?;
+        bench.skip_empty = true;
+        let cut = bench.check(&e, &Traffic::full_speed(), 1)?;
+        let samples = e.params.samples() as u64;
+        md.push_str(&format!(
+            "| {} | {samples} | {} | {:.3} | {} | {:.3} |\n",
+            rtl.p,
+            full.cycles,
+            samples as f64 / (full.cycles as f64 * rtl.p as f64),
+            cut.cycles,
+            cut.cycles as f64 / full.cycles as f64
+        ));
+    }
+    md.push_str(
+        "\nWhere the cycles go (docs/frame-rtl.md, *Cycle budget*): one beat of P samples per clock, \
+         the windows' flush, the pipeline latency, and the read-out of the base plane at one pixel \
+         per clock, which does not shrink with P.\n",
+    );
+    Ok(md)
 }

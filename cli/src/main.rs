@@ -183,7 +183,13 @@ fn render(args: RenderArgs) -> Result<()> {
     let plan = Plan::new(&scene, &vol)?;
     say!("plan: {plan}");
     if scene.run.target.uses_rtl() {
-        // The RTL frame (P = 4) against the model, images beside the output.
+        // The RTL frame (P = 4) against the model, images beside the output. It is the only RTL
+        // variant a scene needs: `CUBE5_TOPS=cube5_frame_p4` builds just it.
+        say!(
+            "rtl: {} (the only RTL variant this scene needs; CUBE5_TOPS={} builds just it)",
+            cube5_tb::frame::P4.variant,
+            cube5_tb::frame::P4.variant
+        );
         let stem = args
             .output
             .file_stem()

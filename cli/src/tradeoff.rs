@@ -157,6 +157,8 @@ pub fn run(args: TradeoffArgs) -> Result<()> {
         bar: Mutex::new(None),
     };
     let report = run_sweeps(&setup, &bars)?;
+    say!("cube5 tradeoff: cycles per frame on the RTL frame (P = 1, 4, 8)");
+    let frame_md = crate::cosim::frame_cost_section(&scene)?;
     let secs = started.elapsed().as_secs_f64();
 
     // Everything is computed: now write, each file atomically.
@@ -185,7 +187,8 @@ pub fn run(args: TradeoffArgs) -> Result<()> {
     };
     let md_path = out_dir.join(md_name);
     let img_rel = if args.write_docs { "img/" } else { "" };
-    let md = document(&setup, &scene, &report, secs, img_rel, args.tiny);
+    let mut md = document(&setup, &scene, &report, secs, img_rel, args.tiny);
+    md.push_str(&frame_md);
     write_atomically(&md_path, md.as_bytes())?;
     written.push(md_path.clone());
     say!(

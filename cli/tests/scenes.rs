@@ -262,6 +262,10 @@ fn rtl_target_cosimulates_the_frame() {
         "{stdout}"
     );
     assert!(stdout.contains("MATCH"), "{stdout}");
+    assert!(
+        stdout.contains("rtl: cube5_frame_p4 (the only RTL variant"),
+        "{stdout}"
+    );
     assert!(png.exists(), "target both also renders the model image");
     let cosim = png.with_file_name(format!(
         "{}-cosim",

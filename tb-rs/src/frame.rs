@@ -692,7 +692,7 @@ impl FrameBench {
         for (a, d) in rtl.volume_writes(vol, lut)? {
             dut.write_config(a, &d)?;
         }
-        Ok(Self {
+        let mut bench = Self {
             rtl,
             dut,
             dims: vol.dims,
@@ -700,7 +700,13 @@ impl FrameBench {
             loaded: None,
             skip_empty: false,
             skip: (0, 0),
-        })
+        };
+        // After reset the compositing buffer clears its valid bits (4 MaxDim^2 / P cycles) before
+        // it takes a command; a command refused for a reserved render mode waits that out, so the
+        // frames measured after it are steady-state frames. `load` rewrites the mode register.
+        bench.write(&[rtl.reg(REG_MODE, 3)])?;
+        bench.refused(OP_RENDER)?;
+        Ok(bench)
     }
 
     pub fn write(&mut self, writes: &[(u32, Vec<u32>)]) -> Result<(), FrameError> {

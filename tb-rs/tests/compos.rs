@@ -8,10 +8,13 @@ use cube5_model::compos::{
 };
 use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
+use cube5_tb::rtl::{RtlError, RtlStream};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run, must_match,
+    must_match_across_a_reset, must_match_items_with_config, random_items, seed, MILLION,
+};
 
 const NARROW: (&str, ComposConfig) = ("cube5_compos_c8", ComposConfig::NARROW);
 const DEFAULT: (&str, ComposConfig) = ("cube5_compos_c12", ComposConfig::DEFAULT);
@@ -29,16 +32,8 @@ fn check_for(gold: &Compos, seed: u64, items: usize) -> StreamCheck {
 
 /// Runs `items` (in order, once) through `variant` and the model under idle and back-pressure.
 fn run_items(variant: &str, gold: &mut Compos, items: Vec<ComposIn>, seed: u64) {
-    let n = items.len();
-    let mut it = items.into_iter().cycle();
-    let check = check_for(gold, seed, n).with_traffic(0.3, 0.3);
-    must_match(
-        variant,
-        gold.config(),
-        gold,
-        &mut |_| it.next().unwrap(),
-        &check,
-    );
+    let (cfg, writes) = (gold.config(), gold.config_writes());
+    must_match_items_with_config(variant, cfg, gold, items, seed, writes);
 }
 
 fn pick<T: Copy>(rng: &mut ChaCha8Rng, xs: &[T]) -> T {
@@ -125,12 +120,16 @@ fn busy_regs(cfg: &ComposConfig, xray_shift: u32, lut_bypass: bool) -> ComposReg
 fn million_random_items_per_config_with_idle_backpressure_and_reset() {
     for (i, ((variant, cfg), ratio)) in CONFIGS.iter().zip([2.0, 0.5, 3f64.sqrt()]).enumerate() {
         let mut gold = unit(*cfg, ratio, busy_regs(cfg, 3 + 5 * i as u32, false));
-        let check = check_for(&gold, seed(300 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(3);
-        let r = must_match(variant, *cfg, &mut gold, &mut random_item(*cfg), &check);
-        assert_eq!(r.resets, 1);
-        assert!(r.compared as usize >= MILLION - 1000);
+        let check =
+            long_run(seed(300 + i as u64), MILLION, 3).with_config_writes(gold.config_writes());
+        must_match_across_a_reset(
+            variant,
+            *cfg,
+            &mut gold,
+            &mut random_item(*cfg),
+            &check,
+            1000,
+        );
     }
 }
 
@@ -485,26 +484,9 @@ fn one_item_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 6;
     for (variant, cfg) in CONFIGS {
         let gold = unit(cfg, 1.0, ComposRegs::defaults(&cfg));
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        for (addr, data) in gold.config_writes() {
-            dut.write_config(addr, &data).unwrap();
-        }
-        let mut rng = ChaCha8Rng::seed_from_u64(seed(11));
-        let mut gen = random_item(cfg);
-        let items: Vec<ComposIn> = (0..100_000).map(|_| gen(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + LATENCY,
-            "{variant}: one item per clock plus the pipeline fill"
-        );
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
+        let writes = gold.config_writes();
+        let items = random_items(seed(11), 100_000, random_item(cfg));
+        let driven = assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, LATENCY);
         let values: Vec<Coxel> = driven.outputs.into_iter().map(|t| t.value).collect();
         assert_eq!(values, gold.clone().run(&items));
     }
@@ -512,18 +494,16 @@ fn one_item_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = ComposConfig::NARROW;
+    let (variant, cfg) = ("cube5_compos_c8_gate", ComposConfig::NARROW);
     let mut gold = unit(cfg, 2.0, busy_regs(&cfg, 2, false));
-    let check = check_for(&gold, seed(21), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1);
-    must_match(
-        "cube5_compos_c8_gate",
+    let writes = gold.config_writes();
+    gate_smoke_with_config(
+        variant,
         cfg,
         &mut gold,
         &mut random_item(cfg),
-        &check,
+        seed(21),
+        writes,
     );
     let regs = busy_regs(&cfg, 0, true);
     let mut gold = unit(cfg, 0.5, regs);
@@ -538,7 +518,7 @@ fn gate_level_netlist_smoke() {
             }
         }
     }
-    run_items("cube5_compos_c8_gate", &mut gold, items, seed(22));
+    run_items(variant, &mut gold, items, seed(22));
 }
 
 /// Beyond trilin's corrupted-output check: the scoreboard also catches a table entry or a register

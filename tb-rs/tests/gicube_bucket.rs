@@ -10,7 +10,10 @@ use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_cycled,
+    must_match_items, random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, BucketConfig); 5] = [
     ("gicube_bucket_slab", BucketConfig::SLAB),
@@ -65,18 +68,14 @@ fn directed_items(cfg: BucketConfig) -> Vec<BucketIn> {
 #[test]
 fn million_random_positions_per_config_with_idle_backpressure_and_reset() {
     for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
-        let check = StreamCheck::new(seed(400 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(3);
-        let r = must_match(
+        must_match_across_a_reset(
             variant,
             *cfg,
             &mut BucketUnit::new(*cfg).unwrap(),
             &mut random_item(*cfg),
-            &check,
+            &long_run(seed(400 + i as u64), MILLION, 3),
+            10,
         );
-        assert_eq!(r.resets, 1);
-        assert!(r.compared as usize >= MILLION - 10);
     }
 }
 
@@ -86,13 +85,12 @@ fn directed_block_and_volume_edges() {
         let items = directed_items(cfg);
         let n = items.len();
         assert!(n > 20);
-        let mut it = items.into_iter().cycle();
         let check = StreamCheck::new(seed(410), 3 * n).with_traffic(0.3, 0.3);
-        must_match(
+        must_match_cycled(
             variant,
             cfg,
             &mut BucketUnit::new(cfg).unwrap(),
-            &mut |_| it.next().unwrap(),
+            items,
             &check,
         );
     }
@@ -102,48 +100,19 @@ fn directed_block_and_volume_edges() {
 fn one_item_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 1;
     for (variant, cfg) in CONFIGS {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        let mut rng = ChaCha8Rng::seed_from_u64(seed(411));
-        let mut gen = random_item(cfg);
-        let items: Vec<BucketIn> = (0..100_000).map(|_| gen(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + LATENCY,
-            "{variant}: {} positions per clock plus the pipeline fill",
-            cfg.lanes
-        );
+        // An item is `cfg.lanes` positions: that many per clock.
+        let items = random_items(seed(411), 100_000, random_item(cfg));
+        assert_one_item_per_clock(variant, cfg, &items, LATENCY);
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = BucketConfig::SKEW6;
-    let check = StreamCheck::new(seed(412), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1);
-    must_match(
-        "gicube_bucket_skew6_gate",
-        cfg,
-        &mut BucketUnit::new(cfg).unwrap(),
-        &mut random_item(cfg),
-        &check,
-    );
-    let items = directed_items(cfg);
-    let n = items.len();
-    let mut it = items.into_iter().cycle();
-    must_match(
-        "gicube_bucket_skew6_gate",
-        cfg,
-        &mut BucketUnit::new(cfg).unwrap(),
-        &mut |_| it.next().unwrap(),
-        &StreamCheck::new(seed(413), n).with_traffic(0.3, 0.3),
-    );
+    let (variant, cfg) = ("gicube_bucket_skew6_gate", BucketConfig::SKEW6);
+    let mut gold = BucketUnit::new(cfg).unwrap();
+    gate_smoke(variant, cfg, &mut gold, &mut random_item(cfg), seed(412));
+    let mut gold = BucketUnit::new(cfg).unwrap();
+    must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(413));
 }
 
 #[test]

@@ -13,7 +13,10 @@ use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_cycled,
+    must_match_items, random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, PacketLoopConfig); 2] = [
     ("gicube_packet_loop_s1", PacketLoopConfig::S1),
@@ -27,18 +30,14 @@ fn random_item(rng: &mut ChaCha8Rng) -> RayPacket {
 #[test]
 fn million_random_packets_per_config_with_idle_backpressure_and_reset() {
     for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
-        let check = StreamCheck::new(seed(300 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(3);
-        let r = must_match(
+        must_match_across_a_reset(
             variant,
             *cfg,
             &mut PacketLoop::new(*cfg).unwrap(),
             &mut random_item,
-            &check,
+            &long_run(seed(300 + i as u64), MILLION, 3),
+            10,
         );
-        assert_eq!(r.resets, 1);
-        assert!(r.compared as usize >= MILLION - 10);
     }
 }
 
@@ -46,14 +45,12 @@ fn million_random_packets_per_config_with_idle_backpressure_and_reset() {
 fn directed_extremes_every_field_wraps() {
     for (variant, cfg) in CONFIGS {
         let items = directed_packets();
-        let n = items.len();
-        let mut it = items.into_iter().cycle();
-        let check = StreamCheck::new(seed(301), 4 * n).with_traffic(0.3, 0.3);
-        must_match(
+        let check = StreamCheck::new(seed(301), 4 * items.len()).with_traffic(0.3, 0.3);
+        must_match_cycled(
             variant,
             cfg,
             &mut PacketLoop::new(cfg).unwrap(),
-            &mut |_| it.next().unwrap(),
+            items,
             &check,
         );
     }
@@ -62,49 +59,18 @@ fn directed_extremes_every_field_wraps() {
 #[test]
 fn one_packet_per_cycle_when_never_stalled() {
     for (variant, cfg) in CONFIGS {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        let mut rng = ChaCha8Rng::seed_from_u64(seed(302));
-        let items: Vec<RayPacket> = (0..100_000).map(|_| random_packet(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + cfg.latency(),
-            "{variant}: one packet per clock plus the pipeline fill"
-        );
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
+        let items = random_items(seed(302), 100_000, random_item);
+        assert_one_item_per_clock(variant, cfg, &items, cfg.latency());
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = PacketLoopConfig::S1;
-    let check = StreamCheck::new(seed(303), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1);
-    must_match(
-        "gicube_packet_loop_s1_gate",
-        cfg,
-        &mut PacketLoop::new(cfg).unwrap(),
-        &mut random_item,
-        &check,
-    );
-    let items = directed_packets();
-    let n = items.len();
-    let mut it = items.into_iter().cycle();
-    must_match(
-        "gicube_packet_loop_s1_gate",
-        cfg,
-        &mut PacketLoop::new(cfg).unwrap(),
-        &mut |_| it.next().unwrap(),
-        &StreamCheck::new(seed(304), n).with_traffic(0.3, 0.3),
-    );
+    let (variant, cfg) = ("gicube_packet_loop_s1_gate", PacketLoopConfig::S1);
+    let mut gold = PacketLoop::new(cfg).unwrap();
+    gate_smoke(variant, cfg, &mut gold, &mut random_item, seed(303));
+    let mut gold = PacketLoop::new(cfg).unwrap();
+    must_match_items(variant, cfg, &mut gold, directed_packets(), seed(304));
 }
 
 /// A Rust layout that differs from the contract: `dir_x` and `dir_y` swapped (equal widths), or the

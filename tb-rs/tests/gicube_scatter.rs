@@ -7,10 +7,13 @@ use cube5_model::gicube::scatter::{
 };
 use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlStream, Traffic};
+use cube5_tb::rtl::RtlStream;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run, must_match,
+    must_match_across_a_reset, must_match_items_with_config, random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, ScatterConfig); 2] = [
     ("gicube_scatter_f8", ScatterConfig::NARROW),
@@ -34,18 +37,7 @@ fn model_and_tables(cfg: ScatterConfig) -> (Scatter, Vec<(u32, Vec<u32>)>) {
 /// Runs `items` (cycled) with idle and back-pressure, tables loaded.
 fn run_directed(variant: &str, cfg: ScatterConfig, items: Vec<ScatterIn>, seed_default: u64) {
     let (mut model, writes) = model_and_tables(cfg);
-    let n = items.len();
-    let mut it = items.into_iter().cycle();
-    let check = StreamCheck::new(seed(seed_default), n)
-        .with_traffic(0.3, 0.3)
-        .with_config_writes(writes);
-    must_match(
-        variant,
-        cfg,
-        &mut model,
-        &mut |_| it.next().unwrap(),
-        &check,
-    );
+    must_match_items_with_config(variant, cfg, &mut model, items, seed(seed_default), writes);
 }
 
 fn base(cfg: &ScatterConfig) -> ScatterIn {
@@ -93,16 +85,8 @@ fn with_materials(cfg: &ScatterConfig, geo: ScatterIn, rays: u32) -> Vec<Scatter
 fn million_random_rays_per_config_with_idle_backpressure_and_reset() {
     for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
         let (mut model, writes) = model_and_tables(*cfg);
-        let check = StreamCheck::new(seed(500 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(3)
-            .with_config_writes(writes);
-        let r = must_match(variant, *cfg, &mut model, &mut gen(*cfg), &check);
-        assert_eq!(r.resets, 1);
-        assert!(
-            r.compared as usize >= MILLION - 200,
-            "a reset drops at most the items in flight"
-        );
+        let check = long_run(seed(500 + i as u64), MILLION, 3).with_config_writes(writes);
+        must_match_across_a_reset(variant, *cfg, &mut model, &mut gen(*cfg), &check, 200);
     }
 }
 
@@ -283,27 +267,9 @@ fn directions_along_an_axis() {
 #[test]
 fn one_ray_per_cycle_when_never_stalled() {
     for (variant, cfg) in CONFIGS {
-        let (_, writes) = model_and_tables(cfg);
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        for (addr, data) in &writes {
-            dut.write_config(*addr, data).unwrap();
-        }
-        let mut rng = ChaCha8Rng::seed_from_u64(seed(41));
-        let items: Vec<ScatterIn> = (0..100_000).map(|_| random_item(&cfg, &mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + LATENCY,
-            "{variant}: one ray per clock plus the pipeline fill"
-        );
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
-        let (model, _) = model_and_tables(cfg);
+        let (model, writes) = model_and_tables(cfg);
+        let items = random_items(seed(41), 100_000, gen(cfg));
+        let driven = assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, LATENCY);
         for (k, (got, it)) in driven.outputs.iter().zip(&items).enumerate() {
             assert_eq!(got.value, model.scatter(it), "{variant}: item {k}");
         }
@@ -325,17 +291,13 @@ fn one_ray_per_cycle_when_never_stalled() {
 fn gate_level_netlist_smoke() {
     let cfg = ScatterConfig::NARROW;
     let (mut model, writes) = model_and_tables(cfg);
-    let check = StreamCheck::new(seed(51), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1)
-        .with_config_writes(writes);
-    must_match(
+    gate_smoke_with_config(
         "gicube_scatter_f8_gate",
         cfg,
         &mut model,
         &mut gen(cfg),
-        &check,
+        seed(51),
+        writes,
     );
 }
 

@@ -10,9 +10,11 @@ use cube5_model::gicube::sorter::{
 use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
-use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_cycled,
+    random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, SorterConfig); 2] = [
     ("gicube_sorter_r8", SorterConfig::R8),
@@ -31,18 +33,10 @@ fn traffic(cfg: SorterConfig) -> impl FnMut(&mut ChaCha8Rng) -> SorterIn {
 fn directed(name: &str, items: impl Fn(SorterConfig) -> Vec<SorterIn>, times: usize) {
     for (variant, cfg) in CONFIGS {
         let seq = items(cfg);
-        let n = seq.len();
-        let mut it = seq.into_iter().cycle();
-        let check = StreamCheck::new(seed(500), times * n)
+        let check = StreamCheck::new(seed(500), times * seq.len())
             .with_traffic(0.3, 0.3)
             .with_batch(BATCH);
-        let r = must_match(
-            variant,
-            cfg,
-            &mut Sorter::new(cfg).unwrap(),
-            &mut |_| it.next().unwrap(),
-            &check,
-        );
+        let r = must_match_cycled(variant, cfg, &mut Sorter::new(cfg).unwrap(), seq, &check);
         eprintln!("{name}: {variant} {} logical cycles", r.compared);
     }
 }
@@ -63,19 +57,15 @@ fn clear_all(cfg: SorterConfig) -> Vec<SorterIn> {
 /// configuration, so each stays well under a minute on a loaded machine).
 fn million_logical_cycles(k: usize) {
     let (variant, cfg) = CONFIGS[k];
-    let check = StreamCheck::new(seed(510 + k as u64), MILLION)
-        .with_traffic(0.2, 0.3)
-        .with_batch(BATCH)
-        .with_reset_in_batch(20);
-    let r = must_match(
+    let check = long_run(seed(510 + k as u64), MILLION, 20).with_batch(BATCH);
+    must_match_across_a_reset(
         variant,
         cfg,
         &mut Sorter::new(cfg).unwrap(),
         &mut traffic(cfg),
         &check,
+        10,
     );
-    assert_eq!(r.resets, 1);
-    assert!(r.compared as usize >= MILLION - 10);
 }
 
 #[test]
@@ -226,20 +216,8 @@ fn directed_importance_at_its_maximum() {
 fn one_update_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 1;
     for (variant, cfg) in CONFIGS {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        let mut rng = ChaCha8Rng::seed_from_u64(seed(520));
-        let mut gen = traffic(cfg);
-        let items: Vec<SorterIn> = (0..50_000).map(|_| gen(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + LATENCY,
-            "{variant}: one update per clock plus one"
-        );
+        let items = random_items(seed(520), 50_000, traffic(cfg));
+        let driven = assert_one_item_per_clock(variant, cfg, &items, LATENCY);
         let expected = Sorter::new(cfg).unwrap().run(&items);
         assert!(driven
             .outputs
@@ -252,16 +230,12 @@ fn one_update_per_cycle_when_never_stalled() {
 #[test]
 fn gate_level_netlist_smoke() {
     let cfg = SorterConfig::R8;
-    let check = StreamCheck::new(seed(530), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1);
-    must_match(
+    gate_smoke(
         "gicube_sorter_r8_gate",
         cfg,
         &mut Sorter::new(cfg).unwrap(),
         &mut traffic(cfg),
-        &check,
+        seed(530),
     );
 }
 

@@ -7,10 +7,13 @@ use cube5_model::gradient::{
 };
 use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
+use cube5_tb::rtl::{RtlError, RtlStream};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_cycled,
+    must_match_items, random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, GradientConfig); 3] = [
     ("cube5_gradient_v8", GradientConfig::NARROW),
@@ -143,20 +146,13 @@ fn directed_items(cfg: GradientConfig) -> Vec<GradientIn> {
 #[test]
 fn million_random_items_per_config_with_idle_backpressure_and_reset() {
     for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
-        let check = StreamCheck::new(seed(300 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(5);
-        let r = must_match(
+        must_match_across_a_reset(
             variant,
             *cfg,
             &mut Gradient::new(*cfg).unwrap(),
             &mut random_item(*cfg),
-            &check,
-        );
-        assert_eq!(r.resets, 1);
-        assert!(
-            r.compared as usize >= MILLION - 1000,
-            "a reset drops at most the items in flight"
+            &long_run(seed(300 + i as u64), MILLION, 5),
+            1000,
         );
     }
 }
@@ -164,17 +160,8 @@ fn million_random_items_per_config_with_idle_backpressure_and_reset() {
 #[test]
 fn directed_extremes() {
     for (variant, cfg) in CONFIGS {
-        let items = directed_items(cfg);
-        let n = items.len();
-        let mut it = items.into_iter().cycle();
-        let check = StreamCheck::new(seed(31), n).with_traffic(0.3, 0.3);
-        must_match(
-            variant,
-            cfg,
-            &mut Gradient::new(cfg).unwrap(),
-            &mut |_| it.next().unwrap(),
-            &check,
-        );
+        let mut gold = Gradient::new(cfg).unwrap();
+        must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(31));
     }
 }
 
@@ -204,14 +191,13 @@ fn n10_rounding_ties_both_signs() {
                 items.push(item);
             }
         }
-        let n = items.len();
-        let mut it = items.into_iter().cycle();
-        must_match(
+        let check = StreamCheck::new(seed(32), items.len()).with_traffic(0.2, 0.2);
+        must_match_cycled(
             variant,
             cfg,
             &mut Gradient::new(cfg).unwrap(),
-            &mut |_| it.next().unwrap(),
-            &StreamCheck::new(seed(32), n).with_traffic(0.2, 0.2),
+            items,
+            &check,
         );
     }
 }
@@ -219,23 +205,8 @@ fn n10_rounding_ties_both_signs() {
 #[test]
 fn one_item_per_cycle_when_never_stalled() {
     for (variant, cfg) in CONFIGS {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        let mut rng = rand::SeedableRng::seed_from_u64(seed(33));
-        let mut gen = random_item(cfg);
-        let items: Vec<GradientIn> = (0..100_000).map(|_| gen(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + LATENCY,
-            "{variant}: one item per clock plus the pipeline fill"
-        );
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
+        let items = random_items(seed(33), 100_000, random_item(cfg));
+        let driven = assert_one_item_per_clock(variant, cfg, &items, LATENCY);
         let gold = Gradient::new(cfg).unwrap().run(&items);
         assert!(driven.outputs.iter().zip(&gold).all(|(t, g)| t.value == *g));
     }
@@ -243,28 +214,11 @@ fn one_item_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = GradientConfig::NARROW;
-    let check = StreamCheck::new(seed(34), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1);
-    must_match(
-        "cube5_gradient_v8_gate",
-        cfg,
-        &mut Gradient::new(cfg).unwrap(),
-        &mut random_item(cfg),
-        &check,
-    );
-    let items = directed_items(cfg);
-    let n = items.len();
-    let mut it = items.into_iter().cycle();
-    must_match(
-        "cube5_gradient_v8_gate",
-        cfg,
-        &mut Gradient::new(cfg).unwrap(),
-        &mut |_| it.next().unwrap(),
-        &StreamCheck::new(seed(35), n).with_traffic(0.3, 0.3),
-    );
+    let (variant, cfg) = ("cube5_gradient_v8_gate", GradientConfig::NARROW);
+    let mut gold = Gradient::new(cfg).unwrap();
+    gate_smoke(variant, cfg, &mut gold, &mut random_item(cfg), seed(34));
+    let mut gold = Gradient::new(cfg).unwrap();
+    must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(35));
 }
 
 /// A golden model with one contract detail changed: co-simulation must reject each, which shows

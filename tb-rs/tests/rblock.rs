@@ -5,9 +5,12 @@ mod support;
 use cube5_model::blocking::{BlockingLuts, RBlock, RBlockConfig, RBlockDir, RBlockIn};
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
-use rand::{Rng, SeedableRng};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_items,
+    random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, RBlockConfig); 3] = [
     ("cube5_rblock_c2", RBlockConfig::NARROW),
@@ -51,35 +54,22 @@ fn directed_items(cfg: RBlockConfig) -> Vec<RBlockIn> {
 #[test]
 fn million_random_conversions_per_config_with_idle_backpressure_and_reset() {
     for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
-        let check = StreamCheck::new(seed(200 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(3);
-        let r = must_match(
+        must_match_across_a_reset(
             variant,
             *cfg,
             &mut RBlock::new(*cfg).unwrap(),
             &mut random_item(*cfg),
-            &check,
+            &long_run(seed(200 + i as u64), MILLION, 3),
+            4,
         );
-        assert_eq!(r.resets, 1);
-        assert!(r.compared as usize >= MILLION - 4);
     }
 }
 
 #[test]
 fn directed_extremes() {
     for (variant, cfg) in CONFIGS {
-        let items = directed_items(cfg);
-        let n = items.len();
-        let mut it = items.into_iter().cycle();
-        let check = StreamCheck::new(seed(7), n).with_traffic(0.3, 0.3);
-        must_match(
-            variant,
-            cfg,
-            &mut RBlock::new(cfg).unwrap(),
-            &mut |_| it.next().unwrap(),
-            &check,
-        );
+        let mut gold = RBlock::new(cfg).unwrap();
+        must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(7));
     }
 }
 
@@ -118,47 +108,18 @@ fn every_index_of_the_patent_example_matches_the_lut_form() {
 fn one_conversion_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 1;
     for (variant, cfg) in CONFIGS {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        let mut rng = ChaCha8Rng::seed_from_u64(seed(11));
-        let mut gen = random_item(cfg);
-        let items: Vec<RBlockIn> = (0..100_000).map(|_| gen(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(driven.stats.cycles, n + LATENCY, "{variant}");
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
+        let items = random_items(seed(11), 100_000, random_item(cfg));
+        assert_one_item_per_clock(variant, cfg, &items, LATENCY);
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = RBlockConfig::NARROW;
-    let check = StreamCheck::new(seed(21), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1);
-    must_match(
-        "cube5_rblock_c2_gate",
-        cfg,
-        &mut RBlock::new(cfg).unwrap(),
-        &mut random_item(cfg),
-        &check,
-    );
-    let items = directed_items(cfg);
-    let n = items.len();
-    let mut it = items.into_iter().cycle();
-    let check = StreamCheck::new(seed(22), n).with_traffic(0.3, 0.3);
-    must_match(
-        "cube5_rblock_c2_gate",
-        cfg,
-        &mut RBlock::new(cfg).unwrap(),
-        &mut |_| it.next().unwrap(),
-        &check,
-    );
+    let (variant, cfg) = ("cube5_rblock_c2_gate", RBlockConfig::NARROW);
+    let mut gold = RBlock::new(cfg).unwrap();
+    gate_smoke(variant, cfg, &mut gold, &mut random_item(cfg), seed(21));
+    let mut gold = RBlock::new(cfg).unwrap();
+    must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(22));
 }
 
 /// The comparison tells the interleave orders apart: a model that interleaves z, y, x (the mirror

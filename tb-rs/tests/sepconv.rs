@@ -8,7 +8,10 @@ use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run, must_match,
+    must_match_across_a_reset, must_match_items_with_config, random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, SepconvConfig); 3] = [
     ("cube5_sepconv_v8", SepconvConfig::NARROW),
@@ -75,15 +78,15 @@ fn million_random_items_per_config_with_idle_backpressure_and_reset() {
         let w = rng.random_range(0..=cfg.weight_max());
         let mut gold = Sepconv::new(*cfg, w).unwrap();
         // The weight is written once, before the first item; it must survive the reset.
-        let check = StreamCheck::new(seed(410 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(5)
-            .with_config_writes(gold.config_writes());
-        let r = must_match(variant, *cfg, &mut gold, &mut random_item(*cfg), &check);
-        assert_eq!(r.resets, 1);
-        assert!(
-            r.compared as usize >= MILLION - 1000,
-            "a reset drops at most the items in flight"
+        let check =
+            long_run(seed(410 + i as u64), MILLION, 5).with_config_writes(gold.config_writes());
+        must_match_across_a_reset(
+            variant,
+            *cfg,
+            &mut gold,
+            &mut random_item(*cfg),
+            &check,
+            1000,
         );
     }
 }
@@ -92,14 +95,10 @@ fn million_random_items_per_config_with_idle_backpressure_and_reset() {
 fn directed_extremes_at_every_weight() {
     for (variant, cfg) in CONFIGS {
         for w in weights(cfg) {
-            let items = directed_items(cfg);
-            let n = items.len();
-            let mut it = items.into_iter().cycle();
             let mut gold = Sepconv::new(cfg, w).unwrap();
-            let check = StreamCheck::new(seed(41), n)
-                .with_traffic(0.3, 0.3)
-                .with_config_writes(gold.config_writes());
-            must_match(variant, cfg, &mut gold, &mut |_| it.next().unwrap(), &check);
+            let writes = gold.config_writes();
+            let items = directed_items(cfg);
+            must_match_items_with_config(variant, cfg, &mut gold, items, seed(41), writes);
         }
     }
 }
@@ -108,26 +107,9 @@ fn directed_extremes_at_every_weight() {
 fn one_item_per_cycle_when_never_stalled() {
     for (variant, cfg) in CONFIGS {
         let gold = Sepconv::new(cfg, cfg.weight_from_f64(2.0)).unwrap();
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        for (addr, data) in gold.config_writes() {
-            dut.write_config(addr, &data).unwrap();
-        }
-        let mut rng = rand::SeedableRng::seed_from_u64(seed(42));
-        let mut gen = random_item(cfg);
-        let items: Vec<SepconvIn> = (0..100_000).map(|_| gen(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + LATENCY,
-            "{variant}: one item per clock plus the pipeline fill"
-        );
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
+        let items = random_items(seed(42), 100_000, random_item(cfg));
+        let writes = gold.config_writes();
+        let driven = assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, LATENCY);
         let want = gold.clone().run(&items);
         assert!(driven.outputs.iter().zip(&want).all(|(t, g)| t.value == *g));
     }
@@ -187,35 +169,22 @@ fn a_weight_write_applies_to_items_accepted_after_it() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = SepconvConfig::NARROW;
+    let (variant, cfg) = ("cube5_sepconv_v8_gate", SepconvConfig::NARROW);
     let mut gold = Sepconv::new(cfg, cfg.weight_from_f64(2.0)).unwrap();
-    let check = StreamCheck::new(seed(44), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1)
-        .with_config_writes(gold.config_writes());
-    must_match(
-        "cube5_sepconv_v8_gate",
+    let writes = gold.config_writes();
+    gate_smoke_with_config(
+        variant,
         cfg,
         &mut gold,
         &mut random_item(cfg),
-        &check,
+        seed(44),
+        writes,
     );
     for w in weights(cfg) {
-        let items = directed_items(cfg);
-        let n = items.len();
-        let mut it = items.into_iter().cycle();
         let mut gold = Sepconv::new(cfg, w).unwrap();
-        let check = StreamCheck::new(seed(45), n)
-            .with_traffic(0.3, 0.3)
-            .with_config_writes(gold.config_writes());
-        must_match(
-            "cube5_sepconv_v8_gate",
-            cfg,
-            &mut gold,
-            &mut |_| it.next().unwrap(),
-            &check,
-        );
+        let writes = gold.config_writes();
+        let items = directed_items(cfg);
+        must_match_items_with_config(variant, cfg, &mut gold, items, seed(45), writes);
     }
 }
 

@@ -16,7 +16,10 @@ use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run, must_match,
+    must_match_across_a_reset, must_match_items_with_config, random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, ShaderConfig); 2] = [
     ("cube5_shader_v8", ShaderConfig::NARROW),
@@ -193,21 +196,15 @@ fn shader(cfg: ShaderConfig, tables: &ShaderTables) -> Shader {
 fn million_random_items_per_config_with_idle_backpressure_and_reset() {
     for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
         let tables = random_tables(cfg, seed(300 + i as u64));
-        let check = StreamCheck::new(seed(100 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(3)
+        let check = long_run(seed(100 + i as u64), MILLION, 3)
             .with_config_writes(tables.config_writes(cfg));
-        let r = must_match(
+        must_match_across_a_reset(
             variant,
             *cfg,
             &mut shader(*cfg, &tables),
             &mut random_item(*cfg),
             &check,
-        );
-        assert_eq!(r.resets, 1);
-        assert!(
-            r.compared as usize >= MILLION - 1000,
-            "a reset drops at most the items in flight"
+            1000,
         );
     }
 }
@@ -220,19 +217,14 @@ fn directed_extremes() {
             ("max", max_tables(&cfg)),
             ("lit", lit_tables(&cfg)),
         ] {
-            let items = directed_items(cfg);
-            let n = items.len();
-            let mut it = items.into_iter().cycle();
-            let check = StreamCheck::new(seed(7), n)
-                .with_traffic(0.3, 0.3)
-                .with_config_writes(tables.config_writes(&cfg));
             eprintln!("{variant}: {name} tables");
-            must_match(
+            must_match_items_with_config(
                 variant,
                 cfg,
                 &mut shader(cfg, &tables),
-                &mut |_| it.next().unwrap(),
-                &check,
+                directed_items(cfg),
+                seed(7),
+                tables.config_writes(&cfg),
             );
         }
     }
@@ -242,26 +234,10 @@ fn directed_extremes() {
 fn one_item_per_cycle_when_never_stalled() {
     for (variant, cfg) in CONFIGS {
         let tables = random_tables(&cfg, 11);
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        for (addr, data) in tables.config_writes(&cfg) {
-            dut.write_config(addr, &data).unwrap();
-        }
-        let mut rng = ChaCha8Rng::seed_from_u64(seed(11));
-        let mut gen = random_item(cfg);
-        let items: Vec<ShaderIn> = (0..100_000).map(|_| gen(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + cfg.latency(),
-            "{variant}: one item per clock plus the pipeline fill"
-        );
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
+        let writes = tables.config_writes(&cfg);
+        let items = random_items(seed(11), 100_000, random_item(cfg));
+        let driven =
+            assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, cfg.latency());
         let want = shader(cfg, &tables).run(&items);
         let got: Vec<Rgba> = driven.outputs.into_iter().map(|t| t.value).collect();
         assert!(
@@ -273,32 +249,23 @@ fn one_item_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = ShaderConfig::NARROW;
+    let (variant, cfg) = ("cube5_shader_v8_gate", ShaderConfig::NARROW);
     let tables = random_tables(&cfg, 21);
-    let check = StreamCheck::new(seed(21), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1)
-        .with_config_writes(tables.config_writes(&cfg));
-    must_match(
-        "cube5_shader_v8_gate",
+    gate_smoke_with_config(
+        variant,
         cfg,
         &mut shader(cfg, &tables),
         &mut random_item(cfg),
-        &check,
+        seed(21),
+        tables.config_writes(&cfg),
     );
-    let items = directed_items(cfg);
-    let n = items.len();
-    let mut it = items.into_iter().cycle();
-    let check = StreamCheck::new(seed(22), n)
-        .with_traffic(0.3, 0.3)
-        .with_config_writes(tables.config_writes(&cfg));
-    must_match(
-        "cube5_shader_v8_gate",
+    must_match_items_with_config(
+        variant,
         cfg,
         &mut shader(cfg, &tables),
-        &mut |_| it.next().unwrap(),
-        &check,
+        directed_items(cfg),
+        seed(22),
+        tables.config_writes(&cfg),
     );
 }
 

@@ -16,7 +16,10 @@ use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run,
+    must_match_across_a_reset, must_match_items_with_config, seed, MILLION,
+};
 
 const VARIANTS: [(&str, SkewConfig); 5] = [
     ("cube5_skewmem_p1", SkewConfig::P1),
@@ -142,22 +145,15 @@ fn scripted(
 fn random_run(variant: &str, cfg: SkewConfig, seed_no: u64, items: usize) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed(seed_no) ^ 0x5eed);
     let (mut gold, fill) = random_scene(cfg, &mut rng);
-    let check = StreamCheck::new(seed(seed_no), items)
-        .with_traffic(0.2, 0.3)
-        .with_reset_in_batch(3)
-        .with_config_writes(gold.config_writes());
+    let check = long_run(seed(seed_no), items, 3).with_config_writes(gold.config_writes());
     let dims = gold.dims().n;
-    let r = must_match(
+    must_match_across_a_reset(
         variant,
         cfg,
         &mut gold,
         &mut scripted(fill, cfg, dims),
         &check,
-    );
-    assert_eq!(r.resets, 1);
-    assert!(
-        r.compared as usize >= items - 64,
-        "a reset drops at most the items in flight"
+        64,
     );
     assert_eq!(gold.checker.conflicts, 0);
     eprintln!(
@@ -290,12 +286,8 @@ fn directed_small(cfg: SkewConfig) -> (SkewMem, Vec<SkewIn>) {
 }
 
 fn run_directed(variant: &str, cfg: SkewConfig, gold: &mut SkewMem, cmds: Vec<SkewIn>, s: u64) {
-    let n = cmds.len();
-    let mut it = cmds.into_iter().cycle();
-    let check = StreamCheck::new(seed(s), n)
-        .with_traffic(0.3, 0.3)
-        .with_config_writes(gold.config_writes());
-    must_match(variant, cfg, gold, &mut |_| it.next().unwrap(), &check);
+    let writes = gold.config_writes();
+    must_match_items_with_config(variant, cfg, gold, cmds, seed(s), writes);
 }
 
 #[test]
@@ -452,55 +444,33 @@ fn random_writes_then_reads_match_a_plain_vector() {
 #[test]
 fn one_command_per_cycle_when_never_stalled() {
     for (variant, cfg) in VARIANTS {
-        let latency = u64::from(cfg.latency());
+        let latency = u64::from(cfg.latency()); // the pipeline fill: ReadLatency + 2
         let mut rng = ChaCha8Rng::seed_from_u64(seed(11));
         let (gold, fill) = random_scene(cfg, &mut rng);
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        for (a, d) in gold.config_writes() {
-            dut.write_config(a, &d).unwrap();
-        }
         let mut items = fill;
         items.extend((0..50_000).map(|_| random_command(cfg, gold.dims().n, &mut rng)));
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + latency,
-            "{variant}: one command per clock plus the pipeline fill (ReadLatency + 2)"
-        );
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(
-            last - first + 1,
-            n,
-            "{variant}: responses leave back to back"
-        );
+        let writes = gold.config_writes();
+        assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, latency);
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = SkewConfig::P2;
+    let (variant, cfg) = ("cube5_skewmem_p2_gate", SkewConfig::P2);
     let mut rng = ChaCha8Rng::seed_from_u64(seed(21));
     let (mut gold, fill) = random_scene(cfg, &mut rng);
     let dims = gold.dims().n;
-    let check = StreamCheck::new(seed(21), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1)
-        .with_config_writes(gold.config_writes());
-    must_match(
-        "cube5_skewmem_p2_gate",
+    let writes = gold.config_writes();
+    gate_smoke_with_config(
+        variant,
         cfg,
         &mut gold,
         &mut scripted(fill, cfg, dims),
-        &check,
+        seed(21),
+        writes,
     );
     let (mut gold, cmds) = directed_full(cfg);
-    run_directed("cube5_skewmem_p2_gate", cfg, &mut gold, cmds, 22);
+    run_directed(variant, cfg, &mut gold, cmds, 22);
 }
 
 /// Stateful checks that trilin's scoreboard never needed: a LUT entry, a dimension or one write

@@ -4,10 +4,13 @@ mod support;
 
 use cube5_model::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
+use cube5_tb::rtl::{RtlError, RtlStream};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-use support::{must_match, seed, MILLION};
+use support::{
+    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_items,
+    random_items, seed, MILLION,
+};
 
 const CONFIGS: [(&str, TrilinConfig); 3] = [
     ("cube5_trilin_v8", TrilinConfig::NARROW),
@@ -71,20 +74,13 @@ fn directed_items(cfg: TrilinConfig) -> Vec<TrilinIn> {
 #[test]
 fn million_random_samples_per_config_with_idle_backpressure_and_reset() {
     for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
-        let check = StreamCheck::new(seed(100 + i as u64), MILLION)
-            .with_traffic(0.2, 0.3)
-            .with_reset_in_batch(3);
-        let r = must_match(
+        must_match_across_a_reset(
             variant,
             *cfg,
             &mut Trilin::new(*cfg).unwrap(),
             &mut random_item(*cfg),
-            &check,
-        );
-        assert_eq!(r.resets, 1);
-        assert!(
-            r.compared as usize >= MILLION - 1000,
-            "a reset drops at most the items in flight"
+            &long_run(seed(100 + i as u64), MILLION, 3),
+            1000,
         );
     }
 }
@@ -92,17 +88,8 @@ fn million_random_samples_per_config_with_idle_backpressure_and_reset() {
 #[test]
 fn directed_extremes() {
     for (variant, cfg) in CONFIGS {
-        let items = directed_items(cfg);
-        let n = items.len();
-        let mut it = items.into_iter().cycle();
-        let check = StreamCheck::new(seed(7), n).with_traffic(0.3, 0.3);
-        must_match(
-            variant,
-            cfg,
-            &mut Trilin::new(cfg).unwrap(),
-            &mut |_| it.next().unwrap(),
-            &check,
-        );
+        let mut gold = Trilin::new(cfg).unwrap();
+        must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(7));
     }
 }
 
@@ -110,51 +97,18 @@ fn directed_extremes() {
 fn one_sample_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 3;
     for (variant, cfg) in CONFIGS {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        let mut rng = rand::SeedableRng::seed_from_u64(seed(11));
-        let mut gen = random_item(cfg);
-        let items: Vec<TrilinIn> = (0..100_000).map(|_| gen(&mut rng)).collect();
-        let n = items.len() as u64;
-        let driven = dut
-            .drive(&items, &Traffic::full_speed(), n, 10 * n)
-            .unwrap();
-        assert_eq!(driven.stats.consumed, n);
-        assert_eq!(
-            driven.stats.cycles,
-            n + LATENCY,
-            "{variant}: one item per clock plus the pipeline fill"
-        );
-        let first = driven.outputs.first().unwrap().cycle;
-        let last = driven.outputs.last().unwrap().cycle;
-        assert_eq!(last - first + 1, n, "{variant}: outputs leave back to back");
+        let items = random_items(seed(11), 100_000, random_item(cfg));
+        assert_one_item_per_clock(variant, cfg, &items, LATENCY);
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = TrilinConfig::NARROW;
-    let check = StreamCheck::new(seed(21), 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1);
-    must_match(
-        "cube5_trilin_v8_gate",
-        cfg,
-        &mut Trilin::new(cfg).unwrap(),
-        &mut random_item(cfg),
-        &check,
-    );
-    let items = directed_items(cfg);
-    let n = items.len();
-    let mut it = items.into_iter().cycle();
-    let check = StreamCheck::new(seed(22), n).with_traffic(0.3, 0.3);
-    must_match(
-        "cube5_trilin_v8_gate",
-        cfg,
-        &mut Trilin::new(cfg).unwrap(),
-        &mut |_| it.next().unwrap(),
-        &check,
-    );
+    let (variant, cfg) = ("cube5_trilin_v8_gate", TrilinConfig::NARROW);
+    let mut gold = Trilin::new(cfg).unwrap();
+    gate_smoke(variant, cfg, &mut gold, &mut random_item(cfg), seed(21));
+    let mut gold = Trilin::new(cfg).unwrap();
+    must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(22));
 }
 
 #[test]

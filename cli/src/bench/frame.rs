@@ -46,11 +46,6 @@ fn measure(rtl: FrameRtl, n: usize, view: [f64; 3], check: bool) -> Result<Row> 
     let t = Instant::now();
     let mut bench = FrameBench::new(rtl, &vol, &lut, 1)?;
     bench.load(&e)?;
-    // After reset the compositing buffer clears its valid bits (4 MaxDim^2 / P cycles): wait for
-    // it with one refused command, so the measured frame is a steady-state frame.
-    bench.write(&[rtl.reg(cube5_tb::frame::REG_MODE, 3)])?;
-    bench.refused(OP_RENDER)?;
-    bench.load(&e)?;
     let load_secs = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let (cycles, sweep) = if check {
