@@ -9,7 +9,7 @@ use cube5_model::camera::Camera;
 use cube5_model::compos::{ComposConfig, Coxel};
 use cube5_model::frame::{self, BasePlane, FrameParams, FrameSetup};
 use cube5_model::phantom::Volume;
-use cube5_model::render::{CompositeMode, Projection};
+use cube5_model::render::{CompositeMode, ImageF64, Projection};
 use cube5_model::scene::Scene;
 use cube5_model::shader::{DistantLight, Phong};
 use cube5_model::skewed::BlockLut;
@@ -255,11 +255,12 @@ pub fn cosim_scene(
 
 /// The base plane as an image, one pixel per coxel.
 fn base_plane_png(bp: &BasePlane, cfg: &ComposConfig) -> image::RgbImage {
-    let mut img = image::RgbImage::new(bp.width as u32, bp.height as u32);
-    for (p, c) in img.pixels_mut().zip(bp.rgb(cfg)) {
-        *p = image::Rgb(c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8));
+    ImageF64 {
+        width: bp.width as u32,
+        height: bp.height as u32,
+        rgb: bp.rgb(cfg),
     }
-    img
+    .to_rgb8()
 }
 
 /// The cost side of the trade in cycles: one frame of `scene` on `cube5_frame` at P = 1, 4, 8,

@@ -139,8 +139,7 @@ pub struct FrameOut {
     pub cycles: u32,
 }
 
-/// Configuration-port writes: (address, data words).
-pub type ConfigWrites = Vec<(u32, Vec<u32>)>;
+pub use crate::rtl::ConfigWrites;
 
 /// What can go wrong driving a frame.
 #[derive(Debug, thiserror::Error)]

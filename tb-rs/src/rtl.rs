@@ -22,6 +22,9 @@ pub enum RtlError {
     Run { name: String, what: String },
 }
 
+/// Configuration-port writes: (address, data words), applied in order.
+pub type ConfigWrites = Vec<(u32, Vec<u32>)>;
+
 /// Per-cycle input idling and output back-pressure, as repeating patterns (nonzero = idle/stall).
 #[derive(Debug, Clone, Default)]
 pub struct Traffic {

@@ -6,9 +6,7 @@
 use anyhow::{anyhow, Result};
 use cube5_model::phantom::head_phantom;
 use cube5_model::skewed::BlockLut;
-use cube5_tb::frame::{
-    as_seen, sparse_scene, Expected, FrameBench, FrameRtl, Look, Render, OP_RENDER,
-};
+use cube5_tb::frame::{as_seen, sparse_scene, Expected, FrameBench, FrameRtl, Look, Render};
 use cube5_tb::rtl::Traffic;
 use std::rc::Rc;
 use std::time::Instant;
@@ -52,19 +50,18 @@ fn measure(rtl: FrameRtl, n: usize, view: [f64; 3], check: bool) -> Result<Row> 
         let st = bench.render_and_compare(&e, &Traffic::full_speed(), 1)?;
         (st.cycles, u64::from(st.sweep))
     } else {
-        let pixels = (e.w * e.h) as u64;
-        let limit = 8 * e.params.samples() as u64 + 1_000_000;
-        let d = bench
-            .dut
-            .drive(&[OP_RENDER], &Traffic::full_speed(), pixels, limit)?;
-        if d.outputs.len() as u64 != pixels {
-            return Err(anyhow!(
-                "{}: {} of {pixels} pixels",
-                rtl.variant,
-                d.outputs.len()
-            ));
+        let got = bench.render(&e, &Traffic::full_speed())?;
+        match got.pixels.first() {
+            Some(first) if got.pixels.len() == e.w * e.h => (got.cycles, u64::from(first.cycles)),
+            _ => {
+                return Err(anyhow!(
+                    "{}: {} of {} pixels",
+                    rtl.variant,
+                    got.pixels.len(),
+                    e.w * e.h
+                ))
+            }
         }
-        (d.stats.cycles, u64::from(d.outputs[0].value.cycles))
     };
     let sim_secs = t.elapsed().as_secs_f64();
     let params = e.params;

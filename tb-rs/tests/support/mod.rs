@@ -11,8 +11,7 @@ use std::fmt::Debug;
 /// Random items per configuration in the long co-simulation runs (the acceptance figure).
 pub const MILLION: usize = 1_000_000;
 
-/// Configuration-port writes (address, data words), loaded before the first item.
-pub type ConfigWrites = Vec<(u32, Vec<u32>)>;
+pub use cube5_tb::rtl::ConfigWrites;
 
 /// A codec the scoreboard can run: inputs it can replay and print, outputs it can compare.
 pub trait Scored: StreamCodec<In: Clone + Debug, Out: Clone + Debug + PartialEq> + Clone {}
