@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// Bumped when the way a variant is built changes, to invalidate every cached object.
-const RECIPE: &str = "cube5-variant-recipe-4";
+const RECIPE: &str = "cube5-variant-recipe-7";
 
 /// Verilator flags for RTL variants (TOOLCHAIN.md; `--x-initial unique` so randReset(2) applies).
 const VERILATE_FLAGS: &[&str] = &[
@@ -30,15 +30,11 @@ const VERILATE_FLAGS: &[&str] = &[
     "--assert",
 ];
 
-/// Extra Verilator flags for gate-level netlists: Verilator 5.006's DFG `REMOVE_NOT_NOT` peephole
-/// mis-simulates some flat netlists at -O3 (docs/architecture.md).
-const GATE_VERILATE_FLAGS: &[&str] = &[
-    "-Wno-fatal",
-    "-Wno-lint",
-    "-Wno-style",
-    "-Wno-UNOPTFLAT",
-    "-fno-dfg-peephole-remove-not-not",
-];
+/// Extra Verilator flags for gate-level netlists. Verilator 5.006 mis-simulates some of Yosys's
+/// flat netlists (Icarus Verilog runs the same netlists right): with its optimisations on (`-O0`
+/// here), and where a vector's bits feed each other through logic (UNOPTFLAT), which `splitnets`
+/// in the Yosys script removes (docs/architecture.md). Both are needed.
+const GATE_VERILATE_FLAGS: &[&str] = &["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O0"];
 
 /// Yosys fails on the warnings that signal a wrong netlist (TOOLCHAIN.md).
 const YOSYS_FATAL: &str = "implicitly declared|Resizing cell port|out of bounds";
@@ -329,7 +325,7 @@ fn build_variant(
             .map(|(k, val)| format!(" -set {k} {val}"))
             .collect();
         let script = format!(
-            "read_verilog -sv {}; {} synth -flatten -top {}; write_verilog -noattr {}",
+            "read_verilog -sv {}; {} synth -flatten -top {}; splitnets; opt_clean; write_verilog -noattr {}",
             reads.join(" "),
             if chparam.is_empty() {
                 String::new()

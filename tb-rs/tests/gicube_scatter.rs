@@ -276,18 +276,8 @@ fn one_ray_per_cycle_when_never_stalled() {
     }
 }
 
-/// Yosys's gate-level netlist of `f8` through the same comparison. Open: the netlist disagrees
-/// with the model (and with the RTL, which matches the model) from the first glossy ray on. Found
-/// so far: Yosys's `proc`, coarse (`synth -run begin:fine`) and `memory_map` netlists all match;
-/// `check` finds no logic loop in the final netlist; Verilator's DFG `REMOVE_NOT_NOT` peephole (off
-/// for gate builds) and Verilator `-O0` change nothing; but the *C++* optimisation level of the
-/// Verilated netlist changes the wrong output (-O0 and -O1 give one direction, -O2 another; and
-/// cube5_frame_s1's gate run fails at -O1 while it passes at -O2), which points at undefined
-/// behaviour in Verilator 5.006's code for large flat netlists rather than at Yosys. Ignored so
-/// `make sim` stays meaningful; the netlist is still built (Yosys must synthesize it without a
-/// fatal warning).
+/// Yosys's gate-level netlist of `f8` through the same comparison.
 #[test]
-#[ignore = "gate netlist of gicube_scatter_f8 mismatches on glossy rays (open; see the comment)"]
 fn gate_level_netlist_smoke() {
     let cfg = ScatterConfig::NARROW;
     let (mut model, writes) = model_and_tables(cfg);
