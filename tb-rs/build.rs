@@ -30,10 +30,9 @@ const VERILATE_FLAGS: &[&str] = &[
     "--assert",
 ];
 
-/// Extra Verilator flags for gate-level netlists. Verilator 5.006 mis-simulates some of Yosys's
-/// flat netlists (Icarus Verilog runs the same netlists right): with its optimisations on (`-O0`
-/// here), and where a vector's bits feed each other through logic (UNOPTFLAT), which `splitnets`
-/// in the Yosys script removes (docs/architecture.md). Both are needed.
+/// Extra Verilator flags for gate-level netlists: `-O0`, because Verilator 5.006's optimisations
+/// mis-simulate some of Yosys's flat netlists. The Yosys script's `splitnets` is the other half of
+/// that workaround (docs/architecture.md, RTL conventions).
 const GATE_VERILATE_FLAGS: &[&str] = &["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O0"];
 
 /// Yosys fails on the warnings that signal a wrong netlist (TOOLCHAIN.md).
