@@ -2,7 +2,10 @@
 CARGO ?= cargo
 DEMO_DIR ?= out
 
-.PHONY: setup demo test sim lint synth bench tradeoff fmt clippy clean
+.PHONY: setup demo test sim sim-full lint synth bench tradeoff fmt clippy clean clean-cache
+
+# The build cache of verilated and compiled RTL variants (shared by every clone on the machine).
+CUBE5_CACHE ?= $(if $(XDG_CACHE_HOME),$(XDG_CACHE_HOME),$(HOME)/.cache)/cube5
 
 setup:
 	@scripts/setup.sh
@@ -19,9 +22,19 @@ demo: setup
 test: setup
 	$(CARGO) test --release --workspace
 
-## The RTL regression alone: every co-simulation test.
+## The RTL regression alone: every co-simulation test that CI runs. `make sim TOP=cube5_trilin`
+## builds only that top's variants and runs its tests (tb-rs/tests/<top>.rs). The build prints
+## which variants it built and which it reused from the cache.
 sim: setup
+ifdef TOP
+	CUBE5_TOPS=$(TOP) $(CARGO) test --release -p cube5-tb --test $(TOP)
+else
 	$(CARGO) test --release -p cube5-tb
+endif
+
+## Everything in `sim` plus the runs too long for CI (tests marked #[ignore = "sim-full: ..."]).
+sim-full: setup
+	CUBE5_FULL=1 $(CARGO) test --release -p cube5-tb -- --include-ignored
 
 lint:
 	@scripts/lint.sh
@@ -45,3 +58,7 @@ clippy:
 clean:
 	$(CARGO) clean
 	rm -rf $(DEMO_DIR)
+
+## Empties the build cache of RTL variants (every variant is rebuilt on the next build).
+clean-cache:
+	rm -rf $(CUBE5_CACHE)

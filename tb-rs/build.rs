@@ -1,8 +1,12 @@
 //! Verilates every RTL variant named in `rtl/**/*.variants` (the one list of verified
 //! configurations), compiles each with the stream shim in `tb/`, and binds them with cxx.
 //!
-//! Each variant is cached in OUT_DIR under a hash of everything that feeds it (RTL files,
-//! parameters, shim headers, tool versions), so touching one unit rebuilds only that unit.
+//! Each variant's object is kept in a content-addressed cache outside `target/`
+//! (`$CUBE5_CACHE`, else `$XDG_CACHE_HOME/cube5`, else `~/.cache/cube5`), keyed on a hash of
+//! everything that feeds it (RTL files, parameters, flags, shim headers, tool versions, this
+//! recipe). An unchanged variant is never compiled twice on a machine: across clones, branches and
+//! `cargo clean`. Entries are built in a private temporary directory and renamed into place, so
+//! two builds can share the cache. `make clean-cache` empties it.
 //! `CUBE5_TOPS=top[,top...]` restricts the build to some tops (for quick iteration on one unit);
 //! CI and `make test` leave it unset and build everything.
 
@@ -13,9 +17,13 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
+use std::time::Instant;
 
 /// Bumped when the way a variant is built changes, to invalidate every cached object.
-const RECIPE: &str = "cube5-variant-recipe-7";
+const RECIPE: &str = "cube5-variant-recipe-8";
+
+/// Layout version of the cache directory (bump when the entry layout changes).
+const CACHE_LAYOUT: &str = "v1";
 
 /// Verilator flags for RTL variants (TOOLCHAIN.md; `--x-initial unique` so randReset(2) applies).
 const VERILATE_FLAGS: &[&str] = &[
@@ -38,10 +46,17 @@ const GATE_VERILATE_FLAGS: &[&str] = &["-Wno-fatal", "-Wno-lint", "-Wno-style", 
 /// Yosys fails on the warnings that signal a wrong netlist (TOOLCHAIN.md).
 const YOSYS_FATAL: &str = "implicitly declared|Resizing cell port|out of bounds";
 
-/// C++ flags from verilated.mk plus an explicit optimisation level.
+/// C++ optimisation level for RTL variants: the co-simulation runs millions of cycles.
+const CXX_OPT_RTL: &str = "-O2";
+
+/// C++ optimisation level for gate-level netlists. Verilator's `-O0` output of a flat netlist is
+/// one huge function that g++ takes 13-17 minutes to compile at `-O2`; the gate tests are short
+/// smoke runs, so compile time dominates (measured in docs/ci.md).
+const CXX_OPT_GATE: &str = "-O0";
+
+/// C++ flags from verilated.mk; the optimisation level comes from `CXX_OPT_*`.
 const CXX_FLAGS: &[&str] = &[
     "-std=c++17",
-    "-O2",
     "-faligned-new",
     "-fcf-protection=none",
     "-DVM_COVERAGE=0",
@@ -60,11 +75,114 @@ struct Variant {
     params: Vec<(String, String)>,
     files: Vec<PathBuf>,
     gate: bool,
+    /// A gate-level netlist with one fault injected by Yosys's `mutate` (an inverted cell pin):
+    /// the tests require the co-simulation to catch it, which shows the gate flow can see a wrong
+    /// netlist at all.
+    mutant: bool,
 }
 
 struct Built {
     full_name: String,
     object: PathBuf,
+    /// Seconds spent building it now; `None` when the cache already held it.
+    built_secs: Option<f64>,
+}
+
+/// The content-addressed store of built objects (see the module comment).
+struct Cache {
+    root: PathBuf,
+}
+
+impl Cache {
+    fn open(out: &Path) -> Self {
+        println!("cargo:rerun-if-env-changed=CUBE5_CACHE");
+        println!("cargo:rerun-if-env-changed=XDG_CACHE_HOME");
+        let base = env::var_os("CUBE5_CACHE")
+            .filter(|s| !s.is_empty())
+            .map(PathBuf::from)
+            .or_else(|| {
+                env::var_os("XDG_CACHE_HOME")
+                    .filter(|s| !s.is_empty())
+                    .map(|x| PathBuf::from(x).join("cube5"))
+            })
+            .or_else(|| env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache/cube5")))
+            // No home directory at all: fall back to the per-build directory (no sharing).
+            .unwrap_or_else(|| out.join("cube5-cache"));
+        let root = base.join(CACHE_LAYOUT);
+        fs::create_dir_all(root.join("tmp"))
+            .unwrap_or_else(|e| panic!("cannot create the build cache {}: {e}", root.display()));
+        Self { root }
+    }
+
+    /// Where the entry for `kind/name` with content hash `stamp` lives once complete.
+    fn entry(&self, kind: &str, name: &str, stamp: &str) -> PathBuf {
+        self.root.join(kind).join(name).join(&stamp[..32])
+    }
+
+    /// A private scratch directory that no other build uses.
+    fn scratch(&self, name: &str) -> PathBuf {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        let dir = self
+            .root
+            .join("tmp")
+            .join(format!("{name}.{}.{nanos}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+        dir
+    }
+
+    /// Moves a finished scratch directory into place. If another build published the same entry
+    /// first, its copy wins (same inputs, same object) and ours is dropped.
+    fn publish(&self, scratch: &Path, entry: &Path) -> Result<(), String> {
+        fs::create_dir_all(entry.parent().unwrap()).map_err(|e| e.to_string())?;
+        if fs::rename(scratch, entry).is_err() {
+            let _ = fs::remove_dir_all(scratch);
+            if !entry.join(COMPLETE).exists() {
+                return Err(format!("cannot publish {} in the cache", entry.display()));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Written last into an entry: its presence means the entry is complete.
+const COMPLETE: &str = "complete";
+
+/// Prints which variants were built and which came from the cache, as cargo warnings (shown by
+/// `make sim`), and writes the same to `target/cube5-variants.txt` with the build times.
+fn report(repo: &Path, cache: &Cache, built: &[Built]) {
+    let fresh: Vec<&Built> = built.iter().filter(|b| b.built_secs.is_some()).collect();
+    let reused = built.len() - fresh.len();
+    let mut text = format!(
+        "cube5 RTL variants: {} built, {} reused from {}\n",
+        fresh.len(),
+        reused,
+        cache.root.display()
+    );
+    for b in built {
+        match b.built_secs {
+            Some(s) => text.push_str(&format!("  built   {:<32} {s:7.1} s\n", b.full_name)),
+            None => text.push_str(&format!("  reused  {}\n", b.full_name)),
+        }
+    }
+    let _ = fs::create_dir_all(repo.join("target"));
+    let _ = fs::write(repo.join("target/cube5-variants.txt"), &text);
+    // Cargo replays this line while the build script is not re-run: it describes the last run.
+    let names: Vec<&str> = fresh.iter().map(|b| b.full_name.as_str()).collect();
+    let listed = if names.is_empty() {
+        String::new()
+    } else if names.len() <= 8 {
+        format!(" ({})", names.join(", "))
+    } else {
+        format!(" ({} and {} more)", names[..8].join(", "), names.len() - 8)
+    };
+    println!(
+        "cargo:warning=RTL variants at the last build of cube5-tb: {} built{listed}, {} reused from the cache; times in target/cube5-variants.txt",
+        fresh.len(),
+        reused
+    );
 }
 
 fn main() {
@@ -109,9 +227,15 @@ fn main() {
         .map(|f| fs::read_to_string(tb.join(f)).unwrap())
         .collect();
     let vlt_text = fs::read_to_string(&vlt).unwrap();
+    let cache = Cache::open(&out);
 
     // Runtime objects, shared by every variant.
-    let runtime = build_runtime(&out, &vl_include, &verilator_version);
+    let runtime = build_runtime(&cache, &vl_include, &verilator_version);
+
+    // Gate-level netlists first: they are the longest builds, so starting them early keeps both
+    // cores busy to the end.
+    let mut selected = selected;
+    selected.sort_by_key(|v| !v.gate);
 
     // Variants, two at a time (the machine has two cores; cargo's NUM_JOBS says how many).
     let jobs: usize = env::var("NUM_JOBS")
@@ -131,11 +255,8 @@ fn main() {
                     v,
                     &[&verilator_version, &yosys_version, &shim_text, &vlt_text],
                 );
-                match build_variant(v, &out, &tb, &vl_include, &vlt, &stamp) {
-                    Ok(obj) => built.lock().unwrap().push(Built {
-                        full_name: v.full_name.clone(),
-                        object: obj,
-                    }),
+                match build_variant(v, &cache, &tb, &vl_include, &vlt, &stamp) {
+                    Ok(b) => built.lock().unwrap().push(b),
                     Err(e) => failures
                         .lock()
                         .unwrap()
@@ -150,6 +271,7 @@ fn main() {
     }
     let mut built = built.into_inner().unwrap();
     built.sort_by(|a, b| a.full_name.cmp(&b.full_name));
+    report(&repo, &cache, &built);
 
     let factory = out.join("duts.cpp");
     write_if_changed(&factory, &factory_source(&built));
@@ -228,10 +350,12 @@ fn parse_variants(repo: &Path, path: &Path) -> Vec<Variant> {
         let name = words.next().unwrap();
         let mut params = Vec::new();
         let mut gate = false;
+        let mut mutant = false;
         for w in words {
             match w.split_once('=') {
                 Some((k, v)) => params.push((k.to_string(), v.to_string())),
                 None if w == "gate" => gate = true,
+                None if w == "mutant" => mutant = true,
                 // Read by scripts/synth.sh only.
                 None if matches!(w, "fmax" | "fmax85" | "sim") => {}
                 None => panic!("{}: unknown flag `{w}`", path.display()),
@@ -243,7 +367,16 @@ fn parse_variants(repo: &Path, path: &Path) -> Vec<Variant> {
             params,
             files: files.clone(),
             gate: false,
+            mutant: false,
         };
+        if mutant {
+            out.push(Variant {
+                full_name: format!("{top}_{name}_mutant"),
+                gate: true,
+                mutant: true,
+                ..base.clone()
+            });
+        }
         if gate {
             out.push(Variant {
                 full_name: format!("{top}_{name}_gate"),
@@ -270,6 +403,9 @@ fn variant_stamp(v: &Variant, extra: &[&str]) -> String {
     h.update(CXX_FLAGS.join(" "));
     if v.gate {
         h.update(GATE_VERILATE_FLAGS.join(" "));
+        h.update(CXX_OPT_GATE);
+    } else {
+        h.update(CXX_OPT_RTL);
     }
     format!("{:x}", h.finalize())
 }
@@ -289,19 +425,49 @@ fn run(cmd: &mut Command, what: &str) -> Result<(), String> {
 
 fn build_variant(
     v: &Variant,
-    out: &Path,
+    cache: &Cache,
     tb: &Path,
     vl_include: &Path,
     vlt: &Path,
     stamp: &str,
-) -> Result<PathBuf, String> {
-    let dir = out.join("variants").join(&v.full_name);
-    let object = dir.join("variant.o");
-    let stamp_file = dir.join("stamp");
-    if object.exists() && fs::read_to_string(&stamp_file).ok().as_deref() == Some(stamp) {
-        return Ok(object);
+) -> Result<Built, String> {
+    let entry = cache.entry("variants", &v.full_name, stamp);
+    if entry.join(COMPLETE).exists() {
+        return Ok(Built {
+            full_name: v.full_name.clone(),
+            object: entry.join("variant.o"),
+            built_secs: None,
+        });
     }
-    let _ = fs::remove_dir_all(&dir); // generated names carry hashes: never reuse stale files
+    let started = Instant::now();
+    let dir = cache.scratch(&v.full_name);
+    let result = compile_variant(v, &dir, tb, vl_include, vlt, stamp);
+    if let Err(e) = result {
+        let _ = fs::remove_dir_all(&dir);
+        return Err(e);
+    }
+    let secs = started.elapsed().as_secs_f64();
+    // The Verilator output is only needed to compile the object; the netlist stays for debugging.
+    let _ = fs::remove_dir_all(dir.join("obj"));
+    fs::write(dir.join(COMPLETE), format!("{secs:.1}\n")).map_err(|e| e.to_string())?;
+    cache.publish(&dir, &entry)?;
+    Ok(Built {
+        full_name: v.full_name.clone(),
+        object: entry.join("variant.o"),
+        built_secs: Some(secs),
+    })
+}
+
+/// Verilates (after Yosys, for a gate-level variant) and compiles one variant into `dir`.
+fn compile_variant(
+    v: &Variant,
+    dir: &Path,
+    tb: &Path,
+    vl_include: &Path,
+    vlt: &Path,
+    stamp: &str,
+) -> Result<(), String> {
+    let object = dir.join("variant.o");
     let mdir = dir.join("obj");
     fs::create_dir_all(&mdir).map_err(|e| e.to_string())?;
     let prefix = format!("V{}", v.full_name);
@@ -323,8 +489,18 @@ fn build_variant(
             .iter()
             .map(|(k, val)| format!(" -set {k} {val}"))
             .collect();
+        // The mutant's one fault: the first of Yosys's evenly sampled inversions, fixed seed.
+        let mutation = if v.mutant {
+            let list = dir.join("mutation.ys");
+            format!(
+                " mutate -list 1 -seed 1 -mode inv -o {0}; script {0};",
+                list.display()
+            )
+        } else {
+            String::new()
+        };
         let script = format!(
-            "read_verilog -sv {}; {} synth -flatten -top {}; splitnets; opt_clean; write_verilog -noattr {}",
+            "read_verilog -sv {}; {} synth -flatten -top {};{mutation} splitnets; opt_clean; write_verilog -noattr {}",
             reads.join(" "),
             if chparam.is_empty() {
                 String::new()
@@ -375,6 +551,7 @@ fn build_variant(
     run(
         Command::new(compiler.path())
             .args(CXX_FLAGS)
+            .arg(if v.gate { CXX_OPT_GATE } else { CXX_OPT_RTL })
             .arg("-I")
             .arg(vl_include)
             .arg("-I")
@@ -389,8 +566,8 @@ fn build_variant(
             .arg(&object),
         "c++",
     )?;
-    fs::write(&stamp_file, stamp).map_err(|e| e.to_string())?;
-    Ok(object)
+    fs::write(dir.join("stamp"), stamp).map_err(|e| e.to_string())?;
+    Ok(())
 }
 
 /// The bit width of a port from Verilator's header: `VL_IN*(&name,MSB,LSB...)` declarations.
@@ -408,30 +585,35 @@ fn port_width(header: &str, port: &str) -> Result<u32, String> {
     Ok(msb + 1)
 }
 
-fn build_runtime(out: &Path, vl_include: &Path, version: &str) -> Vec<PathBuf> {
-    let dir = out.join("verilated-runtime");
-    let stamp_file = dir.join("stamp");
+fn build_runtime(cache: &Cache, vl_include: &Path, version: &str) -> Vec<PathBuf> {
     let sources = [
         "verilated.cpp",
         "verilated_threads.cpp",
         "verilated_vcd_c.cpp",
     ];
-    let objects: Vec<PathBuf> = sources
-        .iter()
-        .map(|s| dir.join(s.replace(".cpp", ".o")))
-        .collect();
-    let stamp = format!("{RECIPE}{version}{}", CXX_FLAGS.join(" "));
-    if objects.iter().all(|o| o.exists())
-        && fs::read_to_string(&stamp_file).ok().as_deref() == Some(stamp.as_str())
-    {
-        return objects;
+    let mut h = Sha256::new();
+    h.update(format!(
+        "{RECIPE}{version}{}{CXX_OPT_RTL}",
+        CXX_FLAGS.join(" ")
+    ));
+    let stamp = format!("{:x}", h.finalize());
+    let entry = cache.entry("runtime", "verilated", &stamp);
+    let objects = |dir: &Path| -> Vec<PathBuf> {
+        sources
+            .iter()
+            .map(|s| dir.join(s.replace(".cpp", ".o")))
+            .collect()
+    };
+    if entry.join(COMPLETE).exists() {
+        return objects(&entry);
     }
-    fs::create_dir_all(&dir).unwrap();
+    let dir = cache.scratch("verilated-runtime");
     let compiler = cc::Build::new().cpp(true).get_compiler();
-    for (src, obj) in sources.iter().zip(&objects) {
+    for (src, obj) in sources.iter().zip(objects(&dir)) {
         run(
             Command::new(compiler.path())
                 .args(CXX_FLAGS)
+                .arg(CXX_OPT_RTL)
                 .arg("-I")
                 .arg(vl_include)
                 .arg("-I")
@@ -444,8 +626,11 @@ fn build_runtime(out: &Path, vl_include: &Path, version: &str) -> Vec<PathBuf> {
         )
         .unwrap_or_else(|e| panic!("{e}"));
     }
-    fs::write(&stamp_file, stamp).unwrap();
-    objects
+    fs::write(dir.join(COMPLETE), "").unwrap();
+    cache
+        .publish(&dir, &entry)
+        .unwrap_or_else(|e| panic!("{e}"));
+    objects(&entry)
 }
 
 fn factory_source(built: &[Built]) -> String {

@@ -1,7 +1,7 @@
 //! Driving `cube5_frame`, the slice-order machine, against the golden model: the frame's stream
 //! and configuration formats (docs/numerics/frame.md, "RTL configuration map"), its verified
 //! configurations, the model's image of a frame, and one loaded DUT that renders a frame and
-//! compares every pixel and channel. Used by tb-rs/tests/frame.rs, `cube5 cosim` and `cube5 bench`.
+//! compares every pixel and channel. Used by tb-rs/tests/cube5_frame.rs, `cube5 cosim` and `cube5 bench`.
 //!
 //! A stream item is a command (`render`); its outputs are the W x H coxels of the base plane, so
 //! the 1:1 `check_stream` does not apply: the volume and the tables go in through the

@@ -111,6 +111,24 @@ fn gate_level_netlist_smoke() {
     must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(22));
 }
 
+/// The gate-level flow must be able to see a wrong netlist: the same smoke run on a netlist with
+/// one inverted cell pin (Yosys `mutate`, variant flag `mutant`) has to mismatch.
+#[test]
+fn gate_level_netlist_with_a_seeded_fault_is_caught() {
+    let (variant, cfg) = ("cube5_trilin_v8_mutant", TrilinConfig::NARROW);
+    let check = StreamCheck::new(seed(23), 30_000).with_traffic(0.2, 0.3);
+    let err = check_stream(
+        variant,
+        cfg,
+        &mut Trilin::new(cfg).unwrap(),
+        &mut random_item(cfg),
+        &check,
+    )
+    .expect_err("the mutated netlist must mismatch the model");
+    assert_ne!(err.item, u64::MAX, "the mutant did not run: {err}");
+    eprintln!("seeded fault caught: {err}");
+}
+
 #[test]
 fn a_flipped_output_bit_is_reported_with_seed_inputs_outputs_and_waveform() {
     let cfg = TrilinConfig::DEFAULT;
