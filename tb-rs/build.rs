@@ -20,7 +20,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 /// Bumped when the way a variant is built changes, to invalidate every cached object.
-const RECIPE: &str = "cube5-variant-recipe-8";
+const RECIPE: &str = "cube5-variant-recipe-9";
 
 /// Layout version of the cache directory (bump when the entry layout changes).
 const CACHE_LAYOUT: &str = "v1";
@@ -253,6 +253,7 @@ fn main() {
                 let Some(v) = selected.get(i) else { break };
                 let stamp = variant_stamp(
                     v,
+                    &repo,
                     &[&verilator_version, &yosys_version, &shim_text, &vlt_text],
                 );
                 match build_variant(v, &cache, &tb, &vl_include, &vlt, &stamp) {
@@ -389,14 +390,25 @@ fn parse_variants(repo: &Path, path: &Path) -> Vec<Variant> {
     out
 }
 
-fn variant_stamp(v: &Variant, extra: &[&str]) -> String {
+/// The cache key of a variant. Files enter by their path relative to the repository and their
+/// text, never by absolute path, so every clone on the machine shares the same entries.
+fn variant_stamp(v: &Variant, repo: &Path, extra: &[&str]) -> String {
     let mut h = Sha256::new();
     h.update(RECIPE);
-    h.update(format!("{v:?}"));
+    h.update(format!(
+        "{} {} {:?} gate={} mutant={}",
+        v.top, v.full_name, v.params, v.gate, v.mutant
+    ));
     for e in extra {
         h.update(e);
     }
     for f in &v.files {
+        h.update(
+            f.strip_prefix(repo)
+                .unwrap_or(f)
+                .to_string_lossy()
+                .as_bytes(),
+        );
         h.update(fs::read(f).unwrap_or_else(|e| panic!("{}: {e}", f.display())));
     }
     h.update(VERILATE_FLAGS.join(" "));

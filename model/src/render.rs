@@ -12,8 +12,10 @@
 //!   every sample comes from the bit-accurate `cube5_trilin` model, every gradient from the
 //!   bit-accurate `cube5_gradient` model (cube3-paper §4's 6-, 10- and 26-neighbourhoods on the ray
 //!   lattice); classification, shading and compositing are f64 rounded to the colour, alpha and
-//!   accumulator widths (the shader and compositing models are wired in later); the base-plane
-//!   image is warped onto the image. See `docs/scenes.md` § Quality.
+//!   accumulator widths, NOT the `cube5_shader`/`cube5_compos` models: this pipeline is the
+//!   what-if renderer for the quality knobs, and the hardware's bits are `frame::render_base_plane`
+//!   (making `cube5 render` run the frame model is issue 13); the base-plane image is warped onto
+//!   the image. See `docs/scenes.md` § Quality.
 
 use crate::camera::Camera;
 use crate::error::{ModelError, Result};
