@@ -25,7 +25,7 @@ const RECIPE: &str = "cube5-variant-recipe-9";
 /// Layout version of the cache directory (bump when the entry layout changes).
 const CACHE_LAYOUT: &str = "v1";
 
-/// Verilator flags for RTL variants (TOOLCHAIN.md; `--x-initial unique` so randReset(2) applies).
+/// Verilator flags for RTL variants (docs/toolchain.md; `--x-initial unique` so randReset(2) applies).
 const VERILATE_FLAGS: &[&str] = &[
     "--cc",
     "--no-timing",
@@ -43,11 +43,42 @@ const VERILATE_FLAGS: &[&str] = &[
 /// that workaround (docs/architecture.md, RTL conventions).
 const GATE_VERILATE_FLAGS: &[&str] = &["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O0"];
 
-/// Yosys fails on the warnings that signal a wrong netlist (TOOLCHAIN.md).
+/// The gate-level netlist: Yosys's `synth -flatten` script from its `fine:` label on, without
+/// `memory_map`. Memories stay memories (written as arrays, as an FPGA flow keeps them in block
+/// RAM) instead of becoming flip-flops and read multiplexers that no FPGA build would contain;
+/// every other cell is a gate, mapped by ABC. This halves the netlist of `cube5_frame` `s1` and
+/// cuts its build from 195 s to 70 s (docs/ci.md).
+const GATE_FINE: &str = "opt -fast -full; opt -full; techmap; opt -fast; abc -fast; opt -fast; \
+                         hierarchy -check; check;";
+
+/// Yosys fails on the warnings that signal a wrong netlist (docs/toolchain.md).
 const YOSYS_FATAL: &str = "implicitly declared|Resizing cell port|out of bounds";
 
-/// C++ optimisation level for RTL variants: the co-simulation runs millions of cycles.
-const CXX_OPT_RTL: &str = "-O2";
+/// C++ optimisation level for RTL variants, unless `CUBE5_RTL_CXX_OPT` says otherwise. `-O1`
+/// compiles the large tops in half the time of `-O2` (`cube5_frame` `p8`: 52 s against 96 s) and
+/// simulates about a quarter slower; `make bench` builds at `-O2` for the simulation-speed figures.
+const CXX_OPT_RTL_DEFAULT: &str = "-O1";
+
+/// The C++ level of RTL variants for this build (read once).
+fn rtl_opt() -> &'static str {
+    static OPT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    OPT.get_or_init(cxx_opt_rtl)
+}
+
+fn cxx_opt_rtl() -> String {
+    println!("cargo:rerun-if-env-changed=CUBE5_RTL_CXX_OPT");
+    match env::var("CUBE5_RTL_CXX_OPT") {
+        Ok(o) if !o.trim().is_empty() => {
+            let o = o.trim().to_string();
+            assert!(
+                matches!(o.as_str(), "-O0" | "-O1" | "-O2" | "-O3" | "-Os"),
+                "CUBE5_RTL_CXX_OPT must be one of -O0, -O1, -O2, -O3, -Os (got `{o}`)"
+            );
+            o
+        }
+        _ => CXX_OPT_RTL_DEFAULT.to_string(),
+    }
+}
 
 /// C++ optimisation level for gate-level netlists. Verilator's `-O0` output of a flat netlist is
 /// one huge function that g++ takes 13-17 minutes to compile at `-O2`; the gate tests are short
@@ -117,6 +148,21 @@ impl Cache {
     /// Where the entry for `kind/name` with content hash `stamp` lives once complete.
     fn entry(&self, kind: &str, name: &str, stamp: &str) -> PathBuf {
         self.root.join(kind).join(name).join(&stamp[..32])
+    }
+
+    /// Seconds the newest complete entry of `name` (any content hash) took to build, if any.
+    fn last_build_secs(&self, name: &str) -> Option<f64> {
+        fs::read_dir(self.root.join("variants").join(name))
+            .ok()?
+            .flatten()
+            .filter_map(|e| {
+                let marker = e.path().join(COMPLETE);
+                let modified = marker.metadata().ok()?.modified().ok()?;
+                let secs: f64 = fs::read_to_string(&marker).ok()?.trim().parse().ok()?;
+                Some((modified, secs))
+            })
+            .max_by_key(|(modified, _)| *modified)
+            .map(|(_, secs)| secs)
     }
 
     /// A private scratch directory that no other build uses.
@@ -232,10 +278,15 @@ fn main() {
     // Runtime objects, shared by every variant.
     let runtime = build_runtime(&cache, &vl_include, &verilator_version);
 
-    // Gate-level netlists first: they are the longest builds, so starting them early keeps both
-    // cores busy to the end.
+    // Longest builds first (by the time the cache recorded for the same variant before; gate
+    // netlists first when nothing is recorded), so both cores stay busy to the end.
     let mut selected = selected;
-    selected.sort_by_key(|v| !v.gate);
+    let expected = |v: &Variant| {
+        cache
+            .last_build_secs(&v.full_name)
+            .unwrap_or(if v.gate { 1e3 } else { 0.0 })
+    };
+    selected.sort_by(|a, b| expected(b).total_cmp(&expected(a)));
 
     // Variants, two at a time (the machine has two cores; cargo's NUM_JOBS says how many).
     let jobs: usize = env::var("NUM_JOBS")
@@ -416,8 +467,9 @@ fn variant_stamp(v: &Variant, repo: &Path, extra: &[&str]) -> String {
     if v.gate {
         h.update(GATE_VERILATE_FLAGS.join(" "));
         h.update(CXX_OPT_GATE);
+        h.update(GATE_FINE);
     } else {
-        h.update(CXX_OPT_RTL);
+        h.update(rtl_opt());
     }
     format!("{:x}", h.finalize())
 }
@@ -512,7 +564,7 @@ fn compile_variant(
             String::new()
         };
         let script = format!(
-            "read_verilog -sv {}; {} synth -flatten -top {};{mutation} splitnets; opt_clean; write_verilog -noattr {}",
+            "read_verilog -sv {}; {} synth -flatten -top {} -run begin:fine; {GATE_FINE}{mutation} splitnets; opt_clean; write_verilog -noattr {}",
             reads.join(" "),
             if chparam.is_empty() {
                 String::new()
@@ -563,7 +615,7 @@ fn compile_variant(
     run(
         Command::new(compiler.path())
             .args(CXX_FLAGS)
-            .arg(if v.gate { CXX_OPT_GATE } else { CXX_OPT_RTL })
+            .arg(if v.gate { CXX_OPT_GATE } else { rtl_opt() })
             .arg("-I")
             .arg(vl_include)
             .arg("-I")
@@ -605,8 +657,9 @@ fn build_runtime(cache: &Cache, vl_include: &Path, version: &str) -> Vec<PathBuf
     ];
     let mut h = Sha256::new();
     h.update(format!(
-        "{RECIPE}{version}{}{CXX_OPT_RTL}",
-        CXX_FLAGS.join(" ")
+        "{RECIPE}{version}{}{}",
+        CXX_FLAGS.join(" "),
+        rtl_opt()
     ));
     let stamp = format!("{:x}", h.finalize());
     let entry = cache.entry("runtime", "verilated", &stamp);
@@ -625,7 +678,7 @@ fn build_runtime(cache: &Cache, vl_include: &Path, version: &str) -> Vec<PathBuf
         run(
             Command::new(compiler.path())
                 .args(CXX_FLAGS)
-                .arg(CXX_OPT_RTL)
+                .arg(rtl_opt())
                 .arg("-I")
                 .arg(vl_include)
                 .arg("-I")
