@@ -21,7 +21,9 @@ use rayon::prelude::*;
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;
 
-/// Largest volume edge the frame supports (the RTL's `MaxDim` default).
+/// Largest volume edge the frame model accepts. It is not an RTL figure: the RTL's `MaxDim`
+/// defaults to 64 and stops at 256 (`$fatal`), and a co-simulation refuses a volume larger than its
+/// variant's `MaxDim`.
 pub const MAX_DIM: usize = 512;
 
 /// The quantized parameters of one frame: everything the RTL is told about the view.
