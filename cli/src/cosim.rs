@@ -6,13 +6,13 @@
 use crate::{load_scene, write_png_atomically};
 use anyhow::{anyhow, bail, Context, Result};
 use cube5_model::camera::Camera;
-use cube5_model::compos::{ComposConfig, Coxel};
-use cube5_model::frame::{self, BasePlane, FrameParams, FrameSetup};
-use cube5_model::phantom::Volume;
 use cube5_model::render::{CompositeMode, ImageF64, Projection};
 use cube5_model::scene::Scene;
-use cube5_model::shader::{DistantLight, Phong};
-use cube5_model::skewed::BlockLut;
+use cube5_model::units::cube5_compos::{ComposConfig, Coxel};
+use cube5_model::units::cube5_frame::{self, BasePlane, FrameParams, FrameSetup};
+use cube5_model::units::cube5_shader::{DistantLight, Phong};
+use cube5_model::units::cube5_skewmem::BlockLut;
+use cube5_model::volume::Volume;
 use cube5_tb::frame::{as_seen, Expected, FrameBench, FrameError, FrameRtl, Look, Render};
 use cube5_tb::rtl::Traffic;
 use std::path::{Path, PathBuf};
@@ -87,7 +87,7 @@ pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
             intensity: (l.colour.iter().sum::<f64>() / 3.0).clamp(0.0, 4.0),
         })
         .collect();
-    let base = frame::frame_phong(params, &lights);
+    let base = cube5_frame::frame_phong(params, &lights);
     if scene.render.shading {
         let m = scene.shading;
         Phong {
@@ -239,7 +239,7 @@ pub fn cosim_scene(
         let base = base_plane_png(bp, &cfg);
         let path = out_dir.join(format!("{who}-base-plane.png"));
         write_png_atomically(&base, &path)?;
-        let warped = frame::warp(
+        let warped = cube5_frame::warp(
             &e.params,
             vol.spacing,
             &bp.rgb(&cfg),

@@ -18,7 +18,7 @@ use clap::{Parser, Subcommand};
 use cube5_model::phantom::{phantom_by_name, PHANTOMS};
 use cube5_model::render::{render_pipeline, render_reference, ImageF64};
 use cube5_model::scene::{Plan, Renderer, Scene};
-use cube5_model::tradeoff::image_error;
+use cube5_model::studies::tradeoff::image_error;
 use cube5_model::volume_io::{self, Endian, NrrdEncoding};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

@@ -1,4 +1,4 @@
-//! `cube5 tradeoff [SCENE]`: runs the sweeps of `cube5_model::tradeoff` with progress bars and
+//! `cube5 tradeoff [SCENE]`: runs the sweeps of `cube5_model::studies::tradeoff` with progress bars and
 //! writes the tables (Markdown and CSV) and plots (PNG). `--write-docs` regenerates
 //! `docs/tradeoffs.md` and `docs/img/tradeoff-*`.
 //!
@@ -7,12 +7,13 @@
 //! not have.
 
 use anyhow::{bail, Context, Result};
-use cube5_model::render::{Quality, RenderParams, TransferFunction};
+use cube5_model::render::{Quality, RenderParams};
 use cube5_model::scene::Scene;
-use cube5_model::tradeoff::{
+use cube5_model::studies::tradeoff::{
     run as run_sweeps, Figure, Progress, Report, Setup, Synth, Table, PAPER_VS_IMAGE_ORDER,
     PAPER_VS_TRUE3D,
 };
+use cube5_model::transfer::TransferFunction;
 use cube5_model::volume_io::write_atomically;
 use image::{Rgb, RgbImage};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -960,7 +961,7 @@ pub fn draw(f: &Figure) -> RgbImage {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cube5_model::tradeoff::Series;
+    use cube5_model::studies::tradeoff::Series;
 
     #[test]
     fn ticks_cover_the_range() {

@@ -2,23 +2,23 @@
 //! contract in `docs/numerics.md`, plus f64 reference renderers to measure error against.
 //!
 //! Pure Rust: builds and tests with no Verilator and no C++ compiler.
+//!
+//! Layering, bottom up: `bits`, `error`, `unit` (the stream trait every unit implements);
+//! `volume`, `transfer`, `camera`; `units` (one module per RTL top, named as the top);
+//! `phantom`, `volume_io`, `scene`, `render` (scenes, files and renderers that use the units);
+//! `studies` (the tradeoff sweeps, not part of the golden model).
 
 pub mod bits;
-pub mod blocking;
 pub mod camera;
-pub mod compos;
 pub mod error;
-pub mod frame;
-pub mod gicube;
-pub mod gradient;
 pub mod phantom;
 pub mod render;
 pub mod scene;
-pub mod shader;
-pub mod skewed;
-pub mod tradeoff;
-pub mod trilin;
+pub mod studies;
+pub mod transfer;
 pub mod unit;
+pub mod units;
+pub mod volume;
 pub mod volume_io;
 
 pub use error::{ModelError, Result};

@@ -8,11 +8,13 @@
 //! at a step of exactly one voxel, ...) and why the others are left out.
 
 use crate::error::{ModelError, Result};
-use crate::phantom::{phantom_by_name, Volume, MAX_EDGE, PHANTOMS};
+use crate::phantom::{phantom_by_name, PHANTOMS};
 use crate::render::{
     CompositeMode, GradientScheme, Interpolation, Light, Material, Projection, Quality,
-    RenderParams, SliceSetup, TfPoint, TransferFunction, View, TF_PRESETS,
+    RenderParams, SliceSetup, View,
 };
+use crate::transfer::{TfPoint, TransferFunction, TF_PRESETS};
+use crate::volume::{Volume, MAX_EDGE};
 use crate::volume_io::{self, Endian, Format, RawSpec, VoxelType};
 use serde::{Deserialize, Serialize};
 use std::fmt;

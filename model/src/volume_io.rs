@@ -11,7 +11,7 @@
 //! makes a reader panic (the header parsers are fuzzed in `model/tests/volume_io.rs`).
 
 use crate::error::{ModelError, Result};
-use crate::phantom::{Volume, MAX_EDGE};
+use crate::volume::{Volume, MAX_EDGE};
 use flate2::read::GzDecoder;
 use flate2::write::GzEncoder;
 use flate2::Compression;

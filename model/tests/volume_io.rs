@@ -2,7 +2,8 @@
 //! and NIfTI read back exactly; and the NRRD and NIfTI header parsers never panic (proptest,
 //! a bounded number of cases in the normal test run).
 
-use cube5_model::phantom::{phantom_by_name, Volume};
+use cube5_model::phantom::phantom_by_name;
+use cube5_model::volume::Volume;
 use cube5_model::volume_io::{
     parse_nifti_header, parse_nrrd_header, read_nifti, read_nrrd, read_raw, write_nifti,
     write_nrrd, Endian, NrrdEncoding, RawSpec, VoxelType,

@@ -1,6 +1,6 @@
 // cube5_compos_pkg: widths, mode codes and configuration addresses of cube5_compos.
 //
-// The SystemVerilog reading of docs/numerics/compos.md; the Rust model (model/src/compos.rs) reads
+// The SystemVerilog reading of docs/numerics/compos.md; the Rust model (model/src/units/cube5_compos.rs) reads
 // the same page independently. Functions assign their name (no `return`) so Yosys 0.23 accepts them.
 package cube5_compos_pkg;
 

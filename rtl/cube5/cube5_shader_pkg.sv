@@ -1,6 +1,6 @@
 // cube5_shader_pkg: widths and encodings of cube5_shader (docs/numerics/shader.md).
 //
-// The SystemVerilog reading of the shader's contract page; the Rust model (model/src/shader.rs)
+// The SystemVerilog reading of the shader's contract page; the Rust model (model/src/units/cube5_shader.rs)
 // reads the same page independently. Functions assign their name (no `return`) for Yosys 0.23.
 package cube5_shader_pkg;
 

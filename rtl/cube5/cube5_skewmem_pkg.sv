@@ -1,6 +1,6 @@
 // cube5_skewmem_pkg: widths and encodings of the skewed memory controller (cube5_skewmem).
 //
-// The SystemVerilog reading of docs/numerics/skewmem.md; the Rust model (model/src/skewed.rs)
+// The SystemVerilog reading of docs/numerics/skewmem.md; the Rust model (model/src/units/cube5_skewmem.rs)
 // reads the same page independently. Functions assign their name (no `return`) for Yosys 0.23.
 package cube5_skewmem_pkg;
 

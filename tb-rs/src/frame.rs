@@ -10,18 +10,24 @@
 
 use crate::rtl::{RtlError, RtlStream, Traffic};
 use cube5_model::bits::{BitReader, BitWriter};
-use cube5_model::compos::{self, Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut};
 use cube5_model::error::ModelError;
-use cube5_model::frame::{self, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepAccesses};
-use cube5_model::gradient::{block_index, Gradient, GradientConfig, GradientIn, GradientMode};
-use cube5_model::phantom::Volume;
-use cube5_model::render::TransferFunction;
-use cube5_model::shader::{
+use cube5_model::transfer::TransferFunction;
+use cube5_model::unit::StreamCodec;
+use cube5_model::units::cube5_compos::{
+    self, Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut,
+};
+use cube5_model::units::cube5_frame::{
+    self, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepAccesses,
+};
+use cube5_model::units::cube5_gradient::{
+    block_index, Gradient, GradientConfig, GradientIn, GradientMode,
+};
+use cube5_model::units::cube5_shader::{
     ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables,
 };
-use cube5_model::skewed::{BlockLut, SkewConfig, SkewDims, SkewMem};
-use cube5_model::trilin::{Trilin, TrilinConfig};
-use cube5_model::unit::StreamCodec;
+use cube5_model::units::cube5_skewmem::{BlockLut, SkewConfig, SkewDims, SkewMem};
+use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig};
+use cube5_model::volume::Volume;
 use std::rc::Rc;
 
 // -------------------------------------------------------------------------------------------------
@@ -294,13 +300,13 @@ impl FrameRtl {
     }
 
     pub fn compos_writes(&self, lut: &OpacityLut, regs: &ComposRegs) -> Vec<(u32, Vec<u32>)> {
-        compos::config_writes(&self.compos, lut, regs)
+        cube5_compos::config_writes(&self.compos, lut, regs)
             .into_iter()
             .map(|(a, d)| (self.addr(REGION_COMPOS, a), d))
             .collect()
     }
 
-    /// The default unit widths, the only ones `cube5_model::frame::FrameUnits` builds.
+    /// The default unit widths, the only ones `cube5_model::units::cube5_frame::FrameUnits` builds.
     pub fn default_widths(&self) -> bool {
         self.trilin == TrilinConfig::DEFAULT
             && self.gradient == GradientConfig::DEFAULT
@@ -474,7 +480,7 @@ impl Units {
     }
 
     /// One sample's way through gradient, adapter, shader: the compositing unit's sample.
-    pub fn shaded(&self, nb: [u32; 7], s: usize) -> compos::Sample {
+    pub fn shaded(&self, nb: [u32; 7], s: usize) -> cube5_compos::Sample {
         let mut samples = [0u32; 27];
         samples[block_index(0, 0, 0)] = nb[0];
         samples[block_index(-1, 0, 0)] = nb[1];
@@ -498,7 +504,7 @@ impl Units {
                 unlit: self.render == Render::Mip,
             },
         });
-        compos::Sample {
+        cube5_compos::Sample {
             rgb: [rgba.r, rgba.g, rgba.b],
             alpha: rgba.a,
             depth: s as u32,
@@ -547,17 +553,17 @@ pub fn as_seen(vol: &Volume, lut: &BlockLut) -> Result<Volume, ModelError> {
     Volume::new(vol.dims, vol.spacing, vol.bits, data)
 }
 
-/// The base-plane image from the unit models along each ray (`frame::fold_rays`), for the widths
+/// The base-plane image from the unit models along each ray (`cube5_frame::fold_rays`), for the widths
 /// and registers `FrameUnits` does not build (narrow widths, early termination); checked against
-/// `frame::render_base_plane` where both apply.
+/// `cube5_frame::render_base_plane` where both apply.
 pub fn model_image(
     params: &FrameParams,
     vol: &Volume,
     units: &Units,
 ) -> (usize, usize, Vec<Coxel>) {
     let init = Coxel::empty(&units.compos.config());
-    frame::fold_rays(params, vol, &units.trilin, init, |cox, c, (a, b), _| {
-        let nb = frame::neighbourhood(params, vol, c, a, b, &units.trilin);
+    cube5_frame::fold_rays(params, vol, &units.trilin, init, |cox, c, (a, b), _| {
+        let nb = cube5_frame::neighbourhood(params, vol, c, a, b, &units.trilin);
         units.compos.step(cox, &units.shaded(nb, c.s))
     })
 }
@@ -566,11 +572,11 @@ pub fn model_image(
 pub fn ray_trail(params: &FrameParams, vol: &Volume, units: &Units, r: usize, q: usize) -> String {
     let mut trail = String::new();
     let init = Coxel::empty(&units.compos.config());
-    let _ = frame::fold_rays(params, vol, &units.trilin, init, |cox, c, (a, b), x| {
+    let _ = cube5_frame::fold_rays(params, vol, &units.trilin, init, |cox, c, (a, b), x| {
         if params.pixel_of(c, a, b) != (r, q) {
             return *cox;
         }
-        let nb = frame::neighbourhood(params, vol, c, a, b, &units.trilin);
+        let nb = cube5_frame::neighbourhood(params, vol, c, a, b, &units.trilin);
         let smp = units.shaded(nb, c.s);
         let next = units.compos.step(cox, &smp);
         if trail.len() < 4000 {
@@ -615,9 +621,9 @@ impl Expected {
             .opacity_ratio
             .clamp(OpacityLut::RATIO_MIN, OpacityLut::RATIO_MAX);
         let (units, w, h, want) = if rtl.default_widths() && !look.early_termination {
-            // The model's own base plane (cube5_model::frame::render_base_plane).
+            // The model's own base plane (cube5_model::units::cube5_frame::render_base_plane).
             let fu = FrameUnits::new(render.mode(), &setup, &look.tf, &look.phong)?;
-            let bp = frame::render_base_plane(&params, seen, &fu);
+            let bp = cube5_frame::render_base_plane(&params, seen, &fu);
             let units = Units {
                 trilin: fu.trilin,
                 gradient: fu.gradient,
@@ -673,7 +679,7 @@ pub struct FrameBench {
     pub lut: BlockLut,
     /// The tables loaded last (render mode, opacity ratio, early termination): reloaded on change.
     pub loaded: Option<(Render, u64, bool)>,
-    /// Skip the empty slices before and after each sweep (`frame::empty_slices`) when a zero
+    /// Skip the empty slices before and after each sweep (`cube5_frame::empty_slices`) when a zero
     /// sample composites as the identity.
     pub skip_empty: bool,
     /// The slices the last loaded frame skips (before, after).
@@ -743,7 +749,7 @@ impl FrameBench {
             Render::Composite => !u.tf2d && u.shader.tables().class.entries()[0].a == 0,
         };
         self.skip = if self.skip_empty && zero_is_identity {
-            frame::empty_slices(&e.params, &self.lut)
+            cube5_frame::empty_slices(&e.params, &self.lut)
         } else {
             (0, 0)
         };
@@ -802,7 +808,7 @@ impl FrameBench {
     ) -> Result<FrameStats, FrameError> {
         let rtl = self.rtl;
         let mut mem = rtl.memory(self.dims, &self.lut)?;
-        let accesses = frame::sweep_memory(&e.params, self.skip, &mut mem)?;
+        let accesses = cube5_frame::sweep_memory(&e.params, self.skip, &mut mem)?;
         let ctx = || {
             format!(
                 "{} view {} {:?}, {:?}, volume {:?}, {:?}, seed {seed}",

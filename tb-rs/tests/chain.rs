@@ -9,18 +9,18 @@
 
 mod support;
 
-use cube5_model::compos::{
+use cube5_model::transfer::TransferFunction;
+use cube5_model::unit::{StreamCodec, StreamUnit};
+use cube5_model::units::cube5_compos::{
     Compos, ComposConfig, ComposIn, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
 };
-use cube5_model::gradient::{
+use cube5_model::units::cube5_gradient::{
     block_index, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
 };
-use cube5_model::render::TransferFunction;
-use cube5_model::shader::{
+use cube5_model::units::cube5_shader::{
     ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables,
 };
-use cube5_model::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
-use cube5_model::unit::{StreamCodec, StreamUnit};
+use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -2,11 +2,11 @@
 
 mod support;
 
-use cube5_model::compos::{
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_compos::{
     config_writes, Compos, ComposConfig, ComposIn, ComposMode, ComposRegs, Coxel, OpacityLut,
     Sample,
 };
-use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream};
 use rand::{Rng, SeedableRng};

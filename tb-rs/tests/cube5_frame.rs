@@ -4,12 +4,13 @@
 
 mod support;
 
-use cube5_model::compos::Coxel;
-use cube5_model::frame::{self, FrameMode, FrameParams, FrameSetup, FrameUnits};
-use cube5_model::phantom::{head_phantom, Volume};
-use cube5_model::render::TransferFunction;
-use cube5_model::shader::Phong;
-use cube5_model::skewed::BlockLut;
+use cube5_model::phantom::head_phantom;
+use cube5_model::transfer::TransferFunction;
+use cube5_model::units::cube5_compos::Coxel;
+use cube5_model::units::cube5_frame::{self, FrameMode, FrameParams, FrameSetup, FrameUnits};
+use cube5_model::units::cube5_shader::Phong;
+use cube5_model::units::cube5_skewmem::BlockLut;
+use cube5_model::volume::Volume;
 use cube5_tb::frame::*;
 use cube5_tb::rtl::Traffic;
 use rand::{Rng, SeedableRng};
@@ -644,7 +645,7 @@ fn test_side_fold_agrees_with_the_model_base_plane() {
                 &Phong::two_lights(),
             )
             .unwrap();
-            let bp = frame::render_base_plane(&p, &vol, &fu);
+            let bp = cube5_frame::render_base_plane(&p, &vol, &fu);
             let units = Units::new(&P1, render, setup.opacity_ratio, &Look::default()).unwrap();
             let (w, h, mine) = model_image(&p, &vol, &units);
             assert_eq!((w, h), (bp.width, bp.height));

@@ -2,10 +2,10 @@
 
 mod support;
 
-use cube5_model::gradient::{
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_gradient::{
     block_index, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
 };
-use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream};
 use rand::Rng;

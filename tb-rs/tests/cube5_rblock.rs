@@ -2,7 +2,7 @@
 
 mod support;
 
-use cube5_model::blocking::{BlockingLuts, RBlock, RBlockConfig, RBlockDir, RBlockIn};
+use cube5_model::units::cube5_rblock::{BlockingLuts, RBlock, RBlockConfig, RBlockDir, RBlockIn};
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
 use rand::Rng;

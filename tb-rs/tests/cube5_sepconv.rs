@@ -2,8 +2,8 @@
 
 mod support;
 
-use cube5_model::gradient::{Sepconv, SepconvConfig, SepconvIn, SepconvKernel};
 use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_sepconv::{Sepconv, SepconvConfig, SepconvIn, SepconvKernel};
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
 use rand::Rng;

@@ -6,12 +6,12 @@
 
 mod support;
 
-use cube5_model::render::TransferFunction;
-use cube5_model::shader::{
+use cube5_model::transfer::TransferFunction;
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_shader::{
     ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn, ShaderMode,
     ShaderTables, Texel,
 };
-use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
 use rand::{Rng, SeedableRng};

@@ -6,11 +6,11 @@
 
 mod support;
 
-use cube5_model::phantom::Volume;
-use cube5_model::skewed::{
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_skewmem::{
     Axis, BlockEntry, BlockLut, SkewConfig, SkewDims, SkewIn, SkewMem, SkewOp,
 };
-use cube5_model::unit::StreamUnit;
+use cube5_model::volume::Volume;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
 use rand::seq::SliceRandom;
@@ -534,7 +534,7 @@ fn the_comparison_bites_on_state_lut_and_counters() {
     }
     impl StreamUnit for MisplacesOneWrite {
         type In = SkewIn;
-        type Out = cube5_model::skewed::SkewOut;
+        type Out = cube5_model::units::cube5_skewmem::SkewOut;
         fn run(&mut self, inputs: &[SkewIn]) -> Vec<Self::Out> {
             inputs
                 .iter()

@@ -2,7 +2,7 @@
 
 mod support;
 
-use cube5_model::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlError, RtlStream};
 use rand::Rng;

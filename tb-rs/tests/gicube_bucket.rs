@@ -2,10 +2,10 @@
 
 mod support;
 
-use cube5_model::gicube::bucket::{
+use cube5_model::units::gicube_bucket::{
     random_position, BucketConfig, BucketIn, BucketUnit, Distribution, Position,
 };
-use cube5_model::gicube::packet::POS_FRAC_W;
+use cube5_model::units::gicube_packet_loop::POS_FRAC_W;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};

@@ -4,11 +4,11 @@
 
 mod support;
 
-use cube5_model::gicube::packet::{
+use cube5_model::unit::StreamCodec;
+use cube5_model::units::gicube_packet_loop::{
     directed_packets, random_packet, PacketLoop, PacketLoopConfig, PacketLoopOut, RayPacket,
     PACKET_WORDS,
 };
-use cube5_model::unit::StreamCodec;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::SeedableRng;

@@ -2,10 +2,10 @@
 
 mod support;
 
-use cube5_model::gicube::scatter::{
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::gicube_scatter::{
     random_item, Scatter, ScatterConfig, ScatterEvent, ScatterIn, ScatterTables, CFG_SEL_SEED,
 };
-use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::RtlStream;
 use rand::{Rng, SeedableRng};

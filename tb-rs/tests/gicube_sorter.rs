@@ -4,10 +4,10 @@
 
 mod support;
 
-use cube5_model::gicube::sorter::{
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::gicube_sorter::{
     RankState, Sorter, SorterConfig, SorterIn, SorterOp, SorterState, SorterTraffic,
 };
-use cube5_model::unit::StreamUnit;
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand_chacha::ChaCha8Rng;

@@ -1,10 +1,10 @@
 //! Benchmark of cube5_compos: speed, and error over long rays against the f64 reference.
 
 use anyhow::Result;
-use cube5_model::compos::{
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_compos::{
     ray_error, Compos, ComposConfig, ComposIn, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
 };
-use cube5_model::unit::StreamUnit;
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

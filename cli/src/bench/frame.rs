@@ -5,7 +5,7 @@
 
 use anyhow::{anyhow, Result};
 use cube5_model::phantom::head_phantom;
-use cube5_model::skewed::BlockLut;
+use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_tb::frame::{as_seen, sparse_scene, Expected, FrameBench, FrameRtl, Look, Render};
 use cube5_tb::rtl::Traffic;
 use std::rc::Rc;

@@ -1,11 +1,9 @@
 //! Benchmark of cube5_gradient and cube5_sepconv: speed, and error against the f64 references.
 
 use anyhow::Result;
-use cube5_model::gradient::{
-    Gradient, GradientConfig, GradientIn, GradientMode, Sepconv, SepconvConfig, SepconvIn,
-    SepconvKernel,
-};
 use cube5_model::unit::{StreamCodec, StreamUnit};
+use cube5_model::units::cube5_gradient::{Gradient, GradientConfig, GradientIn, GradientMode};
+use cube5_model::units::cube5_sepconv::{Sepconv, SepconvConfig, SepconvIn, SepconvKernel};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -2,10 +2,10 @@
 //! (docs/numerics/gicube_scatter.md § Error) at several bit widths.
 
 use anyhow::Result;
-use cube5_model::gicube::scatter::{
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::gicube_scatter::{
     angle_deg, random_item, Scatter, ScatterConfig, ScatterEvent, ScatterIn,
 };
-use cube5_model::unit::StreamUnit;
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;

@@ -2,11 +2,11 @@
 //! with the same tables, and the error of the reflectance-map approach against direct f64 Phong.
 
 use anyhow::Result;
-use cube5_model::render::TransferFunction;
-use cube5_model::shader::{
+use cube5_model::transfer::TransferFunction;
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_shader::{
     ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables,
 };
-use cube5_model::unit::StreamUnit;
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -3,10 +3,13 @@
 //! threshold trades (module reads saved against error), and what recursive blocking buys a cache.
 
 use anyhow::{anyhow, Result};
-use cube5_model::blocking::{BlockingLuts, RBlock, RBlockConfig, RBlockDir, RBlockIn};
-use cube5_model::phantom::{head_phantom, Volume};
-use cube5_model::skewed::{Axis, BlockLut, SkewConfig, SkewDims, SkewIn, SkewMem, SkewOp};
+use cube5_model::phantom::head_phantom;
 use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_rblock::{BlockingLuts, RBlock, RBlockConfig, RBlockDir, RBlockIn};
+use cube5_model::units::cube5_skewmem::{
+    Axis, BlockLut, SkewConfig, SkewDims, SkewIn, SkewMem, SkewOp,
+};
+use cube5_model::volume::Volume;
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -4,14 +4,16 @@
 //! reference and the load balance of the three distributions; packet quantization error.
 
 use anyhow::Result;
-use cube5_model::gicube::bucket::{random_position, BucketConfig, BucketIn, BucketUnit, Position};
-use cube5_model::gicube::packet::{
+use cube5_model::unit::{StreamCodec, StreamUnit};
+use cube5_model::units::gicube_bucket::{
+    random_position, BucketConfig, BucketIn, BucketUnit, Position,
+};
+use cube5_model::units::gicube_packet_loop::{
     random_packet, PacketLoop, PacketLoopConfig, RayPacket, RayReal, RayType, POS_FRAC_W,
 };
-use cube5_model::gicube::sorter::{
+use cube5_model::units::gicube_sorter::{
     measure_accuracy, Sorter, SorterConfig, SorterIn, SorterTraffic, Workload,
 };
-use cube5_model::unit::{StreamCodec, StreamUnit};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -1,8 +1,8 @@
 //! Benchmark of cube5_trilin: speed, and error against the f64 reference.
 
 use anyhow::Result;
-use cube5_model::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use cube5_model::unit::StreamUnit;
+use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -3,18 +3,22 @@
 //! order, the base-plane image, and the (model-only) warp onto the final image.
 
 use crate::camera::Camera;
-use crate::compos::{Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample};
 use crate::error::{ModelError, Result};
-use crate::gradient::{block_index, Gradient, GradientConfig, GradientIn, GradientMode};
-use crate::phantom::Volume;
 use crate::render::ImageF64;
-use crate::render::TransferFunction;
-use crate::shader::{
+use crate::transfer::TransferFunction;
+use crate::units::cube5_compos::{
+    Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
+};
+use crate::units::cube5_gradient::{
+    block_index, Gradient, GradientConfig, GradientIn, GradientMode,
+};
+use crate::units::cube5_shader::{
     ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn,
     ShaderMode, ShaderTables,
 };
-use crate::skewed::{module_of, Axis, BlockLut, SkewIn, SkewMem};
-use crate::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use crate::units::cube5_skewmem::{module_of, Axis, BlockLut, SkewIn, SkewMem};
+use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use crate::volume::Volume;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -679,7 +683,7 @@ impl BasePlane {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::skewed::{SkewConfig, SkewDims};
+    use crate::units::cube5_skewmem::{SkewConfig, SkewDims};
 
     /// A volume whose voxels are 0 outside `lo..hi` along each axis (a noisy blob inside).
     fn slab_volume(n: usize, lo: [usize; 3], hi: [usize; 3]) -> Volume {
@@ -859,9 +863,7 @@ mod tests {
     fn warped_mip_of_the_phantom_matches_the_reference_mip() {
         // Unquantized MIP of the frame's samples, warped, against the f64 image-order MIP: the
         // same framing and close values prove the geometry of set-up, base plane and warp.
-        use crate::render::{
-            render_reference, CompositeMode, RenderParams, TransferFunction, View,
-        };
+        use crate::render::{render_reference, CompositeMode, RenderParams, View};
         let vol = crate::phantom::head_phantom(32, 12).unwrap();
         let view = View {
             azimuth: 35.0,

@@ -10,8 +10,8 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::phantom::Volume;
 use crate::unit::{StreamCodec, StreamUnit};
+use crate::volume::Volume;
 
 /// Parameters of one `cube5_skewmem` configuration (the RTL parameters of the same names).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

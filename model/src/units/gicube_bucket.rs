@@ -3,8 +3,8 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::gicube::packet::{POS_FRAC_W, POS_W};
 use crate::unit::{StreamCodec, StreamUnit};
+use crate::units::gicube_packet_loop::{POS_FRAC_W, POS_W};
 
 /// How blocks are distributed among processors ([348]); the `Dist` parameter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,13 +12,15 @@
 //! and PNG.
 
 use crate::error::{ModelError, Result};
-use crate::gradient::{block_index, Gradient, GradientConfig, GradientIn};
-use crate::phantom::{sphere_phantom, SphereGeometry, Volume};
+use crate::phantom::{sphere_phantom, SphereGeometry};
 use crate::render::{
     render_pipeline, render_reference, CompositeMode, GradientScheme, ImageF64, Interpolation,
-    Quality, RenderParams, SliceSetup, TransferFunction, View, STEP_W,
+    Quality, RenderParams, SliceSetup, View, STEP_W,
 };
-use crate::trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use crate::transfer::TransferFunction;
+use crate::units::cube5_gradient::{block_index, Gradient, GradientConfig, GradientIn};
+use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use crate::volume::Volume;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::BTreeMap;

@@ -6,7 +6,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::render::TransferFunction;
+use crate::transfer::TransferFunction;
 use crate::unit::{StreamCodec, StreamUnit};
 use glam::DVec3;
 

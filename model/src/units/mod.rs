@@ -1,0 +1,20 @@
+//! The golden model of every RTL top: one file per top, named exactly as the top
+//! (`rtl/cube5/cube5_trilin.sv` is modelled in `units/cube5_trilin.rs`), each written from its
+//! contract page in `docs/numerics/`. The table in `docs/architecture.md` ("Where is each top")
+//! lists RTL, model, contract, test and bench of each.
+//!
+//! Slice-order (Cube-5) units first, then the GI-Cube block processor's (patent [25]-[29],
+//! [346]-[392]).
+
+pub mod cube5_compos;
+pub mod cube5_frame;
+pub mod cube5_gradient;
+pub mod cube5_rblock;
+pub mod cube5_sepconv;
+pub mod cube5_shader;
+pub mod cube5_skewmem;
+pub mod cube5_trilin;
+pub mod gicube_bucket;
+pub mod gicube_packet_loop;
+pub mod gicube_scatter;
+pub mod gicube_sorter;
