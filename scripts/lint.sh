@@ -5,14 +5,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 fail=0
 count=0
-while read -r top flist name flags params; do
+while read -r top name flags files params; do
   gflags=()
   for p in $params; do gflags+=("-G$p"); done
-  if ! verilator --lint-only -Wall --assert rtl/lint/verilator.vlt --top-module "$top" "${gflags[@]}" -f "$flist"; then
+  if ! verilator --lint-only -Wall --assert rtl/lint/verilator.vlt --top-module "$top" "${gflags[@]}" ${files//,/ }; then
     echo "lint FAILED: $top $name ($params)"
     fail=1
   fi
   count=$((count + 1))
 done < <(scripts/variants.sh)
+[ "$count" -gt 0 ] || { echo "lint: no configurations read (scripts/variants.sh failed?)"; exit 1; }
 if [ "$fail" -ne 0 ]; then exit 1; fi
 echo "lint clean: $count configurations (verilator $(verilator --version | cut -d' ' -f2) -Wall)"

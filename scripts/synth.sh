@@ -16,7 +16,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out=target/synth
 mkdir -p "$out"
-fatal='implicitly declared|Resizing cell port|out of bounds'
+gen=target/cube5-gen/debug/cube5-gen
+CARGO_TARGET_DIR=target/cube5-gen cargo build -q -p cube5-gen
+fatal=$("$gen" yosys --fatal)
 venv=.venv-synth/bin
 table="$out/area.md"
 {
@@ -27,15 +29,14 @@ count() { # count LOG CELLNAME: sums the cells whose name starts with CELLNAME i
   # statistics block (synth_* prints its own before our `stat`; counting both doubles the figures)
   awk -v c="$2" '/Number of cells:/ {n = 0} $1 ~ "^"c && $2 ~ /^[0-9]+$/ {n += $2} END {print n + 0}' "$1"
 }
-# synth_one TOP FLIST NAME FLAGS PARAMS...: synthesizes one configuration and writes its table row
+# synth_one TOP NAME FLAGS FILES PARAMS...: synthesizes one configuration and writes its table row
 # to $out/TOP_NAME.row (only on success: a missing row is a failed configuration).
 synth_one() {
-  local top=$1 flist=$2 name=$3 flags=$4
+  local top=$1 name=$2 flags=$3 files=${4//,/ }
   shift 4
-  local files chparam="" base="$out/${top}_$name" p
-  files=$(sed -e 's#//.*##' "$flist" | tr '\n' ' ')
-  for p in "$@"; do chparam="$chparam -set ${p%%=*} ${p#*=}"; done
-  [ -n "$chparam" ] && chparam="chparam$chparam $top;"
+  local base="$out/${top}_$name" prelude
+  # read_verilog and chparam: written once, in scripts/cube5-gen (tb-rs/build.rs uses the same).
+  prelude=$("$gen" yosys "$top" "$name")
   local key f
   key=$( { echo "$flows $tools ${SYNTH_FMAX:-1} $flags $*"; cat "$0"; for f in $files; do cat "$f"; done; } | sha256sum | cut -c1-32)
   local cached="$cache/${top}_$name.$key.row"
@@ -48,17 +49,17 @@ synth_one() {
   local t0=$SECONDS generic="-" fmax="n/a"
   local ecp5 ice40
   if flow generic; then
-    yosys -q -e "$fatal" -l "$base.generic.log" -p "read_verilog -sv $files; $chparam synth -flatten -top $top; stat" >/dev/null
+    yosys -q -e "$fatal" -l "$base.generic.log" -p "$prelude synth -flatten -top $top; stat" >/dev/null
     generic=$(awk '/Number of cells:/ {n = $4} END {print n}' "$base.generic.log")
   fi
   if flow ecp5; then
-    yosys -q -e "$fatal" -l "$base.ecp5.log" -p "read_verilog -sv $files; $chparam synth_ecp5 -top $top -json $base.ecp5.json; stat" >/dev/null
+    yosys -q -e "$fatal" -l "$base.ecp5.log" -p "$prelude synth_ecp5 -top $top -json $base.ecp5.json; stat" >/dev/null
     ecp5="$(count "$base.ecp5.log" LUT4) | $(count "$base.ecp5.log" TRELLIS_FF) | $(count "$base.ecp5.log" CCU2C) | $(count "$base.ecp5.log" MULT18X18D) | $(count "$base.ecp5.log" DP16KD)"
   else
     ecp5="- | - | - | - | -"
   fi
   if flow ice40; then
-    yosys -q -e "$fatal" -l "$base.ice40.log" -p "read_verilog -sv $files; $chparam synth_ice40 -top $top; stat" >/dev/null
+    yosys -q -e "$fatal" -l "$base.ice40.log" -p "$prelude synth_ice40 -top $top; stat" >/dev/null
     ice40="$(count "$base.ice40.log" SB_LUT4) | $(count "$base.ice40.log" SB_DFF) | $(count "$base.ice40.log" SB_CARRY)"
   else
     ice40="- | - | -"
@@ -93,11 +94,11 @@ done
 
 jobs=${SYNTH_JOBS:-$(nproc)}
 selected=()
-while read -r top flist name flags params; do
+while read -r top name flags files params; do
   if [ -n "${SYNTH_ONLY:-}" ] && ! echo ",$SYNTH_ONLY," | grep -q ",$top,"; then continue; fi
   # `sim`: a simulation-only configuration (memories too large for Yosys's generic flow).
   if [[ ",$flags," == *,sim,* ]]; then continue; fi
-  selected+=("$top $flist $name $flags $params")
+  selected+=("$top $name $flags $files $params")
   rm -f "$out/${top}_$name.row"
 done < <(scripts/variants.sh)
 
@@ -115,7 +116,7 @@ wait || true
 
 failed=0
 for line in "${selected[@]}"; do
-  read -r top _ name _ <<< "$line"
+  read -r top name _ <<< "$line"
   if [ -f "$out/${top}_$name.row" ]; then
     cat "$out/${top}_$name.row" >> "$table"
   else

@@ -1,16 +1,9 @@
 #!/usr/bin/env bash
-# Lists every verified RTL configuration from rtl/**/<top>.variants (the single source that
-# tb-rs/build.rs reads too), one per line: TOP FILELIST NAME FLAGS [Param=value ...]
-# FLAGS is the comma-joined list of words without `=` (gate, fmax), or `-`.
+# Lists every verified RTL configuration, one per line: TOP NAME FLAGS FILES [Param=value ...]
+# (FLAGS comma-joined or `-`; FILES comma-joined, packages first, `-f` includes expanded). The
+# reader is scripts/cube5-gen, the same code tb-rs/build.rs uses: rtl/**/<top>.variants and
+# <top>.f are parsed in one place only.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-find rtl -name '*.variants' | sort | while read -r vfile; do
-  top=$(basename "$vfile" .variants)
-  flist="${vfile%.variants}.f"
-  sed -e 's/#.*//' "$vfile" | while read -r name rest; do
-    [ -n "$name" ] || continue
-    params=$(echo "$rest" | tr ' ' '\n' | grep '=' | tr '\n' ' ' || true)
-    flags=$(echo "$rest" | tr ' ' '\n' | grep -v '=' | grep . | paste -sd, - || true)
-    echo "$top $flist $name ${flags:--} $params"
-  done
-done
+CARGO_TARGET_DIR=target/cube5-gen cargo build -q -p cube5-gen
+target/cube5-gen/debug/cube5-gen variants

@@ -7,8 +7,9 @@
 //! recipe). An unchanged variant is never compiled twice on a machine: across clones, branches and
 //! `cargo clean`. Entries are built in a private temporary directory and renamed into place, so
 //! two builds can share the cache. `make clean-cache` empties it.
-//! `CUBE5_TOPS=top[,top...]` restricts the build to some tops (for quick iteration on one unit);
-//! CI and `make test` leave it unset and build everything.
+//! `CUBE5_TOPS=entry[,entry...]` restricts the build (for quick iteration on one unit): an entry
+//! is a top, a build name, or a top with parameter values (`cube5_frame:P=4`); CI and `make
+//! test` leave it unset and build everything.
 
 use sha2::{Digest, Sha256};
 use std::env;
@@ -50,9 +51,6 @@ const GATE_VERILATE_FLAGS: &[&str] = &["-Wno-fatal", "-Wno-lint", "-Wno-style", 
 /// cuts its build from 195 s to 70 s (docs/ci.md).
 const GATE_FINE: &str = "opt -fast -full; opt -full; techmap; opt -fast; abc -fast; opt -fast; \
                          hierarchy -check; check;";
-
-/// Yosys fails on the warnings that signal a wrong netlist (docs/toolchain.md).
-const YOSYS_FATAL: &str = "implicitly declared|Resizing cell port|out of bounds";
 
 /// C++ optimisation level for RTL variants, unless `CUBE5_RTL_CXX_OPT` says otherwise. `-O1`
 /// compiles the large tops in half the time of `-O2` (`cube5_frame` `p8`: 52 s against 96 s) and
@@ -101,9 +99,12 @@ const CXX_FLAGS: &[&str] = &[
 #[derive(Debug, Clone)]
 struct Variant {
     top: String,
-    /// `<top>_<config>` or `<top>_<config>_gate`.
+    /// The configuration's name in the `.variants` file (`v8`).
+    config: String,
+    /// `<top>_<config>`, `<top>_<config>_gate` or `<top>_<config>_mutant`.
     full_name: String,
-    params: Vec<(String, String)>,
+    params: Vec<(String, i64)>,
+    flags: Vec<String>,
     files: Vec<PathBuf>,
     gate: bool,
     /// A gate-level netlist with one fault injected by Yosys's `mutate` (an inverted cell pin):
@@ -255,25 +256,35 @@ fn main() {
     let yosys_version = tool_output("yosys", &["-V"]);
     let vl_include = PathBuf::from(verilator_root.trim()).join("include");
 
-    let variants = discover_variants(&repo);
+    let (tops, variants) = discover_variants(&repo);
     let only: Option<Vec<String>> = env::var("CUBE5_TOPS")
         .ok()
         .filter(|s| !s.trim().is_empty())
         .map(|s| s.split(',').map(|t| t.trim().to_string()).collect());
     let selected: Vec<Variant> = variants
-        .into_iter()
+        .iter()
         .filter(|v| {
             only.as_ref()
-                .is_none_or(|o| o.iter().any(|t| *t == v.top || *t == v.full_name))
+                .is_none_or(|o| o.iter().any(|t| selects(t, v)))
         })
+        .cloned()
         .collect();
+
+    let cache = Cache::open(&out);
+    // Every line's resolved top-level parameters, as Verilator elaborates them (defaults
+    // included): the variant table carries them so a test can hold the model to every one.
+    let resolved = resolve_all_params(&cache, &repo, &tops, &verilator_version);
+    let built_names: Vec<String> = selected.iter().map(|v| v.full_name.clone()).collect();
+    write_if_changed(
+        &out.join("variant_table.rs"),
+        &variant_table_source(&variants, &resolved, &built_names),
+    );
 
     let shim_text: String = ["dut_core.h", "stream_shim.h"]
         .iter()
         .map(|f| fs::read_to_string(tb.join(f)).unwrap())
         .collect();
     let vlt_text = fs::read_to_string(&vlt).unwrap();
-    let cache = Cache::open(&out);
 
     // Runtime objects, shared by every variant.
     let runtime = build_runtime(&cache, &vl_include, &verilator_version);
@@ -352,93 +363,47 @@ fn tool_output(tool: &str, args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
-/// Every `rtl/**/<top>.variants` with its filelist `<top>.f` beside it.
-fn discover_variants(repo: &Path) -> Vec<Variant> {
-    let rtl = repo.join("rtl");
-    println!("cargo:rerun-if-changed={}", rtl.display());
-    let mut found = Vec::new();
-    let mut dirs = vec![rtl];
-    while let Some(dir) = dirs.pop() {
-        println!("cargo:rerun-if-changed={}", dir.display());
-        let mut entries: Vec<_> = fs::read_dir(&dir)
-            .unwrap()
-            .flatten()
-            .map(|e| e.path())
-            .collect();
-        entries.sort();
-        for path in entries {
-            if path.is_dir() {
-                dirs.push(path);
-            } else if path.extension().is_some_and(|e| e == "variants") {
-                found.extend(parse_variants(repo, &path));
-            }
-        }
-    }
-    found
-}
-
-fn parse_variants(repo: &Path, path: &Path) -> Vec<Variant> {
-    println!("cargo:rerun-if-changed={}", path.display());
-    let top = path.file_stem().unwrap().to_string_lossy().into_owned();
-    let filelist = path.with_extension("f");
-    println!("cargo:rerun-if-changed={}", filelist.display());
-    let files: Vec<PathBuf> = fs::read_to_string(&filelist)
-        .unwrap_or_else(|e| panic!("{}: {e}", filelist.display()))
-        .lines()
-        .map(|l| l.split("//").next().unwrap().trim())
-        .filter(|l| !l.is_empty())
-        .map(|l| repo.join(l))
-        .collect();
-    for f in &files {
-        println!("cargo:rerun-if-changed={}", f.display());
+/// Every variant of every `rtl/**/<top>.variants`, read by `cube5_gen::variants` (the one reader,
+/// shared with the scripts): the RTL build of each line, and its gate-level and mutant netlists
+/// where the line asks for them.
+fn discover_variants(repo: &Path) -> (Vec<cube5_gen::variants::Top>, Vec<Variant>) {
+    let tops = cube5_gen::variants::discover(repo).unwrap_or_else(|e| panic!("{e}"));
+    for p in cube5_gen::variants::inputs(repo, &tops) {
+        println!("cargo:rerun-if-changed={}", p.display());
     }
     let mut out = Vec::new();
-    for line in fs::read_to_string(path).unwrap().lines() {
-        let line = line.split('#').next().unwrap().trim();
-        if line.is_empty() {
-            continue;
-        }
-        let mut words = line.split_whitespace();
-        let name = words.next().unwrap();
-        let mut params = Vec::new();
-        let mut gate = false;
-        let mut mutant = false;
-        for w in words {
-            match w.split_once('=') {
-                Some((k, v)) => params.push((k.to_string(), v.to_string())),
-                None if w == "gate" => gate = true,
-                None if w == "mutant" => mutant = true,
-                // Read by scripts/synth.sh only.
-                None if matches!(w, "fmax" | "fmax85" | "sim") => {}
-                None => panic!("{}: unknown flag `{w}`", path.display()),
+    for top in &tops {
+        let files: Vec<PathBuf> = top.files.iter().map(|f| repo.join(f)).collect();
+        for line in &top.variants {
+            let base = Variant {
+                top: top.name.clone(),
+                config: line.config.clone(),
+                full_name: line.full_name(),
+                params: line.params.clone(),
+                flags: line.flags.clone(),
+                files: files.clone(),
+                gate: false,
+                mutant: false,
+            };
+            if line.has_flag("mutant") {
+                out.push(Variant {
+                    full_name: format!("{}_mutant", base.full_name),
+                    gate: true,
+                    mutant: true,
+                    ..base.clone()
+                });
             }
+            if line.has_flag("gate") {
+                out.push(Variant {
+                    full_name: format!("{}_gate", base.full_name),
+                    gate: true,
+                    ..base.clone()
+                });
+            }
+            out.push(base);
         }
-        let base = Variant {
-            top: top.clone(),
-            full_name: format!("{top}_{name}"),
-            params,
-            files: files.clone(),
-            gate: false,
-            mutant: false,
-        };
-        if mutant {
-            out.push(Variant {
-                full_name: format!("{top}_{name}_mutant"),
-                gate: true,
-                mutant: true,
-                ..base.clone()
-            });
-        }
-        if gate {
-            out.push(Variant {
-                full_name: format!("{top}_{name}_gate"),
-                gate: true,
-                ..base.clone()
-            });
-        }
-        out.push(base);
     }
-    out
+    (tops, out)
 }
 
 /// The cache key of a variant. Files enter by their path relative to the repository and their
@@ -446,9 +411,16 @@ fn parse_variants(repo: &Path, path: &Path) -> Vec<Variant> {
 fn variant_stamp(v: &Variant, repo: &Path, extra: &[&str]) -> String {
     let mut h = Sha256::new();
     h.update(RECIPE);
+    // Parameters enter as the text they had before they were parsed to integers, so the
+    // stamps (and the cached objects) of unchanged variants stay valid.
+    let params: Vec<(String, String)> = v
+        .params
+        .iter()
+        .map(|(k, x)| (k.clone(), x.to_string()))
+        .collect();
     h.update(format!(
         "{} {} {:?} gate={} mutant={}",
-        v.top, v.full_name, v.params, v.gate, v.mutant
+        v.top, v.full_name, params, v.gate, v.mutant
     ));
     for e in extra {
         h.update(e);
@@ -547,12 +519,6 @@ fn compile_variant(
         .arg(&mdir);
     if v.gate {
         let netlist = dir.join("netlist.v");
-        let reads: Vec<String> = v.files.iter().map(|f| f.display().to_string()).collect();
-        let chparam: String = v
-            .params
-            .iter()
-            .map(|(k, val)| format!(" -set {k} {val}"))
-            .collect();
         // The mutant's one fault: the first of Yosys's evenly sampled inversions, fixed seed.
         let mutation = if v.mutant {
             let list = dir.join("mutation.ys");
@@ -564,18 +530,19 @@ fn compile_variant(
             String::new()
         };
         let script = format!(
-            "read_verilog -sv {}; {} synth -flatten -top {} -run begin:fine; {GATE_FINE}{mutation} splitnets; opt_clean; write_verilog -noattr {}",
-            reads.join(" "),
-            if chparam.is_empty() {
-                String::new()
-            } else {
-                format!("chparam{chparam} {};", v.top)
-            },
+            "{} synth -flatten -top {} -run begin:fine; {GATE_FINE}{mutation} splitnets; opt_clean; write_verilog -noattr {}",
+            cube5_gen::yosys::prelude(&v.files, &v.top, &v.params),
             v.top,
             netlist.display()
         );
         run(
-            Command::new("yosys").args(["-q", "-e", YOSYS_FATAL, "-p", &script]),
+            Command::new("yosys").args([
+                "-q",
+                "-e",
+                cube5_gen::yosys::FATAL_WARNINGS,
+                "-p",
+                &script,
+            ]),
             "yosys",
         )?;
         verilate.args(GATE_VERILATE_FLAGS).arg(&netlist);
@@ -728,6 +695,221 @@ fn factory_source(built: &[Built]) -> String {
         ));
     }
     s.push_str("  return v;\n}\n}  // namespace cube5\n");
+    s
+}
+
+/// One `CUBE5_TOPS` entry: a top (`cube5_trilin`), a build (`cube5_trilin_v8_gate`), or a top
+/// with parameter values its lines must have (`cube5_frame:P=4`, `cube5_frame:P=4:MaxDim=128`),
+/// so a script can select configurations by what they are rather than by name.
+fn selects(entry: &str, v: &Variant) -> bool {
+    let mut parts = entry.split(':');
+    let head = parts.next().unwrap_or_default();
+    let conds: Vec<(&str, &str)> = parts.filter_map(|c| c.split_once('=')).collect();
+    if conds.is_empty() {
+        return head == v.top || head == v.full_name;
+    }
+    head == v.top
+        && conds.iter().all(|(k, val)| {
+            v.params
+                .iter()
+                .any(|(pk, pv)| pk == k && pv.to_string() == *val)
+        })
+}
+
+/// `(top, config) -> [(Param, value)]` for every `.variants` line, read back from Verilator's
+/// elaboration of the top with the line's `-G` overrides (`--xml-only`, 0.1-1 s a line). Cached
+/// under the same content hash discipline as the objects, so it runs once per change.
+type Resolved = std::collections::BTreeMap<(String, String), Vec<(String, i64)>>;
+
+fn resolve_all_params(
+    cache: &Cache,
+    repo: &Path,
+    tops: &[cube5_gen::variants::Top],
+    verilator_version: &str,
+) -> Resolved {
+    let lines: Vec<(&cube5_gen::variants::Top, &cube5_gen::variants::VariantLine)> = tops
+        .iter()
+        .flat_map(|t| t.variants.iter().map(move |l| (t, l)))
+        .collect();
+    let next = AtomicUsize::new(0);
+    let out = Mutex::new(Resolved::new());
+    let failures = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::SeqCst);
+                let Some((top, line)) = lines.get(i) else {
+                    break;
+                };
+                match resolve_params(cache, repo, top, line, verilator_version) {
+                    Ok(p) => {
+                        out.lock()
+                            .unwrap()
+                            .insert((top.name.clone(), line.config.clone()), p);
+                    }
+                    Err(e) => failures
+                        .lock()
+                        .unwrap()
+                        .push(format!("{}: {e}", line.origin)),
+                }
+            });
+        }
+    });
+    let failures = failures.into_inner().unwrap();
+    if !failures.is_empty() {
+        panic!(
+            "cannot elaborate the variants' parameters:\n{}",
+            failures.join("\n")
+        );
+    }
+    out.into_inner().unwrap()
+}
+
+fn resolve_params(
+    cache: &Cache,
+    repo: &Path,
+    top: &cube5_gen::variants::Top,
+    line: &cube5_gen::variants::VariantLine,
+    verilator_version: &str,
+) -> Result<Vec<(String, i64)>, String> {
+    let mut h = Sha256::new();
+    h.update(format!(
+        "{RECIPE} params {} {:?} {verilator_version}",
+        top.name, line.params
+    ));
+    for f in &top.files {
+        h.update(f.to_string_lossy().as_bytes());
+        h.update(fs::read(repo.join(f)).map_err(|e| format!("{}: {e}", f.display()))?);
+    }
+    let stamp = format!("{:x}", h.finalize());
+    let entry = cache.entry("params", &line.full_name(), &stamp);
+    let parse = |text: &str| -> Vec<(String, i64)> {
+        text.lines()
+            .filter_map(|l| {
+                let (k, v) = l.split_once('=')?;
+                Some((k.to_string(), v.parse().ok()?))
+            })
+            .collect()
+    };
+    if entry.join(COMPLETE).exists() {
+        let text = fs::read_to_string(entry.join("params.txt")).map_err(|e| e.to_string())?;
+        return Ok(parse(&text));
+    }
+    let dir = cache.scratch(&format!("{}.params", line.full_name()));
+    let mut cmd = Command::new("verilator");
+    cmd.args(["--xml-only", "-Wno-fatal", "--top-module", &top.name])
+        .arg("--Mdir")
+        .arg(&dir)
+        .arg("--xml-output")
+        .arg(dir.join("top.xml"));
+    for (k, v) in &line.params {
+        cmd.arg(format!("-G{k}={v}"));
+    }
+    cmd.args(top.files.iter().map(|f| repo.join(f)));
+    run(&mut cmd, "verilator --xml-only")?;
+    let xml = fs::read_to_string(dir.join("top.xml")).map_err(|e| e.to_string())?;
+    let params = top_params_from_xml(&xml)?;
+    let text: String = params.iter().map(|(k, v)| format!("{k}={v}\n")).collect();
+    fs::write(dir.join("params.txt"), &text).map_err(|e| e.to_string())?;
+    let _ = fs::remove_file(dir.join("top.xml"));
+    fs::write(dir.join(COMPLETE), "").map_err(|e| e.to_string())?;
+    cache.publish(&dir, &entry)?;
+    Ok(parse(&text))
+}
+
+/// The top module's `param="true"` variables and their constant values from Verilator's XML
+/// (`<var ... name="P" ... param="true"><const ... name="32'sh4" .../>`).
+fn top_params_from_xml(xml: &str) -> Result<Vec<(String, i64)>, String> {
+    let start = xml
+        .find("topModule=\"1\"")
+        .ok_or("no top module in Verilator's XML")?;
+    let module = &xml[start
+        ..xml[start..]
+            .find("</module>")
+            .map_or(xml.len(), |e| start + e)];
+    let attr = |tag: &str, name: &str| -> Option<String> {
+        let key = format!(" {name}=\"");
+        let at = tag.find(&key)? + key.len();
+        Some(tag[at..at + tag[at..].find('"')?].to_string())
+    };
+    let mut out = Vec::new();
+    let mut rest = module;
+    while let Some(at) = rest.find("<var ") {
+        rest = &rest[at..];
+        let tag_end = rest.find('>').ok_or("truncated XML")?;
+        let tag = &rest[..tag_end];
+        if tag.contains(" param=\"true\"") {
+            let name = attr(tag, "name").ok_or("a parameter without a name")?;
+            let body = &rest[tag_end..];
+            let c = body
+                .find("<const ")
+                .ok_or(format!("parameter {name} has no value"))?;
+            let ctag = &body[c..c + body[c..].find('>').ok_or("truncated XML")?];
+            let lit = attr(ctag, "name")
+                .ok_or(format!("parameter {name}: no constant"))?
+                .replace("&apos;", "'");
+            out.push((
+                name.clone(),
+                parse_sv_literal(&lit).ok_or(format!("parameter {name}: cannot read `{lit}`"))?,
+            ));
+        }
+        rest = &rest[tag_end..];
+    }
+    Ok(out)
+}
+
+/// `32'sh4`, `32'd12`, `5'b101` -> value.
+fn parse_sv_literal(lit: &str) -> Option<i64> {
+    let (_, v) = lit.split_once('\'')?;
+    let v = v.trim_start_matches('s');
+    let (radix, digits) = match v.chars().next()? {
+        'h' => (16, &v[1..]),
+        'd' => (10, &v[1..]),
+        'b' => (2, &v[1..]),
+        'o' => (8, &v[1..]),
+        _ => (10, v),
+    };
+    i64::from_str_radix(&digits.replace('_', ""), radix).ok()
+}
+
+/// The variant table for `tb-rs/src/variants.rs`: every variant (built or not), with the
+/// parameters given on its line and the ones the RTL elaborates.
+fn variant_table_source(variants: &[Variant], resolved: &Resolved, built: &[String]) -> String {
+    let pairs = |ps: &[(String, i64)]| -> String {
+        ps.iter()
+            .map(|(k, v)| format!("(\"{k}\", {v})"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut s = String::from(
+        "// Generated by tb-rs/build.rs from rtl/**/*.variants (read by scripts/cube5-gen). Do not edit.\n\
+         pub static VARIANTS: &[Variant] = &[\n",
+    );
+    for v in variants {
+        let netlist = if v.mutant {
+            "Mutant"
+        } else if v.gate {
+            "Gate"
+        } else {
+            "Rtl"
+        };
+        let flags: Vec<String> = v.flags.iter().map(|f| format!("\"{f}\"")).collect();
+        let rtl = resolved
+            .get(&(v.top.clone(), v.config.clone()))
+            .map(|p| pairs(p))
+            .unwrap_or_default();
+        s.push_str(&format!(
+            "    Variant {{ top: \"{}\", config: \"{}\", name: \"{}\", netlist: Netlist::{netlist}, \
+             flags: &[{}], given: &[{}], rtl_params: &[{rtl}], built: {} }},\n",
+            v.top,
+            v.config,
+            v.full_name,
+            flags.join(", "),
+            pairs(&v.params),
+            built.contains(&v.full_name)
+        ));
+    }
+    s.push_str("];\n");
     s
 }
 

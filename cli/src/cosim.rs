@@ -13,7 +13,8 @@ use cube5_model::units::cube5_frame::{self, BasePlane, FrameParams, FrameSetup};
 use cube5_model::units::cube5_shader::{DistantLight, Phong};
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
-use cube5_tb::frame::{as_seen, Expected, FrameBench, FrameError, FrameRtl, Look, Render};
+use cube5_tb::frame::{as_seen, Expected, FrameBench, FrameRtl, Look, Render};
+use cube5_tb::TbError;
 use cube5_tb::rtl::Traffic;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
@@ -48,8 +49,9 @@ pub fn run(args: CosimArgs) -> Result<()> {
     scene.validate(&origin)?;
     let rtl = FrameRtl::with_pipelines(args.pipelines).ok_or_else(|| {
         anyhow!(
-            "--pipelines {}: cube5_frame is built for 1, 4 or 8",
-            args.pipelines
+            "--pipelines {}: cube5_frame is built for {:?} (rtl/cube5/cube5_frame.variants)",
+            args.pipelines,
+            FrameRtl::pipeline_counts()
         )
     })?;
     let result = cosim_scene(&scene, &origin, rtl, &args.out_dir, args.seed)?;
@@ -188,7 +190,7 @@ pub fn cosim_scene(
             );
             true
         }
-        Err(FrameError::Mismatch(report)) => {
+        Err(TbError::Mismatch(report)) => {
             say!("{report}");
             false
         }
@@ -290,7 +292,10 @@ pub fn frame_cost_section(scene: &Scene) -> Result<String> {
     md.push_str("|--:|--------:|-------------:|-----------------------:|------------------------------------:|------:|\n");
     let dir = scene.render_params().direction()?;
     let raw = scene.build_volume()?;
-    for rtl in cube5_tb::frame::BY_P {
+    for rtl in FrameRtl::pipeline_counts()
+        .into_iter()
+        .filter_map(FrameRtl::with_pipelines)
+    {
         let vol = at_voxel_width(&raw, rtl.trilin.voxel_w)?;
         if let Err(why) = rtl.check_volume(&vol) {
             md.push_str(&format!("| {} | | n/a: {why} | | | |\n", rtl.p));

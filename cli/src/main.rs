@@ -13,7 +13,7 @@ mod bench;
 mod cosim;
 mod tradeoff;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::{Parser, Subcommand};
 use cube5_model::phantom::{phantom_by_name, PHANTOMS};
 use cube5_model::render::{render_pipeline, render_reference, ImageF64};
@@ -184,11 +184,13 @@ fn render(args: RenderArgs) -> Result<()> {
     say!("plan: {plan}");
     if scene.run.target.uses_rtl() {
         // The RTL frame (P = 4) against the model, images beside the output. It is the only RTL
-        // variant a scene needs: `CUBE5_TOPS=cube5_frame_p4` builds just it.
+        // variant a scene needs: `CUBE5_TOPS=cube5_frame:P=4:MaxDim=128` builds just it.
+        let rtl = cube5_tb::frame::FrameRtl::with_pipelines(4)
+            .ok_or_else(|| anyhow!("no cube5_frame variant with P = 4 in rtl/cube5/cube5_frame.variants"))?;
         say!(
-            "rtl: {} (the only RTL variant this scene needs; CUBE5_TOPS={} builds just it)",
-            cube5_tb::frame::P4.variant,
-            cube5_tb::frame::P4.variant
+            "rtl: {} (the only RTL variant this scene needs; CUBE5_TOPS={}:P=4:MaxDim=128 builds just it)",
+            rtl.variant,
+            rtl.variant.top
         );
         let stem = args
             .output
@@ -199,7 +201,7 @@ fn render(args: RenderArgs) -> Result<()> {
             .scene
             .as_ref()
             .map_or("the default scene".to_string(), |p| p.display().to_string());
-        let r = cosim::cosim_scene(&scene, &origin, cube5_tb::frame::P4, &dir, 1)?;
+        let r = cosim::cosim_scene(&scene, &origin, rtl, &dir, 1)?;
         if !r.matched {
             bail!(
                 "run.target = \"{}\": the RTL frame differs from the model (report above)",

@@ -28,3 +28,63 @@ pub trait StreamCodec {
     fn pack_in(&self, item: &Self::In) -> Vec<u32>;
     fn unpack_out(&self, words: &[u32]) -> Self::Out;
 }
+
+/// A unit's configuration as the parameters of its RTL top: the model is built from the same
+/// `Param = value` pairs as the RTL (the variant table in `tb-rs` hands them over), and gives back
+/// every parameter so a test can hold it to what the RTL elaborates.
+pub trait UnitConfig: Sized {
+    /// The RTL top this configuration parameterises.
+    const TOP: &'static str;
+
+    /// The configuration for `params`; a parameter not given keeps the RTL's default (which the
+    /// model's default equals: `tb-rs/tests/variant_table.rs` checks it). An unknown parameter or
+    /// an invalid combination is an error.
+    fn from_params(params: &[(&str, i64)]) -> crate::Result<Self>;
+
+    /// Every top-level parameter of the RTL with its value under this configuration.
+    fn to_params(&self) -> Vec<(&'static str, i64)>;
+}
+
+/// Sets `fields` (RTL parameter name, model field) from `params`; `top` names the unit in errors.
+pub fn set_params(
+    top: &str,
+    params: &[(&str, i64)],
+    fields: &mut [(&'static str, &mut u32)],
+) -> crate::Result<()> {
+    for &(name, value) in params {
+        let Some((_, field)) = fields.iter_mut().find(|(n, _)| *n == name) else {
+            let known: Vec<&str> = fields.iter().map(|(n, _)| *n).collect();
+            return Err(crate::ModelError::Config(format!(
+                "{top}: unknown parameter {name} (known: {})",
+                known.join(", ")
+            )));
+        };
+        **field = u32::try_from(value).map_err(|_| {
+            crate::ModelError::Config(format!("{top}: {name} = {value} is out of range"))
+        })?;
+    }
+    Ok(())
+}
+
+/// Implements [`UnitConfig`] for a configuration whose fields are its RTL parameters one to one:
+/// `unit_config!(TrilinConfig, "cube5_trilin", DEFAULT, { "VoxelW" => voxel_w, ... })`.
+/// `DEFAULT` equals the RTL's defaults; `validate()` checks the result.
+#[macro_export]
+macro_rules! unit_config {
+    ($ty:ty, $top:literal, $default:ident, { $($name:literal => $field:ident),+ $(,)? }) => {
+        impl $crate::unit::UnitConfig for $ty {
+            const TOP: &'static str = $top;
+
+            fn from_params(params: &[(&str, i64)]) -> $crate::Result<Self> {
+                let mut c = <$ty>::$default;
+                $crate::unit::set_params($top, params, &mut [$(($name, &mut c.$field)),+])?;
+                c.validate()?;
+                Ok(c)
+            }
+
+            fn to_params(&self) -> Vec<(&'static str, i64)> {
+                vec![$(($name, i64::from(self.$field))),+]
+            }
+        }
+    };
+}

@@ -1,20 +1,10 @@
-rtl/cube5/cube5_skewmem_pkg.sv
-rtl/cube5_pkg.sv
-rtl/cube5/cube5_gradient_pkg.sv
-rtl/cube5/cube5_shader_pkg.sv
-rtl/cube5/cube5_compos_pkg.sv
+// cube5_frame: the sub-tops' filelists (packages first in each), then the frame's own files.
+-f rtl/cube5/cube5_skewmem.f
+-f rtl/cube5/cube5_trilin.f
+-f rtl/cube5/cube5_gradient.f
+-f rtl/cube5/cube5_shader.f
+-f rtl/cube5/cube5_compos.f
 rtl/cube5/cube5_frame_pkg.sv
-rtl/cube5/cube5_skewmem_bank.sv
-rtl/cube5/cube5_skewmem.sv
-rtl/cube5/cube5_lerp.sv
-rtl/cube5/cube5_trilin.sv
-rtl/cube5/cube5_gradient_lerp.sv
-rtl/cube5/cube5_gradient.sv
-rtl/cube5/cube5_shader_ram.sv
-rtl/cube5/cube5_shader_lerp.sv
-rtl/cube5/cube5_shader.sv
-rtl/cube5/cube5_compos_unorm.sv
-rtl/cube5/cube5_compos.sv
 rtl/cube5/cube5_frame_delay.sv
 rtl/cube5/cube5_frame_fifo.sv
 rtl/cube5/cube5_frame_pos.sv

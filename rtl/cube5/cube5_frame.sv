@@ -452,9 +452,9 @@ module cube5_frame #(
   cube5_skewmem #(
     .P           (P),
     .VoxelW      (VoxelW),
-    .MaxDimLog2  (M),
-    .B           (BlockDim),
-    .ReadLatency (MemLatency),
+    .MaxDim      (MaxDim),
+    .BlockDim    (BlockDim),
+    .MemLatency  (MemLatency),
     .CntW        (SkCntW)
   ) u_mem (
     .clk_i       (clk_i),

@@ -3,27 +3,27 @@
 //
 // P single-port modules hold the volume skewed: voxel (x, y, z) in module (x + y + z) mod P, so an
 // aligned beam of P voxels along x, y or z touches every module exactly once and is fetched in one
-// cycle. The volume is kept in B^3 blocks through a block LUT (pointer, empty, masked per block)
+// cycle. The volume is kept in BlockDim^3 blocks through a block LUT (pointer, empty, masked per block)
 // loaded on the configuration port; reads of empty or masked blocks, and of beams outside the
 // volume, are skipped (no module access, zeros returned, flags set).
 //
 // Pipeline: accept (command and its LUT entry registered) -> issue (each module k addresses the
-// voxel of lane (k - s) mod P, s = module of the beam start) -> ReadLatency cycles in the modules
+// voxel of lane (k - s) mod P, s = module of the beam start) -> MemLatency cycles in the modules
 // beside a tag pipe (access counters updated in its first stage) -> rotate by s (de-skew) ->
-// output FIFO of ReadLatency + 3 entries. The modules never stall: a command is accepted only
+// output FIFO of MemLatency + 3 entries. The modules never stall: a command is accepted only
 // while the FIFO has room for everything in flight, which keeps one command per clock at full
-// speed. Latency ReadLatency + 2.
+// speed. Latency MemLatency + 2.
 module cube5_skewmem #(
   /// Memory modules = lanes of a beam: 1, 2, 4, 8 or 16.
   parameter int unsigned P           = 4,
   /// Voxel width, U(VoxelW.0).
   parameter int unsigned VoxelW      = 12,
-  /// The largest volume edge is 2^MaxDimLog2 (coordinates are MaxDimLog2 bits).
-  parameter int unsigned MaxDimLog2  = 5,
-  /// Block edge: a power of two, P <= B < 2^MaxDimLog2, at most 64.
-  parameter int unsigned B           = 8,
+  /// Largest volume edge, a power of two in 4..1024 (coordinates are log2(MaxDim) bits).
+  parameter int unsigned MaxDim      = 16,
+  /// Block edge: a power of two, P <= BlockDim < MaxDim, at most 64.
+  parameter int unsigned BlockDim    = 8,
   /// Module read latency in cycles (1 = SRAM; more = DRAM-like), 1..8.
-  parameter int unsigned ReadLatency = 1,
+  parameter int unsigned MemLatency  = 1,
   /// Access counter width (counters wrap), 8..32.
   parameter int unsigned CntW        = 32
 ) (
@@ -33,16 +33,16 @@ module cube5_skewmem #(
   /// Configuration write this cycle (only while the stream is idle).
   input  logic cfg_valid_i,
   /// Top bit 0: register (0 = dimensions); top bit 1: LUT entry at the low bits.
-  input  logic [cube5_skewmem_pkg::cfg_addr_w(MaxDimLog2, B)-1:0] cfg_addr_i,
-  /// Dimensions nx, ny, nz (MaxDimLog2+1 bits each), or a LUT entry: ptr, empty, masked. LSB first.
-  input  logic [cube5_skewmem_pkg::cfg_data_w(MaxDimLog2, B)-1:0] cfg_data_i,
+  input  logic [cube5_skewmem_pkg::cfg_addr_w($clog2(MaxDim), BlockDim)-1:0] cfg_addr_i,
+  /// Dimensions nx, ny, nz ($clog2(MaxDim)+1 bits each), or a LUT entry: ptr, empty, masked. LSB first.
+  input  logic [cube5_skewmem_pkg::cfg_data_w($clog2(MaxDim), BlockDim)-1:0] cfg_data_i,
 
   /// Command valid.
   input  logic in_valid_i,
   /// Controller takes a command this cycle.
   output logic in_ready_o,
-  /// op (1), axis (2), x, y, z (MaxDimLog2 each), data (VoxelW), probe (max(1, log2 P)), LSB first.
-  input  logic [cube5_skewmem_pkg::in_w(P, VoxelW, MaxDimLog2)-1:0] in_data_i,
+  /// op (1), axis (2), x, y, z ($clog2(MaxDim) each), data (VoxelW), probe (max(1, log2 P)), LSB first.
+  input  logic [cube5_skewmem_pkg::in_w(P, VoxelW, $clog2(MaxDim))-1:0] in_data_i,
 
   /// Response valid.
   output logic out_valid_o,
@@ -54,16 +54,16 @@ module cube5_skewmem #(
 
   localparam int unsigned LogP      = $clog2(P);
   localparam int unsigned ModW      = cube5_skewmem_pkg::mod_w(P);
-  localparam int unsigned LogB      = $clog2(B);
-  localparam int unsigned M         = MaxDimLog2;
-  localparam int unsigned BlkW      = cube5_skewmem_pkg::blk_w(MaxDimLog2, B);
+  localparam int unsigned LogB      = $clog2(BlockDim);
+  localparam int unsigned M         = $clog2(MaxDim);
+  localparam int unsigned BlkW      = cube5_skewmem_pkg::blk_w($clog2(MaxDim), BlockDim);
   localparam int unsigned WordW     = 3 * M - LogP;
   localparam int unsigned DimW      = M + 1;
   localparam int unsigned SumW      = M + 2;  // x + y + z without overflow
   localparam int unsigned LutW      = BlkW + 2;
-  localparam int unsigned InW       = cube5_skewmem_pkg::in_w(P, VoxelW, MaxDimLog2);
+  localparam int unsigned InW       = cube5_skewmem_pkg::in_w(P, VoxelW, $clog2(MaxDim));
   localparam int unsigned OutW      = cube5_skewmem_pkg::out_w(P, VoxelW, CntW);
-  localparam int unsigned FifoDepth = ReadLatency + 3;
+  localparam int unsigned FifoDepth = MemLatency + 3;
   localparam int unsigned FifoPtrW  = $clog2(FifoDepth);
   localparam int unsigned CountW    = $clog2(FifoDepth + 1);
 
@@ -74,15 +74,15 @@ module cube5_skewmem #(
   if (VoxelW < 4 || VoxelW > 16) begin : gen_bad_voxel_w
     $fatal(1, "cube5_skewmem: VoxelW must be 4..16");
   end
-  if (MaxDimLog2 < 2 || MaxDimLog2 > 10) begin : gen_bad_max_dim
-    $fatal(1, "cube5_skewmem: MaxDimLog2 must be 2..10");
+  if (MaxDim < 4 || MaxDim > 1024 || (MaxDim & (MaxDim - 1)) != 0) begin : gen_bad_max_dim
+    $fatal(1, "cube5_skewmem: MaxDim must be a power of two in 4..1024");
   end
-  if (B < 2 || B > 64 || (B & (B - 1)) != 0 || B < P || B >= (1 << MaxDimLog2))
+  if (BlockDim < 2 || BlockDim > 64 || (BlockDim & (BlockDim - 1)) != 0 || BlockDim < P || BlockDim >= MaxDim)
   begin : gen_bad_block
-    $fatal(1, "cube5_skewmem: B must be a power of two in 2..64 with P <= B < 2^MaxDimLog2");
+    $fatal(1, "cube5_skewmem: BlockDim must be a power of two in 2..64 with P <= BlockDim < MaxDim");
   end
-  if (ReadLatency < 1 || ReadLatency > 8) begin : gen_bad_latency
-    $fatal(1, "cube5_skewmem: ReadLatency must be 1..8");
+  if (MemLatency < 1 || MemLatency > 8) begin : gen_bad_latency
+    $fatal(1, "cube5_skewmem: MemLatency must be 1..8");
   end
   if (CntW < 8 || CntW > 32) begin : gen_bad_cnt_w
     $fatal(1, "cube5_skewmem: CntW must be 8..32");
@@ -237,7 +237,7 @@ module cube5_skewmem #(
     cube5_skewmem_bank #(
       .Width   (VoxelW),
       .AddrW   (WordW),
-      .Latency (ReadLatency)
+      .Latency (MemLatency)
     ) u_bank (
       .clk_i   (clk_i),
       .req_i   (req),
@@ -298,32 +298,32 @@ module cube5_skewmem #(
     end
   end
 
-  // The snapshot joins its tag after the remaining ReadLatency - 1 stages.
-  if (ReadLatency == 1) begin : gen_snap_direct
+  // The snapshot joins its tag after the remaining MemLatency - 1 stages.
+  if (MemLatency == 1) begin : gen_snap_direct
     assign snap_l = snap_d;
   end else begin : gen_snap_pipe
-    logic [2*CntW-1:0] snap_q [ReadLatency-1];
+    logic [2*CntW-1:0] snap_q [MemLatency-1];
     always_ff @(posedge clk_i) begin
       snap_q[0] <= snap_d;
     end
-    for (genvar i = 1; i < ReadLatency - 1; i++) begin : gen_stage
+    for (genvar i = 1; i < MemLatency - 1; i++) begin : gen_stage
       always_ff @(posedge clk_i) begin
         snap_q[i] <= snap_q[i-1];
       end
     end
-    assign snap_l = snap_q[ReadLatency-2];
+    assign snap_l = snap_q[MemLatency-2];
   end
 
   // ---------------------------------------------------------------------------
   // Tag pipe beside the modules' read latency (never stalls)
   // ---------------------------------------------------------------------------
-  logic [TagW-1:0]        tag_q [ReadLatency];
-  logic [ReadLatency-1:0] tag_valid_d, tag_valid_q;
+  logic [TagW-1:0]        tag_q [MemLatency];
+  logic [MemLatency-1:0] tag_valid_d, tag_valid_q;
 
   always_ff @(posedge clk_i) begin
     tag_q[0] <= tag_d;
   end
-  for (genvar i = 1; i < ReadLatency; i++) begin : gen_tag_pipe
+  for (genvar i = 1; i < MemLatency; i++) begin : gen_tag_pipe
     always_ff @(posedge clk_i) begin
       tag_q[i] <= tag_q[i-1];
     end
@@ -331,7 +331,7 @@ module cube5_skewmem #(
 
   always_comb begin
     tag_valid_d[0] = s0_valid_q;
-    for (int unsigned i = 1; i < ReadLatency; i++) begin
+    for (int unsigned i = 1; i < MemLatency; i++) begin
       tag_valid_d[i] = tag_valid_q[i-1];
     end
   end
@@ -345,7 +345,7 @@ module cube5_skewmem #(
   logic [OutW-1:0]     resp;
 
   always_comb begin
-    tag_l = tag_q[ReadLatency-1];
+    tag_l = tag_q[MemLatency-1];
     rot   = tag_l[TagRotLsb +: ModW];
     lanes = '0;
     for (int unsigned i = 0; i < P; i++) begin
@@ -359,7 +359,7 @@ module cube5_skewmem #(
             tag_l[TagMasked], tag_l[TagEmpty], tag_l[TagOutside], tag_l[TagBeam], lanes};
   end
 
-  assign push = tag_valid_q[ReadLatency-1];
+  assign push = tag_valid_q[MemLatency-1];
 
   // ---------------------------------------------------------------------------
   // Output FIFO (room for everything in flight, so a returning beam is never lost)

@@ -8,16 +8,19 @@
 //! configuration port, one command is driven with `RtlStream::drive` (expect_out = W H), and the
 //! pixels are compared with the model's image.
 
-use crate::rtl::{RtlError, RtlStream, Traffic};
+use crate::error::{Mismatch, TbError};
+use crate::rtl::{RtlStream, Traffic};
+use crate::variants::{variants_of, Variant};
 use cube5_model::bits::{BitReader, BitWriter};
 use cube5_model::error::ModelError;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::unit::StreamCodec;
+use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_compos::{
     self, Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut,
 };
 use cube5_model::units::cube5_frame::{
-    self, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepAccesses,
+    self, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepAccesses,
 };
 use cube5_model::units::cube5_gradient::{
     block_index, Gradient, GradientConfig, GradientIn, GradientMode,
@@ -34,66 +37,69 @@ use std::rc::Rc;
 // The RTL configurations and the frame's stream and configuration formats
 // -------------------------------------------------------------------------------------------------
 
-/// One verified configuration of cube5_frame (`rtl/cube5/cube5_frame.variants`).
+/// One verified configuration of cube5_frame (a line of `rtl/cube5/cube5_frame.variants`): the
+/// variant and the model's configuration built from its parameters (`FrameConfig` derefs, so
+/// `rtl.p`, `rtl.trilin` read as before).
 #[derive(Debug, Clone, Copy)]
 pub struct FrameRtl {
-    pub variant: &'static str,
-    pub p: usize,
-    pub max_dim_log2: u32,
-    pub block: u32,
-    pub mem_latency: u32,
-    pub trilin: TrilinConfig,
-    pub gradient: GradientConfig,
-    pub shader: ShaderConfig,
-    pub compos: ComposConfig,
+    pub variant: &'static Variant,
+    pub cfg: FrameConfig,
 }
 
-/// The shader at the narrow widths with the compositing unit's 8-bit colour.
-const SHADER_NARROW8: ShaderConfig = ShaderConfig {
-    color_w: 8,
-    ..ShaderConfig::NARROW
-};
+impl std::ops::Deref for FrameRtl {
+    type Target = FrameConfig;
 
-pub const P1: FrameRtl = FrameRtl {
-    variant: "cube5_frame_p1",
-    p: 1,
-    max_dim_log2: 7,
-    block: 8,
-    mem_latency: 1,
-    trilin: TrilinConfig::DEFAULT,
-    gradient: GradientConfig::DEFAULT,
-    shader: ShaderConfig::DEFAULT,
-    compos: ComposConfig::DEFAULT,
-};
-pub const P4: FrameRtl = FrameRtl {
-    variant: "cube5_frame_p4",
-    p: 4,
-    ..P1
-};
-pub const P8: FrameRtl = FrameRtl {
-    variant: "cube5_frame_p8",
-    p: 8,
-    ..P1
-};
-pub const S1: FrameRtl = FrameRtl {
-    variant: "cube5_frame_s1",
-    p: 1,
-    max_dim_log2: 3,
-    block: 4,
-    mem_latency: 1,
-    trilin: TrilinConfig::NARROW,
-    gradient: GradientConfig::NARROW,
-    shader: SHADER_NARROW8,
-    compos: ComposConfig::NARROW,
-};
-pub const S4: FrameRtl = FrameRtl {
-    variant: "cube5_frame_s4",
-    p: 4,
-    ..S1
-};
+    fn deref(&self) -> &FrameConfig {
+        &self.cfg
+    }
+}
 
-/// The default-width configurations, one per pipeline count: what `cube5 cosim` can run.
-pub const BY_P: [FrameRtl; 3] = [P1, P4, P8];
+/// The top whose variants this module drives.
+pub const TOP: &str = FrameConfig::TOP;
+
+impl FrameRtl {
+    /// The configuration of `variant` (which must be a `cube5_frame` variant).
+    pub fn from_variant(variant: &'static Variant) -> Result<Self, TbError> {
+        let cfg = variant
+            .config::<FrameConfig>()
+            .map_err(|e| TbError::setup(variant.name, e))?;
+        Ok(Self { variant, cfg })
+    }
+
+    /// Every RTL build of cube5_frame, in `.variants` order.
+    pub fn all() -> Vec<FrameRtl> {
+        variants_of(TOP)
+            .into_iter()
+            .map(|v| Self::from_variant(v).unwrap_or_else(|e| panic!("{e}")))
+            .collect()
+    }
+
+    /// The configuration with `p` pipelines and the largest memory: the default widths that
+    /// `cube5 cosim` and the whole-frame tests run.
+    pub fn with_pipelines(p: usize) -> Option<FrameRtl> {
+        Self::all()
+            .into_iter()
+            .filter(|r| r.p == p)
+            .max_by_key(|r| r.max_dim_log2)
+    }
+
+    /// The configuration with `p` pipelines and the smallest memory (the narrow, synthesizable
+    /// ones).
+    pub fn smallest(p: usize) -> Option<FrameRtl> {
+        Self::all()
+            .into_iter()
+            .filter(|r| r.p == p)
+            .min_by_key(|r| r.max_dim_log2)
+    }
+
+    /// The pipeline counts of the largest-memory configurations, ascending.
+    pub fn pipeline_counts() -> Vec<usize> {
+        let mut ps: Vec<usize> = Self::all().iter().map(|r| r.p).collect();
+        ps.sort_unstable();
+        ps.dedup();
+        ps
+    }
+}
 
 /// Configuration regions and frame registers.
 pub const REGION_FRAME: u32 = 0;
@@ -147,28 +153,7 @@ pub struct FrameOut {
 
 pub use crate::rtl::ConfigWrites;
 
-/// What can go wrong driving a frame.
-#[derive(Debug, thiserror::Error)]
-pub enum FrameError {
-    #[error(transparent)]
-    Rtl(#[from] RtlError),
-    #[error(transparent)]
-    Model(#[from] ModelError),
-    /// The RTL's image (or its status) differs from the model's: the full report.
-    #[error("{0}")]
-    Mismatch(String),
-}
-
 impl FrameRtl {
-    /// The default-width configuration with `p` pipelines.
-    pub fn with_pipelines(p: usize) -> Option<FrameRtl> {
-        BY_P.into_iter().find(|r| r.p == p)
-    }
-
-    pub fn max_dim(&self) -> usize {
-        1 << self.max_dim_log2
-    }
-
     pub fn skew(&self) -> SkewConfig {
         SkewConfig {
             p: self.p as u32,
@@ -320,19 +305,19 @@ impl FrameRtl {
         if vol.dims.iter().any(|&d| d > max) {
             return Err(format!(
                 "volume {:?} exceeds {}'s memory ({max} voxels per edge)",
-                vol.dims, self.variant
+                vol.dims, self.variant.name
             ));
         }
         if vol.dims.iter().any(|&d| !d.is_multiple_of(self.p)) {
             return Err(format!(
                 "volume {:?}: every edge must be a multiple of P = {} for {}",
-                vol.dims, self.p, self.variant
+                vol.dims, self.p, self.variant.name
             ));
         }
         if vol.bits != self.trilin.voxel_w {
             return Err(format!(
                 "volume of {}-bit voxels; {} takes {}-bit voxels",
-                vol.bits, self.variant, self.trilin.voxel_w
+                vol.bits, self.variant.name, self.trilin.voxel_w
             ));
         }
         Ok(())
@@ -692,7 +677,7 @@ impl FrameBench {
         vol: &Volume,
         lut: &BlockLut,
         dut_seed: u32,
-    ) -> Result<Self, FrameError> {
+    ) -> Result<Self, TbError> {
         let mut dut = RtlStream::new(rtl.variant, rtl, dut_seed)?;
         for (a, d) in rtl.volume_writes(vol, lut)? {
             dut.write_config(a, &d)?;
@@ -714,7 +699,7 @@ impl FrameBench {
         Ok(bench)
     }
 
-    pub fn write(&mut self, writes: &[(u32, Vec<u32>)]) -> Result<(), FrameError> {
+    pub fn write(&mut self, writes: &[(u32, Vec<u32>)]) -> Result<(), TbError> {
         for (a, d) in writes {
             self.dut.write_config(*a, d)?;
         }
@@ -722,7 +707,7 @@ impl FrameBench {
     }
 
     /// Loads a new block LUT (same pointers: only the empty and masked flags change).
-    pub fn set_lut(&mut self, lut: &BlockLut) -> Result<(), FrameError> {
+    pub fn set_lut(&mut self, lut: &BlockLut) -> Result<(), TbError> {
         let writes = self.rtl.block_writes(self.dims, lut)?;
         self.write(&writes)?;
         self.lut = lut.clone();
@@ -730,7 +715,7 @@ impl FrameBench {
     }
 
     /// Loads the tables and registers of a frame.
-    pub fn load(&mut self, e: &Expected) -> Result<(), FrameError> {
+    pub fn load(&mut self, e: &Expected) -> Result<(), TbError> {
         let u = &e.units;
         let key = (
             u.render,
@@ -765,7 +750,7 @@ impl FrameBench {
         e: &Expected,
         traffic: &Traffic,
         seed: u64,
-    ) -> Result<FrameStats, FrameError> {
+    ) -> Result<FrameStats, TbError> {
         self.load(e)?;
         self.render_and_compare(e, traffic, seed)
     }
@@ -776,14 +761,14 @@ impl FrameBench {
         e: &Expected,
         traffic: &Traffic,
         seed: u64,
-    ) -> Result<FrameStats, FrameError> {
+    ) -> Result<FrameStats, TbError> {
         let got = self.render(e, traffic)?;
         self.compare(e, &got, seed)
     }
 
     /// Drives the render command until the W H pixels of `e`'s base plane are out (or a cycle
     /// limit far beyond the frame's budget passes).
-    pub fn render(&mut self, e: &Expected, traffic: &Traffic) -> Result<Rendered, FrameError> {
+    pub fn render(&mut self, e: &Expected, traffic: &Traffic) -> Result<Rendered, TbError> {
         let n = (e.w * e.h) as u64;
         let start = self.dut.cycle();
         let limit = 40 * (e.params.samples() as u64 + n) + 100_000;
@@ -800,12 +785,7 @@ impl FrameBench {
     /// Compares a rendered frame with the model's: every pixel and channel, the error flag, and
     /// the memory beats read against the model's sweep of the skewed memory (which must find no
     /// module conflict). The first difference is reported with the ray's trail.
-    pub fn compare(
-        &self,
-        e: &Expected,
-        got: &Rendered,
-        seed: u64,
-    ) -> Result<FrameStats, FrameError> {
+    pub fn compare(&self, e: &Expected, got: &Rendered, seed: u64) -> Result<FrameStats, TbError> {
         let rtl = self.rtl;
         let mut mem = rtl.memory(self.dims, &self.lut)?;
         let accesses = cube5_frame::sweep_memory(&e.params, self.skip, &mut mem)?;
@@ -815,7 +795,15 @@ impl FrameBench {
                 rtl.variant, e.view, e.dir, e.units.render, self.dims, e.params
             )
         };
-        let fail = |what: String| Err(FrameError::Mismatch(format!("{}: {what}", ctx())));
+        let fail = |what: String| {
+            Err(TbError::from(Mismatch {
+                variant: rtl.variant.name.to_string(),
+                seed,
+                input: ctx(),
+                what,
+                ..Default::default()
+            }))
+        };
         if accesses.conflicts != 0 {
             return fail(format!(
                 "the model's sweep has {} beams with a module conflict",
@@ -823,7 +811,12 @@ impl FrameBench {
             ));
         }
         if got.protocol_errors > 0 {
-            return fail("a stalled output changed".into());
+            return Err(TbError::Protocol {
+                variant: rtl.variant.name.to_string(),
+                seed,
+                cycle: got.cycles,
+                what: format!("a stalled output changed ({})", ctx()),
+            });
         }
         let reads = accesses.beams_read as u32;
         for (i, px) in got.pixels.iter().enumerate() {
@@ -838,7 +831,8 @@ impl FrameBench {
                 ));
             }
             if i < e.want.len() && px.coxel != e.want[i] {
-                return Err(FrameError::Mismatch(mismatch_report(
+                return Err(TbError::from(mismatch_report(
+                    rtl.variant,
                     &ctx(),
                     e,
                     PixelAt {
@@ -854,11 +848,17 @@ impl FrameBench {
         }
         let n = e.w * e.h;
         if got.pixels.len() != n {
-            return fail(format!(
-                "{} of {n} pixels within {} cycles (deadlock or lost pixel)",
-                got.pixels.len(),
-                got.limit
-            ));
+            return Err(TbError::Deadlock {
+                variant: rtl.variant.name.to_string(),
+                seed,
+                cycle: got.cycles,
+                what: format!(
+                    "{} of {n} pixels within {} cycles (deadlock or lost pixel; {})",
+                    got.pixels.len(),
+                    got.limit,
+                    ctx()
+                ),
+            });
         }
         Ok(FrameStats {
             cycles: got.cycles,
@@ -887,17 +887,21 @@ impl FrameBench {
     /// Drives one command that must be refused: exactly one output item, with the error flag, and
     /// nothing after it. (After a reset the command waits for the compositing buffer's clear
     /// pass, 4 MaxDim^2 / P cycles.)
-    pub fn refused(&mut self, op: u32) -> Result<FrameOut, FrameError> {
+    pub fn refused(&mut self, op: u32) -> Result<FrameOut, TbError> {
         let d = self.dut.drive(&[op], &Traffic::full_speed(), 1, 100_000)?;
         let more = self.dut.drive(&[], &Traffic::full_speed(), 1, 200)?;
         match (d.outputs.as_slice(), more.outputs.is_empty()) {
             ([one], true) => Ok(one.value.clone()),
-            _ => Err(FrameError::Mismatch(format!(
-                "{}: command {op} answered {} item(s), then {} more; a refused command has one",
-                self.rtl.variant,
-                d.outputs.len(),
-                more.outputs.len()
-            ))),
+            _ => Err(TbError::from(Mismatch {
+                variant: self.rtl.variant.name.to_string(),
+                input: format!("command {op}"),
+                what: format!(
+                    "answered {} item(s), then {} more; a refused command has one",
+                    d.outputs.len(),
+                    more.outputs.len()
+                ),
+                ..Default::default()
+            })),
         }
     }
 }
@@ -911,38 +915,44 @@ struct PixelAt {
 }
 
 /// The first differing pixel: where, which channel, both values, and the model's trail of the ray.
-fn mismatch_report(ctx: &str, e: &Expected, at: PixelAt, got: &Coxel, seed: u64) -> String {
+fn mismatch_report(
+    variant: &Variant,
+    ctx: &str,
+    e: &Expected,
+    at: PixelAt,
+    got: &Coxel,
+    seed: u64,
+) -> Mismatch {
     let exp = &e.want[at.item];
     let names = ["R", "G", "B", "A"];
-    let mut what = String::new();
-    for (ch, name) in names.iter().enumerate() {
-        if got.rgba[ch] != exp.rgba[ch] {
-            what.push_str(&format!(
-                "\n  channel {name}: rtl {} model {}",
-                got.rgba[ch], exp.rgba[ch]
-            ));
-        }
-    }
+    let mut what: Vec<String> = names
+        .iter()
+        .enumerate()
+        .filter(|&(ch, _)| got.rgba[ch] != exp.rgba[ch])
+        .map(|(_, name)| format!("channel {name}"))
+        .collect();
     if got.z != exp.z || got.geo != exp.geo {
-        what.push_str(&format!(
-            "\n  Z / geometry: rtl {} {:?} model {} {:?}",
-            got.z, got.geo, exp.z, exp.geo
-        ));
+        what.push("Z / geometry".into());
     }
     if got.terminated != exp.terminated {
-        what.push_str(&format!(
-            "\n  terminated: rtl {} model {}",
-            got.terminated, exp.terminated
-        ));
+        what.push("terminated".into());
     }
-    format!(
-        "MISMATCH {ctx}\n  pixel (r, q) = ({}, {}) of the {} x {} base plane (output #{}, taken at cycle {}){what}\n  the model's samples of this ray (slice, anchor, sample, neighbourhood C x- x+ y- y+ B A, shaded, coxel after):{}\n  reproduce with CUBE5_SEED={seed}",
-        at.r,
-        at.q,
-        e.w,
-        e.h,
-        at.item,
-        at.cycle,
-        ray_trail(&e.params, &e.seen, &e.units, at.r, at.q)
-    )
+    Mismatch {
+        variant: variant.name.to_string(),
+        seed,
+        item: at.item as u64,
+        cycle: at.cycle,
+        input: format!(
+            "{ctx}; pixel (r, q) = ({}, {}) of the {} x {} base plane",
+            at.r, at.q, e.w, e.h
+        ),
+        rtl: format!("{got:?}"),
+        model: format!("{exp:?}"),
+        what: format!("{} differ", what.join(", ")),
+        trail: format!(
+            "the model's samples of this ray (slice, anchor, sample, neighbourhood C x- x+ y- y+ B A, shaded, coxel after):{}",
+            ray_trail(&e.params, &e.seen, &e.units, at.r, at.q)
+        ),
+        ..Default::default()
+    }
 }

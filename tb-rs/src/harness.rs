@@ -1,7 +1,9 @@
 //! The co-simulation scoreboard: seeded stimulus into an RTL variant and the golden model, outputs
 //! compared in order with no tolerance, under random idle, back-pressure and a mid-stream reset.
 
-use crate::rtl::{RtlError, RtlStream, Traffic};
+use crate::error::{Mismatch, TbError};
+use crate::rtl::{RtlStream, Traffic};
+use crate::variants::Variant;
 use cube5_model::unit::{StreamCodec, StreamUnit};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -55,6 +57,28 @@ impl StreamCheck {
         }
     }
 
+    /// A directed list under heavy idle and back-pressure (a short list still meets the
+    /// handshake's corner cases). `items` is 0: `support::must_match_items` runs the list once.
+    pub fn directed(seed: u64) -> Self {
+        Self::new(seed, 0).with_traffic(0.3, 0.3)
+    }
+
+    /// A long random run under idle and back-pressure, reset once in batch `reset_in_batch`.
+    pub fn long(seed: u64, items: usize, reset_in_batch: usize) -> Self {
+        Self::new(seed, items)
+            .with_traffic(0.2, 0.3)
+            .with_reset_in_batch(reset_in_batch)
+    }
+
+    /// The gate-level netlist run: 30,000 random items under idle and back-pressure, in batches
+    /// of 10,000 (netlists simulate slowly), with a reset in the middle one.
+    pub fn gate_smoke(seed: u64) -> Self {
+        Self::new(seed, 30_000)
+            .with_traffic(0.2, 0.2)
+            .with_batch(10_000)
+            .with_reset_in_batch(1)
+    }
+
     pub fn with_config_writes(mut self, writes: Vec<(u32, Vec<u32>)>) -> Self {
         self.config_writes = writes;
         self
@@ -97,66 +121,35 @@ impl StreamReport {
     }
 }
 
-/// The first difference between RTL and model, with everything needed to reproduce it.
-#[derive(Debug, Clone)]
-pub struct Mismatch {
-    pub variant: String,
-    pub seed: u64,
-    pub item: u64,
-    pub cycle: u64,
-    pub input: String,
-    pub rtl: String,
-    pub model: String,
-    pub rtl_words: Vec<u32>,
-    pub waveform: Option<PathBuf>,
-    pub what: String,
-}
-
-impl fmt::Display for Mismatch {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.item == u64::MAX {
-            return write!(f, "co-simulation could not start: {}", self.what);
+/// Runs a check and turns any failure into a panic whose message is the full report (the
+/// tests' one entry point); prints what the run did when it passes.
+pub fn must_match<C, G>(
+    variant: &'static Variant,
+    codec: C,
+    gold: &mut G,
+    gen: &mut dyn FnMut(&mut ChaCha8Rng) -> C::In,
+    check: &StreamCheck,
+) -> StreamReport
+where
+    C: StreamCodec + Clone,
+    C::In: Clone + fmt::Debug,
+    C::Out: Clone + fmt::Debug + PartialEq,
+    G: StreamUnit<In = C::In, Out = C::Out>,
+{
+    match check_stream(variant, codec, gold, gen, check) {
+        Ok(r) => {
+            eprintln!(
+                "{variant}: seed {} consumed {} compared {} in {} cycles ({:.4} items/clock), {} reset(s)",
+                r.seed,
+                r.consumed,
+                r.compared,
+                r.cycles,
+                r.items_per_cycle(),
+                r.resets
+            );
+            r
         }
-        writeln!(
-            f,
-            "MISMATCH in {} ({}), seed {}",
-            self.variant, self.what, self.seed
-        )?;
-        writeln!(
-            f,
-            "  item   #{} (output taken at cycle {})",
-            self.item, self.cycle
-        )?;
-        writeln!(f, "  input  {}", self.input)?;
-        writeln!(f, "  rtl    {}  (words {:08x?})", self.rtl, self.rtl_words)?;
-        writeln!(f, "  model  {}", self.model)?;
-        match &self.waveform {
-            Some(p) => writeln!(f, "  waveform {}", p.display())?,
-            None => writeln!(
-                f,
-                "  waveform: not written (unset CUBE5_NO_WAVES to get one)"
-            )?,
-        }
-        write!(f, "  reproduce with CUBE5_SEED={}", self.seed)
-    }
-}
-
-impl std::error::Error for Mismatch {}
-
-impl From<RtlError> for Mismatch {
-    fn from(e: RtlError) -> Self {
-        Mismatch {
-            variant: String::new(),
-            seed: 0,
-            item: 0,
-            cycle: 0,
-            input: String::new(),
-            rtl: String::new(),
-            model: String::new(),
-            rtl_words: Vec::new(),
-            waveform: None,
-            what: e.to_string(),
-        }
+        Err(e) => panic!("{e}"),
     }
 }
 
@@ -165,12 +158,12 @@ impl From<RtlError> for Mismatch {
 /// Deterministic in `check.seed`: the stimulus, the traffic, Verilator's random reset values and
 /// the reset point all derive from it, so a mismatch re-runs identically with a waveform.
 pub fn check_stream<C, G>(
-    variant: &str,
+    variant: &'static Variant,
     codec: C,
     gold: &mut G,
     gen: &mut dyn FnMut(&mut ChaCha8Rng) -> C::In,
     check: &StreamCheck,
-) -> Result<StreamReport, Box<Mismatch>>
+) -> Result<StreamReport, TbError>
 where
     C: StreamCodec + Clone,
     C::In: Clone + fmt::Debug,
@@ -179,8 +172,8 @@ where
 {
     match run_check(variant, codec.clone(), gold, gen, check, None) {
         Ok(r) => Ok(r),
-        Err(mut m) => {
-            if check.waveform_on_mismatch && m.item != u64::MAX && !m.variant.is_empty() {
+        Err(TbError::Mismatch(mut m)) => {
+            if check.waveform_on_mismatch {
                 let dir = PathBuf::from(
                     std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".into()),
                 )
@@ -199,19 +192,20 @@ where
                 );
                 m.waveform = path.exists().then_some(path);
             }
-            Err(m)
+            Err(TbError::Mismatch(m))
         }
+        Err(e) => Err(e),
     }
 }
 
 fn run_check<C, G>(
-    variant: &str,
+    variant: &'static Variant,
     codec: C,
     gold: &mut G,
     gen: &mut dyn FnMut(&mut ChaCha8Rng) -> C::In,
     check: &StreamCheck,
     trace: Option<(PathBuf, (u64, u64))>,
-) -> Result<StreamReport, Box<Mismatch>>
+) -> Result<StreamReport, TbError>
 where
     C: StreamCodec,
     C::In: Clone + fmt::Debug,
@@ -222,26 +216,31 @@ where
     let traffic = Traffic::random(&mut rng, check.idle, check.stall);
     let verilator_seed = rng.random::<u32>();
     let fail = |item: u64, cycle: u64, what: String| Mismatch {
-        variant: variant.to_string(),
+        variant: variant.name.to_string(),
         seed: check.seed,
         item,
         cycle,
-        input: String::new(),
-        rtl: String::new(),
-        model: String::new(),
-        rtl_words: Vec::new(),
-        waveform: None,
         what,
+        ..Default::default()
     };
-    let mut dut = RtlStream::new(variant, codec, verilator_seed).map_err(|e| {
-        Box::new(Mismatch {
-            item: u64::MAX,
-            ..fail(u64::MAX, 0, e.to_string())
-        })
-    })?;
+    // A run error carries the seed of this check.
+    let seeded = |e: TbError| match e {
+        TbError::Protocol {
+            variant,
+            cycle,
+            what,
+            ..
+        } => TbError::Protocol {
+            variant,
+            seed: check.seed,
+            cycle,
+            what,
+        },
+        other => other,
+    };
+    let mut dut = RtlStream::new(variant, codec, verilator_seed)?;
     for (addr, data) in &check.config_writes {
-        dut.write_config(*addr, data)
-            .map_err(|e| Box::new(fail(u64::MAX, 0, e.to_string())))?;
+        dut.write_config(*addr, data)?;
     }
     if let Some((path, (from, to))) = &trace {
         dut.trace_window(path, *from, *to);
@@ -249,7 +248,7 @@ where
     gold.reset();
 
     let mut report = StreamReport {
-        variant: variant.to_string(),
+        variant: variant.name.to_string(),
         seed: check.seed,
         ..Default::default()
     };
@@ -266,7 +265,7 @@ where
             let cut = rng.random_range(1..=(n as u64).max(2));
             let driven = dut
                 .drive(&pending, &traffic, u64::MAX, cut)
-                .map_err(|e| Box::new(fail(item_base, dut.cycle(), e.to_string())))?;
+                .map_err(seeded)?;
             let consumed = driven.stats.consumed as usize;
             let expected = gold.run(&pending[..consumed]);
             compare(
@@ -293,16 +292,17 @@ where
         let want = pending.len() as u64;
         let driven = dut
             .drive(&pending, &traffic, want, 64 * want + 10_000)
-            .map_err(|e| Box::new(fail(item_base, dut.cycle(), e.to_string())))?;
+            .map_err(seeded)?;
         if driven.stats.protocol_errors > 0 {
-            return Err(Box::new(fail(
-                item_base,
-                driven.stats.first_protocol_error_cycle,
-                format!(
+            return Err(TbError::Protocol {
+                variant: variant.name.to_string(),
+                seed: check.seed,
+                cycle: driven.stats.first_protocol_error_cycle,
+                what: format!(
                     "valid/ready violated {} times: a stalled output dropped valid or changed",
                     driven.stats.protocol_errors
                 ),
-            )));
+            });
         }
         compare(
             dut.codec(),
@@ -314,14 +314,15 @@ where
             &fail,
         )?;
         if driven.stats.produced != want {
-            return Err(Box::new(fail(
-                item_base + driven.stats.produced,
-                dut.cycle(),
-                format!(
-                    "RTL produced {} of {} outputs within the cycle limit (deadlock or lost item)",
+            return Err(TbError::Deadlock {
+                variant: variant.name.to_string(),
+                seed: check.seed,
+                cycle: dut.cycle(),
+                what: format!(
+                    "RTL produced {} of {} outputs of the batch from item #{item_base} within the cycle limit (deadlock or lost item)",
                     driven.stats.produced, want
                 ),
-            )));
+            });
         }
         report.consumed += driven.stats.consumed;
         report.compared += driven.stats.produced;
@@ -341,7 +342,7 @@ fn compare<C: StreamCodec>(
     item_base: u64,
     check: &StreamCheck,
     fail: &dyn Fn(u64, u64, String) -> Mismatch,
-) -> Result<(), Box<Mismatch>>
+) -> Result<(), TbError>
 where
     C::In: fmt::Debug,
     C::Out: Clone + fmt::Debug + PartialEq,
@@ -357,7 +358,7 @@ where
             }
         }
         if expected.get(k) != Some(&value) {
-            return Err(Box::new(Mismatch {
+            return Err(TbError::from(Mismatch {
                 input: format!("{:?}", inputs.get(k)),
                 rtl: format!("{value:?}"),
                 model: expected

@@ -1,26 +1,13 @@
 //! A Verilated streaming top behind the same `StreamUnit` trait as the golden model.
 
+use crate::error::TbError;
 use crate::ffi::bridge::{self, RunResult, StreamDut};
+use crate::variants::{Variant, VARIANTS};
 use cube5_model::bits::words_for;
+use cube5_model::unit::UnitConfig;
 use cube5_model::unit::{StreamCodec, StreamUnit};
 use cxx::UniquePtr;
 use std::path::Path;
-use thiserror::Error;
-
-#[derive(Debug, Error)]
-pub enum RtlError {
-    #[error("RTL variant `{name}` is not built into this test bench (built: {built}); check rtl/**/*.variants and CUBE5_TOPS")]
-    NotBuilt { name: String, built: String },
-    #[error("RTL variant `{name}`: {port} is {rtl} bits in the RTL but {model} bits in the model's codec")]
-    WidthMismatch {
-        name: String,
-        port: &'static str,
-        rtl: u32,
-        model: u32,
-    },
-    #[error("RTL variant `{name}`: {what}")]
-    Run { name: String, what: String },
-}
 
 /// Configuration-port writes: (address, data words), applied in order.
 pub type ConfigWrites = Vec<(u32, Vec<u32>)>;
@@ -71,49 +58,71 @@ pub struct Driven<T> {
 pub struct RtlStream<C: StreamCodec> {
     dut: UniquePtr<StreamDut>,
     codec: C,
-    name: String,
+    variant: &'static Variant,
 }
 
-/// Names of every RTL variant built into this test bench.
-pub fn built_variants() -> Vec<String> {
-    bridge::built_variants()
+/// The variants built into this test bench.
+pub fn built_variants() -> Vec<&'static Variant> {
+    let names = bridge::built_variants();
+    VARIANTS
+        .iter()
+        .filter(|v| names.iter().any(|n| n == v.name))
+        .collect()
+}
+
+impl<C: StreamCodec + UnitConfig> RtlStream<C> {
+    /// Opens `variant` with the model's configuration built from its parameters.
+    pub fn open(variant: &'static Variant, seed: u32) -> Result<Self, TbError> {
+        let codec = variant
+            .config::<C>()
+            .map_err(|e| TbError::setup(variant.name, e))?;
+        Self::new(variant, codec, seed)
+    }
 }
 
 impl<C: StreamCodec> RtlStream<C> {
-    /// Instantiates variant `name` (e.g. `cube5_trilin_v12`) with Verilator's random-reset seed
-    /// `seed`, resets it, and checks its port widths against `codec`.
-    pub fn new(name: &str, codec: C, seed: u32) -> Result<Self, RtlError> {
-        let dut = bridge::new_stream_dut(name, seed);
+    /// Instantiates `variant` with Verilator's random-reset seed `seed`, resets it, and checks
+    /// its port widths against `codec`.
+    pub fn new(variant: &'static Variant, codec: C, seed: u32) -> Result<Self, TbError> {
+        let dut = bridge::new_stream_dut(variant.name, seed);
         if dut.is_null() {
-            return Err(RtlError::NotBuilt {
-                name: name.into(),
-                built: built_variants().join(", "),
-            });
+            let built: Vec<&str> = built_variants().iter().map(|v| v.name).collect();
+            return Err(TbError::setup(
+                variant.name,
+                format!(
+                    "not built into this test bench (built: {}); check rtl/**/*.variants and CUBE5_TOPS",
+                    built.join(", ")
+                ),
+            ));
         }
         let mut s = Self {
             dut,
             codec,
-            name: name.into(),
+            variant,
         };
         for (port, rtl, model) in [
             ("in_data_i", s.dut.in_bits(), s.codec.in_width()),
             ("out_data_o", s.dut.out_bits(), s.codec.out_width()),
         ] {
             if rtl != model {
-                return Err(RtlError::WidthMismatch {
-                    name: name.into(),
-                    port,
-                    rtl,
-                    model,
-                });
+                return Err(TbError::setup(
+                    variant.name,
+                    format!(
+                        "{port} is {rtl} bits in the RTL but {model} bits in the model's codec"
+                    ),
+                ));
             }
         }
         s.reset();
         Ok(s)
     }
 
-    pub fn name(&self) -> &str {
-        &self.name
+    pub fn name(&self) -> &'static str {
+        self.variant.name
+    }
+
+    pub fn variant(&self) -> &'static Variant {
+        self.variant
     }
 
     pub fn codec(&self) -> &C {
@@ -130,15 +139,14 @@ impl<C: StreamCodec> RtlStream<C> {
     }
 
     /// One write on the configuration port (LUT and register loads; see the unit's contract).
-    pub fn write_config(&mut self, addr: u32, data: &[u32]) -> Result<(), RtlError> {
+    pub fn write_config(&mut self, addr: u32, data: &[u32]) -> Result<(), TbError> {
         if self.dut.pin_mut().write_config(addr, data) {
             Ok(())
         } else {
-            Err(RtlError::Run {
-                name: self.name.clone(),
-                what: "this top has no configuration port (cfg_valid_i, cfg_addr_i, cfg_data_i)"
-                    .into(),
-            })
+            Err(TbError::setup(
+                self.variant.name,
+                "this top has no configuration port (cfg_valid_i, cfg_addr_i, cfg_data_i)",
+            ))
         }
     }
 
@@ -157,7 +165,7 @@ impl<C: StreamCodec> RtlStream<C> {
         traffic: &Traffic,
         expect_out: u64,
         max_cycles: u64,
-    ) -> Result<Driven<C::Out>, RtlError> {
+    ) -> Result<Driven<C::Out>, TbError> {
         let flat = self.pack(items);
         self.drive_packed(&flat, traffic, expect_out, max_cycles)
     }
@@ -178,7 +186,7 @@ impl<C: StreamCodec> RtlStream<C> {
         traffic: &Traffic,
         expect_out: u64,
         max_cycles: u64,
-    ) -> Result<Driven<C::Out>, RtlError> {
+    ) -> Result<Driven<C::Out>, TbError> {
         let in_words = words_for(self.codec.in_width());
         let out_words = words_for(self.codec.out_width());
         let mut raw = Vec::new();
@@ -193,8 +201,10 @@ impl<C: StreamCodec> RtlStream<C> {
             out_words as u32,
         );
         if stats.finished {
-            return Err(RtlError::Run {
-                name: self.name.clone(),
+            return Err(TbError::Protocol {
+                variant: self.variant.name.to_string(),
+                seed: 0,
+                cycle: self.dut.cycle(),
                 what: "the RTL stopped the simulation ($finish or a failed assertion)".into(),
             });
         }
@@ -227,7 +237,7 @@ where
         assert_eq!(
             driven.stats.produced, n,
             "{}: RTL did not produce every output",
-            self.name
+            self.variant.name
         );
         driven.outputs.into_iter().map(|t| t.value).collect()
     }

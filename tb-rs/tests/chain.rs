@@ -25,7 +25,7 @@ use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::fmt::Debug;
-use support::seed;
+use support::{seed, variant_with};
 
 const RAYS: usize = 10_000;
 const MIN_LEN: usize = 64;
@@ -111,13 +111,13 @@ fn ten_thousand_whole_rays_through_the_chained_units() {
     let mut m_shader = Shader::new(shader_cfg, tables.clone()).unwrap();
     let mut m_compos = Compos::new(compos_cfg, lut.clone(), regs).unwrap();
 
-    let mut r_trilin = RtlStream::new("cube5_trilin_v12", trilin_cfg, rng.random()).unwrap();
-    let mut r_grad = RtlStream::new("cube5_gradient_v12", grad_cfg, rng.random()).unwrap();
-    let mut r_shader = RtlStream::new("cube5_shader_v12", shader_cfg, rng.random()).unwrap();
+    let mut r_trilin = RtlStream::new(variant_with(trilin_cfg), trilin_cfg, rng.random()).unwrap();
+    let mut r_grad = RtlStream::new(variant_with(grad_cfg), grad_cfg, rng.random()).unwrap();
+    let mut r_shader = RtlStream::new(variant_with(shader_cfg), shader_cfg, rng.random()).unwrap();
     for (addr, data) in tables.config_writes(&shader_cfg) {
         r_shader.write_config(addr, &data).unwrap();
     }
-    let mut r_compos = RtlStream::new("cube5_compos_c12", compos_cfg, rng.random()).unwrap();
+    let mut r_compos = RtlStream::new(variant_with(compos_cfg), compos_cfg, rng.random()).unwrap();
     for (addr, data) in m_compos.config_writes() {
         r_compos.write_config(addr, &data).unwrap();
     }

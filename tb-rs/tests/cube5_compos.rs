@@ -7,19 +7,16 @@ use cube5_model::units::cube5_compos::{
     config_writes, Compos, ComposConfig, ComposIn, ComposMode, ComposRegs, Coxel, OpacityLut,
     Sample,
 };
-use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::rtl::RtlStream;
+use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run, must_match,
-    must_match_across_a_reset, must_match_items_with_config, random_items, seed, MILLION,
+    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
+    gate_configs, must_match_across_a_reset, must_match_items, random_items, seed, variant_with,
+    MILLION,
 };
-
-const NARROW: (&str, ComposConfig) = ("cube5_compos_c8", ComposConfig::NARROW);
-const DEFAULT: (&str, ComposConfig) = ("cube5_compos_c12", ComposConfig::DEFAULT);
-const WIDE: (&str, ComposConfig) = ("cube5_compos_c10", ComposConfig::WIDE);
-const CONFIGS: [(&str, ComposConfig); 3] = [NARROW, DEFAULT, WIDE];
 
 fn unit(cfg: ComposConfig, ratio: f64, regs: ComposRegs) -> Compos {
     Compos::new(cfg, OpacityLut::new(ratio, &cfg).unwrap(), regs).unwrap()
@@ -31,9 +28,15 @@ fn check_for(gold: &Compos, seed: u64, items: usize) -> StreamCheck {
 }
 
 /// Runs `items` (in order, once) through `variant` and the model under idle and back-pressure.
-fn run_items(variant: &str, gold: &mut Compos, items: Vec<ComposIn>, seed: u64) {
+fn run_items(variant: &'static Variant, gold: &mut Compos, items: Vec<ComposIn>, seed: u64) {
     let (cfg, writes) = (gold.config(), gold.config_writes());
-    must_match_items_with_config(variant, cfg, gold, items, seed, writes);
+    must_match_items(
+        variant,
+        cfg,
+        gold,
+        items,
+        &StreamCheck::directed(seed).with_config_writes(writes),
+    );
 }
 
 fn pick<T: Copy>(rng: &mut ChaCha8Rng, xs: &[T]) -> T {
@@ -118,18 +121,15 @@ fn busy_regs(cfg: &ComposConfig, xray_shift: u32, lut_bypass: bool) -> ComposReg
 
 #[test]
 fn million_random_items_per_config_with_idle_backpressure_and_reset() {
-    for (i, ((variant, cfg), ratio)) in CONFIGS.iter().zip([2.0, 0.5, 3f64.sqrt()]).enumerate() {
-        let mut gold = unit(*cfg, ratio, busy_regs(cfg, 3 + 5 * i as u32, false));
-        let check =
-            long_run(seed(300 + i as u64), MILLION, 3).with_config_writes(gold.config_writes());
-        must_match_across_a_reset(
-            variant,
-            *cfg,
-            &mut gold,
-            &mut random_item(*cfg),
-            &check,
-            1000,
-        );
+    for (i, ((variant, cfg), ratio)) in configs::<ComposConfig>()
+        .into_iter()
+        .zip([2.0, 0.5, 3f64.sqrt()])
+        .enumerate()
+    {
+        let mut gold = unit(cfg, ratio, busy_regs(&cfg, 3 + 5 * i as u32, false));
+        let check = StreamCheck::long(seed(300 + i as u64), MILLION, 3)
+            .with_config_writes(gold.config_writes());
+        must_match_across_a_reset(variant, cfg, &mut gold, &mut random_item(cfg), &check, 1000);
     }
 }
 
@@ -138,7 +138,7 @@ fn million_random_items_per_config_with_idle_backpressure_and_reset() {
 #[test]
 fn random_tables_registers_and_bypass() {
     let mut rng = ChaCha8Rng::seed_from_u64(seed(310));
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         for bypass in [false, true] {
             let entries = (0..=cfg.alpha_max())
                 .map(|_| rng.random_range(0..(2u32 << cfg.q())))
@@ -215,7 +215,7 @@ fn edge_coxels(cfg: &ComposConfig, regs: &ComposRegs) -> Vec<Coxel> {
 /// alpha 0, 1 LSB, 1 - 1 LSB and 1 in every mode, on every edge coxel, with the LUT and bypassed.
 #[test]
 fn directed_alpha_0_1lsb_1minus1lsb_and_1() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         for bypass in [false, true] {
             let regs = busy_regs(&cfg, 8, bypass);
             let mut gold = unit(cfg, 1.0, regs);
@@ -245,7 +245,7 @@ fn directed_alpha_0_1lsb_1minus1lsb_and_1() {
 /// the faintest codes approach it; every step of the chain is compared.
 #[test]
 fn directed_opacity_saturation_over_10000_samples() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         let regs = ComposRegs::without_termination(&cfg);
         let mut gold = unit(cfg, 1.0, regs);
         let top = cfg.alpha_max();
@@ -292,7 +292,7 @@ fn directed_opacity_correction_1_16_to_16_including_sub_lsb() {
         8.0,
         16.0,
     ];
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         for ratio in ratios {
             let regs = ComposRegs::without_termination(&cfg);
             let mut gold = unit(cfg, ratio, regs);
@@ -319,7 +319,7 @@ fn directed_opacity_correction_1_16_to_16_including_sub_lsb() {
 /// Densities (alpha) and colours 0 and max, every mode, on empty and full coxels.
 #[test]
 fn directed_densities_and_colours_0_and_max() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         let mut gold = unit(cfg, 1.0, ComposRegs::defaults(&cfg));
         let full = Coxel {
             rgba: [cfg.one(); 4],
@@ -346,7 +346,7 @@ fn directed_densities_and_colours_0_and_max() {
 /// shifts 0, 1, 8 and 15.
 #[test]
 fn directed_xray_sum_overflow() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         for shift in [0, 1, 8, 15] {
             let regs = ComposRegs {
                 xray_shift: shift,
@@ -377,7 +377,7 @@ fn directed_xray_sum_overflow() {
 /// reaches the target colour within half an 8-bit display LSB (the contract's stalling table).
 #[test]
 fn directed_eight_bit_alpha_stalling() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         let regs = ComposRegs::without_termination(&cfg);
         let gold = unit(cfg, 1.0, regs);
         let code = (0.002 * f64::from(cfg.alpha_max())).round() as u32;
@@ -405,7 +405,7 @@ fn directed_eight_bit_alpha_stalling() {
 /// back then flush over a whole ray.
 #[test]
 fn directed_depth_test_flush_and_early_termination() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         // FoThreshold exactly at the corrected alpha of the middle code, for the >= edge.
         let mid = cfg.alpha_max() / 2;
         let lut = OpacityLut::new(1.0, &cfg).unwrap();
@@ -482,11 +482,11 @@ fn directed_depth_test_flush_and_early_termination() {
 #[test]
 fn one_item_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 6;
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ComposConfig>() {
         let gold = unit(cfg, 1.0, ComposRegs::defaults(&cfg));
         let writes = gold.config_writes();
         let items = random_items(seed(11), 100_000, random_item(cfg));
-        let driven = assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, LATENCY);
+        let driven = assert_one_item_per_clock(variant, cfg, &writes, &items, LATENCY);
         let values: Vec<Coxel> = driven.outputs.into_iter().map(|t| t.value).collect();
         assert_eq!(values, gold.clone().run(&items));
     }
@@ -494,16 +494,15 @@ fn one_item_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("cube5_compos_c8_gate", ComposConfig::NARROW);
+    let (variant, cfg) = gate_configs::<ComposConfig>()[0];
     let mut gold = unit(cfg, 2.0, busy_regs(&cfg, 2, false));
     let writes = gold.config_writes();
-    gate_smoke_with_config(
+    must_match(
         variant,
         cfg,
         &mut gold,
         &mut random_item(cfg),
-        seed(21),
-        writes,
+        &StreamCheck::gate_smoke(seed(21)).with_config_writes(writes),
     );
     let regs = busy_regs(&cfg, 0, true);
     let mut gold = unit(cfg, 0.5, regs);
@@ -525,7 +524,8 @@ fn gate_level_netlist_smoke() {
 /// that reached the RTL through the configuration port with a different value than the model has.
 #[test]
 fn a_config_write_that_differs_from_the_model_is_caught() {
-    let (variant, cfg) = DEFAULT;
+    let cfg = ComposConfig::DEFAULT;
+    let variant = variant_with(cfg);
     let regs = ComposRegs::defaults(&cfg);
     let gold_unit = unit(cfg, 1.0, regs);
     let item = |i: usize, a: u64| ComposIn {
@@ -554,8 +554,10 @@ fn a_config_write_that_differs_from_the_model_is_caught() {
         check.config_writes = writes;
         check.waveform_on_mismatch = false;
         let mut gold = gold_unit.clone();
-        let err = check_stream(variant, cfg, &mut gold, &mut |_| it.next().unwrap(), &check)
-            .expect_err("a differing configuration write must be caught");
+        let err = expect_mismatch(
+            check_stream(variant, cfg, &mut gold, &mut |_| it.next().unwrap(), &check),
+            "a differing configuration write must be caught",
+        );
         assert_eq!(err.item, first_bad, "{what}");
         let report = err.to_string();
         assert!(
@@ -569,29 +571,24 @@ fn a_config_write_that_differs_from_the_model_is_caught() {
     check.config_writes = gold_unit.config_writes();
     check.corrupt = Some((1234, cfg.coxel_w() - 1));
     check.waveform_on_mismatch = false;
-    let err = check_stream(
-        variant,
-        cfg,
-        &mut gold_unit.clone(),
-        &mut random_item(cfg),
-        &check,
-    )
-    .expect_err("a flipped terminated flag must be caught");
+    let err = expect_mismatch(
+        check_stream(
+            variant,
+            cfg,
+            &mut gold_unit.clone(),
+            &mut random_item(cfg),
+            &check,
+        ),
+        "a flipped terminated flag must be caught",
+    );
     assert_eq!(err.item, 1234);
 }
 
 #[test]
 fn codec_and_variant_are_checked_against_the_rtl() {
-    match RtlStream::new("cube5_compos_c8", ComposConfig::DEFAULT, 1) {
-        Err(RtlError::WidthMismatch {
-            port, rtl, model, ..
-        }) => {
-            assert_eq!((port, rtl, model), ("in_data_i", 112, 172));
-        }
-        other => panic!("expected a width mismatch, got {:?}", other.err()),
-    }
+    assert_foreign_codec_is_refused::<ComposConfig>();
     let cfg = ComposConfig::NARROW;
-    let mut dut = RtlStream::new("cube5_compos_c8", cfg, 1).unwrap();
+    let mut dut = RtlStream::new(variant_with(cfg), cfg, 1).unwrap();
     let writes = config_writes(
         &cfg,
         &OpacityLut::new(1.0, &cfg).unwrap(),

@@ -12,12 +12,24 @@ use cube5_model::units::cube5_shader::Phong;
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
 use cube5_tb::frame::*;
+use cube5_tb::rtl::ConfigWrites;
 use cube5_tb::rtl::Traffic;
+use cube5_tb::variants::gate_variants_of;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::rc::Rc;
 use std::time::Instant;
 use support::seed;
+
+/// The largest-memory configuration with `n` pipelines (default widths).
+fn p(n: usize) -> FrameRtl {
+    FrameRtl::with_pipelines(n).unwrap_or_else(|| panic!("no cube5_frame variant with P = {n}"))
+}
+
+/// The smallest-memory configuration with `n` pipelines (narrow widths, synthesizable).
+fn narrow(n: usize) -> FrameRtl {
+    FrameRtl::smallest(n).unwrap_or_else(|| panic!("no cube5_frame variant with P = {n}"))
+}
 
 // -------------------------------------------------------------------------------------------------
 // Volumes and views
@@ -113,7 +125,7 @@ fn bench(rtl: FrameRtl, vol: &Volume, lut: &BlockLut, s: u64) -> FrameBench {
     must(FrameBench::new(rtl, vol, lut, s as u32))
 }
 
-fn must<T>(r: Result<T, FrameError>) -> T {
+fn must<T>(r: Result<T, cube5_tb::TbError>) -> T {
     r.unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -182,12 +194,12 @@ const SOME_VIEWS: &[usize] = &[0, 6, 10, 11];
 fn plan(render: Render) -> Vec<(FrameRtl, usize, Option<&'static [usize]>)> {
     let mut plan = Vec::new();
     for v in 0..4 {
-        plan.push((P1, v, None));
-        plan.push((P4, v, None));
+        plan.push((p(1), v, None));
+        plan.push((p(4), v, None));
         if v != 2 {
-            plan.push((P8, v, None));
+            plan.push((p(8), v, None));
         } else if render == Render::Mip {
-            plan.push((P8, v, Some(SOME_VIEWS)));
+            plan.push((p(8), v, Some(SOME_VIEWS)));
         }
     }
     plan
@@ -212,7 +224,7 @@ fn accepted(p: &FrameParams, pipes: usize) -> bool {
 #[test]
 fn backpressure_and_mid_frame_reset() {
     let s = seed(3);
-    let rtl = P4;
+    let rtl = p(4);
     let vol = blob_volume([48, 32, 40], 12, s);
     let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
     let seen = seen_of(&vol, &lut);
@@ -271,7 +283,7 @@ fn backpressure_and_mid_frame_reset() {
 #[test]
 fn refused_configurations_answer_one_error_item() {
     let s = seed(4);
-    let rtl = P4;
+    let rtl = p(4);
     let vol = head_phantom(16, 12).unwrap();
     let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
     let seen = seen_of(&vol, &lut);
@@ -354,7 +366,7 @@ fn smallest_volumes_render_and_smaller_are_refused() {
     let s = seed(5);
     for (rtl, dims, ok_views, bad_views) in [
         (
-            P1,
+            p(1),
             [3usize, 4, 3],
             vec![
                 ("-1 -1 +1", [-1.0, -1.0, 1.0]),
@@ -364,19 +376,19 @@ fn smallest_volumes_render_and_smaller_are_refused() {
             vec![("+y (ni 3, nj 3)", [0.0, 1.0, 0.0])],
         ),
         (
-            P1,
+            p(1),
             [3, 3, 3],
             vec![],
             vec![("-1 -1 +1", [-1.0, -1.0, 1.0]), ("+x", [1.0, 0.0, 0.0])],
         ),
         (
-            P4,
+            p(4),
             [12, 4, 4],
             vec![("-1 -1 +1", [-1.0, -1.0, 1.0]), ("-z", [0.0, 0.0, -1.0])],
             vec![("+x (ni 4)", [1.0, 0.0, 0.0])],
         ),
         (
-            P4,
+            p(4),
             [8, 4, 8],
             vec![("+y (ni 8, nj 8)", [0.1, 1.0, -0.3])],
             vec![("+z (ni 8, nj 4)", [0.0, 0.0, 1.0])],
@@ -418,7 +430,7 @@ fn smallest_volumes_render_and_smaller_are_refused() {
 #[test]
 fn block_lut_skips_empty_blocks_and_restricts_to_a_region() {
     let s = seed(6);
-    let rtl = P4;
+    let rtl = p(4);
     let vol = blob_volume([48, 32, 40], 12, s);
     let view = ("oblique x", [0.9, 0.45, -0.2]);
     let full = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
@@ -459,7 +471,7 @@ fn sweep_and_readout_cycles_follow_the_budget() {
     // Set-up 3 + beats + flush (nbs + 2 nbr + 2) + the pipeline; then one pixel per clock.
     let s = seed(7);
     let vol = head_phantom(32, 12).unwrap();
-    for rtl in [P1, P4, P8] {
+    for rtl in [p(1), p(4), p(8)] {
         let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
         let seen = seen_of(&vol, &lut);
         let mut bench = bench(rtl, &vol, &lut, s);
@@ -508,9 +520,9 @@ fn narrow_configurations_s1_s4() {
     let s = seed(8);
     for render in [Render::Mip, Render::Composite] {
         for (rtl, vol) in [
-            (S1, head_phantom(8, 8).unwrap()),
-            (S1, blob_volume([8, 4, 8], 8, s)),
-            (S4, head_phantom(8, 8).unwrap()),
+            (narrow(1), head_phantom(8, 8).unwrap()),
+            (narrow(1), blob_volume([8, 4, 8], 8, s)),
+            (narrow(4), head_phantom(8, 8).unwrap()),
         ] {
             let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
             let seen = seen_of(&vol, &lut);
@@ -537,10 +549,9 @@ fn narrow_configurations_s1_s4() {
 #[test]
 fn gate_level_netlist_smoke() {
     let s = seed(9);
-    let rtl = FrameRtl {
-        variant: "cube5_frame_s1_gate",
-        ..S1
-    };
+    let gate = gate_variants_of(TOP);
+    assert_eq!(gate.len(), 1, "one gate-level frame netlist");
+    let rtl = FrameRtl::from_variant(gate[0]).unwrap();
     let vol = head_phantom(8, 8).unwrap();
     let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
     let seen = seen_of(&vol, &lut);
@@ -568,7 +579,7 @@ fn gate_level_netlist_smoke() {
 #[test]
 fn early_termination_flag_reaches_the_image() {
     let s = seed(10);
-    let rtl = P4;
+    let rtl = p(4);
     let vol = head_phantom(32, 12).unwrap();
     let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
     let seen = seen_of(&vol, &lut);
@@ -594,7 +605,7 @@ fn a_step_one_weight_lsb_off_in_the_rtl_is_reported_with_pixel_channel_and_trail
     // The comparison bites on the frame's own arithmetic (slice constants, rays, rotation), not
     // just on the units': a DY one weight LSB off in the RTL's register alone must be caught.
     let s = seed(11);
-    let rtl = P4;
+    let rtl = p(4);
     let vol = head_phantom(16, 12).unwrap();
     let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
     let seen = seen_of(&vol, &lut);
@@ -646,7 +657,8 @@ fn test_side_fold_agrees_with_the_model_base_plane() {
             )
             .unwrap();
             let bp = cube5_frame::render_base_plane(&p, &vol, &fu);
-            let units = Units::new(&P1, render, setup.opacity_ratio, &Look::default()).unwrap();
+            let units =
+                Units::new(&self::p(1), render, setup.opacity_ratio, &Look::default()).unwrap();
             let (w, h, mine) = model_image(&p, &vol, &units);
             assert_eq!((w, h), (bp.width, bp.height));
             assert!(mine == bp.coxels, "{render:?} {}: images differ", v.0);
@@ -655,41 +667,11 @@ fn test_side_fold_agrees_with_the_model_base_plane() {
 }
 
 #[test]
-fn driver_configurations_agree_with_the_variants_file() {
-    // rtl/cube5/cube5_frame.variants is the one list of configurations; the driver's constants and
-    // the scene limit restate P, MaxDim and the block edge, so they are checked against it.
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../rtl/cube5/cube5_frame.variants"
-    );
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut seen = 0;
-    for line in text.lines().filter(|l| !l.trim_start().starts_with('#')) {
-        let mut words = line.split_whitespace();
-        let Some(name) = words.next() else { continue };
-        let param = |key: &str, default: usize| {
-            line.split_whitespace()
-                .find_map(|w| w.strip_prefix(&format!("{key}=")))
-                .map_or(default, |v| v.parse::<usize>().unwrap())
-        };
-        let rtl = [P1, P4, P8, S1, S4]
-            .into_iter()
-            .find(|r| r.variant == format!("cube5_frame_{name}"))
-            .unwrap_or_else(|| panic!("variant {name} has no FrameRtl"));
-        assert_eq!(param("P", 0), rtl.p, "{name}: P");
-        assert_eq!(param("MaxDim", 0), rtl.max_dim(), "{name}: MaxDim");
-        assert_eq!(param("BlockDim", 8), rtl.block as usize, "{name}: BlockDim");
-        assert_eq!(
-            param("VoxelW", 12),
-            rtl.trilin.voxel_w as usize,
-            "{name}: VoxelW"
-        );
-        seen += 1;
-    }
-    assert_eq!(seen, 5);
-    for rtl in BY_P {
-        assert_eq!(rtl.max_dim(), cube5_model::scene::RTL_MAX_EDGE);
-    }
+fn the_scene_limit_is_the_largest_frame_memory() {
+    // The model's parameters of every variant are checked against the RTL's in
+    // tests/variant_table.rs; here only the scene limit, which restates the largest MaxDim.
+    let largest = FrameRtl::all().iter().map(|r| r.max_dim()).max().unwrap();
+    assert_eq!(largest, cube5_model::scene::RTL_MAX_EDGE);
 }
 
 #[test]
@@ -698,7 +680,7 @@ fn empty_slice_skipping_cuts_cycles_without_changing_a_pixel() {
     let vol = sparse_scene(s);
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let traffic = Traffic::random(&mut rng, 0.0, 0.2);
-    for rtl in [P1, P4] {
+    for rtl in [p(1), p(4)] {
         let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
         let seen = seen_of(&vol, &lut);
         let mut bench = bench(rtl, &vol, &lut, s);

@@ -6,20 +6,14 @@ use cube5_model::unit::StreamUnit;
 use cube5_model::units::cube5_gradient::{
     block_index, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
 };
-use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::rtl::RtlStream;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_cycled,
-    must_match_items, random_items, seed, MILLION,
+    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
+    gate_configs, must_match_across_a_reset, must_match_items, random_items, seed, MILLION,
 };
-
-const CONFIGS: [(&str, GradientConfig); 3] = [
-    ("cube5_gradient_v8", GradientConfig::NARROW),
-    ("cube5_gradient_v12", GradientConfig::DEFAULT),
-    ("cube5_gradient_v16", GradientConfig::WIDE),
-];
 
 const LATENCY: u64 = 5;
 
@@ -145,13 +139,13 @@ fn directed_items(cfg: GradientConfig) -> Vec<GradientIn> {
 
 #[test]
 fn million_random_items_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
+    for (i, (variant, cfg)) in configs::<GradientConfig>().into_iter().enumerate() {
         must_match_across_a_reset(
             variant,
-            *cfg,
-            &mut Gradient::new(*cfg).unwrap(),
-            &mut random_item(*cfg),
-            &long_run(seed(300 + i as u64), MILLION, 5),
+            cfg,
+            &mut Gradient::new(cfg).unwrap(),
+            &mut random_item(cfg),
+            &StreamCheck::long(seed(300 + i as u64), MILLION, 5),
             1000,
         );
     }
@@ -159,9 +153,15 @@ fn million_random_items_per_config_with_idle_backpressure_and_reset() {
 
 #[test]
 fn directed_extremes() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<GradientConfig>() {
         let mut gold = Gradient::new(cfg).unwrap();
-        must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(31));
+        must_match_items(
+            variant,
+            cfg,
+            &mut gold,
+            directed_items(cfg),
+            &StreamCheck::directed(seed(31)),
+        );
     }
 }
 
@@ -170,7 +170,7 @@ fn n10_rounding_ties_both_signs() {
     // One partner sample of value v on the next (or previous) plane with a step of one LSB gives
     // A - B = +-v * 2^WeightW: ties of the final shift by 2 WeightW - 4 whenever v * 2^WeightW is
     // an odd multiple of 2^(2 WeightW - 5), i.e. v = (2k+1) 2^(WeightW-5).
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<GradientConfig>() {
         let unit = Gradient::new(cfg).unwrap();
         let s = 2 * cfg.weight_w - 4;
         let mut items = Vec::new();
@@ -192,7 +192,7 @@ fn n10_rounding_ties_both_signs() {
             }
         }
         let check = StreamCheck::new(seed(32), items.len()).with_traffic(0.2, 0.2);
-        must_match_cycled(
+        must_match_items(
             variant,
             cfg,
             &mut Gradient::new(cfg).unwrap(),
@@ -204,9 +204,9 @@ fn n10_rounding_ties_both_signs() {
 
 #[test]
 fn one_item_per_cycle_when_never_stalled() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<GradientConfig>() {
         let items = random_items(seed(33), 100_000, random_item(cfg));
-        let driven = assert_one_item_per_clock(variant, cfg, &items, LATENCY);
+        let driven = assert_one_item_per_clock(variant, cfg, &[], &items, LATENCY);
         let gold = Gradient::new(cfg).unwrap().run(&items);
         assert!(driven.outputs.iter().zip(&gold).all(|(t, g)| t.value == *g));
     }
@@ -214,11 +214,23 @@ fn one_item_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("cube5_gradient_v8_gate", GradientConfig::NARROW);
+    let (variant, cfg) = gate_configs::<GradientConfig>()[0];
     let mut gold = Gradient::new(cfg).unwrap();
-    gate_smoke(variant, cfg, &mut gold, &mut random_item(cfg), seed(34));
+    must_match(
+        variant,
+        cfg,
+        &mut gold,
+        &mut random_item(cfg),
+        &StreamCheck::gate_smoke(seed(34)),
+    );
     let mut gold = Gradient::new(cfg).unwrap();
-    must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(35));
+    must_match_items(
+        variant,
+        cfg,
+        &mut gold,
+        directed_items(cfg),
+        &StreamCheck::directed(seed(35)),
+    );
 }
 
 /// A golden model with one contract detail changed: co-simulation must reject each, which shows
@@ -304,7 +316,10 @@ impl Mutant {
 
 #[test]
 fn each_mutated_contract_detail_is_caught() {
-    for (variant, cfg) in [CONFIGS[0], CONFIGS[1]] {
+    for (variant, cfg) in [
+        configs::<GradientConfig>()[0],
+        configs::<GradientConfig>()[1],
+    ] {
         for mutation in [
             Mutation::N10TiesDown,
             Mutation::N10PartnerSideFlipped,
@@ -318,8 +333,10 @@ fn each_mutated_contract_detail_is_caught() {
                 unit: Gradient::new(cfg).unwrap(),
                 mutation,
             };
-            let err = check_stream(variant, cfg, &mut mutant, &mut random_item(cfg), &check)
-                .expect_err("a mutated golden model must not match the RTL");
+            let err = expect_mismatch(
+                check_stream(variant, cfg, &mut mutant, &mut random_item(cfg), &check),
+                "a mutated golden model must not match the RTL",
+            );
             assert_eq!(err.what, "output differs", "{variant} {mutation:?}: {err}");
             eprintln!("{variant} {mutation:?}: caught at item {}", err.item);
         }
@@ -328,15 +345,13 @@ fn each_mutated_contract_detail_is_caught() {
 
 #[test]
 fn codec_and_variant_are_checked_against_the_rtl() {
-    match RtlStream::new("cube5_gradient_v8", GradientConfig::DEFAULT, 1) {
-        Err(RtlError::WidthMismatch {
-            port, rtl, model, ..
-        }) => {
-            assert_eq!((port, rtl, model), ("in_data_i", 288, 454));
-        }
-        other => panic!("expected a width mismatch, got {:?}", other.err()),
-    }
-    let mut dut = RtlStream::new("cube5_gradient_v8", GradientConfig::NARROW, 1).unwrap();
+    assert_foreign_codec_is_refused::<GradientConfig>();
+    let mut dut = RtlStream::new(
+        configs::<GradientConfig>()[0].0,
+        configs::<GradientConfig>()[0].1,
+        1,
+    )
+    .unwrap();
     assert!(
         dut.write_config(0, &[1]).is_err(),
         "cube5_gradient has no configuration port"

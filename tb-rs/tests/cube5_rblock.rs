@@ -3,20 +3,15 @@
 mod support;
 
 use cube5_model::units::cube5_rblock::{BlockingLuts, RBlock, RBlockConfig, RBlockDir, RBlockIn};
-use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_items,
-    random_items, seed, MILLION,
+    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
+    gate_configs, must_match_across_a_reset, must_match_items, random_items, seed, variant_with,
+    MILLION,
 };
-
-const CONFIGS: [(&str, RBlockConfig); 3] = [
-    ("cube5_rblock_c2", RBlockConfig::NARROW),
-    ("cube5_rblock_c8", RBlockConfig::DEFAULT),
-    ("cube5_rblock_r759", RBlockConfig::UNEQUAL),
-];
 
 fn random_item(cfg: RBlockConfig) -> impl FnMut(&mut ChaCha8Rng) -> RBlockIn {
     move |rng| RBlockIn {
@@ -53,13 +48,13 @@ fn directed_items(cfg: RBlockConfig) -> Vec<RBlockIn> {
 
 #[test]
 fn million_random_conversions_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
+    for (i, (variant, cfg)) in configs::<RBlockConfig>().into_iter().enumerate() {
         must_match_across_a_reset(
             variant,
-            *cfg,
-            &mut RBlock::new(*cfg).unwrap(),
-            &mut random_item(*cfg),
-            &long_run(seed(200 + i as u64), MILLION, 3),
+            cfg,
+            &mut RBlock::new(cfg).unwrap(),
+            &mut random_item(cfg),
+            &StreamCheck::long(seed(200 + i as u64), MILLION, 3),
             4,
         );
     }
@@ -67,9 +62,15 @@ fn million_random_conversions_per_config_with_idle_backpressure_and_reset() {
 
 #[test]
 fn directed_extremes() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<RBlockConfig>() {
         let mut gold = RBlock::new(cfg).unwrap();
-        must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(7));
+        must_match_items(
+            variant,
+            cfg,
+            &mut gold,
+            directed_items(cfg),
+            &StreamCheck::directed(seed(7)),
+        );
     }
 }
 
@@ -79,7 +80,7 @@ fn directed_extremes() {
 fn every_index_of_the_patent_example_matches_the_lut_form() {
     let cfg = RBlockConfig::NARROW;
     let luts = BlockingLuts::new(cfg, 3).unwrap();
-    let mut dut = RtlStream::new("cube5_rblock_c2", cfg, 3).unwrap();
+    let mut dut = RtlStream::new(variant_with(cfg), cfg, 3).unwrap();
     let mut items: Vec<RBlockIn> = (0..cfg.len())
         .map(|v| RBlockIn {
             value: v,
@@ -107,19 +108,31 @@ fn every_index_of_the_patent_example_matches_the_lut_form() {
 #[test]
 fn one_conversion_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 1;
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<RBlockConfig>() {
         let items = random_items(seed(11), 100_000, random_item(cfg));
-        assert_one_item_per_clock(variant, cfg, &items, LATENCY);
+        assert_one_item_per_clock(variant, cfg, &[], &items, LATENCY);
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("cube5_rblock_c2_gate", RBlockConfig::NARROW);
+    let (variant, cfg) = gate_configs::<RBlockConfig>()[0];
     let mut gold = RBlock::new(cfg).unwrap();
-    gate_smoke(variant, cfg, &mut gold, &mut random_item(cfg), seed(21));
+    must_match(
+        variant,
+        cfg,
+        &mut gold,
+        &mut random_item(cfg),
+        &StreamCheck::gate_smoke(seed(21)),
+    );
     let mut gold = RBlock::new(cfg).unwrap();
-    must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(22));
+    must_match_items(
+        variant,
+        cfg,
+        &mut gold,
+        directed_items(cfg),
+        &StreamCheck::directed(seed(22)),
+    );
 }
 
 /// The comparison tells the interleave orders apart: a model that interleaves z, y, x (the mirror
@@ -153,26 +166,28 @@ fn the_comparison_tells_interleave_orders_apart() {
     let cfg = RBlockConfig::DEFAULT;
     let mut check = StreamCheck::new(4242, 1000).with_traffic(0.1, 0.1);
     check.waveform_on_mismatch = false;
-    let err = check_stream(
-        "cube5_rblock_c8",
-        cfg,
-        &mut MirrorOrder(cfg),
-        &mut random_item(cfg),
-        &check,
-    )
-    .expect_err("the mirror interleave order must be caught");
+    let err = expect_mismatch(
+        check_stream(
+            variant_with(cfg),
+            cfg,
+            &mut MirrorOrder(cfg),
+            &mut random_item(cfg),
+            &check,
+        ),
+        "the mirror interleave order must be caught",
+    );
     assert!(err.item < 10, "caught at once: {err}");
 }
 
 #[test]
 fn codec_is_checked_against_the_rtl() {
-    match RtlStream::new("cube5_rblock_c2", RBlockConfig::DEFAULT, 1) {
-        Err(RtlError::WidthMismatch {
-            port, rtl, model, ..
-        }) => assert_eq!((port, rtl, model), ("in_data_i", 7, 25)),
-        other => panic!("expected a width mismatch, got {:?}", other.err()),
-    }
-    let mut dut = RtlStream::new("cube5_rblock_c2", RBlockConfig::NARROW, 1).unwrap();
+    assert_foreign_codec_is_refused::<RBlockConfig>();
+    let mut dut = RtlStream::new(
+        configs::<RBlockConfig>()[0].0,
+        configs::<RBlockConfig>()[0].1,
+        1,
+    )
+    .unwrap();
     assert!(
         dut.write_config(0, &[1]).is_err(),
         "rblock has no configuration port"

@@ -4,20 +4,14 @@ mod support;
 
 use cube5_model::unit::StreamUnit;
 use cube5_model::units::cube5_sepconv::{Sepconv, SepconvConfig, SepconvIn, SepconvKernel};
-use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run, must_match,
-    must_match_across_a_reset, must_match_items_with_config, random_items, seed, MILLION,
+    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
+    gate_configs, must_match_across_a_reset, must_match_items, random_items, seed, MILLION,
 };
-
-const CONFIGS: [(&str, SepconvConfig); 3] = [
-    ("cube5_sepconv_v8", SepconvConfig::NARROW),
-    ("cube5_sepconv_v12", SepconvConfig::DEFAULT),
-    ("cube5_sepconv_v16", SepconvConfig::WIDE),
-];
 
 const LATENCY: u64 = 2;
 
@@ -73,43 +67,42 @@ fn directed_items(cfg: SepconvConfig) -> Vec<SepconvIn> {
 
 #[test]
 fn million_random_items_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
+    for (i, (variant, cfg)) in configs::<SepconvConfig>().into_iter().enumerate() {
         let mut rng: ChaCha8Rng = rand::SeedableRng::seed_from_u64(seed(400 + i as u64));
         let w = rng.random_range(0..=cfg.weight_max());
-        let mut gold = Sepconv::new(*cfg, w).unwrap();
+        let mut gold = Sepconv::new(cfg, w).unwrap();
         // The weight is written once, before the first item; it must survive the reset.
-        let check =
-            long_run(seed(410 + i as u64), MILLION, 5).with_config_writes(gold.config_writes());
-        must_match_across_a_reset(
-            variant,
-            *cfg,
-            &mut gold,
-            &mut random_item(*cfg),
-            &check,
-            1000,
-        );
+        let check = StreamCheck::long(seed(410 + i as u64), MILLION, 5)
+            .with_config_writes(gold.config_writes());
+        must_match_across_a_reset(variant, cfg, &mut gold, &mut random_item(cfg), &check, 1000);
     }
 }
 
 #[test]
 fn directed_extremes_at_every_weight() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<SepconvConfig>() {
         for w in weights(cfg) {
             let mut gold = Sepconv::new(cfg, w).unwrap();
             let writes = gold.config_writes();
             let items = directed_items(cfg);
-            must_match_items_with_config(variant, cfg, &mut gold, items, seed(41), writes);
+            must_match_items(
+                variant,
+                cfg,
+                &mut gold,
+                items,
+                &StreamCheck::directed(seed(41)).with_config_writes(writes),
+            );
         }
     }
 }
 
 #[test]
 fn one_item_per_cycle_when_never_stalled() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<SepconvConfig>() {
         let gold = Sepconv::new(cfg, cfg.weight_from_f64(2.0)).unwrap();
         let items = random_items(seed(42), 100_000, random_item(cfg));
         let writes = gold.config_writes();
-        let driven = assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, LATENCY);
+        let driven = assert_one_item_per_clock(variant, cfg, &writes, &items, LATENCY);
         let want = gold.clone().run(&items);
         assert!(driven.outputs.iter().zip(&want).all(|(t, g)| t.value == *g));
     }
@@ -119,7 +112,7 @@ fn one_item_per_cycle_when_never_stalled() {
 fn a_weight_write_applies_to_items_accepted_after_it() {
     // Items still in flight when w changes keep the w they were accepted with: drive a batch but
     // stop waiting for its last outputs, write a new w, then drive a second batch.
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<SepconvConfig>() {
         let (w1, w2) = (cfg.weight_from_f64(2.0), cfg.weight_max());
         let mut gold = Sepconv::new(cfg, w1).unwrap();
         let mut dut = RtlStream::new(variant, cfg, 7).unwrap();
@@ -169,22 +162,27 @@ fn a_weight_write_applies_to_items_accepted_after_it() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("cube5_sepconv_v8_gate", SepconvConfig::NARROW);
+    let (variant, cfg) = gate_configs::<SepconvConfig>()[0];
     let mut gold = Sepconv::new(cfg, cfg.weight_from_f64(2.0)).unwrap();
     let writes = gold.config_writes();
-    gate_smoke_with_config(
+    must_match(
         variant,
         cfg,
         &mut gold,
         &mut random_item(cfg),
-        seed(44),
-        writes,
+        &StreamCheck::gate_smoke(seed(44)).with_config_writes(writes),
     );
     for w in weights(cfg) {
         let mut gold = Sepconv::new(cfg, w).unwrap();
         let writes = gold.config_writes();
         let items = directed_items(cfg);
-        must_match_items_with_config(variant, cfg, &mut gold, items, seed(45), writes);
+        must_match_items(
+            variant,
+            cfg,
+            &mut gold,
+            items,
+            &StreamCheck::directed(seed(45)).with_config_writes(writes),
+        );
     }
 }
 
@@ -206,7 +204,7 @@ impl StreamUnit for TiesDown {
 
 #[test]
 fn the_weight_register_and_the_rounding_are_checked() {
-    let (variant, cfg) = CONFIGS[0];
+    let (variant, cfg) = configs::<SepconvConfig>()[0];
     // 2.25: an odd raw weight, so y = 4a + 9b + 4c reaches every residue of the shift by 2 (with
     // w = 2.0 every y is a multiple of 4 and the rounding never sees a tie).
     let w = cfg.weight_from_f64(2.25);
@@ -216,14 +214,16 @@ fn the_weight_register_and_the_rounding_are_checked() {
 
     // The RTL loaded with w one LSB off the model's: the configuration port reaches the datapath.
     let off_by_one = check.clone().with_config_writes(vec![(0, vec![w + 1])]);
-    let err = check_stream(
-        variant,
-        cfg,
-        &mut Sepconv::new(cfg, w).unwrap(),
-        &mut random_item(cfg),
-        &off_by_one,
-    )
-    .expect_err("a different w must be caught");
+    let err = expect_mismatch(
+        check_stream(
+            variant,
+            cfg,
+            &mut Sepconv::new(cfg, w).unwrap(),
+            &mut random_item(cfg),
+            &off_by_one,
+        ),
+        "a different w must be caught",
+    );
     assert_eq!(err.what, "output differs");
 
     // A write to any other address leaves w alone.
@@ -241,25 +241,20 @@ fn the_weight_register_and_the_rounding_are_checked() {
 
     // Round half down instead of up.
     let loaded = check.with_config_writes(vec![(0, vec![w])]);
-    let err = check_stream(
-        variant,
-        cfg,
-        &mut TiesDown(Sepconv::new(cfg, w).unwrap()),
-        &mut random_item(cfg),
-        &loaded,
-    )
-    .expect_err("the rounding direction of ties must be caught");
+    let err = expect_mismatch(
+        check_stream(
+            variant,
+            cfg,
+            &mut TiesDown(Sepconv::new(cfg, w).unwrap()),
+            &mut random_item(cfg),
+            &loaded,
+        ),
+        "the rounding direction of ties must be caught",
+    );
     assert_eq!(err.what, "output differs");
 }
 
 #[test]
 fn codec_and_variant_are_checked_against_the_rtl() {
-    match RtlStream::new("cube5_sepconv_v8", SepconvConfig::DEFAULT, 1) {
-        Err(RtlError::WidthMismatch {
-            port, rtl, model, ..
-        }) => {
-            assert_eq!((port, rtl, model), ("in_data_i", 34, 52));
-        }
-        other => panic!("expected a width mismatch, got {:?}", other.err()),
-    }
+    assert_foreign_codec_is_refused::<SepconvConfig>();
 }

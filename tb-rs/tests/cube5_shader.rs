@@ -12,19 +12,14 @@ use cube5_model::units::cube5_shader::{
     ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn, ShaderMode,
     ShaderTables, Texel,
 };
-use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run, must_match,
-    must_match_across_a_reset, must_match_items_with_config, random_items, seed, MILLION,
+    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
+    gate_configs, must_match_across_a_reset, must_match_items, random_items, seed, MILLION,
 };
-
-const CONFIGS: [(&str, ShaderConfig); 2] = [
-    ("cube5_shader_v8", ShaderConfig::NARROW),
-    ("cube5_shader_v12", ShaderConfig::DEFAULT),
-];
 
 fn random_tables(cfg: &ShaderConfig, seed: u64) -> ShaderTables {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -194,15 +189,15 @@ fn shader(cfg: ShaderConfig, tables: &ShaderTables) -> Shader {
 
 #[test]
 fn million_random_items_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
-        let tables = random_tables(cfg, seed(300 + i as u64));
-        let check = long_run(seed(100 + i as u64), MILLION, 3)
-            .with_config_writes(tables.config_writes(cfg));
+    for (i, (variant, cfg)) in configs::<ShaderConfig>().into_iter().enumerate() {
+        let tables = random_tables(&cfg, seed(300 + i as u64));
+        let check = StreamCheck::long(seed(100 + i as u64), MILLION, 3)
+            .with_config_writes(tables.config_writes(&cfg));
         must_match_across_a_reset(
             variant,
-            *cfg,
-            &mut shader(*cfg, &tables),
-            &mut random_item(*cfg),
+            cfg,
+            &mut shader(cfg, &tables),
+            &mut random_item(cfg),
             &check,
             1000,
         );
@@ -211,20 +206,19 @@ fn million_random_items_per_config_with_idle_backpressure_and_reset() {
 
 #[test]
 fn directed_extremes() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ShaderConfig>() {
         for (name, tables) in [
             ("random", random_tables(&cfg, 7)),
             ("max", max_tables(&cfg)),
             ("lit", lit_tables(&cfg)),
         ] {
             eprintln!("{variant}: {name} tables");
-            must_match_items_with_config(
+            must_match_items(
                 variant,
                 cfg,
                 &mut shader(cfg, &tables),
                 directed_items(cfg),
-                seed(7),
-                tables.config_writes(&cfg),
+                &StreamCheck::directed(seed(7)).with_config_writes(tables.config_writes(&cfg)),
             );
         }
     }
@@ -232,12 +226,11 @@ fn directed_extremes() {
 
 #[test]
 fn one_item_per_cycle_when_never_stalled() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ShaderConfig>() {
         let tables = random_tables(&cfg, 11);
         let writes = tables.config_writes(&cfg);
         let items = random_items(seed(11), 100_000, random_item(cfg));
-        let driven =
-            assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, cfg.latency());
+        let driven = assert_one_item_per_clock(variant, cfg, &writes, &items, cfg.latency());
         let want = shader(cfg, &tables).run(&items);
         let got: Vec<Rgba> = driven.outputs.into_iter().map(|t| t.value).collect();
         assert!(
@@ -249,23 +242,21 @@ fn one_item_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("cube5_shader_v8_gate", ShaderConfig::NARROW);
+    let (variant, cfg) = gate_configs::<ShaderConfig>()[0];
     let tables = random_tables(&cfg, 21);
-    gate_smoke_with_config(
+    must_match(
         variant,
         cfg,
         &mut shader(cfg, &tables),
         &mut random_item(cfg),
-        seed(21),
-        tables.config_writes(&cfg),
+        &StreamCheck::gate_smoke(seed(21)).with_config_writes(tables.config_writes(&cfg)),
     );
-    must_match_items_with_config(
+    must_match_items(
         variant,
         cfg,
         &mut shader(cfg, &tables),
         directed_items(cfg),
-        seed(22),
-        tables.config_writes(&cfg),
+        &StreamCheck::directed(seed(22)).with_config_writes(tables.config_writes(&cfg)),
     );
 }
 
@@ -309,7 +300,7 @@ fn drive_and_compare(
 
 #[test]
 fn tables_survive_resets_and_reload_between_batches() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ShaderConfig>() {
         let mut rng = ChaCha8Rng::seed_from_u64(seed(31));
         let traffic = Traffic::random(&mut rng, 0.2, 0.3);
         let mut gen = random_item(cfg);
@@ -353,10 +344,10 @@ fn tables_survive_resets_and_reload_between_batches() {
 
 #[test]
 fn every_configuration_address_decodes_as_the_model() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
-        let tables = random_tables(cfg, 41 + i as u64);
-        let mut gold = shader(*cfg, &tables);
-        let mut writes = tables.config_writes(cfg);
+    for (i, (variant, cfg)) in configs::<ShaderConfig>().into_iter().enumerate() {
+        let tables = random_tables(&cfg, 41 + i as u64);
+        let mut gold = shader(cfg, &tables);
+        let mut writes = tables.config_writes(&cfg);
         // Random writes over the whole address space: mapped ones change the tables, the rest
         // (region 3, offsets out of range, face 6 and 7, i or j beyond the grid) must not.
         let mut rng = ChaCha8Rng::seed_from_u64(seed(42));
@@ -381,7 +372,7 @@ fn every_configuration_address_decodes_as_the_model() {
         let check = StreamCheck::new(seed(43), 100_000)
             .with_traffic(0.1, 0.1)
             .with_config_writes(writes);
-        must_match(variant, *cfg, &mut gold, &mut random_item(*cfg), &check);
+        must_match(variant, cfg, &mut gold, &mut random_item(cfg), &check);
     }
 }
 
@@ -389,7 +380,7 @@ fn every_configuration_address_decodes_as_the_model() {
 /// texel of each bank, one classification entry or the zero-gradient entry, is caught.
 #[test]
 fn a_table_entry_loaded_wrong_is_caught() {
-    let (variant, cfg) = CONFIGS[1];
+    let (variant, cfg) = configs::<ShaderConfig>()[1];
     let tables = random_tables(&cfg, 51);
     let writes = tables.config_writes(&cfg);
     let find = |addr: u32| writes.iter().position(|w| w.0 == addr).unwrap();
@@ -413,14 +404,16 @@ fn a_table_entry_loaded_wrong_is_caught() {
             .with_traffic(0.1, 0.1)
             .with_config_writes(bad);
         check.waveform_on_mismatch = false;
-        let err = check_stream(
-            variant,
-            cfg,
-            &mut shader(cfg, &tables),
-            &mut random_item(cfg),
-            &check,
-        )
-        .expect_err("a wrong table entry must be caught");
+        let err = expect_mismatch(
+            check_stream(
+                variant,
+                cfg,
+                &mut shader(cfg, &tables),
+                &mut random_item(cfg),
+                &check,
+            ),
+            "a wrong table entry must be caught",
+        );
         assert!(err.to_string().contains("MISMATCH"), "{err}");
         eprintln!(
             "{what} (address {:#x}): caught at item {}",
@@ -431,15 +424,13 @@ fn a_table_entry_loaded_wrong_is_caught() {
 
 #[test]
 fn codec_and_config_port_are_checked_against_the_rtl() {
-    match RtlStream::new("cube5_shader_v8", ShaderConfig::DEFAULT, 1) {
-        Err(RtlError::WidthMismatch {
-            port, rtl, model, ..
-        }) => {
-            assert_eq!((port, rtl, model), ("in_data_i", 60, 90));
-        }
-        other => panic!("expected a width mismatch, got {:?}", other.err()),
-    }
-    let mut dut = RtlStream::new("cube5_shader_v8", ShaderConfig::NARROW, 1).unwrap();
+    assert_foreign_codec_is_refused::<ShaderConfig>();
+    let mut dut = RtlStream::new(
+        configs::<ShaderConfig>()[0].0,
+        configs::<ShaderConfig>()[0].1,
+        1,
+    )
+    .unwrap();
     assert!(
         dut.write_config(0, &[1]).is_ok(),
         "the shader has a configuration port"

@@ -11,23 +11,16 @@ use cube5_model::units::cube5_skewmem::{
     Axis, BlockEntry, BlockLut, SkewConfig, SkewDims, SkewIn, SkewMem, SkewOp,
 };
 use cube5_model::volume::Volume;
-use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream, Traffic};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::rtl::{RtlStream, Traffic};
+use cube5_tb::Variant;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run,
-    must_match_across_a_reset, must_match_items_with_config, seed, MILLION,
+    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
+    gate_configs, must_match_across_a_reset, must_match_items, seed, variant_with, MILLION,
 };
-
-const VARIANTS: [(&str, SkewConfig); 5] = [
-    ("cube5_skewmem_p1", SkewConfig::P1),
-    ("cube5_skewmem_p2", SkewConfig::P2),
-    ("cube5_skewmem_p4", SkewConfig::DEFAULT),
-    ("cube5_skewmem_p4l4", SkewConfig::P4_L4),
-    ("cube5_skewmem_p8", SkewConfig::P8),
-];
 
 /// A random volume of `dims` in which about a quarter of the `B^3` blocks are all zero.
 fn random_volume(cfg: &SkewConfig, dims: [u32; 3], rng: &mut ChaCha8Rng) -> Volume {
@@ -142,10 +135,10 @@ fn scripted(
     }
 }
 
-fn random_run(variant: &str, cfg: SkewConfig, seed_no: u64, items: usize) {
+fn random_run(variant: &'static Variant, cfg: SkewConfig, seed_no: u64, items: usize) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed(seed_no) ^ 0x5eed);
     let (mut gold, fill) = random_scene(cfg, &mut rng);
-    let check = long_run(seed(seed_no), items, 3).with_config_writes(gold.config_writes());
+    let check = StreamCheck::long(seed(seed_no), items, 3).with_config_writes(gold.config_writes());
     let dims = gold.dims().n;
     must_match_across_a_reset(
         variant,
@@ -173,23 +166,33 @@ fn random_run(variant: &str, cfg: SkewConfig, seed_no: u64, items: usize) {
 
 #[test]
 fn million_random_commands_p1_with_idle_backpressure_and_reset() {
-    random_run("cube5_skewmem_p1", SkewConfig::P1, 100, MILLION);
+    random_run(variant_with(SkewConfig::P1), SkewConfig::P1, 100, MILLION);
 }
 
 #[test]
 fn million_random_commands_p4_with_idle_backpressure_and_reset() {
-    random_run("cube5_skewmem_p4", SkewConfig::DEFAULT, 101, MILLION);
+    random_run(
+        variant_with(SkewConfig::DEFAULT),
+        SkewConfig::DEFAULT,
+        101,
+        MILLION,
+    );
 }
 
 #[test]
 fn million_random_commands_p8_with_idle_backpressure_and_reset() {
-    random_run("cube5_skewmem_p8", SkewConfig::P8, 102, MILLION);
+    random_run(variant_with(SkewConfig::P8), SkewConfig::P8, 102, MILLION);
 }
 
 #[test]
 fn random_commands_p2_and_dram_like_p4l4() {
-    random_run("cube5_skewmem_p2", SkewConfig::P2, 103, 300_000);
-    random_run("cube5_skewmem_p4l4", SkewConfig::P4_L4, 104, 300_000);
+    random_run(variant_with(SkewConfig::P2), SkewConfig::P2, 103, 300_000);
+    random_run(
+        variant_with(SkewConfig::P4_L4),
+        SkewConfig::P4_L4,
+        104,
+        300_000,
+    );
 }
 
 /// Extremes: all-max and all-zero voxels, the corner beams with unaligned starts and the reserved
@@ -285,14 +288,26 @@ fn directed_small(cfg: SkewConfig) -> (SkewMem, Vec<SkewIn>) {
     (gold, cmds)
 }
 
-fn run_directed(variant: &str, cfg: SkewConfig, gold: &mut SkewMem, cmds: Vec<SkewIn>, s: u64) {
+fn run_directed(
+    variant: &'static Variant,
+    cfg: SkewConfig,
+    gold: &mut SkewMem,
+    cmds: Vec<SkewIn>,
+    s: u64,
+) {
     let writes = gold.config_writes();
-    must_match_items_with_config(variant, cfg, gold, cmds, seed(s), writes);
+    must_match_items(
+        variant,
+        cfg,
+        gold,
+        cmds,
+        &StreamCheck::directed(seed(s)).with_config_writes(writes),
+    );
 }
 
 #[test]
 fn directed_extremes() {
-    for (variant, cfg) in VARIANTS {
+    for (variant, cfg) in configs::<SkewConfig>() {
         let (mut gold, cmds) = directed_full(cfg);
         run_directed(variant, cfg, &mut gold, cmds, 7);
         let (mut gold, cmds) = directed_small(cfg);
@@ -311,7 +326,7 @@ fn skipped_blocks_read_zero_with_flags_in_rtl() {
         lut.entries[3].empty = empty;
         lut.entries[3].masked = masked;
         let gold = controller(cfg, [m; 3], lut);
-        let mut dut = RtlStream::new("cube5_skewmem_p4", cfg, 3).unwrap();
+        let mut dut = RtlStream::new(variant_with(cfg), cfg, 3).unwrap();
         for (a, d) in gold.config_writes() {
             dut.write_config(a, &d).unwrap();
         }
@@ -332,7 +347,7 @@ fn skipped_blocks_read_zero_with_flags_in_rtl() {
 /// equals the number of beams so far after every beam: each module served each beam exactly once.
 #[test]
 fn every_beam_of_the_whole_volume_along_each_axis_is_conflict_free() {
-    for (variant, cfg) in VARIANTS {
+    for (variant, cfg) in configs::<SkewConfig>() {
         let m = cfg.max_dim();
         let mut rng = ChaCha8Rng::seed_from_u64(seed(12));
         let vol = random_volume(&cfg, [m; 3], &mut rng);
@@ -388,7 +403,7 @@ fn every_beam_of_the_whole_volume_along_each_axis_is_conflict_free() {
 /// Random writes then reads on the RTL alone, compared with a plain `Vec<u16>` (not the model).
 #[test]
 fn random_writes_then_reads_match_a_plain_vector() {
-    for (variant, cfg) in VARIANTS {
+    for (variant, cfg) in configs::<SkewConfig>() {
         let m = cfg.max_dim();
         let dims = [m, m - cfg.p.min(m / 2), m / 2];
         let mut rng = ChaCha8Rng::seed_from_u64(seed(14));
@@ -443,31 +458,30 @@ fn random_writes_then_reads_match_a_plain_vector() {
 
 #[test]
 fn one_command_per_cycle_when_never_stalled() {
-    for (variant, cfg) in VARIANTS {
+    for (variant, cfg) in configs::<SkewConfig>() {
         let latency = u64::from(cfg.latency()); // the pipeline fill: ReadLatency + 2
         let mut rng = ChaCha8Rng::seed_from_u64(seed(11));
         let (gold, fill) = random_scene(cfg, &mut rng);
         let mut items = fill;
         items.extend((0..50_000).map(|_| random_command(cfg, gold.dims().n, &mut rng)));
         let writes = gold.config_writes();
-        assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, latency);
+        assert_one_item_per_clock(variant, cfg, &writes, &items, latency);
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("cube5_skewmem_p2_gate", SkewConfig::P2);
+    let (variant, cfg) = gate_configs::<SkewConfig>()[0];
     let mut rng = ChaCha8Rng::seed_from_u64(seed(21));
     let (mut gold, fill) = random_scene(cfg, &mut rng);
     let dims = gold.dims().n;
     let writes = gold.config_writes();
-    gate_smoke_with_config(
+    must_match(
         variant,
         cfg,
         &mut gold,
         &mut scripted(fill, cfg, dims),
-        seed(21),
-        writes,
+        &StreamCheck::gate_smoke(seed(21)).with_config_writes(writes),
     );
     let (mut gold, cmds) = directed_full(cfg);
     run_directed(variant, cfg, &mut gold, cmds, 22);
@@ -497,14 +511,16 @@ fn the_comparison_bites_on_state_lut_and_counters() {
     rtl_lut.entries[5].empty = true;
     let writes = controller(cfg, [m; 3], rtl_lut).config_writes();
     let mut gold = controller(cfg, [m; 3], lut.clone());
-    let err = check_stream(
-        "cube5_skewmem_p4",
-        cfg,
-        &mut gold,
-        &mut scripted(fill.clone(), cfg, [m; 3]),
-        &quiet(items, writes),
-    )
-    .expect_err("a LUT difference must be caught");
+    let err = expect_mismatch(
+        check_stream(
+            variant_with(cfg),
+            cfg,
+            &mut gold,
+            &mut scripted(fill.clone(), cfg, [m; 3]),
+            &quiet(items, writes),
+        ),
+        "a LUT difference must be caught",
+    );
     assert!(err.rtl.contains("empty: true"), "{err}");
 
     // 2. The RTL was told a smaller volume (nz = 8): writes and reads beyond are dropped there.
@@ -515,14 +531,16 @@ fn the_comparison_bites_on_state_lut_and_counters() {
     )
     .config_writes();
     let mut gold = controller(cfg, [m; 3], lut.clone());
-    let err = check_stream(
-        "cube5_skewmem_p4",
-        cfg,
-        &mut gold,
-        &mut scripted(fill.clone(), cfg, [m; 3]),
-        &quiet(items, writes),
-    )
-    .expect_err("a dimension difference must be caught");
+    let err = expect_mismatch(
+        check_stream(
+            variant_with(cfg),
+            cfg,
+            &mut gold,
+            &mut scripted(fill.clone(), cfg, [m; 3]),
+            &quiet(items, writes),
+        ),
+        "a dimension difference must be caught",
+    );
     assert!(err.rtl.contains("outside: true"), "{err}");
 
     // 3. One write of the fill lands elsewhere in the model (a corrupted address, say): the
@@ -560,26 +578,28 @@ fn the_comparison_bites_on_state_lut_and_counters() {
         lose: 1000,
     };
     let writes = gold.inner.config_writes();
-    let err = check_stream(
-        "cube5_skewmem_p4",
-        cfg,
-        &mut gold,
-        &mut scripted(fill.clone(), cfg, [m; 3]),
-        &quiet(items, writes),
-    )
-    .expect_err("a misplaced write must be caught");
+    let err = expect_mismatch(
+        check_stream(
+            variant_with(cfg),
+            cfg,
+            &mut gold,
+            &mut scripted(fill.clone(), cfg, [m; 3]),
+            &quiet(items, writes),
+        ),
+        "a misplaced write must be caught",
+    );
     eprintln!("{err}");
     assert!(err.item >= 1000, "{err}");
 }
 
 #[test]
 fn codec_and_config_port_are_checked_against_the_rtl() {
-    match RtlStream::new("cube5_skewmem_p4", SkewConfig::P8, 1) {
-        Err(RtlError::WidthMismatch {
-            port, rtl, model, ..
-        }) => assert_eq!((port, rtl, model), ("in_data_i", 29, 34)),
-        other => panic!("expected a width mismatch, got {:?}", other.err()),
-    }
-    let mut dut = RtlStream::new("cube5_skewmem_p1", SkewConfig::P1, 1).unwrap();
+    assert_foreign_codec_is_refused::<SkewConfig>();
+    let mut dut = RtlStream::new(
+        configs::<SkewConfig>()[0].0,
+        configs::<SkewConfig>()[0].1,
+        1,
+    )
+    .unwrap();
     assert!(dut.write_config(0, &[16 | 16 << 5 | 16 << 10]).is_ok());
 }

@@ -2,21 +2,18 @@
 
 mod support;
 
+use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
-use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::{RtlError, RtlStream};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::rtl::RtlStream;
+use cube5_tb::variants::{mutant_variants_of, variants_of};
+use cube5_tb::TbError;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_items,
-    random_items, seed, MILLION,
+    assert_one_item_per_clock, configs, expect_mismatch, gate_configs, must_match_across_a_reset,
+    must_match_items, random_items, seed, MILLION,
 };
-
-const CONFIGS: [(&str, TrilinConfig); 3] = [
-    ("cube5_trilin_v8", TrilinConfig::NARROW),
-    ("cube5_trilin_v12", TrilinConfig::DEFAULT),
-    ("cube5_trilin_v16", TrilinConfig::WIDE),
-];
 
 fn random_item(cfg: TrilinConfig) -> impl FnMut(&mut ChaCha8Rng) -> TrilinIn {
     move |rng| TrilinIn {
@@ -73,13 +70,13 @@ fn directed_items(cfg: TrilinConfig) -> Vec<TrilinIn> {
 
 #[test]
 fn million_random_samples_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
+    for (i, (variant, cfg)) in configs::<TrilinConfig>().into_iter().enumerate() {
         must_match_across_a_reset(
             variant,
-            *cfg,
-            &mut Trilin::new(*cfg).unwrap(),
-            &mut random_item(*cfg),
-            &long_run(seed(100 + i as u64), MILLION, 3),
+            cfg,
+            &mut Trilin::new(cfg).unwrap(),
+            &mut random_item(cfg),
+            &StreamCheck::long(seed(100 + i as u64), MILLION, 3),
             1000,
         );
     }
@@ -87,63 +84,80 @@ fn million_random_samples_per_config_with_idle_backpressure_and_reset() {
 
 #[test]
 fn directed_extremes() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<TrilinConfig>() {
         let mut gold = Trilin::new(cfg).unwrap();
-        must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(7));
+        let items = directed_items(cfg);
+        let check = StreamCheck::directed(seed(7));
+        must_match_items(variant, cfg, &mut gold, items, &check);
     }
 }
 
 #[test]
 fn one_sample_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 3;
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<TrilinConfig>() {
         let items = random_items(seed(11), 100_000, random_item(cfg));
-        assert_one_item_per_clock(variant, cfg, &items, LATENCY);
+        assert_one_item_per_clock(variant, cfg, &[], &items, LATENCY);
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("cube5_trilin_v8_gate", TrilinConfig::NARROW);
-    let mut gold = Trilin::new(cfg).unwrap();
-    gate_smoke(variant, cfg, &mut gold, &mut random_item(cfg), seed(21));
-    let mut gold = Trilin::new(cfg).unwrap();
-    must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(22));
+    for (variant, cfg) in gate_configs::<TrilinConfig>() {
+        let mut gold = Trilin::new(cfg).unwrap();
+        let check = StreamCheck::gate_smoke(seed(21));
+        must_match(variant, cfg, &mut gold, &mut random_item(cfg), &check);
+        let mut gold = Trilin::new(cfg).unwrap();
+        let items = directed_items(cfg);
+        let check = StreamCheck::directed(seed(22));
+        must_match_items(variant, cfg, &mut gold, items, &check);
+    }
 }
 
 /// The gate-level flow must be able to see a wrong netlist: the same smoke run on a netlist with
 /// one inverted cell pin (Yosys `mutate`, variant flag `mutant`) has to mismatch.
 #[test]
 fn gate_level_netlist_with_a_seeded_fault_is_caught() {
-    let (variant, cfg) = ("cube5_trilin_v8_mutant", TrilinConfig::NARROW);
-    let check = StreamCheck::new(seed(23), 30_000).with_traffic(0.2, 0.3);
-    let err = check_stream(
-        variant,
-        cfg,
-        &mut Trilin::new(cfg).unwrap(),
-        &mut random_item(cfg),
-        &check,
-    )
-    .expect_err("the mutated netlist must mismatch the model");
-    assert_ne!(err.item, u64::MAX, "the mutant did not run: {err}");
-    eprintln!("seeded fault caught: {err}");
+    let mutants = mutant_variants_of(TrilinConfig::TOP);
+    assert!(
+        !mutants.is_empty(),
+        "cube5_trilin.variants has a `mutant` line"
+    );
+    for variant in mutants {
+        let cfg: TrilinConfig = variant.config().unwrap();
+        let check = StreamCheck::new(seed(23), 30_000).with_traffic(0.2, 0.3);
+        let err = expect_mismatch(
+            check_stream(
+                variant,
+                cfg,
+                &mut Trilin::new(cfg).unwrap(),
+                &mut random_item(cfg),
+                &check,
+            ),
+            "the mutated netlist must mismatch the model",
+        );
+        eprintln!("seeded fault caught: {err}");
+    }
 }
 
 #[test]
 fn a_flipped_output_bit_is_reported_with_seed_inputs_outputs_and_waveform() {
-    let cfg = TrilinConfig::DEFAULT;
+    let (variant, cfg) = configs::<TrilinConfig>()[0];
     let mut check = StreamCheck::new(4242, 5_000).with_traffic(0.1, 0.1);
     check.corrupt = Some((1234, 3));
     check.waveform_on_mismatch = true;
-    let err = check_stream(
-        "cube5_trilin_v12",
-        cfg,
-        &mut Trilin::new(cfg).unwrap(),
-        &mut random_item(cfg),
-        &check,
-    )
-    .expect_err("a corrupted output must be caught");
-    assert_eq!(err.item, 1234);
+    let err = expect_mismatch(
+        check_stream(
+            variant,
+            cfg,
+            &mut Trilin::new(cfg).unwrap(),
+            &mut random_item(cfg),
+            &check,
+        ),
+        "a corrupted output must be caught",
+    );
+    let m = &err;
+    assert_eq!(m.item, 1234);
     let report = err.to_string();
     for needle in [
         "MISMATCH",
@@ -159,7 +173,7 @@ fn a_flipped_output_bit_is_reported_with_seed_inputs_outputs_and_waveform() {
             "report lacks `{needle}`:\n{report}"
         );
     }
-    let wave = err.waveform.as_ref().expect("a waveform is written");
+    let wave = m.waveform.as_ref().expect("a waveform is written");
     let vcd = std::fs::read_to_string(wave).unwrap();
     assert!(
         vcd.contains("out_data_o") && vcd.contains("#"),
@@ -170,21 +184,23 @@ fn a_flipped_output_bit_is_reported_with_seed_inputs_outputs_and_waveform() {
 
 #[test]
 fn codec_and_variant_are_checked_against_the_rtl() {
-    match RtlStream::new("cube5_trilin_v8", TrilinConfig::DEFAULT, 1) {
-        Err(RtlError::WidthMismatch {
-            port, rtl, model, ..
-        }) => {
-            assert_eq!((port, rtl, model), ("in_data_i", 84, 122));
+    // The narrowest configuration opened with the widest codec: the port widths disagree.
+    let all = configs::<TrilinConfig>();
+    let (narrow, narrow_cfg) = *all.iter().min_by_key(|(_, c)| c.voxel_w).unwrap();
+    let (_, wide_cfg) = *all.iter().max_by_key(|(_, c)| c.voxel_w).unwrap();
+    match RtlStream::new(narrow, wide_cfg, 1) {
+        Err(TbError::Setup { what, .. }) => {
+            assert!(what.contains("in_data_i"), "names the port: {what}");
         }
         other => panic!("expected a width mismatch, got {:?}", other.err()),
     }
-    let mut dut = RtlStream::new("cube5_trilin_v8", TrilinConfig::NARROW, 1).unwrap();
+    let mut dut = RtlStream::new(narrow, narrow_cfg, 1).unwrap();
     assert!(
         dut.write_config(0, &[1]).is_err(),
         "trilin has no configuration port"
     );
-    assert!(matches!(
-        RtlStream::new("cube5_trilin_nonexistent", TrilinConfig::DEFAULT, 1),
-        Err(RtlError::NotBuilt { .. })
-    ));
+    // Every variant of the table opens with the configuration built from its own parameters.
+    for v in variants_of(TrilinConfig::TOP) {
+        RtlStream::<TrilinConfig>::open(v, 1).unwrap();
+    }
 }

@@ -6,22 +6,14 @@ use cube5_model::units::gicube_bucket::{
     random_position, BucketConfig, BucketIn, BucketUnit, Distribution, Position,
 };
 use cube5_model::units::gicube_packet_loop::POS_FRAC_W;
-use cube5_tb::harness::{check_stream, StreamCheck};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_cycled,
-    must_match_items, random_items, seed, MILLION,
+    assert_one_item_per_clock, configs, expect_mismatch, gate_configs, must_match_across_a_reset,
+    must_match_items, random_items, seed, variant_with, MILLION,
 };
-
-const CONFIGS: [(&str, BucketConfig); 5] = [
-    ("gicube_bucket_slab", BucketConfig::SLAB),
-    ("gicube_bucket_skew", BucketConfig::SKEW),
-    ("gicube_bucket_rep", BucketConfig::REP),
-    ("gicube_bucket_slab12", BucketConfig::SLAB12),
-    ("gicube_bucket_skew6", BucketConfig::SKEW6),
-];
 
 fn random_item(cfg: BucketConfig) -> impl FnMut(&mut ChaCha8Rng) -> BucketIn {
     move |rng| BucketIn((0..cfg.lanes).map(|_| random_position(rng, &cfg)).collect())
@@ -67,13 +59,13 @@ fn directed_items(cfg: BucketConfig) -> Vec<BucketIn> {
 
 #[test]
 fn million_random_positions_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
+    for (i, (variant, cfg)) in configs::<BucketConfig>().into_iter().enumerate() {
         must_match_across_a_reset(
             variant,
-            *cfg,
-            &mut BucketUnit::new(*cfg).unwrap(),
-            &mut random_item(*cfg),
-            &long_run(seed(400 + i as u64), MILLION, 3),
+            cfg,
+            &mut BucketUnit::new(cfg).unwrap(),
+            &mut random_item(cfg),
+            &StreamCheck::long(seed(400 + i as u64), MILLION, 3),
             10,
         );
     }
@@ -81,12 +73,12 @@ fn million_random_positions_per_config_with_idle_backpressure_and_reset() {
 
 #[test]
 fn directed_block_and_volume_edges() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<BucketConfig>() {
         let items = directed_items(cfg);
         let n = items.len();
         assert!(n > 20);
         let check = StreamCheck::new(seed(410), 3 * n).with_traffic(0.3, 0.3);
-        must_match_cycled(
+        must_match_items(
             variant,
             cfg,
             &mut BucketUnit::new(cfg).unwrap(),
@@ -99,26 +91,38 @@ fn directed_block_and_volume_edges() {
 #[test]
 fn one_item_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 1;
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<BucketConfig>() {
         // An item is `cfg.lanes` positions: that many per clock.
         let items = random_items(seed(411), 100_000, random_item(cfg));
-        assert_one_item_per_clock(variant, cfg, &items, LATENCY);
+        assert_one_item_per_clock(variant, cfg, &[], &items, LATENCY);
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("gicube_bucket_skew6_gate", BucketConfig::SKEW6);
+    let (variant, cfg) = gate_configs::<BucketConfig>()[0];
     let mut gold = BucketUnit::new(cfg).unwrap();
-    gate_smoke(variant, cfg, &mut gold, &mut random_item(cfg), seed(412));
+    must_match(
+        variant,
+        cfg,
+        &mut gold,
+        &mut random_item(cfg),
+        &StreamCheck::gate_smoke(seed(412)),
+    );
     let mut gold = BucketUnit::new(cfg).unwrap();
-    must_match_items(variant, cfg, &mut gold, directed_items(cfg), seed(413));
+    must_match_items(
+        variant,
+        cfg,
+        &mut gold,
+        directed_items(cfg),
+        &StreamCheck::directed(seed(413)),
+    );
 }
 
 #[test]
 fn every_block_reaches_its_own_queue_in_the_rtl() {
     // The bijection of the contract, on the RTL: one position per block, all (proc, queue) distinct.
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<BucketConfig>() {
         let b = cfg.vol_blocks;
         let side = cfg.block_side();
         let mut rng = ChaCha8Rng::seed_from_u64(seed(414));
@@ -176,13 +180,15 @@ fn a_model_with_the_wrong_distribution_is_caught() {
     };
     let mut check = StreamCheck::new(seed(415), 5_000).with_traffic(0.1, 0.1);
     check.waveform_on_mismatch = false;
-    let err = check_stream(
-        "gicube_bucket_skew",
-        BucketConfig::SKEW,
-        &mut BucketUnit::new(slab).unwrap(),
-        &mut random_item(BucketConfig::SKEW),
-        &check,
-    )
-    .expect_err("slab and skewed distributions differ");
+    let err = expect_mismatch(
+        check_stream(
+            variant_with(BucketConfig::SKEW),
+            BucketConfig::SKEW,
+            &mut BucketUnit::new(slab).unwrap(),
+            &mut random_item(BucketConfig::SKEW),
+            &check,
+        ),
+        "slab and skewed distributions differ",
+    );
     assert!(err.item < 50, "caught at item {}", err.item);
 }

@@ -9,19 +9,14 @@ use cube5_model::units::gicube_packet_loop::{
     directed_packets, random_packet, PacketLoop, PacketLoopConfig, PacketLoopOut, RayPacket,
     PACKET_WORDS,
 };
-use cube5_tb::harness::{check_stream, StreamCheck};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_cycled,
-    must_match_items, random_items, seed, MILLION,
+    assert_one_item_per_clock, configs, expect_mismatch, gate_configs, must_match_across_a_reset,
+    must_match_items, random_items, seed, variant_with, MILLION,
 };
-
-const CONFIGS: [(&str, PacketLoopConfig); 2] = [
-    ("gicube_packet_loop_s1", PacketLoopConfig::S1),
-    ("gicube_packet_loop_s2", PacketLoopConfig::S2),
-];
 
 fn random_item(rng: &mut ChaCha8Rng) -> RayPacket {
     random_packet(rng)
@@ -29,13 +24,13 @@ fn random_item(rng: &mut ChaCha8Rng) -> RayPacket {
 
 #[test]
 fn million_random_packets_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
+    for (i, (variant, cfg)) in configs::<PacketLoopConfig>().into_iter().enumerate() {
         must_match_across_a_reset(
             variant,
-            *cfg,
-            &mut PacketLoop::new(*cfg).unwrap(),
+            cfg,
+            &mut PacketLoop::new(cfg).unwrap(),
             &mut random_item,
-            &long_run(seed(300 + i as u64), MILLION, 3),
+            &StreamCheck::long(seed(300 + i as u64), MILLION, 3),
             10,
         );
     }
@@ -43,10 +38,10 @@ fn million_random_packets_per_config_with_idle_backpressure_and_reset() {
 
 #[test]
 fn directed_extremes_every_field_wraps() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<PacketLoopConfig>() {
         let items = directed_packets();
         let check = StreamCheck::new(seed(301), 4 * items.len()).with_traffic(0.3, 0.3);
-        must_match_cycled(
+        must_match_items(
             variant,
             cfg,
             &mut PacketLoop::new(cfg).unwrap(),
@@ -58,19 +53,31 @@ fn directed_extremes_every_field_wraps() {
 
 #[test]
 fn one_packet_per_cycle_when_never_stalled() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<PacketLoopConfig>() {
         let items = random_items(seed(302), 100_000, random_item);
-        assert_one_item_per_clock(variant, cfg, &items, cfg.latency());
+        assert_one_item_per_clock(variant, cfg, &[], &items, cfg.latency());
     }
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = ("gicube_packet_loop_s1_gate", PacketLoopConfig::S1);
+    let (variant, cfg) = gate_configs::<PacketLoopConfig>()[0];
     let mut gold = PacketLoop::new(cfg).unwrap();
-    gate_smoke(variant, cfg, &mut gold, &mut random_item, seed(303));
+    must_match(
+        variant,
+        cfg,
+        &mut gold,
+        &mut random_item,
+        &StreamCheck::gate_smoke(seed(303)),
+    );
     let mut gold = PacketLoop::new(cfg).unwrap();
-    must_match_items(variant, cfg, &mut gold, directed_packets(), seed(304));
+    must_match_items(
+        variant,
+        cfg,
+        &mut gold,
+        directed_packets(),
+        &StreamCheck::directed(seed(304)),
+    );
 }
 
 /// A Rust layout that differs from the contract: `dir_x` and `dir_y` swapped (equal widths), or the
@@ -150,14 +157,16 @@ fn a_rust_layout_with_swapped_or_moved_fields_is_caught_by_the_probe() {
         };
         let mut check = StreamCheck::new(seed(305), 2_000).with_traffic(0.1, 0.1);
         check.waveform_on_mismatch = false;
-        let err = check_stream(
-            "gicube_packet_loop_s1",
-            MutantCodec(mutant),
-            &mut PacketLoop::new(PacketLoopConfig::S1).unwrap(),
-            &mut gen,
-            &check,
-        )
-        .expect_err("a layout that differs from the SV struct must be caught");
+        let err = expect_mismatch(
+            check_stream(
+                variant_with(PacketLoopConfig::S1),
+                MutantCodec(mutant),
+                &mut PacketLoop::new(PacketLoopConfig::S1).unwrap(),
+                &mut gen,
+                &check,
+            ),
+            "a layout that differs from the SV struct must be caught",
+        );
         assert!(
             err.item < 4,
             "{mutant:?}: caught at once, not at item {}",
@@ -165,7 +174,8 @@ fn a_rust_layout_with_swapped_or_moved_fields_is_caught_by_the_probe() {
         );
         // The plain round trip alone cannot see it: the repack half still agrees.
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let mut dut = RtlStream::new("gicube_packet_loop_s1", MutantCodec(mutant), 1).unwrap();
+        let mut dut =
+            RtlStream::new(variant_with(PacketLoopConfig::S1), MutantCodec(mutant), 1).unwrap();
         let items: Vec<RayPacket> = (0..1000).map(|_| gen(&mut rng)).collect();
         let out = dut
             .drive(&items, &Traffic::full_speed(), 1000, 10_000)

@@ -6,19 +6,15 @@ use cube5_model::unit::StreamUnit;
 use cube5_model::units::gicube_scatter::{
     random_item, Scatter, ScatterConfig, ScatterEvent, ScatterIn, ScatterTables, CFG_SEL_SEED,
 };
-use cube5_tb::harness::{check_stream, StreamCheck};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
 use cube5_tb::rtl::RtlStream;
+use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock_with_config, gate_smoke_with_config, long_run, must_match,
-    must_match_across_a_reset, must_match_items_with_config, random_items, seed, MILLION,
+    assert_one_item_per_clock, configs, expect_mismatch, gate_configs, must_match_across_a_reset,
+    must_match_items, random_items, seed, variant_with, MILLION,
 };
-
-const CONFIGS: [(&str, ScatterConfig); 2] = [
-    ("gicube_scatter_f8", ScatterConfig::NARROW),
-    ("gicube_scatter_f14", ScatterConfig::DEFAULT),
-];
 
 /// Register stages (contract § Timing).
 const LATENCY: u64 = 42;
@@ -35,9 +31,20 @@ fn model_and_tables(cfg: ScatterConfig) -> (Scatter, Vec<(u32, Vec<u32>)>) {
 }
 
 /// Runs `items` (cycled) with idle and back-pressure, tables loaded.
-fn run_directed(variant: &str, cfg: ScatterConfig, items: Vec<ScatterIn>, seed_default: u64) {
+fn run_directed(
+    variant: &'static Variant,
+    cfg: ScatterConfig,
+    items: Vec<ScatterIn>,
+    seed_default: u64,
+) {
     let (mut model, writes) = model_and_tables(cfg);
-    must_match_items_with_config(variant, cfg, &mut model, items, seed(seed_default), writes);
+    must_match_items(
+        variant,
+        cfg,
+        &mut model,
+        items,
+        &StreamCheck::directed(seed(seed_default)).with_config_writes(writes),
+    );
 }
 
 fn base(cfg: &ScatterConfig) -> ScatterIn {
@@ -83,16 +90,16 @@ fn with_materials(cfg: &ScatterConfig, geo: ScatterIn, rays: u32) -> Vec<Scatter
 
 #[test]
 fn million_random_rays_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in CONFIGS.iter().enumerate() {
-        let (mut model, writes) = model_and_tables(*cfg);
-        let check = long_run(seed(500 + i as u64), MILLION, 3).with_config_writes(writes);
-        must_match_across_a_reset(variant, *cfg, &mut model, &mut gen(*cfg), &check, 200);
+    for (i, (variant, cfg)) in configs::<ScatterConfig>().into_iter().enumerate() {
+        let (mut model, writes) = model_and_tables(cfg);
+        let check = StreamCheck::long(seed(500 + i as u64), MILLION, 3).with_config_writes(writes);
+        must_match_across_a_reset(variant, cfg, &mut model, &mut gen(cfg), &check, 200);
     }
 }
 
 #[test]
 fn zero_gradient_and_zero_direction() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ScatterConfig>() {
         let one = 1 << cfg.f();
         let mut items = Vec::new();
         for dir in [[one, 0, 0], [0, 0, 0], [-one, one, -one], [1, 0, 0]] {
@@ -117,7 +124,7 @@ fn zero_gradient_and_zero_direction() {
 
 #[test]
 fn grazing_angles() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ScatterConfig>() {
         let one = 1 << cfg.f();
         let g = cfg.grad_range().1;
         let mut items = Vec::new();
@@ -144,7 +151,7 @@ fn grazing_angles() {
 
 #[test]
 fn glossiness_zero_and_ninety() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ScatterConfig>() {
         let one = 1 << cfg.f();
         let mut items = Vec::new();
         for k in 0..400u32 {
@@ -169,7 +176,7 @@ fn glossiness_zero_and_ninety() {
 
 #[test]
 fn refractivity_one_with_total_internal_reflection() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ScatterConfig>() {
         let model = Scatter::new(cfg).unwrap();
         let one = f64::from(1u32 << cfg.f());
         let mut items = Vec::new();
@@ -214,7 +221,7 @@ fn refractivity_one_with_total_internal_reflection() {
 
 #[test]
 fn directions_along_an_axis() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ScatterConfig>() {
         let one = 1 << cfg.f();
         let (lo, hi) = cfg.dir_range();
         let g = cfg.grad_range();
@@ -266,29 +273,24 @@ fn directions_along_an_axis() {
 
 #[test]
 fn one_ray_per_cycle_when_never_stalled() {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<ScatterConfig>() {
         let (model, writes) = model_and_tables(cfg);
         let items = random_items(seed(41), 100_000, gen(cfg));
-        let driven = assert_one_item_per_clock_with_config(variant, cfg, &writes, &items, LATENCY);
+        let driven = assert_one_item_per_clock(variant, cfg, &writes, &items, LATENCY);
         for (k, (got, it)) in driven.outputs.iter().zip(&items).enumerate() {
             assert_eq!(got.value, model.scatter(it), "{variant}: item {k}");
         }
     }
 }
 
-/// Yosys's gate-level netlist of `f8` through the same comparison.
+/// Yosys's gate-level netlists (lines flagged `gate`) through the same comparison.
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = ScatterConfig::NARROW;
-    let (mut model, writes) = model_and_tables(cfg);
-    gate_smoke_with_config(
-        "gicube_scatter_f8_gate",
-        cfg,
-        &mut model,
-        &mut gen(cfg),
-        seed(51),
-        writes,
-    );
+    for (variant, cfg) in gate_configs::<ScatterConfig>() {
+        let (mut model, writes) = model_and_tables(cfg);
+        let check = StreamCheck::gate_smoke(seed(51)).with_config_writes(writes);
+        must_match(variant, cfg, &mut model, &mut gen(cfg), &check);
+    }
 }
 
 /// Beyond trilin's corrupted-output check: the tables are part of the comparison. One wrong SEED
@@ -308,8 +310,10 @@ fn a_wrong_table_entry_in_the_rtl_is_caught() {
     entry.1[0] ^= 1 << 3;
     let mut check = StreamCheck::new(4343, 20_000).with_config_writes(writes);
     check.waveform_on_mismatch = false;
-    let err = check_stream("gicube_scatter_f14", cfg, &mut model, &mut gen(cfg), &check)
-        .expect_err("a wrong SEED entry must be caught");
+    let err = expect_mismatch(
+        check_stream(variant_with(cfg), cfg, &mut model, &mut gen(cfg), &check),
+        "a wrong SEED entry must be caught",
+    );
     let report = err.to_string();
     assert!(
         report.contains("MISMATCH") && report.contains("seed 4343"),
@@ -322,14 +326,14 @@ fn a_wrong_table_entry_in_the_rtl_is_caught() {
     writes.push((3 << 10, vec![u32::MAX; 2]));
     writes.push((CFG_SEL_SEED << 10 | (1 << si), vec![u32::MAX; 2]));
     let check = StreamCheck::new(seed(52), 20_000).with_config_writes(writes);
-    must_match("gicube_scatter_f14", cfg, &mut model, &mut gen(cfg), &check);
+    must_match(variant_with(cfg), cfg, &mut model, &mut gen(cfg), &check);
 }
 
 /// The output depends only on the item: the same rays in a different order, with a reset in the
 /// middle, give the same results (no hidden random state in either reading).
 #[test]
 fn results_do_not_depend_on_order_or_reset() {
-    let (variant, cfg) = CONFIGS[0];
+    let (variant, cfg) = configs::<ScatterConfig>()[0];
     let (model, writes) = model_and_tables(cfg);
     let mut rng = ChaCha8Rng::seed_from_u64(seed(61));
     let items: Vec<ScatterIn> = (0..5000).map(|_| random_item(&cfg, &mut rng)).collect();

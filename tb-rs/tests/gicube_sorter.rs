@@ -8,18 +8,13 @@ use cube5_model::unit::StreamUnit;
 use cube5_model::units::gicube_sorter::{
     RankState, Sorter, SorterConfig, SorterIn, SorterOp, SorterState, SorterTraffic,
 };
-use cube5_tb::harness::{check_stream, StreamCheck};
+use cube5_tb::harness::{check_stream, must_match, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, gate_smoke, long_run, must_match_across_a_reset, must_match_cycled,
-    random_items, seed, MILLION,
+    assert_one_item_per_clock, configs, expect_mismatch, gate_configs, must_match_across_a_reset,
+    must_match_items, random_items, seed, variant_with, MILLION,
 };
-
-const CONFIGS: [(&str, SorterConfig); 2] = [
-    ("gicube_sorter_r8", SorterConfig::R8),
-    ("gicube_sorter_r32", SorterConfig::R32),
-];
 
 /// Items per batch: a state item of r32 is 1555 bits, so keep the batches small.
 const BATCH: usize = 16_384;
@@ -31,12 +26,12 @@ fn traffic(cfg: SorterConfig) -> impl FnMut(&mut ChaCha8Rng) -> SorterIn {
 
 /// Runs a directed sequence (repeated `times`) on both configurations under idle and back-pressure.
 fn directed(name: &str, items: impl Fn(SorterConfig) -> Vec<SorterIn>, times: usize) {
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<SorterConfig>() {
         let seq = items(cfg);
         let check = StreamCheck::new(seed(500), times * seq.len())
             .with_traffic(0.3, 0.3)
             .with_batch(BATCH);
-        let r = must_match_cycled(variant, cfg, &mut Sorter::new(cfg).unwrap(), seq, &check);
+        let r = must_match_items(variant, cfg, &mut Sorter::new(cfg).unwrap(), seq, &check);
         eprintln!("{name}: {variant} {} logical cycles", r.compared);
     }
 }
@@ -56,8 +51,8 @@ fn clear_all(cfg: SorterConfig) -> Vec<SorterIn> {
 /// A million logical cycles of random update traffic at one configuration (one test per
 /// configuration, so each stays well under a minute on a loaded machine).
 fn million_logical_cycles(k: usize) {
-    let (variant, cfg) = CONFIGS[k];
-    let check = long_run(seed(510 + k as u64), MILLION, 20).with_batch(BATCH);
+    let (variant, cfg) = configs::<SorterConfig>()[k];
+    let check = StreamCheck::long(seed(510 + k as u64), MILLION, 20).with_batch(BATCH);
     must_match_across_a_reset(
         variant,
         cfg,
@@ -215,9 +210,9 @@ fn directed_importance_at_its_maximum() {
 #[test]
 fn one_update_per_cycle_when_never_stalled() {
     const LATENCY: u64 = 1;
-    for (variant, cfg) in CONFIGS {
+    for (variant, cfg) in configs::<SorterConfig>() {
         let items = random_items(seed(520), 50_000, traffic(cfg));
-        let driven = assert_one_item_per_clock(variant, cfg, &items, LATENCY);
+        let driven = assert_one_item_per_clock(variant, cfg, &[], &items, LATENCY);
         let expected = Sorter::new(cfg).unwrap().run(&items);
         assert!(driven
             .outputs
@@ -229,14 +224,16 @@ fn one_update_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let cfg = SorterConfig::R8;
-    gate_smoke(
-        "gicube_sorter_r8_gate",
-        cfg,
-        &mut Sorter::new(cfg).unwrap(),
-        &mut traffic(cfg),
-        seed(530),
-    );
+    for (variant, cfg) in gate_configs::<SorterConfig>() {
+        let check = StreamCheck::gate_smoke(seed(530));
+        must_match(
+            variant,
+            cfg,
+            &mut Sorter::new(cfg).unwrap(),
+            &mut traffic(cfg),
+            &check,
+        );
+    }
 }
 
 /// The model's state one logical cycle late: the order of events is right, the timing is not.
@@ -293,23 +290,27 @@ fn the_whole_state_comparison_catches_timing_and_in_flight_errors() {
     let cfg = SorterConfig::R8;
     let mut check = StreamCheck::new(seed(540), 5_000).with_traffic(0.2, 0.2);
     check.waveform_on_mismatch = false;
-    let late = check_stream(
-        "gicube_sorter_r8",
-        cfg,
-        &mut OneCycleLate(Sorter::new(cfg).unwrap(), None),
-        &mut traffic(cfg),
-        &check,
-    )
-    .expect_err("a one-cycle timing error must be caught");
+    let late = expect_mismatch(
+        check_stream(
+            variant_with(cfg),
+            cfg,
+            &mut OneCycleLate(Sorter::new(cfg).unwrap(), None),
+            &mut traffic(cfg),
+            &check,
+        ),
+        "a one-cycle timing error must be caught",
+    );
     assert!(late.item < 100, "caught at item {}", late.item);
-    let hidden = check_stream(
-        "gicube_sorter_r8",
-        cfg,
-        &mut SelectedOnly(Sorter::new(cfg).unwrap()),
-        &mut traffic(cfg),
-        &check,
-    )
-    .expect_err("the in-flight comparison buffers are compared too");
+    let hidden = expect_mismatch(
+        check_stream(
+            variant_with(cfg),
+            cfg,
+            &mut SelectedOnly(Sorter::new(cfg).unwrap()),
+            &mut traffic(cfg),
+            &check,
+        ),
+        "the in-flight comparison buffers are compared too",
+    );
     assert!(hidden.item < 100, "caught at item {}", hidden.item);
 }
 
@@ -321,7 +322,7 @@ fn ties_keep_the_incumbent_in_the_rtl() {
     let mut items = vec![SorterIn::add(0, 1), SorterIn::NOOP];
     items.extend([SorterIn::set(4, 9), SorterIn::set(2, 9)]);
     items.extend(noops(6));
-    let mut dut = RtlStream::new("gicube_sorter_r8", cfg, 1).unwrap();
+    let mut dut = RtlStream::new(variant_with(cfg), cfg, 1).unwrap();
     let out = dut
         .drive(&items, &Traffic::full_speed(), items.len() as u64, 1000)
         .unwrap();

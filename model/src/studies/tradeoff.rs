@@ -614,9 +614,9 @@ pub fn run(setup: &Setup, progress: &dyn Progress) -> Result<Report> {
         ],
     );
     for (name, c) in [
-        ("v8", TrilinConfig::NARROW),
-        ("v12", TrilinConfig::DEFAULT),
-        ("v16", TrilinConfig::WIDE),
+        ("narrow", TrilinConfig::NARROW),
+        ("default", TrilinConfig::DEFAULT),
+        ("wide", TrilinConfig::WIDE),
     ] {
         let q = Quality {
             voxel_bits: Some(c.voxel_w),

@@ -740,6 +740,15 @@ pub fn ray_error(
     (fixed, refs, max)
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(ComposConfig, "cube5_compos", DEFAULT, {
+    "ColorW" => color_w,
+    "AlphaW" => alpha_w,
+    "ExtraW" => extra_w,
+    "AccW" => acc_w,
+    "ZW" => z_w,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

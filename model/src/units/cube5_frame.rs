@@ -30,6 +30,130 @@ pub const STEP_W: u32 = 16;
 /// variant's `MaxDim`.
 pub const MAX_DIM: usize = 512;
 
+/// One configuration of the `cube5_frame` RTL: pipelines, memory and the widths of its units.
+/// Several frame parameters set more than one unit (`VoxelW` sets trilin, gradient and shader;
+/// `ColorW` and `AlphaW` set shader and compos), so the units always agree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FrameConfig {
+    /// Pipelines (`P`).
+    pub p: usize,
+    /// log2 of the largest volume edge (`MaxDim = 2^max_dim_log2`).
+    pub max_dim_log2: u32,
+    /// Block edge of the skewed memory (`BlockDim`).
+    pub block: u32,
+    /// Read latency of the memory modules (`MemLatency`).
+    pub mem_latency: u32,
+    pub trilin: TrilinConfig,
+    pub gradient: GradientConfig,
+    pub shader: ShaderConfig,
+    pub compos: ComposConfig,
+}
+
+impl FrameConfig {
+    /// The RTL's defaults: four pipelines, 64^3 volumes, the default widths of every unit.
+    pub const DEFAULT: Self = Self {
+        p: 4,
+        max_dim_log2: 6,
+        block: 8,
+        mem_latency: 1,
+        trilin: TrilinConfig::DEFAULT,
+        gradient: GradientConfig::DEFAULT,
+        shader: ShaderConfig::DEFAULT,
+        compos: ComposConfig::DEFAULT,
+    };
+
+    /// The largest volume edge (`MaxDim`).
+    pub fn max_dim(&self) -> usize {
+        1 << self.max_dim_log2
+    }
+}
+
+// The RTL parameters of cube5_frame, each mapped onto every unit it sets.
+impl crate::unit::UnitConfig for FrameConfig {
+    const TOP: &'static str = "cube5_frame";
+
+    fn from_params(params: &[(&str, i64)]) -> Result<Self> {
+        let d = Self::DEFAULT;
+        let mut p = d.p as u32;
+        let mut max_dim = 1u32 << d.max_dim_log2;
+        let (mut block, mut mem_latency) = (d.block, d.mem_latency);
+        let (mut t, mut g, mut s, mut c) = (d.trilin, d.gradient, d.shader, d.compos);
+        crate::unit::set_params(
+            Self::TOP,
+            params,
+            &mut [
+                ("P", &mut p),
+                ("MaxDim", &mut max_dim),
+                ("VoxelW", &mut t.voxel_w),
+                ("WeightW", &mut t.weight_w),
+                ("FracW", &mut t.frac_w),
+                ("BlockDim", &mut block),
+                ("MemLatency", &mut mem_latency),
+                ("ClassIdxW", &mut s.class_idx_w),
+                ("MagIdxW", &mut s.mag_idx_w),
+                ("MagShift", &mut s.mag_shift),
+                ("ColorW", &mut c.color_w),
+                ("AlphaW", &mut c.alpha_w),
+                ("RmLog2", &mut s.rm_log2),
+                ("RmFracW", &mut s.rm_frac_w),
+                ("DiffW", &mut s.diff_w),
+                ("SpecW", &mut s.spec_w),
+                ("ExtraW", &mut c.extra_w),
+                ("AccW", &mut c.acc_w),
+                ("ZW", &mut c.z_w),
+            ],
+        )?;
+        if !max_dim.is_power_of_two() {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: MaxDim = {max_dim} is not a power of two"
+            )));
+        }
+        (g.voxel_w, g.weight_w, g.frac_w) = (t.voxel_w, t.weight_w, t.frac_w);
+        (s.voxel_w, s.frac_w) = (t.voxel_w, t.frac_w);
+        (s.color_w, s.alpha_w) = (c.color_w, c.alpha_w);
+        t.validate()?;
+        g.validate()?;
+        s.validate()?;
+        c.validate()?;
+        Ok(Self {
+            p: p as usize,
+            max_dim_log2: max_dim.trailing_zeros(),
+            block,
+            mem_latency,
+            trilin: t,
+            gradient: g,
+            shader: s,
+            compos: c,
+        })
+    }
+
+    fn to_params(&self) -> Vec<(&'static str, i64)> {
+        let (t, s, c) = (&self.trilin, &self.shader, &self.compos);
+        let i = i64::from;
+        vec![
+            ("P", self.p as i64),
+            ("MaxDim", 1i64 << self.max_dim_log2),
+            ("VoxelW", i(t.voxel_w)),
+            ("WeightW", i(t.weight_w)),
+            ("FracW", i(t.frac_w)),
+            ("BlockDim", i(self.block)),
+            ("MemLatency", i(self.mem_latency)),
+            ("ClassIdxW", i(s.class_idx_w)),
+            ("MagIdxW", i(s.mag_idx_w)),
+            ("MagShift", i(s.mag_shift)),
+            ("ColorW", i(c.color_w)),
+            ("AlphaW", i(c.alpha_w)),
+            ("RmLog2", i(s.rm_log2)),
+            ("RmFracW", i(s.rm_frac_w)),
+            ("DiffW", i(s.diff_w)),
+            ("SpecW", i(s.spec_w)),
+            ("ExtraW", i(c.extra_w)),
+            ("AccW", i(c.acc_w)),
+            ("ZW", i(c.z_w)),
+        ]
+    }
+}
+
 /// The quantized parameters of one frame: everything the RTL is told about the view.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FrameParams {

@@ -369,6 +369,13 @@ impl StreamCodec for GradientConfig {
     }
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(GradientConfig, "cube5_gradient", DEFAULT, {
+    "VoxelW" => voxel_w,
+    "FracW" => frac_w,
+    "WeightW" => weight_w,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

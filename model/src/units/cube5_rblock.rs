@@ -300,6 +300,13 @@ impl StreamCodec for RBlockConfig {
     }
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(RBlockConfig, "cube5_rblock", DEFAULT, {
+    "XBits" => x_bits,
+    "YBits" => y_bits,
+    "ZBits" => z_bits,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

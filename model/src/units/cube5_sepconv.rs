@@ -243,6 +243,13 @@ impl StreamCodec for SepconvConfig {
     }
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(SepconvConfig, "cube5_sepconv", DEFAULT, {
+    "TapW" => tap_w,
+    "WeightFracW" => weight_frac_w,
+    "OutShift" => out_shift,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -850,6 +850,21 @@ impl StreamCodec for ShaderConfig {
     }
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(ShaderConfig, "cube5_shader", DEFAULT, {
+    "VoxelW" => voxel_w,
+    "FracW" => frac_w,
+    "ClassIdxW" => class_idx_w,
+    "MagIdxW" => mag_idx_w,
+    "MagShift" => mag_shift,
+    "ColorW" => color_w,
+    "AlphaW" => alpha_w,
+    "RmLog2" => rm_log2,
+    "RmFracW" => rm_frac_w,
+    "DiffW" => diff_w,
+    "SpecW" => spec_w,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -708,6 +708,47 @@ impl StreamCodec for SkewConfig {
     }
 }
 
+// The RTL parameters: `MaxDim` is the largest edge (a power of two), the model keeps its log2.
+impl crate::unit::UnitConfig for SkewConfig {
+    const TOP: &'static str = "cube5_skewmem";
+
+    fn from_params(params: &[(&str, i64)]) -> Result<Self> {
+        let mut c = Self::DEFAULT;
+        let mut max_dim = 1u32 << c.max_dim_log2;
+        crate::unit::set_params(
+            Self::TOP,
+            params,
+            &mut [
+                ("P", &mut c.p),
+                ("VoxelW", &mut c.voxel_w),
+                ("MaxDim", &mut max_dim),
+                ("BlockDim", &mut c.block),
+                ("MemLatency", &mut c.read_latency),
+                ("CntW", &mut c.cnt_w),
+            ],
+        )?;
+        if !max_dim.is_power_of_two() {
+            return Err(ModelError::Config(format!(
+                "cube5_skewmem: MaxDim = {max_dim} is not a power of two"
+            )));
+        }
+        c.max_dim_log2 = max_dim.trailing_zeros();
+        c.validate()?;
+        Ok(c)
+    }
+
+    fn to_params(&self) -> Vec<(&'static str, i64)> {
+        vec![
+            ("P", i64::from(self.p)),
+            ("VoxelW", i64::from(self.voxel_w)),
+            ("MaxDim", 1i64 << self.max_dim_log2),
+            ("BlockDim", i64::from(self.block)),
+            ("MemLatency", i64::from(self.read_latency)),
+            ("CntW", i64::from(self.cnt_w)),
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

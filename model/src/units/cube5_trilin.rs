@@ -217,6 +217,13 @@ impl StreamCodec for TrilinConfig {
     }
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(TrilinConfig, "cube5_trilin", DEFAULT, {
+    "VoxelW" => voxel_w,
+    "WeightW" => weight_w,
+    "FracW" => frac_w,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

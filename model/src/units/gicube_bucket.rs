@@ -322,6 +322,49 @@ pub fn random_position(rng: &mut impl rand::Rng, cfg: &BucketConfig) -> Position
     Position([axis(rng), axis(rng), axis(rng)])
 }
 
+// The RTL parameters (`Dist` is the [`Distribution`] code); the RTL defaults are `SLAB`.
+impl crate::unit::UnitConfig for BucketConfig {
+    const TOP: &'static str = "gicube_bucket";
+
+    fn from_params(params: &[(&str, i64)]) -> Result<Self> {
+        let mut c = Self::SLAB;
+        let mut dist = c.dist as u32;
+        crate::unit::set_params(
+            Self::TOP,
+            params,
+            &mut [
+                ("BlockLog2", &mut c.block_log2),
+                ("VolBlocks", &mut c.vol_blocks),
+                ("ProcLog2", &mut c.proc_log2),
+                ("Dist", &mut dist),
+                ("Lanes", &mut c.lanes),
+            ],
+        )?;
+        c.dist = match dist {
+            0 => Distribution::Slab,
+            1 => Distribution::RepeatingSlab,
+            2 => Distribution::Skewed,
+            d => {
+                return Err(ModelError::Config(format!(
+                    "gicube_bucket: Dist = {d} (0 slab, 1 repeating slab, 2 skewed)"
+                )))
+            }
+        };
+        c.validate()?;
+        Ok(c)
+    }
+
+    fn to_params(&self) -> Vec<(&'static str, i64)> {
+        vec![
+            ("BlockLog2", i64::from(self.block_log2)),
+            ("VolBlocks", i64::from(self.vol_blocks)),
+            ("ProcLog2", i64::from(self.proc_log2)),
+            ("Dist", self.dist as i64),
+            ("Lanes", i64::from(self.lanes)),
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

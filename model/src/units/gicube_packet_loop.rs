@@ -440,6 +440,11 @@ pub fn directed_packets() -> Vec<RayPacket> {
     out
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `S1`).
+crate::unit_config!(PacketLoopConfig, "gicube_packet_loop", S1, {
+    "Stages" => stages,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -773,6 +773,15 @@ pub fn random_item(cfg: &ScatterConfig, rng: &mut impl rand::Rng) -> ScatterIn {
     }
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(ScatterConfig, "gicube_scatter", DEFAULT, {
+    "DirFracW" => dir_frac_w,
+    "GradW" => grad_w,
+    "MatW" => mat_w,
+    "AngW" => ang_w,
+    "IsoW" => iso_w,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

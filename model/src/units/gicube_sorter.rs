@@ -814,6 +814,13 @@ impl Workload {
     }
 }
 
+// The RTL parameters of this unit (the RTL defaults are the model's `R32`).
+crate::unit_config!(SorterConfig, "gicube_sorter", R32, {
+    "Ranks" => ranks,
+    "QueueW" => queue_w,
+    "ImpW" => imp_w,
+});
+
 #[cfg(test)]
 mod tests {
     use super::*;

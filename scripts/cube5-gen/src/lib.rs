@@ -4,3 +4,4 @@
 
 pub mod regs;
 pub mod variants;
+pub mod yosys;

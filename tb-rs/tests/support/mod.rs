@@ -1,9 +1,12 @@
-//! Helpers shared by the co-simulation tests.
+//! Helpers shared by the co-simulation tests. The scoreboard and its presets live in the library
+//! (`cube5_tb::harness`: `must_match`, `StreamCheck::{directed, long, gate_smoke}`); these add
+//! only what several test files repeat.
 #![allow(dead_code)]
 
 use cube5_model::unit::{StreamCodec, StreamUnit};
-use cube5_tb::harness::{check_stream, seed_from_env, StreamCheck, StreamReport};
+use cube5_tb::harness::{seed_from_env, StreamCheck, StreamReport};
 use cube5_tb::rtl::{Driven, RtlStream, Traffic};
+use cube5_tb::{must_match, Variant};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::fmt::Debug;
@@ -11,41 +14,10 @@ use std::fmt::Debug;
 /// Random items per configuration in the long co-simulation runs (the acceptance figure).
 pub const MILLION: usize = 1_000_000;
 
-pub use cube5_tb::rtl::ConfigWrites;
-
 /// A codec the scoreboard can run: inputs it can replay and print, outputs it can compare.
 pub trait Scored: StreamCodec<In: Clone + Debug, Out: Clone + Debug + PartialEq> + Clone {}
 
 impl<C: StreamCodec<In: Clone + Debug, Out: Clone + Debug + PartialEq> + Clone> Scored for C {}
-
-/// Runs a check and turns a mismatch into a test failure whose message is the full report.
-pub fn must_match<C, G>(
-    variant: &str,
-    codec: C,
-    gold: &mut G,
-    gen: &mut dyn FnMut(&mut ChaCha8Rng) -> C::In,
-    check: &StreamCheck,
-) -> StreamReport
-where
-    C: Scored,
-    G: StreamUnit<In = C::In, Out = C::Out>,
-{
-    match check_stream(variant, codec, gold, gen, check) {
-        Ok(r) => {
-            eprintln!(
-                "{variant}: seed {} consumed {} compared {} in {} cycles ({:.4} items/clock), {} reset(s)",
-                r.seed,
-                r.consumed,
-                r.compared,
-                r.cycles,
-                r.items_per_cycle(),
-                r.resets
-            );
-            r
-        }
-        Err(m) => panic!("{m}"),
-    }
-}
 
 /// The seed of a test: `CUBE5_SEED` if set, else a fixed default per test.
 pub fn seed(default: u64) -> u64 {
@@ -58,9 +30,10 @@ pub fn random_items<T>(seed: u64, n: usize, mut gen: impl FnMut(&mut ChaCha8Rng)
     (0..n).map(|_| gen(&mut rng)).collect()
 }
 
-/// `must_match` on `items` in order, started over as often as `check.items` asks.
-pub fn must_match_cycled<C, G>(
-    variant: &str,
+/// `must_match` on `items` in order, started over as often as `check.items` asks; once when it
+/// is 0 (`StreamCheck::directed`).
+pub fn must_match_items<C, G>(
+    variant: &'static Variant,
     codec: C,
     gold: &mut G,
     items: Vec<C::In>,
@@ -70,60 +43,20 @@ where
     C: Scored,
     G: StreamUnit<In = C::In, Out = C::Out>,
 {
+    let mut check = check.clone();
+    if check.items == 0 {
+        check.items = items.len();
+    }
     let mut it = items.into_iter().cycle();
-    must_match(variant, codec, gold, &mut |_| it.next().unwrap(), check)
+    must_match(variant, codec, gold, &mut |_| it.next().unwrap(), &check)
 }
 
-/// One pass over directed `items` under heavy idle and back-pressure: a short list still meets
-/// the handshake's corner cases.
-pub fn must_match_items<C, G>(
-    variant: &str,
-    codec: C,
-    gold: &mut G,
-    items: Vec<C::In>,
-    seed: u64,
-) -> StreamReport
-where
-    C: Scored,
-    G: StreamUnit<In = C::In, Out = C::Out>,
-{
-    must_match_items_with_config(variant, codec, gold, items, seed, Vec::new())
-}
-
-/// `must_match_items` with `writes` loaded into the RTL first (the model holds the same tables).
-pub fn must_match_items_with_config<C, G>(
-    variant: &str,
-    codec: C,
-    gold: &mut G,
-    items: Vec<C::In>,
-    seed: u64,
-    writes: ConfigWrites,
-) -> StreamReport
-where
-    C: Scored,
-    G: StreamUnit<In = C::In, Out = C::Out>,
-{
-    let check = StreamCheck::new(seed, items.len())
-        .with_traffic(0.3, 0.3)
-        .with_config_writes(writes);
-    must_match_cycled(variant, codec, gold, items, &check)
-}
-
-/// Drives `items` at full speed and asserts the throughput contract: every item taken, the run
-/// lasts exactly one clock per item plus `latency`, and the outputs leave back to back. Returns
-/// the outputs for any comparison the caller adds.
+/// Drives `items` at full speed (after `writes` on the configuration port) and asserts the
+/// throughput contract: every item taken, the run lasts exactly one clock per item plus
+/// `latency`, and the outputs leave back to back. Returns the outputs for any comparison the
+/// caller adds.
 pub fn assert_one_item_per_clock<C: StreamCodec>(
-    variant: &str,
-    codec: C,
-    items: &[C::In],
-    latency: u64,
-) -> Driven<C::Out> {
-    assert_one_item_per_clock_with_config(variant, codec, &[], items, latency)
-}
-
-/// `assert_one_item_per_clock` with `writes` loaded into the RTL first.
-pub fn assert_one_item_per_clock_with_config<C: StreamCodec>(
-    variant: &str,
+    variant: &'static Variant,
     codec: C,
     writes: &[(u32, Vec<u32>)],
     items: &[C::In],
@@ -152,55 +85,10 @@ pub fn assert_one_item_per_clock_with_config<C: StreamCodec>(
     driven
 }
 
-/// The gate-level netlist run: 30,000 random items under idle and back-pressure, in batches of
-/// 10,000 (netlists simulate slowly), with a reset in the middle one.
-pub fn gate_smoke<C, G>(
-    variant: &str,
-    codec: C,
-    gold: &mut G,
-    gen: &mut dyn FnMut(&mut ChaCha8Rng) -> C::In,
-    seed: u64,
-) -> StreamReport
-where
-    C: Scored,
-    G: StreamUnit<In = C::In, Out = C::Out>,
-{
-    gate_smoke_with_config(variant, codec, gold, gen, seed, Vec::new())
-}
-
-/// `gate_smoke` with `writes` loaded into the netlist first.
-pub fn gate_smoke_with_config<C, G>(
-    variant: &str,
-    codec: C,
-    gold: &mut G,
-    gen: &mut dyn FnMut(&mut ChaCha8Rng) -> C::In,
-    seed: u64,
-    writes: ConfigWrites,
-) -> StreamReport
-where
-    C: Scored,
-    G: StreamUnit<In = C::In, Out = C::Out>,
-{
-    let check = StreamCheck::new(seed, 30_000)
-        .with_traffic(0.2, 0.2)
-        .with_batch(10_000)
-        .with_reset_in_batch(1)
-        .with_config_writes(writes);
-    must_match(variant, codec, gold, gen, &check)
-}
-
-/// A long random run: `items` items under idle and back-pressure, reset once in batch
-/// `reset_in_batch`.
-pub fn long_run(seed: u64, items: usize, reset_in_batch: usize) -> StreamCheck {
-    StreamCheck::new(seed, items)
-        .with_traffic(0.2, 0.3)
-        .with_reset_in_batch(reset_in_batch)
-}
-
 /// `must_match` on a check with one reset: asserts the reset happened and dropped no more than
 /// `in_flight` items (those the pipeline held at the time).
 pub fn must_match_across_a_reset<C, G>(
-    variant: &str,
+    variant: &'static Variant,
     codec: C,
     gold: &mut G,
     gen: &mut dyn FnMut(&mut ChaCha8Rng) -> C::In,
@@ -218,4 +106,71 @@ where
         "{variant}: a reset drops at most the items in flight"
     );
     r
+}
+
+/// The RTL builds of `C`'s top with the model's configuration of each, in `.variants` order.
+pub fn configs<C: cube5_model::unit::UnitConfig>() -> Vec<(&'static Variant, C)> {
+    cube5_tb::variants_of(C::TOP)
+        .into_iter()
+        .map(|v| (v, v.config().unwrap_or_else(|e| panic!("{v}: {e}"))))
+        .collect()
+}
+
+/// The gate-level builds of `C`'s top (lines flagged `gate`) with the model's configuration.
+pub fn gate_configs<C: cube5_model::unit::UnitConfig>() -> Vec<(&'static Variant, C)> {
+    cube5_tb::gate_variants_of(C::TOP)
+        .into_iter()
+        .map(|v| (v, v.config().unwrap_or_else(|e| panic!("{v}: {e}"))))
+        .collect()
+}
+
+/// Opens the first variant of `C`'s top with the configuration of another variant whose port
+/// widths differ: the test bench must refuse it with a set-up error that names the port.
+pub fn assert_foreign_codec_is_refused<C>()
+where
+    C: cube5_model::unit::UnitConfig + StreamCodec + Copy,
+{
+    let all = configs::<C>();
+    let (variant, own) = all[0];
+    let foreign = all
+        .iter()
+        .map(|&(_, c)| c)
+        .find(|c| c.in_width() != own.in_width() || c.out_width() != own.out_width())
+        .expect("two variants with different port widths");
+    match RtlStream::new(variant, foreign, 1) {
+        Err(cube5_tb::TbError::Setup { what, .. }) => {
+            assert!(
+                what.contains("in_data_i") || what.contains("out_data_o"),
+                "the refusal names the port: {what}"
+            );
+        }
+        Err(e) => panic!("{variant}: expected a width refusal, got {e}"),
+        Ok(_) => panic!("{variant}: a codec of other widths was accepted"),
+    }
+}
+
+/// The mismatch a run must end in (a mutated model, a corrupted output); panics with `why` if it
+/// passed or failed in another way.
+pub fn expect_mismatch<T: Debug>(
+    run: Result<T, cube5_tb::TbError>,
+    why: &str,
+) -> cube5_tb::Mismatch {
+    match run {
+        Err(cube5_tb::TbError::Mismatch(m)) => *m,
+        Err(e) => panic!("{why}: the run failed otherwise: {e}"),
+        Ok(r) => panic!("{why}: the run passed ({r:?})"),
+    }
+}
+
+/// The variant whose configuration is `cfg` (a test that needs one particular configuration says
+/// which by its value, never by the variant's name); panics if no `.variants` line has it.
+pub fn variant_with<C>(cfg: C) -> &'static Variant
+where
+    C: cube5_model::unit::UnitConfig + PartialEq + Debug,
+{
+    configs::<C>()
+        .into_iter()
+        .find(|(_, c)| *c == cfg)
+        .map(|(v, _)| v)
+        .unwrap_or_else(|| panic!("no variant of {} has the configuration {cfg:?}", C::TOP))
 }

@@ -8,7 +8,10 @@ fn main() -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("variants") => cube5_gen::variants::main(&args[1..]),
         Some("regs") => cube5_gen::regs::main(&args[1..]),
-        _ => Err("usage: cube5-gen variants|regs [...] (see scripts/cube5-gen/src/lib.rs)".into()),
+        Some("yosys") => cube5_gen::yosys::main(&args[1..]),
+        _ => Err(
+            "usage: cube5-gen variants|regs|yosys [...] (see scripts/cube5-gen/src/lib.rs)".into(),
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
