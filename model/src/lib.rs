@@ -12,6 +12,7 @@ pub mod frame;
 pub mod gicube;
 pub mod gradient;
 pub mod phantom;
+pub mod regs;
 pub mod render;
 pub mod scene;
 pub mod shader;
