@@ -35,3 +35,21 @@ fn every_description_found() {
         );
     }
 }
+
+/// The example of the format in docs/adding-a-unit.md is a valid description.
+#[test]
+fn documented_example_parses() {
+    let page = std::fs::read_to_string(root().join("docs/adding-a-unit.md")).unwrap();
+    let section = page
+        .split("## Registers and shared constants")
+        .nth(1)
+        .expect("section in docs/adding-a-unit.md");
+    let toml = section
+        .split("```toml\n")
+        .nth(1)
+        .and_then(|s| s.split("```").next())
+        .expect("a toml example");
+    let path = std::path::Path::new("rtl/cube5/cube5_x.regs.toml");
+    let b = cube5_gen::regs::desc::parse(toml, path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(b.desc.register.len(), 1);
+}
