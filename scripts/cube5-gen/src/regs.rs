@@ -419,6 +419,47 @@ field = [ { name = "done", width = 1, doc = "frame done" }, { name = "err", widt
     }
 
     #[test]
+    fn duplicate_name_and_wrong_subset_refused() {
+        let e = err(r#"
+[[constant]]
+name = "RegA"
+value = 1
+doc = "clash"
+[[register]]
+name = "A"
+offset = 0
+access = "RO"
+doc = "a"
+"#);
+        assert_eq!(e, "rtl/t.regs.toml: register A: name RegA defined twice");
+        let modes = r#"
+[[enum]]
+name = "Mode"
+rust_prefix = "MODE"
+width = 3
+doc = "m"
+value = [ { name = "Max", value = 2 } ]
+"#;
+        let a = parse(&format!("{HEAD}{modes}"), Path::new("rtl/a.regs.toml")).unwrap();
+        let b = parse(
+            &format!(
+                "{}{}",
+                HEAD.replace("cube5_t", "cube5_u"),
+                modes
+                    .replace("value = 2", "value = 3")
+                    .replace("width = 3", "width = 3\nsubset_of = \"cube5_t.Mode\"")
+            ),
+            Path::new("rtl/b.regs.toml"),
+        )
+        .unwrap();
+        let e = desc::check_subsets(&[a, b]).unwrap_err();
+        assert_eq!(
+            e,
+            "rtl/b.regs.toml: enum Mode: Max = 3 (3 bits) is not in cube5_t.Mode"
+        );
+    }
+
+    #[test]
     fn missing_marker_named() {
         let b = parse(HEAD, Path::new("rtl/t.regs.toml")).unwrap();
         let e = generate_from(&[b], &|_| Ok("package t;\nendpackage\n".into())).unwrap_err();
