@@ -2,7 +2,7 @@
 CARGO ?= cargo
 DEMO_DIR ?= out
 
-.PHONY: setup demo test sim sim-full lint synth bench tradeoff fmt clippy clean clean-cache
+.PHONY: setup demo test sim sim-full lint synth bench tradeoff regs fmt clippy clean clean-cache
 
 # The build cache of verilated and compiled RTL variants (shared by every clone on the machine).
 CUBE5_CACHE ?= $(if $(XDG_CACHE_HOME),$(XDG_CACHE_HOME),$(HOME)/.cache)/cube5
@@ -50,6 +50,10 @@ bench: setup
 ## Regenerates docs/tradeoffs.md and its plots (speed/area against accuracy sweeps).
 tradeoff: setup
 	$(CARGO) run --release -q -p cube5-cli -- tradeoff --write-docs
+
+## Regenerates the register maps and shared constants from rtl/**/*.regs.toml (SV packages, model/src/regs, docs tables).
+regs:
+	$(CARGO) run -q -p cube5-gen -- regs --write
 
 fmt:
 	$(CARGO) fmt --all

@@ -12,6 +12,7 @@ pub mod bits;
 pub mod camera;
 pub mod error;
 pub mod phantom;
+pub mod regs;
 pub mod render;
 pub mod scene;
 pub mod studies;

@@ -101,28 +101,16 @@ impl FrameRtl {
     }
 }
 
-/// Configuration regions and frame registers.
-pub const REGION_FRAME: u32 = 0;
-pub const REGION_VOXEL: u32 = 1;
-pub const REGION_BLOCK: u32 = 2;
-pub const REGION_SHADER: u32 = 3;
-pub const REGION_COMPOS: u32 = 4;
-pub const REG_DIMS: u32 = 0;
-pub const REG_VIEW: u32 = 1;
-pub const REG_DX: u32 = 2;
-pub const REG_DY: u32 = 3;
-pub const REG_MODE: u32 = 4;
-pub const REG_SKIP: u32 = 5;
-
-/// Commands.
-pub const OP_RENDER: u32 = 0;
-
-/// Latencies of the units (trilin.md and compos.md; cube5_gradient's five register stages; the
-/// shader's and the memory's come from their model configurations). Only the cycle budget and
-/// the smallest-volume rule (compos) depend on them.
-pub const TRILIN_LATENCY: u64 = 3;
-pub const GRADIENT_LATENCY: u64 = 5;
-pub const COMPOS_LATENCY: u64 = 6;
+/// Configuration regions, frame registers, commands and the latencies of the units (trilin.md,
+/// gradient.md and compos.md; the shader's and the memory's come from their model
+/// configurations): generated from `rtl/cube5/cube5_frame.regs.toml` (`make regs`), the same
+/// description as `cube5_frame_pkg`. Only the cycle budget and the smallest-volume rule (compos)
+/// depend on the latencies.
+pub use cube5_model::regs::cube5_frame::{
+    COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK, REGION_COMPOS, REGION_FRAME,
+    REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE, REG_SKIP, REG_VIEW,
+    TRILIN_LATENCY,
+};
 
 /// The frame's two renderings (docs/numerics/frame.md, "The pipeline of one sample").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

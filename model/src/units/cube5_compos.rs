@@ -6,6 +6,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
+use crate::regs::cube5_compos as regmap;
 use crate::unit::{StreamCodec, StreamUnit};
 
 /// Widths of one `cube5_compos` configuration (the RTL parameters of the same names).
@@ -124,7 +125,8 @@ impl ComposConfig {
         3 * self.color_w + self.alpha_w + self.z_w + 3
     }
 
-    /// Address of register `k` (0 = Ctrl, 1 = EtThreshold, 2 = FoThreshold) on the config port.
+    /// Address of register `k` (`REG_CTRL`, `REG_ET_THRESHOLD`, `REG_FO_THRESHOLD` of
+    /// `regs::cube5_compos`) on the config port.
     pub fn reg_addr(&self, k: u32) -> u32 {
         (1 << self.alpha_w) + k
     }
@@ -158,15 +160,15 @@ pub fn rnd(x: u64, s: u32) -> u64 {
 /// The 3-bit `mode` field.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ComposMode {
-    FrontToBack = 0,
-    BackToFront = 1,
-    Max = 2,
-    Min = 3,
-    XraySum = 4,
-    FirstOpaque = 5,
-    Flush = 6,
+    FrontToBack = regmap::MODE_FRONT_TO_BACK as isize,
+    BackToFront = regmap::MODE_BACK_TO_FRONT as isize,
+    Max = regmap::MODE_MAX as isize,
+    Min = regmap::MODE_MIN as isize,
+    XraySum = regmap::MODE_XRAY_SUM as isize,
+    FirstOpaque = regmap::MODE_FIRST_OPAQUE as isize,
+    Flush = regmap::MODE_FLUSH as isize,
     /// Reserved encoding: passes the coxel unchanged.
-    Reserved = 7,
+    Reserved = regmap::MODE_RESERVED as isize,
 }
 
 impl ComposMode {
@@ -532,10 +534,17 @@ pub fn config_writes(
         .enumerate()
         .map(|(r, &e)| (r as u32, data(u64::from(e))))
         .collect();
-    let ctrl = u64::from(regs.lut_bypass) | u64::from(regs.xray_shift) << 1;
-    writes.push((cfg.reg_addr(0), data(ctrl)));
-    writes.push((cfg.reg_addr(1), data(regs.et_threshold)));
-    writes.push((cfg.reg_addr(2), data(regs.fo_threshold)));
+    let ctrl = regmap::REG_CTRL_LUT_BYPASS.set(0, u64::from(regs.lut_bypass));
+    let ctrl = regmap::REG_CTRL_XRAY_SHIFT.set(ctrl, u64::from(regs.xray_shift));
+    writes.push((cfg.reg_addr(regmap::REG_CTRL), data(ctrl)));
+    writes.push((
+        cfg.reg_addr(regmap::REG_ET_THRESHOLD),
+        data(regs.et_threshold),
+    ));
+    writes.push((
+        cfg.reg_addr(regmap::REG_FO_THRESHOLD),
+        data(regs.fo_threshold),
+    ));
     writes
 }
 

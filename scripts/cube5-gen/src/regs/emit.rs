@@ -1,0 +1,535 @@
+//! The three readings of a checked description: SV localparams, a Rust module, Markdown tables.
+
+use super::desc::{camel, screaming, Checked, Expr, Field, Resolved};
+use std::fmt::Write;
+
+/// Lines are wrapped at this column (STYLE.md, rustfmt's default).
+const COLUMNS: usize = 100;
+
+/// `text` as comment lines `prefix ...`, wrapped at [`COLUMNS`].
+fn wrap(out: &mut String, prefix: &str, text: &str) {
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        if !line.is_empty() && prefix.len() + line.len() + 1 + word.len() > COLUMNS {
+            let _ = writeln!(out, "{prefix}{line}");
+            line.clear();
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    if !line.is_empty() {
+        let _ = writeln!(out, "{prefix}{line}");
+    }
+}
+
+/// A field in words: `nx (m + 1)` or `axis_k [1:0]`.
+fn field_text(f: &Field) -> String {
+    match (&f.lsb, &f.width) {
+        (Resolved::Num(l), Resolved::Num(1)) => format!("{} [{l}]", f.name),
+        (Resolved::Num(l), Resolved::Num(w)) => format!("{} [{}:{l}]", f.name, l + w - 1),
+        (_, w) => format!("{} ({})", f.name, w.text()),
+    }
+}
+
+fn fields_numeric(fs: &[Field]) -> impl Iterator<Item = (&Field, u64, u64)> {
+    fs.iter().filter_map(|f| match (&f.lsb, &f.width) {
+        (Resolved::Num(l), Resolved::Num(w)) => Some((f, *l, *w)),
+        _ => None,
+    })
+}
+
+/// The SV text between the markers of the block's package, indented by `indent`.
+pub fn sv(b: &Checked, indent: &str) -> String {
+    let d = &b.desc;
+    let mut out = String::new();
+    let doc = format!("{indent}/// ");
+    for c in &d.constant {
+        wrap(&mut out, &doc, &c.doc);
+        let value = b.exprs[&c.name].render(&|n: &str| n.to_string());
+        let _ = writeln!(out, "{indent}localparam int unsigned {} = {value};", c.name);
+        out.push('\n');
+    }
+    for en in &d.enums {
+        wrap(&mut out, &doc, &en.doc);
+        if let Some(w) = &en.width_param {
+            let _ = writeln!(out, "{indent}localparam int unsigned {w} = {};", en.width);
+        }
+        let pad = en.value.iter().map(|v| v.name.len()).max().unwrap_or(0);
+        let decls: Vec<(String, &str)> = en
+            .value
+            .iter()
+            .map(|v| {
+                let decl = format!(
+                    "{indent}localparam logic [{}:0] {}{:<pad$} = {}'d{};",
+                    en.width - 1,
+                    en.name,
+                    v.name,
+                    en.width,
+                    v.value
+                );
+                (decl, v.doc.as_str())
+            })
+            .collect();
+        // Trailing comments when every one fits, else each above its line.
+        let trailing = decls
+            .iter()
+            .all(|(d, c)| c.is_empty() || d.len() + 4 + c.len() <= COLUMNS);
+        for (decl, comment) in decls {
+            if trailing || comment.is_empty() {
+                push_trailing(&mut out, decl, comment);
+            } else {
+                wrap(&mut out, &format!("{indent}// "), comment);
+                let _ = writeln!(out, "{decl}");
+            }
+        }
+        out.push('\n');
+    }
+    if !d.register.is_empty() {
+        let base = d.block.base_doc.as_deref().unwrap_or("byte address / 4 =");
+        wrap(
+            &mut out,
+            &doc,
+            &format!("Registers by word offset ({base} the offset), access, fields LSB first."),
+        );
+        let pad = d.register.iter().map(|r| r.name.len()).max().unwrap_or(0);
+        for (r, fs) in d.register.iter().zip(&b.fields) {
+            let decl = format!(
+                "{indent}localparam int unsigned Reg{:<pad$} = {};",
+                r.name, r.offset
+            );
+            let fields: Vec<String> = fs.iter().map(field_text).collect();
+            push_trailing(
+                &mut out,
+                decl,
+                &format!("{}: {}", r.access.as_str(), fields.join(", ")),
+            );
+        }
+        let resets: Vec<_> = d.register.iter().filter(|r| r.reset.is_some()).collect();
+        if !resets.is_empty() {
+            out.push('\n');
+            let _ = writeln!(out, "{indent}/// Reset values.");
+            for r in resets {
+                let w = d.block.data_w;
+                let _ = writeln!(
+                    out,
+                    "{indent}localparam logic [{}:0] Reg{}Reset = {w}'h{:x};",
+                    w - 1,
+                    r.name,
+                    r.reset.unwrap_or(0)
+                );
+            }
+        }
+        let numeric: Vec<(String, u64, u64)> = d
+            .register
+            .iter()
+            .zip(&b.fields)
+            .flat_map(|(r, fs)| {
+                fields_numeric(fs)
+                    .map(|(f, l, w)| (format!("Reg{}{}", r.name, camel(&f.name)), l, w))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        if !numeric.is_empty() {
+            out.push('\n');
+            let _ = writeln!(
+                out,
+                "{indent}/// Fields whose place does not depend on parameters: lowest bit, width."
+            );
+            let pad = numeric.iter().map(|(n, _, _)| n.len()).max().unwrap_or(0) + 3;
+            for (n, l, w) in numeric {
+                let _ = writeln!(
+                    out,
+                    "{indent}localparam int unsigned {:<pad$} = {l};",
+                    format!("{n}Lsb")
+                );
+                let _ = writeln!(
+                    out,
+                    "{indent}localparam int unsigned {:<pad$} = {w};",
+                    format!("{n}W")
+                );
+            }
+        }
+    }
+    while out.ends_with("\n\n") {
+        out.pop();
+    }
+    out
+}
+
+/// `decl  // comment`, or the comment on the line above when that would pass [`COLUMNS`].
+fn push_trailing(out: &mut String, decl: String, comment: &str) {
+    if comment.is_empty() {
+        let _ = writeln!(out, "{decl}");
+    } else if decl.len() + 4 + comment.len() <= COLUMNS {
+        let _ = writeln!(out, "{decl}  // {comment}");
+    } else {
+        let indent: String = decl.chars().take_while(|c| *c == ' ').collect();
+        wrap(out, &format!("{indent}// "), comment);
+        let _ = writeln!(out, "{decl}");
+    }
+}
+
+/// The whole generated Rust module of a block.
+pub fn rust(b: &Checked) -> String {
+    let d = &b.desc;
+    let mut out = String::new();
+    wrap(
+        &mut out,
+        "//! ",
+        &format!(
+            "Generated by `cube5-gen regs` from `{}`: do not edit; change the description and \
+             run `make regs`.",
+            b.rel.display()
+        ),
+    );
+    out.push_str("//!\n");
+    wrap(&mut out, "//! ", &d.block.doc);
+
+    let has_fields = b
+        .fields
+        .iter()
+        .any(|fs| fields_numeric(fs).next().is_some());
+    let mut uses = Vec::new();
+    if !d.register.is_empty() {
+        uses.push("Access");
+    }
+    if has_fields {
+        uses.push("Field");
+    }
+    if !d.register.is_empty() {
+        uses.push("Register");
+    }
+    match uses.len() {
+        0 => {}
+        1 => {
+            let _ = write!(out, "\nuse super::{};\n", uses[0]);
+        }
+        _ => {
+            let _ = write!(out, "\nuse super::{{{}}};\n", uses.join(", "));
+        }
+    }
+
+    for c in &d.constant {
+        out.push('\n');
+        wrap(&mut out, "/// ", &c.doc);
+        let e = &b.exprs[&c.name];
+        let mut names = Vec::new();
+        e.names(&mut names);
+        let same_type = names.iter().all(|n| {
+            d.constant
+                .iter()
+                .any(|o| &o.name == n && o.rust_type == c.rust_type)
+        });
+        let value = if same_type {
+            e.render(&|n: &str| screaming(n))
+        } else {
+            b.values[&c.name].to_string()
+        };
+        let _ = writeln!(
+            out,
+            "pub const {}: {} = {value};",
+            screaming(&c.name),
+            c.rust_type
+        );
+    }
+
+    for en in &d.enums {
+        out.push('\n');
+        wrap(&mut out, "// ", &en.doc);
+        if let Some(w) = &en.width_param {
+            let _ = writeln!(out, "pub const {}: u32 = {};", screaming(w), en.width);
+        }
+        for v in &en.value {
+            if !v.doc.is_empty() {
+                wrap(&mut out, "/// ", &v.doc);
+            }
+            let _ = writeln!(
+                out,
+                "pub const {}_{}: u32 = {};",
+                en.rust_prefix,
+                screaming(&v.name),
+                v.value
+            );
+        }
+    }
+
+    if !d.register.is_empty() {
+        out.push('\n');
+        let base = d.block.base_doc.as_deref().unwrap_or("byte address / 4 =");
+        wrap(
+            &mut out,
+            "// ",
+            &format!("Registers by word offset ({base} the offset)."),
+        );
+        for (r, fs) in d.register.iter().zip(&b.fields) {
+            let fields: Vec<String> = fs.iter().map(field_text).collect();
+            wrap(
+                &mut out,
+                "/// ",
+                &format!(
+                    "`{}` ({}): {}. Fields: {}.",
+                    r.name,
+                    r.access.as_str(),
+                    r.doc,
+                    fields.join(", ")
+                ),
+            );
+            let _ = writeln!(
+                out,
+                "pub const REG_{}: u32 = {};",
+                screaming(&r.name),
+                r.offset
+            );
+            for (f, l, w) in fields_numeric(fs) {
+                let text = if f.doc.is_empty() {
+                    format!("Field `{}` of `{}`.", f.name, r.name)
+                } else {
+                    format!("Field `{}` of `{}`: {}.", f.name, r.name, f.doc)
+                };
+                wrap(&mut out, "/// ", &text);
+                let name = format!("REG_{}_{}", screaming(&r.name), screaming(&f.name));
+                let line = format!("pub const {name}: Field = Field::new({l}, {w});");
+                if line.len() <= COLUMNS {
+                    let _ = writeln!(out, "{line}");
+                } else {
+                    let _ = writeln!(out, "pub const {name}: Field =\n    Field::new({l}, {w});");
+                }
+            }
+        }
+        out.push('\n');
+        out.push_str("/// Every register, by offset.\n");
+        let _ = writeln!(
+            out,
+            "pub const REGISTERS: [Register; {}] = [",
+            d.register.len()
+        );
+        let mut regs: Vec<_> = d.register.iter().collect();
+        regs.sort_by_key(|r| r.offset);
+        for r in regs {
+            let reset = match r.reset {
+                Some(v) => format!("Some({v:#x})"),
+                None => "None".into(),
+            };
+            let _ = writeln!(
+                out,
+                "    Register::new(\"{}\", {}, Access::{}, {reset}),",
+                r.name,
+                r.offset,
+                r.access.rust()
+            );
+        }
+        out.push_str("];\n");
+    }
+    out
+}
+
+/// `model/src/regs/mod.rs`: the blocks' modules and the types they share.
+pub fn rust_mod(modules: &[String]) -> String {
+    let mut out = String::from(RUST_MOD_HEAD);
+    for m in modules {
+        let _ = writeln!(out, "pub mod {m};");
+    }
+    out.push_str(RUST_MOD_TAIL);
+    out
+}
+
+const RUST_MOD_HEAD: &str = "\
+//! Register maps and shared constants of the RTL blocks, generated by `cube5-gen regs` from
+//! `rtl/**/<block>.regs.toml`: do not edit; change the descriptions and run `make regs`
+//! (docs/adding-a-unit.md, \"Registers and shared constants\").
+
+";
+
+const RUST_MOD_TAIL: &str = "
+/// Who may access a register on the bus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Access {
+    /// Read and write.
+    Rw,
+    /// Read only.
+    Ro,
+    /// Write only.
+    Wo,
+    /// Read; writing 1 clears that bit.
+    W1c,
+}
+
+/// One register: name, word offset, access, reset value (`None`: reset leaves it as it is).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Register {
+    pub name: &'static str,
+    pub offset: u32,
+    pub access: Access,
+    pub reset: Option<u64>,
+}
+
+impl Register {
+    pub const fn new(name: &'static str, offset: u32, access: Access, reset: Option<u64>) -> Self {
+        Self {
+            name,
+            offset,
+            access,
+            reset,
+        }
+    }
+
+    /// Byte address on a bus of `word_bytes`-byte registers whose offset 0 is at `base`.
+    pub const fn byte_addr(&self, base: u64, word_bytes: u64) -> u64 {
+        base + self.offset as u64 * word_bytes
+    }
+}
+
+/// A bit field of a register: `width` bits (1..=64) from bit `lsb`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Field {
+    pub lsb: u32,
+    pub width: u32,
+}
+
+impl Field {
+    pub const fn new(lsb: u32, width: u32) -> Self {
+        Self { lsb, width }
+    }
+
+    /// The field's bits in the register word.
+    pub const fn mask(self) -> u64 {
+        (u64::MAX >> (64 - self.width)) << self.lsb
+    }
+
+    /// The field's value in `word`.
+    pub const fn get(self, word: u64) -> u64 {
+        (word & self.mask()) >> self.lsb
+    }
+
+    /// `word` with the field set to `value` (bits of `value` above the field are dropped).
+    pub const fn set(self, word: u64, value: u64) -> u64 {
+        (word & !self.mask()) | ((value << self.lsb) & self.mask())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn field_get_set() {
+        let f = Field::new(1, 4);
+        assert_eq!(f.mask(), 0x1e);
+        assert_eq!(f.set(0x21, 0xff), 0x3f);
+        assert_eq!(f.get(0x3f), 0xf);
+        assert_eq!(Field::new(0, 64).mask(), u64::MAX);
+    }
+}
+";
+
+/// The Markdown text of one docs section (`constants`, `enums`, `enum:<Name>`, `registers`).
+pub fn md(b: &Checked, section: &str) -> String {
+    let d = &b.desc;
+    let mut out = String::new();
+    match section {
+        "constants" => {
+            out.push_str("| constant | Rust | value | meaning |\n");
+            out.push_str("|----------|------|------:|---------|\n");
+            for c in &d.constant {
+                let e = &b.exprs[&c.name];
+                let value = match e {
+                    Expr::Num(n) => n.to_string(),
+                    _ => format!(
+                        "`{}` = {}",
+                        e.render(&|n: &str| n.to_string()),
+                        b.values[&c.name]
+                    ),
+                };
+                let _ = writeln!(
+                    out,
+                    "| `{}` | `{}` | {value} | {} |",
+                    c.name,
+                    screaming(&c.name),
+                    c.doc
+                );
+            }
+        }
+        "enums" => {
+            out.push_str("| encoding | bits | value | SV | Rust | meaning |\n");
+            out.push_str("|----------|-----:|------:|----|------|---------|\n");
+            for en in &d.enums {
+                for v in &en.value {
+                    let _ = writeln!(
+                        out,
+                        "| {} | {} | {} | `{}{}` | `{}_{}` | {} |",
+                        en.name,
+                        en.width,
+                        v.value,
+                        en.name,
+                        v.name,
+                        en.rust_prefix,
+                        screaming(&v.name),
+                        v.doc
+                    );
+                }
+            }
+        }
+        "registers" => {
+            let base = d.block.base_doc.as_deref().unwrap_or("");
+            out.push_str(
+                "| offset | byte | register | access | reset | fields (LSB first) | meaning |\n",
+            );
+            out.push_str(
+                "|-------:|-----:|----------|--------|------:|--------------------|---------|\n",
+            );
+            for (r, fs) in d.register.iter().zip(&b.fields) {
+                let offset = if base.is_empty() {
+                    r.offset.to_string()
+                } else {
+                    format!("{base} {}", r.offset)
+                };
+                let byte = d.block.base + r.offset * d.block.word_bytes;
+                let reset = match r.reset {
+                    Some(v) => format!("`{v:#x}`"),
+                    None => "kept".into(),
+                };
+                let fields: Vec<String> = fs
+                    .iter()
+                    .map(|f| {
+                        let t = field_text(f);
+                        match t.split_once(' ') {
+                            Some((n, rest)) => {
+                                format!("`{n}` {}", rest.replace('(', "(`").replace(')', "`)"))
+                            }
+                            None => format!("`{t}`"),
+                        }
+                    })
+                    .collect();
+                let mut meaning = r.doc.clone();
+                for f in fs.iter().filter(|f| !f.doc.is_empty()) {
+                    let _ = write!(meaning, "; `{}`: {}", f.name, f.doc);
+                }
+                let _ = writeln!(
+                    out,
+                    "| {offset} | `{byte:#05x}` | `{}` | {} | {reset} | {} | {meaning} |",
+                    r.name,
+                    r.access.as_str(),
+                    fields.join(", ")
+                );
+            }
+        }
+        _ => {
+            let name = section.trim_start_matches("enum:");
+            if let Some(en) = d.enums.iter().find(|e| e.name == name) {
+                let _ = writeln!(
+                    out,
+                    "| {} | name | meaning |",
+                    screaming(&en.name).to_lowercase()
+                );
+                out.push_str("|-----:|------|---------|\n");
+                for v in &en.value {
+                    let _ = writeln!(out, "| {} | `{}` | {} |", v.value, v.name, v.doc);
+                }
+            }
+        }
+    }
+    out.pop();
+    out
+}
