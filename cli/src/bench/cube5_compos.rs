@@ -1,20 +1,16 @@
 //! Benchmark of cube5_compos: speed, and error over long rays against the f64 reference.
 
+use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
 use anyhow::Result;
-use cube5_model::unit::StreamUnit;
+use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_compos::{
     ray_error, Compos, ComposConfig, ComposIn, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
 };
-use cube5_tb::rtl::{RtlStream, Traffic};
+use cube5_tb::variants_of;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::time::Instant;
 
-const CONFIGS: [(&str, ComposConfig); 3] = [
-    ("c8", ComposConfig::NARROW),
-    ("c12", ComposConfig::DEFAULT),
-    ("c10", ComposConfig::WIDE),
-];
+pub const TOP: &str = ComposConfig::TOP;
 
 /// Rays are this long in the error table (a 256^3 volume at one sample per voxel).
 const RAY: usize = 256;
@@ -61,43 +57,20 @@ fn items(cfg: &ComposConfig, n: usize, seed: u64) -> Vec<ComposIn> {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## cube5_compos\n");
-    println!("| unit | config | RTL cycles | items/clock | sim cycles/s | model items/s | model/sim speed |");
-    println!("|------|--------|-----------:|------------:|-------------:|--------------:|----------------:|");
-    for (name, cfg) in CONFIGS {
+    println!("## {TOP}\n");
+    speed_header();
+    for v in variants_of(TOP) {
+        let cfg: ComposConfig = v.config()?;
         let mut model = Compos::new(cfg, OpacityLut::new(0.5, &cfg)?, ComposRegs::defaults(&cfg))?;
         let items = items(&cfg, n_items, 1);
-        let mut dut = RtlStream::new(&format!("cube5_compos_{name}"), cfg, 1)?;
-        for (addr, data) in model.config_writes() {
-            dut.write_config(addr, &data)?;
-        }
-        let n = items.len() as u64;
-        let packed = dut.pack(&items);
-        let t = Instant::now();
-        let driven = dut.drive_packed(&packed, &Traffic::full_speed(), n, 2 * n + 1000)?;
-        let sim_secs = t.elapsed().as_secs_f64();
-        let cycles = driven.stats.cycles;
-
-        let t = Instant::now();
-        let out = model.run(&items);
-        let model_secs = t.elapsed().as_secs_f64();
-        std::hint::black_box(out);
-
-        let sim_rate = cycles as f64 / sim_secs;
-        let model_rate = n as f64 / model_secs;
-        println!(
-            "| cube5_compos | {name} | {cycles} | {:.4} | {:.2e} | {:.2e} | {:.1}x |",
-            n as f64 / cycles as f64,
-            sim_rate,
-            model_rate,
-            model_rate / sim_rate
-        );
+        let mut dut = open(v, cfg, &model.config_writes())?;
+        speed_row(&mut dut, &mut model, &items, Compare::No)?;
     }
 
     let rays = (n_items / RAY).max(1);
     println!();
     println!(
-        "Error of cube5_compos against its f64 reference: {rays} rays of {RAY} samples from an empty \
+        "Error of {TOP} against its f64 reference: {rays} rays of {RAY} samples from an empty \
          coxel (90% of alphas below 1/8), opacity LUT for d/k = 1/2, no early termination; the \
          largest and RMS difference of the final R, G, B, A, in display LSBs (1/255) and in coxel \
          LSBs (2^-AccW):"
@@ -105,7 +78,8 @@ pub fn run(n_items: usize) -> Result<()> {
     println!();
     println!("| config | mode | max abs (display LSB) | RMS (display LSB) | mean (display LSB) | max abs (coxel LSB) |");
     println!("|--------|------|----------------------:|------------------:|-------------------:|--------------------:|");
-    for (name, cfg) in CONFIGS {
+    for v in variants_of(TOP) {
+        let cfg: ComposConfig = v.config()?;
         let regs = ComposRegs {
             xray_shift: 8,
             ..ComposRegs::without_termination(&cfg)
@@ -118,28 +92,22 @@ pub fn run(n_items: usize) -> Result<()> {
             ComposMode::XraySum,
         ] {
             let mut rng = ChaCha8Rng::seed_from_u64(2);
-            let (mut max, mut sq, mut sum, mut count) = (0.0f64, 0.0f64, 0.0f64, 0usize);
+            let mut s = ErrorStats::default();
             let one = cfg.one() as f64;
             for _ in 0..rays {
                 let samples: Vec<Sample> = (0..RAY).map(|_| sample(&mut rng, &cfg, mode)).collect();
                 let start = Coxel::empty(&cfg);
                 let (fixed, refs, _) = ray_error(&unit, &start, &samples);
                 let (f, r) = (fixed.last().unwrap(), refs.last().unwrap());
-                for ch in 0..4 {
-                    let e = f.rgba[ch] as f64 / one - r.rgba[ch];
-                    max = max.max(e.abs());
-                    sq += e * e;
-                    sum += e;
-                    count += 1;
-                }
+                s.extend((0..4).map(|ch| f.rgba[ch] as f64 / one - r.rgba[ch]));
             }
-            let n = count as f64;
             println!(
-                "| {name} | {mode:?} | {:.3} | {:.3} | {:+.3} | {:.1} |",
-                max * 255.0,
-                (sq / n).sqrt() * 255.0,
-                sum / n * 255.0,
-                max * one
+                "| {} | {mode:?} | {:.3} | {:.3} | {:+.3} | {:.1} |",
+                v.config,
+                s.max_abs * 255.0,
+                s.rms() * 255.0,
+                s.mean() * 255.0,
+                s.max_abs * one
             );
         }
     }

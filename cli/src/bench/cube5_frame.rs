@@ -5,14 +5,20 @@
 
 use anyhow::{anyhow, Result};
 use cube5_model::phantom::head_phantom;
+use cube5_model::unit::UnitConfig;
+use cube5_model::units::cube5_frame::FrameConfig;
 use cube5_model::units::cube5_skewmem::BlockLut;
+use cube5_model::volume::Volume;
 use cube5_tb::frame::{as_seen, sparse_scene, Expected, FrameBench, FrameRtl, Look, Render};
 use cube5_tb::rtl::Traffic;
 use std::rc::Rc;
 use std::time::Instant;
 
+pub const TOP: &str = FrameConfig::TOP;
+
 /// One measured frame.
 struct Row {
+    config: &'static str,
     p: usize,
     n: usize,
     samples: u64,
@@ -27,10 +33,10 @@ struct Row {
     checked: bool,
 }
 
-fn measure(rtl: FrameRtl, n: usize, view: [f64; 3], check: bool) -> Result<Row> {
-    let vol = head_phantom(n, 12)?;
+fn measure(rtl: FrameRtl, vol: &Volume, view: [f64; 3], check: bool) -> Result<Row> {
+    let n = vol.dims[0];
     let lut = BlockLut::identity(vol.dims, rtl.block as usize)?;
-    let seen = Rc::new(as_seen(&vol, &lut)?);
+    let seen = Rc::new(as_seen(vol, &lut)?);
     let t = Instant::now();
     let e = Expected::new(
         &rtl,
@@ -42,7 +48,7 @@ fn measure(rtl: FrameRtl, n: usize, view: [f64; 3], check: bool) -> Result<Row> 
     )?;
     let model_secs = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let mut bench = FrameBench::new(rtl, &vol, &lut, 1)?;
+    let mut bench = FrameBench::new(rtl, vol, &lut, 1)?;
     bench.load(&e)?;
     let load_secs = t.elapsed().as_secs_f64();
     let t = Instant::now();
@@ -74,6 +80,7 @@ fn measure(rtl: FrameRtl, n: usize, view: [f64; 3], check: bool) -> Result<Row> 
     let beats = samples / p;
     let flush = nbs + 2 * nbr + 2;
     Ok(Row {
+        config: rtl.variant.config,
         p: rtl.p,
         n,
         samples,
@@ -90,33 +97,49 @@ fn measure(rtl: FrameRtl, n: usize, view: [f64; 3], check: bool) -> Result<Row> 
 }
 
 /// `n_items` bounds the volumes: 128^3 frames (2.1 M samples each) run when `n_items >= 100_000`.
+/// Every configuration that holds the volume (edge, voxel width) renders it.
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## cube5_frame\n");
-    println!(
-        "One composite frame (head phantom, view (-0.37, 0.81, -1), all blocks present) per row, \
-         configurations p1/p4/p8 (MaxDim 128, default widths). Cycles from the command to the \
-         last pixel; samples/clock/pipeline = samples / (cycles * P), the limit is 1.0. 64^3 \
-         images are checked against the model bit for bit.\n"
-    );
-    println!(
-        "| P | volume | samples | cycles/frame | samples/clock/pipeline | without read-out | sweep beats | flush | set-up + pipeline | read-out | sim cycles/s | model samples/s | volume load (s) |"
-    );
-    println!(
-        "|--:|--------|--------:|-------------:|-----------------------:|-----------------:|------------:|------:|------------------:|---------:|-------------:|----------------:|----------------:|"
-    );
     let sizes: Vec<usize> = if n_items >= 100_000 {
         vec![64, 128]
     } else {
         vec![64]
     };
     let view = [-0.37, 0.81, -1.0];
-    for &n in &sizes {
-        for p in [1, 4, 8] {
-            let rtl = FrameRtl::with_pipelines(p).ok_or_else(|| anyhow!("no P = {p} frame"))?;
-            let r = measure(rtl, n, view, n <= 64)?;
+    let all = FrameRtl::all();
+    let volumes = sizes
+        .iter()
+        .map(|&n| head_phantom(n, 12))
+        .collect::<Result<Vec<Volume>, _>>()?;
+    // The frame model builds the default unit widths only.
+    let holds =
+        |rtl: &FrameRtl, vol: &Volume| rtl.default_widths() && rtl.check_volume(vol).is_ok();
+    let measured: Vec<&str> = all
+        .iter()
+        .filter(|r| volumes.iter().any(|vol| holds(r, vol)))
+        .map(|r| r.variant.config)
+        .collect();
+    println!("## {TOP}\n");
+    println!(
+        "One composite frame (head phantom, 12-bit voxels, view (-0.37, 0.81, -1), all blocks \
+         present) per row, on every configuration that holds the volume ({}). Cycles from the \
+         command to the last pixel; samples/clock/pipeline = samples / (cycles * P), the limit is \
+         1.0. 64^3 images are checked against the model bit for bit.\n",
+        measured.join(", ")
+    );
+    println!(
+        "| config | P | volume | samples | cycles/frame | samples/clock/pipeline | without read-out | sweep beats | flush | set-up + pipeline | read-out | sim cycles/s | model samples/s | volume load (s) |"
+    );
+    println!(
+        "|--------|--:|--------|--------:|-------------:|-----------------------:|-----------------:|------------:|------:|------------------:|---------:|-------------:|----------------:|----------------:|"
+    );
+    for vol in &volumes {
+        let n = vol.dims[0];
+        for rtl in all.iter().filter(|r| holds(r, vol)) {
+            let r = measure(*rtl, vol, view, n <= 64)?;
             let pp = r.p as f64;
             println!(
-                "| {} | {}^3 | {} | {} | {:.3} | {:.3} | {} | {} | {} | {} | {:.2e} | {:.2e}{} | {:.1} |",
+                "| {} | {} | {}^3 | {} | {} | {:.3} | {:.3} | {} | {} | {} | {} | {:.2e} | {:.2e}{} | {:.1} |",
+                r.config,
                 r.p,
                 r.n,
                 r.samples,
@@ -135,6 +158,14 @@ pub fn run(n_items: usize) -> Result<()> {
         }
     }
     println!();
+    for rtl in all.iter().filter(|r| !measured.contains(&r.variant.config)) {
+        let why = match volumes.iter().find_map(|vol| rtl.check_volume(vol).err()) {
+            Some(limit) => limit,
+            None => "unit widths other than the frame model's".to_string(),
+        };
+        println!("Not measured: `{}` ({why}).", rtl.variant.config);
+    }
+    println!();
     println!(
         "Where the cycles go: `sweep beats` = samples / P (one beam per clock: the limit), `flush` = \
          ni nj / P + 2 ni / P + 2 (the voxel and sample windows' lag, docs/frame-rtl.md), `set-up + \
@@ -150,14 +181,17 @@ pub fn run(n_items: usize) -> Result<()> {
 /// Empty-slice skipping on the sparse scene (64^3, data in a box inside): sweep and frame cycles
 /// with and without it, P = 4, images compared bit for bit with the model's full sweep.
 fn skipping() -> Result<()> {
-    println!("### Empty-slice skipping (sparse scene, P = 4)\n");
+    let rtl = FrameRtl::with_pipelines(4).ok_or_else(|| anyhow!("no P = 4 frame"))?;
+    println!(
+        "### Empty-slice skipping (sparse scene, P = 4: `{}`)\n",
+        rtl.variant.config
+    );
     println!(
         "64^3 volume with data only in [20, 44) x [14, 50) x [22, 41), blocks of 8^3; composite; \
          both frames compared with the model's full sweep, bit for bit.\n"
     );
     println!("| view | slices skipped (front + back of nk) | sweep cycles | with skipping | ratio | frame cycles | with skipping | ratio |");
     println!("|------|------------------------------------|-------------:|--------------:|------:|-------------:|--------------:|------:|");
-    let rtl = FrameRtl::with_pipelines(4).ok_or_else(|| anyhow!("no P = 4 frame"))?;
     let vol = sparse_scene(7);
     let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0)?;
     let seen = Rc::new(as_seen(&vol, &lut)?);

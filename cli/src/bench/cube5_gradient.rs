@@ -1,25 +1,15 @@
-//! Benchmark of cube5_gradient and cube5_sepconv: speed, and error against the f64 references.
+//! Benchmark of cube5_gradient: speed, the components' error against the f64 reference and the
+//! magnitude estimate's against the Euclidean norm.
 
+use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
 use anyhow::Result;
-use cube5_model::unit::{StreamCodec, StreamUnit};
+use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_gradient::{Gradient, GradientConfig, GradientIn, GradientMode};
-use cube5_model::units::cube5_sepconv::{Sepconv, SepconvConfig, SepconvIn, SepconvKernel};
-use cube5_tb::rtl::{RtlStream, Traffic};
+use cube5_tb::variants_of;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::time::Instant;
 
-const GRADIENT_CONFIGS: [(&str, GradientConfig); 3] = [
-    ("v8", GradientConfig::NARROW),
-    ("v12", GradientConfig::DEFAULT),
-    ("v16", GradientConfig::WIDE),
-];
-
-const SEPCONV_CONFIGS: [(&str, SepconvConfig); 3] = [
-    ("v8", SepconvConfig::NARROW),
-    ("v12", SepconvConfig::DEFAULT),
-    ("v16", SepconvConfig::WIDE),
-];
+pub const TOP: &str = GradientConfig::TOP;
 
 /// Uniform samples, steps in [-1, 1], the given mode (or every mode when `None`).
 fn gradient_items(
@@ -75,112 +65,47 @@ fn ramp_items(cfg: &GradientConfig, n: usize, seed: u64) -> Vec<GradientIn> {
         .collect()
 }
 
-/// Times the RTL at full speed and the model on the same items; prints one table row.
-fn speed_row<C, G>(
-    unit: &str,
-    name: &str,
-    codec: C,
-    gold: &mut G,
-    items: &[C::In],
-    cfg_writes: &[(u32, Vec<u32>)],
-) -> Result<()>
-where
-    C: StreamCodec + Clone,
-    C::In: Clone + std::fmt::Debug,
-    C::Out: Clone + std::fmt::Debug + PartialEq,
-    G: StreamUnit<In = C::In, Out = C::Out>,
-{
-    let variant = format!("{unit}_{name}");
-    let mut dut = RtlStream::new(&variant, codec, 1)?;
-    for (addr, data) in cfg_writes {
-        dut.write_config(*addr, data)?;
-    }
-    let n = items.len() as u64;
-    let packed = dut.pack(items);
-    let t = Instant::now();
-    let driven = dut.drive_packed(&packed, &Traffic::full_speed(), n, 2 * n + 1000)?;
-    let sim_secs = t.elapsed().as_secs_f64();
-    let cycles = driven.stats.cycles;
-
-    let t = Instant::now();
-    let out = gold.run(items);
-    let model_secs = t.elapsed().as_secs_f64();
-    std::hint::black_box(out);
-
-    let sim_rate = cycles as f64 / sim_secs;
-    let model_rate = n as f64 / model_secs;
-    println!(
-        "| {unit} | {name} | {cycles} | {:.4} | {:.2e} | {:.2e} | {:.1}x |",
-        n as f64 / cycles as f64,
-        sim_rate,
-        model_rate,
-        model_rate / sim_rate
-    );
-    Ok(())
-}
-
-/// Max abs, RMS and mean of a list of errors.
-fn stats(errs: impl IntoIterator<Item = f64>) -> (f64, f64, f64) {
-    let (mut max, mut sq, mut sum, mut n) = (0.0f64, 0.0, 0.0, 0usize);
-    for e in errs {
-        max = max.max(e.abs());
-        sq += e * e;
-        sum += e;
-        n += 1;
-    }
-    let n = n.max(1) as f64;
-    (max, (sq / n).sqrt(), sum / n)
-}
-
-const SPEED_HEADER: &str = "| unit | config | RTL cycles | items/clock | sim cycles/s | model items/s | model/sim speed |\n\
-                            |------|--------|-----------:|------------:|-------------:|--------------:|----------------:|";
-
 pub fn run(n_items: usize) -> Result<()> {
-    gradient(n_items)?;
-    sepconv(n_items)
-}
-
-fn gradient(n_items: usize) -> Result<()> {
-    println!("## cube5_gradient\n");
-    println!("{SPEED_HEADER}");
-    for (name, cfg) in GRADIENT_CONFIGS {
+    println!("## {TOP}\n");
+    speed_header();
+    for v in variants_of(TOP) {
+        let cfg: GradientConfig = v.config()?;
         let items = gradient_items(&cfg, n_items, 1, None);
-        speed_row(
-            "cube5_gradient",
-            name,
-            cfg,
-            &mut Gradient::new(cfg)?,
-            &items,
-            &[],
-        )?;
+        let mut dut = open(v, cfg, &[])?;
+        speed_row(&mut dut, &mut Gradient::new(cfg)?, &items, Compare::No)?;
     }
 
     println!();
     println!(
-        "Component error of cube5_gradient against its f64 reference ({n_items} random items per \
+        "Component error of {TOP} against its f64 reference ({n_items} random items per \
          mode, uniform samples, steps in [-1, 1]), in output LSBs (2^-(FracW+5) voxel units); the \
          contract: exact, except N10's gz within 1/2 LSB:"
     );
     println!();
     println!("| config | mode | max abs error gx, gy (LSB) | max abs error gz (LSB) | RMS gz (LSB) | mean gz (LSB) |");
     println!("|--------|------|---------------------------:|-----------------------:|-------------:|--------------:|");
-    for (name, cfg) in GRADIENT_CONFIGS {
+    for v in variants_of(TOP) {
+        let cfg: GradientConfig = v.config()?;
         let model = Gradient::new(cfg)?;
         let lsb = cfg.lsb();
         for mode in [GradientMode::N6, GradientMode::N10, GradientMode::N26] {
             let items = gradient_items(&cfg, n_items, 2, Some(mode));
-            let mut xy = 0.0f64;
-            let mut z = Vec::with_capacity(items.len());
+            let (mut xy, mut z) = (ErrorStats::default(), ErrorStats::default());
             for it in &items {
                 let out = model.gradient(it);
                 let r = model.reference(it);
-                xy = xy
-                    .max((f64::from(out.gx) - r.g[0] / lsb).abs())
-                    .max((f64::from(out.gy) - r.g[1] / lsb).abs());
-                z.push(f64::from(out.gz) - r.g[2] / lsb);
+                xy.add(f64::from(out.gx) - r.g[0] / lsb);
+                xy.add(f64::from(out.gy) - r.g[1] / lsb);
+                z.add(f64::from(out.gz) - r.g[2] / lsb);
             }
-            let (max, rms, mean) = stats(z);
-            println!("| {name} | {mode:?} | {xy:.3} | {max:.3} | {rms:.3} | {mean:+.4} |");
+            println!(
+                "| {} | {mode:?} | {:.3} | {:.3} | {:.3} | {:+.4} |",
+                v.config,
+                xy.max_abs,
+                z.max_abs,
+                z.rms(),
+                z.mean()
+            );
         }
     }
 
@@ -194,74 +119,24 @@ fn gradient(n_items: usize) -> Result<()> {
     println!();
     println!("| config | min error (%) | max error (%) | RMS error (%) | mean error (%) |");
     println!("|--------|--------------:|--------------:|--------------:|---------------:|");
-    for (name, cfg) in GRADIENT_CONFIGS {
+    for v in variants_of(TOP) {
+        let cfg: GradientConfig = v.config()?;
         let model = Gradient::new(cfg)?;
         let lsb = cfg.lsb();
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        let mut rel = Vec::with_capacity(n_items);
+        let mut rel = ErrorStats::default();
         for it in &ramp_items(&cfg, n_items, 3) {
             let r = model.reference(it);
-            if r.norm <= 0.0 {
-                continue;
+            if r.norm > 0.0 {
+                rel.add(100.0 * (f64::from(model.gradient(it).mag) * lsb / r.norm - 1.0));
             }
-            let e = 100.0 * (f64::from(model.gradient(it).mag) * lsb / r.norm - 1.0);
-            lo = lo.min(e);
-            hi = hi.max(e);
-            rel.push(e);
         }
-        let (_, rms, mean) = stats(rel);
-        println!("| {name} | {lo:+.3} | {hi:+.3} | {rms:.3} | {mean:+.3} |");
-    }
-    println!();
-    Ok(())
-}
-
-/// Random taps over the whole range, both kernels.
-fn sepconv_items(cfg: &SepconvConfig, n: usize, seed: u64) -> Vec<SepconvIn> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    (0..n)
-        .map(|_| SepconvIn {
-            taps: std::array::from_fn(|_| rng.random_range(cfg.tap_min()..=cfg.tap_max())),
-            kernel: SepconvKernel::from_bits(rng.random_range(0..2)),
-        })
-        .collect()
-}
-
-fn sepconv(n_items: usize) -> Result<()> {
-    // A Gaussian of sigma = 1: w = exp(1 / (2 sigma^2)).
-    let w_real = 0.5f64.exp();
-    println!("## cube5_sepconv\n");
-    println!("{SPEED_HEADER}");
-    for (name, cfg) in SEPCONV_CONFIGS {
-        let items = sepconv_items(&cfg, n_items, 1);
-        let mut gold = Sepconv::new(cfg, cfg.weight_from_f64(w_real))?;
-        let writes = gold.config_writes();
-        speed_row("cube5_sepconv", name, cfg, &mut gold, &items, &writes)?;
-    }
-    println!();
-    println!(
-        "Error of cube5_sepconv against the exact real convolution ({n_items} random items, both \
-         kernels, w = exp(1/2) rounded to U(4.WeightFracW)), in output LSBs; the contract: exact \
-         when OutShift = 0, else within 1/2 LSB:"
-    );
-    println!();
-    println!(
-        "| config | w | OutShift | max abs error (LSB) | RMS error (LSB) | mean error (LSB) |"
-    );
-    println!(
-        "|--------|---|---------:|--------------------:|----------------:|-----------------:|"
-    );
-    for (name, cfg) in SEPCONV_CONFIGS {
-        let unit = Sepconv::new(cfg, cfg.weight_from_f64(w_real))?;
-        let errs = sepconv_items(&cfg, n_items, 2)
-            .iter()
-            .map(|it| unit.convolve(it) as f64 - unit.reference(it) / unit.out_lsb())
-            .collect::<Vec<_>>();
-        let (max, rms, mean) = stats(errs);
-        let w = f64::from(unit.weight()) / f64::from(1u32 << cfg.weight_frac_w);
         println!(
-            "| {name} | {w} | {} | {max:.3} | {rms:.3} | {mean:+.4} |",
-            cfg.out_shift
+            "| {} | {:+.3} | {:+.3} | {:.3} | {:+.3} |",
+            v.config,
+            rel.min,
+            rel.max,
+            rel.rms(),
+            rel.mean()
         );
     }
     println!();

@@ -1,56 +1,42 @@
 //! Benchmark of gicube_scatter: speed, and the angular error against the f64 reference
 //! (docs/numerics/gicube_scatter.md § Error) at several bit widths.
 
+use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
 use anyhow::Result;
-use cube5_model::unit::StreamUnit;
+use cube5_model::unit::UnitConfig;
 use cube5_model::units::gicube_scatter::{
     angle_deg, random_item, Scatter, ScatterConfig, ScatterEvent, ScatterIn,
 };
-use cube5_tb::rtl::{RtlStream, Traffic};
+use cube5_tb::variants_of;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use std::time::Instant;
 
-/// The verified RTL configurations.
-const RTL_CONFIGS: [(&str, ScatterConfig); 2] = [
-    ("f8", ScatterConfig::NARROW),
-    ("f14", ScatterConfig::DEFAULT),
-];
+pub const TOP: &str = ScatterConfig::TOP;
+
+/// Widths the error table measures on the model alone, besides the verified configurations.
+fn model_widths() -> Result<Vec<ScatterConfig>> {
+    Ok(vec![
+        ScatterConfig::new(10, 17, 7, 7, 7)?,
+        ScatterConfig::new(12, 19, 8, 8, 8)?,
+        ScatterConfig::new(14, 21, 10, 10, 10)?,
+    ])
+}
 
 fn items(cfg: &ScatterConfig, n: usize, seed: u64) -> Vec<ScatterIn> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     (0..n).map(|_| random_item(cfg, &mut rng)).collect()
 }
 
-/// Max, RMS and 99th percentile of a set of errors (degrees).
-struct Stats {
-    n: usize,
-    max: f64,
-    rms: f64,
-    p99: f64,
-}
-
-impl Stats {
-    fn of(mut errs: Vec<f64>) -> Self {
-        let n = errs.len();
-        if n == 0 {
-            return Self {
-                n,
-                max: 0.0,
-                rms: 0.0,
-                p99: 0.0,
-            };
-        }
-        errs.sort_by(f64::total_cmp);
-        let rms = (errs.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
-        let p99 = errs[((n as f64 * 0.99) as usize).min(n - 1)];
-        Self {
-            n,
-            max: errs[n - 1],
-            rms,
-            p99,
-        }
-    }
+/// The statistics of a set of errors (degrees, never negative) and their 99th percentile.
+fn stats(mut errs: Vec<f64>) -> (ErrorStats, f64) {
+    errs.sort_by(f64::total_cmp);
+    let n = errs.len();
+    let p99 = if n == 0 {
+        0.0
+    } else {
+        errs[((n as f64 * 0.99) as usize).min(n - 1)]
+    };
+    (errs.into_iter().collect(), p99)
 }
 
 /// Angular errors (degrees) per event of the model against its f64 reference.
@@ -67,72 +53,40 @@ fn errors(cfg: &ScatterConfig, n: usize) -> Result<[Vec<f64>; 4]> {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## gicube_scatter\n");
-    println!("| unit | config | RTL cycles | items/clock | sim cycles/s | model items/s | model/sim speed |");
-    println!("|------|--------|-----------:|------------:|-------------:|--------------:|----------------:|");
-    for (name, cfg) in RTL_CONFIGS {
+    let variants = variants_of(TOP);
+    println!("## {TOP}\n");
+    speed_header();
+    for &v in &variants {
+        let cfg: ScatterConfig = v.config()?;
         let its = items(&cfg, n_items, 1);
         let mut model = Scatter::new(cfg)?;
-        let variant = format!("gicube_scatter_{name}");
-        let mut dut = RtlStream::new(&variant, cfg, 1)?;
-        for (addr, data) in model.tables().config_writes(&cfg) {
-            dut.write_config(addr, &data)?;
-        }
-        let n = its.len() as u64;
-        let packed = dut.pack(&its);
-        let t = Instant::now();
-        let driven = dut.drive_packed(&packed, &Traffic::full_speed(), n, 2 * n + 1000)?;
-        let sim_secs = t.elapsed().as_secs_f64();
-        let cycles = driven.stats.cycles;
-
-        let t = Instant::now();
-        let out = model.run(&its);
-        let model_secs = t.elapsed().as_secs_f64();
-        let agree = driven
-            .outputs
-            .iter()
-            .zip(&out)
-            .filter(|(r, m)| r.value == **m)
-            .count();
-        anyhow::ensure!(
-            agree == its.len(),
-            "{variant}: RTL and model disagree on {} of {} items",
-            its.len() - agree,
-            its.len()
-        );
-
-        let sim_rate = cycles as f64 / sim_secs;
-        let model_rate = n as f64 / model_secs;
-        println!(
-            "| gicube_scatter | {name} | {cycles} | {:.4} | {:.2e} | {:.2e} | {:.1}x |",
-            n as f64 / cycles as f64,
-            sim_rate,
-            model_rate,
-            model_rate / sim_rate
-        );
+        let mut dut = open(v, cfg, &model.tables().config_writes(&cfg))?;
+        speed_row(&mut dut, &mut model, &its, Compare::Outputs)?;
     }
 
+    // The verified configurations (named) and the model at other widths (unnamed), narrowest first.
+    let mut widths: Vec<(&str, ScatterConfig)> = Vec::new();
+    for &v in &variants {
+        widths.push((v.config, v.config()?));
+    }
+    widths.extend(model_widths()?.into_iter().map(|c| ("model", c)));
+    widths.sort_by_key(|(_, c)| (c.f(), c.ang_w));
+    let named: Vec<String> = variants.iter().map(|v| format!("`{}`", v.config)).collect();
     println!();
     println!(
-        "Angular error of gicube_scatter against its f64 reference ({n_items} random rays each: \
+        "Angular error of {TOP} against its f64 reference ({n_items} random rays each: \
          random directions and gradients, materials with 0 and 1 well represented, eta in [0, 4)), \
-         in degrees and in 2^-F rad (an output LSB). `f8` and `f14` are the verified RTL \
-         configurations; the other rows are the model at other widths:"
+         in degrees and in 2^-F rad (an output LSB). {} are the verified RTL configurations; the \
+         `model` rows are the model at other widths:",
+        named.join(" and ")
     );
     println!();
     println!("| config | F | M | A | I | rays | max (deg) | RMS (deg) | p99 (deg) | max (LSB) | RMS (LSB) | p99 (LSB) |");
     println!("|--------|---|---|---|---|-----:|----------:|----------:|----------:|----------:|----------:|----------:|");
-    let widths = [
-        ("f8", ScatterConfig::NARROW),
-        ("f10", ScatterConfig::new(10, 17, 7, 7, 7)?),
-        ("f12", ScatterConfig::new(12, 19, 8, 8, 8)?),
-        ("f14", ScatterConfig::DEFAULT),
-        ("f14a10", ScatterConfig::new(14, 21, 10, 10, 10)?),
-    ];
     let mut per_event = Vec::new();
     for (name, cfg) in widths {
         let errs = errors(&cfg, n_items)?;
-        let all = Stats::of(errs.iter().flatten().copied().collect());
+        let (all, p99) = stats(errs.iter().flatten().copied().collect());
         let lsb = (1.0 / f64::from(1u32 << cfg.f())).to_degrees();
         println!(
             "| {name} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.1} | {:.2} | {:.2} |",
@@ -141,14 +95,14 @@ pub fn run(n_items: usize) -> Result<()> {
             cfg.ang_w,
             cfg.iso_w,
             all.n,
-            all.max,
-            all.rms,
-            all.p99,
-            all.max / lsb,
-            all.rms / lsb,
-            all.p99 / lsb
+            all.max_abs,
+            all.rms(),
+            p99,
+            all.max_abs / lsb,
+            all.rms() / lsb,
+            p99 / lsb
         );
-        if name == "f8" || name == "f14" {
+        if variants.iter().any(|v| v.config == name) {
             per_event.push((name, errs));
         }
     }
@@ -167,10 +121,12 @@ pub fn run(n_items: usize) -> Result<()> {
         .iter()
         .zip(errs)
         {
-            let s = Stats::of(e);
+            let (s, p99) = stats(e);
             println!(
-                "| {name} | {ev:?} | {} | {:.4} | {:.4} | {:.4} |",
-                s.n, s.max, s.rms, s.p99
+                "| {name} | {ev:?} | {} | {:.4} | {:.4} | {p99:.4} |",
+                s.n,
+                s.max_abs,
+                s.rms()
             );
         }
     }
