@@ -153,14 +153,17 @@ module gicube_scatter #(
     in_mat  = in_data_i[ReflLsb +: 4*MW1];
     in_eta  = in_data_i[EtaLsb +: ETW];
     in_ray  = in_data_i[RayLsb +: 32];
-    in_l2   = '0;
-    for (int unsigned c = 0; c < 3; c++) begin
-      logic signed [L2W-1:0] dc;
-      dc    = {{(L2W-DW){in_dir[c*DW + DW-1]}}, in_dir[c*DW +: DW]};
-      in_l2 = in_l2 + L2W'(dc * dc);
-    end
-    in_e2 = E2W'(in_eta) * E2W'(in_eta);
+    in_e2   = E2W'(in_eta) * E2W'(in_eta);
   end
+
+  gicube_scatter_dot3 #(
+    .VW (DW),
+    .OW (L2W)
+  ) u_l2 (
+    .x_i (in_dir),
+    .y_i (in_dir),
+    .z_o (in_l2)
+  );
 
   // ---------------------------------------------------------------------------
   // Stages 1-7: N = normalize(G); beside it the random draw (stages 1-4)

@@ -69,10 +69,10 @@ module gicube_scatter_draw #(
   // ---------------------------------------------------------------------------
   // Stage 3: the drawn event, h = |u0 + u1 + u2 + u3 + 2 - 2^(M+1)|, phi, the ISO index
   // ---------------------------------------------------------------------------
-  logic [1:0]      drawn_d, drawn_q, drawn_q2;
+  logic [1:0]      drawn_d;
   logic [M:0]      h_d, h_q;
-  logic [PhiW-1:0] phi_d, phi_q, phi_q2;
-  logic [I-1:0]    isoi_d, isoi_q, isoi_q2;
+  logic [PhiW-1:0] phi_d;
+  logic [I-1:0]    isoi_d;
   logic [MW1-1:0]  gloss_d, gloss_q;
 
   always_comb begin
@@ -94,6 +94,17 @@ module gicube_scatter_draw #(
     gloss_d = mat_s2[3*MW1 +: MW1];
   end
 
+  // The event, phi and the ISO index wait one stage beside theta.
+  gicube_scatter_pipe #(
+    .W (2 + PhiW + I),
+    .N (2)
+  ) u_side_wait (
+    .clk_i (clk_i),
+    .en_i  (en_i),
+    .d_i   ({isoi_d, phi_d, drawn_d}),
+    .q_o   ({iso_idx_o, phi_o, drawn_o})
+  );
+
   // ---------------------------------------------------------------------------
   // Stage 4: theta = min(rnd(gloss' h, 2M + 1 - A), 2^A - 1)
   // ---------------------------------------------------------------------------
@@ -109,23 +120,14 @@ module gicube_scatter_draw #(
   always_ff @(posedge clk_i) begin
     if (en_i) begin
       // Stage 3
-      drawn_q  <= drawn_d;
-      h_q      <= h_d;
-      phi_q    <= phi_d;
-      isoi_q   <= isoi_d;
-      gloss_q  <= gloss_d;
+      h_q     <= h_d;
+      gloss_q <= gloss_d;
       // Stage 4
-      theta_q  <= theta_d;
-      drawn_q2 <= drawn_q;
-      phi_q2   <= phi_q;
-      isoi_q2  <= isoi_q;
+      theta_q <= theta_d;
     end
   end
 
-  assign drawn_o   = drawn_q2;
-  assign theta_o   = theta_q;
-  assign phi_o     = phi_q2;
-  assign iso_idx_o = isoi_q2;
+  assign theta_o = theta_q;
 
   // Pool bits beyond the fields; the bits of gloss' h below the rounding.
   logic unused_draw;

@@ -65,11 +65,10 @@ module gicube_scatter_frame #(
     .entry1_o    (trig_ph)
   );
 
-  logic [F:0]      ct_d, ct_q, ct_q2, st_d, st_q, st_q2;
-  logic [DW-1:0]   cp_d, cp_q, cp_q2, sp_d, sp_q, sp_q2;   // cos, sin of phi, S(2.F)
-  logic [1:0]      axis_d, axis_q, axis_q2;
-  logic [3*DW-1:0] abc_d, abc_q;                           // a, b, cc: Ê_i, Ê_j, Ê_k
-  logic [3*DW-1:0] eh_q, eh_q2;
+  logic [F:0]      ct_d, st_d;
+  logic [DW-1:0]   cp_d, sp_d;               // cos, sin of phi, S(2.F)
+  logic [1:0]      axis_d;
+  logic [3*DW-1:0] abc_d, abc_q;             // a, b, cc: Ê_i, Ê_j, Ê_k
 
   always_comb begin
     logic [DW-1:0] cv, sv;
@@ -100,6 +99,17 @@ module gicube_scatter_frame #(
     endcase
   end
 
+  // The angles, the axis and Ê wait one stage beside w, V, U.
+  gicube_scatter_pipe #(
+    .W (2*(F+1) + 2*DW + 2 + 3*DW),
+    .N (2)
+  ) u_side_wait (
+    .clk_i (clk_i),
+    .en_i  (en_i),
+    .d_i   ({eh_i, axis_d, sp_d, cp_d, st_d, ct_d}),
+    .q_o   ({eh_o, axis_o, sp_o, cp_o, st_o, ct_o})
+  );
+
   // ---------------------------------------------------------------------------
   // Stage 29: w = b^2 + cc^2; V = (rnd(w, F), rnd(-a b, F), rnd(-a cc, F)); U = (0, -cc, b)
   // ---------------------------------------------------------------------------
@@ -128,35 +138,17 @@ module gicube_scatter_frame #(
   always_ff @(posedge clk_i) begin
     if (en_i) begin
       // Stage 28
-      ct_q    <= ct_d;
-      st_q    <= st_d;
-      cp_q    <= cp_d;
-      sp_q    <= sp_d;
-      axis_q  <= axis_d;
-      abc_q   <= abc_d;
-      eh_q    <= eh_i;
+      abc_q <= abc_d;
       // Stage 29
-      w_q     <= w_d;
-      v_q     <= v_d;
-      u_q     <= u_d;
-      ct_q2   <= ct_q;
-      st_q2   <= st_q;
-      cp_q2   <= cp_q;
-      sp_q2   <= sp_q;
-      axis_q2 <= axis_q;
-      eh_q2   <= eh_q;
+      w_q   <= w_d;
+      v_q   <= v_d;
+      u_q   <= u_d;
     end
   end
 
-  assign w_o    = w_q;
-  assign v_o    = v_q;
-  assign u_o    = u_q;
-  assign ct_o   = ct_q2;
-  assign st_o   = st_q2;
-  assign cp_o   = cp_q2;
-  assign sp_o   = sp_q2;
-  assign axis_o = axis_q2;
-  assign eh_o   = eh_q2;
+  assign w_o = w_q;
+  assign v_o = v_q;
+  assign u_o = u_q;
 
   // Products beyond the contract's ranges and below the roundings.
   logic unused_frame;

@@ -41,15 +41,16 @@ module gicube_scatter_norm #(
   logic [3*VW-1:0] v_q;
   logic            zero_d, zero_q;
 
-  always_comb begin
-    q_d = '0;
-    for (int unsigned c = 0; c < 3; c++) begin
-      logic signed [QW-1:0] vc;
-      vc  = {{(QW-VW){v_i[c*VW + VW-1]}}, v_i[c*VW +: VW]};
-      q_d = q_d + QW'(vc * vc);
-    end
-    zero_d = (v_i == '0);
-  end
+  gicube_scatter_dot3 #(
+    .VW (VW),
+    .OW (QW)
+  ) u_sum_sq (
+    .x_i (v_i),
+    .y_i (v_i),
+    .z_o (q_d)
+  );
+
+  assign zero_d = (v_i == '0);
 
   // ---------------------------------------------------------------------------
   // Stages 2-5: rsq(q); V and the zero flag wait beside it

@@ -55,15 +55,14 @@ module gicube_scatter_surface #(
   logic [L2W-1:0]        l2_q, l2_q2, l2_q3, l2_q4;
   logic [ETW-1:0]        eta_q, eta_q2;
 
-  always_comb begin
-    dn_d = '0;
-    for (int unsigned c = 0; c < 3; c++) begin
-      logic signed [DnW-1:0] dc, nc;
-      dc   = {{(DnW-DW){d_i[c*DW + DW-1]}}, d_i[c*DW +: DW]};
-      nc   = {{(DnW-DW){n_i[c*DW + DW-1]}}, n_i[c*DW +: DW]};
-      dn_d = dn_d + dc * nc;
-    end
-  end
+  gicube_scatter_dot3 #(
+    .VW (DW),
+    .OW (DnW)
+  ) u_dn (
+    .x_i (d_i),
+    .y_i (n_i),
+    .z_o (dn_d)
+  );
 
   // ---------------------------------------------------------------------------
   // Stage 9: turn the normal to face the ray; c = rnd(|dn|, F)
