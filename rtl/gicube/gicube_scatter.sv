@@ -22,7 +22,9 @@ module gicube_scatter #(
   /// Index bits I of the isotropic direction LUT.
   parameter int unsigned IsoW     = 8
 ) (
+  /// Clock.
   input  logic clk_i,
+  /// Synchronous reset, active low: clears the valids only (no datapath or table reset).
   input  logic rst_ni,
 
   /// Input item valid.
@@ -67,7 +69,7 @@ module gicube_scatter #(
   localparam int unsigned SWrW = gicube_scatter_pkg::seed_wr_w(F);
   localparam int unsigned L    = gicube_scatter_pkg::Latency;
 
-  // Stage boundaries: each stage module starts where the one before it ends.
+  // Register stages of the stage modules (gicube_scatter_pkg); the delay lines are sized from them.
   localparam int unsigned NormL = gicube_scatter_pkg::NormLatency;
   localparam int unsigned SurfL = gicube_scatter_pkg::SurfaceLatency;
   localparam int unsigned RefrL = gicube_scatter_pkg::RefractLatency;
@@ -91,6 +93,7 @@ module gicube_scatter #(
   if (IsoW < 4 || IsoW > 10) begin : gen_bad_iso_w
     $fatal(1, "gicube_scatter: IsoW must be 4..10");
   end
+  // The stage modules chain up to the contract's latency; the draw fits beside the first normalize.
   if (NormL + SurfL + RefrL + SelL + NormL + FrmL + RotL + NormL != L
       || gicube_scatter_pkg::DrawLatency > NormL) begin : gen_bad_latency
     $fatal(1, "gicube_scatter: the stage latencies do not add up to Latency");

@@ -11,6 +11,7 @@ module gicube_scatter_draw #(
   /// Index bits I of the isotropic direction LUT.
   parameter int unsigned I = 8
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,

@@ -10,6 +10,7 @@ module gicube_scatter_frame #(
   /// Index bits A of the quarter-wave trigonometry table.
   parameter int unsigned A = 8
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,
@@ -19,9 +20,11 @@ module gicube_scatter_frame #(
   input  logic [A-1:0] theta_i,
   /// Axis angle phi, 2^-(A+2) turns.
   input  logic [A+1:0] phi_i,
-  /// TRIG table write, index and entry (cos at [0 +: F+1], sin at [F+1 +: F+1]).
+  /// TRIG table write.
   input  logic trig_we_i,
+  /// TRIG index written.
   input  logic [A-1:0] trig_widx_i,
+  /// TRIG entry written: cos at [0 +: F+1], sin at [F+1 +: F+1].
   input  logic [2*F+1:0] trig_wdata_i,
   /// w = b^2 + cc^2, 2F fraction bits, FrameLatency stages after the inputs (as are all outputs).
   output logic [gicube_scatter_pkg::sq_w(F)-1:0] w_o,
@@ -29,11 +32,13 @@ module gicube_scatter_frame #(
   output logic [3*gicube_scatter_pkg::vv_w(F)-1:0] v_o,
   /// U_j = -cc, U_k = b (U_i = 0), S(2.F).
   output logic [2*(F+2)-1:0] u_o,
-  /// cos(theta), sin(theta), U(1.F).
+  /// cos(theta), U(1.F).
   output logic [F:0] ct_o,
+  /// sin(theta), U(1.F).
   output logic [F:0] st_o,
-  /// cos(phi), sin(phi), S(2.F).
+  /// cos(phi), S(2.F).
   output logic [F+1:0] cp_o,
+  /// sin(phi), S(2.F).
   output logic [F+1:0] sp_o,
   /// The axis i.
   output logic [1:0] axis_o,

@@ -6,6 +6,7 @@
 // written as a package function called three times from one always_comb block (the gate-level
 // co-simulation caught it), so no function is used here.
 module gicube_scatter_hash (
+  /// Clock.
   input  logic        clk_i,
   /// Pipeline advance.
   input  logic        en_i,

@@ -9,6 +9,7 @@ module gicube_scatter_norm #(
   /// Direction fraction bits F of the output.
   parameter int unsigned F  = 14
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,

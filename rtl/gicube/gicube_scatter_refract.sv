@@ -10,6 +10,7 @@ module gicube_scatter_refract #(
   /// Fraction bits M of the material fields.
   parameter int unsigned M = 8
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,

@@ -9,6 +9,7 @@ module gicube_scatter_rotate #(
   /// Direction fraction bits F.
   parameter int unsigned F = 14
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,
@@ -18,11 +19,13 @@ module gicube_scatter_rotate #(
   input  logic [3*gicube_scatter_pkg::vv_w(F)-1:0] v_i,
   /// U_j, U_k, S(2.F).
   input  logic [2*(F+2)-1:0] u_i,
-  /// cos(theta), sin(theta), U(1.F).
+  /// cos(theta), U(1.F).
   input  logic [F:0] ct_i,
+  /// sin(theta), U(1.F).
   input  logic [F:0] st_i,
-  /// cos(phi), sin(phi), S(2.F).
+  /// cos(phi), S(2.F).
   input  logic [F+1:0] cp_i,
+  /// sin(phi), S(2.F).
   input  logic [F+1:0] sp_i,
   /// The axis i of the (i, j, k) frame.
   input  logic [1:0] axis_i,

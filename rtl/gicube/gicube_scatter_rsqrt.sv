@@ -13,6 +13,7 @@ module gicube_scatter_rsqrt #(
   /// Bits of the exponent kk (at least $clog2 of the number of bit pairs in q).
   parameter int unsigned KW = 5
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,

@@ -12,6 +12,7 @@ module gicube_scatter_select #(
   /// Index bits I of the isotropic direction LUT.
   parameter int unsigned I = 8
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,
@@ -37,9 +38,11 @@ module gicube_scatter_select #(
   input  logic [A+1:0] phi_i,
   /// Index into the ISO table.
   input  logic [I-1:0] iso_idx_i,
-  /// ISO table write, entry index and entry (x, y, z, S(2.F) each).
+  /// ISO table write.
   input  logic iso_we_i,
+  /// ISO index written.
   input  logic [I-1:0] iso_widx_i,
+  /// ISO entry written: x, y, z, S(2.F) each.
   input  logic [3*(F+2)-1:0] iso_wdata_i,
   /// E, S(6.F) components, SelectLatency stages after the inputs (as are all outputs).
   output logic [3*gicube_scatter_pkg::ev_w(F)-1:0] e_o,
