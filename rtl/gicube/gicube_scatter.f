@@ -1,7 +1,15 @@
 rtl/gicube/gicube_scatter_pkg.sv
 rtl/gicube/gicube_scatter_pipe.sv
+rtl/gicube/gicube_scatter_dot3.sv
+rtl/gicube/gicube_scatter_madd3.sv
 rtl/gicube/gicube_scatter_hash.sv
 rtl/gicube/gicube_scatter_rsqrt.sv
 rtl/gicube/gicube_scatter_norm.sv
 rtl/gicube/gicube_scatter_trig.sv
+rtl/gicube/gicube_scatter_draw.sv
+rtl/gicube/gicube_scatter_surface.sv
+rtl/gicube/gicube_scatter_refract.sv
+rtl/gicube/gicube_scatter_select.sv
+rtl/gicube/gicube_scatter_frame.sv
+rtl/gicube/gicube_scatter_rotate.sv
 rtl/gicube/gicube_scatter.sv

@@ -1,25 +1,22 @@
-// gicube_scatter_norm: normalize(V) of docs/numerics/gicube_scatter.md: a vector of signed
-// integers to unit length in S(2.F), out_c = rnd(V_c y, kk + 3) with (y, kk) = rsq(sum V_c^2).
-// Seven register stages: the sum of squares, rsq (four), the products, the rounding shift.
-// The variable right shift by kk + 3 is done as a left shift by KMax - kk and a fixed rounding
-// shift by KMax + 3 (the same integer; the model shifts right directly).
+// gicube_scatter_norm: normalize(V) of docs/numerics/gicube_scatter.md (patent [385]-[386]): a
+// vector of signed integers to unit length in S(2.F), out_c = rnd(V_c y, kk + 3) with
+// (y, kk) = rsq(sum V_c^2). Seven register stages: the sum of squares, rsq (four), the products,
+// the rounding shift. The variable right shift by kk + 3 is done as a left shift by KMax - kk and
+// a fixed rounding shift by KMax + 3 (the same integer; the model shifts right directly).
 module gicube_scatter_norm #(
   /// Bits of each input component (two's complement).
   parameter int unsigned VW = 16,
   /// Direction fraction bits F of the output.
   parameter int unsigned F  = 14
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,
   /// V, component c at [c*VW +: VW].
   input  logic [3*VW-1:0] v_i,
-
-  /// SEED table write, index and value (see gicube_scatter_rsqrt).
-  input  logic cfg_we_i,
-  input  logic [gicube_scatter_pkg::seed_idx_w(F)-1:0] cfg_idx_i,
-  input  logic [gicube_scatter_pkg::seed_frac_w(F)-1:0] cfg_seed_i,
-
+  /// SEED table write {we, index, value} (see gicube_scatter_rsqrt).
+  input  logic [gicube_scatter_pkg::seed_wr_w(F)-1:0] seed_wr_i,
   /// normalize(V), S(2.F) components, NormLatency stages after v_i.
   output logic [3*(F+2)-1:0] vn_o,
   /// V was the zero vector (then vn_o is zero too).
@@ -41,28 +38,20 @@ module gicube_scatter_norm #(
   // ---------------------------------------------------------------------------
   // Stage 1: q = sum of squares
   // ---------------------------------------------------------------------------
-  logic [QW-1:0] q_d;
-
-  always_comb begin
-    q_d = '0;
-    for (int unsigned c = 0; c < 3; c++) begin
-      logic signed [QW-1:0] vc;
-      vc  = {{(QW-VW){v_i[c*VW + VW-1]}}, v_i[c*VW +: VW]};
-      q_d = q_d + QW'(vc * vc);
-    end
-  end
-
-  logic [QW-1:0]   q_q;
+  logic [QW-1:0]   q_d, q_q;
   logic [3*VW-1:0] v_q;
-  logic            zero_q;
+  logic            zero_d, zero_q;
 
-  always_ff @(posedge clk_i) begin
-    if (en_i) begin
-      q_q    <= q_d;
-      v_q    <= v_i;
-      zero_q <= (v_i == '0);
-    end
-  end
+  gicube_scatter_dot3 #(
+    .VW (VW),
+    .OW (QW)
+  ) u_sum_sq (
+    .x_i (v_i),
+    .y_i (v_i),
+    .z_o (q_d)
+  );
+
+  assign zero_d = (v_i == '0);
 
   // ---------------------------------------------------------------------------
   // Stages 2-5: rsq(q); V and the zero flag wait beside it
@@ -70,23 +59,21 @@ module gicube_scatter_norm #(
   logic [YF:0]     y;
   logic [KW-1:0]   kk;
   logic [YF+1:0]   m_unused;
-  logic [3*VW-1:0] v_late;
-  logic            zero_late;
+  logic [3*VW-1:0] v_s5;
+  logic            zero_s5;
 
   gicube_scatter_rsqrt #(
     .QW (QW),
     .F  (F),
     .KW (KW)
   ) u_rsqrt (
-    .clk_i      (clk_i),
-    .en_i       (en_i),
-    .q_i        (q_q),
-    .cfg_we_i   (cfg_we_i),
-    .cfg_idx_i  (cfg_idx_i),
-    .cfg_seed_i (cfg_seed_i),
-    .y_o        (y),
-    .kk_o       (kk),
-    .m_o        (m_unused)
+    .clk_i     (clk_i),
+    .en_i      (en_i),
+    .q_i       (q_q),
+    .seed_wr_i (seed_wr_i),
+    .y_o       (y),
+    .kk_o      (kk),
+    .m_o       (m_unused)
   );
 
   gicube_scatter_pipe #(
@@ -96,7 +83,7 @@ module gicube_scatter_norm #(
     .clk_i (clk_i),
     .en_i  (en_i),
     .d_i   ({zero_q, v_q}),
-    .q_o   ({zero_late, v_late})
+    .q_o   ({zero_s5, v_s5})
   );
 
   // ---------------------------------------------------------------------------
@@ -104,22 +91,14 @@ module gicube_scatter_norm #(
   // ---------------------------------------------------------------------------
   logic [3*PW-1:0] prod_d, prod_q;
   logic [KW-1:0]   kk_q;
-  logic            zero_q6;
+  logic            zero_q2;
 
   always_comb begin
     for (int unsigned c = 0; c < 3; c++) begin
       logic signed [PW-1:0] vc, ys;
-      vc = {{(PW-VW){v_late[c*VW + VW-1]}}, v_late[c*VW +: VW]};
+      vc = {{(PW-VW){v_s5[c*VW + VW-1]}}, v_s5[c*VW +: VW]};
       ys = PW'({1'b0, y});
       prod_d[c*PW +: PW] = vc * ys;
-    end
-  end
-
-  always_ff @(posedge clk_i) begin
-    if (en_i) begin
-      prod_q  <= prod_d;
-      kk_q    <= kk;
-      zero_q6 <= zero_late;
     end
   end
 
@@ -128,7 +107,7 @@ module gicube_scatter_norm #(
   // ---------------------------------------------------------------------------
   logic [3*OW-1:0] out_d, out_q;
   logic [3*SW-1:0] sum_d;  // kept whole for the unused-bit tie-off
-  logic            zero_q7;
+  logic            zero_q3;
 
   always_comb begin
     for (int unsigned c = 0; c < 3; c++) begin
@@ -141,13 +120,22 @@ module gicube_scatter_norm #(
 
   always_ff @(posedge clk_i) begin
     if (en_i) begin
+      // Stage 1
+      q_q     <= q_d;
+      v_q     <= v_i;
+      zero_q  <= zero_d;
+      // Stage 6
+      prod_q  <= prod_d;
+      kk_q    <= kk;
+      zero_q2 <= zero_s5;
+      // Stage 7
       out_q   <= out_d;
-      zero_q7 <= zero_q6;
+      zero_q3 <= zero_q2;
     end
   end
 
   assign vn_o   = out_q;
-  assign zero_o = zero_q7;
+  assign zero_o = zero_q3;
 
   logic unused_norm;
   assign unused_norm = ^{m_unused, sum_d};

@@ -1,11 +1,13 @@
 // gicube_scatter_pipe: a delay line of N register stages that all load on one enable. Carries the
-// fields of an item beside the arithmetic of the scattering pipeline (datapath: no reset).
+// fields of an item beside the arithmetic of the scattering pipeline (datapath: no reset; patent
+// [385]-[386], one scattering result per clock).
 module gicube_scatter_pipe #(
   /// Bits carried.
   parameter int unsigned W = 1,
   /// Register stages (0 = a wire).
   parameter int unsigned N = 1
 ) (
+  /// Clock.
   input  logic         clk_i,
   /// Pipeline advance: every stage loads.
   input  logic         en_i,

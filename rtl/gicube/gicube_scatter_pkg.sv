@@ -50,6 +50,45 @@ package gicube_scatter_pkg;
     newton_frac_w = f + 3;
   endfunction
 
+  /// Bits of the SEED write bus {we, index, value} that every rsq copy receives.
+  function automatic int unsigned seed_wr_w(int unsigned f);
+    seed_wr_w = 1 + seed_idx_w(f) + seed_frac_w(f);
+  endfunction
+
+  // ---------------------------------------------------------------------------
+  // Formats passed between the stage modules (docs/numerics/gicube_scatter.md)
+  // ---------------------------------------------------------------------------
+
+  /// Event direction component (R, T, E), S(6.F).
+  function automatic int unsigned ev_w(int unsigned f);
+    ev_w = f + 6;
+  endfunction
+
+  /// |D|^2, k, s2, w: 2F fraction bits.
+  function automatic int unsigned sq_w(int unsigned f);
+    sq_w = 2 * f + 4;
+  endfunction
+
+  /// eta^2, 2M fraction bits.
+  function automatic int unsigned eta2_w(int unsigned m);
+    eta2_w = 2 * m + 4;
+  endfunction
+
+  /// ec = rnd(eta c, M), U(4.F).
+  function automatic int unsigned ec_w(int unsigned f);
+    ec_w = f + 4;
+  endfunction
+
+  /// rnd(eta D_c, M) and coef = ec - sqrt(k), signed, F fraction bits.
+  function automatic int unsigned ed_w(int unsigned f);
+    ed_w = f + 5;
+  endfunction
+
+  /// V components and B components of the glossy frame, signed, F fraction bits.
+  function automatic int unsigned vv_w(int unsigned f);
+    vv_w = f + 4;
+  endfunction
+
   // ---------------------------------------------------------------------------
   // Events and latencies
   // ---------------------------------------------------------------------------
@@ -63,6 +102,13 @@ package gicube_scatter_pkg;
   localparam int unsigned RsqLatency  = 4;
   localparam int unsigned NormLatency = 7;
   localparam int unsigned HashLatency = 2;
+  /// Register stages of the stage modules, in pipeline order (the top checks that they add up).
+  localparam int unsigned DrawLatency    = 4;   // gicube_scatter_draw, beside the first normalize
+  localparam int unsigned SurfaceLatency = 4;   // gicube_scatter_surface
+  localparam int unsigned RefractLatency = 7;   // gicube_scatter_refract
+  localparam int unsigned SelectLatency  = 2;   // gicube_scatter_select
+  localparam int unsigned FrameLatency   = 2;   // gicube_scatter_frame
+  localparam int unsigned RotateLatency  = 6;   // gicube_scatter_rotate
   /// Register stages of the whole unit (docs/numerics/gicube_scatter.md, Timing).
   localparam int unsigned Latency     = 42;
 

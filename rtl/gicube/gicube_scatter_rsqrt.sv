@@ -13,18 +13,15 @@ module gicube_scatter_rsqrt #(
   /// Bits of the exponent kk (at least $clog2 of the number of bit pairs in q).
   parameter int unsigned KW = 5
 ) (
+  /// Clock.
   input  logic clk_i,
   /// Pipeline advance: every stage loads.
   input  logic en_i,
   /// Operand.
   input  logic [QW-1:0] q_i,
 
-  /// SEED table write (all copies of the table receive the same writes).
-  input  logic cfg_we_i,
-  /// SEED index.
-  input  logic [gicube_scatter_pkg::seed_idx_w(F)-1:0] cfg_idx_i,
-  /// SEED value, U(0.SF).
-  input  logic [gicube_scatter_pkg::seed_frac_w(F)-1:0] cfg_seed_i,
+  /// SEED table write {we, index, value U(0.SF)}; every copy of the table receives the same writes.
+  input  logic [gicube_scatter_pkg::seed_wr_w(F)-1:0] seed_wr_i,
 
   /// y, U(1.YF), four stages after q_i.
   output logic [gicube_scatter_pkg::newton_frac_w(F):0] y_o,
@@ -51,10 +48,15 @@ module gicube_scatter_rsqrt #(
   // ---------------------------------------------------------------------------
   // SEED table: written by the configuration port, read asynchronously in stage B
   // ---------------------------------------------------------------------------
+  logic          seed_we;
+  logic [SI-1:0] seed_idx;
+  logic [SF-1:0] seed_val;
   logic [SF-1:0] seed_q [2**SI];
 
+  assign {seed_we, seed_idx, seed_val} = seed_wr_i;
+
   always_ff @(posedge clk_i) begin
-    if (cfg_we_i) seed_q[cfg_idx_i] <= cfg_seed_i;
+    if (seed_we) seed_q[seed_idx] <= seed_val;
   end
 
   // ---------------------------------------------------------------------------
@@ -62,113 +64,89 @@ module gicube_scatter_rsqrt #(
   // ---------------------------------------------------------------------------
   logic [Q2-1:0]    q_even, q_top;
   logic [Q2+MW-1:0] q_pad;  // q_top with MW zeros below, for any Q2 versus MW
-  logic [KW-1:0]    kk_a;
-  logic [MW-1:0]    m_a;
+  logic [KW-1:0]    kk_d, kk_q;
+  logic [MW-1:0]    m_d, m_q;
+  logic             zero_d, zero_q, zero_q2, zero_q3;
 
   always_comb begin
     q_even = Q2'(q_i);
-    kk_a   = '0;
+    kk_d   = '0;
     for (int unsigned i = 0; i < Pairs; i++) begin
-      if (q_even[2*i +: 2] != 2'b00) kk_a = KW'(i);
+      if (q_even[2*i +: 2] != 2'b00) kk_d = KW'(i);
     end
     // The leading pair moves to the top two bits: a left shift by Q2 - 2 - 2 kk.
-    q_top = q_even << (Q2 - 2 - 2 * 32'(kk_a));
-    q_pad = {q_top, {MW{1'b0}}};
-    m_a   = q_pad[Q2+MW-1 -: MW];
+    q_top  = q_even << (Q2 - 2 - 2 * 32'(kk_d));
+    q_pad  = {q_top, {MW{1'b0}}};
+    m_d    = q_pad[Q2+MW-1 -: MW];
+    zero_d = (q_i == '0);
   end
 
-  logic [MW-1:0] m_b_q;
-  logic [KW-1:0] kk_b_q;
-  logic          zero_b_q;
-
-  always_ff @(posedge clk_i) begin
-    if (en_i) begin
-      m_b_q    <= m_a;
-      kk_b_q   <= kk_a;
-      zero_b_q <= (q_i == '0);
-    end
-  end
+  // m and kk leave the unit beside y: stages B, C, D carry them unchanged.
+  gicube_scatter_pipe #(
+    .W (MW + KW),
+    .N (3)
+  ) u_m_kk_wait (
+    .clk_i (clk_i),
+    .en_i  (en_i),
+    .d_i   ({m_q, kk_q}),
+    .q_o   ({m_o, kk_o})
+  );
 
   // ---------------------------------------------------------------------------
-  // Stage B: seed and pp = rnd(m y0, SF)
+  // Stage B: seed y0 and pp = rnd(m y0, SF)
   // ---------------------------------------------------------------------------
-  logic [SF-1:0]    y0_b;
+  logic [SF-1:0]    y0_d, y0_q, y0_q2;
   logic [MW+SF-1:0] pp_full;
-  logic [MW-1:0]    pp_b;
+  logic [MW-1:0]    pp_d, pp_q;
 
   always_comb begin
-    y0_b    = seed_q[m_b_q[MW-1 -: SI]];
-    pp_full = (MW+SF)'(m_b_q) * (MW+SF)'(y0_b) + (MW+SF)'(1 << (SF - 1));
-    pp_b    = pp_full[SF +: MW];
-  end
-
-  logic [MW-1:0] pp_c_q, m_c_q;
-  logic [SF-1:0] y0_c_q;
-  logic [KW-1:0] kk_c_q;
-  logic          zero_c_q;
-
-  always_ff @(posedge clk_i) begin
-    if (en_i) begin
-      pp_c_q   <= pp_b;
-      y0_c_q   <= y0_b;
-      m_c_q    <= m_b_q;
-      kk_c_q   <= kk_b_q;
-      zero_c_q <= zero_b_q;
-    end
+    y0_d    = seed_q[m_q[MW-1 -: SI]];
+    pp_full = (MW+SF)'(m_q) * (MW+SF)'(y0_d) + (MW+SF)'(1 << (SF - 1));
+    pp_d    = pp_full[SF +: MW];
   end
 
   // ---------------------------------------------------------------------------
   // Stage C: b = rnd(pp y0, SF), c3 = 3 * 2^NF - b
   // ---------------------------------------------------------------------------
   logic [MW+SF-1:0] b_full;
-  logic [MW-1:0]    c3_c;
+  logic [MW-1:0]    c3_d, c3_q;
 
   always_comb begin
-    b_full = (MW+SF)'(pp_c_q) * (MW+SF)'(y0_c_q) + (MW+SF)'(1 << (SF - 1));
-    c3_c   = (MW'(3) << MF) - b_full[SF +: MW];
-  end
-
-  logic [MW-1:0] c3_d_q, m_d_q;
-  logic [SF-1:0] y0_d_q;
-  logic [KW-1:0] kk_d_q;
-  logic          zero_d_q;
-
-  always_ff @(posedge clk_i) begin
-    if (en_i) begin
-      c3_d_q   <= c3_c;
-      y0_d_q   <= y0_c_q;
-      m_d_q    <= m_c_q;
-      kk_d_q   <= kk_c_q;
-      zero_d_q <= zero_c_q;
-    end
+    b_full = (MW+SF)'(pp_q) * (MW+SF)'(y0_q) + (MW+SF)'(1 << (SF - 1));
+    c3_d   = (MW'(3) << MF) - b_full[SF +: MW];
   end
 
   // ---------------------------------------------------------------------------
   // Stage D: y = rnd(y0 c3, SF + 1)
   // ---------------------------------------------------------------------------
   logic [MW+SF-1:0] y_full;
-  logic [MF:0]      y_d;
+  logic [MF:0]      y_d, y_q;
 
   always_comb begin
-    y_full = (MW+SF)'(y0_d_q) * (MW+SF)'(c3_d_q) + (MW+SF)'(1 << SF);
-    y_d    = zero_d_q ? '0 : y_full[SF + 1 +: MF + 1];
+    y_full = (MW+SF)'(y0_q2) * (MW+SF)'(c3_q) + (MW+SF)'(1 << SF);
+    y_d    = zero_q3 ? '0 : y_full[SF + 1 +: MF + 1];
   end
-
-  logic [MF:0]   y_q;
-  logic [MW-1:0] m_q;
-  logic [KW-1:0] kk_q;
 
   always_ff @(posedge clk_i) begin
     if (en_i) begin
-      y_q  <= y_d;
-      m_q  <= m_d_q;
-      kk_q <= kk_d_q;
+      // Stage A
+      m_q     <= m_d;
+      kk_q    <= kk_d;
+      zero_q  <= zero_d;
+      // Stage B
+      y0_q    <= y0_d;
+      pp_q    <= pp_d;
+      zero_q2 <= zero_q;
+      // Stage C
+      c3_q    <= c3_d;
+      y0_q2   <= y0_q;
+      zero_q3 <= zero_q2;
+      // Stage D
+      y_q     <= y_d;
     end
   end
 
-  assign y_o  = y_q;
-  assign kk_o = kk_q;
-  assign m_o  = m_q;
+  assign y_o = y_q;
 
   // The rounded-off fractions, and the pad below the mantissa.
   logic unused_rsqrt;
