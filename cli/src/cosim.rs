@@ -14,8 +14,8 @@ use cube5_model::units::cube5_shader::{DistantLight, Phong};
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
 use cube5_tb::frame::{as_seen, Expected, FrameBench, FrameRtl, Look, Render};
-use cube5_tb::TbError;
 use cube5_tb::rtl::Traffic;
+use cube5_tb::TbError;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 use std::time::Instant;
@@ -24,7 +24,7 @@ use std::time::Instant;
 pub struct CosimArgs {
     /// Scene file (TOML); omit for the embedded default scene.
     scene: Option<PathBuf>,
-    /// Pipelines: 1, 4 or 8 (the cube5_frame configurations p1, p4, p8).
+    /// Pipelines: a P that rtl/cube5/cube5_frame.variants has (1, 4 or 8 today).
     #[arg(short, long, default_value_t = 4)]
     pipelines: usize,
     /// Directory for the images (created if missing).
@@ -49,9 +49,13 @@ pub fn run(args: CosimArgs) -> Result<()> {
     scene.validate(&origin)?;
     let rtl = FrameRtl::with_pipelines(args.pipelines).ok_or_else(|| {
         anyhow!(
-            "--pipelines {}: cube5_frame is built for {:?} (rtl/cube5/cube5_frame.variants)",
+            "--pipelines {}: cube5_frame is built for P = {} (rtl/cube5/cube5_frame.variants)",
             args.pipelines,
             FrameRtl::pipeline_counts()
+                .iter()
+                .map(|p| p.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         )
     })?;
     let result = cosim_scene(&scene, &origin, rtl, &args.out_dir, args.seed)?;
@@ -112,6 +116,25 @@ pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
 
 /// One frame of `scene` on `rtl` and on the model; prints the comparison and the figures and
 /// writes the images into `out_dir`.
+/// What a frame of `scene` on `rtl` needs besides the volume (already at the variant's voxel
+/// width) and its set-up: the block LUT (blocks of 0 empty), the volume as the RTL sees it, and the
+/// scene's look (no early termination).
+fn frame_inputs(
+    scene: &Scene,
+    rtl: &FrameRtl,
+    vol: &Volume,
+    setup: &FrameSetup,
+) -> Result<(BlockLut, Rc<Volume>, Look)> {
+    let lut = BlockLut::from_volume(vol, rtl.block as usize, 0)?;
+    let seen = Rc::new(as_seen(vol, &lut)?);
+    let look = Look {
+        tf: scene.transfer_function(),
+        phong: scene_phong(scene, &setup.params),
+        early_termination: false,
+    };
+    Ok((lut, seen, look))
+}
+
 pub fn cosim_scene(
     scene: &Scene,
     origin: &str,
@@ -140,14 +163,8 @@ pub fn cosim_scene(
     rtl.check_volume(&vol)
         .map_err(|e| anyhow!("{origin}: volume: {e}"))?;
     // Blocks whose voxels are all 0 are marked empty: the memory skips their beams.
-    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0)?;
-    let seen = Rc::new(as_seen(&vol, &lut)?);
     let setup = FrameSetup::new(vol.dims, vol.spacing, dir, rtl.p)?;
-    let look = Look {
-        tf: scene.transfer_function(),
-        phong: scene_phong(scene, &setup.params),
-        early_termination: false,
-    };
+    let (lut, seen, look) = frame_inputs(scene, &rtl, &vol, &setup)?;
     say!(
         "cosim: {} volume {}x{}x{} ({}-bit, as {}-bit), {} on {} ({} pipelines), view {:.4?}",
         origin,
@@ -301,14 +318,8 @@ pub fn frame_cost_section(scene: &Scene) -> Result<String> {
             md.push_str(&format!("| {} | | n/a: {why} | | | |\n", rtl.p));
             continue;
         }
-        let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0)?;
-        let seen = Rc::new(as_seen(&vol, &lut)?);
         let setup = FrameSetup::new(vol.dims, vol.spacing, dir, rtl.p)?;
-        let look = Look {
-            tf: scene.transfer_function(),
-            phong: scene_phong(scene, &setup.params),
-            early_termination: false,
-        };
+        let (lut, seen, look) = frame_inputs(scene, &rtl, &vol, &setup)?;
         let e = Expected::new(&rtl, &seen, "scene", dir.to_array(), render, &look)?;
         let mut bench = FrameBench::new(rtl, &vol, &lut, 1)?;
         let full = bench.check(&e, &Traffic::full_speed(), 1)?;

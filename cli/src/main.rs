@@ -185,8 +185,9 @@ fn render(args: RenderArgs) -> Result<()> {
     if scene.run.target.uses_rtl() {
         // The RTL frame (P = 4) against the model, images beside the output. It is the only RTL
         // variant a scene needs: `CUBE5_TOPS=cube5_frame:P=4:MaxDim=128` builds just it.
-        let rtl = cube5_tb::frame::FrameRtl::with_pipelines(4)
-            .ok_or_else(|| anyhow!("no cube5_frame variant with P = 4 in rtl/cube5/cube5_frame.variants"))?;
+        let rtl = cube5_tb::frame::FrameRtl::with_pipelines(4).ok_or_else(|| {
+            anyhow!("no cube5_frame variant with P = 4 in rtl/cube5/cube5_frame.variants")
+        })?;
         say!(
             "rtl: {} (the only RTL variant this scene needs; CUBE5_TOPS={}:P=4:MaxDim=128 builds just it)",
             rtl.variant,
@@ -308,21 +309,13 @@ fn phantom(args: PhantomArgs) -> Result<()> {
     Ok(())
 }
 
-/// Writes to a temporary name beside the target and renames, so a failure leaves no partial file.
+/// Encodes the PNG, then writes it to a temporary name beside the target and renames, so a failure
+/// leaves no partial file.
 fn write_png_atomically(img: &image::RgbImage, path: &Path) -> Result<()> {
     check_png_path(path)?;
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let tmp = dir.join(format!(
-        ".{}.tmp",
-        path.file_name()
-            .map(|n| n.to_string_lossy())
-            .unwrap_or_default()
-    ));
-    img.save_with_format(&tmp, image::ImageFormat::Png)
-        .with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("renaming to {}", path.display()))?;
+    let mut png = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut png, image::ImageFormat::Png)
+        .with_context(|| format!("encoding {}", path.display()))?;
+    volume_io::write_atomically(path, png.get_ref())?;
     Ok(())
 }

@@ -1,21 +1,10 @@
 //! The command line as a user meets it: good runs write what they say, bad input gets one line
 //! and a non-zero exit code, never a panic, and leaves no partial output.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod support;
 
-fn cube5(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cube5"))
-        .args(args)
-        .output()
-        .expect("run cube5")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+use std::process::Output;
+use support::{cube5, scratch};
 
 /// Asserts a refusal: non-zero exit, exactly one line on stderr containing `needle`, no panic.
 fn assert_refused(out: &Output, needle: &str) {
@@ -206,6 +195,6 @@ fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
         "cosim-p3.toml",
         "[volume]\nsize = 16\n",
         &["-p", "3"],
-        "1, 4 or 8",
+        "built for P = 1, 4, 8",
     );
 }

@@ -2,28 +2,11 @@
 //! (docs/scenes.md § Bad input) gets one line naming the file and the field, a non-zero exit code
 //! and no output; `cube5 tradeoff` runs a tiny sweep end to end.
 
+mod support;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn cube5(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cube5"))
-        .args(args)
-        .output()
-        .expect("run cube5")
-}
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("scene-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
+use std::process::Output;
+use support::{cube5, scratch};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -66,7 +49,7 @@ fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
 
 #[test]
 fn every_example_scene_renders() {
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir(repo().join("scenes"))
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(cube5_model::repo_root().join("scenes"))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))

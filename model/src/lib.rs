@@ -23,3 +23,10 @@ pub mod volume;
 pub mod volume_io;
 
 pub use error::{ModelError, Result};
+
+/// The repository this crate was built from (`docs/`, `rtl/`, `scenes/`): for the tests and tools
+/// that read the repository's own files.
+pub fn repo_root() -> std::path::PathBuf {
+    let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    here.parent().unwrap_or(here).to_path_buf()
+}

@@ -47,31 +47,13 @@ fn head_blobs() -> Vec<Blob> {
 pub fn head_phantom(n: usize, bits: u32) -> Result<Volume> {
     check_phantom_args(n, bits)?;
     let blobs = head_blobs();
-    let max = f64::from((1u32 << bits) - 1);
-    let to_norm = |i: f64| (i + 0.5) / n as f64 * 2.0 - 1.0;
-    let data: Vec<u16> = (0..n * n * n)
-        .into_par_iter()
-        .map(|idx| {
-            let (x, y, z) = (idx % n, (idx / n) % n, idx / (n * n));
-            let mut acc = 0.0;
-            for s in 0..8 {
-                let off = |bit: usize| if (s >> bit) & 1 == 1 { 0.25 } else { -0.25 };
-                let p = [
-                    to_norm(x as f64 + off(0)),
-                    to_norm(y as f64 + off(1)),
-                    to_norm(z as f64 + off(2)),
-                ];
-                let d = blobs
-                    .iter()
-                    .rev()
-                    .find(|b| b.inside(p))
-                    .map_or(0.0, |b| b.density);
-                acc += d / 8.0;
-            }
-            (acc * max).round() as u16
-        })
-        .collect();
-    Volume::new([n; 3], [1.0; 3], bits, data)
+    supersampled(n, bits, |p| {
+        blobs
+            .iter()
+            .rev()
+            .find(|b| b.inside(p))
+            .map_or(0.0, |b| b.density)
+    })
 }
 
 /// The embedded phantoms by name (scene files say `phantom = "NAME"`).
@@ -178,6 +160,17 @@ pub fn bubbles_phantom(n: usize, bits: u32) -> Result<Volume> {
         ([0.55, 0.5, 0.5], 0.15, 0.45),
         ([-0.5, -0.45, -0.5], 0.18, 0.05),
     ];
+    supersampled(n, bits, |p| {
+        holes
+            .iter()
+            .find(|(c, r, _)| (0..3).map(|a| (p[a] - c[a]).powi(2)).sum::<f64>() <= r * r)
+            .map_or(0.75, |h| h.2)
+    })
+}
+
+/// An `n^3` volume of `bits` bits whose voxels are the density `f` (0..=1, at points of the
+/// normalized cube -1..1) averaged over 2x2x2 samples at +-1/4 voxel: anti-aliased edges.
+fn supersampled(n: usize, bits: u32, f: impl Fn([f64; 3]) -> f64 + Sync) -> Result<Volume> {
     let max = f64::from((1u32 << bits) - 1);
     let to_norm = |i: f64| (i + 0.5) / n as f64 * 2.0 - 1.0;
     let data: Vec<u16> = (0..n * n * n)
@@ -192,11 +185,7 @@ pub fn bubbles_phantom(n: usize, bits: u32) -> Result<Volume> {
                     to_norm(y as f64 + off(1)),
                     to_norm(z as f64 + off(2)),
                 ];
-                let d = holes
-                    .iter()
-                    .find(|(c, r, _)| (0..3).map(|a| (p[a] - c[a]).powi(2)).sum::<f64>() <= r * r)
-                    .map_or(0.75, |h| h.2);
-                acc += d / 8.0;
+                acc += f(p) / 8.0;
             }
             (acc * max).round() as u16
         })

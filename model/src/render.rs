@@ -596,8 +596,10 @@ impl GradientScheme {
     }
 }
 
-/// The knobs that trade accuracy for speed or area in the pipeline model.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The knobs that trade accuracy for speed or area in the pipeline model (a scene's `[quality]`
+/// table, every key optional).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Quality {
     /// Voxel width fed to interpolation (`VoxelW`); `None`: the volume's own width (at least 4).
     pub voxel_bits: Option<u32>,
@@ -606,6 +608,7 @@ pub struct Quality {
     /// Fraction bits of a sample (`FracW`, 0..=8).
     pub frac_bits: u32,
     /// R, G, B code width (classification and shading output), 2..=16.
+    #[serde(alias = "color_bits")]
     pub colour_bits: u32,
     /// Sample alpha code width, 2..=16.
     pub alpha_bits: u32,

@@ -10,8 +10,7 @@
 use crate::error::{ModelError, Result};
 use crate::phantom::{phantom_by_name, PHANTOMS};
 use crate::render::{
-    CompositeMode, GradientScheme, Interpolation, Light, Material, Projection, Quality,
-    RenderParams, SliceSetup, View,
+    CompositeMode, Light, Material, Projection, Quality, RenderParams, SliceSetup, View,
 };
 use crate::transfer::{TfPoint, TransferFunction, TF_PRESETS};
 use crate::volume::{Volume, MAX_EDGE};
@@ -135,22 +134,8 @@ pub struct TransferSpec {
     pub points: Option<Vec<TfPoint>>,
 }
 
-/// The pipeline model's knobs (`render::Quality`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct QualitySpec {
-    pub voxel_bits: Option<u32>,
-    pub weight_bits: u32,
-    pub frac_bits: u32,
-    #[serde(alias = "color_bits")]
-    pub colour_bits: u32,
-    pub alpha_bits: u32,
-    pub acc_bits: u32,
-    pub samples_per_slice: u32,
-    pub supersampling: u32,
-    pub interpolation: Interpolation,
-    pub gradient: GradientScheme,
-}
+/// The pipeline model's knobs: a scene's `[quality]` table is read straight into `render::Quality`.
+pub type QualitySpec = Quality;
 
 /// What to run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -198,13 +183,14 @@ impl Default for VolumeSpec {
 
 impl Default for ViewSpec {
     fn default() -> Self {
+        let p = RenderParams::default();
         Self {
-            azimuth: 30.0,
-            elevation: 20.0,
-            direction: None,
-            projection: Projection::Parallel,
-            fov: 30.0,
-            zoom: 1.0,
+            azimuth: p.view.azimuth,
+            elevation: p.view.elevation,
+            direction: p.direction,
+            projection: p.projection,
+            fov: p.fov,
+            zoom: p.zoom,
         }
     }
 }
@@ -227,24 +213,6 @@ impl Default for RenderSpec {
             step: p.step,
             early_termination: p.early_termination,
             threshold: p.threshold,
-        }
-    }
-}
-
-impl Default for QualitySpec {
-    fn default() -> Self {
-        let q = Quality::default();
-        Self {
-            voxel_bits: q.voxel_bits,
-            weight_bits: q.weight_bits,
-            frac_bits: q.frac_bits,
-            colour_bits: q.colour_bits,
-            alpha_bits: q.alpha_bits,
-            acc_bits: q.acc_bits,
-            samples_per_slice: q.samples_per_slice,
-            supersampling: q.supersampling,
-            interpolation: q.interpolation,
-            gradient: q.gradient,
         }
     }
 }
@@ -703,19 +671,7 @@ impl Scene {
     }
 
     pub fn quality(&self) -> Quality {
-        let q = &self.quality;
-        Quality {
-            voxel_bits: q.voxel_bits,
-            weight_bits: q.weight_bits,
-            frac_bits: q.frac_bits,
-            colour_bits: q.colour_bits,
-            alpha_bits: q.alpha_bits,
-            acc_bits: q.acc_bits,
-            samples_per_slice: q.samples_per_slice,
-            supersampling: q.supersampling,
-            interpolation: q.interpolation,
-            gradient: q.gradient,
-        }
+        self.quality
     }
 }
 

@@ -66,6 +66,23 @@ pub fn set_params(
     Ok(())
 }
 
+/// Implements [`StreamUnit`] for a unit whose output for an item depends on that item alone (reset
+/// a no-op): `item_by_item!(Trilin, TrilinIn => u32, |unit, item| unit.sample(item))`.
+#[macro_export]
+macro_rules! item_by_item {
+    ($ty:ty, $in:ty => $out:ty, |$unit:ident, $item:ident| $body:expr) => {
+        impl $crate::unit::StreamUnit for $ty {
+            type In = $in;
+            type Out = $out;
+
+            fn run(&mut self, inputs: &[$in]) -> Vec<$out> {
+                let $unit = &*self;
+                inputs.iter().map(|$item| $body).collect()
+            }
+        }
+    };
+}
+
 /// Implements [`UnitConfig`] for a configuration whose fields are its RTL parameters one to one:
 /// `unit_config!(TrilinConfig, "cube5_trilin", DEFAULT, { "VoxelW" => voxel_w, ... })`.
 /// `DEFAULT` equals the RTL's defaults; `validate()` checks the result.

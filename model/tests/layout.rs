@@ -3,14 +3,7 @@
 
 use std::collections::BTreeSet;
 use std::fs;
-use std::path::{Path, PathBuf};
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
+use std::path::Path;
 
 /// Tops of every `rtl/**/<top>.variants`.
 fn tops_with_variants(dir: &Path, out: &mut BTreeSet<String>) {
@@ -47,7 +40,7 @@ fn table_rows(doc: &str) -> Vec<(String, Vec<String>)> {
 
 #[test]
 fn every_top_has_one_row_and_every_path_in_it_exists() {
-    let repo = repo();
+    let repo = cube5_model::repo_root();
     let doc = fs::read_to_string(repo.join("docs/architecture.md")).unwrap();
     let rows = table_rows(&doc);
     let mut tops = BTreeSet::new();

@@ -11,13 +11,6 @@ use cube5_model::volume_io::{
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("cube5-model-tests-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -26,7 +19,7 @@ fn scratch(name: &str) -> PathBuf {
 
 #[test]
 fn shipped_volumes_are_the_phantoms() {
-    let data = repo().join("scenes/data");
+    let data = cube5_model::repo_root().join("scenes/data");
     let head8 = phantom_by_name("head", 64, 8).unwrap();
     assert!(same(
         &read_nifti(&data.join("head64.nii.gz"), None).unwrap(),

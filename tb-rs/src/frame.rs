@@ -16,17 +16,13 @@ use cube5_model::error::ModelError;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::unit::StreamCodec;
 use cube5_model::unit::UnitConfig;
-use cube5_model::units::cube5_compos::{
-    self, Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut,
-};
+use cube5_model::units::cube5_compos::{self, Compos, ComposConfig, ComposRegs, Coxel, OpacityLut};
 use cube5_model::units::cube5_frame::{
     self, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepAccesses,
 };
-use cube5_model::units::cube5_gradient::{
-    block_index, Gradient, GradientConfig, GradientIn, GradientMode,
-};
+use cube5_model::units::cube5_gradient::{Gradient, GradientConfig};
 use cube5_model::units::cube5_shader::{
-    ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables,
+    ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderMode, ShaderTables,
 };
 use cube5_model::units::cube5_skewmem::{BlockLut, SkewConfig, SkewDims, SkewMem};
 use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig};
@@ -331,19 +327,9 @@ impl StreamCodec for FrameRtl {
     }
 
     fn unpack_out(&self, words: &[u32]) -> FrameOut {
-        let c = &self.compos;
         let mut r = BitReader::new(words);
-        let rgba = std::array::from_fn(|_| r.get(c.acc_w + 1));
-        let z = r.get(c.z_w) as u32;
-        let geo = std::array::from_fn(|_| r.get(c.color_w) as u32);
-        let terminated = r.get_bool();
         FrameOut {
-            coxel: Coxel {
-                rgba,
-                z,
-                geo,
-                terminated,
-            },
+            coxel: cube5_compos::get_coxel(&mut r, &self.compos),
             error: r.get_bool(),
             reads: r.get(32) as u32,
             cycles: r.get(32) as u32,
@@ -454,38 +440,11 @@ impl Units {
 
     /// One sample's way through gradient, adapter, shader: the compositing unit's sample.
     pub fn shaded(&self, nb: [u32; 7], s: usize) -> cube5_compos::Sample {
-        let mut samples = [0u32; 27];
-        samples[block_index(0, 0, 0)] = nb[0];
-        samples[block_index(-1, 0, 0)] = nb[1];
-        samples[block_index(1, 0, 0)] = nb[2];
-        samples[block_index(0, -1, 0)] = nb[3];
-        samples[block_index(0, 1, 0)] = nb[4];
-        samples[block_index(0, 0, -1)] = nb[5];
-        samples[block_index(0, 0, 1)] = nb[6];
-        let g = self.gradient.gradient(&GradientIn {
-            samples,
-            dx: 0,
-            dy: 0,
-            mode: GradientMode::N6,
-        });
-        let rgba = self.shader.shade(&ShaderIn {
-            sample: nb[0],
-            grad: [g.gx >> 4, g.gy >> 4, g.gz >> 4],
-            mag: g.mag >> 4,
-            mode: ShaderMode {
-                tf2d: self.tf2d,
-                unlit: self.render == Render::Mip,
-            },
-        });
-        cube5_compos::Sample {
-            rgb: [rgba.r, rgba.g, rgba.b],
-            alpha: rgba.a,
-            depth: s as u32,
-            mode: match self.render {
-                Render::Mip => ComposMode::Max,
-                Render::Composite => ComposMode::FrontToBack,
-            },
-        }
+        let mode = ShaderMode {
+            tf2d: self.tf2d,
+            unlit: self.render == Render::Mip,
+        };
+        cube5_frame::shade_n6(&self.gradient, &self.shader, &nb, mode, s as u32)
     }
 }
 

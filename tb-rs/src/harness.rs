@@ -2,7 +2,7 @@
 //! compared in order with no tolerance, under random idle, back-pressure and a mid-stream reset.
 
 use crate::error::{Mismatch, TbError};
-use crate::rtl::{RtlStream, Traffic};
+use crate::rtl::{Driven, RtlStream, Traffic};
 use crate::variants::Variant;
 use cube5_model::unit::{StreamCodec, StreamUnit};
 use rand::{Rng, SeedableRng};
@@ -115,6 +115,13 @@ pub struct StreamReport {
 }
 
 impl StreamReport {
+    /// Adds a driven batch's items, outputs and clocks.
+    fn count<T>(&mut self, driven: &Driven<T>) {
+        self.consumed += driven.stats.consumed;
+        self.compared += driven.stats.produced;
+        self.cycles += driven.stats.cycles;
+    }
+
     /// Items accepted per clock.
     pub fn items_per_cycle(&self) -> f64 {
         self.consumed as f64 / self.cycles.max(1) as f64
@@ -224,6 +231,10 @@ where
         ..Default::default()
     };
     // A run error carries the seed of this check.
+    let compare_batch =
+        |codec: &C, driven: &Driven<C::Out>, want: &[C::Out], items: &[C::In], base: u64| {
+            compare(codec, &driven.outputs, want, items, base, check, &fail)
+        };
     let seeded = |e: TbError| match e {
         TbError::Protocol {
             variant,
@@ -268,18 +279,8 @@ where
                 .map_err(seeded)?;
             let consumed = driven.stats.consumed as usize;
             let expected = gold.run(&pending[..consumed]);
-            compare(
-                dut.codec(),
-                &driven.outputs,
-                &expected,
-                &pending,
-                item_base,
-                check,
-                &fail,
-            )?;
-            report.consumed += driven.stats.consumed;
-            report.compared += driven.stats.produced;
-            report.cycles += driven.stats.cycles;
+            compare_batch(dut.codec(), &driven, &expected, &pending, item_base)?;
+            report.count(&driven);
             // Items accepted but not yet out are lost with the reset, in RTL and model alike.
             dut.reset();
             gold.reset();
@@ -304,15 +305,7 @@ where
                 ),
             });
         }
-        compare(
-            dut.codec(),
-            &driven.outputs,
-            &expected,
-            &pending,
-            item_base,
-            check,
-            &fail,
-        )?;
+        compare_batch(dut.codec(), &driven, &expected, &pending, item_base)?;
         if driven.stats.produced != want {
             return Err(TbError::Deadlock {
                 variant: variant.name.to_string(),
@@ -324,9 +317,7 @@ where
                 ),
             });
         }
-        report.consumed += driven.stats.consumed;
-        report.compared += driven.stats.produced;
-        report.cycles += driven.stats.cycles;
+        report.count(&driven);
         item_base += want;
         batch_no += 1;
     }

@@ -14,9 +14,8 @@ use cube5_model::unit::{StreamCodec, StreamUnit};
 use cube5_model::units::cube5_compos::{
     Compos, ComposConfig, ComposIn, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
 };
-use cube5_model::units::cube5_gradient::{
-    block_index, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
-};
+use cube5_model::units::cube5_frame::{n6_gradient_in, shader_in, N6_OFFSETS};
+use cube5_model::units::cube5_gradient::{Gradient, GradientConfig, GradientIn, GradientOut};
 use cube5_model::units::cube5_shader::{
     ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables,
 };
@@ -30,17 +29,6 @@ use support::{seed, variant_with};
 const RAYS: usize = 10_000;
 const MIN_LEN: usize = 64;
 const MAX_LEN: usize = 512;
-
-/// The neighbour offsets in the order the seven interpolations are made.
-const OFFSETS: [(i32, i32, i32); 7] = [
-    (0, 0, 0),
-    (-1, 0, 0),
-    (1, 0, 0),
-    (0, -1, 0),
-    (0, 1, 0),
-    (0, 0, -1),
-    (0, 0, 1),
-];
 
 struct Ray {
     len: usize,
@@ -160,11 +148,11 @@ fn ten_thousand_whole_rays_through_the_chained_units() {
         samples_total += active.len();
 
         // Trilin: seven interpolations per sample around the ray's current density.
-        let mut trilin_in = Vec::with_capacity(active.len() * OFFSETS.len());
+        let mut trilin_in = Vec::with_capacity(active.len() * N6_OFFSETS.len());
         for &r in &active {
             let ray = &mut rays[r];
             ray.density = (ray.density + rng.random_range(-90..=90)).clamp(0, voxel_max);
-            for _ in OFFSETS {
+            for _ in N6_OFFSETS {
                 let base = (ray.density + rng.random_range(-150..=150)).clamp(0, voxel_max);
                 trilin_in.push(TrilinIn {
                     voxels: std::array::from_fn(|_| {
@@ -187,19 +175,8 @@ fn ten_thousand_whole_rays_through_the_chained_units() {
 
         // Gradient, N6 on the orthogonal neighbours.
         let grad_in: Vec<GradientIn> = samples
-            .chunks_exact(OFFSETS.len())
-            .map(|s| {
-                let mut block = [0u32; 27];
-                for (v, (di, dj, dk)) in s.iter().zip(OFFSETS) {
-                    block[block_index(di, dj, dk)] = *v;
-                }
-                GradientIn {
-                    samples: block,
-                    dx: 0,
-                    dy: 0,
-                    mode: GradientMode::N6,
-                }
-            })
+            .chunks_exact(N6_OFFSETS.len())
+            .map(n6_gradient_in)
             .collect();
         let grads: Vec<GradientOut> = stage(
             &mut r_grad,
@@ -215,15 +192,13 @@ fn ten_thousand_whole_rays_through_the_chained_units() {
         let shader_in: Vec<ShaderIn> = active
             .iter()
             .zip(&grads)
-            .zip(samples.chunks_exact(OFFSETS.len()))
-            .map(|((&r, g), s)| ShaderIn {
-                sample: s[0],
-                grad: [g.gx >> 4, g.gy >> 4, g.gz >> 4],
-                mag: g.mag >> 4,
-                mode: ShaderMode {
+            .zip(samples.chunks_exact(N6_OFFSETS.len()))
+            .map(|((&r, g), s)| {
+                let mode = ShaderMode {
                     tf2d: rays[r].tf2d,
                     unlit: rays[r].mode != ComposMode::FrontToBack,
-                },
+                };
+                shader_in(s[0], g, mode)
             })
             .collect();
         let shaded: Vec<Rgba> = stage(
@@ -273,7 +248,7 @@ fn ten_thousand_whole_rays_through_the_chained_units() {
         .count();
     eprintln!(
         "{RAYS} rays, {samples_total} samples, {} interpolations: bit-exact at every stage; {terminated} rays terminated, {opaque} at least half opaque (seed {seed})",
-        samples_total * OFFSETS.len()
+        samples_total * N6_OFFSETS.len()
     );
     assert!(samples_total >= RAYS * MIN_LEN);
     assert!(

@@ -4,8 +4,8 @@ mod support;
 
 use cube5_model::unit::StreamUnit;
 use cube5_model::units::cube5_compos::{
-    config_writes, Compos, ComposConfig, ComposIn, ComposMode, ComposRegs, Coxel, OpacityLut,
-    Sample,
+    config_writes, correction_ratios, Compos, ComposConfig, ComposIn, ComposMode, ComposRegs,
+    Coxel, OpacityLut, Sample,
 };
 use cube5_tb::harness::{check_stream, must_match, StreamCheck};
 use cube5_tb::rtl::RtlStream;
@@ -280,20 +280,8 @@ fn directed_opacity_saturation_over_10000_samples() {
 /// an empty coxel under front to back returns A = Lut[r] on the coxel scale, every code.
 #[test]
 fn directed_opacity_correction_1_16_to_16_including_sub_lsb() {
-    let ratios = [
-        1.0 / 16.0,
-        1.0 / 8.0,
-        0.25,
-        0.5,
-        1.0,
-        3f64.sqrt(),
-        2.0,
-        4.0,
-        8.0,
-        16.0,
-    ];
     for (variant, cfg) in configs::<ComposConfig>() {
-        for ratio in ratios {
+        for ratio in correction_ratios() {
             let regs = ComposRegs::without_termination(&cfg);
             let mut gold = unit(cfg, ratio, regs);
             let items: Vec<ComposIn> = (0..=cfg.alpha_max())
@@ -497,13 +485,8 @@ fn gate_level_netlist_smoke() {
     let (variant, cfg) = gate_configs::<ComposConfig>()[0];
     let mut gold = unit(cfg, 2.0, busy_regs(&cfg, 2, false));
     let writes = gold.config_writes();
-    must_match(
-        variant,
-        cfg,
-        &mut gold,
-        &mut random_item(cfg),
-        &StreamCheck::gate_smoke(seed(21)).with_config_writes(writes),
-    );
+    let smoke = StreamCheck::gate_smoke(seed(21)).with_config_writes(writes);
+    must_match(variant, cfg, &mut gold, &mut random_item(cfg), &smoke);
     let regs = busy_regs(&cfg, 0, true);
     let mut gold = unit(cfg, 0.5, regs);
     let mut items = Vec::new();

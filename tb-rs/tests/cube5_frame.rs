@@ -80,7 +80,7 @@ fn views() -> Vec<(&'static str, [f64; 3])> {
         ("45-1e-3 xz", [1.0 - 1e-3, 0.0, 1.0]),
         ("45 -x-y", [-1.0, -1.0, 0.0]),
         ("diagonal", [1.0, 1.0, 1.0]),
-        ("oblique z", [-0.37, 0.81, -1.0]),
+        OBLIQUE_Z,
         ("oblique y", [0.6, -1.0, 0.3]),
         ("oblique x", [0.9, 0.45, -0.2]),
     ]
@@ -123,6 +123,29 @@ fn seen_of(vol: &Volume, lut: &BlockLut) -> Rc<Volume> {
 
 fn bench(rtl: FrameRtl, vol: &Volume, lut: &BlockLut, s: u64) -> FrameBench {
     must(FrameBench::new(rtl, vol, lut, s as u32))
+}
+
+/// A bench of `rtl` loaded with `vol` (blocks of 0 empty), and the volume as the RTL sees it.
+fn loaded(rtl: FrameRtl, vol: &Volume, s: u64) -> (FrameBench, Rc<Volume>) {
+    let lut = BlockLut::from_volume(vol, rtl.block as usize, 0).unwrap();
+    let seen = seen_of(vol, &lut);
+    (bench(rtl, vol, &lut, s), seen)
+}
+
+/// The oblique view most single-frame tests render.
+const OBLIQUE_Z: (&str, [f64; 3]) = ("oblique z", [-0.37, 0.81, -1.0]);
+
+/// A P = 4 bench loaded with the `n`^3 head phantom, and its oblique composite frame (early
+/// termination `et`).
+fn oblique_head_p4(n: usize, et: bool, s: u64) -> (FrameRtl, FrameBench, Expected) {
+    let rtl = p(4);
+    let vol = head_phantom(n, 12).unwrap();
+    let (bench, seen) = loaded(rtl, &vol, s);
+    (
+        rtl,
+        bench,
+        expect(&rtl, &seen, OBLIQUE_Z, Render::Composite, et),
+    )
 }
 
 fn must<T>(r: Result<T, cube5_tb::TbError>) -> T {
@@ -226,18 +249,10 @@ fn backpressure_and_mid_frame_reset() {
     let s = seed(3);
     let rtl = p(4);
     let vol = blob_volume([48, 32, 40], 12, s);
-    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-    let seen = seen_of(&vol, &lut);
+    let (mut bench, seen) = loaded(rtl, &vol, s);
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let heavy = Traffic::random(&mut rng, 0.0, 0.6);
-    let mut bench = bench(rtl, &vol, &lut, s);
-    let comp = expect(
-        &rtl,
-        &seen,
-        ("oblique z", [-0.37, 0.81, -1.0]),
-        Render::Composite,
-        false,
-    );
+    let comp = expect(&rtl, &seen, OBLIQUE_Z, Render::Composite, false);
     let mip = expect(
         &rtl,
         &seen,
@@ -285,9 +300,7 @@ fn refused_configurations_answer_one_error_item() {
     let s = seed(4);
     let rtl = p(4);
     let vol = head_phantom(16, 12).unwrap();
-    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-    let seen = seen_of(&vol, &lut);
-    let mut bench = bench(rtl, &vol, &lut, s);
+    let (mut bench, seen) = loaded(rtl, &vol, s);
     let good = expect(
         &rtl,
         &seen,
@@ -395,9 +408,7 @@ fn smallest_volumes_render_and_smaller_are_refused() {
         ),
     ] {
         let vol = noise_volume(dims, s);
-        let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-        let seen = seen_of(&vol, &lut);
-        let mut bench = bench(rtl, &vol, &lut, s);
+        let (mut bench, seen) = loaded(rtl, &vol, s);
         for render in [Render::Mip, Render::Composite] {
             for v in &ok_views {
                 let e = expect(&rtl, &seen, *v, render, false);
@@ -472,9 +483,7 @@ fn sweep_and_readout_cycles_follow_the_budget() {
     let s = seed(7);
     let vol = head_phantom(32, 12).unwrap();
     for rtl in [p(1), p(4), p(8)] {
-        let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-        let seen = seen_of(&vol, &lut);
-        let mut bench = bench(rtl, &vol, &lut, s);
+        let (mut bench, seen) = loaded(rtl, &vol, s);
         // Memory L + 2, corner register 1, trilin, window register 1, gradient, shader, buffer
         // read 1, compos, write-back count 1.
         let pipeline = u64::from(rtl.skew().latency())
@@ -486,7 +495,7 @@ fn sweep_and_readout_cycles_follow_the_budget() {
             + 1
             + COMPOS_LATENCY
             + 1;
-        for v in [("+z", [0.0, 0.0, 1.0]), ("oblique z", [-0.37, 0.81, -1.0])] {
+        for v in [("+z", [0.0, 0.0, 1.0]), OBLIQUE_Z] {
             let e = expect(&rtl, &seen, v, Render::Composite, false);
             let st = must(bench.check(&e, &Traffic::full_speed(), s));
             let p = &e.params;
@@ -524,9 +533,7 @@ fn narrow_configurations_s1_s4() {
             (narrow(1), blob_volume([8, 4, 8], 8, s)),
             (narrow(4), head_phantom(8, 8).unwrap()),
         ] {
-            let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-            let seen = seen_of(&vol, &lut);
-            let mut bench = bench(rtl, &vol, &lut, s);
+            let (mut bench, seen) = loaded(rtl, &vol, s);
             let mut rng = ChaCha8Rng::seed_from_u64(s);
             let traffic = Traffic::random(&mut rng, 0.0, 0.3);
             let mut n = 0;
@@ -553,9 +560,7 @@ fn gate_level_netlist_smoke() {
     assert_eq!(gate.len(), 1, "one gate-level frame netlist");
     let rtl = FrameRtl::from_variant(gate[0]).unwrap();
     let vol = head_phantom(8, 8).unwrap();
-    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-    let seen = seen_of(&vol, &lut);
-    let mut bench = bench(rtl, &vol, &lut, s);
+    let (mut bench, seen) = loaded(rtl, &vol, s);
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let traffic = Traffic::random(&mut rng, 0.0, 0.3);
     for render in [Render::Mip, Render::Composite] {
@@ -579,18 +584,7 @@ fn gate_level_netlist_smoke() {
 #[test]
 fn early_termination_flag_reaches_the_image() {
     let s = seed(10);
-    let rtl = p(4);
-    let vol = head_phantom(32, 12).unwrap();
-    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-    let seen = seen_of(&vol, &lut);
-    let mut bench = bench(rtl, &vol, &lut, s);
-    let e = expect(
-        &rtl,
-        &seen,
-        ("oblique z", [-0.37, 0.81, -1.0]),
-        Render::Composite,
-        true,
-    );
+    let (_, mut bench, e) = oblique_head_p4(32, true, s);
     let terminated = e.want.iter().filter(|c| c.terminated).count();
     assert!(terminated > 0, "some rays reach the threshold");
     must(bench.check(&e, &Traffic::full_speed(), s));
@@ -605,18 +599,7 @@ fn a_step_one_weight_lsb_off_in_the_rtl_is_reported_with_pixel_channel_and_trail
     // The comparison bites on the frame's own arithmetic (slice constants, rays, rotation), not
     // just on the units': a DY one weight LSB off in the RTL's register alone must be caught.
     let s = seed(11);
-    let rtl = p(4);
-    let vol = head_phantom(16, 12).unwrap();
-    let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-    let seen = seen_of(&vol, &lut);
-    let mut bench = bench(rtl, &vol, &lut, s);
-    let e = expect(
-        &rtl,
-        &seen,
-        ("oblique z", [-0.37, 0.81, -1.0]),
-        Render::Composite,
-        false,
-    );
+    let (rtl, mut bench, e) = oblique_head_p4(16, false, s);
     must(bench.load(&e));
     let lsb = 1 << (16 - rtl.trilin.weight_w);
     must(bench.write(&[rtl.reg(REG_DY, ((e.params.dy + lsb) as u32) & 0x3ffff)]));
@@ -681,9 +664,7 @@ fn empty_slice_skipping_cuts_cycles_without_changing_a_pixel() {
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let traffic = Traffic::random(&mut rng, 0.0, 0.2);
     for rtl in [p(1), p(4)] {
-        let lut = BlockLut::from_volume(&vol, rtl.block as usize, 0).unwrap();
-        let seen = seen_of(&vol, &lut);
-        let mut bench = bench(rtl, &vol, &lut, s);
+        let (mut bench, seen) = loaded(rtl, &vol, s);
         let (mut plain, mut skipping) = (0u64, 0u64);
         for (i, v) in views().into_iter().enumerate() {
             for render in [Render::Mip, Render::Composite] {

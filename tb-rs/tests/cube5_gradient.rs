@@ -4,15 +4,17 @@ mod support;
 
 use cube5_model::unit::StreamUnit;
 use cube5_model::units::cube5_gradient::{
-    block_index, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
+    block_index, block_offset, block_where, Gradient, GradientConfig, GradientIn, GradientMode,
+    GradientOut,
 };
-use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::RtlStream;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
     assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
-    gate_configs, must_match_across_a_reset, must_match_items, random_items, seed, MILLION,
+    gate_smoke_then_directed, must_match_across_a_reset, must_match_items, random_items, seed,
+    MILLION,
 };
 
 const LATENCY: u64 = 5;
@@ -41,8 +43,9 @@ fn random_item(cfg: GradientConfig) -> impl FnMut(&mut ChaCha8Rng) -> GradientIn
                 );
                 let base = rng.random_range(0..=max);
                 std::array::from_fn(|i| {
-                    let (di, dj, dk) = (i as i64 % 3 - 1, (i as i64 / 3) % 3 - 1, i as i64 / 9 - 1);
-                    (base + a * di + b * dj + c * dk).clamp(0, max) as u32
+                    let (di, dj, dk) = block_offset(i);
+                    let d = a * i64::from(di) + b * i64::from(dj) + c * i64::from(dk);
+                    (base + d).clamp(0, max) as u32
                 })
             }
         };
@@ -74,30 +77,20 @@ fn random_item(cfg: GradientConfig) -> impl FnMut(&mut ChaCha8Rng) -> GradientIn
 fn directed_items(cfg: GradientConfig) -> Vec<GradientIn> {
     let max = cfg.sample_max();
     let one = 1i32 << cfg.weight_w;
-    let pick = |f: &dyn Fn(i32, i32, i32) -> bool| -> [u32; 27] {
-        std::array::from_fn(|i| {
-            let (di, dj, dk) = (i as i32 % 3 - 1, (i as i32 / 3) % 3 - 1, i as i32 / 9 - 1);
-            if f(di, dj, dk) {
-                max
-            } else {
-                0
-            }
-        })
-    };
     let blocks = [
         [0; 27],
         [max; 27],
-        pick(&|di, dj, dk| di + dj + dk > 0),
-        pick(&|di, dj, dk| di + dj + dk < 0),
-        pick(&|di, dj, dk| di > 0 || dj > 0 || dk > 0),
-        pick(&|di, dj, dk| di < 0 || dj < 0 || dk < 0),
-        pick(&|di, _, _| di > 0),
-        pick(&|_, dj, _| dj < 0),
-        pick(&|_, _, dk| dk > 0),
-        pick(&|di, dj, dk| (di + dj + dk) & 1 == 0),
-        pick(&|di, dj, dk| di * dj * dk != 0),
-        pick(&|di, dj, dk| di == 1 && dj == 1 && dk == 1),
-        pick(&|di, dj, dk| di == -1 && dj == -1 && dk == -1),
+        block_where(max, |di, dj, dk| di + dj + dk > 0),
+        block_where(max, |di, dj, dk| di + dj + dk < 0),
+        block_where(max, |di, dj, dk| di > 0 || dj > 0 || dk > 0),
+        block_where(max, |di, dj, dk| di < 0 || dj < 0 || dk < 0),
+        block_where(max, |di, _, _| di > 0),
+        block_where(max, |_, dj, _| dj < 0),
+        block_where(max, |_, _, dk| dk > 0),
+        block_where(max, |di, dj, dk| (di + dj + dk) & 1 == 0),
+        block_where(max, |di, dj, dk| di * dj * dk != 0),
+        block_where(max, |di, dj, dk| di == 1 && dj == 1 && dk == 1),
+        block_where(max, |di, dj, dk| di == -1 && dj == -1 && dk == -1),
     ];
     let steps = [
         0,
@@ -214,23 +207,7 @@ fn one_item_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = gate_configs::<GradientConfig>()[0];
-    let mut gold = Gradient::new(cfg).unwrap();
-    must_match(
-        variant,
-        cfg,
-        &mut gold,
-        &mut random_item(cfg),
-        &StreamCheck::gate_smoke(seed(34)),
-    );
-    let mut gold = Gradient::new(cfg).unwrap();
-    must_match_items(
-        variant,
-        cfg,
-        &mut gold,
-        directed_items(cfg),
-        &StreamCheck::directed(seed(35)),
-    );
+    gate_smoke_then_directed(Gradient::new, random_item, directed_items, 34);
 }
 
 /// A golden model with one contract detail changed: co-simulation must reject each, which shows

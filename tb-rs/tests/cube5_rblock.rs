@@ -3,13 +3,13 @@
 mod support;
 
 use cube5_model::units::cube5_rblock::{BlockingLuts, RBlock, RBlockConfig, RBlockDir, RBlockIn};
-use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
-    gate_configs, must_match_across_a_reset, must_match_items, random_items, seed, variant_with,
+    assert_foreign_codec_is_refused, configs, expect_mismatch, gate_smoke_then_directed,
+    must_match_across_a_reset, must_match_items, random_items_one_per_clock, seed, variant_with,
     MILLION,
 };
 
@@ -107,32 +107,12 @@ fn every_index_of_the_patent_example_matches_the_lut_form() {
 
 #[test]
 fn one_conversion_per_cycle_when_never_stalled() {
-    const LATENCY: u64 = 1;
-    for (variant, cfg) in configs::<RBlockConfig>() {
-        let items = random_items(seed(11), 100_000, random_item(cfg));
-        assert_one_item_per_clock(variant, cfg, &[], &items, LATENCY);
-    }
+    random_items_one_per_clock(random_item, 11, 1);
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = gate_configs::<RBlockConfig>()[0];
-    let mut gold = RBlock::new(cfg).unwrap();
-    must_match(
-        variant,
-        cfg,
-        &mut gold,
-        &mut random_item(cfg),
-        &StreamCheck::gate_smoke(seed(21)),
-    );
-    let mut gold = RBlock::new(cfg).unwrap();
-    must_match_items(
-        variant,
-        cfg,
-        &mut gold,
-        directed_items(cfg),
-        &StreamCheck::directed(seed(22)),
-    );
+    gate_smoke_then_directed(RBlock::new, random_item, directed_items, 21);
 }
 
 /// The comparison tells the interleave orders apart: a model that interleaves z, y, x (the mirror

@@ -6,6 +6,7 @@ use cube5_model::unit::StreamUnit;
 use cube5_model::units::cube5_sepconv::{Sepconv, SepconvConfig, SepconvIn, SepconvKernel};
 use cube5_tb::harness::{check_stream, must_match, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
+use cube5_tb::Variant;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
@@ -78,21 +79,20 @@ fn million_random_items_per_config_with_idle_backpressure_and_reset() {
     }
 }
 
+/// The directed items at every weight of `weights`, each weight loaded through the port.
+fn directed_at_every_weight(variant: &'static Variant, cfg: SepconvConfig, seed_no: u64) {
+    for w in weights(cfg) {
+        let mut gold = Sepconv::new(cfg, w).unwrap();
+        let writes = gold.config_writes();
+        let check = StreamCheck::directed(seed(seed_no)).with_config_writes(writes);
+        must_match_items(variant, cfg, &mut gold, directed_items(cfg), &check);
+    }
+}
+
 #[test]
 fn directed_extremes_at_every_weight() {
     for (variant, cfg) in configs::<SepconvConfig>() {
-        for w in weights(cfg) {
-            let mut gold = Sepconv::new(cfg, w).unwrap();
-            let writes = gold.config_writes();
-            let items = directed_items(cfg);
-            must_match_items(
-                variant,
-                cfg,
-                &mut gold,
-                items,
-                &StreamCheck::directed(seed(41)).with_config_writes(writes),
-            );
-        }
+        directed_at_every_weight(variant, cfg, 41);
     }
 }
 
@@ -165,25 +165,9 @@ fn gate_level_netlist_smoke() {
     let (variant, cfg) = gate_configs::<SepconvConfig>()[0];
     let mut gold = Sepconv::new(cfg, cfg.weight_from_f64(2.0)).unwrap();
     let writes = gold.config_writes();
-    must_match(
-        variant,
-        cfg,
-        &mut gold,
-        &mut random_item(cfg),
-        &StreamCheck::gate_smoke(seed(44)).with_config_writes(writes),
-    );
-    for w in weights(cfg) {
-        let mut gold = Sepconv::new(cfg, w).unwrap();
-        let writes = gold.config_writes();
-        let items = directed_items(cfg);
-        must_match_items(
-            variant,
-            cfg,
-            &mut gold,
-            items,
-            &StreamCheck::directed(seed(45)).with_config_writes(writes),
-        );
-    }
+    let smoke = StreamCheck::gate_smoke(seed(44)).with_config_writes(writes);
+    must_match(variant, cfg, &mut gold, &mut random_item(cfg), &smoke);
+    directed_at_every_weight(variant, cfg, 45);
 }
 
 /// A golden model that rounds ties down instead of up.

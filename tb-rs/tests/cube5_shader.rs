@@ -22,21 +22,7 @@ use support::{
 };
 
 fn random_tables(cfg: &ShaderConfig, seed: u64) -> ShaderTables {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let class = ClassLut::from_fn(cfg, |_| Rgba {
-        r: rng.random_range(0..=cfg.color_max()),
-        g: rng.random_range(0..=cfg.color_max()),
-        b: rng.random_range(0..=cfg.color_max()),
-        a: rng.random_range(0..=cfg.alpha_max()),
-    })
-    .unwrap();
-    let mut texel = || Texel {
-        d: rng.random_range(0..=cfg.diff_max()),
-        sp: rng.random_range(0..=cfg.spec_max()),
-    };
-    let zero = texel();
-    let rmap = ReflectanceMap::from_fn(cfg, |_, _, _| texel(), zero).unwrap();
-    ShaderTables { class, rmap }
+    ShaderTables::random(cfg, &mut ChaCha8Rng::seed_from_u64(seed)).unwrap()
 }
 
 /// Every entry at its maximum: every lit channel saturates.

@@ -8,12 +8,12 @@ mod support;
 
 use cube5_model::unit::StreamUnit;
 use cube5_model::units::cube5_skewmem::{
-    Axis, BlockEntry, BlockLut, SkewConfig, SkewDims, SkewIn, SkewMem, SkewOp,
+    Axis, BlockEntry, BlockLut, SkewConfig, SkewDims, SkewIn, SkewMem, SkewOp, SkewOut,
 };
 use cube5_model::volume::Volume;
 use cube5_tb::harness::{check_stream, must_match, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
-use cube5_tb::Variant;
+use cube5_tb::{Mismatch, Variant};
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -315,12 +315,17 @@ fn directed_extremes() {
     }
 }
 
-#[test]
-fn skipped_blocks_read_zero_with_flags_in_rtl() {
+/// The default configuration, its largest edge `M` and a random `M^3` volume (seed `s`).
+fn default_full_volume(s: u64) -> (SkewConfig, u32, Volume) {
     let cfg = SkewConfig::DEFAULT;
     let m = cfg.max_dim();
-    let mut rng = ChaCha8Rng::seed_from_u64(seed(9));
-    let vol = random_volume(&cfg, [m; 3], &mut rng);
+    let vol = random_volume(&cfg, [m; 3], &mut ChaCha8Rng::seed_from_u64(s));
+    (cfg, m, vol)
+}
+
+#[test]
+fn skipped_blocks_read_zero_with_flags_in_rtl() {
+    let (cfg, m, vol) = default_full_volume(seed(9));
     for (empty, masked) in [(true, false), (false, true)] {
         let mut lut = BlockLut::from_volume(&vol, 8, 0).unwrap();
         lut.entries[3].empty = empty;
@@ -491,36 +496,37 @@ fn gate_level_netlist_smoke() {
 /// that differs between RTL and model is caught downstream, by a later beam or counter.
 #[test]
 fn the_comparison_bites_on_state_lut_and_counters() {
-    let cfg = SkewConfig::DEFAULT;
-    let m = cfg.max_dim();
-    let mut rng = ChaCha8Rng::seed_from_u64(4242);
-    let vol = random_volume(&cfg, [m; 3], &mut rng);
+    let (cfg, m, vol) = default_full_volume(4242);
     let lut = BlockLut::identity([m as usize; 3], 8).unwrap();
     let fill = fill_commands(&vol);
-    let quiet = |items: usize, writes: Vec<(u32, Vec<u32>)>| {
-        let mut c = StreamCheck::new(4242, items)
+    // The fill, then 5000 random commands, on an RTL configured by `writes` against `gold`: the
+    // mismatch that must be reported.
+    fn caught<G: StreamUnit<In = SkewIn, Out = SkewOut>>(
+        cfg: SkewConfig,
+        gold: &mut G,
+        fill: &[SkewIn],
+        writes: Vec<(u32, Vec<u32>)>,
+        why: &str,
+    ) -> Mismatch {
+        let m = cfg.max_dim();
+        let mut check = StreamCheck::new(4242, fill.len() + 5_000)
             .with_traffic(0.1, 0.1)
             .with_config_writes(writes);
-        c.waveform_on_mismatch = false;
-        c
-    };
-    let items = fill.len() + 5_000;
+        check.waveform_on_mismatch = false;
+        let mut gen = scripted(fill.to_vec(), cfg, [m; 3]);
+        expect_mismatch(
+            check_stream(variant_with(cfg), cfg, gold, &mut gen, &check),
+            why,
+        )
+    }
 
     // 1. The RTL gets a LUT in which block 5 is empty; the model does not know.
     let mut rtl_lut = lut.clone();
     rtl_lut.entries[5].empty = true;
     let writes = controller(cfg, [m; 3], rtl_lut).config_writes();
     let mut gold = controller(cfg, [m; 3], lut.clone());
-    let err = expect_mismatch(
-        check_stream(
-            variant_with(cfg),
-            cfg,
-            &mut gold,
-            &mut scripted(fill.clone(), cfg, [m; 3]),
-            &quiet(items, writes),
-        ),
-        "a LUT difference must be caught",
-    );
+    let why = "a LUT difference must be caught";
+    let err = caught(cfg, &mut gold, &fill, writes, why);
     assert!(err.rtl.contains("empty: true"), "{err}");
 
     // 2. The RTL was told a smaller volume (nz = 8): writes and reads beyond are dropped there.
@@ -531,16 +537,8 @@ fn the_comparison_bites_on_state_lut_and_counters() {
     )
     .config_writes();
     let mut gold = controller(cfg, [m; 3], lut.clone());
-    let err = expect_mismatch(
-        check_stream(
-            variant_with(cfg),
-            cfg,
-            &mut gold,
-            &mut scripted(fill.clone(), cfg, [m; 3]),
-            &quiet(items, writes),
-        ),
-        "a dimension difference must be caught",
-    );
+    let why = "a dimension difference must be caught";
+    let err = caught(cfg, &mut gold, &fill, writes, why);
     assert!(err.rtl.contains("outside: true"), "{err}");
 
     // 3. One write of the fill lands elsewhere in the model (a corrupted address, say): the
@@ -552,7 +550,7 @@ fn the_comparison_bites_on_state_lut_and_counters() {
     }
     impl StreamUnit for MisplacesOneWrite {
         type In = SkewIn;
-        type Out = cube5_model::units::cube5_skewmem::SkewOut;
+        type Out = SkewOut;
         fn run(&mut self, inputs: &[SkewIn]) -> Vec<Self::Out> {
             inputs
                 .iter()
@@ -578,16 +576,8 @@ fn the_comparison_bites_on_state_lut_and_counters() {
         lose: 1000,
     };
     let writes = gold.inner.config_writes();
-    let err = expect_mismatch(
-        check_stream(
-            variant_with(cfg),
-            cfg,
-            &mut gold,
-            &mut scripted(fill.clone(), cfg, [m; 3]),
-            &quiet(items, writes),
-        ),
-        "a misplaced write must be caught",
-    );
+    let why = "a misplaced write must be caught";
+    let err = caught(cfg, &mut gold, &fill, writes, why);
     eprintln!("{err}");
     assert!(err.item >= 1000, "{err}");
 }

@@ -4,15 +4,15 @@ mod support;
 
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
-use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::RtlStream;
 use cube5_tb::variants::{mutant_variants_of, variants_of};
-use cube5_tb::TbError;
+use cube5_tb::{Mismatch, TbError, Variant};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, configs, expect_mismatch, gate_configs, must_match_across_a_reset,
-    must_match_items, random_items, seed, MILLION,
+    configs, expect_mismatch, gate_smoke_then_directed, must_match_across_a_reset,
+    must_match_items, random_items_one_per_clock, seed, MILLION,
 };
 
 fn random_item(cfg: TrilinConfig) -> impl FnMut(&mut ChaCha8Rng) -> TrilinIn {
@@ -82,6 +82,18 @@ fn million_random_samples_per_config_with_idle_backpressure_and_reset() {
     }
 }
 
+/// A random run that must mismatch (`why` it must): the mismatch reported.
+fn random_run_mismatch(
+    variant: &'static Variant,
+    cfg: TrilinConfig,
+    check: &StreamCheck,
+    why: &str,
+) -> Mismatch {
+    let mut gold = Trilin::new(cfg).unwrap();
+    let run = check_stream(variant, cfg, &mut gold, &mut random_item(cfg), check);
+    expect_mismatch(run, why)
+}
+
 #[test]
 fn directed_extremes() {
     for (variant, cfg) in configs::<TrilinConfig>() {
@@ -94,24 +106,12 @@ fn directed_extremes() {
 
 #[test]
 fn one_sample_per_cycle_when_never_stalled() {
-    const LATENCY: u64 = 3;
-    for (variant, cfg) in configs::<TrilinConfig>() {
-        let items = random_items(seed(11), 100_000, random_item(cfg));
-        assert_one_item_per_clock(variant, cfg, &[], &items, LATENCY);
-    }
+    random_items_one_per_clock(random_item, 11, 3);
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    for (variant, cfg) in gate_configs::<TrilinConfig>() {
-        let mut gold = Trilin::new(cfg).unwrap();
-        let check = StreamCheck::gate_smoke(seed(21));
-        must_match(variant, cfg, &mut gold, &mut random_item(cfg), &check);
-        let mut gold = Trilin::new(cfg).unwrap();
-        let items = directed_items(cfg);
-        let check = StreamCheck::directed(seed(22));
-        must_match_items(variant, cfg, &mut gold, items, &check);
-    }
+    gate_smoke_then_directed(Trilin::new, random_item, directed_items, 21);
 }
 
 /// The gate-level flow must be able to see a wrong netlist: the same smoke run on a netlist with
@@ -126,14 +126,10 @@ fn gate_level_netlist_with_a_seeded_fault_is_caught() {
     for variant in mutants {
         let cfg: TrilinConfig = variant.config().unwrap();
         let check = StreamCheck::new(seed(23), 30_000).with_traffic(0.2, 0.3);
-        let err = expect_mismatch(
-            check_stream(
-                variant,
-                cfg,
-                &mut Trilin::new(cfg).unwrap(),
-                &mut random_item(cfg),
-                &check,
-            ),
+        let err = random_run_mismatch(
+            variant,
+            cfg,
+            &check,
             "the mutated netlist must mismatch the model",
         );
         eprintln!("seeded fault caught: {err}");
@@ -146,16 +142,7 @@ fn a_flipped_output_bit_is_reported_with_seed_inputs_outputs_and_waveform() {
     let mut check = StreamCheck::new(4242, 5_000).with_traffic(0.1, 0.1);
     check.corrupt = Some((1234, 3));
     check.waveform_on_mismatch = true;
-    let err = expect_mismatch(
-        check_stream(
-            variant,
-            cfg,
-            &mut Trilin::new(cfg).unwrap(),
-            &mut random_item(cfg),
-            &check,
-        ),
-        "a corrupted output must be caught",
-    );
+    let err = random_run_mismatch(variant, cfg, &check, "a corrupted output must be caught");
     let m = &err;
     assert_eq!(m.item, 1234);
     let report = err.to_string();

@@ -6,13 +6,13 @@ use cube5_model::units::gicube_bucket::{
     random_position, BucketConfig, BucketIn, BucketUnit, Distribution, Position,
 };
 use cube5_model::units::gicube_packet_loop::POS_FRAC_W;
-use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, configs, expect_mismatch, gate_configs, must_match_across_a_reset,
-    must_match_items, random_items, seed, variant_with, MILLION,
+    configs, expect_mismatch, gate_smoke_then_directed, must_match_across_a_reset,
+    must_match_items, random_items_one_per_clock, seed, variant_with, MILLION,
 };
 
 fn random_item(cfg: BucketConfig) -> impl FnMut(&mut ChaCha8Rng) -> BucketIn {
@@ -90,33 +90,13 @@ fn directed_block_and_volume_edges() {
 
 #[test]
 fn one_item_per_cycle_when_never_stalled() {
-    const LATENCY: u64 = 1;
-    for (variant, cfg) in configs::<BucketConfig>() {
-        // An item is `cfg.lanes` positions: that many per clock.
-        let items = random_items(seed(411), 100_000, random_item(cfg));
-        assert_one_item_per_clock(variant, cfg, &[], &items, LATENCY);
-    }
+    // An item is `cfg.lanes` positions: that many per clock.
+    random_items_one_per_clock(random_item, 411, 1);
 }
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = gate_configs::<BucketConfig>()[0];
-    let mut gold = BucketUnit::new(cfg).unwrap();
-    must_match(
-        variant,
-        cfg,
-        &mut gold,
-        &mut random_item(cfg),
-        &StreamCheck::gate_smoke(seed(412)),
-    );
-    let mut gold = BucketUnit::new(cfg).unwrap();
-    must_match_items(
-        variant,
-        cfg,
-        &mut gold,
-        directed_items(cfg),
-        &StreamCheck::directed(seed(413)),
-    );
+    gate_smoke_then_directed(BucketUnit::new, random_item, directed_items, 412);
 }
 
 #[test]

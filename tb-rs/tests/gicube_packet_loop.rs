@@ -9,13 +9,13 @@ use cube5_model::units::gicube_packet_loop::{
     directed_packets, random_packet, PacketLoop, PacketLoopConfig, PacketLoopOut, RayPacket,
     PACKET_WORDS,
 };
-use cube5_tb::harness::{check_stream, must_match, StreamCheck};
+use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, configs, expect_mismatch, gate_configs, must_match_across_a_reset,
-    must_match_items, random_items, seed, variant_with, MILLION,
+    assert_one_item_per_clock, configs, expect_mismatch, gate_smoke_then_directed,
+    must_match_across_a_reset, must_match_items, random_items, seed, variant_with, MILLION,
 };
 
 fn random_item(rng: &mut ChaCha8Rng) -> RayPacket {
@@ -61,22 +61,11 @@ fn one_packet_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = gate_configs::<PacketLoopConfig>()[0];
-    let mut gold = PacketLoop::new(cfg).unwrap();
-    must_match(
-        variant,
-        cfg,
-        &mut gold,
-        &mut random_item,
-        &StreamCheck::gate_smoke(seed(303)),
-    );
-    let mut gold = PacketLoop::new(cfg).unwrap();
-    must_match_items(
-        variant,
-        cfg,
-        &mut gold,
-        directed_packets(),
-        &StreamCheck::directed(seed(304)),
+    gate_smoke_then_directed(
+        PacketLoop::new,
+        |_| random_item,
+        |_| directed_packets(),
+        303,
     );
 }
 

@@ -105,13 +105,6 @@ fn a_parameter_the_model_sets_differently_is_caught() {
     assert!(FrameConfig::from_params(&[("NoSuchParam", 1)]).is_err());
 }
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .into()
-}
-
 /// Files that may name variants: none but the generated table (in OUT_DIR) and the `.variants`
 /// files themselves (and their reader's own tests of the naming rule, and this file). Docs
 /// (Markdown) name configurations in their tables; that is prose.
@@ -167,7 +160,7 @@ fn literals(text: &str) -> Vec<String> {
 
 #[test]
 fn no_variant_is_named_by_a_string_outside_the_table_and_the_variants_files() {
-    let repo = repo();
+    let repo = cube5_model::repo_root();
     let mut files = Vec::new();
     sources(&repo, &mut files);
     assert!(files.len() > 50, "the scan sees the sources");

@@ -457,12 +457,7 @@ impl Setup {
     }
 
     /// A tiny sweep for tests: a few settings of every knob, three angles.
-    pub fn tiny(
-        volume: Volume,
-        tf: TransferFunction,
-        params: RenderParams,
-        quality: Quality,
-    ) -> Self {
+    pub fn tiny(vol: Volume, tf: TransferFunction, params: RenderParams, quality: Quality) -> Self {
         Self {
             voxel_bits: vec![8, 12],
             weight_bits: vec![4, 8],
@@ -472,7 +467,7 @@ impl Setup {
             thresholds: vec![0.9, 1.0],
             angles: vec![0.0, 30.0, 45.0],
             sphere_size: 24,
-            ..Self::new(volume, tf, params, quality)
+            ..Self::new(vol, tf, params, quality)
         }
     }
 }

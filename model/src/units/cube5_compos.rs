@@ -7,7 +7,7 @@
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
 use crate::regs::cube5_compos as regmap;
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 
 /// Widths of one `cube5_compos` configuration (the RTL parameters of the same names).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -281,6 +281,23 @@ impl ComposRegs {
     }
 }
 
+/// The step ratios `d/k` the opacity-correction tables are checked at: 1/16 to 16 by powers of two,
+/// and the diagonal step `sqrt(3)`.
+pub fn correction_ratios() -> [f64; 10] {
+    [
+        1.0 / 16.0,
+        1.0 / 8.0,
+        1.0 / 4.0,
+        0.5,
+        1.0,
+        3f64.sqrt(),
+        2.0,
+        4.0,
+        8.0,
+        16.0,
+    ]
+}
+
 /// The opacity-correction table `alpha' = 1 - (1 - alpha)^(d/k)`, `2^AlphaW` entries of `U(1.Q)`.
 /// Produced here and nowhere else; loaded into the model directly and into the RTL through the
 /// configuration port (`config_writes`).
@@ -548,17 +565,7 @@ pub fn config_writes(
     writes
 }
 
-impl StreamUnit for Compos {
-    type In = ComposIn;
-    type Out = Coxel;
-
-    fn run(&mut self, inputs: &[ComposIn]) -> Vec<Coxel> {
-        inputs
-            .iter()
-            .map(|it| self.step(&it.coxel, &it.sample))
-            .collect()
-    }
-}
+crate::item_by_item!(Compos, ComposIn => Coxel, |unit, it| unit.step(&it.coxel, &it.sample));
 
 impl StreamCodec for ComposConfig {
     type In = ComposIn;
@@ -586,17 +593,17 @@ impl StreamCodec for ComposConfig {
     }
 
     fn unpack_out(&self, words: &[u32]) -> Coxel {
-        let mut r = BitReader::new(words);
-        let rgba = std::array::from_fn(|_| r.get(self.acc_w + 1));
-        let z = r.get(self.z_w) as u32;
-        let geo = std::array::from_fn(|_| r.get(self.color_w) as u32);
-        let terminated = r.get_bool();
-        Coxel {
-            rgba,
-            z,
-            geo,
-            terminated,
-        }
+        get_coxel(&mut BitReader::new(words), self)
+    }
+}
+
+/// Reads a coxel in the stream layout of `put_coxel` (`coxel_w` bits): R, G, B, A, Z, GEO, T.
+pub fn get_coxel(r: &mut BitReader, cfg: &ComposConfig) -> Coxel {
+    Coxel {
+        rgba: std::array::from_fn(|_| r.get(cfg.acc_w + 1)),
+        z: r.get(cfg.z_w) as u32,
+        geo: std::array::from_fn(|_| r.get(cfg.color_w) as u32),
+        terminated: r.get_bool(),
     }
 }
 
@@ -909,21 +916,9 @@ mod tests {
     /// value, and the documented behaviour for values under one LSB.
     #[test]
     fn opacity_correction_1_16_to_16_including_sub_lsb() {
-        let ratios = [
-            1.0 / 16.0,
-            1.0 / 8.0,
-            1.0 / 4.0,
-            0.5,
-            1.0,
-            3f64.sqrt(),
-            2.0,
-            4.0,
-            8.0,
-            16.0,
-        ];
         for cfg in CONFIGS {
             let scale = f64::from(1u32 << cfg.q());
-            for ratio in ratios {
+            for ratio in correction_ratios() {
                 let lut = OpacityLut::new(ratio, &cfg).unwrap();
                 let e = lut.entries();
                 assert_eq!(e[0], 0);

@@ -10,7 +10,7 @@ use crate::units::cube5_compos::{
     Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
 };
 use crate::units::cube5_gradient::{
-    block_index, Gradient, GradientConfig, GradientIn, GradientMode,
+    block_index, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
 };
 use crate::units::cube5_shader::{
     ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn,
@@ -729,42 +729,71 @@ impl FrameUnits {
         b: usize,
     ) -> Sample {
         let n = neighbourhood(params, vol, c, a, b, &self.trilin);
-        let mut block = [0u32; 27];
-        for (v, (di, dj, dk)) in n.iter().zip([
-            (0, 0, 0),
-            (-1, 0, 0),
-            (1, 0, 0),
-            (0, -1, 0),
-            (0, 1, 0),
-            (0, 0, -1),
-            (0, 0, 1),
-        ]) {
-            block[block_index(di, dj, dk)] = *v;
-        }
-        let g = self.gradient.gradient(&GradientIn {
-            samples: block,
-            dx: 0,
-            dy: 0,
-            mode: GradientMode::N6,
-        });
-        let shaded = self.shader.shade(&ShaderIn {
-            sample: n[0],
-            grad: [g.gx >> 4, g.gy >> 4, g.gz >> 4],
-            mag: g.mag >> 4,
-            mode: ShaderMode {
-                tf2d: false,
-                unlit: self.mode == FrameMode::Mip,
-            },
-        });
-        Sample {
-            rgb: [shaded.r, shaded.g, shaded.b],
-            alpha: shaded.a,
-            depth: c.s as u32,
-            mode: match self.mode {
-                FrameMode::Mip => ComposMode::Max,
-                FrameMode::Composite => ComposMode::FrontToBack,
-            },
-        }
+        let mode = ShaderMode {
+            tf2d: false,
+            unlit: self.mode == FrameMode::Mip,
+        };
+        shade_n6(&self.gradient, &self.shader, &n, mode, c.s as u32)
+    }
+}
+
+/// The offsets of the seven samples of a neighbourhood (`neighbourhood`), in the order the seven
+/// interpolations are made: the centre, then -/+ along i, j and k.
+pub const N6_OFFSETS: [(i32, i32, i32); 7] = [
+    (0, 0, 0),
+    (-1, 0, 0),
+    (1, 0, 0),
+    (0, -1, 0),
+    (0, 1, 0),
+    (0, 0, -1),
+    (0, 0, 1),
+];
+
+/// The gradient unit's input for the seven samples `nb` of a neighbourhood (in `N6_OFFSETS`
+/// order): N6 on the orthogonal neighbours, zero steps.
+pub fn n6_gradient_in(nb: &[u32]) -> GradientIn {
+    let mut samples = [0u32; 27];
+    for (v, (di, dj, dk)) in nb.iter().zip(N6_OFFSETS) {
+        samples[block_index(di, dj, dk)] = *v;
+    }
+    GradientIn {
+        samples,
+        dx: 0,
+        dy: 0,
+        mode: GradientMode::N6,
+    }
+}
+
+/// The frame's adapter from the gradient unit to the shader (components and magnitude `>> 4`).
+pub fn shader_in(sample: u32, g: &GradientOut, mode: ShaderMode) -> ShaderIn {
+    ShaderIn {
+        sample,
+        grad: [g.gx >> 4, g.gy >> 4, g.gz >> 4],
+        mag: g.mag >> 4,
+        mode,
+    }
+}
+
+/// One sample's way through gradient, adapter and shader: the compositing unit's sample at slice
+/// `depth` (MIP when the shader runs unlit, front to back otherwise).
+pub fn shade_n6(
+    gradient: &Gradient,
+    shader: &Shader,
+    nb: &[u32; 7],
+    mode: ShaderMode,
+    depth: u32,
+) -> Sample {
+    let g = gradient.gradient(&n6_gradient_in(nb));
+    let shaded = shader.shade(&shader_in(nb[0], &g, mode));
+    Sample {
+        rgb: [shaded.r, shaded.g, shaded.b],
+        alpha: shaded.a,
+        depth,
+        mode: if mode.unlit {
+            ComposMode::Max
+        } else {
+            ComposMode::FrontToBack
+        },
     }
 }
 

@@ -5,7 +5,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 
 /// `rnd_s(x, s)`: round half up (toward +infinity) of `x / 2^s` for signed `x`.
 pub fn round_half_up_signed(x: i64, s: u32) -> i64 {
@@ -133,6 +133,25 @@ impl GradientMode {
 /// Index of offset `(di, dj, dk)` (each in -1..=1) in the block: `(di+1) + 3(dj+1) + 9(dk+1)`.
 pub const fn block_index(di: i32, dj: i32, dk: i32) -> usize {
     ((di + 1) + 3 * (dj + 1) + 9 * (dk + 1)) as usize
+}
+
+/// Offset `(di, dj, dk)` of block index `i` (0..27): the inverse of `block_index`.
+pub const fn block_offset(i: usize) -> (i32, i32, i32) {
+    let i = i as i32;
+    (i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1)
+}
+
+/// A block of samples at `max` wherever `f(di, dj, dk)` holds and at 0 elsewhere: the extreme
+/// stimuli of the unit tests and the co-simulation.
+pub fn block_where(max: u32, f: impl Fn(i32, i32, i32) -> bool) -> [u32; 27] {
+    std::array::from_fn(|i| {
+        let (di, dj, dk) = block_offset(i);
+        if f(di, dj, dk) {
+            max
+        } else {
+            0
+        }
+    })
 }
 
 /// One input item: the 3x3x3 sample block (raw `U(VoxelW.FracW)`), the ray steps `dx`, `dy` (raw
@@ -322,14 +341,7 @@ impl Gradient {
     }
 }
 
-impl StreamUnit for Gradient {
-    type In = GradientIn;
-    type Out = GradientOut;
-
-    fn run(&mut self, inputs: &[GradientIn]) -> Vec<GradientOut> {
-        inputs.iter().map(|item| self.gradient(item)).collect()
-    }
-}
+crate::item_by_item!(Gradient, GradientIn => GradientOut, |unit, item| unit.gradient(item));
 
 impl StreamCodec for GradientConfig {
     type In = GradientIn;
@@ -400,8 +412,8 @@ mod tests {
     /// Samples of the linear field `c0 + a*di + b*dj + c*dk` (raw units), which must stay in range.
     fn ramp(c0: i64, a: i64, b: i64, c: i64) -> [u32; 27] {
         std::array::from_fn(|i| {
-            let (di, dj, dk) = (i as i64 % 3 - 1, (i as i64 / 3) % 3 - 1, i as i64 / 9 - 1);
-            (c0 + a * di + b * dj + c * dk) as u32
+            let (di, dj, dk) = block_offset(i);
+            (c0 + a * i64::from(di) + b * i64::from(dj) + c * i64::from(dk)) as u32
         })
     }
 
@@ -549,25 +561,15 @@ mod tests {
 
     /// Blocks at the extremes: all 0, all max, and max wherever a predicate on the offset holds.
     fn extreme_blocks(max: u32) -> Vec<[u32; 27]> {
-        let pick = |f: &dyn Fn(i32, i32, i32) -> bool| -> [u32; 27] {
-            std::array::from_fn(|i| {
-                let (di, dj, dk) = (i as i32 % 3 - 1, (i as i32 / 3) % 3 - 1, i as i32 / 9 - 1);
-                if f(di, dj, dk) {
-                    max
-                } else {
-                    0
-                }
-            })
-        };
         vec![
             [0; 27],
             [max; 27],
-            pick(&|di, dj, dk| di + dj + dk > 0),
-            pick(&|di, dj, dk| di + dj + dk < 0),
-            pick(&|di, dj, dk| di >= 0 && dj >= 0 && dk >= 0),
-            pick(&|di, dj, dk| di > 0 || dj > 0 || dk > 0),
-            pick(&|di, dj, dk| di < 0 || dj < 0 || dk < 0),
-            pick(&|di, dj, dk| (di + dj + dk) & 1 == 0),
+            block_where(max, |di, dj, dk| di + dj + dk > 0),
+            block_where(max, |di, dj, dk| di + dj + dk < 0),
+            block_where(max, |di, dj, dk| di >= 0 && dj >= 0 && dk >= 0),
+            block_where(max, |di, dj, dk| di > 0 || dj > 0 || dk > 0),
+            block_where(max, |di, dj, dk| di < 0 || dj < 0 || dk < 0),
+            block_where(max, |di, dj, dk| (di + dj + dk) & 1 == 0),
         ]
     }
 

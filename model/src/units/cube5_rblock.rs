@@ -8,7 +8,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 
 /// The volume edges of one `cube5_rblock` configuration, as bit counts (the RTL parameters).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -267,14 +267,7 @@ impl RBlock {
     }
 }
 
-impl StreamUnit for RBlock {
-    type In = RBlockIn;
-    type Out = u64;
-
-    fn run(&mut self, inputs: &[RBlockIn]) -> Vec<u64> {
-        inputs.iter().map(|i| self.convert(i)).collect()
-    }
-}
+crate::item_by_item!(RBlock, RBlockIn => u64, |unit, i| unit.convert(i));
 
 impl StreamCodec for RBlockConfig {
     type In = RBlockIn;

@@ -4,7 +4,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 use crate::units::cube5_gradient::{round_half_up_signed, sign_extend};
 // =================================================================================================
 // cube5_sepconv
@@ -206,15 +206,8 @@ impl Sepconv {
     }
 }
 
-impl StreamUnit for Sepconv {
-    type In = SepconvIn;
-    type Out = i64;
-
-    fn run(&mut self, inputs: &[SepconvIn]) -> Vec<i64> {
-        inputs.iter().map(|item| self.convolve(item)).collect()
-    }
-    // reset(): the weight register survives reset (docs/numerics/sepconv.md), so the default no-op.
-}
+// Reset: the weight register survives reset (docs/numerics/sepconv.md), so the default no-op.
+crate::item_by_item!(Sepconv, SepconvIn => i64, |unit, item| unit.convolve(item));
 
 impl StreamCodec for SepconvConfig {
     type In = SepconvIn;

@@ -7,7 +7,7 @@
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
 use crate::transfer::TransferFunction;
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 use glam::DVec3;
 
 /// Widths of one `cube5_shader` configuration (the RTL parameters of the same names).
@@ -464,6 +464,25 @@ pub struct ShaderTables {
 }
 
 impl ShaderTables {
+    /// Random tables, every field uniform over its range (so every table bit can reach the
+    /// output): the classification entries in order, then the zero-gradient texel, then the
+    /// reflectance map's texels. Fails only for a configuration that does not validate.
+    pub fn random<R: rand::Rng + ?Sized>(cfg: &ShaderConfig, rng: &mut R) -> Result<Self> {
+        let class = ClassLut::from_fn(cfg, |_| Rgba {
+            r: rng.random_range(0..=cfg.color_max()),
+            g: rng.random_range(0..=cfg.color_max()),
+            b: rng.random_range(0..=cfg.color_max()),
+            a: rng.random_range(0..=cfg.alpha_max()),
+        })?;
+        let mut texel = || Texel {
+            d: rng.random_range(0..=cfg.diff_max()),
+            sp: rng.random_range(0..=cfg.spec_max()),
+        };
+        let zero = texel();
+        let rmap = ReflectanceMap::from_fn(cfg, |_, _, _| texel(), zero)?;
+        Ok(ShaderTables { class, rmap })
+    }
+
     /// Every configuration-port write that loads these tables (contract § Configuration port):
     /// classification entries, texels, the zero-gradient entry.
     pub fn config_writes(&self, cfg: &ShaderConfig) -> Vec<(u32, Vec<u32>)> {
@@ -802,16 +821,8 @@ impl Shader {
     }
 }
 
-impl StreamUnit for Shader {
-    type In = ShaderIn;
-    type Out = Rgba;
-
-    fn run(&mut self, inputs: &[ShaderIn]) -> Vec<Rgba> {
-        inputs.iter().map(|item| self.shade(item)).collect()
-    }
-
-    // Reset leaves the tables alone (contract § Configuration port): the default no-op.
-}
+// Reset leaves the tables alone (contract § Configuration port): the default no-op.
+crate::item_by_item!(Shader, ShaderIn => Rgba, |unit, item| unit.shade(item));
 
 impl StreamCodec for ShaderConfig {
     type In = ShaderIn;
@@ -872,23 +883,6 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     const CONFIGS: [ShaderConfig; 2] = [ShaderConfig::NARROW, ShaderConfig::DEFAULT];
-
-    fn random_tables(cfg: &ShaderConfig, rng: &mut ChaCha8Rng) -> ShaderTables {
-        let class = ClassLut::from_fn(cfg, |_| Rgba {
-            r: rng.random_range(0..=cfg.color_max()),
-            g: rng.random_range(0..=cfg.color_max()),
-            b: rng.random_range(0..=cfg.color_max()),
-            a: rng.random_range(0..=cfg.alpha_max()),
-        })
-        .unwrap();
-        let texel = |rng: &mut ChaCha8Rng| Texel {
-            d: rng.random_range(0..=cfg.diff_max()),
-            sp: rng.random_range(0..=cfg.spec_max()),
-        };
-        let zero = texel(rng);
-        let rmap = ReflectanceMap::from_fn(cfg, |_, _, _| texel(rng), zero).unwrap();
-        ShaderTables { class, rmap }
-    }
 
     fn random_item(cfg: &ShaderConfig, rng: &mut ChaCha8Rng) -> ShaderIn {
         let gmax = cfg.grad_max();
@@ -954,7 +948,7 @@ mod tests {
         }
         // Tables of one configuration do not fit another.
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let t = random_tables(&ShaderConfig::DEFAULT, &mut rng);
+        let t = ShaderTables::random(&ShaderConfig::DEFAULT, &mut rng).unwrap();
         assert!(Shader::new(ShaderConfig::NARROW, t).is_err());
         let too_wide = ClassLut::from_fn(&d, |_| Rgba {
             r: 256,
@@ -1041,7 +1035,7 @@ mod tests {
     fn zero_gradient_unlit_and_saturation() {
         for cfg in CONFIGS {
             let mut rng = ChaCha8Rng::seed_from_u64(3);
-            let mut t = random_tables(&cfg, &mut rng);
+            let mut t = ShaderTables::random(&cfg, &mut rng).unwrap();
             let idx = 5;
             let e = Rgba {
                 r: cfg.color_max(),
@@ -1108,7 +1102,7 @@ mod tests {
     fn identity_map_passes_colour_exactly() {
         for cfg in CONFIGS {
             let mut rng = ChaCha8Rng::seed_from_u64(4);
-            let mut t = random_tables(&cfg, &mut rng);
+            let mut t = ShaderTables::random(&cfg, &mut rng).unwrap();
             let one = Texel {
                 d: 1 << (cfg.diff_w - 1),
                 sp: 0,
@@ -1172,7 +1166,7 @@ mod tests {
     fn constant_map_error_is_rounding_only() {
         for cfg in CONFIGS {
             let mut rng = ChaCha8Rng::seed_from_u64(6);
-            let mut t = random_tables(&cfg, &mut rng);
+            let mut t = ShaderTables::random(&cfg, &mut rng).unwrap();
             let k = Texel {
                 d: cfg.diff_max() / 3,
                 sp: cfg.spec_max() / 5,
@@ -1238,7 +1232,7 @@ mod tests {
     fn config_writes_load_the_model_like_direct_tables() {
         for cfg in CONFIGS {
             let mut rng = ChaCha8Rng::seed_from_u64(8);
-            let tables = random_tables(&cfg, &mut rng);
+            let tables = ShaderTables::random(&cfg, &mut rng).unwrap();
             let mut s = Shader::zeroed(cfg).unwrap();
             for (addr, data) in tables.config_writes(&cfg) {
                 assert!(s.write_config(addr, &data), "address {addr:#x} is mapped");

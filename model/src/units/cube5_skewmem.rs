@@ -749,6 +749,63 @@ impl crate::unit::UnitConfig for SkewConfig {
     }
 }
 
+/// A `SkewMem` with the identity block LUT and a plain `Vec<u16>` volume written alongside it:
+/// every beam read is checked against what was written (the model's tests, `cube5 bench`).
+pub struct Mirrored {
+    pub mem: SkewMem,
+    cfg: SkewConfig,
+    n: [u32; 3],
+    plain: Vec<u16>,
+}
+
+impl Mirrored {
+    /// A controller of dimensions `n` and its mirror, both reading 0.
+    pub fn new(cfg: SkewConfig, n: [u32; 3]) -> Result<Self> {
+        let dims = SkewDims::new(&cfg, n)?;
+        let lut = BlockLut::identity(n.map(|d| d as usize), cfg.block as usize)?;
+        Ok(Self {
+            mem: SkewMem::new(cfg, dims, lut)?,
+            cfg,
+            n,
+            plain: vec![0u16; dims.voxels()],
+        })
+    }
+
+    fn idx(&self, c: [u32; 3]) -> usize {
+        (c[0] + self.n[0] * (c[1] + self.n[1] * c[2])) as usize
+    }
+
+    /// Writes a random voxel value (one draw) at `c`, to both.
+    pub fn write_random(&mut self, c: [u32; 3], rng: &mut (impl rand::Rng + ?Sized)) {
+        let v = rng.random_range(0..=self.cfg.voxel_max());
+        self.mem.command(&SkewIn::write(c, v));
+        let at = self.idx(c);
+        self.plain[at] = v as u16;
+    }
+
+    /// Reads the beam through `c` along a random axis (one draw): `(position, read, written)` for
+    /// each of its `P` voxels.
+    pub fn read_random(
+        &mut self,
+        c: [u32; 3],
+        rng: &mut (impl rand::Rng + ?Sized),
+    ) -> Vec<([u32; 3], u32, u32)> {
+        let axis = Axis::ALL[rng.random_range(0..3)];
+        let r = self.mem.command(&SkewIn::read(c, axis));
+        let mut s = c;
+        s[axis.index()] &= !(self.cfg.p - 1);
+        r.voxels
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                let mut q = s;
+                q[axis.index()] += i as u32;
+                (q, v, u32::from(self.plain[self.idx(q)]))
+            })
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -893,26 +950,14 @@ mod tests {
         for cfg in ALL {
             let m = cfg.max_dim();
             let n = [m, m - cfg.p, (m / 2).max(cfg.p)];
-            let dims = SkewDims::new(&cfg, n).unwrap();
-            let lut = BlockLut::identity(n.map(|d| d as usize), cfg.block as usize).unwrap();
-            let mut mem = SkewMem::new(cfg, dims, lut).unwrap();
-            let mut plain = vec![0u16; dims.voxels()];
-            let idx = |c: [u32; 3]| (c[0] + n[0] * (c[1] + n[1] * c[2])) as usize;
+            let mut mirror = Mirrored::new(cfg, n).unwrap();
             for round in 0..20_000 {
                 let c = [0, 1, 2].map(|a| rng.random_range(0..n[a]));
                 if round % 3 != 2 {
-                    let v = rng.random_range(0..=cfg.voxel_max());
-                    mem.command(&SkewIn::write(c, v));
-                    plain[idx(c)] = v as u16;
+                    mirror.write_random(c, &mut rng);
                 } else {
-                    let axis = Axis::ALL[rng.random_range(0..3)];
-                    let r = mem.command(&SkewIn::read(c, axis));
-                    let mut s = c;
-                    s[axis.index()] &= !(cfg.p - 1);
-                    for (i, &v) in r.voxels.iter().enumerate() {
-                        let mut q = s;
-                        q[axis.index()] += i as u32;
-                        assert_eq!(v, u32::from(plain[idx(q)]), "{cfg:?} {q:?}");
+                    for (q, got, want) in mirror.read_random(c, &mut rng) {
+                        assert_eq!(got, want, "{cfg:?} {q:?}");
                     }
                 }
             }

@@ -3,7 +3,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 
 /// Widths of one `cube5_trilin` configuration (the RTL parameters of the same names).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -179,14 +179,7 @@ pub fn round_half_up(x: u64, s: u32) -> u64 {
     }
 }
 
-impl StreamUnit for Trilin {
-    type In = TrilinIn;
-    type Out = u32;
-
-    fn run(&mut self, inputs: &[TrilinIn]) -> Vec<u32> {
-        inputs.iter().map(|item| self.sample(item)).collect()
-    }
-}
+crate::item_by_item!(Trilin, TrilinIn => u32, |unit, item| unit.sample(item));
 
 impl StreamCodec for TrilinConfig {
     type In = TrilinIn;

@@ -3,7 +3,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 use crate::units::gicube_packet_loop::{POS_FRAC_W, POS_W};
 
 /// How blocks are distributed among processors ([348]); the `Dist` parameter.
@@ -248,17 +248,9 @@ impl BucketUnit {
     }
 }
 
-impl StreamUnit for BucketUnit {
-    type In = BucketIn;
-    type Out = BucketOut;
-
-    fn run(&mut self, inputs: &[BucketIn]) -> Vec<BucketOut> {
-        inputs
-            .iter()
-            .map(|item| BucketOut(item.0.iter().map(|&p| self.bucket(p)).collect()))
-            .collect()
-    }
-}
+crate::item_by_item!(BucketUnit, BucketIn => BucketOut, |unit, item| {
+    BucketOut(item.0.iter().map(|&p| unit.bucket(p)).collect())
+});
 
 impl StreamCodec for BucketConfig {
     type In = BucketIn;

@@ -4,7 +4,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 
 /// Bits in a packet.
 pub const PACKET_BITS: u32 = 256;
@@ -318,6 +318,28 @@ pub struct RayReal {
     pub flags: u8,
 }
 
+impl RayReal {
+    /// A random rendering ray inside the packet's ranges (the quantization stimulus): pixel,
+    /// start, direction, colour, opacity, contribution, interaction, lifetime and generation drawn
+    /// in that order; type `Rendering`, no flags.
+    pub fn random<R: rand::Rng + ?Sized>(rng: &mut R) -> Self {
+        RayReal {
+            u: rng.random_range(0..4096),
+            v: rng.random_range(0..4096),
+            start: std::array::from_fn(|_| rng.random_range(0.0..4095.99)),
+            dir: std::array::from_fn(|_| rng.random_range(-1.0..=1.0)),
+            color: std::array::from_fn(|_| rng.random_range(0.0..0.9998)),
+            opacity: rng.random_range(0.0..0.9998),
+            contribution: rng.random_range(0.0..0.9998),
+            interaction: rng.random_range(0.0..0.99999),
+            lifetime: rng.random(),
+            generation: rng.random(),
+            ray_type: RayType::Rendering,
+            flags: 0,
+        }
+    }
+}
+
 /// `gicube_packet_loop` configuration: register stages between input and output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PacketLoopConfig {
@@ -368,20 +390,10 @@ impl PacketLoop {
     }
 }
 
-impl StreamUnit for PacketLoop {
-    type In = RayPacket;
-    type Out = PacketLoopOut;
-
-    fn run(&mut self, inputs: &[RayPacket]) -> Vec<PacketLoopOut> {
-        inputs
-            .iter()
-            .map(|p| PacketLoopOut {
-                repack: *p,
-                probe: p.probed(),
-            })
-            .collect()
-    }
-}
+crate::item_by_item!(PacketLoop, RayPacket => PacketLoopOut, |_unit, p| PacketLoopOut {
+    repack: *p,
+    probe: p.probed(),
+});
 
 impl StreamCodec for PacketLoopConfig {
     type In = RayPacket;
@@ -448,6 +460,7 @@ crate::unit_config!(PacketLoopConfig, "gicube_packet_loop", S1, {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::unit::StreamUnit;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
@@ -538,21 +551,9 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         use rand::Rng;
         for _ in 0..100_000 {
-            let dir: [f64; 3] = std::array::from_fn(|_| rng.random_range(-1.0..=1.0));
-            let r = RayReal {
-                u: rng.random_range(0..4096),
-                v: rng.random_range(0..4096),
-                start: std::array::from_fn(|_| rng.random_range(0.0..4095.99)),
-                dir,
-                color: std::array::from_fn(|_| rng.random_range(0.0..0.9998)),
-                opacity: rng.random_range(0.0..0.9998),
-                contribution: rng.random_range(0.0..0.9998),
-                interaction: rng.random_range(0.0..0.99999),
-                lifetime: rng.random(),
-                generation: rng.random(),
-                ray_type: RayType::from_bits(rng.random_range(0..4)),
-                flags: rng.random_range(0..64),
-            };
+            let mut r = RayReal::random(&mut rng);
+            r.ray_type = RayType::from_bits(rng.random_range(0..4));
+            r.flags = rng.random_range(0..64);
             let p = RayPacket::from_real(&r).unwrap();
             let back = p.to_real();
             for a in 0..3 {

@@ -3,7 +3,7 @@
 //! only what several test files repeat.
 #![allow(dead_code)]
 
-use cube5_model::unit::{StreamCodec, StreamUnit};
+use cube5_model::unit::{StreamCodec, StreamUnit, UnitConfig};
 use cube5_tb::harness::{seed_from_env, StreamCheck, StreamReport};
 use cube5_tb::rtl::{Driven, RtlStream, Traffic};
 use cube5_tb::{must_match, Variant};
@@ -49,6 +49,39 @@ where
     }
     let mut it = items.into_iter().cycle();
     must_match(variant, codec, gold, &mut |_| it.next().unwrap(), &check)
+}
+
+/// On every gate-level build of `C`'s top: the smoke run of `gen` (seed `seed_no`), then the
+/// `directed` items once (seed `seed_no + 1`), each on a fresh model from `new`.
+pub fn gate_smoke_then_directed<C, G, F>(
+    new: impl Fn(C) -> cube5_model::Result<G>,
+    gen: impl Fn(C) -> F,
+    directed: impl Fn(C) -> Vec<C::In>,
+    seed_no: u64,
+) where
+    C: Scored + UnitConfig + Copy,
+    G: StreamUnit<In = C::In, Out = C::Out>,
+    F: FnMut(&mut ChaCha8Rng) -> C::In,
+{
+    for (variant, cfg) in gate_configs::<C>() {
+        let smoke = StreamCheck::gate_smoke(seed(seed_no));
+        must_match(variant, cfg, &mut new(cfg).unwrap(), &mut gen(cfg), &smoke);
+        let check = StreamCheck::directed(seed(seed_no + 1));
+        must_match_items(variant, cfg, &mut new(cfg).unwrap(), directed(cfg), &check);
+    }
+}
+
+/// On every build of `C`'s top: 100 000 items of `gen` (seed `seed_no`) at one a clock, out
+/// `latency` clocks later (`assert_one_item_per_clock`, no configuration writes).
+pub fn random_items_one_per_clock<C, F>(gen: impl Fn(C) -> F, seed_no: u64, latency: u64)
+where
+    C: StreamCodec + UnitConfig + Copy,
+    F: FnMut(&mut ChaCha8Rng) -> C::In,
+{
+    for (variant, cfg) in configs::<C>() {
+        let items = random_items(seed(seed_no), 100_000, gen(cfg));
+        assert_one_item_per_clock(variant, cfg, &[], &items, latency);
+    }
 }
 
 /// Drives `items` at full speed (after `writes` on the configuration port) and asserts the
