@@ -170,6 +170,211 @@ fn check_spacing(path: &Path, field: &str, spacing: [f64; 3]) -> Result<()> {
     Ok(())
 }
 
+// ------------------------------------------------------------------------------------------------
+// Orientation: stored voxel axes to RAS+
+// ------------------------------------------------------------------------------------------------
+
+/// World axis names of RAS+ (NIfTI's world, nifti1.h: +x Right, +y Anterior, +z Superior), as
+/// `(towards +, towards -)`.
+const RAS_LETTERS: [(char, char); 3] = [('R', 'L'), ('A', 'P'), ('S', 'I')];
+
+/// How the stored voxel axes lie in the RAS+ world (+x towards the subject's Right, +y Anterior,
+/// +z Superior): stored axis `a` runs along world axis `ras[a]`, towards decreasing world
+/// coordinates when `flip[a]`. The readers apply it ([`reorient`]), so every [`Volume`] read from a
+/// file is stored RAS: x (fastest) from Left to Right, y from Posterior to Anterior, z from
+/// Inferior to Superior.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AxisMap {
+    pub ras: [usize; 3],
+    pub flip: [bool; 3],
+}
+
+impl AxisMap {
+    /// Stored axes already RAS.
+    pub const RAS: Self = Self {
+        ras: [0, 1, 2],
+        flip: [false; 3],
+    };
+
+    /// From axis codes as nibabel's `aff2axcodes` gives them: the world direction each stored axis
+    /// runs towards (`"RAS"`, `"LPS"`, `"ASL"`, ...). `None` unless the three name distinct axes.
+    pub fn from_codes(codes: &str) -> Option<Self> {
+        let c: Vec<char> = codes.chars().map(|c| c.to_ascii_uppercase()).collect();
+        if c.len() != 3 {
+            return None;
+        }
+        let mut map = Self::RAS;
+        let mut seen = [false; 3];
+        for (a, &letter) in c.iter().enumerate() {
+            let (w, &(_, minus)) = RAS_LETTERS
+                .iter()
+                .enumerate()
+                .find(|(_, (p, m))| *p == letter || *m == letter)?;
+            if std::mem::replace(&mut seen[w], true) {
+                return None;
+            }
+            map.ras[a] = w;
+            map.flip[a] = letter == minus;
+        }
+        Some(map)
+    }
+
+    /// The axis codes (`"RAS"`, `"LPS"`, ...), as nibabel's `aff2axcodes` names them.
+    pub fn codes(&self) -> String {
+        (0..3)
+            .map(|a| {
+                let (plus, minus) = RAS_LETTERS[self.ras[a]];
+                if self.flip[a] {
+                    minus
+                } else {
+                    plus
+                }
+            })
+            .collect()
+    }
+
+    /// The map from RAS back to this orientation: `reorient(reorient(v, m), m.inverse()) == v`.
+    pub fn inverse(&self) -> Self {
+        let mut inv = Self::RAS;
+        for a in 0..3 {
+            inv.ras[self.ras[a]] = a;
+            inv.flip[self.ras[a]] = self.flip[a];
+        }
+        inv
+    }
+
+    /// The direction part of a voxel-to-RAS affine for this map, `m[row][column]`: column `a` is
+    /// stored axis `a`'s step, `±spacing[a]` along world axis `ras[a]`.
+    pub fn direction_matrix(&self, spacing: [f64; 3]) -> [[f64; 3]; 3] {
+        let mut m = [[0.0; 3]; 3];
+        for a in 0..3 {
+            m[self.ras[a]][a] = if self.flip[a] {
+                -spacing[a]
+            } else {
+                spacing[a]
+            };
+        }
+        m
+    }
+}
+
+/// Largest distortion, in voxels from one corner of the volume to the opposite one, accepted when
+/// an oblique direction matrix is taken as axis-aligned: half a voxel, so no voxel lands nearer a
+/// neighbour's place than its own. A rounding error of the f32 header fields (about 1e-7 of the
+/// spacing) stays far below it even at 1024 voxels; a real tilt of 0.1 degree across 300 voxels
+/// (0.52 voxels) does not.
+pub const MAX_OBLIQUE_VOXELS: f64 = 0.5;
+
+/// The axis map and the spacings (stored order, mm: the column lengths) of a voxel-to-RAS
+/// direction matrix `m` (`m[row][column]`; column `a` = the world step of stored axis `a`), for a
+/// grid of `dims`. Each stored axis goes to the world axis its column points along most (as
+/// nibabel's `io_orientation`), and the reason is given as text when the matrix cannot be
+/// represented that way: not finite, a zero column, two axes along one world axis, or oblique or
+/// sheared by more than [`MAX_OBLIQUE_VOXELS`] across the volume.
+pub fn axis_map(
+    m: [[f64; 3]; 3],
+    dims: [usize; 3],
+) -> std::result::Result<(AxisMap, [f64; 3]), String> {
+    const NAME: [&str; 3] = ["i", "j", "k"];
+    if m.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(format!("direction matrix {m:?} is not finite"));
+    }
+    let col = |a: usize| [m[0][a], m[1][a], m[2][a]];
+    let mut map = AxisMap::RAS;
+    let mut spacing = [0.0; 3];
+    let mut taken: [Option<usize>; 3] = [None; 3];
+    let mut angle = 0.0f64;
+    for a in 0..3 {
+        let c = col(a);
+        let len = c.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(len > 0.0 && len.is_finite()) {
+            return Err(format!(
+                "voxel axis {} has length {len}: the direction matrix is singular",
+                NAME[a]
+            ));
+        }
+        let w = (0..3)
+            .max_by(|&x, &y| c[x].abs().total_cmp(&c[y].abs()))
+            .unwrap_or(0);
+        if let Some(b) = taken[w] {
+            return Err(format!(
+                "voxel axes {} and {} both run nearest to world axis {}: the direction matrix is \
+                 degenerate",
+                NAME[b], NAME[a], RAS_LETTERS[w].0
+            ));
+        }
+        taken[w] = Some(a);
+        map.ras[a] = w;
+        map.flip[a] = c[w] < 0.0;
+        spacing[a] = len;
+        angle = angle.max((c[w].abs() / len).min(1.0).acos().to_degrees());
+    }
+    // Distortion from taking the grid as axis-aligned: the largest difference, across the volume,
+    // between where a voxel is and where the axis-aligned grid puts it, along each world axis, in
+    // that axis's voxels.
+    let ideal = map.direction_matrix(spacing);
+    let mut worst = 0.0f64;
+    for w in 0..3 {
+        let off: f64 = (0..3)
+            .map(|a| dims[a].saturating_sub(1) as f64 * (m[w][a] - ideal[w][a]).abs())
+            .sum();
+        let along = taken[w].map_or(1.0, |a| spacing[a]);
+        worst = worst.max(off / along);
+    }
+    if worst > MAX_OBLIQUE_VOXELS {
+        return Err(format!(
+            "oblique: a voxel axis is {angle:.3} degrees off the nearest RAS axis, which would \
+             distort the volume by {worst:.2} voxels (at most {MAX_OBLIQUE_VOXELS}) if drawn \
+             axis-aligned; resample it onto an axis-aligned grid first"
+        ));
+    }
+    Ok((map, spacing))
+}
+
+/// The volume with its axes permuted and reversed as `map` says, so that a volume stored in the
+/// orientation `map` describes comes out stored RAS (spacings permuted with the axes).
+pub fn reorient(vol: Volume, map: AxisMap) -> Volume {
+    if map == AxisMap::RAS {
+        return vol;
+    }
+    let n = vol.dims;
+    let mut dims = [0; 3];
+    let mut spacing = [0.0; 3];
+    for a in 0..3 {
+        dims[map.ras[a]] = n[a];
+        spacing[map.ras[a]] = vol.spacing[a];
+    }
+    let stride = [1, dims[0], dims[0] * dims[1]];
+    let (mut start, mut step) = (0isize, [0isize; 3]);
+    for a in 0..3 {
+        let s = stride[map.ras[a]] as isize;
+        if map.flip[a] {
+            start += s * (n[a] as isize - 1);
+            step[a] = -s;
+        } else {
+            step[a] = s;
+        }
+    }
+    let mut data = vec![0u16; vol.data.len()];
+    let mut src = vol.data.iter();
+    for z in 0..n[2] as isize {
+        for y in 0..n[1] as isize {
+            let row = start + step[1] * y + step[2] * z;
+            for x in 0..n[0] as isize {
+                if let Some(&v) = src.next() {
+                    data[(row + step[0] * x) as usize] = v;
+                }
+            }
+        }
+    }
+    Volume {
+        dims,
+        spacing,
+        bits: vol.bits,
+        data,
+    }
+}
+
 /// How stored voxels are laid out.
 struct Stored {
     voxel_type: VoxelType,
@@ -178,6 +383,8 @@ struct Stored {
     spacing: [f64; 3],
     /// NIfTI's `(scl_slope, scl_inter)`.
     scale: Option<(f64, f64)>,
+    /// How the stored axes lie in RAS: applied last.
+    orient: AxisMap,
 }
 
 /// Turns stored values into a [`Volume`] (the rules in the module comment). `bits` is the width
@@ -189,6 +396,7 @@ fn to_volume(path: &Path, data: &[u8], st: Stored, bits: Option<u32>) -> Result<
         dims,
         spacing,
         scale,
+        orient,
     } = st;
     check_dims(path, "dimensions", dims)?;
     check_spacing(path, "spacing", spacing)?;
@@ -263,7 +471,8 @@ fn to_volume(path: &Path, data: &[u8], st: Stored, bits: Option<u32>) -> Result<
             })
             .collect();
     }
-    Volume::new(dims, spacing, width, out).map_err(|e| err(path, "volume", e))
+    let stored = Volume::new(dims, spacing, width, out).map_err(|e| err(path, "volume", e))?;
+    Ok(reorient(stored, orient))
 }
 
 /// Reads a raw volume as `spec` describes; the file must hold exactly `offset + dims x size` bytes.
@@ -297,6 +506,7 @@ pub fn read_raw(path: &Path, spec: &RawSpec, bits: Option<u32>) -> Result<Volume
             dims: spec.dims,
             spacing: spec.spacing,
             scale: None,
+            orient: AxisMap::RAS,
         },
         bits,
     )
@@ -321,7 +531,13 @@ pub struct NrrdHeader {
     pub dims: [usize; 3],
     pub encoding: NrrdEncoding,
     pub endian: Endian,
+    /// Voxel size along each stored axis (`spacings`, or the lengths of the `space directions`).
     pub spacing: [f64; 3],
+    /// `space`, as written (`right-anterior-superior`, `LPS`, ...).
+    pub space: Option<String>,
+    /// How the stored axes lie in RAS: from `space` and `space directions`; [`AxisMap::RAS`] when
+    /// the header gives no directions.
+    pub orientation: AxisMap,
     /// Detached data file (`data file:`), relative to the header's directory.
     pub data_file: Option<String>,
     pub line_skip: usize,
@@ -366,7 +582,9 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
     let mut encoding = None;
     let mut endian = None;
     let mut spacings: Option<Vec<f64>> = None;
-    let mut directions: Option<Vec<Option<f64>>> = None;
+    let mut directions: Option<Vec<Option<Vec<f64>>>> = None;
+    let mut space: Option<String> = None;
+    let mut space_dimension: Option<String> = None;
     let mut data_file = None;
     let mut line_skip = 0usize;
     let mut byte_skip = 0i64;
@@ -444,6 +662,8 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
                 )
             }
             "space directions" => directions = Some(parse_space_directions(value, origin)?),
+            "space" => space = Some(value.to_string()),
+            "space dimension" => space_dimension = Some(value.to_string()),
             "data file" | "datafile" => {
                 if value.starts_with("LIST") || value.split_whitespace().count() > 1 {
                     return Err(e(
@@ -466,7 +686,7 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
                     return Err(e("byte skip", format!("{byte_skip} is below -1")));
                 }
             }
-            _ => {} // space, kinds, centers, units, origin, ...: not needed to render
+            _ => {} // kinds, centers, units, space origin, ...: not needed to render
         }
     }
     let voxel_type = voxel_type.ok_or_else(|| e("type", "missing".into()))?;
@@ -493,7 +713,57 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
     let dims = [sizes[first], sizes[first + 1], sizes[first + 2]];
     check_dims(origin, "sizes", dims)?;
     let mut spacing = [1.0; 3];
-    if let Some(s) = &spacings {
+    let mut orientation = AxisMap::RAS;
+    // Signs taking the space's coordinates to RAS.
+    let to_ras = match &space {
+        Some(name) => nrrd_space_to_ras(name).map_err(|m| e("space", m))?,
+        None => [1.0; 3],
+    };
+    if let Some(sd) = &space_dimension {
+        if sd.trim() != "3" {
+            return Err(e(
+                "space dimension",
+                format!("`{sd}`: only 3-D spaces are supported"),
+            ));
+        }
+    }
+    if let Some(d) = &directions {
+        if d.len() != dimension {
+            return Err(e(
+                "space directions",
+                format!("{} entries for dimension {dimension}", d.len()),
+            ));
+        }
+        if spatial == 1 && d[0].is_some() {
+            return Err(e(
+                "space directions",
+                "the leading non-spatial axis must be `none`".into(),
+            ));
+        }
+        let mut m = [[0.0; 3]; 3];
+        for a in 0..3 {
+            let v = d[spatial + a].as_ref().ok_or_else(|| {
+                e(
+                    "space directions",
+                    format!("axis {}: `none` for a spatial axis", spatial + a),
+                )
+            })?;
+            if v.len() != 3 {
+                return Err(e(
+                    "space directions",
+                    format!(
+                        "axis {}: {} components, 3 expected (a 3-D space)",
+                        spatial + a,
+                        v.len()
+                    ),
+                ));
+            }
+            for r in 0..3 {
+                m[r][a] = v[r] * to_ras[r];
+            }
+        }
+        (orientation, spacing) = axis_map(m, dims).map_err(|m| e("space directions", m))?;
+    } else if let Some(s) = &spacings {
         if s.len() != dimension {
             return Err(e(
                 "spacings",
@@ -506,15 +776,6 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
                 spacing[a] = s[spatial + a];
             }
         }
-    } else if let Some(d) = &directions {
-        let spatial_dirs: Vec<f64> = d.iter().flatten().copied().collect();
-        if spatial_dirs.len() != 3 {
-            return Err(e(
-                "space directions",
-                format!("{} spatial vectors, 3 expected", spatial_dirs.len()),
-            ));
-        }
-        spacing.copy_from_slice(&spatial_dirs);
     }
     check_spacing(origin, "spacings", spacing)?;
     let endian = match endian {
@@ -539,6 +800,8 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
             encoding,
             endian,
             spacing,
+            space,
+            orientation,
             data_file,
             line_skip,
             byte_skip,
@@ -547,7 +810,31 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
     ))
 }
 
-fn parse_space_directions(value: &str, origin: &Path) -> Result<Vec<Option<f64>>> {
+/// The signs that take coordinates of the NRRD `space` to RAS, or why the space is refused.
+/// `scanner-xyz` and `3D-right-handed` carry no anatomical orientation: their x, y, z are taken as
+/// R, A, S, the same rule as a NIfTI file without qform or sform (ITK, and so 3D Slicer, takes them
+/// as L, P, S instead). `3D-left-handed` cannot be put in RAS without a mirror nobody asked for.
+fn nrrd_space_to_ras(space: &str) -> std::result::Result<[f64; 3], String> {
+    match space.trim().to_ascii_lowercase().as_str() {
+        "right-anterior-superior" | "ras" => Ok([1.0, 1.0, 1.0]),
+        "left-anterior-superior" | "las" => Ok([-1.0, 1.0, 1.0]),
+        "left-posterior-superior" | "lps" => Ok([-1.0, -1.0, 1.0]),
+        "scanner-xyz" | "3d-right-handed" => Ok([1.0, 1.0, 1.0]),
+        "3d-left-handed" => Err(format!(
+            "`{space}`: a left-handed space with no anatomical axes cannot be put in RAS without \
+             mirroring it"
+        )),
+        s if s.ends_with("-time") || matches!(s, "rast" | "last" | "lpst") => {
+            Err(format!("`{space}`: only 3-D spaces are supported"))
+        }
+        _ => Err(format!(
+            "`{space}` is not supported (right-anterior-superior, left-anterior-superior, \
+             left-posterior-superior, scanner-xyz, 3D-right-handed)"
+        )),
+    }
+}
+
+fn parse_space_directions(value: &str, origin: &Path) -> Result<Vec<Option<Vec<f64>>>> {
     let e = |m: String| err(origin, "space directions", m);
     let mut out = Vec::new();
     let mut rest = value.trim();
@@ -567,7 +854,7 @@ fn parse_space_directions(value: &str, origin: &Path) -> Result<Vec<Option<f64>>
                         .map_err(|_| e(format!("`{}` is not a number", v.trim())))
                 })
                 .collect::<Result<_>>()?;
-            out.push(Some(comps.iter().map(|c| c * c).sum::<f64>().sqrt()));
+            out.push(Some(comps));
             rest = rest[close + 1..].trim_start();
         } else {
             return Err(e(format!("unexpected `{rest}`")));
@@ -667,6 +954,7 @@ pub fn read_nrrd(path: &Path, bits: Option<u32>) -> Result<Volume> {
                     dims: h.dims,
                     spacing: h.spacing,
                     scale: None,
+                    orient: h.orientation,
                 },
                 bits,
             );
@@ -681,6 +969,7 @@ pub fn read_nrrd(path: &Path, bits: Option<u32>) -> Result<Volume> {
             dims: h.dims,
             spacing: h.spacing,
             scale: None,
+            orient: h.orientation,
         },
         bits,
     )
@@ -750,7 +1039,9 @@ fn gzip(bytes: &[u8]) -> Vec<u8> {
     enc.finish().expect("writing to memory")
 }
 
-/// Writes `vol` as an NRRD file with attached data (u8 or u16, little endian).
+/// Writes `vol` as an NRRD file with attached data (u8 or u16, little endian), stored RAS as a
+/// [`Volume`] is: `space: right-anterior-superior`, `space directions` the diagonal of the
+/// spacings, `space origin` 0 (what 3D Slicer and ITK need to place it).
 pub fn write_nrrd(path: &Path, vol: &Volume, encoding: NrrdEncoding, comment: &str) -> Result<()> {
     let (t, raw) = voxel_bytes(vol, Endian::Little);
     let mut out = Vec::new();
@@ -767,8 +1058,9 @@ pub fn write_nrrd(path: &Path, vol: &Volume, encoding: NrrdEncoding, comment: &s
     let [sx, sy, sz] = vol.spacing;
     out.extend_from_slice(
         format!(
-            "type: {}\ndimension: 3\nsizes: {nx} {ny} {nz}\nspacings: {sx} {sy} {sz}\n\
-             encoding: {enc}\nendian: little\n\n",
+            "type: {}\ndimension: 3\nspace: right-anterior-superior\nsizes: {nx} {ny} {nz}\n\
+             space directions: ({sx},0,0) (0,{sy},0) (0,0,{sz})\nkinds: domain domain domain\n\
+             space origin: (0,0,0)\nencoding: {enc}\nendian: little\n\n",
             if t == VoxelType::U8 {
                 "uint8"
             } else {
@@ -802,13 +1094,29 @@ pub fn write_raw(path: &Path, vol: &Volume, endian: Endian) -> Result<VoxelType>
 // NIfTI-1
 // ------------------------------------------------------------------------------------------------
 
+/// Which NIfTI-1 transform placed a volume (chosen as nibabel's `get_best_affine` does).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NiftiTransform {
+    /// `sform_code > 0`: the affine `srow_x`, `srow_y`, `srow_z`.
+    Sform,
+    /// `sform_code` 0 and `qform_code > 0`: the quaternion, `pixdim` and `qfac` (`pixdim[0]`).
+    Qform,
+    /// Both codes 0 (the standard's "method 1"): `pixdim` only, axes taken as RAS.
+    Pixdim,
+}
+
 /// The fields of a NIfTI-1 header that matter here.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NiftiHeader {
     pub endian: Endian,
     pub dims: [usize; 3],
     pub voxel_type: VoxelType,
+    /// Voxel size along each stored axis: the column lengths of the chosen affine (`pixdim` for a
+    /// qform or no transform).
     pub spacing: [f64; 3],
+    pub transform: NiftiTransform,
+    /// How the stored axes lie in RAS (applied by [`read_nifti`]).
+    pub orientation: AxisMap,
     /// Byte offset of the voxels in the (decompressed) `.nii` file.
     pub vox_offset: usize,
     /// `(scl_slope, scl_inter)` when the slope is set (non-zero) and not the identity.
@@ -923,15 +1231,7 @@ pub fn parse_nifti_header(bytes: &[u8], origin: &Path) -> Result<NiftiHeader> {
             format!("{bitpix} does not match datatype {datatype}"),
         ));
     }
-    let mut spacing = [1.0; 3];
-    for (a, s) in spacing.iter_mut().enumerate() {
-        let p = f32_at(76 + 4 * (a + 1)).abs();
-        // pixdim 0 means "not set" in many writers.
-        if p != 0.0 {
-            *s = p;
-        }
-    }
-    check_spacing(origin, "pixdim", spacing)?;
+    let (transform, orientation, spacing) = nifti_orientation(dims, &i16_at, &f32_at, origin)?;
     let vox_offset = f32_at(108);
     if !(vox_offset.is_finite() && vox_offset >= NIFTI_HEADER as f64 && vox_offset < 1e12) {
         return Err(e(
@@ -952,9 +1252,165 @@ pub fn parse_nifti_header(bytes: &[u8], origin: &Path) -> Result<NiftiHeader> {
         dims,
         voxel_type,
         spacing,
+        transform,
+        orientation,
         vox_offset: vox_offset as usize,
         scale,
     })
+}
+
+/// Chooses the transform as nibabel's `Nifti1Header.get_best_affine` does (the sform when
+/// `sform_code` is set, else the qform when `qform_code` is set, else `pixdim` alone) and finds how
+/// the stored axes lie in RAS ([`axis_map`]). Header offsets: nifti1.h.
+fn nifti_orientation(
+    dims: [usize; 3],
+    i16_at: &dyn Fn(usize) -> i16,
+    f32_at: &dyn Fn(usize) -> f64,
+    origin: &Path,
+) -> Result<(NiftiTransform, AxisMap, [f64; 3])> {
+    let e = |field: &str, m: String| err(origin, field, m);
+    let (qform_code, sform_code) = (i16_at(252), i16_at(254));
+    for (field, code) in [("qform_code", qform_code), ("sform_code", sform_code)] {
+        if code < 0 {
+            return Err(e(
+                field,
+                format!("{code}: transform codes are 0 or positive"),
+            ));
+        }
+    }
+    let pixdim = [f32_at(80), f32_at(84), f32_at(88)];
+    if sform_code > 0 {
+        let mut m = [[0.0; 3]; 3];
+        for (r, row) in m.iter_mut().enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                *v = f32_at(280 + 16 * r + 4 * c);
+            }
+        }
+        let (map, spacing) = axis_map(m, dims).map_err(|m| e("sform", m))?;
+        return Ok((NiftiTransform::Sform, map, spacing));
+    }
+    // pixdim 0 means "not set" in many writers (nifti1_io.c reads it as 1 too).
+    let spacing = pixdim.map(|p| if p == 0.0 { 1.0 } else { p.abs() });
+    if qform_code > 0 {
+        if let Some(a) = (0..3).find(|&a| pixdim[a] < 0.0) {
+            // nibabel refuses these; nifti1_io.c silently reads 1.0.
+            return Err(e(
+                &format!("pixdim[{}]", a + 1),
+                format!(
+                    "{}: a negative voxel size with a qform is ambiguous (a flip or not?)",
+                    pixdim[a]
+                ),
+            ));
+        }
+        let q = [f32_at(256), f32_at(260), f32_at(264)];
+        let r = quaternion_matrix(q).map_err(|m| e("quatern_b/c/d", m))?;
+        // qfac = pixdim[0]: -1 reverses the third axis, anything else counts as 1 (nifti1_io.c).
+        let qfac = if f32_at(76) < 0.0 { -1.0 } else { 1.0 };
+        check_spacing(origin, "pixdim", spacing)?;
+        let scale = [spacing[0], spacing[1], spacing[2] * qfac];
+        let mut m = [[0.0; 3]; 3];
+        for (i, row) in m.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = r[i][j] * scale[j];
+            }
+        }
+        // The spacings stay pixdim's: the f32 quaternion's columns are unit only to ~1e-7.
+        let (map, _) = axis_map(m, dims).map_err(|m| e("qform", m))?;
+        return Ok((NiftiTransform::Qform, map, spacing));
+    }
+    check_spacing(origin, "pixdim", spacing)?;
+    Ok((NiftiTransform::Pixdim, AxisMap::RAS, spacing))
+}
+
+/// The rotation matrix of NIfTI's quaternion `(b, c, d)`, `a = sqrt(1 - b² - c² - d²)` (nifti1.h,
+/// "QUATERNION REPRESENTATION OF ROTATION MATRIX"). A vector a little longer than 1 (f32 rounding,
+/// up to 1e-6) is normalized with `a = 0`, a 180-degree turn, as nifti1_io.c does; a longer one is
+/// refused, as nibabel refuses it.
+pub fn quaternion_matrix(q: [f64; 3]) -> std::result::Result<[[f64; 3]; 3], String> {
+    let [mut b, mut c, mut d] = q;
+    if q.iter().any(|v| !v.is_finite()) {
+        return Err(format!("({b}, {c}, {d}) is not finite"));
+    }
+    let n2 = b * b + c * c + d * d;
+    if n2 > 1.0 + 1e-6 {
+        return Err(format!(
+            "({b}, {c}, {d}) is longer than 1: not a unit quaternion"
+        ));
+    }
+    let mut a = 1.0 - n2;
+    if a < 1e-7 {
+        let n = n2.sqrt();
+        (b, c, d) = (b / n, c / n, d / n);
+        a = 0.0;
+    } else {
+        a = a.sqrt();
+    }
+    Ok([
+        [
+            a * a + b * b - c * c - d * d,
+            2.0 * (b * c - a * d),
+            2.0 * (b * d + a * c),
+        ],
+        [
+            2.0 * (b * c + a * d),
+            a * a + c * c - b * b - d * d,
+            2.0 * (c * d - a * b),
+        ],
+        [
+            2.0 * (b * d - a * c),
+            2.0 * (c * d + a * b),
+            a * a + d * d - b * b - c * c,
+        ],
+    ])
+}
+
+/// NIfTI's quaternion `(b, c, d)` of a rotation matrix (`det = +1`), with `a >= 0` as the
+/// standard asks: the inverse of [`quaternion_matrix`] (Shepperd's method: divide by the largest of
+/// the four components).
+pub fn matrix_quaternion(r: [[f64; 3]; 3]) -> [f64; 3] {
+    let trace = r[0][0] + r[1][1] + r[2][2];
+    let four = [
+        1.0 + trace,                       // 4a²
+        1.0 + r[0][0] - r[1][1] - r[2][2], // 4b²
+        1.0 - r[0][0] + r[1][1] - r[2][2], // 4c²
+        1.0 - r[0][0] - r[1][1] + r[2][2], // 4d²
+    ];
+    let big = (0..4)
+        .max_by(|&x, &y| four[x].total_cmp(&four[y]))
+        .unwrap_or(0);
+    let s = 0.5 * four[big].max(0.0).sqrt(); // the largest component
+    let k = 0.25 / s;
+    let (a, b, c, d) = match big {
+        0 => (
+            s,
+            (r[2][1] - r[1][2]) * k,
+            (r[0][2] - r[2][0]) * k,
+            (r[1][0] - r[0][1]) * k,
+        ),
+        1 => (
+            (r[2][1] - r[1][2]) * k,
+            s,
+            (r[0][1] + r[1][0]) * k,
+            (r[0][2] + r[2][0]) * k,
+        ),
+        2 => (
+            (r[0][2] - r[2][0]) * k,
+            (r[0][1] + r[1][0]) * k,
+            s,
+            (r[1][2] + r[2][1]) * k,
+        ),
+        _ => (
+            (r[1][0] - r[0][1]) * k,
+            (r[0][2] + r[2][0]) * k,
+            (r[1][2] + r[2][1]) * k,
+            s,
+        ),
+    };
+    if a < 0.0 {
+        [-b, -c, -d]
+    } else {
+        [b, c, d]
+    }
 }
 
 /// Reads a NIfTI-1 volume (`.nii`, or gzip-compressed `.nii.gz`).
@@ -1007,14 +1463,100 @@ pub fn read_nifti(path: &Path, bits: Option<u32>) -> Result<Volume> {
             dims: h.dims,
             spacing: h.spacing,
             scale: h.scale,
+            orient: h.orientation,
         },
         bits,
     )
 }
 
+/// The orientation fields [`write_nifti_with`] writes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NiftiXform {
+    /// Voxel-to-world affine, its first three rows (nibabel's `img.affine[:3]`), world = RAS+ mm.
+    pub affine: [[f64; 4]; 3],
+    /// 0: no sform; 1: scanner anatomical; 2: aligned to another file (nibabel's default); ...
+    pub sform_code: i16,
+    /// As `sform_code`. The quaternion, `qfac`, `pixdim` and `qoffset` are derived from the affine
+    /// whatever the code, as nibabel's `set_qform` does; a sheared affine is refused unless 0.
+    pub qform_code: i16,
+}
+
+impl NiftiXform {
+    /// How [`write_nifti`] places a volume (stored RAS): `diag(spacing)`, voxel 0 at the origin, both
+    /// codes 1 (scanner anatomical), so every reader (nibabel, 3D Slicer, FSL) agrees.
+    pub fn ras(spacing: [f64; 3]) -> Self {
+        Self::from_axes(AxisMap::RAS, spacing)
+    }
+
+    /// The affine of a volume stored as `map` says (spacings in stored order), codes 1.
+    pub fn from_axes(map: AxisMap, spacing: [f64; 3]) -> Self {
+        let m = map.direction_matrix(spacing);
+        let mut affine = [[0.0; 4]; 3];
+        for r in 0..3 {
+            affine[r][..3].copy_from_slice(&m[r]);
+        }
+        Self {
+            affine,
+            sform_code: 1,
+            qform_code: 1,
+        }
+    }
+}
+
 /// Writes `vol` as a single-file NIfTI-1 (u8 or u16, little endian), gzip-compressed when the name
-/// ends in `.gz`.
+/// ends in `.gz`, stored RAS as a [`Volume`] is ([`NiftiXform::ras`]).
 pub fn write_nifti(path: &Path, vol: &Volume, description: &str) -> Result<()> {
+    write_nifti_with(path, vol, description, &NiftiXform::ras(vol.spacing))
+}
+
+/// Writes `vol`'s voxels as they are stored, placed by `xform` (which need not be RAS: the tests
+/// write the same volume in other orientations, and oblique). `pixdim` is the affine's column
+/// lengths; `vol.spacing` is not used.
+pub fn write_nifti_with(
+    path: &Path,
+    vol: &Volume,
+    description: &str,
+    xform: &NiftiXform,
+) -> Result<()> {
+    let fail = |field: &str, m: String| err(path, field, m);
+    let a = &xform.affine;
+    if a.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(fail("affine", format!("{a:?} is not finite")));
+    }
+    let zooms: [f64; 3] =
+        std::array::from_fn(|c| (0..3).map(|r| a[r][c] * a[r][c]).sum::<f64>().sqrt());
+    if zooms.contains(&0.0) {
+        return Err(fail("affine", format!("{a:?} has a zero column")));
+    }
+    // The qform: R = columns / zooms, the third reversed (qfac = -1) when R is a reflection.
+    let mut r: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| a[i][j] / zooms[j]));
+    let det = r[0][0] * (r[1][1] * r[2][2] - r[1][2] * r[2][1])
+        - r[0][1] * (r[1][0] * r[2][2] - r[1][2] * r[2][0])
+        + r[0][2] * (r[1][0] * r[2][1] - r[1][1] * r[2][0]);
+    let qfac = if det < 0.0 { -1.0 } else { 1.0 };
+    for row in r.iter_mut() {
+        row[2] *= qfac;
+    }
+    let orthogonal = (0..3).all(|i| {
+        (0..3).all(|j| {
+            let dot: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();
+            (dot - f64::from(u8::from(i == j))).abs() < 1e-6
+        })
+    });
+    if !orthogonal && xform.qform_code != 0 {
+        return Err(fail(
+            "qform_code",
+            format!(
+                "{}: a sheared affine cannot be a qform (write qform_code 0)",
+                xform.qform_code
+            ),
+        ));
+    }
+    let quatern = if orthogonal {
+        matrix_quaternion(r)
+    } else {
+        [0.0; 3]
+    };
     let (t, raw) = voxel_bytes(vol, Endian::Little);
     let mut h = vec![0u8; NIFTI_HEADER + 4];
     let put_i16 = |h: &mut Vec<u8>, o: usize, v: i16| h[o..o + 2].copy_from_slice(&v.to_le_bytes());
@@ -1035,19 +1577,25 @@ pub fn write_nifti(path: &Path, vol: &Volume, description: &str) -> Result<()> {
     };
     put_i16(&mut h, 70, datatype);
     put_i16(&mut h, 72, bitpix);
-    put_f32(&mut h, 76, 1.0); // qfac
-    for a in 0..3 {
-        put_f32(&mut h, 80 + 4 * a, vol.spacing[a] as f32);
+    put_f32(&mut h, 76, qfac as f32);
+    for (k, z) in zooms.iter().enumerate() {
+        put_f32(&mut h, 80 + 4 * k, *z as f32);
     }
     put_f32(&mut h, 108, (NIFTI_HEADER + 4) as f32);
     put_f32(&mut h, 112, 1.0); // scl_slope
     h[123] = 2; // xyzt_units: millimetres
     let d = description.as_bytes();
     h[148..148 + d.len().min(79)].copy_from_slice(&d[..d.len().min(79)]);
-    put_i16(&mut h, 254, 1); // sform_code: scanner
-    for a in 0..3 {
-        // srow_x/y/z: a diagonal of the spacings.
-        put_f32(&mut h, 280 + 16 * a + 4 * a, vol.spacing[a] as f32);
+    put_i16(&mut h, 252, xform.qform_code);
+    put_i16(&mut h, 254, xform.sform_code);
+    for k in 0..3 {
+        put_f32(&mut h, 256 + 4 * k, quatern[k] as f32);
+        put_f32(&mut h, 268 + 4 * k, a[k][3] as f32); // qoffset_x/y/z
+    }
+    for (row, srow) in a.iter().enumerate() {
+        for (c, v) in srow.iter().enumerate() {
+            put_f32(&mut h, 280 + 16 * row + 4 * c, *v as f32);
+        }
     }
     h[344..348].copy_from_slice(b"n+1\0");
     h.extend_from_slice(&raw);

@@ -106,6 +106,12 @@ fn detached_nrrd_and_big_endian_nifti() {
     for o in [108, 112, 116] {
         swap(&mut h, o, 4);
     }
+    // qform_code, sform_code; quatern_b/c/d, qoffset_x/y/z, srow_x/y/z.
+    swap(&mut h, 252, 2);
+    swap(&mut h, 254, 2);
+    for k in 0..18 {
+        swap(&mut h, 256 + 4 * k, 4);
+    }
     for i in 0..vol.len() {
         swap(&mut h, 352 + 2 * i, 2);
     }
