@@ -129,6 +129,11 @@ fn valid_nrrd_header() -> Vec<u8> {
     b"NRRD0004\ntype: ushort\ndimension: 3\nsizes: 3 4 5\nspacings: 1 1 2\nencoding: gzip\nendian: little\n\n".to_vec()
 }
 
+/// The same with an orientation (the mutations reach `space` and `space directions` too).
+fn oriented_nrrd_header() -> Vec<u8> {
+    b"NRRD0004\ntype: ushort\ndimension: 3\nspace: LPS\nsizes: 3 4 5\nspace directions: (0,1,0) (-1,0,0) (0,0,2)\nencoding: gzip\nendian: little\n\n".to_vec()
+}
+
 fn valid_nifti() -> Vec<u8> {
     let vol: Volume = phantom_by_name("sphere", 4, 12).unwrap();
     let p = scratch("fuzz-seed.nii");
@@ -151,8 +156,9 @@ proptest! {
     fn mutated_nrrd_headers_never_panic(
         edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8),
         cut in any::<prop::sample::Index>(),
+        oriented in any::<bool>(),
     ) {
-        let mut h = valid_nrrd_header();
+        let mut h = if oriented { oriented_nrrd_header() } else { valid_nrrd_header() };
         for (i, b) in edits {
             let at = i.index(h.len());
             h[at] = b;
