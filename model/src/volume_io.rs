@@ -7,6 +7,10 @@
 //! floating-point types (after NIfTI's `scl_slope`/`scl_inter`) are mapped linearly from their
 //! range `[min, max]` onto `0 ..= 2^bits - 1` (12 bits unless asked), rounding to nearest.
 //!
+//! Orientation: every volume is read into RAS (x Left to Right, y Posterior to Anterior, z Inferior
+//! to Superior) from NIfTI's sform or qform and NRRD's `space directions`, by permuting and
+//! reversing axes; oblique files are refused ([`axis_map`]; the rules in `docs/scenes.md`).
+//!
 //! Every error names the file and the header field (or the byte count) that is wrong; no input
 //! makes a reader panic (the header parsers are fuzzed in `model/tests/volume_io.rs`).
 
