@@ -34,7 +34,7 @@ endif
 
 ## Everything in `sim` plus the runs too long for CI (tests marked #[ignore = "sim-full: ..."]).
 sim-full: setup
-	CUBE5_FULL=1 $(CARGO) test --release -p cube5-tb -- --include-ignored
+	CUBE5_FULL=1 $(CARGO) test --release -p cube5-tb -p cube5-cli -- --include-ignored
 
 lint:
 	@scripts/lint.sh

@@ -5,19 +5,15 @@
 
 use crate::{load_scene, write_png_atomically};
 use anyhow::{anyhow, bail, Context, Result};
-use cube5_model::camera::Camera;
-use cube5_model::render::{CompositeMode, ImageF64, Projection};
+use cube5_model::render::ImageF64;
 use cube5_model::scene::Scene;
+use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
 use cube5_model::units::cube5_compos::{ComposConfig, Coxel};
-use cube5_model::units::cube5_frame::{self, BasePlane, FrameParams, FrameSetup};
-use cube5_model::units::cube5_shader::{DistantLight, Phong};
-use cube5_model::units::cube5_skewmem::BlockLut;
-use cube5_model::volume::Volume;
-use cube5_tb::frame::{as_seen, Expected, FrameBench, FrameRtl, Look, Render};
+use cube5_model::units::cube5_frame::{BasePlane, FrameConfig};
+use cube5_tb::frame::{Expected, FrameBench, FrameRtl};
 use cube5_tb::rtl::Traffic;
 use cube5_tb::TbError;
 use std::path::{Path, PathBuf};
-use std::rc::Rc;
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
@@ -65,76 +61,22 @@ pub fn run(args: CosimArgs) -> Result<()> {
     Ok(())
 }
 
-/// The scene's volume at the frame's voxel width: `v << (W - bits)` or `v >> (bits - W)`, the same
-/// integers for model and RTL.
-pub fn at_voxel_width(vol: &Volume, w: u32) -> Result<Volume> {
-    let data = vol
-        .data
-        .iter()
-        .map(|&v| {
-            if vol.bits <= w {
-                v << (w - vol.bits)
-            } else {
-                v >> (vol.bits - w)
-            }
+/// The cube5_frame variant a scene co-simulates on: its widths, four pipelines where built, the
+/// largest memory.
+pub fn variant_for(scene: &Scene) -> Result<FrameRtl> {
+    let want = frame_config(scene)?;
+    let widths = |c: &FrameConfig| (c.trilin, c.gradient, c.shader, c.compos);
+    FrameRtl::all()
+        .into_iter()
+        .filter(|r| widths(r) == widths(&want))
+        .max_by_key(|r| (r.p == 4, r.max_dim_log2))
+        .ok_or_else(|| {
+            anyhow!("no cube5_frame variant in rtl/cube5/cube5_frame.variants has the scene's widths ([quality]): the model renders it, the RTL cannot be co-simulated")
         })
-        .collect();
-    Ok(Volume::new(vol.dims, vol.spacing, w, data)?)
 }
 
-/// The scene's lights and material in the frame's axes (the reflectance map's input).
-pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
-    let lights: Vec<DistantLight> = scene
-        .lights
-        .iter()
-        .map(|l| DistantLight {
-            // The scene gives the direction light travels; the map wants the way to the light.
-            direction: l.direction.map(|c| -c),
-            intensity: (l.colour.iter().sum::<f64>() / 3.0).clamp(0.0, 4.0),
-        })
-        .collect();
-    let base = cube5_frame::frame_phong(params, &lights);
-    if scene.render.shading {
-        let m = scene.shading;
-        Phong {
-            ambient: m.ambient,
-            diffuse: m.diffuse,
-            specular: m.specular,
-            shininess: m.shininess,
-            ..base
-        }
-    } else {
-        // Unlit: the map is 1 everywhere.
-        Phong {
-            ambient: 1.0,
-            diffuse: 0.0,
-            specular: 0.0,
-            ..base
-        }
-    }
-}
-
-/// One frame of `scene` on `rtl` and on the model; prints the comparison and the figures and
-/// writes the images into `out_dir`.
-/// What a frame of `scene` on `rtl` needs besides the volume (already at the variant's voxel
-/// width) and its set-up: the block LUT (blocks of 0 empty), the volume as the RTL sees it, and the
-/// scene's look (no early termination).
-fn frame_inputs(
-    scene: &Scene,
-    rtl: &FrameRtl,
-    vol: &Volume,
-    setup: &FrameSetup,
-) -> Result<(BlockLut, Rc<Volume>, Look)> {
-    let lut = BlockLut::from_volume(vol, rtl.block as usize, 0)?;
-    let seen = Rc::new(as_seen(vol, &lut)?);
-    let look = Look {
-        tf: scene.transfer_function(),
-        phong: scene_phong(scene, &setup.params),
-        early_termination: false,
-    };
-    Ok((lut, seen, look))
-}
-
+/// One frame of `scene` on `rtl` and on the model (`FrameJob`, what `cube5 render` computes);
+/// prints the comparison and the figures and writes the images into `out_dir`.
 pub fn cosim_scene(
     scene: &Scene,
     origin: &str,
@@ -142,29 +84,32 @@ pub fn cosim_scene(
     out_dir: &Path,
     seed: u32,
 ) -> Result<CosimResult> {
-    let render = match scene.render.mode {
-        CompositeMode::Composite => Render::Composite,
-        CompositeMode::Mip => Render::Mip,
-        m => bail!(
-            "{origin}: render.mode = \"{}\": cube5_frame renders \"composite\" and \"mip\"",
-            m.name()
-        ),
-    };
-    if scene.view.projection != Projection::Parallel {
-        bail!("{origin}: view.projection: cube5_frame renders parallel projections only");
+    let why = not_expressible(scene);
+    if !why.is_empty() {
+        bail!(
+            "{origin}: cube5_frame cannot render this scene: {}",
+            why.join("; ")
+        );
     }
     let params_r = scene.render_params();
     let dir = params_r.direction().context(origin.to_string())?;
     std::fs::create_dir_all(out_dir)
         .with_context(|| format!("output directory {}", out_dir.display()))?;
-
+    let want = frame_config(scene)?;
+    if (want.trilin, want.gradient, want.shader, want.compos)
+        != (rtl.trilin, rtl.gradient, rtl.shader, rtl.compos)
+    {
+        // `cube5 cosim -p P` names the variant by P; the scene's widths must be its widths.
+        bail!(
+            "{origin}: the scene's widths ([quality]) are not those of {} (the defaults): co-simulate it on a cube5_frame variant with its widths",
+            rtl.variant
+        );
+    }
     let raw = scene.build_volume()?;
-    let vol = at_voxel_width(&raw, rtl.trilin.voxel_w)?;
-    rtl.check_volume(&vol)
+    let job = FrameJob::new(scene, &raw, rtl.cfg, rtl.p)?;
+    let vol = &job.seen;
+    rtl.check_volume(vol)
         .map_err(|e| anyhow!("{origin}: volume: {e}"))?;
-    // Blocks whose voxels are all 0 are marked empty: the memory skips their beams.
-    let setup = FrameSetup::new(vol.dims, vol.spacing, dir, rtl.p)?;
-    let (lut, seen, look) = frame_inputs(scene, &rtl, &vol, &setup)?;
     say!(
         "cosim: {} volume {}x{}x{} ({}-bit, as {}-bit), {} on {} ({} pipelines), view {:.4?}",
         origin,
@@ -180,10 +125,10 @@ pub fn cosim_scene(
     );
 
     let t = Instant::now();
-    let e = Expected::new(&rtl, &seen, "scene", dir.to_array(), render, &look)?;
+    let e = Expected::from_job(&job, job.render(), "scene");
     let model_secs = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let mut bench = FrameBench::new(rtl, &vol, &lut, seed)?;
+    let mut bench = FrameBench::new(rtl, vol, &job.lut, seed)?;
     bench.skip_empty = true;
     bench.load(&e)?;
     let load_secs = t.elapsed().as_secs_f64();
@@ -247,24 +192,11 @@ pub fn cosim_scene(
         height: e.h,
         coxels: rtl_coxels,
     };
-    let camera = Camera::new(
-        dir,
-        vol.dims,
-        vol.spacing,
-        scene.image.width,
-        scene.image.height,
-    );
     for (who, bp) in [("model", &model_bp), ("rtl", &rtl_bp)] {
         let base = base_plane_png(bp, &cfg);
         let path = out_dir.join(format!("{who}-base-plane.png"));
         write_png_atomically(&base, &path)?;
-        let warped = cube5_frame::warp(
-            &e.params,
-            vol.spacing,
-            &bp.rgb(&cfg),
-            (bp.width, bp.height),
-            &camera,
-        );
+        let warped = job.image(scene, bp);
         let path2 = out_dir.join(format!("{who}.png"));
         write_png_atomically(&warped.to_rgb8(), &path2)?;
         say!("wrote {} and {}", path.display(), path2.display());
@@ -287,17 +219,14 @@ fn base_plane_png(bp: &BasePlane, cfg: &ComposConfig) -> image::RgbImage {
 /// bit for bit. A Markdown section for `cube5 tradeoff`.
 pub fn frame_cost_section(scene: &Scene) -> Result<String> {
     let mut md = String::from("## Cycles per frame (`cube5_frame`, RTL)\n\n");
-    let render = match scene.render.mode {
-        CompositeMode::Composite => Render::Composite,
-        CompositeMode::Mip => Render::Mip,
-        m => {
-            md.push_str(&format!(
-                "cube5_frame renders composite and MIP; this scene's mode is {}.\n\n",
-                m.name()
-            ));
-            return Ok(md);
-        }
-    };
+    let why = not_expressible(scene);
+    if !why.is_empty() {
+        md.push_str(&format!(
+            "cube5_frame cannot render this scene: {}.\n\n",
+            why.join("; ")
+        ));
+        return Ok(md);
+    }
     md.push_str(
         "The baseline scene's volume and view on the verified frame configurations (default widths): \
          cycles from the render command to the last base-plane pixel, measured in simulation; the \
@@ -307,21 +236,24 @@ pub fn frame_cost_section(scene: &Scene) -> Result<String> {
     );
     md.push_str("| P | samples | cycles/frame | samples/clock/pipeline | skipping empty slices: cycles/frame | ratio |\n");
     md.push_str("|--:|--------:|-------------:|-----------------------:|------------------------------------:|------:|\n");
-    let dir = scene.render_params().direction()?;
     let raw = scene.build_volume()?;
     for rtl in FrameRtl::pipeline_counts()
         .into_iter()
         .filter_map(FrameRtl::with_pipelines)
     {
-        let vol = at_voxel_width(&raw, rtl.trilin.voxel_w)?;
-        if let Err(why) = rtl.check_volume(&vol) {
+        let job = match FrameJob::new(scene, &raw, rtl.cfg, rtl.p) {
+            Ok(job) => job,
+            Err(why) => {
+                md.push_str(&format!("| {} | | n/a: {why} | | | |\n", rtl.p));
+                continue;
+            }
+        };
+        if let Err(why) = rtl.check_volume(&job.seen) {
             md.push_str(&format!("| {} | | n/a: {why} | | | |\n", rtl.p));
             continue;
         }
-        let setup = FrameSetup::new(vol.dims, vol.spacing, dir, rtl.p)?;
-        let (lut, seen, look) = frame_inputs(scene, &rtl, &vol, &setup)?;
-        let e = Expected::new(&rtl, &seen, "scene", dir.to_array(), render, &look)?;
-        let mut bench = FrameBench::new(rtl, &vol, &lut, 1)?;
+        let e = Expected::from_job(&job, job.render(), "scene");
+        let mut bench = FrameBench::new(rtl, &job.seen, &job.lut, 1)?;
         let full = bench.check(&e, &Traffic::full_speed(), 1)?;
         bench.skip_empty = true;
         let cut = bench.check(&e, &Traffic::full_speed(), 1)?;

@@ -9,19 +9,23 @@ macro_rules! say {
     }};
 }
 
+#[cfg(feature = "rtl")]
 mod bench;
+#[cfg(feature = "rtl")]
 mod cosim;
 mod tradeoff;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use cube5_model::phantom::{phantom_by_name, PHANTOMS};
 use cube5_model::render::{render_pipeline, render_reference, ImageF64};
-use cube5_model::scene::{Plan, Renderer, Scene};
+use cube5_model::scene::{Plan, Renderer, Scene, Target};
+use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
 use cube5_model::studies::tradeoff::image_error;
 use cube5_model::volume_io::{self, Endian, NrrdEncoding};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -43,8 +47,10 @@ enum Command {
     /// Write an embedded phantom as a volume file (.nrrd, .nii, .nii.gz or .raw).
     Phantom(PhantomArgs),
     /// Co-simulate one frame of a scene: the RTL frame against the golden model, bit for bit.
+    #[cfg(feature = "rtl")]
     Cosim(cosim::CosimArgs),
     /// Print speed figures: simulated RTL cycles per second and model samples per second.
+    #[cfg(feature = "rtl")]
     Bench(bench::BenchArgs),
 }
 
@@ -73,6 +79,12 @@ struct RenderArgs {
     /// Also render the f64 reference and print the pipeline's error against it.
     #[arg(long)]
     compare: bool,
+    /// Override run.target: model, rtl (co-simulate the RTL frame) or both.
+    #[arg(long, value_parser = parse_target)]
+    target: Option<Target>,
+    /// Render the frame this many times (volume loaded once) and print the best time.
+    #[arg(long, default_value_t = 1)]
+    repeat: u32,
 }
 
 #[derive(Debug, clap::Args)]
@@ -123,8 +135,19 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render(args),
         Command::Tradeoff(args) => tradeoff::run(args),
         Command::Phantom(args) => phantom(args),
+        #[cfg(feature = "rtl")]
         Command::Bench(args) => bench::run(args),
+        #[cfg(feature = "rtl")]
         Command::Cosim(args) => cosim::run(args),
+    }
+}
+
+fn parse_target(s: &str) -> std::result::Result<Target, String> {
+    match s {
+        "model" => Ok(Target::Model),
+        "rtl" => Ok(Target::Rtl),
+        "both" => Ok(Target::Both),
+        _ => Err(format!("`{s}`: must be model, rtl or both")),
     }
 }
 
@@ -177,68 +200,88 @@ fn render(args: RenderArgs) -> Result<()> {
     if args.reference {
         scene.run.renderer = Renderer::Reference;
     }
+    if let Some(t) = args.target {
+        scene.run.target = t;
+    }
     scene.validate("command line")?;
     check_png_path(&args.output)?;
     let vol = scene.build_volume()?;
     let plan = Plan::new(&scene, &vol)?;
     say!("plan: {plan}");
     if scene.run.target.uses_rtl() {
-        // The RTL frame (P = 4) against the model, images beside the output. It is the only RTL
-        // variant a scene needs: `CUBE5_TOPS=cube5_frame:P=4:MaxDim=128` builds just it.
-        let rtl = cube5_tb::frame::FrameRtl::with_pipelines(4).ok_or_else(|| {
-            anyhow!("no cube5_frame variant with P = 4 in rtl/cube5/cube5_frame.variants")
-        })?;
-        say!(
-            "rtl: {} (the only RTL variant this scene needs; CUBE5_TOPS={}:P=4:MaxDim=128 builds just it)",
-            rtl.variant,
-            rtl.variant.top
-        );
-        let stem = args
-            .output
-            .file_stem()
-            .map_or("cube5".into(), |s| s.to_string_lossy().into_owned());
-        let dir = args.output.with_file_name(format!("{stem}-cosim"));
-        let origin = args
-            .scene
-            .as_ref()
-            .map_or("the default scene".to_string(), |p| p.display().to_string());
-        let r = cosim::cosim_scene(&scene, &origin, rtl, &dir, 1)?;
-        if !r.matched {
-            bail!(
-                "run.target = \"{}\": the RTL frame differs from the model (report above)",
-                scene.run.target.name()
-            );
-        }
-        if scene.run.target == cube5_model::scene::Target::Rtl {
+        let done = cosim_for_render(&scene, &args)?;
+        if done {
             return Ok(());
         }
     }
     let params = scene.render_params();
     let tf = scene.transfer_function();
-    let start = std::time::Instant::now();
-    let (img, what): (ImageF64, String) = match scene.run.renderer {
-        Renderer::Reference => (
-            render_reference(&vol, &tf, &params)?,
-            format!("f64 reference renderer, step {}", params.step),
-        ),
-        Renderer::Pipeline => {
-            let q = scene.quality();
-            let out = render_pipeline(&vol, &tf, &params, &q)?;
-            let s = out.stats;
-            (
-                out.image,
-                format!(
-                    "pipeline model: {} interpolation, {}-neighbourhood gradient, base plane {}x{}, {} samples",
+    let what_if = not_expressible(&scene);
+    let repeat = args.repeat.max(1);
+    let mut best = f64::INFINITY;
+    let mut frame = || -> Result<(ImageF64, String, u64)> {
+        let start = std::time::Instant::now();
+        let out = match scene.run.renderer {
+            Renderer::Reference => {
+                let img = render_reference(&vol, &tf, &params)?;
+                let what = format!("f64 reference renderer, step {}", params.step);
+                (img, what, 0)
+            }
+            Renderer::Pipeline if what_if.is_empty() => {
+                // The one golden model: the frame the RTL computes, then the warp.
+                let job = FrameJob::new(&scene, &vol, frame_config(&scene)?, 1)?;
+                let run = job.render();
+                let img = job.image(&scene, &run.base);
+                let what = format!(
+                    "frame model = cube5_frame's bits: base plane {}x{}, {} samples, {} + {} of {} slices skipped (empty), {} of {} rays terminated early",
+                    run.base.width,
+                    run.base.height,
+                    run.samples,
+                    run.skipped_slices.0,
+                    run.skipped_slices.1,
+                    run.slices,
+                    run.terminated_rays,
+                    run.base.coxels.len()
+                );
+                (img, what, run.samples)
+            }
+            Renderer::Pipeline => {
+                let q = scene.quality();
+                let out = render_pipeline(&vol, &tf, &params, &q)?;
+                let s = out.stats;
+                let what = format!(
+                    "what-if pipeline model, not the hardware ({}): {} interpolation, {}-neighbourhood gradient, base plane {}x{}, {} samples",
+                    what_if.join("; "),
                     q.interpolation.name(),
                     u32::from(q.gradient),
                     s.base_plane[0],
                     s.base_plane[1],
                     s.samples
-                ),
-            )
-        }
+                );
+                (out.image, what, s.samples)
+            }
+        };
+        best = best.min(start.elapsed().as_secs_f64());
+        Ok(out)
     };
-    let secs = start.elapsed().as_secs_f64();
+    let (img, what, samples) = frame()?;
+    let mut last = Instant::now();
+    for n in 1..repeat {
+        frame()?;
+        if last.elapsed().as_secs_f64() > 2.0 {
+            eprintln!("frame {} of {repeat}", n + 1);
+            last = Instant::now();
+        }
+    }
+    if args.repeat > 1 {
+        say!(
+            "time: frame {:.2} ms (best of {repeat}), {:.1} M samples/s, {} threads",
+            best * 1e3,
+            samples as f64 / best / 1e6,
+            rayon::current_num_threads()
+        );
+    }
+    let secs = best;
     if args.compare && scene.run.renderer == Renderer::Pipeline {
         let reference = render_reference(&vol, &tf, &params)?;
         let e = image_error(&img, &reference);
@@ -258,7 +301,7 @@ fn render(args: RenderArgs) -> Result<()> {
         ),
     };
     say!(
-        "rendered {}x{}x{} volume, {view}, {}x{} pixels in {:.2} s ({what})",
+        "rendered {}x{}x{} volume, {view}, {}x{} pixels in {:.4} s ({what})",
         vol.dims[0],
         vol.dims[1],
         vol.dims[2],
@@ -268,6 +311,47 @@ fn render(args: RenderArgs) -> Result<()> {
     );
     say!("wrote {}", args.output.display());
     Ok(())
+}
+
+/// `run.target = "rtl"` or `"both"`: the RTL frame (P = 4) against the model, images beside the
+/// output. True when the scene asks for the RTL only (nothing more to render).
+#[cfg(feature = "rtl")]
+fn cosim_for_render(scene: &Scene, args: &RenderArgs) -> Result<bool> {
+    // The RTL frame (P = 4) against the model, images beside the output. It is the only RTL
+    // variant a scene needs: `CUBE5_TOPS=cube5_frame:P=4:MaxDim=128` builds just it.
+    let rtl = cosim::variant_for(scene)?;
+    say!(
+        "rtl: {} (the only RTL variant this scene needs; CUBE5_TOPS={}:P={}:MaxDim={} builds just it)",
+        rtl.variant,
+        rtl.variant.top,
+        rtl.p,
+        rtl.max_dim()
+    );
+    let stem = args
+        .output
+        .file_stem()
+        .map_or("cube5".into(), |s| s.to_string_lossy().into_owned());
+    let dir = args.output.with_file_name(format!("{stem}-cosim"));
+    let origin = args
+        .scene
+        .as_ref()
+        .map_or("the default scene".to_string(), |p| p.display().to_string());
+    let r = cosim::cosim_scene(scene, &origin, rtl, &dir, 1)?;
+    if !r.matched {
+        bail!(
+            "run.target = \"{}\": the RTL frame differs from the model (report above)",
+            scene.run.target.name()
+        );
+    }
+    Ok(scene.run.target == Target::Rtl)
+}
+
+#[cfg(not(feature = "rtl"))]
+fn cosim_for_render(scene: &Scene, _args: &RenderArgs) -> Result<bool> {
+    bail!(
+        "run.target = \"{}\": this cube5 was built without the RTL (cargo feature `rtl`); render with run.target = \"model\" or build with the default features",
+        scene.run.target.name()
+    )
 }
 
 fn phantom(args: PhantomArgs) -> Result<()> {

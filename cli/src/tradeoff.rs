@@ -158,8 +158,16 @@ pub fn run(args: TradeoffArgs) -> Result<()> {
         bar: Mutex::new(None),
     };
     let report = run_sweeps(&setup, &bars)?;
-    say!("cube5 tradeoff: cycles per frame on the RTL frame (P = 1, 4, 8)");
-    let frame_md = crate::cosim::frame_cost_section(&scene)?;
+    #[cfg(feature = "rtl")]
+    let frame_md = {
+        say!("cube5 tradeoff: cycles per frame on the RTL frame (P = 1, 4, 8)");
+        crate::cosim::frame_cost_section(&scene)?
+    };
+    #[cfg(not(feature = "rtl"))]
+    let frame_md = String::from(
+        "## Cycles per frame (`cube5_frame`, RTL)\n\nThis cube5 was built without the RTL \
+         (cargo feature `rtl`): no cycles measured.\n\n",
+    );
     let secs = started.elapsed().as_secs_f64();
 
     // Everything is computed: now write, each file atomically.

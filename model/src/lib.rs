@@ -6,6 +6,7 @@
 //! Layering, bottom up: `bits`, `error`, `unit` (the stream trait every unit implements);
 //! `volume`, `transfer`, `camera`; `units` (one module per RTL top, named as the top);
 //! `phantom`, `volume_io`, `scene`, `render` (scenes, files and renderers that use the units);
+//! `scene_render` (what `cube5 render` runs: a scene on the frame model, or a named what-if);
 //! `studies` (the tradeoff sweeps, not part of the golden model).
 
 pub mod bits;
@@ -15,6 +16,7 @@ pub mod phantom;
 pub mod regs;
 pub mod render;
 pub mod scene;
+pub mod scene_render;
 pub mod studies;
 pub mod transfer;
 pub mod unit;

@@ -280,7 +280,7 @@ impl RenderParams {
     }
 
     /// The orthographic camera (shared with the warp), zoom applied.
-    fn camera(&self, vol: &Volume, dir: DVec3) -> Camera {
+    pub fn camera(&self, vol: &Volume, dir: DVec3) -> Camera {
         let mut cam = Camera::new(dir, vol.dims, vol.spacing, self.width, self.height);
         cam.half /= self.zoom;
         cam
@@ -527,8 +527,9 @@ impl Interpolation {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(try_from = "u32", into = "u32")]
 pub enum GradientScheme {
-    Six,
+    /// The frame's: central differences of the six orthogonal neighbours.
     #[default]
+    Six,
     Ten,
     TwentySix,
 }
@@ -634,7 +635,7 @@ impl Default for Quality {
             samples_per_slice: 1,
             supersampling: 1,
             interpolation: Interpolation::BilinearSlice,
-            gradient: GradientScheme::Ten,
+            gradient: GradientScheme::Six,
         }
     }
 }

@@ -736,6 +736,8 @@ pub struct PlanEntry {
 /// What a scene needs modelled (and, later, built and simulated on the RTL side).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
+    /// The model that renders: the frame (the hardware's bits) or a what-if, with the reasons.
+    pub model: String,
     pub entries: Vec<PlanEntry>,
     pub renderer: Renderer,
     pub target: Target,
@@ -875,7 +877,20 @@ impl Plan {
                 "parallel projection".into()
             },
         );
+        let what_if = crate::scene_render::not_expressible(scene);
+        let model = match scene.run.renderer {
+            Renderer::Reference => "f64 reference renderer (not the hardware)".to_string(),
+            Renderer::Pipeline if what_if.is_empty() => {
+                frame_entries(&mut entries, scene, vol);
+                "frame (cube5_frame's bits, then the warp)".to_string()
+            }
+            Renderer::Pipeline => format!(
+                "what-if pipeline (not the hardware: {})",
+                what_if.join("; ")
+            ),
+        };
         Ok(Self {
+            model,
             entries,
             renderer: scene.run.renderer,
             target: scene.run.target,
@@ -899,8 +914,71 @@ impl fmt::Display for Plan {
                 .collect::<Vec<_>>()
                 .join(", ")
         };
-        write!(f, "modelled: {}; left out: {}", list(true), list(false))
+        write!(
+            f,
+            "{}; modelled: {}; left out: {}",
+            self.model,
+            list(true),
+            list(false)
+        )
     }
+}
+
+/// The plan's entries as the frame computes them: all four units run for every sample (MIP takes
+/// the density ramp, unlit), the gradient is the 6-neighbourhood at orthogonal positions, and the
+/// sweep skips whole empty slices at its ends (blocks of zeros), not transparent blocks.
+fn frame_entries(entries: &mut [PlanEntry], scene: &Scene, vol: &Volume) {
+    let mip = scene.render.mode == CompositeMode::Mip;
+    for e in entries.iter_mut() {
+        match e.unit {
+            Unit::Gradient if mip => {
+                e.needed = true;
+                e.detail = "computed, unused: MIP is unlit".into();
+            }
+            Unit::Gradient => {
+                e.detail = "6-neighbourhood at orthogonal positions".into();
+                e.needed = true;
+            }
+            Unit::Shader if mip => {
+                e.needed = true;
+                e.detail = "density ramp, unlit".into();
+            }
+            Unit::Shader if !scene.render.shading => {
+                e.detail = "classification, reflectance map 1 (shading off)".into();
+            }
+            Unit::EmptySpaceSkip => {
+                let zero = zero_block_fraction(vol);
+                e.needed = zero > 0.0;
+                e.detail = if e.needed {
+                    format!(
+                        "{:.0}% of {SKIP_BLOCK}^3 blocks are zero: their beams are not read, whole empty slices at the sweep's ends are skipped",
+                        100.0 * zero
+                    )
+                } else {
+                    "no block is zero".into()
+                };
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Fraction of `SKIP_BLOCK`^3 blocks whose voxels are all 0 (the frame's block LUT marks them
+/// empty).
+pub fn zero_block_fraction(vol: &Volume) -> f64 {
+    let nb = vol.dims.map(|d| d.div_ceil(SKIP_BLOCK));
+    let mut zero = vec![true; nb[0] * nb[1] * nb[2]];
+    for z in 0..vol.dims[2] {
+        for y in 0..vol.dims[1] {
+            for x in 0..vol.dims[0] {
+                if vol.data[x + vol.dims[0] * (y + vol.dims[1] * z)] != 0 {
+                    let b = [x, y, z].map(|v| v / SKIP_BLOCK);
+                    zero[b[0] + nb[0] * (b[1] + nb[1] * b[2])] = false;
+                }
+            }
+        }
+    }
+    zero.iter().filter(|z| **z).count() as f64 / zero.len() as f64
 }
 
 /// Fraction of `SKIP_BLOCK`^3 blocks (with a one-voxel apron, as interpolation reads it) whose
@@ -974,6 +1052,18 @@ mod tests {
         let vol = crate::phantom::head_phantom(32, 12).unwrap();
         let scene = Scene::parse("[render]\nmode = \"mip\"\n", "s").unwrap();
         let plan = Plan::new(&scene, &vol).unwrap();
+        // The frame runs every unit for every sample; MIP leaves the gradient unused.
+        assert!(plan.model.starts_with("frame"), "{}", plan.model);
+        assert!(plan.needs(Unit::Gradient) && plan.needs(Unit::Shader));
+        let text = plan.to_string();
+        assert!(
+            text.contains("gradient (computed, unused: MIP is unlit)"),
+            "{text}"
+        );
+        // The what-if pipeline leaves them out.
+        let what_if = "[render]\nmode = \"mip\"\n[quality]\ninterpolation = \"sheared\"\n";
+        let plan = Plan::new(&Scene::parse(what_if, "s").unwrap(), &vol).unwrap();
+        assert!(plan.model.starts_with("what-if"), "{}", plan.model);
         assert!(plan.needs(Unit::Trilin) && plan.needs(Unit::Compos));
         assert!(!plan.needs(Unit::Gradient) && !plan.needs(Unit::Shader));
         let text = plan.to_string();

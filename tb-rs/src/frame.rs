@@ -13,6 +13,7 @@ use crate::rtl::{RtlStream, Traffic};
 use crate::variants::{variants_of, Variant};
 use cube5_model::bits::{BitReader, BitWriter};
 use cube5_model::error::ModelError;
+use cube5_model::scene_render::{FrameJob, FrameRun};
 use cube5_model::transfer::TransferFunction;
 use cube5_model::unit::StreamCodec;
 use cube5_model::unit::UnitConfig;
@@ -22,7 +23,7 @@ use cube5_model::units::cube5_frame::{
 };
 use cube5_model::units::cube5_gradient::{Gradient, GradientConfig};
 use cube5_model::units::cube5_shader::{
-    ClassLut, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderMode, ShaderTables,
+    ClassLut, Phong, ReflectanceMap, Shader, ShaderConfig, ShaderMode, ShaderTables,
 };
 use cube5_model::units::cube5_skewmem::{BlockLut, SkewConfig, SkewDims, SkewMem};
 use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig};
@@ -351,20 +352,7 @@ pub struct Units {
     pub tf2d: bool,
 }
 
-/// The MIP classification table of the contract: the density ramp, grey.
-pub fn density_ramp(cfg: &ShaderConfig) -> Result<ClassLut, ModelError> {
-    let top = (1u64 << cfg.class_idx_w) - 1;
-    let scale = |idx: usize, w: u32| (idx as u64 * ((1u64 << w) - 1) / top) as u32;
-    ClassLut::from_fn(cfg, |idx| {
-        let c = scale(idx, cfg.color_w);
-        Rgba {
-            r: c,
-            g: c,
-            b: c,
-            a: scale(idx, cfg.alpha_w),
-        }
-    })
-}
+pub use cube5_model::scene_render::density_ramp;
 
 /// The look of a rendering: transfer function and lighting (frame axes), opacity correction and
 /// early termination.
@@ -471,19 +459,7 @@ pub fn sparse_scene(seed: u64) -> Volume {
 
 /// What the memory returns: the volume with the voxels of skipped blocks (empty or masked) read as
 /// 0 (docs/numerics/skewmem.md).
-pub fn as_seen(vol: &Volume, lut: &BlockLut) -> Result<Volume, ModelError> {
-    let b = lut.block as usize;
-    let [nx, ny, _] = vol.dims;
-    let mut data = vol.data.clone();
-    for (i, v) in data.iter_mut().enumerate() {
-        let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
-        let e = lut.entry([(x / b) as u32, (y / b) as u32, (z / b) as u32]);
-        if e.is_none_or(|e| e.empty || e.masked) {
-            *v = 0;
-        }
-    }
-    Volume::new(vol.dims, vol.spacing, vol.bits, data)
-}
+pub use cube5_model::scene_render::seen_through as as_seen;
 
 /// The base-plane image from the unit models along each ray (`cube5_frame::fold_rays`), for the widths
 /// and registers `FrameUnits` does not build (narrow widths, early termination); checked against
@@ -580,6 +556,34 @@ impl Expected {
             h,
             want,
         })
+    }
+}
+
+impl Expected {
+    /// The model's frame of a scene, exactly what `cube5 render` computes for it
+    /// (`cube5_model::scene_render::FrameJob`): the RTL is compared with that image.
+    pub fn from_job(job: &FrameJob, run: FrameRun, view: &str) -> Self {
+        let u = job.units.clone();
+        Expected {
+            seen: Rc::new(job.seen.clone()),
+            view: view.to_string(),
+            dir: job.dir.to_array(),
+            params: job.setup.params,
+            units: Units {
+                trilin: u.trilin,
+                gradient: u.gradient,
+                shader: u.shader,
+                compos: u.compos,
+                render: match u.mode {
+                    FrameMode::Mip => Render::Mip,
+                    FrameMode::Composite => Render::Composite,
+                },
+                tf2d: false,
+            },
+            w: run.base.width,
+            h: run.base.height,
+            want: run.base.coxels,
+        }
     }
 }
 

@@ -1,0 +1,408 @@
+//! What `cube5 render` runs for a scene: the frame model (`units::cube5_frame`, bit-exact with the
+//! RTL frame) for every scene the hardware can express, else a what-if model named as such.
+//!
+//! A scene is one frame of `cube5_frame` when its mode is composite or MIP, its projection
+//! parallel, and its `[quality]` asks for nothing the frame does not compute (bilinear samples on
+//! the slices, one sample per slice, one ray per voxel, the 6-neighbourhood gradient at orthogonal
+//! positions). Its widths become the frame's parameters (`FrameConfig`), so a width is a knob of
+//! the one model, not of a second one. Everything else (sheared or tri-linear interpolation, more
+//! samples per slice, supersampling, the 10- and 26-neighbourhood gradients, X-ray, MinIP and
+//! first-opaque) runs on the what-if pipeline model `render::render_pipeline`, and `plan:` says so.
+
+use crate::camera::Camera;
+use crate::error::{ModelError, Result};
+use crate::render::{CompositeMode, GradientScheme, ImageF64, Interpolation, Projection};
+use crate::scene::Scene;
+use crate::transfer::TransferFunction;
+use crate::unit::UnitConfig;
+use crate::units::cube5_compos::{ComposConfig, ComposRegs, OpacityLut};
+use crate::units::cube5_frame::{
+    self, BasePlane, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits,
+};
+use crate::units::cube5_shader::{
+    ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderTables,
+};
+use crate::units::cube5_skewmem::BlockLut;
+use crate::units::cube5_trilin::Trilin;
+use crate::units::{cube5_compos::Compos, cube5_gradient::Gradient};
+use crate::volume::Volume;
+use glam::DVec3;
+
+/// Why a scene is not one frame of the hardware: one phrase per setting (empty: it is).
+pub fn not_expressible(scene: &Scene) -> Vec<String> {
+    let q = scene.quality();
+    let mut why = Vec::new();
+    match scene.render.mode {
+        CompositeMode::Composite | CompositeMode::Mip => {}
+        m => why.push(format!(
+            "render.mode = \"{}\" (the frame composites and takes maxima)",
+            m.name()
+        )),
+    }
+    if scene.view.projection != Projection::Parallel {
+        why.push("perspective projection (the frame is parallel only)".into());
+    }
+    if q.interpolation != Interpolation::BilinearSlice {
+        why.push(format!(
+            "quality.interpolation = \"{}\" (the frame samples bilinearly on the slices)",
+            q.interpolation.name()
+        ));
+    }
+    if q.samples_per_slice != 1 {
+        why.push(format!(
+            "quality.samples_per_slice = {} (the frame takes one per slice)",
+            q.samples_per_slice
+        ));
+    }
+    if q.supersampling != 1 {
+        why.push(format!(
+            "quality.supersampling = {} (the frame casts one ray per voxel)",
+            q.supersampling
+        ));
+    }
+    if q.gradient != GradientScheme::Six {
+        why.push(format!(
+            "quality.gradient = {} (the frame's gradient is the 6-neighbourhood)",
+            u32::from(q.gradient)
+        ));
+    }
+    if why.is_empty() {
+        if let Err(e) = frame_config(scene) {
+            why.push(e.to_string());
+        }
+    }
+    why
+}
+
+/// The frame configuration of a scene's widths (`[quality]`), on the RTL's defaults otherwise;
+/// `voxel_bits` unset keeps the frame's `VoxelW` (volumes are scaled onto it).
+pub fn frame_config(scene: &Scene) -> Result<FrameConfig> {
+    let q = scene.quality();
+    let mut params = FrameConfig::DEFAULT.to_params();
+    for (name, value) in [
+        ("VoxelW", q.voxel_bits),
+        ("WeightW", Some(q.weight_bits)),
+        ("FracW", Some(q.frac_bits)),
+        ("ColorW", Some(q.colour_bits)),
+        ("AlphaW", Some(q.alpha_bits)),
+        ("AccW", Some(q.acc_bits)),
+    ] {
+        if let (Some(v), Some(slot)) = (value, params.iter_mut().find(|(n, _)| *n == name)) {
+            slot.1 = i64::from(v);
+        }
+    }
+    FrameConfig::from_params(&params)
+        .map_err(|e| ModelError::Config(format!("the frame cannot take these widths: {e}")))
+}
+
+/// The volume at voxel width `w`: `v << (w - bits)` or `v >> (bits - w)`, the same integers the
+/// RTL's memory is loaded with.
+pub fn at_voxel_width(vol: &Volume, w: u32) -> Result<Volume> {
+    let data = vol
+        .data
+        .iter()
+        .map(|&v| {
+            if vol.bits <= w {
+                v << (w - vol.bits)
+            } else {
+                v >> (vol.bits - w)
+            }
+        })
+        .collect();
+    Volume::new(vol.dims, vol.spacing, w, data)
+}
+
+/// The scene's lights and material in the frame's axes (the reflectance map's input).
+pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
+    let lights: Vec<DistantLight> = scene
+        .lights
+        .iter()
+        .map(|l| DistantLight {
+            // The scene gives the direction light travels; the map wants the way to the light.
+            direction: l.direction.map(|c| -c),
+            intensity: (l.colour.iter().sum::<f64>() / 3.0).clamp(0.0, 4.0),
+        })
+        .collect();
+    let base = cube5_frame::frame_phong(params, &lights);
+    if scene.render.shading {
+        let m = scene.shading;
+        Phong {
+            ambient: m.ambient,
+            diffuse: m.diffuse,
+            specular: m.specular,
+            shininess: m.shininess,
+            ..base
+        }
+    } else {
+        // Unlit: the map is 1 everywhere.
+        Phong {
+            ambient: 1.0,
+            diffuse: 0.0,
+            specular: 0.0,
+            ..base
+        }
+    }
+}
+
+/// The MIP classification table of the frame contract: the density ramp, grey.
+pub fn density_ramp(cfg: &ShaderConfig) -> Result<ClassLut> {
+    let top = (cfg.class_entries() - 1) as u64;
+    let scale = |idx: usize, max: u32| ((idx as u64 * u64::from(max)) / top) as u32;
+    ClassLut::from_fn(cfg, |idx| Rgba {
+        r: scale(idx, cfg.color_max()),
+        g: scale(idx, cfg.color_max()),
+        b: scale(idx, cfg.color_max()),
+        a: scale(idx, cfg.alpha_max()),
+    })
+}
+
+/// The look of a frame: transfer function, lighting (frame axes) and the early-termination
+/// threshold (accumulated opacity in 0..1; `None` or >= 1: off).
+#[derive(Debug, Clone)]
+pub struct Look {
+    pub tf: TransferFunction,
+    pub phong: Phong,
+    pub early_termination: Option<f64>,
+}
+
+/// The compositing registers of a look: termination at `threshold` of the coxel's opacity scale
+/// (rounded down), off when absent or >= 1.
+pub fn compos_regs(cfg: &ComposConfig, mode: FrameMode, threshold: Option<f64>) -> ComposRegs {
+    let off = ComposRegs::without_termination(cfg);
+    match (mode, threshold) {
+        (FrameMode::Mip, _) => ComposRegs {
+            lut_bypass: true,
+            ..off
+        },
+        (FrameMode::Composite, Some(t)) if t < 1.0 => ComposRegs {
+            et_threshold: (t.max(0.0) * cfg.one() as f64) as u64,
+            ..off
+        },
+        (FrameMode::Composite, _) => off,
+    }
+}
+
+/// The four units of a frame at `cfg`'s widths with the tables and registers of `mode` and `look`
+/// (the frame contract's "pipeline of one sample").
+pub fn frame_units(
+    cfg: &FrameConfig,
+    mode: FrameMode,
+    setup: &FrameSetup,
+    look: &Look,
+) -> Result<FrameUnits> {
+    let rmap = ReflectanceMap::from_lights(&cfg.shader, &look.phong)?;
+    let (class, ratio) = match mode {
+        FrameMode::Mip => (density_ramp(&cfg.shader)?, 1.0),
+        FrameMode::Composite => (
+            ClassLut::from_transfer(&cfg.shader, &look.tf)?,
+            setup
+                .opacity_ratio
+                .clamp(OpacityLut::RATIO_MIN, OpacityLut::RATIO_MAX),
+        ),
+    };
+    Ok(FrameUnits {
+        trilin: Trilin::new(cfg.trilin)?,
+        gradient: Gradient::new(cfg.gradient)?,
+        shader: Shader::new(cfg.shader, ShaderTables { class, rmap })?,
+        compos: Compos::new(
+            cfg.compos,
+            OpacityLut::new(ratio, &cfg.compos)?,
+            compos_regs(&cfg.compos, mode, look.early_termination),
+        )?,
+        mode,
+    })
+}
+
+/// One frame of a scene, set up as the host sets up the RTL: the volume at the frame's voxel
+/// width as the memory returns it, the view, the block LUT and the units.
+#[derive(Debug, Clone)]
+pub struct FrameJob {
+    pub cfg: FrameConfig,
+    /// The volume as the memory returns it: voxels of blocks the LUT skips read as 0.
+    pub seen: Volume,
+    pub dir: DVec3,
+    pub setup: FrameSetup,
+    pub lut: BlockLut,
+    pub look: Look,
+    pub units: FrameUnits,
+}
+
+/// What one frame of the model computed.
+#[derive(Debug, Clone)]
+pub struct FrameRun {
+    pub base: BasePlane,
+    /// Samples the sweep takes (one per voxel of every slice it does not skip).
+    pub samples: u64,
+    /// Empty slices the sweep skips before and after (`cube5_frame::empty_slices`).
+    pub skipped_slices: (usize, usize),
+    pub slices: usize,
+    /// Rays the compositing unit terminated early (opaque), of all rays of the base plane.
+    pub terminated_rays: usize,
+}
+
+impl FrameJob {
+    /// Sets up one frame of `scene` on `raw` at `cfg` for `p` pipelines (the set-up refuses
+    /// dimensions that are not multiples of `p`; the image does not depend on `p`).
+    pub fn new(scene: &Scene, raw: &Volume, cfg: FrameConfig, p: usize) -> Result<Self> {
+        let mode = match scene.render.mode {
+            CompositeMode::Composite => FrameMode::Composite,
+            CompositeMode::Mip => FrameMode::Mip,
+            m => {
+                return Err(ModelError::Config(format!(
+                    "render.mode = \"{}\": the frame renders composite and MIP",
+                    m.name()
+                )))
+            }
+        };
+        let vol = at_voxel_width(raw, cfg.trilin.voxel_w)?;
+        let dir = scene.render_params().direction()?;
+        let setup = FrameSetup::new(vol.dims, vol.spacing, dir, p)?;
+        // Blocks whose voxels are all 0 are marked empty: the memory skips their beams.
+        let lut = BlockLut::from_volume(&vol, cfg.block as usize, 0)?;
+        let seen = seen_through(&vol, &lut)?;
+        let look = Look {
+            tf: scene.transfer_function(),
+            phong: scene_phong(scene, &setup.params),
+            early_termination: match mode {
+                FrameMode::Composite => Some(scene.render.early_termination),
+                FrameMode::Mip => None,
+            },
+        };
+        let units = frame_units(&cfg, mode, &setup, &look)?;
+        Ok(Self {
+            cfg,
+            seen,
+            dir,
+            setup,
+            lut,
+            look,
+            units,
+        })
+    }
+
+    /// The base plane, bit-exact with the RTL frame, and what the sweep did.
+    pub fn render(&self) -> FrameRun {
+        let params = &self.setup.params;
+        let base = cube5_frame::render_base_plane(params, &self.seen, &self.units);
+        let skipped_slices = cube5_frame::empty_slices(params, &self.lut);
+        let swept = params.nk - skipped_slices.0 - skipped_slices.1;
+        FrameRun {
+            samples: (swept * params.ni * params.nj) as u64,
+            skipped_slices,
+            slices: params.nk,
+            terminated_rays: base.coxels.iter().filter(|c| c.terminated).count(),
+            base,
+        }
+    }
+
+    /// The base plane warped onto the scene's image (bilinear, model only).
+    pub fn image(&self, scene: &Scene, base: &BasePlane) -> ImageF64 {
+        let mut camera = Camera::new(
+            self.dir,
+            self.seen.dims,
+            self.seen.spacing,
+            scene.image.width,
+            scene.image.height,
+        );
+        camera.half /= scene.view.zoom;
+        cube5_frame::warp(
+            &self.setup.params,
+            self.seen.spacing,
+            &base.rgb(&self.cfg.compos),
+            (base.width, base.height),
+            &camera,
+        )
+    }
+}
+
+/// What the memory returns: `vol` with the voxels of blocks the LUT skips (empty or masked) read
+/// as 0 (docs/numerics/skewmem.md).
+pub fn seen_through(vol: &Volume, lut: &BlockLut) -> Result<Volume> {
+    let b = lut.block as usize;
+    let [nx, ny, _] = vol.dims;
+    let mut data = vol.data.clone();
+    for (i, v) in data.iter_mut().enumerate() {
+        let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
+        let e = lut.entry([(x / b) as u32, (y / b) as u32, (z / b) as u32]);
+        if e.is_none_or(|e| e.empty || e.masked) {
+            *v = 0;
+        }
+    }
+    Volume::new(vol.dims, vol.spacing, vol.bits, data)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(text: &str) -> Scene {
+        Scene::parse(text, "s.toml").unwrap()
+    }
+
+    #[test]
+    fn the_default_scene_is_one_frame() {
+        assert!(not_expressible(&Scene::default()).is_empty());
+        assert_eq!(
+            frame_config(&Scene::default()).unwrap(),
+            FrameConfig::DEFAULT
+        );
+    }
+
+    #[test]
+    fn what_the_frame_cannot_do_is_named() {
+        let why = not_expressible(&scene(
+            "[quality]\ninterpolation = \"sheared\"\nsamples_per_slice = 2\ngradient = 10\n",
+        ));
+        assert_eq!(why.len(), 3, "{why:?}");
+        assert!(why[0].contains("sheared") && why[2].contains("gradient = 10"));
+        let why = not_expressible(&scene("[render]\nmode = \"xray\"\n"));
+        assert!(why[0].contains("xray"), "{why:?}");
+        let why = not_expressible(&scene("[quality]\nacc_bits = 8\n"));
+        assert!(why[0].contains("widths"), "{why:?}");
+    }
+
+    #[test]
+    fn widths_are_frame_parameters() {
+        let cfg = frame_config(&scene("[quality]\ncolour_bits = 10\nvoxel_bits = 16\n")).unwrap();
+        assert_eq!((cfg.compos.color_w, cfg.shader.color_w), (10, 10));
+        assert_eq!((cfg.trilin.voxel_w, cfg.gradient.voxel_w), (16, 16));
+    }
+
+    #[test]
+    fn units_at_the_default_widths_are_the_frame_models() {
+        // frame_units at FrameConfig::DEFAULT without termination builds what FrameUnits::new does.
+        let vol = crate::phantom::head_phantom(16, 12).unwrap();
+        for mode in ["composite", "mip"] {
+            let s = scene(&format!(
+                "[render]\nmode = \"{mode}\"\nearly_termination = 1.0\n"
+            ));
+            let job = FrameJob::new(&s, &vol, FrameConfig::DEFAULT, 1).unwrap();
+            let fu =
+                FrameUnits::new(job.units.mode, &job.setup, &job.look.tf, &job.look.phong).unwrap();
+            let a = cube5_frame::render_base_plane(&job.setup.params, &job.seen, &job.units);
+            let b = cube5_frame::render_base_plane(&job.setup.params, &job.seen, &fu);
+            assert!(a.coxels == b.coxels, "{mode}");
+        }
+    }
+
+    #[test]
+    fn early_termination_follows_the_scene() {
+        let vol = crate::phantom::head_phantom(24, 12).unwrap();
+        let on = FrameJob::new(
+            &scene("[render]\nearly_termination = 0.3\n"),
+            &vol,
+            FrameConfig::DEFAULT,
+            1,
+        )
+        .unwrap();
+        let off = FrameJob::new(
+            &scene("[render]\nearly_termination = 1.0\n"),
+            &vol,
+            FrameConfig::DEFAULT,
+            1,
+        )
+        .unwrap();
+        let (a, b) = (on.render(), off.render());
+        assert!(a.terminated_rays > 0 && b.terminated_rays == 0);
+    }
+}
