@@ -66,6 +66,14 @@ pub fn not_expressible(scene: &Scene) -> Vec<String> {
             u32::from(q.gradient)
         ));
     }
+    for (i, l) in scene.lights.iter().enumerate() {
+        if l.colour.iter().any(|&c| c != l.colour[0]) {
+            why.push(format!(
+                "light[{i}].colour = {:?} (the frame's reflectance map is one intensity per light)",
+                l.colour
+            ));
+        }
+    }
     if why.is_empty() {
         if let Err(e) = frame_config(scene) {
             why.push(e.to_string());
@@ -357,6 +365,11 @@ mod tests {
         assert!(why[0].contains("sheared") && why[2].contains("gradient = 10"));
         let why = not_expressible(&scene("[render]\nmode = \"xray\"\n"));
         assert!(why[0].contains("xray"), "{why:?}");
+        let why = not_expressible(&scene(
+            "[[light]]\ndirection = [1, 0, 0]\ncolour = [1.0, 0.5, 0.5]\n[[light]]\ndirection = [0, 1, 0]\ncolour = [2.0, 2.0, 2.0]\n",
+        ));
+        assert_eq!(why.len(), 1, "{why:?}");
+        assert!(why[0].contains("light[0].colour"), "{why:?}");
         let why = not_expressible(&scene("[quality]\nacc_bits = 8\n"));
         assert!(why[0].contains("widths"), "{why:?}");
     }
