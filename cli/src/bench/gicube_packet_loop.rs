@@ -5,10 +5,10 @@ use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::gicube_packet_loop::{
-    random_packet, PacketLoop, PacketLoopConfig, RayPacket, RayReal, RayType,
+    random_packet, PacketLoop, PacketLoopConfig, RayPacket, RayReal,
 };
 use cube5_tb::variants_of;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 pub const TOP: &str = PacketLoopConfig::TOP;
@@ -37,20 +37,7 @@ pub fn run(n_items: usize) -> Result<()> {
     let mut rng = ChaCha8Rng::seed_from_u64(6);
     let mut acc = [ErrorStats::default(); 4];
     for _ in 0..n_items {
-        let r = RayReal {
-            u: rng.random_range(0..4096),
-            v: rng.random_range(0..4096),
-            start: std::array::from_fn(|_| rng.random_range(0.0..4095.99)),
-            dir: std::array::from_fn(|_| rng.random_range(-1.0..=1.0)),
-            color: std::array::from_fn(|_| rng.random_range(0.0..0.9998)),
-            opacity: rng.random_range(0.0..0.9998),
-            contribution: rng.random_range(0.0..0.9998),
-            interaction: rng.random_range(0.0..0.99999),
-            lifetime: rng.random(),
-            generation: rng.random(),
-            ray_type: RayType::Rendering,
-            flags: 0,
-        };
+        let r = RayReal::random(&mut rng);
         let back = RayPacket::from_real(&r)?.to_real();
         let mut add = |k: usize, got: f64, want: f64, frac: u32| {
             acc[k].add((got - want).abs() * f64::from(1u32 << frac));
