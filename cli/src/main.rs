@@ -233,10 +233,11 @@ fn render(args: RenderArgs) -> Result<()> {
                 let run = job.render();
                 let img = job.image(&scene, &run.base);
                 let what = format!(
-                    "frame model = cube5_frame's bits: base plane {}x{}, {} samples, {} + {} of {} slices skipped (empty), {} of {} rays terminated early",
+                    "frame model = cube5_frame's bits: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early",
                     run.base.width,
                     run.base.height,
                     run.samples,
+                    run.samples_in_skipped_blocks,
                     run.skipped_slices.0,
                     run.skipped_slices.1,
                     run.slices,

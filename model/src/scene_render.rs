@@ -244,6 +244,9 @@ pub struct FrameRun {
     /// Empty slices the sweep skips before and after (`cube5_frame::empty_slices`).
     pub skipped_slices: (usize, usize),
     pub slices: usize,
+    /// Samples of the swept slices whose voxels lie in blocks the LUT skips: their memory reads
+    /// are not made (they read as 0).
+    pub samples_in_skipped_blocks: u64,
     /// Rays the compositing unit terminated early (opaque), of all rays of the base plane.
     pub terminated_rays: usize,
 }
@@ -294,8 +297,26 @@ impl FrameJob {
         let base = cube5_frame::render_base_plane(params, &self.seen, &self.units);
         let skipped_slices = cube5_frame::empty_slices(params, &self.lut);
         let swept = params.nk - skipped_slices.0 - skipped_slices.1;
+        let b = self.lut.block as usize;
+        let mut in_skipped = 0u64;
+        for s in skipped_slices.0..params.nk - skipped_slices.1 {
+            let k = params.slice(s).k;
+            for bj in 0..params.nj.div_ceil(b) {
+                for bi in 0..params.ni.div_ceil(b) {
+                    let mut blk = [0u32; 3];
+                    blk[params.axis_i] = bi as u32;
+                    blk[params.axis_j] = bj as u32;
+                    blk[params.axis_k] = (k / b) as u32;
+                    if self.lut.entry(blk).is_none_or(|e| e.empty || e.masked) {
+                        let w = b.min(params.ni - bi * b) * b.min(params.nj - bj * b);
+                        in_skipped += w as u64;
+                    }
+                }
+            }
+        }
         FrameRun {
             samples: (swept * params.ni * params.nj) as u64,
+            samples_in_skipped_blocks: in_skipped,
             skipped_slices,
             slices: params.nk,
             terminated_rays: base.coxels.iter().filter(|c| c.terminated).count(),
@@ -417,5 +438,41 @@ mod tests {
         .unwrap();
         let (a, b) = (on.render(), off.render());
         assert!(a.terminated_rays > 0 && b.terminated_rays == 0);
+    }
+
+    #[test]
+    fn samples_in_skipped_blocks_are_the_memory_model_s_skipped_beams() {
+        use crate::units::cube5_skewmem::{SkewConfig, SkewDims, SkewMem};
+        let vol = crate::phantom::head_phantom(32, 12).unwrap();
+        for view in [
+            "[view]\nazimuth = 30.0\n",
+            "[view]\ndirection = [1, 0.2, -0.4]\n",
+        ] {
+            let job = FrameJob::new(&scene(view), &vol, FrameConfig::DEFAULT, 4).unwrap();
+            let run = job.render();
+            assert!(run.samples_in_skipped_blocks > 0, "{view}");
+            let cfg = SkewConfig {
+                p: 4,
+                voxel_w: 12,
+                max_dim_log2: 5,
+                block: 8,
+                read_latency: 1,
+                cnt_w: 16,
+            };
+            let dims = SkewDims::new(&cfg, job.seen.dims.map(|d| d as u32)).unwrap();
+            let mut mem = SkewMem::new(cfg, dims, job.lut.clone()).unwrap();
+            let acc =
+                cube5_frame::sweep_memory(&job.setup.params, run.skipped_slices, &mut mem).unwrap();
+            assert_eq!(
+                run.samples_in_skipped_blocks,
+                acc.beams_skipped * 4,
+                "{view}"
+            );
+            assert_eq!(
+                run.samples,
+                (acc.beams_read + acc.beams_skipped) * 4,
+                "{view}"
+            );
+        }
     }
 }
