@@ -165,17 +165,17 @@ impl Head {
 
         // ---- Bone: the skull (thicker towards its base), the facial bones, the mandible with
         // its teeth, the cervical spine; the orbits are cut out of it.
-        let cerebrum = ellipsoid(p, [0.0, -0.03, 0.21], [0.51, 0.66, 0.53]);
+        let cerebrum = ellipsoid(p, [0.0, -0.03, 0.21], [0.49, 0.64, 0.51]);
         let cerebellum = ellipsoid(p, [0.0, -0.38, -0.22], [0.38, 0.22, 0.16]);
         let cavity = smin(cerebrum, cerebellum, 0.08);
-        let thick = 0.07 + 0.06 * smoothstep(0.0, -0.45, z);
+        let thick = 0.085 + 0.05 * smoothstep(0.0, -0.45, z);
         let skull = (cranium + 0.045).max(-cavity).max(cavity - thick);
         let facial = (face + 0.05)
-            .max(-(face + 0.10))
+            .max(-(face + 0.12))
             .max(0.15 - y)
             .max(z + 0.08)
             .max(-0.50 - z);
-        let jaw_ring = ellipse_ring([x, y - 0.12], [0.34, 0.40]) - 0.035;
+        let jaw_ring = ellipse_ring([x, y - 0.12], [0.34, 0.40]) - 0.04;
         let mandible = jaw_ring.max(-y).max((z + 0.61).abs() - 0.07);
         let ramus = ellipsoid(m, [0.35, 0.04, -0.42], [0.03, 0.07, 0.18]);
         let teeth_row = ellipse_ring([x, y - 0.14], [0.30, 0.36]) - 0.03;
@@ -439,7 +439,7 @@ mod tests {
         assert_eq!(v.get(0, 0, 0), 0, "corners are air");
         assert_eq!(v.get(-1, 5, 5), 0, "outside reads zero");
         for (what, p, want) in [
-            ("skull vertex", [0.0, -0.03, 0.78], BONE),
+            ("skull vertex", [0.0, -0.03, 0.77], BONE),
             ("white matter", [0.25, -0.2, 0.3], WHITE),
             ("lateral ventricle", [0.09, -0.02, 0.17], CSF),
             ("right eye", [0.22, 0.52, -0.12], EYE),
