@@ -181,6 +181,31 @@ fn proposed_tf() -> TransferFunction {
 
 const SKIN_A: f64 = 0.035;
 
+/// `--scene FILE`: renders a scene file as `cube5 render` does (the pipeline model, or the
+/// reference where the scene asks for it) into the `--png` directory (given before it).
+fn render_scene(file: &str, png: Option<&std::path::Path>) {
+    let scene = Scene::load(std::path::Path::new(file)).unwrap();
+    let vol = scene.build_volume().unwrap();
+    let (tf, params) = (scene.transfer_function(), scene.render_params());
+    let img = match scene.run.renderer {
+        cube5_model::scene::Renderer::Reference => render_reference(&vol, &tf, &params).unwrap(),
+        cube5_model::scene::Renderer::Pipeline => {
+            render_pipeline(&vol, &tf, &params, &scene.quality())
+                .unwrap()
+                .image
+        }
+    };
+    let stem = std::path::Path::new(file)
+        .file_stem()
+        .unwrap()
+        .to_string_lossy();
+    let dir = png.unwrap_or(std::path::Path::new("."));
+    std::fs::create_dir_all(dir).unwrap();
+    img.to_rgb8()
+        .save(dir.join(format!("scene-{stem}.png")))
+        .unwrap();
+}
+
 fn main() {
     let mut sizes = vec![96];
     let mut images = vec![384];
@@ -200,6 +225,10 @@ fn main() {
             "--what" => what = val().split(',').map(str::to_string).collect(),
             "--png" => png = Some(PathBuf::from(val())),
             "--old" => old = true,
+            "--scene" => {
+                render_scene(&val(), png.as_deref());
+                return;
+            }
             "--gen-only" => gen_only = true,
             "--azimuth" => azimuth = Some(val().parse().unwrap()),
             other => panic!("unknown argument {other}"),
