@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! cargo run --release -p cube5-model --example phantom_psnr -- [--sizes 96,128] [--images 384]
-//!     [--tf head|bone|...] [--what frame,pipeline,ss2,spp4,precise,g26,refstep] [--png DIR]
+//!     [--tf head|proposed|PRESET] [--what frame,pipeline,ss2,spp4,precise,g6,g26,refstep]
+//!     [--azimuth DEG] [--unlit] [--no-specular] [--rm-log2 N] [--old] [--gen-only] [--png DIR] [--scene FILE]
 //! ```
 //!
 //! `frame` is what the hardware makes; the `pipeline` rows are `render_pipeline`'s what-if knobs
@@ -22,7 +23,9 @@ use cube5_model::transfer::{TfPoint, TransferFunction};
 use cube5_model::units::cube5_frame::{
     frame_phong, render_base_plane, warp, FrameMode, FrameSetup, FrameUnits,
 };
-use cube5_model::units::cube5_shader::Phong;
+use cube5_model::units::cube5_shader::{
+    ClassLut, Phong, ReflectanceMap, Shader, ShaderConfig, ShaderTables,
+};
 use cube5_model::volume::Volume;
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -113,19 +116,42 @@ fn supersampled(n: usize, bits: u32, f: impl Fn([f64; 3]) -> f64 + Sync) -> Volu
 }
 
 /// The frame model's image of `vol` at `params`: base plane (bit-exact) warped onto the image.
-fn frame_image(vol: &Volume, tf: &TransferFunction, params: &RenderParams) -> (ImageF64, f64) {
+fn frame_image(
+    vol: &Volume,
+    tf: &TransferFunction,
+    params: &RenderParams,
+    rm_log2: Option<u32>,
+) -> (ImageF64, f64) {
     let t = Instant::now();
     let dir = params.direction().unwrap();
     let setup = FrameSetup::new(vol.dims, vol.spacing, dir, 4).unwrap();
     let m = params.material;
+    // Unlit (shading off): the reflectance map is 1 everywhere, as `cube5 cosim` sets it.
+    let (ambient, diffuse, specular) = if params.shading {
+        (m.ambient, m.diffuse, m.specular)
+    } else {
+        (1.0, 0.0, 0.0)
+    };
     let phong = Phong {
-        ambient: m.ambient,
-        diffuse: m.diffuse,
-        specular: m.specular,
+        ambient,
+        diffuse,
+        specular,
         shininess: m.shininess,
         ..frame_phong(&setup.params, &[])
     };
-    let units = FrameUnits::new(FrameMode::Composite, &setup, tf, &phong).unwrap();
+    let mut units = FrameUnits::new(FrameMode::Composite, &setup, tf, &phong).unwrap();
+    if let Some(r) = rm_log2 {
+        // What-if: a finer reflectance map (`RmLog2`), the rest at the defaults.
+        let cfg = ShaderConfig {
+            rm_log2: r,
+            ..ShaderConfig::DEFAULT
+        };
+        let tables = ShaderTables {
+            class: ClassLut::from_transfer(&cfg, tf).unwrap(),
+            rmap: ReflectanceMap::from_lights(&cfg, &phong).unwrap(),
+        };
+        units.shader = Shader::new(cfg, tables).unwrap();
+    }
     let bp = render_base_plane(&setup.params, vol, &units);
     let cam = Camera::new(dir, vol.dims, vol.spacing, params.width, params.height);
     let img = warp(
@@ -215,6 +241,9 @@ fn main() {
     let mut azimuth: Option<f64> = None;
     let mut old = false;
     let mut gen_only = false;
+    let mut unlit = false;
+    let mut no_specular = false;
+    let mut rm_log2: Option<u32> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut val = || args.next().expect("a value");
@@ -230,6 +259,9 @@ fn main() {
                 return;
             }
             "--gen-only" => gen_only = true,
+            "--unlit" => unlit = true,
+            "--no-specular" => no_specular = true,
+            "--rm-log2" => rm_log2 = Some(val().parse().unwrap()),
             "--azimuth" => azimuth = Some(val().parse().unwrap()),
             other => panic!("unknown argument {other}"),
         }
@@ -267,6 +299,10 @@ fn main() {
         }
         for &px in &images {
             let mut params = s.render_params();
+            params.shading = !unlit;
+            if no_specular {
+                params.material.specular = 0.0;
+            }
             if let Some(a) = azimuth {
                 params.view.azimuth = a;
             }
@@ -294,9 +330,23 @@ fn main() {
                 let t = Instant::now();
                 let img = match w.as_str() {
                     "frame" => {
-                        let (img, secs) = frame_image(&vol, &tf, &params);
+                        let (img, secs) = frame_image(&vol, &tf, &params, rm_log2);
                         row("frame (bit-exact) + warp", &img, secs);
                         if let Some(dir) = &png {
+                            let diff = ImageF64 {
+                                rgb: img
+                                    .rgb
+                                    .iter()
+                                    .zip(&reference.rgb)
+                                    .map(|(a, b)| {
+                                        std::array::from_fn(|c| 4.0 * (a[c] - b[c]).abs())
+                                    })
+                                    .collect(),
+                                ..img.clone()
+                            };
+                            diff.to_rgb8()
+                                .save(dir.join(format!("{tag}{tf_name}-{n}-{px}-diff4.png")))
+                                .unwrap();
                             img.to_rgb8()
                                 .save(dir.join(format!("{tag}{tf_name}-{n}-{px}-frame.png")))
                                 .unwrap();
