@@ -19,7 +19,7 @@ use cube5_model::render::{
 };
 use cube5_model::scene::Scene;
 use cube5_model::studies::tradeoff::image_error;
-use cube5_model::transfer::{TfPoint, TransferFunction};
+use cube5_model::transfer::TransferFunction;
 use cube5_model::units::cube5_frame::{
     frame_phong, render_base_plane, warp, FrameMode, FrameSetup, FrameUnits,
 };
@@ -185,27 +185,12 @@ fn slices(vol: &Volume) -> image::GrayImage {
     img
 }
 
-/// A head transfer function without narrow high-opacity tents between soft tissue and bone
-/// (every bone edge crosses the 0.5 .. 0.8 range): translucent skin, faint brain, white bone.
+/// The head transfer function of main (`TransferFunction::head_default`, this study's proposal).
 fn proposed_tf() -> TransferFunction {
-    let p = |density, rgba| TfPoint { density, rgba };
-    let skin = [0.93, 0.70, 0.58];
-    let brain = [0.90, 0.62, 0.60];
-    let bone = [0.96, 0.94, 0.88];
-    TransferFunction::new(vec![
-        p(0.00, [0.0; 4]),
-        p(0.15, [skin[0], skin[1], skin[2], 0.0]),
-        p(0.22, [skin[0], skin[1], skin[2], SKIN_A]),
-        p(0.30, [brain[0], brain[1], brain[2], 0.004]),
-        p(0.38, [brain[0], brain[1], brain[2], 0.008]),
-        p(0.50, [bone[0], bone[1], bone[2], 0.03]),
-        p(0.86, [bone[0], bone[1], bone[2], 0.35]),
-        p(1.00, [bone[0], bone[1], bone[2], 0.5]),
-    ])
-    .unwrap()
+    TransferFunction::head_default()
 }
 
-const SKIN_A: f64 = 0.035;
+
 
 /// `--scene FILE`: renders a scene file as `cube5 render` does (the pipeline model, or the
 /// reference where the scene asks for it) into the `--png` directory (given before it).

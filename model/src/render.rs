@@ -167,7 +167,7 @@ impl Default for RenderParams {
             width: 256,
             height: 256,
             view: View {
-                azimuth: 30.0,
+                azimuth: 65.0,
                 elevation: 20.0,
             },
             direction: None,

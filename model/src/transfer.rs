@@ -104,27 +104,25 @@ impl TransferFunction {
         })
     }
 
-    /// The default for the head phantom: faint skin and brain, coloured lesions, white bone.
+    /// The default for the head phantom: translucent skin, faint brain, white bone. Its ramps are
+    /// wide (no narrow high-opacity band that every bone edge would cross and paint as a ring at
+    /// one sample per slice), so the frame model reaches 40 dB against the f64 reference on the
+    /// band-limited phantom (docs/scenes.md).
     pub fn head_default() -> Self {
         let p = |density, rgba| TfPoint { density, rgba };
+        let skin = [0.93, 0.70, 0.58];
+        let brain = [0.90, 0.62, 0.60];
+        let bone = [0.96, 0.94, 0.88];
         Self {
             points: vec![
-                p(0.00, [0.0, 0.0, 0.0, 0.0]),
-                p(0.17, [0.0, 0.0, 0.0, 0.0]),
-                p(0.22, [0.85, 0.60, 0.50, 0.004]),
-                p(0.28, [0.0, 0.0, 0.0, 0.0]),
-                p(0.33, [0.90, 0.55, 0.55, 0.0]),
-                p(0.36, [0.90, 0.55, 0.55, 0.006]),
-                p(0.42, [0.0, 0.0, 0.0, 0.0]),
-                p(0.50, [0.95, 0.85, 0.20, 0.45]),
-                p(0.55, [0.0, 0.0, 0.0, 0.0]),
-                p(0.61, [0.30, 0.90, 0.35, 0.55]),
-                p(0.67, [0.0, 0.0, 0.0, 0.0]),
-                p(0.75, [0.95, 0.25, 0.20, 0.7]),
-                p(0.80, [0.95, 0.93, 0.88, 0.0]),
-                p(0.86, [0.95, 0.93, 0.88, 0.12]),
-                p(0.92, [0.95, 0.93, 0.88, 0.0]),
-                p(1.00, [0.40, 0.85, 1.00, 1.0]),
+                p(0.00, [0.0; 4]),
+                p(0.15, [skin[0], skin[1], skin[2], 0.0]),
+                p(0.22, [skin[0], skin[1], skin[2], 0.035]),
+                p(0.30, [brain[0], brain[1], brain[2], 0.004]),
+                p(0.38, [brain[0], brain[1], brain[2], 0.008]),
+                p(0.50, [bone[0], bone[1], bone[2], 0.03]),
+                p(0.86, [bone[0], bone[1], bone[2], 0.35]),
+                p(1.00, [bone[0], bone[1], bone[2], 0.5]),
             ],
         }
     }
