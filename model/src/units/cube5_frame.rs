@@ -22,6 +22,9 @@ use crate::volume::Volume;
 use glam::DVec3;
 use rayon::prelude::*;
 
+mod fast;
+pub use fast::{render_base_plane, render_base_plane_stats, SweepStats};
+
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;
 
@@ -684,8 +687,21 @@ impl FrameUnits {
         tf: &TransferFunction,
         phong: &Phong,
     ) -> Result<Self> {
-        let shader_cfg = ShaderConfig::DEFAULT;
-        let compos_cfg = ComposConfig::DEFAULT;
+        Self::with_config(&FrameConfig::DEFAULT, mode, setup, tf, phong, false)
+    }
+
+    /// As [`FrameUnits::new`], with the unit widths of `cfg` and, when `early_termination` is set
+    /// (`Composite` only), the compositing unit's default termination threshold (`1 - 2^-8`).
+    pub fn with_config(
+        cfg: &FrameConfig,
+        mode: FrameMode,
+        setup: &FrameSetup,
+        tf: &TransferFunction,
+        phong: &Phong,
+        early_termination: bool,
+    ) -> Result<Self> {
+        let shader_cfg = cfg.shader;
+        let compos_cfg = cfg.compos;
         let (class, rmap, lut, regs) = match mode {
             FrameMode::Mip => {
                 let top = (shader_cfg.class_entries() - 1) as u64;
@@ -707,12 +723,16 @@ impl FrameUnits {
                 ClassLut::from_transfer(&shader_cfg, tf)?,
                 ReflectanceMap::from_lights(&shader_cfg, phong)?,
                 OpacityLut::new(setup.opacity_ratio, &compos_cfg)?,
-                ComposRegs::without_termination(&compos_cfg),
+                if early_termination {
+                    ComposRegs::defaults(&compos_cfg)
+                } else {
+                    ComposRegs::without_termination(&compos_cfg)
+                },
             ),
         };
         Ok(Self {
-            trilin: Trilin::new(TrilinConfig::DEFAULT)?,
-            gradient: Gradient::new(GradientConfig::DEFAULT)?,
+            trilin: Trilin::new(cfg.trilin)?,
+            gradient: Gradient::new(cfg.gradient)?,
             shader: Shader::new(shader_cfg, ShaderTables { class, rmap })?,
             compos: Compos::new(compos_cfg, lut, regs)?,
             mode,
@@ -797,8 +817,15 @@ pub fn shade_n6(
     }
 }
 
-/// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md).
-pub fn render_base_plane(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
+/// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md): the
+/// reference, written sample by sample from the contract (seven interpolations per sample through
+/// [`neighbourhood`], then gradient, shader and compositing). [`render_base_plane`] is the fast
+/// path everything uses; the test `fast_path_equals_the_reference` holds the two equal.
+pub fn render_base_plane_reference(
+    params: &FrameParams,
+    vol: &Volume,
+    units: &FrameUnits,
+) -> BasePlane {
     let (w, h) = params.base_plane_size();
     let init = Coxel::empty(&units.compos.config());
     let mut coxels = vec![init; w * h];

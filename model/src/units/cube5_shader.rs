@@ -667,7 +667,21 @@ impl Shader {
         }
     }
 
+    /// Whether `shade` reads an item's gradient or magnitude: lit items do, and so does 2-D
+    /// classification. When it does not, `shade` of any gradient is the classified entry.
+    pub fn reads_gradient(mode: ShaderMode) -> bool {
+        !mode.unlit || mode.tf2d
+    }
+
+    /// The classified entry of an item. `shade(item).a` is always its alpha (illumination leaves
+    /// alpha alone), so without `tf2d` the alpha of a sample is known before its gradient.
+    #[inline]
+    pub fn classify(&self, item: &ShaderIn) -> Rgba {
+        self.tables.class.entries[self.class_index(item)]
+    }
+
     /// The classification index (contract § Classification).
+    #[inline]
     pub fn class_index(&self, item: &ShaderIn) -> usize {
         let c = &self.cfg;
         if item.mode.tf2d {
@@ -738,7 +752,7 @@ impl Shader {
     /// One shaded sample.
     pub fn shade(&self, item: &ShaderIn) -> Rgba {
         let c = &self.cfg;
-        let e = self.tables.class.entries[self.class_index(item)];
+        let e = self.classify(item);
         if item.mode.unlit {
             return e;
         }
