@@ -453,6 +453,19 @@ impl Compos {
         depth: u32,
         mode: ComposMode,
     ) -> bool {
+        self.leaves_unchanged_corrected(coxel, self.corrected(alpha), depth, mode)
+    }
+
+    /// [`Compos::leaves_unchanged`] of a sample whose corrected alpha `self.corrected(alpha)` is
+    /// `a` (for callers that keep the corrected alpha of each alpha code at hand).
+    #[inline]
+    pub fn leaves_unchanged_corrected(
+        &self,
+        coxel: &Coxel,
+        a: u64,
+        depth: u32,
+        mode: ComposMode,
+    ) -> bool {
         let cfg = &self.cfg;
         // Rule 1.
         if mode == ComposMode::Reserved || coxel.terminated {
@@ -469,7 +482,6 @@ impl Compos {
             return true;
         }
         // Rule 5.
-        let a = self.corrected(alpha);
         let a_in = coxel.rgba[3];
         match mode {
             // A zero weight adds 0 and saturates what is already in range.

@@ -10,7 +10,7 @@ use crate::units::cube5_compos::{
     Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
 };
 use crate::units::cube5_gradient::{
-    block_index, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
+    block_index, n6_components, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
 };
 use crate::units::cube5_shader::{
     ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn,
@@ -579,34 +579,39 @@ pub fn warp(
             base[y as usize * w + x as usize]
         }
     };
-    let mut rgb = Vec::with_capacity((camera.width * camera.height) as usize);
-    for py in 0..camera.height {
-        for px in 0..camera.width {
-            let o = camera.ray_origin(px, py) / sp;
-            let t = (k0 - o[params.axis_k]) / dir_v[params.axis_k];
-            let p = o + dir_v * t;
-            let (x, y) = (
-                p[params.axis_i] + max_sx as f64,
-                p[params.axis_j] + max_sy as f64,
-            );
-            let (x0, y0) = (x.floor(), y.floor());
-            let (fx, fy) = (x - x0, y - y0);
-            let (x0, y0) = (x0 as i64, y0 as i64);
-            let mut c = [0.0; 3];
-            for (dx, dy, wgt) in [
-                (0, 0, (1.0 - fx) * (1.0 - fy)),
-                (1, 0, fx * (1.0 - fy)),
-                (0, 1, (1.0 - fx) * fy),
-                (1, 1, fx * fy),
-            ] {
-                let t = texel(x0 + dx, y0 + dy);
-                for ch in 0..3 {
-                    c[ch] += wgt * t[ch];
+    // Output rows in parallel, each pixel on its own.
+    let mut rgb = vec![[0.0; 3]; (camera.width * camera.height) as usize];
+    let row_len = (camera.width as usize).max(1);
+    rgb.par_chunks_mut(row_len)
+        .enumerate()
+        .for_each(|(py, row)| {
+            for (px, out) in row.iter_mut().enumerate() {
+                let (px, py) = (px as u32, py as u32);
+                let o = camera.ray_origin(px, py) / sp;
+                let t = (k0 - o[params.axis_k]) / dir_v[params.axis_k];
+                let p = o + dir_v * t;
+                let (x, y) = (
+                    p[params.axis_i] + max_sx as f64,
+                    p[params.axis_j] + max_sy as f64,
+                );
+                let (x0, y0) = (x.floor(), y.floor());
+                let (fx, fy) = (x - x0, y - y0);
+                let (x0, y0) = (x0 as i64, y0 as i64);
+                let mut c = [0.0; 3];
+                for (dx, dy, wgt) in [
+                    (0, 0, (1.0 - fx) * (1.0 - fy)),
+                    (1, 0, fx * (1.0 - fy)),
+                    (0, 1, (1.0 - fx) * fy),
+                    (1, 1, fx * fy),
+                ] {
+                    let t = texel(x0 + dx, y0 + dy);
+                    for ch in 0..3 {
+                        c[ch] += wgt * t[ch];
+                    }
                 }
+                *out = c;
             }
-            rgb.push(c);
-        }
-    }
+        });
     ImageF64 {
         width: camera.width,
         height: camera.height,
@@ -803,7 +808,9 @@ pub fn shade_n6(
     mode: ShaderMode,
     depth: u32,
 ) -> Sample {
-    let g = gradient.gradient(&n6_gradient_in(nb));
+    // `gradient.gradient(&n6_gradient_in(nb))`, without building the 27-sample block.
+    let [_, xm, xp, ym, yp, zm, zp] = nb.map(i64::from);
+    let g = gradient.output(n6_components([xm, xp, ym, yp, zm, zp]));
     let shaded = shader.shade(&shader_in(nb[0], &g, mode));
     Sample {
         rgb: [shaded.r, shaded.g, shaded.b],
@@ -972,6 +979,27 @@ mod tests {
                 assert_eq!(acc.beams_read + acc.beams_skipped, voxels / u64::from(p));
                 assert_eq!(acc.beams_read, voxels / 2 / u64::from(p), "half the blocks");
             }
+        }
+    }
+
+    /// `shade_n6` takes the gradient unit's `N6` output of the seven samples.
+    #[test]
+    fn shade_n6_uses_the_units_n6_gradient() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let g = Gradient::new(GradientConfig::DEFAULT).unwrap();
+        let max = GradientConfig::DEFAULT.sample_max();
+        for _ in 0..10_000 {
+            let nb: [u32; 7] = std::array::from_fn(|_| match rng.random_range(0..3) {
+                0 => 0,
+                _ => rng.random_range(0..=max),
+            });
+            let [_, xm, xp, ym, yp, zm, zp] = nb.map(i64::from);
+            assert_eq!(
+                g.output(n6_components([xm, xp, ym, yp, zm, zp])),
+                g.gradient(&n6_gradient_in(&nb)),
+                "{nb:?}"
+            );
         }
     }
 

@@ -114,7 +114,7 @@ impl Trilin {
     }
 
     /// The effective weight on the scale `2^WeightW` = 1.0 (table in the contract).
-    #[inline]
+    #[inline(always)]
     fn effective_weight(&self, w: u32, mode: TrilinMode) -> u64 {
         let one = 1u64 << self.cfg.weight_w;
         match mode {
@@ -131,7 +131,7 @@ impl Trilin {
     }
 
     /// `lerp(a, b, e) = rnd(a * (2^WeightW - e) + b * e, WeightW)`.
-    #[inline]
+    #[inline(always)]
     fn lerp(&self, a: u64, b: u64, e: u64) -> u64 {
         let one = 1u64 << self.cfg.weight_w;
         round_half_up(a * (one - e) + b * e, self.cfg.weight_w)
@@ -145,12 +145,17 @@ impl Trilin {
 
     /// `sample` of a `Lerp` item whose corners in the slice `z + 1` are 0 and whose `wz` is 0: the
     /// bilinear sample within one slice that the frame takes (`docs/numerics/frame.md`), corners
-    /// `[(0,0), (1,0), (0,1), (1,1)]`. The same arithmetic as `sample`, for the frame's fast path.
-    #[inline]
+    /// `[(0,0), (1,0), (0,1), (1,1)]`, for the frame's fast path. The same lerps as `sample` minus
+    /// those that cannot change the result: `lerp(0, 0, e) = 0` (the half added by the rounding
+    /// is below one LSB) and `lerp(q, 0, 0) = q`, for every `WeightW >= 1` (tested).
+    #[inline(always)]
     pub fn sample_in_slice(&self, corners: [u32; 4], wx: u32, wy: u32) -> u32 {
-        let [c0, c1, c2, c3] = corners;
+        let wide = |c: usize| u64::from(corners[c]) << self.cfg.frac_w;
         let e = |w| self.effective_weight(w, TrilinMode::Lerp);
-        self.interpolate(&[c0, c1, c2, c3, 0, 0, 0, 0], [e(wx), e(wy), 0])
+        let (ex, ey) = (e(wx), e(wy));
+        let p0 = self.lerp(wide(0), wide(1), ex);
+        let p1 = self.lerp(wide(2), wide(3), ex);
+        self.lerp(p0, p1, ey) as u32
     }
 
     /// The seven interpolations of the contract with the effective weights `[ex, ey, ez]`.
@@ -189,7 +194,7 @@ impl Trilin {
 }
 
 /// `rnd(x, s)`: round half up of `x / 2^s`.
-#[inline]
+#[inline(always)]
 pub fn round_half_up(x: u64, s: u32) -> u64 {
     if s == 0 {
         x
@@ -316,19 +321,31 @@ mod tests {
     /// `sample_in_slice` is `sample` of the frame's items (`Lerp`, `wz = 0`, upper corners 0).
     #[test]
     fn sample_in_slice_is_sample_of_a_lerp_item_in_one_slice() {
+        let every_weight_w = (1..=12).map(|w| TrilinConfig::new(12, w, 4).unwrap());
         for cfg in [
             TrilinConfig::NARROW,
             TrilinConfig::DEFAULT,
             TrilinConfig::WIDE,
-        ] {
+            TrilinConfig::new(16, 12, 8).unwrap(),
+            TrilinConfig::new(4, 1, 0).unwrap(),
+        ]
+        .into_iter()
+        .chain(every_weight_w)
+        {
             let unit = Trilin::new(cfg).unwrap();
             let mut rng = ChaCha8Rng::seed_from_u64(11);
             for _ in 0..20_000 {
-                let c: [u32; 4] = std::array::from_fn(|_| rng.random_range(0..=cfg.voxel_max()));
-                let (wx, wy) = (
-                    rng.random_range(0..=cfg.weight_max()),
-                    rng.random_range(0..=cfg.weight_max()),
-                );
+                let c: [u32; 4] = std::array::from_fn(|_| match rng.random_range(0..4) {
+                    0 => 0,
+                    1 => cfg.voxel_max(),
+                    _ => rng.random_range(0..=cfg.voxel_max()),
+                });
+                let mut w = || match rng.random_range(0..4) {
+                    0 => 0,
+                    1 => cfg.weight_max(),
+                    _ => rng.random_range(0..=cfg.weight_max()),
+                };
+                let (wx, wy) = (w(), w());
                 let item = TrilinIn {
                     voxels: [c[0], c[1], c[2], c[3], 0, 0, 0, 0],
                     weights: [wx, wy, 0],

@@ -156,19 +156,24 @@ pub fn render_base_plane_stats(
     };
     let ww = units.trilin.config().weight_w;
     let weight = |f: u32| f >> (STEP_W - ww);
-    // The alpha of a sample, known before its gradient (no 2-D classification in the frame).
-    let alpha_of = |sample: u32| {
-        units
-            .shader
-            .classify(&ShaderIn {
-                sample,
-                grad: [0; 3],
-                mag: 0,
-                mode: smode,
-            })
-            .a
+    // The corrected alpha of a sample, known before its gradient (no 2-D classification in the
+    // frame): the compositing unit's correction of the classified alpha, per class index.
+    let class_in = |sample: u32| ShaderIn {
+        sample,
+        grad: [0; 3],
+        mag: 0,
+        mode: smode,
     };
-    let alpha0 = alpha_of(0);
+    let corrected: Vec<u64> = units
+        .shader
+        .tables()
+        .class
+        .entries()
+        .iter()
+        .map(|e| units.compos.corrected(e.a))
+        .collect();
+    let corrected_of = |sample: u32| corrected[units.shader.class_index(&class_in(sample))];
+    let alpha0 = corrected_of(0);
 
     // Leading and trailing slices with every voxel 0 (their samples, and their neighbours' reads
     // of them, are 0 with or without them).
@@ -198,9 +203,11 @@ pub fn render_base_plane_stats(
         let empty = s < front_zero || s >= nk - back_zero;
         if empty
             && rows.par_chunks(w).all(|row| {
-                row[r0..r0 + ni]
-                    .iter()
-                    .all(|cox| units.compos.leaves_unchanged(cox, alpha0, depth, cmode))
+                row[r0..r0 + ni].iter().all(|cox| {
+                    units
+                        .compos
+                        .leaves_unchanged_corrected(cox, alpha0, depth, cmode)
+                })
             })
         {
             if s < front_zero {
@@ -260,10 +267,12 @@ pub fn render_base_plane_stats(
                         continue;
                     }
                     let centre = at(a, b);
-                    if units
-                        .compos
-                        .leaves_unchanged(cox, alpha_of(centre), depth, cmode)
-                    {
+                    if units.compos.leaves_unchanged_corrected(
+                        cox,
+                        corrected_of(centre),
+                        depth,
+                        cmode,
+                    ) {
                         st.without_effect += 1;
                         continue;
                     }
