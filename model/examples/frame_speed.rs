@@ -68,15 +68,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     p.samples() as f64 / cpu / 1e6,
                 );
                 if reference {
-                    let secs = pool.install(|| {
-                        let t = Instant::now();
+                    let (secs, cpu) = pool.install(|| {
+                        let (t, c0) = (Instant::now(), cpu_secs());
                         let _ = render_base_plane_reference(&p, &vol, &units);
-                        t.elapsed().as_secs_f64()
+                        (t.elapsed().as_secs_f64(), cpu_secs() - c0)
                     });
                     println!(
-                        "{n}^3 {mode:?} threads {threads}: reference {:.1} ms, {:.2} M samples/s",
+                        "{n}^3 {mode:?} threads {threads}: reference {:.1} ms, {:.2} M samples/s, {:.2} M samples per CPU-s",
                         secs * 1e3,
-                        p.samples() as f64 / secs / 1e6
+                        p.samples() as f64 / secs / 1e6,
+                        p.samples() as f64 / cpu / 1e6
                     );
                 }
             }
