@@ -134,11 +134,13 @@ impl ComposConfig {
 
 /// `E_W(r) = r (2^W + 1) + (r >> (W-1))`: a `W`-bit unit-interval code (all-ones = 1.0) on the
 /// scale `2^(2W)`, within `2^-(2W+1)` of `r / (2^W - 1)`.
+#[inline]
 pub fn expand_double(r: u32, w: u32) -> u64 {
     u64::from(r) * ((1 << w) + 1) + u64::from(r >> (w - 1))
 }
 
 /// `U(r, W, S)`: a `W`-bit unit-interval code on the scale `2^S` (contract: *Number formats*).
+#[inline]
 pub fn unit_code(r: u32, w: u32, s: u32) -> u64 {
     let e = expand_double(r, w);
     if s >= 2 * w {
@@ -149,6 +151,7 @@ pub fn unit_code(r: u32, w: u32, s: u32) -> u64 {
 }
 
 /// `rnd(x, s)`: round half up of `x / 2^s`.
+#[inline]
 pub fn rnd(x: u64, s: u32) -> u64 {
     if s == 0 {
         x
@@ -432,6 +435,7 @@ impl Compos {
     }
 
     /// The corrected alpha `a` of alpha code `r`, `U(1.Q)`.
+    #[inline]
     pub fn corrected(&self, r: u32) -> u64 {
         if self.regs.lut_bypass {
             unit_code(r, self.cfg.alpha_w, self.cfg.q())
@@ -495,6 +499,7 @@ impl Compos {
     }
 
     /// One item: the coxel after this sample.
+    #[inline]
     pub fn step(&self, coxel: &Coxel, s: &Sample) -> Coxel {
         let cfg = &self.cfg;
         let (f, q, cw) = (cfg.acc_w, cfg.q(), cfg.color_w);

@@ -790,6 +790,7 @@ pub fn n6_gradient_in(nb: &[u32]) -> GradientIn {
 }
 
 /// The frame's adapter from the gradient unit to the shader (components and magnitude `>> 4`).
+#[inline]
 pub fn shader_in(sample: u32, g: &GradientOut, mode: ShaderMode) -> ShaderIn {
     ShaderIn {
         sample,
@@ -801,6 +802,7 @@ pub fn shader_in(sample: u32, g: &GradientOut, mode: ShaderMode) -> ShaderIn {
 
 /// One sample's way through gradient, adapter and shader: the compositing unit's sample at slice
 /// `depth` (MIP when the shader runs unlit, front to back otherwise).
+#[inline]
 pub fn shade_n6(
     gradient: &Gradient,
     shader: &Shader,

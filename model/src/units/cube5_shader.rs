@@ -447,6 +447,7 @@ impl ReflectanceMap {
         )
     }
 
+    #[inline]
     pub fn texel(&self, face: usize, i: usize, j: usize) -> Texel {
         self.texels[(face * self.side + j) * self.side + i]
     }
@@ -558,6 +559,7 @@ pub struct FaceCoord {
 }
 
 /// Major axis, sign, and minor axes of a nonzero gradient; `None` for the zero gradient.
+#[inline]
 fn major_axis(g: [i64; 3]) -> Option<(usize, bool, usize, usize)> {
     let a = g.map(i64::abs);
     if a == [0, 0, 0] {
@@ -574,6 +576,7 @@ fn major_axis(g: [i64; 3]) -> Option<(usize, bool, usize, usize)> {
 }
 
 /// `rnd(x, s)`: round half up of `x / 2^s`.
+#[inline]
 fn rnd(x: u64, s: u32) -> u64 {
     if s == 0 {
         x
@@ -695,6 +698,7 @@ impl Shader {
     }
 
     /// Face, rounded face coordinates, cell and weights; `None` for the zero gradient.
+    #[inline]
     pub fn face_coord(&self, grad: [i32; 3]) -> Option<FaceCoord> {
         let c = &self.cfg;
         let g = grad.map(i64::from);
@@ -724,6 +728,7 @@ impl Shader {
     }
 
     /// Diffuse and specular intensity for a gradient: bilinear on the map, or the zero entry.
+    #[inline]
     pub fn intensity(&self, grad: [i32; 3]) -> Texel {
         let Some(fc) = self.face_coord(grad) else {
             return self.tables.rmap.zero;
@@ -750,6 +755,7 @@ impl Shader {
     }
 
     /// One shaded sample.
+    #[inline]
     pub fn shade(&self, item: &ShaderIn) -> Rgba {
         let c = &self.cfg;
         let e = self.classify(item);

@@ -63,13 +63,17 @@ struct Frame<'a> {
 }
 
 impl Frame<'_> {
-    /// Voxel `(i, j)` of slice plane `k`, 0 beyond the far faces (frame contract).
+    /// The corners `(i, j)`, `(i+1, j)`, `(i, j+1)`, `(i+1, j+1)` of slice plane `k` for anchor
+    /// `(i, j)` of the face, 0 beyond the far faces (frame contract).
     #[inline]
-    fn voxel(&self, i: usize, j: usize, k: usize) -> u32 {
-        if i >= self.ni || j >= self.nj {
-            0
-        } else {
-            u32::from(self.data[i * self.si + j * self.sj + k * self.sk])
+    fn corners(&self, i: usize, j: usize, k: usize) -> [u32; 4] {
+        let at = i * self.si + j * self.sj + k * self.sk;
+        let v = |o: usize| u32::from(self.data[at + o]);
+        match (i + 1 < self.ni, j + 1 < self.nj) {
+            (true, true) => [v(0), v(self.si), v(self.sj), v(self.si + self.sj)],
+            (true, false) => [v(0), v(self.si), 0, 0],
+            (false, true) => [v(0), 0, v(self.sj), 0],
+            (false, false) => [v(0), 0, 0, 0],
         }
     }
 
@@ -218,12 +222,18 @@ pub fn render_base_plane_stats(
             continue;
         }
         let (wx, wy) = (weight(c.frac_x), weight(c.frac_y));
+        // The sample of four zero voxels (a row of them is filled without interpolating).
+        let zero_sample = units.trilin.sample_in_slice([0; 4], wx, wy);
         // 1. The plane of samples S_s.
         plane.par_chunks_mut(ni).enumerate().for_each_init(
             || (vec![0u32; ni + 1], vec![0u32; ni + 1]),
             |(top, bot), (b, out)| {
                 frame.row(b, c.k, top);
                 frame.row(b + 1, c.k, bot);
+                if top.iter().chain(bot.iter()).all(|&v| v == 0) {
+                    out.fill(zero_sample);
+                    return;
+                }
                 for (a, o) in out.iter_mut().enumerate() {
                     *o = units.trilin.sample_in_slice(
                         [top[a], top[a + 1], bot[a], bot[a + 1]],
@@ -250,16 +260,7 @@ pub fn render_base_plane_stats(
                 // S'(t) at anchor (a, b): slice k(t)'s voxels, slice s's weights.
                 let other = |k: Option<usize>, a: usize| match k {
                     None => 0,
-                    Some(k) => units.trilin.sample_in_slice(
-                        [
-                            frame.voxel(a, b, k),
-                            frame.voxel(a + 1, b, k),
-                            frame.voxel(a, b + 1, k),
-                            frame.voxel(a + 1, b + 1, k),
-                        ],
-                        wx,
-                        wy,
-                    ),
+                    Some(k) => units.trilin.sample_in_slice(frame.corners(a, b, k), wx, wy),
                 };
                 for (a, cox) in row[r0..r0 + ni].iter_mut().enumerate() {
                     if cox.terminated {
