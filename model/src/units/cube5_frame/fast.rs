@@ -107,6 +107,114 @@ impl Frame<'_> {
     }
 }
 
+/// The shader's and the compositing unit's modes of a frame mode (frame contract, steps 4, 5).
+#[inline(always)]
+fn modes(mode: FrameMode) -> (ShaderMode, ComposMode) {
+    match mode {
+        FrameMode::Mip => (
+            ShaderMode {
+                tf2d: false,
+                unlit: true,
+            },
+            ComposMode::Max,
+        ),
+        FrameMode::Composite => (
+            ShaderMode {
+                tf2d: false,
+                unlit: false,
+            },
+            ComposMode::FrontToBack,
+        ),
+    }
+}
+
+/// The shader's input for classifying a sample (no 2-D classification: gradient unused).
+#[inline(always)]
+fn class_in(sample: u32, mode: ShaderMode) -> ShaderIn {
+    ShaderIn {
+        sample,
+        grad: [0; 3],
+        mag: 0,
+        mode,
+    }
+}
+
+/// What the rows of one slice share.
+struct SliceWork<'a> {
+    units: &'a FrameUnits,
+    frame: &'a Frame<'a>,
+    /// `S_s`, anchor order.
+    plane: &'a [u32],
+    /// The corrected alpha of each class index (the compositing unit's `corrected` of the class
+    /// entry's alpha): a sample's effect is known before its gradient.
+    corrected: &'a [u64],
+    /// Base-plane column of anchor 0.
+    r0: usize,
+    depth: u32,
+    wx: u32,
+    wy: u32,
+    /// Volume slices of `s - 1` and `s + 1` (none outside the sweep).
+    k_before: Option<usize>,
+    k_after: Option<usize>,
+}
+
+impl SliceWork<'_> {
+    /// Anchor row `b` against its row of coxels (`row`, one base-plane row). Inlined at a
+    /// constant `mode` so that the unit functions' mode branches fold.
+    #[inline(always)]
+    fn row(&self, b: usize, row: &mut [Coxel], mode: FrameMode) -> SweepStats {
+        let (smode, cmode) = modes(mode);
+        let (units, frame, plane) = (self.units, self.frame, self.plane);
+        let (ni, nj, depth) = (frame.ni, frame.nj, self.depth);
+        let mut st = SweepStats {
+            samples: ni as u64,
+            ..SweepStats::default()
+        };
+        let at = |a: usize, b: usize| plane[b * ni + a];
+        // S'(t) at anchor (a, b): slice k(t)'s voxels, slice s's weights.
+        let other = |k: Option<usize>, a: usize| match k {
+            None => 0,
+            Some(k) => units
+                .trilin
+                .sample_in_slice(frame.corners(a, b, k), self.wx, self.wy),
+        };
+        let lit = Shader::reads_gradient(smode);
+        for (a, cox) in row[self.r0..self.r0 + ni].iter_mut().enumerate() {
+            if cox.terminated {
+                st.after_termination += 1;
+                continue;
+            }
+            let centre = at(a, b);
+            let corrected = self.corrected[units.shader.class_index(&class_in(centre, smode))];
+            if units
+                .compos
+                .leaves_unchanged_corrected(cox, corrected, depth, cmode)
+            {
+                st.without_effect += 1;
+                continue;
+            }
+            // Unlit without tf2d, the shader reads no gradient: the neighbours stay 0.
+            let nb = if lit {
+                [
+                    centre,
+                    if a > 0 { at(a - 1, b) } else { 0 },
+                    if a + 1 < ni { at(a + 1, b) } else { 0 },
+                    if b > 0 { at(a, b - 1) } else { 0 },
+                    if b + 1 < nj { at(a, b + 1) } else { 0 },
+                    other(self.k_before, a),
+                    other(self.k_after, a),
+                ]
+            } else {
+                [centre, 0, 0, 0, 0, 0, 0]
+            };
+            let sample = shade_n6(&units.gradient, &units.shader, &nb, smode, depth);
+            *cox = units.compos.step(cox, &sample);
+            st.shaded += 1;
+        }
+        st
+    }
+}
+
 /// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md): the
 /// fast path, equal to [`render_base_plane_reference`] coxel for coxel.
 pub fn render_base_plane(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
@@ -150,24 +258,11 @@ pub fn render_base_plane_stats(
     let ((_, max_sx), (_, max_sy)) = params.shift_range();
     let init = Coxel::empty(&units.compos.config());
     let mut coxels = vec![init; w * h];
-    let smode = ShaderMode {
-        tf2d: false,
-        unlit: units.mode == FrameMode::Mip,
-    };
-    let cmode = match units.mode {
-        FrameMode::Mip => ComposMode::Max,
-        FrameMode::Composite => ComposMode::FrontToBack,
-    };
+    let (smode, cmode) = modes(units.mode);
     let ww = units.trilin.config().weight_w;
     let weight = |f: u32| f >> (STEP_W - ww);
     // The corrected alpha of a sample, known before its gradient (no 2-D classification in the
     // frame): the compositing unit's correction of the classified alpha, per class index.
-    let class_in = |sample: u32| ShaderIn {
-        sample,
-        grad: [0; 3],
-        mag: 0,
-        mode: smode,
-    };
     let corrected: Vec<u64> = units
         .shader
         .tables()
@@ -176,8 +271,7 @@ pub fn render_base_plane_stats(
         .iter()
         .map(|e| units.compos.corrected(e.a))
         .collect();
-    let corrected_of = |sample: u32| corrected[units.shader.class_index(&class_in(sample))];
-    let alpha0 = corrected_of(0);
+    let alpha0 = corrected[units.shader.class_index(&class_in(0, smode))];
 
     // Leading and trailing slices with every voxel 0 (their samples, and their neighbours' reads
     // of them, are 0 with or without them).
@@ -244,58 +338,25 @@ pub fn render_base_plane_stats(
             },
         );
         // 2. Every anchor against the coxel of its ray, rows in parallel.
-        let plane = &plane;
-        let k_before = (s > 0).then(|| params.slice(s - 1).k);
-        let k_after = (s + 1 < nk).then(|| params.slice(s + 1).k);
-        let lit = Shader::reads_gradient(smode);
+        let work = SliceWork {
+            units,
+            frame: &frame,
+            plane: &plane,
+            corrected: &corrected,
+            r0,
+            depth,
+            wx,
+            wy,
+            k_before: (s > 0).then(|| params.slice(s - 1).k),
+            k_after: (s + 1 < nk).then(|| params.slice(s + 1).k),
+        };
+        // One copy of the row loop per mode, so that the units' mode branches fold away.
         let part = rows
             .par_chunks_mut(w)
             .enumerate()
-            .map(|(b, row)| {
-                let mut st = SweepStats {
-                    samples: ni as u64,
-                    ..SweepStats::default()
-                };
-                let at = |a: usize, b: usize| plane[b * ni + a];
-                // S'(t) at anchor (a, b): slice k(t)'s voxels, slice s's weights.
-                let other = |k: Option<usize>, a: usize| match k {
-                    None => 0,
-                    Some(k) => units.trilin.sample_in_slice(frame.corners(a, b, k), wx, wy),
-                };
-                for (a, cox) in row[r0..r0 + ni].iter_mut().enumerate() {
-                    if cox.terminated {
-                        st.after_termination += 1;
-                        continue;
-                    }
-                    let centre = at(a, b);
-                    if units.compos.leaves_unchanged_corrected(
-                        cox,
-                        corrected_of(centre),
-                        depth,
-                        cmode,
-                    ) {
-                        st.without_effect += 1;
-                        continue;
-                    }
-                    // Unlit without tf2d, the shader reads no gradient: the neighbours stay 0.
-                    let nb = if lit {
-                        [
-                            centre,
-                            if a > 0 { at(a - 1, b) } else { 0 },
-                            if a + 1 < ni { at(a + 1, b) } else { 0 },
-                            if b > 0 { at(a, b - 1) } else { 0 },
-                            if b + 1 < nj { at(a, b + 1) } else { 0 },
-                            other(k_before, a),
-                            other(k_after, a),
-                        ]
-                    } else {
-                        [centre, 0, 0, 0, 0, 0, 0]
-                    };
-                    let sample = shade_n6(&units.gradient, &units.shader, &nb, smode, depth);
-                    *cox = units.compos.step(cox, &sample);
-                    st.shaded += 1;
-                }
-                st
+            .map(|(b, row)| match units.mode {
+                FrameMode::Mip => work.row(b, row, FrameMode::Mip),
+                FrameMode::Composite => work.row(b, row, FrameMode::Composite),
             })
             .reduce(SweepStats::default, SweepStats::add);
         stats = stats.add(part);
