@@ -271,7 +271,6 @@ pub fn render_base_plane_stats(
         .iter()
         .map(|e| units.compos.corrected(e.a))
         .collect();
-    let alpha0 = corrected[units.shader.class_index(&class_in(0, smode))];
 
     // Leading and trailing slices with every voxel 0 (their samples, and their neighbours' reads
     // of them, are 0 with or without them).
@@ -298,6 +297,11 @@ pub fn render_base_plane_stats(
         let r0 = (max_sx - c.shift_x) as usize;
         let q0 = (max_sy - c.shift_y) as usize;
         let rows = &mut coxels[q0 * w..(q0 + nj) * w];
+        let (wx, wy) = (weight(c.frac_x), weight(c.frac_y));
+        // The sample of four zero voxels (a row of them is filled without interpolating) and
+        // its corrected alpha.
+        let zero_sample = units.trilin.sample_in_slice([0; 4], wx, wy);
+        let alpha0 = corrected[units.shader.class_index(&class_in(zero_sample, smode))];
         let empty = s < front_zero || s >= nk - back_zero;
         if empty
             && rows.par_chunks(w).all(|row| {
@@ -315,9 +319,6 @@ pub fn render_base_plane_stats(
             }
             continue;
         }
-        let (wx, wy) = (weight(c.frac_x), weight(c.frac_y));
-        // The sample of four zero voxels (a row of them is filled without interpolating).
-        let zero_sample = units.trilin.sample_in_slice([0; 4], wx, wy);
         // 1. The plane of samples S_s.
         plane.par_chunks_mut(ni).enumerate().for_each_init(
             || (vec![0u32; ni + 1], vec![0u32; ni + 1]),
