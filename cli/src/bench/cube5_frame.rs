@@ -5,8 +5,12 @@
 
 use anyhow::{anyhow, Result};
 use cube5_model::phantom::head_phantom;
+use cube5_model::transfer::TransferFunction;
 use cube5_model::unit::UnitConfig;
-use cube5_model::units::cube5_frame::FrameConfig;
+use cube5_model::units::cube5_frame::{
+    frame_phong, render_base_plane_reference, render_base_plane_stats, FrameConfig, FrameMode,
+    FrameSetup, FrameUnits, SweepStats,
+};
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
 use cube5_tb::frame::{as_seen, sparse_scene, Expected, FrameBench, FrameRtl, Look, Render};
@@ -175,6 +179,82 @@ pub fn run(n_items: usize) -> Result<()> {
     );
     println!();
     skipping()?;
+    model_speed(n_items)?;
+    Ok(())
+}
+
+/// Best wall-clock seconds of `f` over at least `runs` runs and at least `min_secs` in all.
+fn best_secs<T>(runs: usize, min_secs: f64, mut f: impl FnMut() -> T) -> (f64, T) {
+    let start = Instant::now();
+    let mut best = f64::INFINITY;
+    let mut n = 0;
+    loop {
+        let t = Instant::now();
+        let out = f();
+        best = best.min(t.elapsed().as_secs_f64());
+        n += 1;
+        if n >= runs && start.elapsed().as_secs_f64() >= min_secs {
+            return (best, out);
+        }
+    }
+}
+
+/// The golden model alone: samples/s of the frame model's fast path (`render_base_plane`) at 1
+/// and 2 threads, and of the per-sample reference it is tested against, on the head phantom
+/// (12-bit voxels, view (-0.37, 0.81, -1), default widths), composite shaded and MIP. 256^3 runs
+/// when `n_items >= 100_000`; the reference only at 128^3 and below (it takes seconds a frame).
+fn model_speed(n_items: usize) -> Result<()> {
+    let sizes: Vec<usize> = if n_items >= 100_000 {
+        vec![128, 256]
+    } else {
+        vec![64, 128]
+    };
+    println!("### The frame model's speed (no RTL)\n");
+    println!(
+        "Head phantom, 12-bit voxels, view (-0.37, 0.81, -1), default widths, no early \
+         termination; best wall-clock time of several frames (on a shared machine, the threads get what \
+         the other jobs leave). `fast` is `render_base_plane` (the model everything uses), `reference` \
+         the per-sample `render_base_plane_reference`; both give the same base plane bit for bit (model \
+         test `fast_path_equals_the_reference`). Shaded: samples that went through gradient and \
+         shader; without effect: samples the compositing would leave unchanged (classified only).\n"
+    );
+    println!("| volume | render | threads | fast ms/frame | fast samples/s | reference samples/s | speed-up | shaded | without effect | slices skipped |");
+    println!("|--------|--------|--------:|--------------:|---------------:|--------------------:|---------:|-------:|---------------:|---------------:|");
+    let tf = TransferFunction::head_default();
+    for n in sizes {
+        let vol = head_phantom(n, 12)?;
+        let setup = FrameSetup::new(vol.dims, vol.spacing, [-0.37, 0.81, -1.0].into(), 4)?;
+        let p = setup.params;
+        let samples = p.samples() as f64;
+        for mode in [FrameMode::Composite, FrameMode::Mip] {
+            let units = FrameUnits::new(mode, &setup, &tf, &frame_phong(&p, &[]))?;
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()?;
+                let (fast, st): (f64, SweepStats) = pool
+                    .install(|| best_secs(3, 1.0, || render_base_plane_stats(&p, &vol, &units).1));
+                let reference = (n <= 128).then(|| {
+                    pool.install(|| {
+                        best_secs(1, 0.0, || render_base_plane_reference(&p, &vol, &units)).0
+                    })
+                });
+                println!(
+                    "| {n}^3 | {} | {threads} | {:.1} | {:.3e} | {} | {} | {:.1} % | {:.1} % | {} + {} |",
+                    if mode == FrameMode::Mip { "MIP" } else { "composite shaded" },
+                    fast * 1e3,
+                    samples / fast,
+                    reference.map_or("-".into(), |r| format!("{:.3e}", samples / r)),
+                    reference.map_or("-".into(), |r| format!("{:.1}x", r / fast)),
+                    100.0 * st.shaded as f64 / samples,
+                    100.0 * st.without_effect as f64 / samples,
+                    st.slices_skipped.0,
+                    st.slices_skipped.1,
+                );
+            }
+        }
+    }
+    println!();
     Ok(())
 }
 

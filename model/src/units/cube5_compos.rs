@@ -134,11 +134,13 @@ impl ComposConfig {
 
 /// `E_W(r) = r (2^W + 1) + (r >> (W-1))`: a `W`-bit unit-interval code (all-ones = 1.0) on the
 /// scale `2^(2W)`, within `2^-(2W+1)` of `r / (2^W - 1)`.
+#[inline]
 pub fn expand_double(r: u32, w: u32) -> u64 {
     u64::from(r) * ((1 << w) + 1) + u64::from(r >> (w - 1))
 }
 
 /// `U(r, W, S)`: a `W`-bit unit-interval code on the scale `2^S` (contract: *Number formats*).
+#[inline]
 pub fn unit_code(r: u32, w: u32, s: u32) -> u64 {
     let e = expand_double(r, w);
     if s >= 2 * w {
@@ -149,6 +151,7 @@ pub fn unit_code(r: u32, w: u32, s: u32) -> u64 {
 }
 
 /// `rnd(x, s)`: round half up of `x / 2^s`.
+#[inline]
 pub fn rnd(x: u64, s: u32) -> u64 {
     if s == 0 {
         x
@@ -432,6 +435,7 @@ impl Compos {
     }
 
     /// The corrected alpha `a` of alpha code `r`, `U(1.Q)`.
+    #[inline]
     pub fn corrected(&self, r: u32) -> u64 {
         if self.regs.lut_bypass {
             unit_code(r, self.cfg.alpha_w, self.cfg.q())
@@ -440,7 +444,62 @@ impl Compos {
         }
     }
 
+    /// Whether `step(coxel, s)` returns `coxel` itself for every colour of a sample `s` with this
+    /// alpha code, depth and mode (a transparent sample, one that does not win a `Max`, any sample
+    /// of a terminated ray, ...). It reads `step`'s rules in order and says `false` wherever a rule
+    /// could write the coxel, so it may answer `false` for a sample that changes nothing, never
+    /// `true` for one that changes something (the frame's fast path skips shading on `true`).
+    #[inline]
+    pub fn leaves_unchanged(
+        &self,
+        coxel: &Coxel,
+        alpha: u32,
+        depth: u32,
+        mode: ComposMode,
+    ) -> bool {
+        self.leaves_unchanged_corrected(coxel, self.corrected(alpha), depth, mode)
+    }
+
+    /// [`Compos::leaves_unchanged`] of a sample whose corrected alpha `self.corrected(alpha)` is
+    /// `a` (for callers that keep the corrected alpha of each alpha code at hand).
+    #[inline]
+    pub fn leaves_unchanged_corrected(
+        &self,
+        coxel: &Coxel,
+        a: u64,
+        depth: u32,
+        mode: ComposMode,
+    ) -> bool {
+        let cfg = &self.cfg;
+        // Rule 1.
+        if mode == ComposMode::Reserved || coxel.terminated {
+            return true;
+        }
+        // Rules 2 and 3.
+        if mode == ComposMode::Flush
+            || (mode == ComposMode::FrontToBack && coxel.rgba[3] >= self.regs.et_threshold)
+        {
+            return false;
+        }
+        // Rule 4.
+        if depth >= coxel.z {
+            return true;
+        }
+        // Rule 5.
+        let a_in = coxel.rgba[3];
+        match mode {
+            // A zero weight adds 0 and saturates what is already in range.
+            ComposMode::FrontToBack => {
+                a == 0 && coxel.rgba[..3].iter().all(|&c| c <= cfg.chan_max())
+            }
+            ComposMode::Max => (a << (cfg.acc_w - cfg.q())) <= a_in,
+            ComposMode::Min => (a << (cfg.acc_w - cfg.q())) >= a_in,
+            _ => false,
+        }
+    }
+
     /// One item: the coxel after this sample.
+    #[inline]
     pub fn step(&self, coxel: &Coxel, s: &Sample) -> Coxel {
         let cfg = &self.cfg;
         let (f, q, cw) = (cfg.acc_w, cfg.q(), cfg.color_w);
@@ -1191,6 +1250,66 @@ mod tests {
         // Znone never lets a sample at depth Znone contribute.
         let s_far = sample([255; 3], 4095, cfg.z_none(), ComposMode::FrontToBack);
         assert_eq!(u.step(&e, &s_far), e);
+    }
+
+    /// `leaves_unchanged` never says so of a sample that changes the coxel, and does say so of
+    /// transparent samples, samples below a maximum and samples of terminated rays.
+    #[test]
+    fn leaves_unchanged_only_when_step_changes_nothing() {
+        use rand::{Rng, SeedableRng};
+        let cfg = ComposConfig::DEFAULT;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(31);
+        let mut said = [0usize; 8];
+        for (n, regs) in [
+            ComposRegs::defaults(&cfg),
+            ComposRegs::without_termination(&cfg),
+            ComposRegs {
+                et_threshold: 0,
+                ..ComposRegs::defaults(&cfg)
+            },
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            for ratio in [0.5, 1.0, 3f64.sqrt()] {
+                let c = unit(cfg, ratio, regs);
+                for _ in 0..20_000 {
+                    let mode = ComposMode::from_bits(rng.random_range(0..8));
+                    // Small alphas and colours, often 0, so that every rule is reached.
+                    let pick = |rng: &mut rand_chacha::ChaCha8Rng, max: u64| -> u64 {
+                        match rng.random_range(0..4) {
+                            0 => 0,
+                            1 => rng.random_range(0..=4.min(max)),
+                            _ => rng.random_range(0..=max),
+                        }
+                    };
+                    let coxel = Coxel {
+                        rgba: std::array::from_fn(|_| pick(&mut rng, cfg.chan_max())),
+                        z: if rng.random_bool(0.7) {
+                            cfg.z_none()
+                        } else {
+                            rng.random_range(0..=cfg.z_none())
+                        },
+                        geo: std::array::from_fn(|_| rng.random_range(0..=cfg.color_max())),
+                        terminated: rng.random_bool(0.1),
+                    };
+                    let alpha = pick(&mut rng, u64::from(cfg.alpha_max())) as u32;
+                    let depth = rng.random_range(0..=cfg.z_none());
+                    if c.leaves_unchanged(&coxel, alpha, depth, mode) {
+                        said[mode as usize] += 1;
+                        for _ in 0..4 {
+                            let rgb =
+                                std::array::from_fn(|_| rng.random_range(0..=cfg.color_max()));
+                            let s = sample(rgb, alpha, depth, mode);
+                            assert_eq!(c.step(&coxel, &s), coxel, "regs {n} {s:?} on {coxel:?}");
+                        }
+                    }
+                }
+            }
+        }
+        for mode in [ComposMode::FrontToBack, ComposMode::Max, ComposMode::Min] {
+            assert!(said[mode as usize] > 100, "{mode:?}: {said:?}");
+        }
     }
 
     #[test]

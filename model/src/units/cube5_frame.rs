@@ -10,7 +10,7 @@ use crate::units::cube5_compos::{
     Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
 };
 use crate::units::cube5_gradient::{
-    block_index, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
+    block_index, n6_components, Gradient, GradientConfig, GradientIn, GradientMode, GradientOut,
 };
 use crate::units::cube5_shader::{
     ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderIn,
@@ -21,6 +21,9 @@ use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use crate::volume::Volume;
 use glam::DVec3;
 use rayon::prelude::*;
+
+mod fast;
+pub use fast::{render_base_plane, render_base_plane_stats, SweepStats};
 
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;
@@ -576,34 +579,39 @@ pub fn warp(
             base[y as usize * w + x as usize]
         }
     };
-    let mut rgb = Vec::with_capacity((camera.width * camera.height) as usize);
-    for py in 0..camera.height {
-        for px in 0..camera.width {
-            let o = camera.ray_origin(px, py) / sp;
-            let t = (k0 - o[params.axis_k]) / dir_v[params.axis_k];
-            let p = o + dir_v * t;
-            let (x, y) = (
-                p[params.axis_i] + max_sx as f64,
-                p[params.axis_j] + max_sy as f64,
-            );
-            let (x0, y0) = (x.floor(), y.floor());
-            let (fx, fy) = (x - x0, y - y0);
-            let (x0, y0) = (x0 as i64, y0 as i64);
-            let mut c = [0.0; 3];
-            for (dx, dy, wgt) in [
-                (0, 0, (1.0 - fx) * (1.0 - fy)),
-                (1, 0, fx * (1.0 - fy)),
-                (0, 1, (1.0 - fx) * fy),
-                (1, 1, fx * fy),
-            ] {
-                let t = texel(x0 + dx, y0 + dy);
-                for ch in 0..3 {
-                    c[ch] += wgt * t[ch];
+    // Output rows in parallel, each pixel on its own.
+    let mut rgb = vec![[0.0; 3]; (camera.width * camera.height) as usize];
+    let row_len = (camera.width as usize).max(1);
+    rgb.par_chunks_mut(row_len)
+        .enumerate()
+        .for_each(|(py, row)| {
+            for (px, out) in row.iter_mut().enumerate() {
+                let (px, py) = (px as u32, py as u32);
+                let o = camera.ray_origin(px, py) / sp;
+                let t = (k0 - o[params.axis_k]) / dir_v[params.axis_k];
+                let p = o + dir_v * t;
+                let (x, y) = (
+                    p[params.axis_i] + max_sx as f64,
+                    p[params.axis_j] + max_sy as f64,
+                );
+                let (x0, y0) = (x.floor(), y.floor());
+                let (fx, fy) = (x - x0, y - y0);
+                let (x0, y0) = (x0 as i64, y0 as i64);
+                let mut c = [0.0; 3];
+                for (dx, dy, wgt) in [
+                    (0, 0, (1.0 - fx) * (1.0 - fy)),
+                    (1, 0, fx * (1.0 - fy)),
+                    (0, 1, (1.0 - fx) * fy),
+                    (1, 1, fx * fy),
+                ] {
+                    let t = texel(x0 + dx, y0 + dy);
+                    for ch in 0..3 {
+                        c[ch] += wgt * t[ch];
+                    }
                 }
+                *out = c;
             }
-            rgb.push(c);
-        }
-    }
+        });
     ImageF64 {
         width: camera.width,
         height: camera.height,
@@ -684,8 +692,21 @@ impl FrameUnits {
         tf: &TransferFunction,
         phong: &Phong,
     ) -> Result<Self> {
-        let shader_cfg = ShaderConfig::DEFAULT;
-        let compos_cfg = ComposConfig::DEFAULT;
+        Self::with_config(&FrameConfig::DEFAULT, mode, setup, tf, phong, false)
+    }
+
+    /// As [`FrameUnits::new`], with the unit widths of `cfg` and, when `early_termination` is set
+    /// (`Composite` only), the compositing unit's default termination threshold (`1 - 2^-8`).
+    pub fn with_config(
+        cfg: &FrameConfig,
+        mode: FrameMode,
+        setup: &FrameSetup,
+        tf: &TransferFunction,
+        phong: &Phong,
+        early_termination: bool,
+    ) -> Result<Self> {
+        let shader_cfg = cfg.shader;
+        let compos_cfg = cfg.compos;
         let (class, rmap, lut, regs) = match mode {
             FrameMode::Mip => {
                 let top = (shader_cfg.class_entries() - 1) as u64;
@@ -707,12 +728,16 @@ impl FrameUnits {
                 ClassLut::from_transfer(&shader_cfg, tf)?,
                 ReflectanceMap::from_lights(&shader_cfg, phong)?,
                 OpacityLut::new(setup.opacity_ratio, &compos_cfg)?,
-                ComposRegs::without_termination(&compos_cfg),
+                if early_termination {
+                    ComposRegs::defaults(&compos_cfg)
+                } else {
+                    ComposRegs::without_termination(&compos_cfg)
+                },
             ),
         };
         Ok(Self {
-            trilin: Trilin::new(TrilinConfig::DEFAULT)?,
-            gradient: Gradient::new(GradientConfig::DEFAULT)?,
+            trilin: Trilin::new(cfg.trilin)?,
+            gradient: Gradient::new(cfg.gradient)?,
             shader: Shader::new(shader_cfg, ShaderTables { class, rmap })?,
             compos: Compos::new(compos_cfg, lut, regs)?,
             mode,
@@ -765,6 +790,7 @@ pub fn n6_gradient_in(nb: &[u32]) -> GradientIn {
 }
 
 /// The frame's adapter from the gradient unit to the shader (components and magnitude `>> 4`).
+#[inline]
 pub fn shader_in(sample: u32, g: &GradientOut, mode: ShaderMode) -> ShaderIn {
     ShaderIn {
         sample,
@@ -776,6 +802,7 @@ pub fn shader_in(sample: u32, g: &GradientOut, mode: ShaderMode) -> ShaderIn {
 
 /// One sample's way through gradient, adapter and shader: the compositing unit's sample at slice
 /// `depth` (MIP when the shader runs unlit, front to back otherwise).
+#[inline]
 pub fn shade_n6(
     gradient: &Gradient,
     shader: &Shader,
@@ -783,7 +810,9 @@ pub fn shade_n6(
     mode: ShaderMode,
     depth: u32,
 ) -> Sample {
-    let g = gradient.gradient(&n6_gradient_in(nb));
+    // `gradient.gradient(&n6_gradient_in(nb))`, without building the 27-sample block.
+    let [_, xm, xp, ym, yp, zm, zp] = nb.map(i64::from);
+    let g = gradient.output(n6_components([xm, xp, ym, yp, zm, zp]));
     let shaded = shader.shade(&shader_in(nb[0], &g, mode));
     Sample {
         rgb: [shaded.r, shaded.g, shaded.b],
@@ -797,8 +826,15 @@ pub fn shade_n6(
     }
 }
 
-/// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md).
-pub fn render_base_plane(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
+/// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md): the
+/// reference, written sample by sample from the contract (seven interpolations per sample through
+/// [`neighbourhood`], then gradient, shader and compositing). [`render_base_plane`] is the fast
+/// path everything uses; the test `fast_path_equals_the_reference` holds the two equal.
+pub fn render_base_plane_reference(
+    params: &FrameParams,
+    vol: &Volume,
+    units: &FrameUnits,
+) -> BasePlane {
     let (w, h) = params.base_plane_size();
     let init = Coxel::empty(&units.compos.config());
     let mut coxels = vec![init; w * h];
@@ -945,6 +981,27 @@ mod tests {
                 assert_eq!(acc.beams_read + acc.beams_skipped, voxels / u64::from(p));
                 assert_eq!(acc.beams_read, voxels / 2 / u64::from(p), "half the blocks");
             }
+        }
+    }
+
+    /// `shade_n6` takes the gradient unit's `N6` output of the seven samples.
+    #[test]
+    fn shade_n6_uses_the_units_n6_gradient() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let g = Gradient::new(GradientConfig::DEFAULT).unwrap();
+        let max = GradientConfig::DEFAULT.sample_max();
+        for _ in 0..10_000 {
+            let nb: [u32; 7] = std::array::from_fn(|_| match rng.random_range(0..3) {
+                0 => 0,
+                _ => rng.random_range(0..=max),
+            });
+            let [_, xm, xp, ym, yp, zm, zp] = nb.map(i64::from);
+            assert_eq!(
+                g.output(n6_components([xm, xp, ym, yp, zm, zp])),
+                g.gradient(&n6_gradient_in(&nb)),
+                "{nb:?}"
+            );
         }
     }
 

@@ -22,6 +22,13 @@ pub(crate) fn sign_extend(raw: u64, width: u32) -> i64 {
     ((raw << shift) as i64) >> shift
 }
 
+/// The `N6` components `16 (s(+1) - s(-1))` along x, y and z, raw, from the six orthogonal
+/// neighbours `[x-, x+, y-, y+, z-, z+]` (the mode `N6` of `Gradient::components`).
+#[inline]
+pub fn n6_components(n: [i64; 6]) -> [i64; 3] {
+    [16 * (n[1] - n[0]), 16 * (n[3] - n[2]), 16 * (n[5] - n[4])]
+}
+
 // =================================================================================================
 // cube5_gradient
 // =================================================================================================
@@ -240,11 +247,14 @@ impl Gradient {
 
     /// The three components, raw.
     pub fn components(&self, item: &GradientIn) -> [i64; 3] {
-        let n6 = [
-            16 * (item.at(1, 0, 0) - item.at(-1, 0, 0)),
-            16 * (item.at(0, 1, 0) - item.at(0, -1, 0)),
-            16 * (item.at(0, 0, 1) - item.at(0, 0, -1)),
-        ];
+        let n6 = n6_components([
+            item.at(-1, 0, 0),
+            item.at(1, 0, 0),
+            item.at(0, -1, 0),
+            item.at(0, 1, 0),
+            item.at(0, 0, -1),
+            item.at(0, 0, 1),
+        ]);
         match item.mode {
             GradientMode::N6 | GradientMode::Reserved => n6,
             GradientMode::N10 => {
@@ -271,6 +281,7 @@ impl Gradient {
     }
 
     /// `mag = rnd(30 M + 13 m + 9 n, 5)` of the sorted component magnitudes.
+    #[inline]
     pub fn magnitude(&self, g: [i64; 3]) -> u32 {
         let mut a = g.map(i64::abs);
         a.sort_unstable_by(|x, y| y.cmp(x));
@@ -280,7 +291,12 @@ impl Gradient {
 
     /// One output item.
     pub fn gradient(&self, item: &GradientIn) -> GradientOut {
-        let g = self.components(item);
+        self.output(self.components(item))
+    }
+
+    /// The output item of the raw components `g`: the components and their magnitude.
+    #[inline]
+    pub fn output(&self, g: [i64; 3]) -> GradientOut {
         GradientOut {
             gx: g[0] as i32,
             gy: g[1] as i32,

@@ -447,6 +447,7 @@ impl ReflectanceMap {
         )
     }
 
+    #[inline]
     pub fn texel(&self, face: usize, i: usize, j: usize) -> Texel {
         self.texels[(face * self.side + j) * self.side + i]
     }
@@ -558,6 +559,7 @@ pub struct FaceCoord {
 }
 
 /// Major axis, sign, and minor axes of a nonzero gradient; `None` for the zero gradient.
+#[inline]
 fn major_axis(g: [i64; 3]) -> Option<(usize, bool, usize, usize)> {
     let a = g.map(i64::abs);
     if a == [0, 0, 0] {
@@ -574,6 +576,7 @@ fn major_axis(g: [i64; 3]) -> Option<(usize, bool, usize, usize)> {
 }
 
 /// `rnd(x, s)`: round half up of `x / 2^s`.
+#[inline]
 fn rnd(x: u64, s: u32) -> u64 {
     if s == 0 {
         x
@@ -667,7 +670,21 @@ impl Shader {
         }
     }
 
+    /// Whether `shade` reads an item's gradient or magnitude: lit items do, and so does 2-D
+    /// classification. When it does not, `shade` of any gradient is the classified entry.
+    pub fn reads_gradient(mode: ShaderMode) -> bool {
+        !mode.unlit || mode.tf2d
+    }
+
+    /// The classified entry of an item. `shade(item).a` is always its alpha (illumination leaves
+    /// alpha alone), so without `tf2d` the alpha of a sample is known before its gradient.
+    #[inline]
+    pub fn classify(&self, item: &ShaderIn) -> Rgba {
+        self.tables.class.entries[self.class_index(item)]
+    }
+
     /// The classification index (contract § Classification).
+    #[inline]
     pub fn class_index(&self, item: &ShaderIn) -> usize {
         let c = &self.cfg;
         if item.mode.tf2d {
@@ -681,6 +698,7 @@ impl Shader {
     }
 
     /// Face, rounded face coordinates, cell and weights; `None` for the zero gradient.
+    #[inline]
     pub fn face_coord(&self, grad: [i32; 3]) -> Option<FaceCoord> {
         let c = &self.cfg;
         let g = grad.map(i64::from);
@@ -710,6 +728,7 @@ impl Shader {
     }
 
     /// Diffuse and specular intensity for a gradient: bilinear on the map, or the zero entry.
+    #[inline]
     pub fn intensity(&self, grad: [i32; 3]) -> Texel {
         let Some(fc) = self.face_coord(grad) else {
             return self.tables.rmap.zero;
@@ -736,9 +755,10 @@ impl Shader {
     }
 
     /// One shaded sample.
+    #[inline]
     pub fn shade(&self, item: &ShaderIn) -> Rgba {
         let c = &self.cfg;
-        let e = self.tables.class.entries[self.class_index(item)];
+        let e = self.classify(item);
         if item.mode.unlit {
             return e;
         }

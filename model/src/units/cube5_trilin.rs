@@ -114,6 +114,7 @@ impl Trilin {
     }
 
     /// The effective weight on the scale `2^WeightW` = 1.0 (table in the contract).
+    #[inline(always)]
     fn effective_weight(&self, w: u32, mode: TrilinMode) -> u64 {
         let one = 1u64 << self.cfg.weight_w;
         match mode {
@@ -130,6 +131,7 @@ impl Trilin {
     }
 
     /// `lerp(a, b, e) = rnd(a * (2^WeightW - e) + b * e, WeightW)`.
+    #[inline(always)]
     fn lerp(&self, a: u64, b: u64, e: u64) -> u64 {
         let one = 1u64 << self.cfg.weight_w;
         round_half_up(a * (one - e) + b * e, self.cfg.weight_w)
@@ -137,8 +139,29 @@ impl Trilin {
 
     /// One sample, `U(VoxelW.FracW)`.
     pub fn sample(&self, item: &TrilinIn) -> u32 {
-        let wide = |c: usize| u64::from(item.voxels[c]) << self.cfg.frac_w;
-        let [ex, ey, ez] = item.weights.map(|w| self.effective_weight(w, item.mode));
+        let e = item.weights.map(|w| self.effective_weight(w, item.mode));
+        self.interpolate(&item.voxels, e)
+    }
+
+    /// `sample` of a `Lerp` item whose corners in the slice `z + 1` are 0 and whose `wz` is 0: the
+    /// bilinear sample within one slice that the frame takes (`docs/numerics/frame.md`), corners
+    /// `[(0,0), (1,0), (0,1), (1,1)]`, for the frame's fast path. The same lerps as `sample` minus
+    /// those that cannot change the result: `lerp(0, 0, e) = 0` (the half added by the rounding
+    /// is below one LSB) and `lerp(q, 0, 0) = q`, for every `WeightW >= 1` (tested).
+    #[inline(always)]
+    pub fn sample_in_slice(&self, corners: [u32; 4], wx: u32, wy: u32) -> u32 {
+        let wide = |c: usize| u64::from(corners[c]) << self.cfg.frac_w;
+        let e = |w| self.effective_weight(w, TrilinMode::Lerp);
+        let (ex, ey) = (e(wx), e(wy));
+        let p0 = self.lerp(wide(0), wide(1), ex);
+        let p1 = self.lerp(wide(2), wide(3), ex);
+        self.lerp(p0, p1, ey) as u32
+    }
+
+    /// The seven interpolations of the contract with the effective weights `[ex, ey, ez]`.
+    #[inline]
+    fn interpolate(&self, voxels: &[u32; 8], [ex, ey, ez]: [u64; 3]) -> u32 {
+        let wide = |c: usize| u64::from(voxels[c]) << self.cfg.frac_w;
         let p = [
             self.lerp(wide(0), wide(1), ex),
             self.lerp(wide(2), wide(3), ex),
@@ -171,6 +194,7 @@ impl Trilin {
 }
 
 /// `rnd(x, s)`: round half up of `x / 2^s`.
+#[inline(always)]
 pub fn round_half_up(x: u64, s: u32) -> u64 {
     if s == 0 {
         x
@@ -292,6 +316,48 @@ mod tests {
             ..ramp
         };
         assert_eq!(unit.sample(&half), (9 << cfg.frac_w) / 2);
+    }
+
+    /// `sample_in_slice` is `sample` of the frame's items (`Lerp`, `wz = 0`, upper corners 0).
+    #[test]
+    fn sample_in_slice_is_sample_of_a_lerp_item_in_one_slice() {
+        let every_weight_w = (1..=12).map(|w| TrilinConfig::new(12, w, 4).unwrap());
+        for cfg in [
+            TrilinConfig::NARROW,
+            TrilinConfig::DEFAULT,
+            TrilinConfig::WIDE,
+            TrilinConfig::new(16, 12, 8).unwrap(),
+            TrilinConfig::new(4, 1, 0).unwrap(),
+        ]
+        .into_iter()
+        .chain(every_weight_w)
+        {
+            let unit = Trilin::new(cfg).unwrap();
+            let mut rng = ChaCha8Rng::seed_from_u64(11);
+            for _ in 0..20_000 {
+                let c: [u32; 4] = std::array::from_fn(|_| match rng.random_range(0..4) {
+                    0 => 0,
+                    1 => cfg.voxel_max(),
+                    _ => rng.random_range(0..=cfg.voxel_max()),
+                });
+                let mut w = || match rng.random_range(0..4) {
+                    0 => 0,
+                    1 => cfg.weight_max(),
+                    _ => rng.random_range(0..=cfg.weight_max()),
+                };
+                let (wx, wy) = (w(), w());
+                let item = TrilinIn {
+                    voxels: [c[0], c[1], c[2], c[3], 0, 0, 0, 0],
+                    weights: [wx, wy, 0],
+                    mode: TrilinMode::Lerp,
+                };
+                assert_eq!(
+                    unit.sample_in_slice(c, wx, wy),
+                    unit.sample(&item),
+                    "{item:?}"
+                );
+            }
+        }
     }
 
     #[test]
