@@ -218,6 +218,14 @@ fn render(args: RenderArgs) -> Result<()> {
     let tf = scene.transfer_function();
     let what_if = not_expressible(&scene);
     let repeat = args.repeat.max(1);
+    // The frame's set-up (volume at VoxelW, block LUT, tables) is made once; a frame is the sweep
+    // and the warp.
+    let job = match scene.run.renderer {
+        Renderer::Pipeline if what_if.is_empty() => {
+            Some(FrameJob::new(&scene, &vol, frame_config(&scene)?, 1)?)
+        }
+        _ => None,
+    };
     let mut best = f64::INFINITY;
     let mut frame = || -> Result<(ImageF64, String, u64)> {
         let start = std::time::Instant::now();
@@ -227,13 +235,12 @@ fn render(args: RenderArgs) -> Result<()> {
                 let what = format!("f64 reference renderer, step {}", params.step);
                 (img, what, 0)
             }
-            Renderer::Pipeline if what_if.is_empty() => {
+            Renderer::Pipeline if let Some(job) = &job => {
                 // The one golden model: the frame the RTL computes, then the warp.
-                let job = FrameJob::new(&scene, &vol, frame_config(&scene)?, 1)?;
                 let run = job.render();
                 let img = job.image(&scene, &run.base);
                 let what = format!(
-                    "frame model = cube5_frame's bits: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early",
+                    "frame model = cube5_frame's bits: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination",
                     run.base.width,
                     run.base.height,
                     run.samples,
@@ -242,7 +249,10 @@ fn render(args: RenderArgs) -> Result<()> {
                     run.skipped_slices.1,
                     run.slices,
                     run.terminated_rays,
-                    run.base.coxels.len()
+                    run.base.coxels.len(),
+                    run.model.shaded,
+                    run.model.without_effect,
+                    run.model.after_termination
                 );
                 (img, what, run.samples)
             }

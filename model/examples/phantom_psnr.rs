@@ -190,8 +190,6 @@ fn proposed_tf() -> TransferFunction {
     TransferFunction::head_default()
 }
 
-
-
 /// `--scene FILE`: renders a scene file as `cube5 render` does (the pipeline model, or the
 /// reference where the scene asks for it) into the `--png` directory (given before it).
 fn render_scene(file: &str, png: Option<&std::path::Path>) {

@@ -15,16 +15,11 @@ use crate::render::{CompositeMode, GradientScheme, ImageF64, Interpolation, Proj
 use crate::scene::Scene;
 use crate::transfer::TransferFunction;
 use crate::unit::UnitConfig;
-use crate::units::cube5_compos::{ComposConfig, ComposRegs, OpacityLut};
 use crate::units::cube5_frame::{
-    self, BasePlane, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits,
+    self, BasePlane, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepStats,
 };
-use crate::units::cube5_shader::{
-    ClassLut, DistantLight, Phong, ReflectanceMap, Rgba, Shader, ShaderConfig, ShaderTables,
-};
+use crate::units::cube5_shader::{DistantLight, Phong};
 use crate::units::cube5_skewmem::BlockLut;
-use crate::units::cube5_trilin::Trilin;
-use crate::units::{cube5_compos::Compos, cube5_gradient::Gradient};
 use crate::volume::Volume;
 use glam::DVec3;
 
@@ -152,18 +147,6 @@ pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
     }
 }
 
-/// The MIP classification table of the frame contract: the density ramp, grey.
-pub fn density_ramp(cfg: &ShaderConfig) -> Result<ClassLut> {
-    let top = (cfg.class_entries() - 1) as u64;
-    let scale = |idx: usize, max: u32| ((idx as u64 * u64::from(max)) / top) as u32;
-    ClassLut::from_fn(cfg, |idx| Rgba {
-        r: scale(idx, cfg.color_max()),
-        g: scale(idx, cfg.color_max()),
-        b: scale(idx, cfg.color_max()),
-        a: scale(idx, cfg.alpha_max()),
-    })
-}
-
 /// The look of a frame: transfer function, lighting (frame axes) and the early-termination
 /// threshold (accumulated opacity in 0..1; `None` or >= 1: off).
 #[derive(Debug, Clone)]
@@ -171,54 +154,6 @@ pub struct Look {
     pub tf: TransferFunction,
     pub phong: Phong,
     pub early_termination: Option<f64>,
-}
-
-/// The compositing registers of a look: termination at `threshold` of the coxel's opacity scale
-/// (rounded down), off when absent or >= 1.
-pub fn compos_regs(cfg: &ComposConfig, mode: FrameMode, threshold: Option<f64>) -> ComposRegs {
-    let off = ComposRegs::without_termination(cfg);
-    match (mode, threshold) {
-        (FrameMode::Mip, _) => ComposRegs {
-            lut_bypass: true,
-            ..off
-        },
-        (FrameMode::Composite, Some(t)) if t < 1.0 => ComposRegs {
-            et_threshold: (t.max(0.0) * cfg.one() as f64) as u64,
-            ..off
-        },
-        (FrameMode::Composite, _) => off,
-    }
-}
-
-/// The four units of a frame at `cfg`'s widths with the tables and registers of `mode` and `look`
-/// (the frame contract's "pipeline of one sample").
-pub fn frame_units(
-    cfg: &FrameConfig,
-    mode: FrameMode,
-    setup: &FrameSetup,
-    look: &Look,
-) -> Result<FrameUnits> {
-    let rmap = ReflectanceMap::from_lights(&cfg.shader, &look.phong)?;
-    let (class, ratio) = match mode {
-        FrameMode::Mip => (density_ramp(&cfg.shader)?, 1.0),
-        FrameMode::Composite => (
-            ClassLut::from_transfer(&cfg.shader, &look.tf)?,
-            setup
-                .opacity_ratio
-                .clamp(OpacityLut::RATIO_MIN, OpacityLut::RATIO_MAX),
-        ),
-    };
-    Ok(FrameUnits {
-        trilin: Trilin::new(cfg.trilin)?,
-        gradient: Gradient::new(cfg.gradient)?,
-        shader: Shader::new(cfg.shader, ShaderTables { class, rmap })?,
-        compos: Compos::new(
-            cfg.compos,
-            OpacityLut::new(ratio, &cfg.compos)?,
-            compos_regs(&cfg.compos, mode, look.early_termination),
-        )?,
-        mode,
-    })
 }
 
 /// One frame of a scene, set up as the host sets up the RTL: the volume at the frame's voxel
@@ -249,6 +184,8 @@ pub struct FrameRun {
     pub samples_in_skipped_blocks: u64,
     /// Rays the compositing unit terminated early (opaque), of all rays of the base plane.
     pub terminated_rays: usize,
+    /// What the model's sweep computed (samples shaded, classified only, after termination).
+    pub model: SweepStats,
 }
 
 impl FrameJob {
@@ -279,7 +216,14 @@ impl FrameJob {
                 FrameMode::Mip => None,
             },
         };
-        let units = frame_units(&cfg, mode, &setup, &look)?;
+        let units = FrameUnits::with_config(
+            &cfg,
+            mode,
+            &setup,
+            &look.tf,
+            &look.phong,
+            look.early_termination,
+        )?;
         Ok(Self {
             cfg,
             seen,
@@ -294,7 +238,7 @@ impl FrameJob {
     /// The base plane, bit-exact with the RTL frame, and what the sweep did.
     pub fn render(&self) -> FrameRun {
         let params = &self.setup.params;
-        let base = cube5_frame::render_base_plane(params, &self.seen, &self.units);
+        let (base, model) = cube5_frame::render_base_plane_stats(params, &self.seen, &self.units);
         let skipped_slices = cube5_frame::empty_slices(params, &self.lut);
         let swept = params.nk - skipped_slices.0 - skipped_slices.1;
         let b = self.lut.block as usize;
@@ -320,6 +264,7 @@ impl FrameJob {
             skipped_slices,
             slices: params.nk,
             terminated_rays: base.coxels.iter().filter(|c| c.terminated).count(),
+            model,
             base,
         }
     }

@@ -352,7 +352,7 @@ pub struct Units {
     pub tf2d: bool,
 }
 
-pub use cube5_model::scene_render::density_ramp;
+pub use cube5_model::units::cube5_frame::density_ramp;
 
 /// The look of a rendering: transfer function and lighting (frame axes), opacity correction and
 /// early termination.

@@ -682,6 +682,39 @@ pub fn frame_phong(params: &FrameParams, lights: &[DistantLight]) -> Phong {
     }
 }
 
+/// The compositing unit's default early-termination threshold, `1 - 2^-8` of the opacity scale
+/// (`ComposRegs::defaults`).
+pub const ET_DEFAULT: f64 = 1.0 - 1.0 / 256.0;
+
+/// The MIP classification table of the frame contract: the density ramp, grey.
+pub fn density_ramp(cfg: &ShaderConfig) -> Result<ClassLut> {
+    let top = (cfg.class_entries() - 1) as u64;
+    let scale = |idx: usize, max: u32| ((idx as u64 * u64::from(max)) / top) as u32;
+    ClassLut::from_fn(cfg, |idx| Rgba {
+        r: scale(idx, cfg.color_max()),
+        g: scale(idx, cfg.color_max()),
+        b: scale(idx, cfg.color_max()),
+        a: scale(idx, cfg.alpha_max()),
+    })
+}
+
+/// The compositing registers of a frame: MIP bypasses the opacity LUT; composite terminates at
+/// `threshold` of the coxel's opacity scale (rounded down), off when absent or >= 1.
+pub fn compos_regs(cfg: &ComposConfig, mode: FrameMode, threshold: Option<f64>) -> ComposRegs {
+    let off = ComposRegs::without_termination(cfg);
+    match (mode, threshold) {
+        (FrameMode::Mip, _) => ComposRegs {
+            lut_bypass: true,
+            ..off
+        },
+        (FrameMode::Composite, Some(t)) if t < 1.0 => ComposRegs {
+            et_threshold: (t.max(0.0) * cfg.one() as f64) as u64,
+            ..off
+        },
+        (FrameMode::Composite, _) => off,
+    }
+}
+
 impl FrameUnits {
     /// The default widths (trilin v12, gradient v12, shader v12, compos c12) with the tables of
     /// `mode`: for `Composite` the transfer function, the reflectance map of `phong` and the
@@ -692,54 +725,40 @@ impl FrameUnits {
         tf: &TransferFunction,
         phong: &Phong,
     ) -> Result<Self> {
-        Self::with_config(&FrameConfig::DEFAULT, mode, setup, tf, phong, false)
+        Self::with_config(&FrameConfig::DEFAULT, mode, setup, tf, phong, None)
     }
 
-    /// As [`FrameUnits::new`], with the unit widths of `cfg` and, when `early_termination` is set
-    /// (`Composite` only), the compositing unit's default termination threshold (`1 - 2^-8`).
+    /// As [`FrameUnits::new`], with the unit widths of `cfg` and early termination at
+    /// `early_termination` of the accumulated opacity (`Composite` only; `None` or >= 1: off;
+    /// [`ET_DEFAULT`] is the compositing unit's default `1 - 2^-8`). The opacity-correction ratio is
+    /// clamped to the LUT's range.
     pub fn with_config(
         cfg: &FrameConfig,
         mode: FrameMode,
         setup: &FrameSetup,
         tf: &TransferFunction,
         phong: &Phong,
-        early_termination: bool,
+        early_termination: Option<f64>,
     ) -> Result<Self> {
-        let shader_cfg = cfg.shader;
-        let compos_cfg = cfg.compos;
-        let (class, rmap, lut, regs) = match mode {
-            FrameMode::Mip => {
-                let top = (shader_cfg.class_entries() - 1) as u64;
-                let scale = |idx: usize, max: u32| ((idx as u64 * u64::from(max)) / top) as u32;
-                let class = ClassLut::from_fn(&shader_cfg, |idx| Rgba {
-                    r: scale(idx, shader_cfg.color_max()),
-                    g: scale(idx, shader_cfg.color_max()),
-                    b: scale(idx, shader_cfg.color_max()),
-                    a: scale(idx, shader_cfg.alpha_max()),
-                })?;
-                let rmap = ReflectanceMap::from_lights(&shader_cfg, phong)?;
-                let regs = ComposRegs {
-                    lut_bypass: true,
-                    ..ComposRegs::without_termination(&compos_cfg)
-                };
-                (class, rmap, OpacityLut::new(1.0, &compos_cfg)?, regs)
-            }
+        let rmap = ReflectanceMap::from_lights(&cfg.shader, phong)?;
+        let (class, ratio) = match mode {
+            FrameMode::Mip => (density_ramp(&cfg.shader)?, 1.0),
             FrameMode::Composite => (
-                ClassLut::from_transfer(&shader_cfg, tf)?,
-                ReflectanceMap::from_lights(&shader_cfg, phong)?,
-                OpacityLut::new(setup.opacity_ratio, &compos_cfg)?,
-                if early_termination {
-                    ComposRegs::defaults(&compos_cfg)
-                } else {
-                    ComposRegs::without_termination(&compos_cfg)
-                },
+                ClassLut::from_transfer(&cfg.shader, tf)?,
+                setup
+                    .opacity_ratio
+                    .clamp(OpacityLut::RATIO_MIN, OpacityLut::RATIO_MAX),
             ),
         };
         Ok(Self {
             trilin: Trilin::new(cfg.trilin)?,
             gradient: Gradient::new(cfg.gradient)?,
-            shader: Shader::new(shader_cfg, ShaderTables { class, rmap })?,
-            compos: Compos::new(compos_cfg, lut, regs)?,
+            shader: Shader::new(cfg.shader, ShaderTables { class, rmap })?,
+            compos: Compos::new(
+                cfg.compos,
+                OpacityLut::new(ratio, &cfg.compos)?,
+                compos_regs(&cfg.compos, mode, early_termination),
+            )?,
             mode,
         })
     }

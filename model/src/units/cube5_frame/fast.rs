@@ -380,6 +380,7 @@ mod tests {
     use crate::transfer::TransferFunction;
     use crate::unit::UnitConfig;
     use crate::units::cube5_compos::{Compos, ComposRegs};
+    use crate::units::cube5_frame::ET_DEFAULT;
     use crate::units::cube5_frame::{frame_phong, FrameConfig, FrameSetup};
     use glam::DVec3;
     use rand::{Rng, SeedableRng};
@@ -451,7 +452,7 @@ mod tests {
                     &setup,
                     tf,
                     &frame_phong(&params, &[]),
-                    early_termination,
+                    early_termination.then_some(ET_DEFAULT),
                 )
                 .unwrap();
                 let want = render_base_plane_reference(&params, vol, &units);
@@ -596,7 +597,7 @@ mod tests {
                 &setup,
                 &tf,
                 &frame_phong(&p, &[]),
-                true,
+                Some(ET_DEFAULT),
             )
             .unwrap();
             let c = &units.compos;
