@@ -2,23 +2,30 @@
 //! writes the tables (Markdown and CSV) and plots (PNG). `--write-docs` regenerates
 //! `docs/tradeoffs.md` and `docs/img/tradeoff-*`.
 //!
-//! The plots are drawn with `image` and a built-in 5x7 bitmap font: `plotters` without its
-//! font-kit feature draws no text at all, and font-kit needs system fonts that a CI machine need
-//! not have.
+//! The plots are drawn with `plotters` into an RGB buffer. Their text is DejaVu Sans, embedded in
+//! the binary (`cli/assets/fonts/`, with its licence) and rendered anti-aliased by plotters'
+//! `ab_glyph` feature, so no system fonts are needed (CI machines have none; plotters' default
+//! font-kit text looks them up).
 
 use anyhow::{bail, Context, Result};
 use cube5_model::render::{Quality, RenderParams};
 use cube5_model::scene::Scene;
 use cube5_model::studies::tradeoff::{
-    run as run_sweeps, Figure, Progress, Report, Setup, Synth, Table, PAPER_VS_IMAGE_ORDER,
+    run as run_sweeps, Figure, Progress, Report, Series, Setup, Synth, Table, PAPER_VS_IMAGE_ORDER,
     PAPER_VS_TRUE3D,
 };
 use cube5_model::transfer::TransferFunction;
 use cube5_model::volume_io::write_atomically;
-use image::{Rgb, RgbImage};
+use image::RgbImage;
 use indicatif::{ProgressBar, ProgressStyle};
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+use plotters::style::register_font;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
@@ -567,249 +574,36 @@ fn document(
 }
 
 // =================================================================================================
-// Plotting with `image` and a 5x7 bitmap font
+// Plotting with `plotters` and the embedded DejaVu Sans
 // =================================================================================================
+
+/// DejaVu Sans 2.37 from Debian's fonts-dejavu-core (`cli/assets/fonts/`: its licence and where it
+/// came from).
+static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+/// The family name the plots ask for; the embedded font is registered under it.
+const FAMILY: &str = "sans-serif";
+
+/// Registers the embedded font with plotters' `ab_glyph` text renderer, once per process.
+fn font_loaded() -> bool {
+    static LOADED: OnceLock<bool> = OnceLock::new();
+    *LOADED.get_or_init(|| register_font(FAMILY, FontStyle::Normal, FONT).is_ok())
+}
 
 const W: u32 = 900;
 const H: u32 = 540;
-const LEFT: i32 = 90;
-const RIGHT: i32 = 30;
-const TOP: i32 = 50;
-const BOTTOM: i32 = 70;
-const PALETTE: [[u8; 3]; 6] = [
-    [31, 119, 180],
-    [214, 39, 40],
-    [44, 160, 44],
-    [148, 103, 189],
-    [255, 127, 14],
-    [23, 190, 207],
+/// Height of one legend row below the plot (two entries per row).
+const LEGEND_ROW: u32 = 24;
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
 ];
-
-/// 5x7 glyphs, rows top to bottom, `#` lit. Lower case prints as upper case.
-fn glyph(c: char) -> [&'static str; 7] {
-    match c.to_ascii_uppercase() {
-        '0' => [
-            " ### ", "#   #", "#  ##", "# # #", "##  #", "#   #", " ### ",
-        ],
-        '1' => [
-            "  #  ", " ##  ", "  #  ", "  #  ", "  #  ", "  #  ", " ### ",
-        ],
-        '2' => [
-            " ### ", "#   #", "    #", "   # ", "  #  ", " #   ", "#####",
-        ],
-        '3' => [
-            "#####", "   # ", "  #  ", "   # ", "    #", "#   #", " ### ",
-        ],
-        '4' => [
-            "   # ", "  ## ", " # # ", "#  # ", "#####", "   # ", "   # ",
-        ],
-        '5' => [
-            "#####", "#    ", "#### ", "    #", "    #", "#   #", " ### ",
-        ],
-        '6' => [
-            "  ## ", " #   ", "#    ", "#### ", "#   #", "#   #", " ### ",
-        ],
-        '7' => [
-            "#####", "    #", "   # ", "  #  ", " #   ", " #   ", " #   ",
-        ],
-        '8' => [
-            " ### ", "#   #", "#   #", " ### ", "#   #", "#   #", " ### ",
-        ],
-        '9' => [
-            " ### ", "#   #", "#   #", " ####", "    #", "   # ", " ##  ",
-        ],
-        'A' => [
-            " ### ", "#   #", "#   #", "#####", "#   #", "#   #", "#   #",
-        ],
-        'B' => [
-            "#### ", "#   #", "#   #", "#### ", "#   #", "#   #", "#### ",
-        ],
-        'C' => [
-            " ### ", "#   #", "#    ", "#    ", "#    ", "#   #", " ### ",
-        ],
-        'D' => [
-            "###  ", "#  # ", "#   #", "#   #", "#   #", "#  # ", "###  ",
-        ],
-        'E' => [
-            "#####", "#    ", "#    ", "#### ", "#    ", "#    ", "#####",
-        ],
-        'F' => [
-            "#####", "#    ", "#    ", "#### ", "#    ", "#    ", "#    ",
-        ],
-        'G' => [
-            " ### ", "#   #", "#    ", "# ###", "#   #", "#   #", " ####",
-        ],
-        'H' => [
-            "#   #", "#   #", "#   #", "#####", "#   #", "#   #", "#   #",
-        ],
-        'I' => [
-            " ### ", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ", " ### ",
-        ],
-        'J' => [
-            "  ###", "   # ", "   # ", "   # ", "   # ", "#  # ", " ##  ",
-        ],
-        'K' => [
-            "#   #", "#  # ", "# #  ", "##   ", "# #  ", "#  # ", "#   #",
-        ],
-        'L' => [
-            "#    ", "#    ", "#    ", "#    ", "#    ", "#    ", "#####",
-        ],
-        'M' => [
-            "#   #", "## ##", "# # #", "# # #", "#   #", "#   #", "#   #",
-        ],
-        'N' => [
-            "#   #", "#   #", "##  #", "# # #", "#  ##", "#   #", "#   #",
-        ],
-        'O' => [
-            " ### ", "#   #", "#   #", "#   #", "#   #", "#   #", " ### ",
-        ],
-        'P' => [
-            "#### ", "#   #", "#   #", "#### ", "#    ", "#    ", "#    ",
-        ],
-        'Q' => [
-            " ### ", "#   #", "#   #", "#   #", "# # #", "#  # ", " ## #",
-        ],
-        'R' => [
-            "#### ", "#   #", "#   #", "#### ", "# #  ", "#  # ", "#   #",
-        ],
-        'S' => [
-            " ####", "#    ", "#    ", " ### ", "    #", "    #", "#### ",
-        ],
-        'T' => [
-            "#####", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ",
-        ],
-        'U' => [
-            "#   #", "#   #", "#   #", "#   #", "#   #", "#   #", " ### ",
-        ],
-        'V' => [
-            "#   #", "#   #", "#   #", "#   #", "#   #", " # # ", "  #  ",
-        ],
-        'W' => [
-            "#   #", "#   #", "#   #", "# # #", "# # #", "# # #", " # # ",
-        ],
-        'X' => [
-            "#   #", "#   #", " # # ", "  #  ", " # # ", "#   #", "#   #",
-        ],
-        'Y' => [
-            "#   #", "#   #", " # # ", "  #  ", "  #  ", "  #  ", "  #  ",
-        ],
-        'Z' => [
-            "#####", "    #", "   # ", "  #  ", " #   ", "#    ", "#####",
-        ],
-        '.' => [
-            "     ", "     ", "     ", "     ", "     ", " ##  ", " ##  ",
-        ],
-        ',' => [
-            "     ", "     ", "     ", "     ", " ##  ", "  #  ", " #   ",
-        ],
-        '-' => [
-            "     ", "     ", "     ", "#####", "     ", "     ", "     ",
-        ],
-        '+' => [
-            "     ", "  #  ", "  #  ", "#####", "  #  ", "  #  ", "     ",
-        ],
-        '(' => [
-            "   # ", "  #  ", " #   ", " #   ", " #   ", "  #  ", "   # ",
-        ],
-        ')' => [
-            " #   ", "  #  ", "   # ", "   # ", "   # ", "  #  ", " #   ",
-        ],
-        '%' => [
-            "##   ", "##  #", "   # ", "  #  ", " #   ", "#  ##", "   ##",
-        ],
-        ':' => [
-            "     ", " ##  ", " ##  ", "     ", " ##  ", " ##  ", "     ",
-        ],
-        '/' => [
-            "     ", "    #", "   # ", "  #  ", " #   ", "#    ", "     ",
-        ],
-        '<' => [
-            "   # ", "  #  ", " #   ", "#    ", " #   ", "  #  ", "   # ",
-        ],
-        '>' => [
-            " #   ", "  #  ", "   # ", "    #", "   # ", "  #  ", " #   ",
-        ],
-        '=' => [
-            "     ", "     ", "#####", "     ", "#####", "     ", "     ",
-        ],
-        '^' => [
-            "  #  ", " # # ", "#   #", "     ", "     ", "     ", "     ",
-        ],
-        '_' => [
-            "     ", "     ", "     ", "     ", "     ", "     ", "#####",
-        ],
-        '\'' => [
-            "  #  ", "  #  ", " #   ", "     ", "     ", "     ", "     ",
-        ],
-        ' ' => ["     "; 7],
-        _ => [
-            " ### ", "#   #", "    #", "   # ", "  #  ", "     ", "  #  ",
-        ],
-    }
-}
-
-const SCALE: i32 = 2;
-const ADVANCE: i32 = 6 * SCALE;
-
-fn text_width(t: &str) -> i32 {
-    t.chars().count() as i32 * ADVANCE
-}
-
-fn put(img: &mut RgbImage, x: i32, y: i32, c: [u8; 3]) {
-    if x >= 0 && y >= 0 && (x as u32) < img.width() && (y as u32) < img.height() {
-        img.put_pixel(x as u32, y as u32, Rgb(c));
-    }
-}
-
-/// Draws `t` with its top-left corner at (x, y); `vertical` runs it bottom to top.
-fn text(img: &mut RgbImage, x: i32, y: i32, t: &str, c: [u8; 3], vertical: bool) {
-    for (i, ch) in t.chars().enumerate() {
-        let g = glyph(ch);
-        for (row, line) in g.iter().enumerate() {
-            for (col, b) in line.bytes().enumerate() {
-                if b != b'#' {
-                    continue;
-                }
-                for sy in 0..SCALE {
-                    for sx in 0..SCALE {
-                        let (gx, gy) = (col as i32 * SCALE + sx, row as i32 * SCALE + sy);
-                        let off = i as i32 * ADVANCE;
-                        if vertical {
-                            put(img, x + gy, y - off - gx, c);
-                        } else {
-                            put(img, x + off + gx, y + gy, c);
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-fn line(img: &mut RgbImage, (x0, y0): (i32, i32), (x1, y1): (i32, i32), c: [u8; 3], thick: i32) {
-    let (dx, dy) = ((x1 - x0).abs(), -(y1 - y0).abs());
-    let (sx, sy) = (if x0 < x1 { 1 } else { -1 }, if y0 < y1 { 1 } else { -1 });
-    let (mut x, mut y, mut err) = (x0, y0, dx + dy);
-    loop {
-        for ox in 0..thick {
-            for oy in 0..thick {
-                put(img, x + ox - thick / 2, y + oy - thick / 2, c);
-            }
-        }
-        if x == x1 && y == y1 {
-            break;
-        }
-        let e2 = 2 * err;
-        if e2 >= dy {
-            err += dy;
-            x += sx;
-        }
-        if e2 <= dx {
-            err += dx;
-            y += sy;
-        }
-    }
-}
+const INK: RGBColor = RGBColor(40, 40, 40);
+const GRID: RGBColor = RGBColor(225, 225, 225);
+const MARK: RGBColor = RGBColor(110, 110, 110);
 
 /// Tick positions covering [lo, hi] with a 1-2-5 step.
 fn ticks(lo: f64, hi: f64) -> Vec<f64> {
@@ -830,6 +624,60 @@ fn ticks(lo: f64, hi: f64) -> Vec<f64> {
     out
 }
 
+/// Ticks of a log2 axis, in log2 units: whole powers of two (every n-th one when there are many),
+/// or 1-2-5 ticks of the exponent when the range spans less than two octaves.
+fn log2_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let (first, last) = (lo.ceil(), hi.floor());
+    if last - first < 1.0 {
+        return ticks(lo, hi);
+    }
+    let step = ((last - first) / 8.0).ceil().max(1.0);
+    let mut out = Vec::new();
+    let mut t = first;
+    while t <= last {
+        out.push(t);
+        t += step;
+    }
+    out
+}
+
+/// A linear axis with our own ticks (plotters' `with_key_points` loses the f64 label formatting).
+struct Axis {
+    coord: RangedCoordf64,
+    ticks: Vec<f64>,
+}
+
+impl Axis {
+    fn new(range: Range<f64>, ticks: Vec<f64>) -> Self {
+        Self {
+            coord: range.into(),
+            ticks,
+        }
+    }
+}
+
+impl Ranged for Axis {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.coord.map(value, limit)
+    }
+
+    /// The ticks as the bold grid lines; no light ones.
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            self.ticks.clone()
+        }
+    }
+
+    fn range(&self) -> Range<f64> {
+        self.coord.range()
+    }
+}
+
 fn label(v: f64) -> String {
     if v == 0.0 {
         return "0".into();
@@ -846,130 +694,143 @@ fn label(v: f64) -> String {
     }
 }
 
-/// Draws a line plot.
+/// The image size [`draw`] makes for `f`: 900 x 540 and one legend row per two series.
+pub fn size(f: &Figure) -> (u32, u32) {
+    (W, H + f.series.len().div_ceil(2) as u32 * LEGEND_ROW + 6)
+}
+
+/// Draws a line plot: title, axes with grid and labels, the series in the palette with point
+/// markers, the marks as dashed horizontal lines labelled at the right, and the legend below.
 pub fn draw(f: &Figure) -> RgbImage {
-    // The legend sits below the plot, two entries per row.
-    let legend_rows = f.series.len().div_ceil(2) as i32;
-    let height = H as i32 + legend_rows * 22 + 6;
-    let mut img = RgbImage::from_pixel(W, height as u32, Rgb([255, 255, 255]));
-    let (px0, px1) = (LEFT, W as i32 - RIGHT);
-    let (py0, py1) = (TOP, H as i32 - BOTTOM);
-    let pts = f.series.iter().flat_map(|s| s.points.iter());
-    let xs: Vec<f64> = pts.clone().map(|p| p.0).filter(|v| v.is_finite()).collect();
-    let ys: Vec<f64> = pts
-        .map(|p| p.1)
-        .chain(f.marks.iter().map(|m| m.0))
-        .filter(|v| v.is_finite())
-        .collect();
-    let (mut x_lo, mut x_hi) = (
-        xs.iter().copied().fold(f64::INFINITY, f64::min),
-        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-    );
+    assert!(font_loaded(), "the embedded DejaVu Sans did not load");
+    let (w, h) = size(f);
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    plot(f, &mut buf, (w, h)).expect("plotting into a bitmap with the embedded font");
+    RgbImage::from_raw(w, h, buf).expect("the buffer holds w x h RGB pixels")
+}
+
+fn plot(f: &Figure, buf: &mut [u8], (w, h): (u32, u32)) -> Result<()> {
+    let root = BitMapBackend::with_buffer(buf, (w, h)).into_drawing_area();
+    let (upper, _) = root.split_vertically(H);
+
+    // Data ranges; x in log2 units on a log axis (points at x <= 0 cannot be shown there).
+    let fx = |x: f64| if f.log_x { x.log2() } else { x };
+    let points = |s: &Series| -> Vec<(f64, f64)> {
+        s.points
+            .iter()
+            .map(|&(x, y)| (fx(x), y))
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect()
+    };
+    let all: Vec<(f64, f64)> = f.series.iter().flat_map(points).collect();
+    let (mut x_lo, mut x_hi) = all
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.0), hi.max(p.0))
+        });
     if !x_lo.is_finite() {
         (x_lo, x_hi) = (0.0, 1.0);
     }
     if x_hi - x_lo < 1e-12 {
         x_hi = x_lo + 1.0;
     }
-    let y_lo = 0.0f64.min(ys.iter().copied().fold(f64::INFINITY, f64::min));
-    let mut y_hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max) * 1.1;
+    let ys = all
+        .iter()
+        .map(|p| p.1)
+        .chain(f.marks.iter().map(|m| m.0))
+        .filter(|v| v.is_finite());
+    let (y_min, y_max) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+        (lo.min(y), hi.max(y))
+    });
+    let y_lo = 0.0f64.min(y_min);
+    let mut y_hi = y_max * 1.1;
     if !y_hi.is_finite() || y_hi <= y_lo {
         y_hi = y_lo + 1.0;
     }
-    let map_x = |x: f64| px0 + ((x - x_lo) / (x_hi - x_lo) * f64::from(px1 - px0)).round() as i32;
-    let map_y = |y: f64| py1 - ((y - y_lo) / (y_hi - y_lo) * f64::from(py1 - py0)).round() as i32;
-    let grid = [225, 225, 225];
-    let ink = [40, 40, 40];
-    for t in ticks(y_lo, y_hi) {
-        let y = map_y(t);
-        line(&mut img, (px0, y), (px1, y), grid, 1);
-        let l = label(t);
-        text(&mut img, px0 - 8 - text_width(&l), y - 7, &l, ink, false);
-    }
-    for t in ticks(x_lo, x_hi) {
-        let x = map_x(t);
-        line(&mut img, (x, py0), (x, py1), grid, 1);
-        let l = label(t);
-        text(&mut img, x - text_width(&l) / 2, py1 + 8, &l, ink, false);
-    }
-    line(&mut img, (px0, py1), (px1, py1), ink, 2);
-    line(&mut img, (px0, py0), (px0, py1), ink, 2);
-    text(
-        &mut img,
-        (W as i32 - text_width(&f.title)) / 2,
-        14,
-        &f.title,
-        ink,
-        false,
-    );
-    text(
-        &mut img,
-        (px0 + px1 - text_width(&f.x_label)) / 2,
-        H as i32 - 30,
-        &f.x_label,
-        ink,
-        false,
-    );
-    text(
-        &mut img,
-        12,
-        (py0 + py1 + text_width(&f.y_label)) / 2,
-        &f.y_label,
-        ink,
-        true,
-    );
+    let x_ticks = if f.log_x {
+        log2_ticks(x_lo, x_hi)
+    } else {
+        ticks(x_lo, x_hi)
+    };
+    // A little room left and right so that the end points' markers are not cut.
+    let pad = (x_hi - x_lo) * 0.02;
+    let x_axis = Axis::new((x_lo - pad)..(x_hi + pad), x_ticks);
+    let y_axis = Axis::new(y_lo..y_hi, ticks(y_lo, y_hi));
+
+    let font = |size: f64| (FAMILY, size).into_font().color(&INK);
+    let mut chart = ChartBuilder::on(&upper)
+        .caption(&f.title, font(22.0))
+        .margin_top(12)
+        .margin_left(16)
+        .margin_right(30)
+        .margin_bottom(8)
+        .x_label_area_size(56)
+        .y_label_area_size(78)
+        .build_cartesian_2d(x_axis, y_axis)?;
+    let x_fmt = |v: &f64| label(if f.log_x { v.exp2() } else { *v });
+    chart
+        .configure_mesh()
+        .bold_line_style(GRID)
+        .light_line_style(TRANSPARENT)
+        .axis_style(INK.stroke_width(2))
+        .label_style(font(15.0))
+        .axis_desc_style(font(16.0))
+        .x_desc(f.x_label.as_str())
+        .y_desc(f.y_label.as_str())
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&|v| label(*v))
+        .draw()?;
+
+    let mark_font = font(14.0).color(&MARK);
     for (value, name) in &f.marks {
-        let y = map_y(*value);
-        let mut x = px0;
-        while x < px1 {
-            line(&mut img, (x, y), ((x + 8).min(px1), y), [120, 120, 120], 1);
-            x += 14;
-        }
-        let (tx, ty) = (px1 - text_width(name) - 6, y - 19);
-        for yy in ty - 2..ty + 16 {
-            for xx in tx - 3..tx + text_width(name) + 3 {
-                put(&mut img, xx, yy, [255, 255, 255]);
-            }
-        }
-        text(&mut img, tx, ty, name, [90, 90, 90], false);
+        chart.draw_series(DashedLineSeries::new(
+            [(x_lo - pad, *value), (x_hi + pad, *value)],
+            8,
+            6,
+            MARK.stroke_width(1),
+        ))?;
+        // The label sits above the line's right end, on white so that grid lines do not cross it.
+        let (x, y) = chart.backend_coord(&(x_hi + pad, *value));
+        let (tw, th) = upper.estimate_text_size(name, &mark_font)?;
+        let (tx, ty) = (x - 6 - tw as i32, y - 4 - th as i32);
+        upper.draw(&Rectangle::new(
+            [(tx - 3, ty - 2), (tx + tw as i32 + 3, ty + th as i32 + 2)],
+            WHITE.filled(),
+        ))?;
+        upper.draw_text(name, &mark_font, (tx, ty))?;
     }
     for (i, s) in f.series.iter().enumerate() {
         let c = PALETTE[i % PALETTE.len()];
-        let p: Vec<(i32, i32)> = s
-            .points
-            .iter()
-            .filter(|p| p.0.is_finite() && p.1.is_finite())
-            .map(|&(x, y)| (map_x(x), map_y(y)))
-            .collect();
-        for w in p.windows(2) {
-            line(&mut img, w[0], w[1], c, 2);
-        }
-        for &(x, y) in &p {
-            for ox in -3..=3 {
-                for oy in -3..=3 {
-                    put(&mut img, x + ox, y + oy, c);
-                }
-            }
-        }
+        let p = points(s);
+        chart.draw_series(LineSeries::new(p.iter().copied(), c.stroke_width(2)))?;
+        chart.draw_series(p.iter().map(|&q| Circle::new(q, 3, c.filled())))?;
     }
-    // Legend, below the x label.
-    let col_w = (px1 - px0) / 2;
+
+    // Legend below the plot, two entries per row, aligned with the plotting area.
+    let (px, _) = chart.plotting_area().get_pixel_range();
+    let col_w = (px.end - px.start) / 2;
     for (i, s) in f.series.iter().enumerate() {
         let c = PALETTE[i % PALETTE.len()];
-        let (lx, ly) = (
-            px0 + (i as i32 % 2) * col_w,
-            H as i32 - 2 + (i as i32 / 2) * 22,
-        );
-        line(&mut img, (lx, ly + 7), (lx + 28, ly + 7), c, 3);
-        text(&mut img, lx + 36, ly, &s.name, ink, false);
+        let lx = px.start + (i as i32 % 2) * col_w;
+        let ly = H as i32 + (i as i32 / 2) * LEGEND_ROW as i32 + LEGEND_ROW as i32 / 2;
+        root.draw(&PathElement::new(
+            [(lx, ly), (lx + 28, ly)],
+            c.stroke_width(3),
+        ))?;
+        root.draw(&Circle::new((lx + 14, ly), 3, c.filled()))?;
+        root.draw_text(
+            &s.name,
+            &font(15.0).pos(Pos::new(HPos::Left, VPos::Center)),
+            (lx + 38, ly),
+        )?;
     }
-    img
+    root.present()?;
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cube5_model::studies::tradeoff::Series;
 
     #[test]
     fn ticks_cover_the_range() {
@@ -978,24 +839,7 @@ mod tests {
         assert!(*t.last().unwrap() >= 80.0 && t.len() <= 12);
         assert_eq!(label(0.25), "0.25");
         assert_eq!(label(45.0), "45");
-    }
-
-    #[test]
-    fn plot_draws_ink() {
-        let f = Figure {
-            name: "t".into(),
-            title: "Title (%)".into(),
-            x_label: "x".into(),
-            y_label: "y".into(),
-            series: vec![Series {
-                name: "a".into(),
-                points: vec![(0.0, 1.0), (1.0, 2.0)],
-            }],
-            marks: vec![(1.5, "mark".into())],
-            log_x: false,
-        };
-        let img = draw(&f);
-        let dark = img.pixels().filter(|p| p.0[0] < 100).count();
-        assert!(dark > 500, "{dark}");
+        assert_eq!(log2_ticks(1.0, 10.0), vec![1.0, 3.0, 5.0, 7.0, 9.0]);
+        assert_eq!(log2_ticks(2.0, 6.5), vec![2.0, 3.0, 4.0, 5.0, 6.0]);
     }
 }
