@@ -2,11 +2,14 @@
 //! writes the tables (Markdown and CSV) and plots (PNG). `--write-docs` regenerates
 //! `docs/tradeoffs.md` and `docs/img/tradeoff-*`.
 //!
-//! The plots are drawn with `plotters` into an RGB buffer. Their text is DejaVu Sans, embedded in
-//! the binary (`cli/assets/fonts/`, with its licence) and rendered anti-aliased by plotters'
-//! `ab_glyph` feature, so no system fonts are needed (CI machines have none; plotters' default
-//! font-kit text looks them up).
+//! The plots are drawn with `plotters` into an RGB buffer (grid, axes, curves, markers) and their
+//! text with `ab_glyph` in DejaVu Sans, embedded in the binary (`cli/assets/fonts/`, with its
+//! licence), so no system fonts are needed (CI machines have none; plotters' default font-kit text
+//! looks them up). The text is not plotters' own: its `ab_glyph` feature drops each glyph's left
+//! side bearing and rounds the pen to whole pixels, so at 15 px the gap between neighbouring letters
+//! is off by 0.5 px on average and up to 2 px ("im age"); `draw_text` places glyphs exactly.
 
+use ab_glyph::{point, Font, FontRef, ScaleFont};
 use anyhow::{bail, Context, Result};
 use cube5_model::render::{Quality, RenderParams};
 use cube5_model::scene::Scene;
@@ -21,8 +24,6 @@ use indicatif::{ProgressBar, ProgressStyle};
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
-use plotters::style::register_font;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
@@ -574,19 +575,17 @@ fn document(
 }
 
 // =================================================================================================
-// Plotting with `plotters` and the embedded DejaVu Sans
+// Plotting: geometry with `plotters`, text with `ab_glyph` in the embedded DejaVu Sans
 // =================================================================================================
 
 /// DejaVu Sans 2.37 from Debian's fonts-dejavu-core (`cli/assets/fonts/`: its licence and where it
 /// came from).
-static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-/// The family name the plots ask for; the embedded font is registered under it.
-const FAMILY: &str = "sans-serif";
+static FONT_TTF: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 
-/// Registers the embedded font with plotters' `ab_glyph` text renderer, once per process.
-fn font_loaded() -> bool {
-    static LOADED: OnceLock<bool> = OnceLock::new();
-    *LOADED.get_or_init(|| register_font(FAMILY, FontStyle::Normal, FONT).is_ok())
+/// The embedded font, parsed once.
+fn font() -> &'static FontRef<'static> {
+    static FONT: OnceLock<FontRef<'static>> = OnceLock::new();
+    FONT.get_or_init(|| FontRef::try_from_slice(FONT_TTF).expect("the embedded DejaVu Sans parses"))
 }
 
 const W: u32 = 900;
@@ -604,17 +603,26 @@ const PALETTE: [RGBColor; 6] = [
 const INK: RGBColor = RGBColor(40, 40, 40);
 const GRID: RGBColor = RGBColor(225, 225, 225);
 const MARK: RGBColor = RGBColor(110, 110, 110);
+/// Text sizes in pixels (line height, as `ab_glyph`'s `PxScale`).
+const TITLE_PX: f32 = 22.0;
+const LABEL_PX: f32 = 15.0;
+const DESC_PX: f32 = 16.0;
+const MARK_PX: f32 = 14.0;
 
-/// Tick positions covering [lo, hi] with a 1-2-5 step.
-fn ticks(lo: f64, hi: f64) -> Vec<f64> {
-    let span = (hi - lo).max(1e-12);
-    let raw = span / 6.0;
+/// A 1-2-5 step that cuts [lo, hi] into about six parts.
+fn tick_step(lo: f64, hi: f64) -> f64 {
+    let raw = (hi - lo).max(1e-12) / 6.0;
     let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
+    [1.0, 2.0, 5.0, 10.0]
         .iter()
         .map(|m| m * mag)
         .find(|s| *s >= raw)
-        .unwrap_or(10.0 * mag);
+        .unwrap_or(10.0 * mag)
+}
+
+/// Tick positions covering [lo, hi] with a 1-2-5 step.
+fn ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let step = tick_step(lo, hi);
     let mut t = (lo / step).ceil() * step;
     let mut out = Vec::new();
     while t <= hi + 1e-9 * step {
@@ -624,24 +632,59 @@ fn ticks(lo: f64, hi: f64) -> Vec<f64> {
     out
 }
 
-/// Ticks of a log2 axis, in log2 units: whole powers of two (every n-th one when there are many),
-/// or 1-2-5 ticks of the exponent when the range spans less than two octaves.
-fn log2_ticks(lo: f64, hi: f64) -> Vec<f64> {
+/// Ticks of a log2 axis as (position in log2 units, label): whole powers of two (every n-th one
+/// when there are many), or 1-2-5 ticks of the values when the range spans less than two octaves.
+fn log2_ticks(lo: f64, hi: f64) -> Vec<(f64, String)> {
     let (first, last) = (lo.ceil(), hi.floor());
-    if last - first < 1.0 {
-        return ticks(lo, hi);
+    if last - first < 2.0 {
+        let (a, b) = (lo.exp2(), hi.exp2());
+        let step = tick_step(a, b);
+        return ticks(a, b)
+            .into_iter()
+            .filter(|v| *v > 0.0)
+            .map(|v| (v.log2(), label(v, step)))
+            .collect();
     }
-    let step = ((last - first) / 8.0).ceil().max(1.0);
+    let step = ((last - first) / 8.0).ceil();
     let mut out = Vec::new();
     let mut t = first;
     while t <= last {
-        out.push(t);
+        let v = t.exp2();
+        // A power of two prints exactly in its shortest form (0.125, 64).
+        let l = if (1e-3..1e5).contains(&v) {
+            format!("{v}")
+        } else {
+            format!("{v:.1e}")
+        };
+        out.push((t, l));
         t += step;
     }
     out
 }
 
-/// A linear axis with our own ticks (plotters' `with_key_points` loses the f64 label formatting).
+/// Ticks of a linear axis as (position, label).
+fn linear_ticks(lo: f64, hi: f64) -> Vec<(f64, String)> {
+    let step = tick_step(lo, hi);
+    ticks(lo, hi)
+        .into_iter()
+        .map(|t| (t, label(t, step)))
+        .collect()
+}
+
+/// A tick label: as many decimals as the tick step needs, exponent notation far from 1.
+fn label(v: f64, step: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if !(1e-3..1e5).contains(&a) {
+        return format!("{v:.1e}");
+    }
+    let decimals = (-step.abs().log10() - 1e-9).ceil().clamp(0.0, 4.0) as usize;
+    format!("{v:.decimals$}")
+}
+
+/// A linear axis with our own ticks as its grid lines.
 struct Axis {
     coord: RangedCoordf64,
     ticks: Vec<f64>,
@@ -678,40 +721,125 @@ impl Ranged for Axis {
     }
 }
 
-fn label(v: f64) -> String {
-    if v == 0.0 {
-        return "0".into();
+/// Where a text's anchor point sits on it.
+#[derive(Clone, Copy, PartialEq)]
+enum Align {
+    Start,
+    Centre,
+    End,
+}
+
+/// One line of text to draw: anchored at `at` (pixels), horizontal or running bottom to top.
+struct Text {
+    s: String,
+    at: (i32, i32),
+    px: f32,
+    colour: RGBColor,
+    /// Along the text and across it.
+    align: (Align, Align),
+    vertical: bool,
+}
+
+/// The advance width of `s` at `px` (with kerning).
+fn text_width(s: &str, px: f32) -> f32 {
+    let f = font().as_scaled(px);
+    let mut w = 0.0;
+    let mut prev = None;
+    for c in s.chars() {
+        let id = f.glyph_id(c);
+        if let Some(p) = prev {
+            w += f.kern(p, id);
+        }
+        w += f.h_advance(id);
+        prev = Some(id);
     }
-    let a = v.abs();
-    if !(0.01..1000.0).contains(&a) {
-        format!("{v:.1e}")
-    } else if a >= 10.0 {
-        format!("{v:.0}")
-    } else if a >= 1.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.2}")
+    w
+}
+
+/// Draws `t` anti-aliased: each glyph outlined at its sub-pixel pen position (advance, kerning,
+/// side bearing), its coverage blended over the image.
+fn draw_text(img: &mut RgbImage, t: &Text) {
+    let f = font().as_scaled(t.px);
+    let width = text_width(&t.s, t.px);
+    // Local frame: x along the text from its start, y down from the top of the line box.
+    let x0 = match t.align.0 {
+        Align::Start => 0.0,
+        Align::Centre => -width / 2.0,
+        Align::End => -width,
+    };
+    // Centre on the capitals' middle rather than the line box's, which looks centred.
+    let cap = f.ascent() * 0.75;
+    let baseline = match t.align.1 {
+        Align::Start => f.ascent(),
+        Align::Centre => cap / 2.0,
+        Align::End => f.descent(),
+    };
+    let (w, h) = (img.width() as i32, img.height() as i32);
+    let colour = [t.colour.0, t.colour.1, t.colour.2];
+    let mut pen = x0;
+    let mut prev = None;
+    for c in t.s.chars() {
+        let id = f.glyph_id(c);
+        if let Some(p) = prev {
+            pen += f.kern(p, id);
+        }
+        prev = Some(id);
+        let glyph = id.with_scale_and_position(t.px, point(pen, baseline));
+        pen += f.h_advance(id);
+        let Some(outline) = f.outline_glyph(glyph) else {
+            continue;
+        };
+        let b = outline.px_bounds();
+        outline.draw(|gx, gy, cover| {
+            let (lx, ly) = (b.min.x as i32 + gx as i32, b.min.y as i32 + gy as i32);
+            let (x, y) = if t.vertical {
+                (t.at.0 + ly, t.at.1 - lx)
+            } else {
+                (t.at.0 + lx, t.at.1 + ly)
+            };
+            if (0..w).contains(&x) && (0..h).contains(&y) {
+                let p = img.get_pixel_mut(x as u32, y as u32);
+                let a = cover.clamp(0.0, 1.0);
+                for (d, s) in p.0.iter_mut().zip(colour) {
+                    *d = (f32::from(*d) * (1.0 - a) + f32::from(s) * a).round() as u8;
+                }
+            }
+        });
     }
 }
 
 /// The image size [`draw`] makes for `f`: 900 x 540 and one legend row per two series.
-pub fn size(f: &Figure) -> (u32, u32) {
+fn size(f: &Figure) -> (u32, u32) {
     (W, H + f.series.len().div_ceil(2) as u32 * LEGEND_ROW + 6)
 }
 
-/// Draws a line plot: title, axes with grid and labels, the series in the palette with point
+/// Draws a line plot: title, axes with grid and tick labels, the series in the palette with point
 /// markers, the marks as dashed horizontal lines labelled at the right, and the legend below.
 pub fn draw(f: &Figure) -> RgbImage {
-    assert!(font_loaded(), "the embedded DejaVu Sans did not load");
     let (w, h) = size(f);
     let mut buf = vec![255u8; (w * h * 3) as usize];
-    plot(f, &mut buf, (w, h)).expect("plotting into a bitmap with the embedded font");
-    RgbImage::from_raw(w, h, buf).expect("the buffer holds w x h RGB pixels")
+    let texts = plot(f, &mut buf, (w, h)).expect("plotting into a bitmap of the right size");
+    let mut img = RgbImage::from_raw(w, h, buf).expect("the buffer holds w x h RGB pixels");
+    for t in &texts {
+        draw_text(&mut img, t);
+    }
+    img
 }
 
-fn plot(f: &Figure, buf: &mut [u8], (w, h): (u32, u32)) -> Result<()> {
+/// Draws everything but the text with plotters and returns the text to draw over it (the module
+/// comment says why plotters does not draw the text).
+fn plot(f: &Figure, buf: &mut [u8], (w, h): (u32, u32)) -> Result<Vec<Text>> {
     let root = BitMapBackend::with_buffer(buf, (w, h)).into_drawing_area();
     let (upper, _) = root.split_vertically(H);
+    let mut texts = Vec::new();
+    let text = |s: &str, at: (i32, i32), px: f32, align: (Align, Align)| Text {
+        s: s.to_string(),
+        at,
+        px,
+        colour: INK,
+        align,
+        vertical: false,
+    };
 
     // Data ranges; x in log2 units on a log axis (points at x <= 0 cannot be shown there).
     let fx = |x: f64| if f.log_x { x.log2() } else { x };
@@ -743,61 +871,99 @@ fn plot(f: &Figure, buf: &mut [u8], (w, h): (u32, u32)) -> Result<()> {
         (lo.min(y), hi.max(y))
     });
     let y_lo = 0.0f64.min(y_min);
-    let mut y_hi = y_max * 1.1;
+    let mut y_hi = y_max * 1.05;
     if !y_hi.is_finite() || y_hi <= y_lo {
         y_hi = y_lo + 1.0;
     }
+    // The y axis ends on a tick.
+    let y_step = tick_step(y_lo, y_hi);
+    y_hi = (y_hi / y_step - 1e-9).ceil() * y_step;
+    let y_ticks = linear_ticks(y_lo, y_hi);
     let x_ticks = if f.log_x {
         log2_ticks(x_lo, x_hi)
     } else {
-        ticks(x_lo, x_hi)
+        linear_ticks(x_lo, x_hi)
     };
     // A little room left and right so that the end points' markers are not cut.
     let pad = (x_hi - x_lo) * 0.02;
-    let x_axis = Axis::new((x_lo - pad)..(x_hi + pad), x_ticks);
-    let y_axis = Axis::new(y_lo..y_hi, ticks(y_lo, y_hi));
+    let (x_lo, x_hi) = (x_lo - pad, x_hi + pad);
 
-    let font = |size: f64| (FAMILY, size).into_font().color(&INK);
     let mut chart = ChartBuilder::on(&upper)
-        .caption(&f.title, font(22.0))
-        .margin_top(12)
+        .margin_top(48)
         .margin_left(16)
         .margin_right(30)
         .margin_bottom(8)
         .x_label_area_size(56)
-        .y_label_area_size(78)
-        .build_cartesian_2d(x_axis, y_axis)?;
-    let x_fmt = |v: &f64| label(if f.log_x { v.exp2() } else { *v });
+        .y_label_area_size(72)
+        .build_cartesian_2d(
+            Axis::new(x_lo..x_hi, x_ticks.iter().map(|t| t.0).collect()),
+            Axis::new(y_lo..y_hi, y_ticks.iter().map(|t| t.0).collect()),
+        )?;
+    let (px, py) = chart.plotting_area().get_pixel_range();
+    let (left, right, top, bottom) = (px.start, px.end - 1, py.start, py.end - 1);
+
+    // Grid, axes, ticks and their labels.
     chart
         .configure_mesh()
         .bold_line_style(GRID)
         .light_line_style(TRANSPARENT)
-        .axis_style(INK.stroke_width(2))
-        .label_style(font(15.0))
-        .axis_desc_style(font(16.0))
-        .x_desc(f.x_label.as_str())
-        .y_desc(f.y_label.as_str())
-        .x_label_formatter(&x_fmt)
-        .y_label_formatter(&|v| label(*v))
+        .disable_x_axis()
+        .disable_y_axis()
         .draw()?;
+    for (t, l) in &x_ticks {
+        let (x, _) = chart.backend_coord(&(*t, y_lo));
+        root.draw(&PathElement::new([(x, bottom), (x, bottom + 5)], INK))?;
+        texts.push(text(
+            l,
+            (x, bottom + 9),
+            LABEL_PX,
+            (Align::Centre, Align::Start),
+        ));
+    }
+    for (t, l) in &y_ticks {
+        let (_, y) = chart.backend_coord(&(x_lo, *t));
+        root.draw(&PathElement::new([(left - 5, y), (left, y)], INK))?;
+        texts.push(text(
+            l,
+            (left - 9, y),
+            LABEL_PX,
+            (Align::End, Align::Centre),
+        ));
+    }
+    root.draw(&PathElement::new(
+        [(left, top), (left, bottom), (right, bottom)],
+        INK.stroke_width(2),
+    ))?;
+    texts.push(text(
+        &f.title,
+        (W as i32 / 2, 14),
+        TITLE_PX,
+        (Align::Centre, Align::Start),
+    ));
+    texts.push(text(
+        &f.x_label,
+        ((left + right) / 2, bottom + 32),
+        DESC_PX,
+        (Align::Centre, Align::Start),
+    ));
+    texts.push(Text {
+        vertical: true,
+        ..text(
+            &f.y_label,
+            (14, (top + bottom) / 2),
+            DESC_PX,
+            (Align::Centre, Align::Start),
+        )
+    });
 
-    let mark_font = font(14.0).color(&MARK);
-    for (value, name) in &f.marks {
+    // Marks and series; the marks' labels go on a veil over the series so that both show.
+    for (value, _) in &f.marks {
         chart.draw_series(DashedLineSeries::new(
-            [(x_lo - pad, *value), (x_hi + pad, *value)],
+            [(x_lo, *value), (x_hi, *value)],
             8,
             6,
             MARK.stroke_width(1),
         ))?;
-        // The label sits above the line's right end, on white so that grid lines do not cross it.
-        let (x, y) = chart.backend_coord(&(x_hi + pad, *value));
-        let (tw, th) = upper.estimate_text_size(name, &mark_font)?;
-        let (tx, ty) = (x - 6 - tw as i32, y - 4 - th as i32);
-        upper.draw(&Rectangle::new(
-            [(tx - 3, ty - 2), (tx + tw as i32 + 3, ty + th as i32 + 2)],
-            WHITE.filled(),
-        ))?;
-        upper.draw_text(name, &mark_font, (tx, ty))?;
     }
     for (i, s) in f.series.iter().enumerate() {
         let c = PALETTE[i % PALETTE.len()];
@@ -805,27 +971,40 @@ fn plot(f: &Figure, buf: &mut [u8], (w, h): (u32, u32)) -> Result<()> {
         chart.draw_series(LineSeries::new(p.iter().copied(), c.stroke_width(2)))?;
         chart.draw_series(p.iter().map(|&q| Circle::new(q, 3, c.filled())))?;
     }
+    for (value, name) in &f.marks {
+        let (_, y) = chart.backend_coord(&(x_hi, *value));
+        let tw = text_width(name, MARK_PX).ceil() as i32;
+        let (tx, ty) = (right - 6, y - 4);
+        root.draw(&Rectangle::new(
+            [(tx - tw - 3, ty - MARK_PX as i32), (tx + 3, ty + 1)],
+            WHITE.mix(0.85).filled(),
+        ))?;
+        texts.push(Text {
+            colour: MARK,
+            ..text(name, (tx, ty), MARK_PX, (Align::End, Align::End))
+        });
+    }
 
     // Legend below the plot, two entries per row, aligned with the plotting area.
-    let (px, _) = chart.plotting_area().get_pixel_range();
-    let col_w = (px.end - px.start) / 2;
+    let col_w = (right - left) / 2;
     for (i, s) in f.series.iter().enumerate() {
         let c = PALETTE[i % PALETTE.len()];
-        let lx = px.start + (i as i32 % 2) * col_w;
+        let lx = left + (i as i32 % 2) * col_w;
         let ly = H as i32 + (i as i32 / 2) * LEGEND_ROW as i32 + LEGEND_ROW as i32 / 2;
         root.draw(&PathElement::new(
             [(lx, ly), (lx + 28, ly)],
             c.stroke_width(3),
         ))?;
         root.draw(&Circle::new((lx + 14, ly), 3, c.filled()))?;
-        root.draw_text(
+        texts.push(text(
             &s.name,
-            &font(15.0).pos(Pos::new(HPos::Left, VPos::Center)),
             (lx + 38, ly),
-        )?;
+            LABEL_PX,
+            (Align::Start, Align::Centre),
+        ));
     }
     root.present()?;
-    Ok(())
+    Ok(texts)
 }
 
 #[cfg(test)]
@@ -837,9 +1016,61 @@ mod tests {
         let t = ticks(0.0, 93.0);
         assert_eq!(t.first(), Some(&0.0));
         assert!(*t.last().unwrap() >= 80.0 && t.len() <= 12);
-        assert_eq!(label(0.25), "0.25");
-        assert_eq!(label(45.0), "45");
-        assert_eq!(log2_ticks(1.0, 10.0), vec![1.0, 3.0, 5.0, 7.0, 9.0]);
-        assert_eq!(log2_ticks(2.0, 6.5), vec![2.0, 3.0, 4.0, 5.0, 6.0]);
+        assert_eq!(label(0.25, 0.05), "0.25");
+        assert_eq!(label(45.0, 5.0), "45");
+        assert_eq!(label(1.5, 0.5), "1.5");
+        assert_eq!(label(5.0, 5.0), "5");
+        assert_eq!(label(0.004, 0.001), "0.004");
+        let pos = |t: Vec<(f64, String)>| t.into_iter().map(|t| t.0).collect::<Vec<_>>();
+        assert_eq!(pos(log2_ticks(1.0, 10.0)), vec![1.0, 3.0, 5.0, 7.0, 9.0]);
+        assert_eq!(pos(log2_ticks(2.0, 6.5)), vec![2.0, 3.0, 4.0, 5.0, 6.0]);
+        let labels: Vec<String> = log2_ticks(-3.0, 0.5).into_iter().map(|t| t.1).collect();
+        assert_eq!(labels, ["0.125", "0.25", "0.5", "1"]);
+        // Less than two octaves: 1-2-5 ticks of the values.
+        let labels: Vec<String> = log2_ticks(-1.0, 0.0).into_iter().map(|t| t.1).collect();
+        assert_eq!(labels, ["0.5", "0.6", "0.7", "0.8", "0.9", "1.0"]);
+    }
+
+    fn figure(title: &str, series: usize, log_x: bool) -> Figure {
+        Figure {
+            name: "t".into(),
+            title: title.into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            series: (0..series)
+                .map(|i| Series {
+                    name: format!("series {i}"),
+                    points: vec![(1.0, 1.0 + i as f64), (64.0, 2.0 + i as f64)],
+                })
+                .collect(),
+            marks: vec![(1.5, "mark".into())],
+            log_x,
+        }
+    }
+
+    /// Pixels in the title's band (above the plotting area) that are not white, and of those the
+    /// grey ones that only anti-aliased text makes.
+    fn title_ink(img: &RgbImage) -> (usize, usize) {
+        let band = (250..650).flat_map(|x| (8..44).map(move |y| (x, y)));
+        let px: Vec<[u8; 3]> = band.map(|(x, y)| img.get_pixel(x, y).0).collect();
+        let inked = px.iter().filter(|p| **p != [255; 3]).count();
+        let grey = px.iter().filter(|p| p[0] > 60 && p[0] < 200).count();
+        (inked, grey)
+    }
+
+    #[test]
+    fn draw_makes_the_size_and_writes_the_title_in_the_embedded_font() {
+        for (series, log_x, h) in [(1, false, 570), (3, true, 594), (6, false, 618)] {
+            let img = draw(&figure("Error vs samples (%)", series, log_x));
+            assert_eq!(img.dimensions(), (900, h), "{series} series");
+            let (inked, grey) = title_ink(&img);
+            assert!(
+                inked > 400 && grey > 100,
+                "title: {inked} inked, {grey} grey pixels"
+            );
+            let plot = img.pixels().filter(|p| p.0 == [31, 119, 180]).count();
+            assert!(plot > 500, "the first series is drawn: {plot} pixels");
+        }
+        assert_eq!(title_ink(&draw(&figure("", 2, false))), (0, 0), "no title");
     }
 }
