@@ -19,6 +19,7 @@ use cube5_model::studies::tradeoff::{
 };
 use cube5_model::transfer::TransferFunction;
 use cube5_model::volume_io::write_atomically;
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::RgbImage;
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
@@ -189,10 +190,13 @@ pub fn run(args: TradeoffArgs) -> Result<()> {
         let p = img_dir.join(format!("{}.png", f.name));
         let png = draw(f);
         let mut bytes = Vec::new();
-        png.write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
+        // `write_to` compresses fast; the default level makes the anti-aliased plots half as
+        // large (100 -> 54 KB) for about 30 ms a plot.
+        png.write_with_encoder(PngEncoder::new_with_quality(
+            &mut bytes,
+            CompressionType::Default,
+            FilterType::Adaptive,
+        ))
         .context("encoding a plot")?;
         write_atomically(&p, &bytes)?;
         written.push(p);
