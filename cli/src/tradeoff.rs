@@ -2,23 +2,32 @@
 //! writes the tables (Markdown and CSV) and plots (PNG). `--write-docs` regenerates
 //! `docs/tradeoffs.md` and `docs/img/tradeoff-*`.
 //!
-//! The plots are drawn with `image` and a built-in 5x7 bitmap font: `plotters` without its
-//! font-kit feature draws no text at all, and font-kit needs system fonts that a CI machine need
-//! not have.
+//! The plots are drawn with `plotters` into an RGB buffer (grid, axes, curves, markers) and their
+//! text with `ab_glyph` in DejaVu Sans, embedded in the binary (`cli/assets/fonts/`, with its
+//! licence), so no system fonts are needed (CI machines have none; plotters' default font-kit text
+//! looks them up). The text is not plotters' own: its `ab_glyph` feature drops each glyph's left
+//! side bearing and rounds the pen to whole pixels, so at 15 px the gap between neighbouring letters
+//! is off by 0.5 px on average and up to 2 px ("im age"); `draw_text` places glyphs exactly.
 
+use ab_glyph::{point, Font, FontRef, ScaleFont};
 use anyhow::{bail, Context, Result};
 use cube5_model::render::{Quality, RenderParams};
 use cube5_model::scene::Scene;
 use cube5_model::studies::tradeoff::{
-    run as run_sweeps, Figure, Progress, Report, Setup, Synth, Table, PAPER_VS_IMAGE_ORDER,
+    run as run_sweeps, Figure, Progress, Report, Series, Setup, Synth, Table, PAPER_VS_IMAGE_ORDER,
     PAPER_VS_TRUE3D,
 };
 use cube5_model::transfer::TransferFunction;
 use cube5_model::volume_io::write_atomically;
-use image::{Rgb, RgbImage};
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+use image::RgbImage;
 use indicatif::{ProgressBar, ProgressStyle};
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint};
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
 #[derive(Debug, clap::Args)]
@@ -181,10 +190,13 @@ pub fn run(args: TradeoffArgs) -> Result<()> {
         let p = img_dir.join(format!("{}.png", f.name));
         let png = draw(f);
         let mut bytes = Vec::new();
-        png.write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
+        // `write_to` compresses fast; the default level makes the anti-aliased plots half as
+        // large (100 -> 54 KB) for about 30 ms a plot.
+        png.write_with_encoder(PngEncoder::new_with_quality(
+            &mut bytes,
+            CompressionType::Default,
+            FilterType::Adaptive,
+        ))
         .context("encoding a plot")?;
         write_atomically(&p, &bytes)?;
         written.push(p);
@@ -567,260 +579,54 @@ fn document(
 }
 
 // =================================================================================================
-// Plotting with `image` and a 5x7 bitmap font
+// Plotting: geometry with `plotters`, text with `ab_glyph` in the embedded DejaVu Sans
 // =================================================================================================
+
+/// DejaVu Sans 2.37 from Debian's fonts-dejavu-core (`cli/assets/fonts/`: its licence and where it
+/// came from).
+static FONT_TTF: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+
+/// The embedded font, parsed once.
+fn font() -> &'static FontRef<'static> {
+    static FONT: OnceLock<FontRef<'static>> = OnceLock::new();
+    FONT.get_or_init(|| FontRef::try_from_slice(FONT_TTF).expect("the embedded DejaVu Sans parses"))
+}
 
 const W: u32 = 900;
 const H: u32 = 540;
-const LEFT: i32 = 90;
-const RIGHT: i32 = 30;
-const TOP: i32 = 50;
-const BOTTOM: i32 = 70;
-const PALETTE: [[u8; 3]; 6] = [
-    [31, 119, 180],
-    [214, 39, 40],
-    [44, 160, 44],
-    [148, 103, 189],
-    [255, 127, 14],
-    [23, 190, 207],
+/// Height of one legend row below the plot (two entries per row).
+const LEGEND_ROW: u32 = 24;
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
 ];
+const INK: RGBColor = RGBColor(40, 40, 40);
+const GRID: RGBColor = RGBColor(225, 225, 225);
+const MARK: RGBColor = RGBColor(110, 110, 110);
+/// Text sizes in pixels (line height, as `ab_glyph`'s `PxScale`).
+const TITLE_PX: f32 = 22.0;
+const LABEL_PX: f32 = 15.0;
+const DESC_PX: f32 = 16.0;
+const MARK_PX: f32 = 14.0;
 
-/// 5x7 glyphs, rows top to bottom, `#` lit. Lower case prints as upper case.
-fn glyph(c: char) -> [&'static str; 7] {
-    match c.to_ascii_uppercase() {
-        '0' => [
-            " ### ", "#   #", "#  ##", "# # #", "##  #", "#   #", " ### ",
-        ],
-        '1' => [
-            "  #  ", " ##  ", "  #  ", "  #  ", "  #  ", "  #  ", " ### ",
-        ],
-        '2' => [
-            " ### ", "#   #", "    #", "   # ", "  #  ", " #   ", "#####",
-        ],
-        '3' => [
-            "#####", "   # ", "  #  ", "   # ", "    #", "#   #", " ### ",
-        ],
-        '4' => [
-            "   # ", "  ## ", " # # ", "#  # ", "#####", "   # ", "   # ",
-        ],
-        '5' => [
-            "#####", "#    ", "#### ", "    #", "    #", "#   #", " ### ",
-        ],
-        '6' => [
-            "  ## ", " #   ", "#    ", "#### ", "#   #", "#   #", " ### ",
-        ],
-        '7' => [
-            "#####", "    #", "   # ", "  #  ", " #   ", " #   ", " #   ",
-        ],
-        '8' => [
-            " ### ", "#   #", "#   #", " ### ", "#   #", "#   #", " ### ",
-        ],
-        '9' => [
-            " ### ", "#   #", "#   #", " ####", "    #", "   # ", " ##  ",
-        ],
-        'A' => [
-            " ### ", "#   #", "#   #", "#####", "#   #", "#   #", "#   #",
-        ],
-        'B' => [
-            "#### ", "#   #", "#   #", "#### ", "#   #", "#   #", "#### ",
-        ],
-        'C' => [
-            " ### ", "#   #", "#    ", "#    ", "#    ", "#   #", " ### ",
-        ],
-        'D' => [
-            "###  ", "#  # ", "#   #", "#   #", "#   #", "#  # ", "###  ",
-        ],
-        'E' => [
-            "#####", "#    ", "#    ", "#### ", "#    ", "#    ", "#####",
-        ],
-        'F' => [
-            "#####", "#    ", "#    ", "#### ", "#    ", "#    ", "#    ",
-        ],
-        'G' => [
-            " ### ", "#   #", "#    ", "# ###", "#   #", "#   #", " ####",
-        ],
-        'H' => [
-            "#   #", "#   #", "#   #", "#####", "#   #", "#   #", "#   #",
-        ],
-        'I' => [
-            " ### ", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ", " ### ",
-        ],
-        'J' => [
-            "  ###", "   # ", "   # ", "   # ", "   # ", "#  # ", " ##  ",
-        ],
-        'K' => [
-            "#   #", "#  # ", "# #  ", "##   ", "# #  ", "#  # ", "#   #",
-        ],
-        'L' => [
-            "#    ", "#    ", "#    ", "#    ", "#    ", "#    ", "#####",
-        ],
-        'M' => [
-            "#   #", "## ##", "# # #", "# # #", "#   #", "#   #", "#   #",
-        ],
-        'N' => [
-            "#   #", "#   #", "##  #", "# # #", "#  ##", "#   #", "#   #",
-        ],
-        'O' => [
-            " ### ", "#   #", "#   #", "#   #", "#   #", "#   #", " ### ",
-        ],
-        'P' => [
-            "#### ", "#   #", "#   #", "#### ", "#    ", "#    ", "#    ",
-        ],
-        'Q' => [
-            " ### ", "#   #", "#   #", "#   #", "# # #", "#  # ", " ## #",
-        ],
-        'R' => [
-            "#### ", "#   #", "#   #", "#### ", "# #  ", "#  # ", "#   #",
-        ],
-        'S' => [
-            " ####", "#    ", "#    ", " ### ", "    #", "    #", "#### ",
-        ],
-        'T' => [
-            "#####", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ", "  #  ",
-        ],
-        'U' => [
-            "#   #", "#   #", "#   #", "#   #", "#   #", "#   #", " ### ",
-        ],
-        'V' => [
-            "#   #", "#   #", "#   #", "#   #", "#   #", " # # ", "  #  ",
-        ],
-        'W' => [
-            "#   #", "#   #", "#   #", "# # #", "# # #", "# # #", " # # ",
-        ],
-        'X' => [
-            "#   #", "#   #", " # # ", "  #  ", " # # ", "#   #", "#   #",
-        ],
-        'Y' => [
-            "#   #", "#   #", " # # ", "  #  ", "  #  ", "  #  ", "  #  ",
-        ],
-        'Z' => [
-            "#####", "    #", "   # ", "  #  ", " #   ", "#    ", "#####",
-        ],
-        '.' => [
-            "     ", "     ", "     ", "     ", "     ", " ##  ", " ##  ",
-        ],
-        ',' => [
-            "     ", "     ", "     ", "     ", " ##  ", "  #  ", " #   ",
-        ],
-        '-' => [
-            "     ", "     ", "     ", "#####", "     ", "     ", "     ",
-        ],
-        '+' => [
-            "     ", "  #  ", "  #  ", "#####", "  #  ", "  #  ", "     ",
-        ],
-        '(' => [
-            "   # ", "  #  ", " #   ", " #   ", " #   ", "  #  ", "   # ",
-        ],
-        ')' => [
-            " #   ", "  #  ", "   # ", "   # ", "   # ", "  #  ", " #   ",
-        ],
-        '%' => [
-            "##   ", "##  #", "   # ", "  #  ", " #   ", "#  ##", "   ##",
-        ],
-        ':' => [
-            "     ", " ##  ", " ##  ", "     ", " ##  ", " ##  ", "     ",
-        ],
-        '/' => [
-            "     ", "    #", "   # ", "  #  ", " #   ", "#    ", "     ",
-        ],
-        '<' => [
-            "   # ", "  #  ", " #   ", "#    ", " #   ", "  #  ", "   # ",
-        ],
-        '>' => [
-            " #   ", "  #  ", "   # ", "    #", "   # ", "  #  ", " #   ",
-        ],
-        '=' => [
-            "     ", "     ", "#####", "     ", "#####", "     ", "     ",
-        ],
-        '^' => [
-            "  #  ", " # # ", "#   #", "     ", "     ", "     ", "     ",
-        ],
-        '_' => [
-            "     ", "     ", "     ", "     ", "     ", "     ", "#####",
-        ],
-        '\'' => [
-            "  #  ", "  #  ", " #   ", "     ", "     ", "     ", "     ",
-        ],
-        ' ' => ["     "; 7],
-        _ => [
-            " ### ", "#   #", "    #", "   # ", "  #  ", "     ", "  #  ",
-        ],
-    }
-}
-
-const SCALE: i32 = 2;
-const ADVANCE: i32 = 6 * SCALE;
-
-fn text_width(t: &str) -> i32 {
-    t.chars().count() as i32 * ADVANCE
-}
-
-fn put(img: &mut RgbImage, x: i32, y: i32, c: [u8; 3]) {
-    if x >= 0 && y >= 0 && (x as u32) < img.width() && (y as u32) < img.height() {
-        img.put_pixel(x as u32, y as u32, Rgb(c));
-    }
-}
-
-/// Draws `t` with its top-left corner at (x, y); `vertical` runs it bottom to top.
-fn text(img: &mut RgbImage, x: i32, y: i32, t: &str, c: [u8; 3], vertical: bool) {
-    for (i, ch) in t.chars().enumerate() {
-        let g = glyph(ch);
-        for (row, line) in g.iter().enumerate() {
-            for (col, b) in line.bytes().enumerate() {
-                if b != b'#' {
-                    continue;
-                }
-                for sy in 0..SCALE {
-                    for sx in 0..SCALE {
-                        let (gx, gy) = (col as i32 * SCALE + sx, row as i32 * SCALE + sy);
-                        let off = i as i32 * ADVANCE;
-                        if vertical {
-                            put(img, x + gy, y - off - gx, c);
-                        } else {
-                            put(img, x + off + gx, y + gy, c);
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-fn line(img: &mut RgbImage, (x0, y0): (i32, i32), (x1, y1): (i32, i32), c: [u8; 3], thick: i32) {
-    let (dx, dy) = ((x1 - x0).abs(), -(y1 - y0).abs());
-    let (sx, sy) = (if x0 < x1 { 1 } else { -1 }, if y0 < y1 { 1 } else { -1 });
-    let (mut x, mut y, mut err) = (x0, y0, dx + dy);
-    loop {
-        for ox in 0..thick {
-            for oy in 0..thick {
-                put(img, x + ox - thick / 2, y + oy - thick / 2, c);
-            }
-        }
-        if x == x1 && y == y1 {
-            break;
-        }
-        let e2 = 2 * err;
-        if e2 >= dy {
-            err += dy;
-            x += sx;
-        }
-        if e2 <= dx {
-            err += dx;
-            y += sy;
-        }
-    }
+/// A 1-2-5 step that cuts [lo, hi] into about six parts.
+fn tick_step(lo: f64, hi: f64) -> f64 {
+    let raw = (hi - lo).max(1e-12) / 6.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag)
 }
 
 /// Tick positions covering [lo, hi] with a 1-2-5 step.
 fn ticks(lo: f64, hi: f64) -> Vec<f64> {
-    let span = (hi - lo).max(1e-12);
-    let raw = span / 6.0;
-    let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * mag)
-        .find(|s| *s >= raw)
-        .unwrap_or(10.0 * mag);
+    let step = tick_step(lo, hi);
     let mut t = (lo / step).ceil() * step;
     let mut out = Vec::new();
     while t <= hi + 1e-9 * step {
@@ -830,172 +636,445 @@ fn ticks(lo: f64, hi: f64) -> Vec<f64> {
     out
 }
 
-fn label(v: f64) -> String {
+/// Ticks of a log2 axis as (position in log2 units, label): whole powers of two (every n-th one
+/// when there are many), or 1-2-5 ticks of the values when the range spans less than two octaves.
+fn log2_ticks(lo: f64, hi: f64) -> Vec<(f64, String)> {
+    let (first, last) = (lo.ceil(), hi.floor());
+    if last - first < 2.0 {
+        let (a, b) = (lo.exp2(), hi.exp2());
+        let step = tick_step(a, b);
+        return ticks(a, b)
+            .into_iter()
+            .filter(|v| *v > 0.0)
+            .map(|v| (v.log2(), label(v, step)))
+            .collect();
+    }
+    let step = ((last - first) / 8.0).ceil();
+    let mut out = Vec::new();
+    let mut t = first;
+    while t <= last {
+        let v = t.exp2();
+        // A power of two prints exactly in its shortest form (0.125, 64).
+        let l = if (1e-3..1e5).contains(&v) {
+            format!("{v}")
+        } else {
+            format!("{v:.1e}")
+        };
+        out.push((t, l));
+        t += step;
+    }
+    out
+}
+
+/// Ticks of a linear axis as (position, label).
+fn linear_ticks(lo: f64, hi: f64) -> Vec<(f64, String)> {
+    let step = tick_step(lo, hi);
+    ticks(lo, hi)
+        .into_iter()
+        .map(|t| (t, label(t, step)))
+        .collect()
+}
+
+/// A tick label: as many decimals as the tick step needs, exponent notation far from 1.
+fn label(v: f64, step: f64) -> String {
     if v == 0.0 {
         return "0".into();
     }
     let a = v.abs();
-    if !(0.01..1000.0).contains(&a) {
-        format!("{v:.1e}")
-    } else if a >= 10.0 {
-        format!("{v:.0}")
-    } else if a >= 1.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.2}")
+    if !(1e-3..1e5).contains(&a) {
+        return format!("{v:.1e}");
+    }
+    let decimals = (-step.abs().log10() - 1e-9).ceil().clamp(0.0, 4.0) as usize;
+    format!("{v:.decimals$}")
+}
+
+/// A linear axis with our own ticks as its grid lines.
+struct Axis {
+    coord: RangedCoordf64,
+    ticks: Vec<f64>,
+}
+
+impl Axis {
+    fn new(range: Range<f64>, ticks: Vec<f64>) -> Self {
+        Self {
+            coord: range.into(),
+            ticks,
+        }
     }
 }
 
-/// Draws a line plot.
+impl Ranged for Axis {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.coord.map(value, limit)
+    }
+
+    /// The ticks as the bold grid lines; no light ones.
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            Vec::new()
+        } else {
+            self.ticks.clone()
+        }
+    }
+
+    fn range(&self) -> Range<f64> {
+        self.coord.range()
+    }
+}
+
+/// Where a text's anchor point sits on it.
+#[derive(Clone, Copy, PartialEq)]
+enum Align {
+    Start,
+    Centre,
+    End,
+}
+
+/// One line of text to draw: anchored at `at` (pixels), horizontal or running bottom to top.
+struct Text {
+    s: String,
+    at: (i32, i32),
+    px: f32,
+    colour: RGBColor,
+    /// Along the text and across it.
+    align: (Align, Align),
+    vertical: bool,
+}
+
+/// The advance width of `s` at `px` (with kerning).
+fn text_width(s: &str, px: f32) -> f32 {
+    let f = font().as_scaled(px);
+    let mut w = 0.0;
+    let mut prev = None;
+    for c in s.chars() {
+        let id = f.glyph_id(c);
+        if let Some(p) = prev {
+            w += f.kern(p, id);
+        }
+        w += f.h_advance(id);
+        prev = Some(id);
+    }
+    w
+}
+
+/// Draws `t` anti-aliased: each glyph outlined at its sub-pixel pen position (advance, kerning,
+/// side bearing), its coverage blended over the image.
+fn draw_text(img: &mut RgbImage, t: &Text) {
+    let f = font().as_scaled(t.px);
+    let width = text_width(&t.s, t.px);
+    // Local frame: x along the text from its start, y down from the top of the line box.
+    let x0 = match t.align.0 {
+        Align::Start => 0.0,
+        Align::Centre => -width / 2.0,
+        Align::End => -width,
+    };
+    // Centre on the capitals' middle rather than the line box's, which looks centred.
+    let cap = f.ascent() * 0.75;
+    let baseline = match t.align.1 {
+        Align::Start => f.ascent(),
+        Align::Centre => cap / 2.0,
+        Align::End => f.descent(),
+    };
+    let (w, h) = (img.width() as i32, img.height() as i32);
+    let colour = [t.colour.0, t.colour.1, t.colour.2];
+    let mut pen = x0;
+    let mut prev = None;
+    for c in t.s.chars() {
+        let id = f.glyph_id(c);
+        if let Some(p) = prev {
+            pen += f.kern(p, id);
+        }
+        prev = Some(id);
+        let glyph = id.with_scale_and_position(t.px, point(pen, baseline));
+        pen += f.h_advance(id);
+        let Some(outline) = f.outline_glyph(glyph) else {
+            continue;
+        };
+        let b = outline.px_bounds();
+        outline.draw(|gx, gy, cover| {
+            let (lx, ly) = (b.min.x as i32 + gx as i32, b.min.y as i32 + gy as i32);
+            let (x, y) = if t.vertical {
+                (t.at.0 + ly, t.at.1 - lx)
+            } else {
+                (t.at.0 + lx, t.at.1 + ly)
+            };
+            if (0..w).contains(&x) && (0..h).contains(&y) {
+                let p = img.get_pixel_mut(x as u32, y as u32);
+                let a = cover.clamp(0.0, 1.0);
+                for (d, s) in p.0.iter_mut().zip(colour) {
+                    *d = (f32::from(*d) * (1.0 - a) + f32::from(s) * a).round() as u8;
+                }
+            }
+        });
+    }
+}
+
+/// The image size [`draw`] makes for `f`: 900 x 540 and one legend row per two series.
+fn size(f: &Figure) -> (u32, u32) {
+    (W, H + f.series.len().div_ceil(2) as u32 * LEGEND_ROW + 6)
+}
+
+/// Draws a line plot: title, axes with grid and tick labels, the series in the palette with point
+/// markers, the marks as dashed horizontal lines labelled at the right, and the legend below.
 pub fn draw(f: &Figure) -> RgbImage {
-    // The legend sits below the plot, two entries per row.
-    let legend_rows = f.series.len().div_ceil(2) as i32;
-    let height = H as i32 + legend_rows * 22 + 6;
-    let mut img = RgbImage::from_pixel(W, height as u32, Rgb([255, 255, 255]));
-    let (px0, px1) = (LEFT, W as i32 - RIGHT);
-    let (py0, py1) = (TOP, H as i32 - BOTTOM);
-    let pts = f.series.iter().flat_map(|s| s.points.iter());
-    let xs: Vec<f64> = pts.clone().map(|p| p.0).filter(|v| v.is_finite()).collect();
-    let ys: Vec<f64> = pts
-        .map(|p| p.1)
-        .chain(f.marks.iter().map(|m| m.0))
-        .filter(|v| v.is_finite())
-        .collect();
-    let (mut x_lo, mut x_hi) = (
-        xs.iter().copied().fold(f64::INFINITY, f64::min),
-        xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-    );
+    let (w, h) = size(f);
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    let texts = plot(f, &mut buf, (w, h)).expect("plotting into a bitmap of the right size");
+    let mut img = RgbImage::from_raw(w, h, buf).expect("the buffer holds w x h RGB pixels");
+    for t in &texts {
+        draw_text(&mut img, t);
+    }
+    img
+}
+
+/// Draws everything but the text with plotters and returns the text to draw over it (the module
+/// comment says why plotters does not draw the text).
+fn plot(f: &Figure, buf: &mut [u8], (w, h): (u32, u32)) -> Result<Vec<Text>> {
+    let root = BitMapBackend::with_buffer(buf, (w, h)).into_drawing_area();
+    let (upper, _) = root.split_vertically(H);
+    let mut texts = Vec::new();
+    let text = |s: &str, at: (i32, i32), px: f32, align: (Align, Align)| Text {
+        s: s.to_string(),
+        at,
+        px,
+        colour: INK,
+        align,
+        vertical: false,
+    };
+
+    // Data ranges; x in log2 units on a log axis (points at x <= 0 cannot be shown there).
+    let fx = |x: f64| if f.log_x { x.log2() } else { x };
+    let points = |s: &Series| -> Vec<(f64, f64)> {
+        s.points
+            .iter()
+            .map(|&(x, y)| (fx(x), y))
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect()
+    };
+    let all: Vec<(f64, f64)> = f.series.iter().flat_map(points).collect();
+    let (mut x_lo, mut x_hi) = all
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.0), hi.max(p.0))
+        });
     if !x_lo.is_finite() {
         (x_lo, x_hi) = (0.0, 1.0);
     }
     if x_hi - x_lo < 1e-12 {
         x_hi = x_lo + 1.0;
     }
-    let y_lo = 0.0f64.min(ys.iter().copied().fold(f64::INFINITY, f64::min));
-    let mut y_hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max) * 1.1;
+    let ys = all
+        .iter()
+        .map(|p| p.1)
+        .chain(f.marks.iter().map(|m| m.0))
+        .filter(|v| v.is_finite());
+    let (y_min, y_max) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+        (lo.min(y), hi.max(y))
+    });
+    let y_lo = 0.0f64.min(y_min);
+    let mut y_hi = y_max * 1.05;
     if !y_hi.is_finite() || y_hi <= y_lo {
         y_hi = y_lo + 1.0;
     }
-    let map_x = |x: f64| px0 + ((x - x_lo) / (x_hi - x_lo) * f64::from(px1 - px0)).round() as i32;
-    let map_y = |y: f64| py1 - ((y - y_lo) / (y_hi - y_lo) * f64::from(py1 - py0)).round() as i32;
-    let grid = [225, 225, 225];
-    let ink = [40, 40, 40];
-    for t in ticks(y_lo, y_hi) {
-        let y = map_y(t);
-        line(&mut img, (px0, y), (px1, y), grid, 1);
-        let l = label(t);
-        text(&mut img, px0 - 8 - text_width(&l), y - 7, &l, ink, false);
+    // The y axis ends on a tick.
+    let y_step = tick_step(y_lo, y_hi);
+    y_hi = (y_hi / y_step - 1e-9).ceil() * y_step;
+    let y_ticks = linear_ticks(y_lo, y_hi);
+    let x_ticks = if f.log_x {
+        log2_ticks(x_lo, x_hi)
+    } else {
+        linear_ticks(x_lo, x_hi)
+    };
+    // A little room left and right so that the end points' markers are not cut.
+    let pad = (x_hi - x_lo) * 0.02;
+    let (x_lo, x_hi) = (x_lo - pad, x_hi + pad);
+
+    let mut chart = ChartBuilder::on(&upper)
+        .margin_top(48)
+        .margin_left(16)
+        .margin_right(30)
+        .margin_bottom(8)
+        .x_label_area_size(56)
+        .y_label_area_size(72)
+        .build_cartesian_2d(
+            Axis::new(x_lo..x_hi, x_ticks.iter().map(|t| t.0).collect()),
+            Axis::new(y_lo..y_hi, y_ticks.iter().map(|t| t.0).collect()),
+        )?;
+    let (px, py) = chart.plotting_area().get_pixel_range();
+    let (left, right, top, bottom) = (px.start, px.end - 1, py.start, py.end - 1);
+
+    // Grid, axes, ticks and their labels.
+    chart
+        .configure_mesh()
+        .bold_line_style(GRID)
+        .light_line_style(TRANSPARENT)
+        .disable_x_axis()
+        .disable_y_axis()
+        .draw()?;
+    for (t, l) in &x_ticks {
+        let (x, _) = chart.backend_coord(&(*t, y_lo));
+        root.draw(&PathElement::new([(x, bottom), (x, bottom + 5)], INK))?;
+        texts.push(text(
+            l,
+            (x, bottom + 9),
+            LABEL_PX,
+            (Align::Centre, Align::Start),
+        ));
     }
-    for t in ticks(x_lo, x_hi) {
-        let x = map_x(t);
-        line(&mut img, (x, py0), (x, py1), grid, 1);
-        let l = label(t);
-        text(&mut img, x - text_width(&l) / 2, py1 + 8, &l, ink, false);
+    for (t, l) in &y_ticks {
+        let (_, y) = chart.backend_coord(&(x_lo, *t));
+        root.draw(&PathElement::new([(left - 5, y), (left, y)], INK))?;
+        texts.push(text(
+            l,
+            (left - 9, y),
+            LABEL_PX,
+            (Align::End, Align::Centre),
+        ));
     }
-    line(&mut img, (px0, py1), (px1, py1), ink, 2);
-    line(&mut img, (px0, py0), (px0, py1), ink, 2);
-    text(
-        &mut img,
-        (W as i32 - text_width(&f.title)) / 2,
-        14,
+    root.draw(&PathElement::new(
+        [(left, top), (left, bottom), (right, bottom)],
+        INK.stroke_width(2),
+    ))?;
+    texts.push(text(
         &f.title,
-        ink,
-        false,
-    );
-    text(
-        &mut img,
-        (px0 + px1 - text_width(&f.x_label)) / 2,
-        H as i32 - 30,
+        (W as i32 / 2, 14),
+        TITLE_PX,
+        (Align::Centre, Align::Start),
+    ));
+    texts.push(text(
         &f.x_label,
-        ink,
-        false,
-    );
-    text(
-        &mut img,
-        12,
-        (py0 + py1 + text_width(&f.y_label)) / 2,
-        &f.y_label,
-        ink,
-        true,
-    );
+        ((left + right) / 2, bottom + 32),
+        DESC_PX,
+        (Align::Centre, Align::Start),
+    ));
+    texts.push(Text {
+        vertical: true,
+        ..text(
+            &f.y_label,
+            (14, (top + bottom) / 2),
+            DESC_PX,
+            (Align::Centre, Align::Start),
+        )
+    });
+
+    // Marks and series; the marks' labels go on a veil over the series so that both show.
+    for (value, _) in &f.marks {
+        chart.draw_series(DashedLineSeries::new(
+            [(x_lo, *value), (x_hi, *value)],
+            8,
+            6,
+            MARK.stroke_width(1),
+        ))?;
+    }
+    for (i, s) in f.series.iter().enumerate() {
+        let c = PALETTE[i % PALETTE.len()];
+        let p = points(s);
+        chart.draw_series(LineSeries::new(p.iter().copied(), c.stroke_width(2)))?;
+        chart.draw_series(p.iter().map(|&q| Circle::new(q, 3, c.filled())))?;
+    }
     for (value, name) in &f.marks {
-        let y = map_y(*value);
-        let mut x = px0;
-        while x < px1 {
-            line(&mut img, (x, y), ((x + 8).min(px1), y), [120, 120, 120], 1);
-            x += 14;
-        }
-        let (tx, ty) = (px1 - text_width(name) - 6, y - 19);
-        for yy in ty - 2..ty + 16 {
-            for xx in tx - 3..tx + text_width(name) + 3 {
-                put(&mut img, xx, yy, [255, 255, 255]);
-            }
-        }
-        text(&mut img, tx, ty, name, [90, 90, 90], false);
+        let (_, y) = chart.backend_coord(&(x_hi, *value));
+        let tw = text_width(name, MARK_PX).ceil() as i32;
+        let (tx, ty) = (right - 6, y - 4);
+        root.draw(&Rectangle::new(
+            [(tx - tw - 3, ty - MARK_PX as i32), (tx + 3, ty + 1)],
+            WHITE.mix(0.85).filled(),
+        ))?;
+        texts.push(Text {
+            colour: MARK,
+            ..text(name, (tx, ty), MARK_PX, (Align::End, Align::End))
+        });
     }
+
+    // Legend below the plot, two entries per row, aligned with the plotting area.
+    let col_w = (right - left) / 2;
     for (i, s) in f.series.iter().enumerate() {
         let c = PALETTE[i % PALETTE.len()];
-        let p: Vec<(i32, i32)> = s
-            .points
-            .iter()
-            .filter(|p| p.0.is_finite() && p.1.is_finite())
-            .map(|&(x, y)| (map_x(x), map_y(y)))
-            .collect();
-        for w in p.windows(2) {
-            line(&mut img, w[0], w[1], c, 2);
-        }
-        for &(x, y) in &p {
-            for ox in -3..=3 {
-                for oy in -3..=3 {
-                    put(&mut img, x + ox, y + oy, c);
-                }
-            }
-        }
+        let lx = left + (i as i32 % 2) * col_w;
+        let ly = H as i32 + (i as i32 / 2) * LEGEND_ROW as i32 + LEGEND_ROW as i32 / 2;
+        root.draw(&PathElement::new(
+            [(lx, ly), (lx + 28, ly)],
+            c.stroke_width(3),
+        ))?;
+        root.draw(&Circle::new((lx + 14, ly), 3, c.filled()))?;
+        texts.push(text(
+            &s.name,
+            (lx + 38, ly),
+            LABEL_PX,
+            (Align::Start, Align::Centre),
+        ));
     }
-    // Legend, below the x label.
-    let col_w = (px1 - px0) / 2;
-    for (i, s) in f.series.iter().enumerate() {
-        let c = PALETTE[i % PALETTE.len()];
-        let (lx, ly) = (
-            px0 + (i as i32 % 2) * col_w,
-            H as i32 - 2 + (i as i32 / 2) * 22,
-        );
-        line(&mut img, (lx, ly + 7), (lx + 28, ly + 7), c, 3);
-        text(&mut img, lx + 36, ly, &s.name, ink, false);
-    }
-    img
+    root.present()?;
+    Ok(texts)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cube5_model::studies::tradeoff::Series;
 
     #[test]
     fn ticks_cover_the_range() {
         let t = ticks(0.0, 93.0);
         assert_eq!(t.first(), Some(&0.0));
         assert!(*t.last().unwrap() >= 80.0 && t.len() <= 12);
-        assert_eq!(label(0.25), "0.25");
-        assert_eq!(label(45.0), "45");
+        assert_eq!(label(0.25, 0.05), "0.25");
+        assert_eq!(label(45.0, 5.0), "45");
+        assert_eq!(label(1.5, 0.5), "1.5");
+        assert_eq!(label(5.0, 5.0), "5");
+        assert_eq!(label(0.004, 0.001), "0.004");
+        let pos = |t: Vec<(f64, String)>| t.into_iter().map(|t| t.0).collect::<Vec<_>>();
+        assert_eq!(pos(log2_ticks(1.0, 10.0)), vec![1.0, 3.0, 5.0, 7.0, 9.0]);
+        assert_eq!(pos(log2_ticks(2.0, 6.5)), vec![2.0, 3.0, 4.0, 5.0, 6.0]);
+        let labels: Vec<String> = log2_ticks(-3.0, 0.5).into_iter().map(|t| t.1).collect();
+        assert_eq!(labels, ["0.125", "0.25", "0.5", "1"]);
+        // Less than two octaves: 1-2-5 ticks of the values.
+        let labels: Vec<String> = log2_ticks(-1.0, 0.0).into_iter().map(|t| t.1).collect();
+        assert_eq!(labels, ["0.5", "0.6", "0.7", "0.8", "0.9", "1.0"]);
+    }
+
+    fn figure(title: &str, series: usize, log_x: bool) -> Figure {
+        Figure {
+            name: "t".into(),
+            title: title.into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            series: (0..series)
+                .map(|i| Series {
+                    name: format!("series {i}"),
+                    points: vec![(1.0, 1.0 + i as f64), (64.0, 2.0 + i as f64)],
+                })
+                .collect(),
+            marks: vec![(1.5, "mark".into())],
+            log_x,
+        }
+    }
+
+    /// Pixels in the title's band (above the plotting area) that are not white, and of those the
+    /// grey ones that only anti-aliased text makes.
+    fn title_ink(img: &RgbImage) -> (usize, usize) {
+        let band = (250..650).flat_map(|x| (8..44).map(move |y| (x, y)));
+        let px: Vec<[u8; 3]> = band.map(|(x, y)| img.get_pixel(x, y).0).collect();
+        let inked = px.iter().filter(|p| **p != [255; 3]).count();
+        let grey = px.iter().filter(|p| p[0] > 60 && p[0] < 200).count();
+        (inked, grey)
     }
 
     #[test]
-    fn plot_draws_ink() {
-        let f = Figure {
-            name: "t".into(),
-            title: "Title (%)".into(),
-            x_label: "x".into(),
-            y_label: "y".into(),
-            series: vec![Series {
-                name: "a".into(),
-                points: vec![(0.0, 1.0), (1.0, 2.0)],
-            }],
-            marks: vec![(1.5, "mark".into())],
-            log_x: false,
-        };
-        let img = draw(&f);
-        let dark = img.pixels().filter(|p| p.0[0] < 100).count();
-        assert!(dark > 500, "{dark}");
+    fn draw_makes_the_size_and_writes_the_title_in_the_embedded_font() {
+        for (series, log_x, h) in [(1, false, 570), (3, true, 594), (6, false, 618)] {
+            let img = draw(&figure("Error vs samples (%)", series, log_x));
+            assert_eq!(img.dimensions(), (900, h), "{series} series");
+            let (inked, grey) = title_ink(&img);
+            assert!(
+                inked > 400 && grey > 100,
+                "title: {inked} inked, {grey} grey pixels"
+            );
+            let plot = img.pixels().filter(|p| p.0 == [31, 119, 180]).count();
+            assert!(plot > 500, "the first series is drawn: {plot} pixels");
+        }
+        assert_eq!(title_ink(&draw(&figure("", 2, false))), (0, 0), "no title");
     }
 }

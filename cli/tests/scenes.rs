@@ -423,6 +423,16 @@ fn tradeoff_tiny_sweep_end_to_end() {
     );
     let csv = std::fs::read_to_string(dir.join("tradeoff-interpolation.csv")).unwrap();
     assert!(csv.lines().count() == 4, "{csv}");
-    let png = image::open(dir.join("tradeoff-gradient.png")).unwrap();
-    assert!(png.width() >= 800);
+    // 900 x 540 and a legend row per two series; the title in anti-aliased text (grey edge
+    // pixels), which needs the embedded font.
+    let png = image::open(dir.join("tradeoff-gradient.png"))
+        .unwrap()
+        .to_rgb8();
+    assert_eq!(png.dimensions(), (900, 540 + 2 * 24 + 6));
+    let title: Vec<[u8; 3]> = (250..650)
+        .flat_map(|x| (8..44).map(move |y| (x, y)))
+        .map(|(x, y)| png.get_pixel(x, y).0)
+        .collect();
+    let grey = title.iter().filter(|p| p[0] > 60 && p[0] < 200).count();
+    assert!(grey > 100, "no anti-aliased title text: {grey} grey pixels");
 }
