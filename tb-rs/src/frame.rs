@@ -461,9 +461,8 @@ pub fn sparse_scene(seed: u64) -> Volume {
 /// 0 (docs/numerics/skewmem.md).
 pub use cube5_model::scene_render::seen_through as as_seen;
 
-/// The base-plane image from the unit models along each ray (`cube5_frame::fold_rays`), for the widths
-/// and registers `FrameUnits` does not build (narrow widths, early termination); checked against
-/// `cube5_frame::render_base_plane` where both apply.
+/// The base-plane image from the unit models along each ray (`cube5_frame::fold_rays`): the test
+/// bench's own fold, a cross-check of `cube5_frame::render_base_plane` (tests/cube5_frame.rs).
 pub fn model_image(
     params: &FrameParams,
     vol: &Volume,
@@ -525,27 +524,26 @@ impl Expected {
         // that the dimensions are multiples of P does).
         let setup = FrameSetup::new(seen.dims, seen.spacing, dir.into(), 1)?;
         let params = setup.params;
-        let ratio = setup
-            .opacity_ratio
-            .clamp(OpacityLut::RATIO_MIN, OpacityLut::RATIO_MAX);
-        let (units, w, h, want) = if rtl.default_widths() && !look.early_termination {
-            // The model's own base plane (cube5_model::units::cube5_frame::render_base_plane).
-            let fu = FrameUnits::new(render.mode(), &setup, &look.tf, &look.phong)?;
-            let bp = cube5_frame::render_base_plane(&params, seen, &fu);
-            let units = Units {
-                trilin: fu.trilin,
-                gradient: fu.gradient,
-                shader: fu.shader,
-                compos: fu.compos,
-                render,
-                tf2d: false,
-            };
-            (units, bp.width, bp.height, bp.coxels)
-        } else {
-            let units = Units::new(rtl, render, ratio, look)?;
-            let (w, h, want) = model_image(&params, seen, &units);
-            (units, w, h, want)
+        // The model's own base plane at the variant's widths
+        // (cube5_model::units::cube5_frame::render_base_plane): what `cube5 render` computes.
+        let fu = FrameUnits::with_config(
+            &rtl.cfg,
+            render.mode(),
+            &setup,
+            &look.tf,
+            &look.phong,
+            look.early_termination.then_some(cube5_frame::ET_DEFAULT),
+        )?;
+        let bp = cube5_frame::render_base_plane(&params, seen, &fu);
+        let units = Units {
+            trilin: fu.trilin,
+            gradient: fu.gradient,
+            shader: fu.shader,
+            compos: fu.compos,
+            render,
+            tf2d: false,
         };
+        let (w, h, want) = (bp.width, bp.height, bp.coxels);
         Ok(Expected {
             seen: seen.clone(),
             view: view.to_string(),

@@ -5,10 +5,9 @@
 mod support;
 
 use cube5_model::phantom::head_phantom;
-use cube5_model::transfer::TransferFunction;
+use cube5_model::transfer::{TfPoint, TransferFunction};
 use cube5_model::units::cube5_compos::Coxel;
 use cube5_model::units::cube5_frame::{self, FrameMode, FrameParams, FrameSetup, FrameUnits};
-use cube5_model::units::cube5_shader::Phong;
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
 use cube5_tb::frame::*;
@@ -109,8 +108,22 @@ fn expect(
     render: Render,
     et: bool,
 ) -> Expected {
+    // With early termination, tissue made nearly opaque: rays must reach the threshold.
     let look = Look {
         early_termination: et,
+        tf: if et {
+            let p = |density, rgba| TfPoint { density, rgba };
+            TransferFunction {
+                points: vec![
+                    p(0.0, [0.0; 4]),
+                    p(0.15, [0.9, 0.7, 0.6, 0.0]),
+                    p(0.3, [0.9, 0.7, 0.6, 0.6]),
+                    p(1.0, [1.0, 1.0, 1.0, 0.9]),
+                ],
+            }
+        } else {
+            TransferFunction::head_default()
+        },
         ..Look::default()
     };
     Expected::new(rtl, seen, view.0, view.1, render, &look).unwrap()
@@ -629,22 +642,37 @@ fn test_side_fold_agrees_with_the_model_base_plane() {
         (Render::Mip, FrameMode::Mip),
         (Render::Composite, FrameMode::Composite),
     ] {
-        for v in [views()[6], views()[11], views()[13]] {
+        for (v, et) in [
+            (views()[6], false),
+            (views()[11], false),
+            (views()[13], false),
+            (views()[6], true),
+            (views()[13], true),
+        ] {
             let setup = FrameSetup::new(vol.dims, vol.spacing, v.1.into(), 1).unwrap();
             let p = setup.params;
-            let fu = FrameUnits::new(
+            let look = Look {
+                early_termination: et,
+                ..Look::default()
+            };
+            let fu = FrameUnits::with_config(
+                &self::p(1).cfg,
                 mode,
                 &setup,
-                &TransferFunction::head_default(),
-                &Phong::two_lights(),
+                &look.tf,
+                &look.phong,
+                et.then_some(cube5_frame::ET_DEFAULT),
             )
             .unwrap();
             let bp = cube5_frame::render_base_plane(&p, &vol, &fu);
-            let units =
-                Units::new(&self::p(1), render, setup.opacity_ratio, &Look::default()).unwrap();
+            let units = Units::new(&self::p(1), render, setup.opacity_ratio, &look).unwrap();
             let (w, h, mine) = model_image(&p, &vol, &units);
             assert_eq!((w, h), (bp.width, bp.height));
-            assert!(mine == bp.coxels, "{render:?} {}: images differ", v.0);
+            assert!(
+                mine == bp.coxels,
+                "{render:?} {} et {et}: images differ",
+                v.0
+            );
         }
     }
 }
