@@ -1,0 +1,24 @@
+//! The default scene a user first renders: the frame model (the hardware's bits, warped) within
+//! 40 dB of the f64 reference (issue 13's goal; docs/scenes.md). At 192 x 192 pixels: the PSNR does
+//! not depend on the image size (docs/measurements.md), the reference's cost does.
+
+use cube5_model::render::render_reference;
+use cube5_model::scene::Scene;
+use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
+use cube5_model::studies::tradeoff::image_error;
+
+#[test]
+fn the_default_scene_is_a_frame_within_40_db_of_the_reference() {
+    let mut scene = Scene::default();
+    (scene.image.width, scene.image.height) = (192, 192);
+    assert!(not_expressible(&scene).is_empty());
+    let vol = scene.build_volume().unwrap();
+    let job = FrameJob::new(&scene, &vol, frame_config(&scene).unwrap(), 1).unwrap();
+    let run = job.render();
+    let img = job.image(&scene, &run.base);
+    let reference =
+        render_reference(&vol, &scene.transfer_function(), &scene.render_params()).unwrap();
+    let e = image_error(&img, &reference);
+    eprintln!("default scene at 192 x 192: PSNR {:.2} dB", e.psnr_db);
+    assert!(e.psnr_db >= 40.0, "PSNR {:.2} dB", e.psnr_db);
+}
