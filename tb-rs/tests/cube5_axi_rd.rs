@@ -394,8 +394,41 @@ fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
             let s = seed(100 + 10 * i as u64 + k);
             let case = random_case(cfg, s, 300);
             let r = must(variant, cfg, s, &case);
-            assert!(r.beats > 1000, "{variant}: the case reads enough beats");
-            assert_eq!(r.rready_low, 0, "{variant}: RREADY never holds the bus");
+            assert!(
+                r.beats > 1000,
+                "{variant}: the case reads enough beats (seed {s})"
+            );
+            assert_eq!(
+                r.rready_low, 0,
+                "{variant}: RREADY never holds the bus (seed {s})"
+            );
+        }
+    }
+}
+
+/// The acceptance figure (docs/adding-a-unit.md): at least 1,000,000 random beats per
+/// configuration, in cases of 2,000 commands each with its own latency, gaps, bandwidth and
+/// back-pressure, the third of them reset in mid-stream.
+#[test]
+fn a_million_random_beats_per_config() {
+    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
+        let mut beats = 0u64;
+        let mut k = 0u64;
+        while beats < 1_000_000 {
+            let s = seed(600 + 100 * i as u64 + k);
+            let mut case = random_case(cfg, s, 2000);
+            if k == 2 {
+                let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+                let after = random_cmds(cfg, &case.mem, 2000, &mut rng);
+                case.reset = Some((rng.random_range(1000..100_000), after));
+            }
+            let r = must(variant, cfg, s, &case);
+            assert_eq!(
+                r.rready_low, 0,
+                "{variant}: RREADY never holds the bus (seed {s})"
+            );
+            beats += r.beats;
+            k += 1;
         }
     }
 }
@@ -620,10 +653,10 @@ fn gate_level_netlist_smoke() {
     }
 }
 
-/// The check bites: a model whose image differs in one byte disagrees on the beat holding it, and
-/// the report names the command and beat.
+/// The checks bite: a model whose image differs in one byte disagrees on the beat holding it (the
+/// report names the command and beat), and one that splits differently disagrees on AR.
 #[test]
-fn the_comparison_sees_a_wrong_beat_and_names_its_command() {
+fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
     let (variant, cfg) = configs::<AxiRdConfig>()[0];
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let mem = random_image(cfg, &mut rng);
@@ -663,4 +696,32 @@ fn the_comparison_sees_a_wrong_beat_and_names_its_command() {
     // The AR of a 4 KB crossing is two bursts: one beat to the boundary, two after it.
     let (_, bursts) = cfg.expected(&cmds, &mem);
     assert_eq!(bursts.len(), 2);
+
+    // A model that splits at half the RTL's MaxBurst disagrees on the first AR burst.
+    let half = AxiRdConfig {
+        max_burst: cfg.max_burst / 2,
+        ..cfg
+    };
+    let long = vec![AxiRdCmd {
+        addr: mem.base,
+        len: cfg.max_burst,
+    }];
+    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
+    dut.axi_setup(&case.setup).unwrap();
+    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
+    let err = drive_and_compare(
+        &mut dut,
+        variant,
+        half,
+        1,
+        &long,
+        &mem,
+        &case.traffic,
+        None,
+        &mut Report::default(),
+    )
+    .unwrap_err();
+    let m = err.mismatch().expect("a mismatch");
+    assert!(m.what.starts_with("AR burst differs"), "{err}");
+    assert_eq!(m.item, 0);
 }
