@@ -8,8 +8,8 @@
 // consumer never stalls the bus. The FIFO is one write port and one registered read port with no
 // reset on the array, so synth_ecp5 maps it to block RAM (DP16KD).
 //
-//   command ─► splitter (cur_addr, remaining) ─► AR register ─► AR channel
-//                 │ last-of-command flag per burst ─► info FIFO (Outstanding) ─┐
+//   command ─► splitter (cur_addr, remaining) ─► plan register ─► AR register ─► AR channel
+//                                     last-of-command flag per burst ─► info FIFO (Outstanding) ─┐
 //   R channel (RREADY = 1) ─► {resp, last, data} ─► return FIFO (RAM) ─► read register ─► out
 module cube5_axi_rd #(
   /// Byte address width of the AXI port (>= 13).
@@ -18,7 +18,7 @@ module cube5_axi_rd #(
   parameter int unsigned DataW = 64,
   /// Bits of a command's length in beats.
   parameter int unsigned LenW = 16,
-  /// Longest burst in beats: a power of two, 1 .. 256, and MaxBurst * DataW / 8 <= 4096.
+  /// Longest burst in beats: a power of two, 2 .. 256, and MaxBurst * DataW / 8 <= 4096.
   parameter int unsigned MaxBurst = 16,
   /// Bursts in flight at most: a power of two >= 2.
   parameter int unsigned Outstanding = 4,
@@ -95,9 +95,9 @@ module cube5_axi_rd #(
   if (DataW < 8 || DataW > 1024 || (1 << $clog2(DataW)) != DataW) begin : gen_bad_data_w
     $fatal(1, "cube5_axi_rd: DataW must be a power of two in 8..1024");
   end
-  if (MaxBurst < 1 || MaxBurst > 256 || (1 << $clog2(MaxBurst)) != MaxBurst
+  if (MaxBurst < 2 || MaxBurst > 256 || (1 << $clog2(MaxBurst)) != MaxBurst
       || MaxBurst > BeatsPer4k) begin : gen_bad_max_burst
-    $fatal(1, "cube5_axi_rd: MaxBurst must be a power of two in 1..256 with MaxBurst * DataW/8 <= 4096");
+    $fatal(1, "cube5_axi_rd: MaxBurst must be a power of two in 2..256 with MaxBurst * DataW/8 <= 4096");
   end
   if (Outstanding < 2 || (1 << $clog2(Outstanding)) != Outstanding) begin : gen_bad_outstanding
     $fatal(1, "cube5_axi_rd: Outstanding must be a power of two >= 2");
@@ -110,8 +110,15 @@ module cube5_axi_rd #(
   end
 
   // ==============================================================================================
-  // Command splitter and AR register
+  // Command splitter, burst plan register and AR register
   // ==============================================================================================
+  //
+  // Two stages, so the burst-length arithmetic and the credit check are not one path: the
+  // splitter plans the next burst of the current command into the plan register; the plan is
+  // issued (loaded into the AR register) when its beats fit the credits.
+
+  localparam int unsigned MbW    = $clog2(MaxBurst);  // low address bits inside a MaxBurst span
+  localparam int unsigned BurstW = MbW + 1;           // 1 .. MaxBurst
 
   logic             in_fire;
   logic [AddrW-1:0] in_addr;
@@ -123,6 +130,11 @@ module cube5_axi_rd #(
   logic [AddrW-1:0] cur_addr_q, cur_addr_d;
   logic [LenW-1:0]  rem_q, rem_d;
 
+  logic              plan_valid_q, plan_valid_d;
+  logic [AddrW-1:0]  plan_addr_q, plan_addr_d;
+  logic [BurstW-1:0] plan_len_q, plan_len_d;
+  logic              plan_last_q, plan_last_d;
+
   logic [AddrW-1:0] araddr_q, araddr_d;
   logic [7:0]       arlen_q, arlen_d;
   logic             arvalid_q, arvalid_d;
@@ -130,39 +142,61 @@ module cube5_axi_rd #(
   logic [CntW-1:0]  credit_q, credit_d;  // return-FIFO slots not reserved by a burst
   logic [OCntW-1:0] bursts_q, bursts_d;  // bursts issued whose RLAST has not arrived
 
-  // Beats to the next 4 KB boundary (1 .. BeatsPer4k), the burst cap, and this burst's length.
-  logic [CmpW-1:0] to_4k, cap, rem_ext, blen;
+  // This burst's cap: MaxBurst, or the beats to the 4 KB boundary when that is nearer, i.e. when
+  // the address lies in the last MaxBurst-beat span below the boundary but not at its start.
+  // blen = min(remaining, cap).
+  logic [BurstW-1:0] cap, blen;
+  logic [MbW-1:0]    span_off;   // beat offset inside the MaxBurst span
+  logic              last_span;  // the span ends at the 4 KB boundary
+  logic              rem_small;
+  assign span_off = cur_addr_q[SizeW+MbW-1:SizeW];
+  if (SizeW + MbW < 12) begin : gen_last_span
+    assign last_span = (cur_addr_q[11:SizeW+MbW] == '1);
+  end else begin : gen_one_span
+    assign last_span = 1'b1;  // MaxBurst beats are 4 KB: every span ends at a boundary
+  end
   always_comb begin
-    to_4k   = CmpW'(BeatsPer4k) - CmpW'(cur_addr_q[11:SizeW]);
-    cap     = (to_4k < CmpW'(MaxBurst)) ? to_4k : CmpW'(MaxBurst);
-    rem_ext = CmpW'(rem_q);
-    blen    = (rem_ext < cap) ? rem_ext : cap;
+    cap = BurstW'(MaxBurst);
+    if (last_span && span_off != '0) cap = BurstW'(MaxBurst) - BurstW'(span_off);
+    rem_small = (CmpW'(rem_q) < CmpW'(cap));
+    blen      = rem_small ? BurstW'(rem_q) : cap;
   end
 
-  logic ar_free, issue, issue_last;
-  assign ar_free    = !arvalid_q || m_axi_arready_i;
-  assign issue      = active_q && ar_free && (CmpW'(credit_q) >= blen)
-                      && (bursts_q < OCntW'(Outstanding));
-  assign issue_last = issue && (rem_ext == blen);
+  logic ar_free, issue, plan_fill, plan_fill_last;
+  assign ar_free        = !arvalid_q || m_axi_arready_i;
+  assign issue          = plan_valid_q && ar_free && (credit_q >= CntW'(plan_len_q))
+                          && (bursts_q < OCntW'(Outstanding));
+  assign plan_fill      = active_q && (!plan_valid_q || issue);
+  assign plan_fill_last = plan_fill && (CmpW'(rem_q) == CmpW'(blen));
 
-  // A new command is taken when the splitter is idle or hands out its last burst this cycle.
-  assign in_ready_o = !active_q || issue_last;
+  // A new command is taken when the splitter is idle or plans its last burst this cycle.
+  assign in_ready_o = !active_q || plan_fill_last;
   assign in_fire    = in_valid_i && in_ready_o;
 
   always_comb begin
-    active_d   = active_q;
-    cur_addr_d = cur_addr_q;
-    rem_d      = rem_q;
-    araddr_d   = araddr_q;
-    arlen_d    = arlen_q;
-    arvalid_d  = arvalid_q && !m_axi_arready_i;
+    active_d     = active_q;
+    cur_addr_d   = cur_addr_q;
+    rem_d        = rem_q;
+    plan_valid_d = plan_valid_q && !issue;
+    plan_addr_d  = plan_addr_q;
+    plan_len_d   = plan_len_q;
+    plan_last_d  = plan_last_q;
+    araddr_d     = araddr_q;
+    arlen_d      = arlen_q;
+    arvalid_d    = arvalid_q && !m_axi_arready_i;
     if (issue) begin
-      araddr_d   = cur_addr_q;
-      arlen_d    = 8'(blen - CmpW'(1));
-      arvalid_d  = 1'b1;
-      cur_addr_d = cur_addr_q + (AddrW'(blen) << SizeW);
-      rem_d      = rem_q - LenW'(blen);
-      if (issue_last) active_d = 1'b0;
+      araddr_d  = plan_addr_q;
+      arlen_d   = 8'(plan_len_q) - 8'd1;  // MaxBurst = 256 wraps to 255 as it should
+      arvalid_d = 1'b1;
+    end
+    if (plan_fill) begin
+      plan_valid_d = 1'b1;
+      plan_addr_d  = cur_addr_q;
+      plan_len_d   = blen;
+      plan_last_d  = plan_fill_last;
+      cur_addr_d   = cur_addr_q + (AddrW'(blen) << SizeW);
+      rem_d        = rem_q - LenW'(blen);
+      if (plan_fill_last) active_d = 1'b0;
     end
     if (in_fire) begin
       active_d   = (in_len != '0);
@@ -173,20 +207,25 @@ module cube5_axi_rd #(
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
-      active_q  <= 1'b0;
-      arvalid_q <= 1'b0;
+      active_q     <= 1'b0;
+      plan_valid_q <= 1'b0;
+      arvalid_q    <= 1'b0;
     end else begin
-      active_q  <= active_d;
-      arvalid_q <= arvalid_d;
+      active_q     <= active_d;
+      plan_valid_q <= plan_valid_d;
+      arvalid_q    <= arvalid_d;
     end
   end
 
-  // Datapath: no reset (qualified by active_q / arvalid_q).
+  // Datapath: no reset (qualified by active_q / plan_valid_q / arvalid_q).
   always_ff @(posedge clk_i) begin
-    cur_addr_q <= cur_addr_d;
-    rem_q      <= rem_d;
-    araddr_q   <= araddr_d;
-    arlen_q    <= arlen_d;
+    cur_addr_q  <= cur_addr_d;
+    rem_q       <= rem_d;
+    plan_addr_q <= plan_addr_d;
+    plan_len_q  <= plan_len_d;
+    plan_last_q <= plan_last_d;
+    araddr_q    <= araddr_d;
+    arlen_q     <= arlen_d;
   end
 
   assign m_axi_araddr_o  = araddr_q;
@@ -213,7 +252,7 @@ module cube5_axi_rd #(
     info_wr_d = info_wr_q;
     info_rd_d = info_rd_q;
     if (issue) begin
-      info_d[info_wr_q] = issue_last;
+      info_d[info_wr_q] = plan_last_q;
       info_wr_d = info_wr_q + OPtrW'(1);
     end
     if (r_end) info_rd_d = info_rd_q + OPtrW'(1);
@@ -253,7 +292,7 @@ module cube5_axi_rd #(
     rd_ptr_d    = ren ? rd_ptr_q + PtrW'(1) : rd_ptr_q;
     count_d     = count_q + CntW'(r_fire) - CntW'(ren);
     out_valid_d = ren || (out_valid_q && !out_ready_i);
-    credit_d    = credit_q + CntW'(ren) - (issue ? CntW'(blen) : CntW'(0));
+    credit_d    = credit_q + CntW'(ren) - (issue ? CntW'(plan_len_q) : CntW'(0));
     bursts_d    = bursts_q + OCntW'(issue) - OCntW'(r_end);
     err_d       = err_q || (r_fire && m_axi_rresp_i != 2'b00);
   end

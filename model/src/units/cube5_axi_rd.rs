@@ -21,7 +21,7 @@ pub struct AxiRdConfig {
     pub data_w: u32,
     /// Bits of a command's length in beats (1..=32).
     pub len_w: u32,
-    /// Longest burst in beats (a power of two, 1..=256, at most 4 KB).
+    /// Longest burst in beats (a power of two, 2..=256, at most 4 KB).
     pub max_burst: u32,
     /// Bursts in flight at most (a power of two >= 2).
     pub outstanding: u32,
@@ -48,12 +48,12 @@ impl AxiRdConfig {
                 self.data_w
             ));
         }
-        if !(1..=256).contains(&self.max_burst)
+        if !(2..=256).contains(&self.max_burst)
             || !self.max_burst.is_power_of_two()
             || self.max_burst * self.bytes() > 4096
         {
             return bad(format!(
-                "MaxBurst {} is not a power of two in 1..=256 with MaxBurst * DataW/8 <= 4096",
+                "MaxBurst {} is not a power of two in 2..=256 with MaxBurst * DataW/8 <= 4096",
                 self.max_burst
             ));
         }
@@ -414,6 +414,7 @@ mod tests {
                 ..C
             },
             AxiRdConfig { addr_w: 12, ..C },
+            AxiRdConfig { max_burst: 1, ..C },
         ] {
             assert!(bad.validate().is_err(), "{bad:?}");
         }
