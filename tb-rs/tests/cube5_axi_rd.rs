@@ -548,6 +548,7 @@ fn directed_extremes() {
 #[test]
 fn reset_in_mid_stream_leaves_nothing_outstanding_and_the_next_commands_are_exact() {
     for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
+        let mut dropped = 0;
         for k in 0..3 {
             let s = seed(400 + 10 * i as u64 + k);
             let mut case = random_case(cfg, s, 100);
@@ -557,7 +558,12 @@ fn reset_in_mid_stream_leaves_nothing_outstanding_and_the_next_commands_are_exac
             case.reset = Some((rng.random_range(30..3000), after));
             let r = must(variant, cfg, s, &case);
             assert!(r.beats > 0);
+            dropped += r.dropped_at_reset;
         }
+        assert!(
+            dropped > 0,
+            "{variant}: some reset landed with bursts in flight"
+        );
     }
 }
 
