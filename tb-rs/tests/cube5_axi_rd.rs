@@ -731,3 +731,51 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
     assert!(m.what.starts_with("AR burst differs"), "{err}");
     assert_eq!(m.item, 0);
 }
+
+/// The subordinate's protocol checker bites, and its report reaches the test: told the bus is
+/// twice as wide as it is, it refuses the unit's ARSIZE; told the address space is 8 KB, it
+/// refuses a burst above it. Both fail as protocol errors naming the rule and the seed.
+#[test]
+fn the_axi_checker_reports_a_violation() {
+    let (variant, cfg) = configs::<AxiRdConfig>()[0];
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mem = random_image(cfg, &mut rng);
+    let good = mem_setup(cfg, &mem, (10, 0), (200, 0), (0, 1), 1);
+    let cmds = vec![AxiRdCmd {
+        addr: mem.base + 0x3000,
+        len: 4,
+    }];
+    for (setup, rule) in [
+        (
+            AxiMemSetup {
+                data_bytes: 2 * cfg.bytes(),
+                ..good
+            },
+            "ARSIZE",
+        ),
+        (
+            AxiMemSetup {
+                addr_bits: 13,
+                ..good
+            },
+            "past the address space",
+        ),
+    ] {
+        let case = Case {
+            setup,
+            traffic: Traffic::full_speed(),
+            cmds: cmds.clone(),
+            mem: mem.clone(),
+            reset: None,
+        };
+        match check(variant, cfg, 77, &case) {
+            Err(e @ TbError::Protocol { .. }) => {
+                let text = e.to_string();
+                assert!(text.contains(rule), "{text}");
+                assert!(text.contains("CUBE5_SEED=77"), "{text}");
+            }
+            Err(e) => panic!("{variant}: expected a protocol error about {rule}, got {e}"),
+            Ok(r) => panic!("{variant}: the checker let it pass ({r:?})"),
+        }
+    }
+}
