@@ -244,6 +244,8 @@ fn main() {
     for f in [
         "dut_core.h",
         "stream_shim.h",
+        "axi_mem.h",
+        "axi_shim.h",
         "stream_dut.h",
         "stream_dut.cpp",
     ] {
@@ -285,6 +287,12 @@ fn main() {
         .map(|f| fs::read_to_string(tb.join(f)).unwrap())
         .collect();
     let vlt_text = fs::read_to_string(&vlt).unwrap();
+    // Tops with an AXI port are wrapped in AxiShim: its headers enter their stamps only, so the
+    // other tops' cached objects stay valid.
+    let axi_text: String = ["axi_mem.h", "axi_shim.h"]
+        .iter()
+        .map(|f| fs::read_to_string(tb.join(f)).unwrap())
+        .collect();
 
     // Runtime objects, shared by every variant.
     let runtime = build_runtime(&cache, &vl_include, &verilator_version);
@@ -313,10 +321,17 @@ fn main() {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(v) = selected.get(i) else { break };
+                let axi: &str = if has_axi_port(v) { &axi_text } else { "" };
                 let stamp = variant_stamp(
                     v,
                     &repo,
-                    &[&verilator_version, &yosys_version, &shim_text, &vlt_text],
+                    &[
+                        &verilator_version,
+                        &yosys_version,
+                        &shim_text,
+                        &vlt_text,
+                        axi,
+                    ],
                 );
                 match build_variant(v, &cache, &tb, &vl_include, &vlt, &stamp) {
                     Ok(b) => built.lock().unwrap().push(b),
@@ -570,9 +585,14 @@ fn compile_variant(
     for c in &cpps {
         unity.push_str(&format!("#include \"{c}\"\n"));
     }
+    let (header, shim) = if has_axi_port(v) {
+        ("axi_shim.h", "AxiShim")
+    } else {
+        ("stream_shim.h", "StreamShim")
+    };
     unity.push_str(&format!(
-        "#include \"stream_shim.h\"\nnamespace cube5 {{\nDutCore* make_{name}(uint32_t seed) {{\n  \
-         return new StreamShim<{prefix}>(seed, PortWidths{{{in_bits}, {out_bits}}});\n}}\n}}\n",
+        "#include \"{header}\"\nnamespace cube5 {{\nDutCore* make_{name}(uint32_t seed) {{\n  \
+         return new {shim}<{prefix}>(seed, PortWidths{{{in_bits}, {out_bits}}});\n}}\n}}\n",
         name = v.full_name
     ));
     let unity_path = dir.join("unity.cpp");
@@ -599,6 +619,16 @@ fn compile_variant(
     )?;
     fs::write(dir.join("stamp"), stamp).map_err(|e| e.to_string())?;
     Ok(())
+}
+
+/// Whether the top has an AXI4 read manager port (`m_axi_arvalid_o` in its own file): such tops
+/// run in `AxiShim` (tb/axi_shim.h) with the AXI memory subordinate in the clock loop.
+fn has_axi_port(v: &Variant) -> bool {
+    let own = format!("{}.sv", v.top);
+    v.files.iter().any(|f| {
+        f.file_name().is_some_and(|n| n.to_string_lossy() == own)
+            && fs::read_to_string(f).is_ok_and(|t| t.contains("m_axi_arvalid_o"))
+    })
 }
 
 /// The bit width of a port from Verilator's header: `VL_IN*(&name,MSB,LSB...)` declarations.

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "axi_mem.h"
+
 #include "cube5-tb/src/ffi.rs.h"
 
 namespace cube5 {
@@ -31,6 +33,61 @@ bool StreamDut::write_config(uint32_t addr, rust::Slice<const uint32_t> data) {
 
 bool StreamDut::trace_window(rust::Str path, uint64_t from_cycle, uint64_t to_cycle) {
   return core_->trace_window(std::string(path), from_cycle, to_cycle);
+}
+
+AxiHost* StreamDut::axi() const { return dynamic_cast<AxiHost*>(core_.get()); }
+
+bool StreamDut::axi_setup(const AxiMemSetup& s) {
+  AxiHost* h = axi();
+  if (!h) return false;
+  AxiMemConfig c;
+  c.data_bytes = s.data_bytes;
+  c.addr_bits = s.addr_bits;
+  c.latency_fixed = s.latency_fixed;
+  c.latency_random = s.latency_random;
+  c.ar_gap_permille = s.ar_gap_permille;
+  c.r_gap_permille = s.r_gap_permille;
+  c.bw_num = s.bw_num;
+  c.bw_den = s.bw_den;
+  c.max_bursts = s.max_bursts;
+  c.seed = s.seed;
+  c.slverr_lo = s.slverr_lo;
+  c.slverr_hi = s.slverr_hi;
+  h->axi_mem().configure(c);
+  return true;
+}
+
+bool StreamDut::axi_load(uint64_t base, rust::Slice<const uint8_t> bytes) {
+  AxiHost* h = axi();
+  if (!h) return false;
+  h->axi_mem().load(base, bytes.data(), bytes.size());
+  return true;
+}
+
+bool StreamDut::axi_take_ar(rust::Vec<uint64_t>& out) {
+  AxiHost* h = axi();
+  if (!h) return false;
+  for (const ArRecord& r : h->axi_mem().read.take_records()) {
+    out.push_back(r.cycle);
+    out.push_back(r.addr);
+    out.push_back(uint64_t{r.len} | uint64_t{r.size} << 8 | uint64_t{r.burst} << 12 |
+                  uint64_t{r.id} << 16);
+  }
+  return true;
+}
+
+AxiCounters StreamDut::axi_counters() const {
+  AxiHost* h = axi();
+  if (!h) return AxiCounters{};
+  const AxiStats& s = h->axi_mem().stats;
+  return AxiCounters{s.ar_accepted,      s.r_beats,    s.protocol_errors,
+                     s.first_error_cycle, s.dropped_at_reset, s.rready_low,
+                     h->axi_mem().read.in_flight(), h->axi_err_flag()};
+}
+
+rust::String StreamDut::axi_first_error() const {
+  AxiHost* h = axi();
+  return rust::String(h ? h->axi_mem().stats.first_error : std::string());
 }
 
 uint64_t StreamDut::cycle() const { return core_->cycle(); }

@@ -9,6 +9,9 @@
 namespace cube5 {
 
 struct RunResult;
+struct AxiMemSetup;
+struct AxiCounters;
+class AxiHost;
 
 class StreamDut {
  public:
@@ -21,10 +24,18 @@ class StreamDut {
   bool write_config(uint32_t addr, rust::Slice<const uint32_t> data);
   bool trace_window(rust::Str path, uint64_t from_cycle, uint64_t to_cycle);
   uint64_t cycle() const;
+  // The AXI memory subordinate of a top with an AXI port (tb/axi_shim.h); false/empty otherwise.
+  bool axi_setup(const AxiMemSetup& setup);
+  bool axi_load(uint64_t base, rust::Slice<const uint8_t> bytes);
+  bool axi_take_ar(rust::Vec<uint64_t>& out);
+  AxiCounters axi_counters() const;
+  rust::String axi_first_error() const;
   uint32_t in_bits() const;
   uint32_t out_bits() const;
 
  private:
+  AxiHost* axi() const;
+
   std::unique_ptr<DutCore> core_;
 };
 

@@ -13,6 +13,36 @@ pub mod bridge {
         finished: bool,
     }
 
+    /// The AXI memory subordinate's set-up (mirrors `AxiMemConfig` in tb/axi_mem.h).
+    #[derive(Debug, Clone, Copy, Default)]
+    struct AxiMemSetup {
+        data_bytes: u32,
+        addr_bits: u32,
+        latency_fixed: u32,
+        latency_random: u32,
+        ar_gap_permille: u32,
+        r_gap_permille: u32,
+        bw_num: u32,
+        bw_den: u32,
+        max_bursts: u32,
+        seed: u64,
+        slverr_lo: u64,
+        slverr_hi: u64,
+    }
+
+    /// The subordinate's counters (mirrors `AxiStats` in tb/axi_mem.h) and the top's `err_o`.
+    #[derive(Debug, Clone, Copy, Default)]
+    struct AxiCounters {
+        ar_accepted: u64,
+        r_beats: u64,
+        protocol_errors: u64,
+        first_error_cycle: u64,
+        dropped_at_reset: u64,
+        rready_low: u64,
+        in_flight: u64,
+        err_flag: bool,
+    }
+
     unsafe extern "C++" {
         include!("stream_dut.h");
 
@@ -42,6 +72,14 @@ pub mod bridge {
             to_cycle: u64,
         ) -> bool;
         fn cycle(self: &StreamDut) -> u64;
+        /// False if the top has no AXI port (tb/axi_shim.h).
+        fn axi_setup(self: Pin<&mut StreamDut>, setup: &AxiMemSetup) -> bool;
+        fn axi_load(self: Pin<&mut StreamDut>, base: u64, bytes: &[u8]) -> bool;
+        /// Appends the AR handshakes since the last call: (cycle, addr, len | size << 8 |
+        /// burst << 12 | id << 16) each.
+        fn axi_take_ar(self: Pin<&mut StreamDut>, out: &mut Vec<u64>) -> bool;
+        fn axi_counters(self: &StreamDut) -> AxiCounters;
+        fn axi_first_error(self: &StreamDut) -> String;
         fn in_bits(self: &StreamDut) -> u32;
         fn out_bits(self: &StreamDut) -> u32;
     }

@@ -2,6 +2,7 @@
 
 use crate::error::TbError;
 use crate::ffi::bridge::{self, RunResult, StreamDut};
+pub use crate::ffi::bridge::{AxiCounters, AxiMemSetup};
 use crate::variants::{Variant, VARIANTS};
 use cube5_model::bits::words_for;
 use cube5_model::unit::UnitConfig;
@@ -38,6 +39,18 @@ impl Traffic {
             stall: pattern(rng, stall, 4111),
         }
     }
+}
+
+/// One AR handshake as the AXI memory subordinate accepted it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ArHandshake {
+    pub cycle: u64,
+    pub addr: u64,
+    /// ARLEN: beats - 1.
+    pub len: u32,
+    pub size: u32,
+    pub burst: u32,
+    pub id: u32,
 }
 
 /// One output as it left the RTL: the cycle it was taken and its value.
@@ -148,6 +161,60 @@ impl<C: StreamCodec> RtlStream<C> {
                 "this top has no configuration port (cfg_valid_i, cfg_addr_i, cfg_data_i)",
             ))
         }
+    }
+
+    /// Sets up the AXI memory subordinate of a top with an AXI port (tb/axi_mem.h).
+    pub fn axi_setup(&mut self, setup: &AxiMemSetup) -> Result<(), TbError> {
+        if self.dut.pin_mut().axi_setup(setup) {
+            Ok(())
+        } else {
+            Err(self.no_axi())
+        }
+    }
+
+    /// Loads the subordinate's memory image: `bytes` from byte address `base` (replaces the last).
+    pub fn axi_load(&mut self, base: u64, bytes: &[u8]) -> Result<(), TbError> {
+        if self.dut.pin_mut().axi_load(base, bytes) {
+            Ok(())
+        } else {
+            Err(self.no_axi())
+        }
+    }
+
+    /// The AR handshakes the subordinate accepted since the last call, in order.
+    pub fn axi_take_ar(&mut self) -> Result<Vec<ArHandshake>, TbError> {
+        let mut raw = Vec::new();
+        if !self.dut.pin_mut().axi_take_ar(&mut raw) {
+            return Err(self.no_axi());
+        }
+        Ok(raw
+            .chunks_exact(3)
+            .map(|r| ArHandshake {
+                cycle: r[0],
+                addr: r[1],
+                len: (r[2] & 0xff) as u32,
+                size: ((r[2] >> 8) & 0x7) as u32,
+                burst: ((r[2] >> 12) & 0x3) as u32,
+                id: (r[2] >> 16) as u32,
+            })
+            .collect())
+    }
+
+    /// The subordinate's counters and the top's `err_o`.
+    pub fn axi_counters(&self) -> AxiCounters {
+        self.dut.axi_counters()
+    }
+
+    /// The subordinate's first protocol violation (empty if none).
+    pub fn axi_first_error(&self) -> String {
+        self.dut.axi_first_error()
+    }
+
+    fn no_axi(&self) -> TbError {
+        TbError::setup(
+            self.variant.name,
+            "this top has no AXI4 manager port (m_axi_ar*, m_axi_r*)",
+        )
     }
 
     /// Records cycles `[from, to]` into a VCD file.

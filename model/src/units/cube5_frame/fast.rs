@@ -575,7 +575,7 @@ mod tests {
         ))
         .unwrap();
         let tf = TransferFunction::head_default();
-        for (name, cfg) in [("v8", narrow), ("wide", wide)] {
+        for (name, cfg) in [("narrow", narrow), ("wide", wide)] {
             let vol = head_phantom(16, cfg.trilin.voxel_w).unwrap();
             // Narrow depth (ZW = 8) is smaller than the slice count here: samples past it fail
             // the depth test.

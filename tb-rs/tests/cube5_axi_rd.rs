@@ -1,0 +1,781 @@
+//! Co-simulation of cube5_axi_rd against its model (docs/numerics/axi_rd.md), with the AXI4
+//! memory subordinate of tb/axi_mem.h answering the manager port in the clock loop: every output
+//! beat (data, last, resp) and every AR burst (address, length, size, type, ID) is compared in
+//! order, and the subordinate's protocol checker must stay silent.
+
+mod support;
+
+use cube5_model::units::cube5_axi_rd::{AxiMemImage, AxiRdCmd, AxiRdConfig, Burst};
+use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
+use cube5_tb::{Mismatch, TbError, Variant};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::path::PathBuf;
+use support::{configs, gate_configs, seed};
+
+/// One run: commands, the memory, how the subordinate behaves, the output traffic, and
+/// optionally a reset after `reset_at` cycles followed by `after` commands.
+#[derive(Clone)]
+struct Case {
+    cmds: Vec<AxiRdCmd>,
+    mem: AxiMemImage,
+    setup: AxiMemSetup,
+    traffic: Traffic,
+    reset: Option<(u64, Vec<AxiRdCmd>)>,
+}
+
+/// What a passing run measured.
+#[derive(Debug, Default)]
+struct Report {
+    beats: u64,
+    bursts: u64,
+    cycles: u64,
+    rready_low: u64,
+    dropped_at_reset: u64,
+}
+
+impl Report {
+    fn beats_per_cycle(&self) -> f64 {
+        self.beats as f64 / self.cycles.max(1) as f64
+    }
+}
+
+/// The subordinate: latency `fixed + U(0..random)`, ARREADY/RVALID gaps, bandwidth `bw` bytes
+/// per cycle as `(num, den)` (`num = 0`: unlimited).
+fn mem_setup(
+    cfg: AxiRdConfig,
+    mem: &AxiMemImage,
+    lat: (u32, u32),
+    gaps: (u32, u32),
+    bw: (u32, u32),
+    seed: u64,
+) -> AxiMemSetup {
+    AxiMemSetup {
+        data_bytes: cfg.bytes(),
+        addr_bits: cfg.addr_w,
+        latency_fixed: lat.0,
+        latency_random: lat.1,
+        ar_gap_permille: gaps.0,
+        r_gap_permille: gaps.1,
+        bw_num: bw.0,
+        bw_den: bw.1.max(1),
+        max_bursts: 64,
+        seed,
+        slverr_lo: mem.slverr_lo,
+        slverr_hi: mem.slverr_hi,
+    }
+}
+
+/// A 64 KB image of random bytes: at 0 for a 16-bit address space (it is the whole space, so
+/// commands that wrap read memory), else at 0x10000; an SLVERR window of 64 bytes inside.
+fn random_image(cfg: AxiRdConfig, rng: &mut ChaCha8Rng) -> AxiMemImage {
+    let base = if cfg.addr_w <= 16 { 0 } else { 0x1_0000 };
+    let bytes: Vec<u8> = (0..0x1_0000).map(|_| rng.random()).collect();
+    let lo = base + rng.random_range(0..0x1_0000u64 / 64) * 64;
+    AxiMemImage {
+        base,
+        bytes,
+        slverr_lo: lo,
+        slverr_hi: lo + 64,
+    }
+}
+
+/// Random commands: mostly inside the image, some just below it (DECERR), lengths mostly up to
+/// three bursts, some long, a few zero.
+fn random_cmds(
+    cfg: AxiRdConfig,
+    mem: &AxiMemImage,
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<AxiRdCmd> {
+    let bytes = u64::from(cfg.bytes());
+    let space = cfg.address_space().unwrap_or(u64::MAX);
+    (0..n)
+        .map(|_| {
+            let len: u32 = match rng.random_range(0..20) {
+                0 => 0,
+                1..=3 => rng.random_range(1..=300),
+                _ => rng.random_range(1..=3 * cfg.max_burst),
+            };
+            let lo = mem.base.saturating_sub(512);
+            let hi = mem.base + mem.bytes.len() as u64;
+            let mut addr = rng.random_range(lo..hi) / bytes * bytes;
+            if cfg.addr_w > 16 && addr + u64::from(len) * bytes > space {
+                addr = 0;
+            }
+            AxiRdCmd { addr, len }
+        })
+        .collect()
+}
+
+/// Runs `case` on `variant` and compares everything; re-runs with a waveform on a mismatch.
+fn check(
+    variant: &'static Variant,
+    cfg: AxiRdConfig,
+    seed: u64,
+    case: &Case,
+) -> Result<Report, TbError> {
+    match run(variant, cfg, seed, case, None) {
+        Err(TbError::Mismatch(mut m)) if std::env::var_os("CUBE5_NO_WAVES").is_none() => {
+            let dir = PathBuf::from(
+                std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".into()),
+            )
+            .join("cube5-waves");
+            let _ = std::fs::create_dir_all(&dir);
+            let path = dir.join(format!("{variant}-seed{seed}.vcd"));
+            let window = (m.cycle.saturating_sub(64), m.cycle + 8);
+            let _ = run(variant, cfg, seed, case, Some((path.clone(), window)));
+            m.waveform = path.exists().then_some(path);
+            Err(TbError::Mismatch(m))
+        }
+        other => other,
+    }
+}
+
+fn must(variant: &'static Variant, cfg: AxiRdConfig, seed: u64, case: &Case) -> Report {
+    match check(variant, cfg, seed, case) {
+        Ok(r) => {
+            eprintln!(
+                "{variant}: seed {seed}: {} beats, {} bursts in {} cycles ({:.4} beats/clock), RREADY low {} cycles, {} bursts dropped at reset",
+                r.beats,
+                r.bursts,
+                r.cycles,
+                r.beats_per_cycle(),
+                r.rready_low,
+                r.dropped_at_reset
+            );
+            r
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// The item a beat belongs to, for a mismatch report.
+fn describe_beat(cfg: AxiRdConfig, cmds: &[AxiRdCmd], k: usize) -> String {
+    let mut at = 0usize;
+    for (i, c) in cmds.iter().enumerate() {
+        let n = c.len as usize;
+        if k < at + n {
+            let j = k - at;
+            let addr = c.addr + j as u64 * u64::from(cfg.bytes());
+            return format!("command #{i} ({c}), beat {j} (byte address {addr:#x})");
+        }
+        at += n;
+    }
+    "(no command: an extra beat)".into()
+}
+
+/// Drives one list of commands (`max_cycles` bounds it) and compares what came out as a prefix
+/// (`exact = false`: a reset cuts the run) or in full.
+#[allow(clippy::too_many_arguments)]
+fn drive_and_compare(
+    dut: &mut RtlStream<AxiRdConfig>,
+    variant: &'static Variant,
+    cfg: AxiRdConfig,
+    seed: u64,
+    cmds: &[AxiRdCmd],
+    mem: &AxiMemImage,
+    traffic: &Traffic,
+    max_cycles: Option<u64>,
+    report: &mut Report,
+) -> Result<(), TbError> {
+    let (want, bursts) = cfg.expected(cmds, mem);
+    let exact = max_cycles.is_none();
+    let limit = max_cycles.unwrap_or(200_000 + 40 * want.len() as u64 + 300 * bursts.len() as u64);
+    let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
+    let protocol = |cycle: u64, what: String| TbError::Protocol {
+        variant: variant.name.to_string(),
+        seed,
+        cycle,
+        what,
+    };
+    if driven.stats.protocol_errors > 0 {
+        return Err(protocol(
+            driven.stats.first_protocol_error_cycle,
+            "a stalled output beat dropped valid or changed".into(),
+        ));
+    }
+    let counters = dut.axi_counters();
+    if counters.protocol_errors > 0 {
+        return Err(protocol(
+            counters.first_error_cycle,
+            format!(
+                "AXI checker: {} ({} violations)",
+                dut.axi_first_error(),
+                counters.protocol_errors
+            ),
+        ));
+    }
+    let fail = |item: u64, cycle: u64, what: &str, input: String, rtl: String, model: String| {
+        TbError::from(Mismatch {
+            variant: variant.name.to_string(),
+            seed,
+            item,
+            cycle,
+            input,
+            rtl,
+            model,
+            what: what.into(),
+            ..Default::default()
+        })
+    };
+    // AR first: a wrong burst explains a wrong beat.
+    let ars = dut.axi_take_ar()?;
+    for (k, ar) in ars.iter().enumerate() {
+        let model = bursts.get(k);
+        let got = Burst {
+            addr: ar.addr,
+            beats: ar.len + 1,
+        };
+        if model != Some(&got) || ar.size != cfg.size() || ar.burst != 1 || ar.id != 0 {
+            return Err(fail(
+                k as u64,
+                ar.cycle,
+                "AR burst differs (address, beats; ARSIZE, ARBURST = INCR, ARID = 0)",
+                format!("burst #{k} of commands {cmds:?}"),
+                format!("{got:?} size {} burst {} id {}", ar.size, ar.burst, ar.id),
+                model.map_or("(no burst expected)".into(), |b| {
+                    format!("{b:?} size {} burst 1 id 0", cfg.size())
+                }),
+            ));
+        }
+    }
+    for (k, taken) in driven.outputs.iter().enumerate() {
+        if want.get(k) != Some(&taken.value) {
+            return Err(fail(
+                k as u64,
+                taken.cycle,
+                "output beat differs",
+                describe_beat(cfg, cmds, k),
+                format!("{:?}", taken.value),
+                want.get(k)
+                    .map_or("(no beat expected)".into(), |b| format!("{b:?}")),
+            ));
+        }
+    }
+    if exact {
+        let missing = |what: String| TbError::Deadlock {
+            variant: variant.name.to_string(),
+            seed,
+            cycle: dut.cycle(),
+            what,
+        };
+        if driven.outputs.len() != want.len() {
+            return Err(missing(format!(
+                "{} of {} beats out within {limit} cycles",
+                driven.outputs.len(),
+                want.len()
+            )));
+        }
+        if ars.len() != bursts.len() {
+            return Err(missing(format!(
+                "{} of {} bursts issued",
+                ars.len(),
+                bursts.len()
+            )));
+        }
+        let any_err = want.iter().any(|b| b.resp != 0);
+        if dut.axi_counters().err_flag != any_err {
+            return Err(fail(
+                0,
+                dut.cycle(),
+                "err_o differs (sticky: some beat's RRESP != OKAY since reset)",
+                format!("{} commands", cmds.len()),
+                format!("err_o = {}", !any_err),
+                format!("err_o = {any_err}"),
+            ));
+        }
+    }
+    report.beats += driven.outputs.len() as u64;
+    report.bursts += ars.len() as u64;
+    report.cycles += driven.stats.cycles;
+    Ok(())
+}
+
+fn run(
+    variant: &'static Variant,
+    cfg: AxiRdConfig,
+    seed: u64,
+    case: &Case,
+    trace: Option<(PathBuf, (u64, u64))>,
+) -> Result<Report, TbError> {
+    for c in case.cmds.iter().chain(case.reset.iter().flat_map(|r| &r.1)) {
+        cfg.check_cmd(c)
+            .map_err(|e| TbError::setup(variant.name, e))?;
+    }
+    let mut dut = RtlStream::new(variant, cfg, seed as u32)?;
+    dut.axi_setup(&case.setup)?;
+    dut.axi_load(case.mem.base, &case.mem.bytes)?;
+    if let Some((path, (from, to))) = &trace {
+        dut.trace_window(path, *from, *to);
+    }
+    let mut report = Report::default();
+    let (mem, traffic) = (&case.mem, &case.traffic);
+    match &case.reset {
+        None => drive_and_compare(
+            &mut dut,
+            variant,
+            cfg,
+            seed,
+            &case.cmds,
+            mem,
+            traffic,
+            None,
+            &mut report,
+        )?,
+        Some((at, after)) => {
+            drive_and_compare(
+                &mut dut,
+                variant,
+                cfg,
+                seed,
+                &case.cmds,
+                mem,
+                traffic,
+                Some(*at),
+                &mut report,
+            )?;
+            dut.reset();
+            let c = dut.axi_counters();
+            if c.in_flight != 0 {
+                return Err(TbError::Protocol {
+                    variant: variant.name.to_string(),
+                    seed,
+                    cycle: dut.cycle(),
+                    what: format!("{} bursts still in flight after the reset", c.in_flight),
+                });
+            }
+            report.dropped_at_reset = c.dropped_at_reset;
+            drive_and_compare(
+                &mut dut,
+                variant,
+                cfg,
+                seed,
+                after,
+                mem,
+                traffic,
+                None,
+                &mut report,
+            )?;
+        }
+    }
+    report.rready_low = dut.axi_counters().rready_low;
+    Ok(report)
+}
+
+/// A random case at `seed`: random latency 10..200, gaps on AR and R, back-pressure on the output,
+/// a bandwidth limit on some seeds.
+fn random_case(cfg: AxiRdConfig, seed: u64, n: usize) -> Case {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mem = random_image(cfg, &mut rng);
+    let cmds = random_cmds(cfg, &mem, n, &mut rng);
+    let bw = if rng.random_bool(0.5) {
+        (rng.random_range(1..=2 * cfg.bytes()), 2)
+    } else {
+        (0, 1)
+    };
+    let gaps = (rng.random_range(0..500), rng.random_range(0..500));
+    let setup = mem_setup(cfg, &mem, (10, 190), gaps, bw, rng.random());
+    let stall = rng.random_range(0.0..0.6);
+    let traffic = Traffic::random(&mut rng, 0.3, stall);
+    Case {
+        cmds,
+        mem,
+        setup,
+        traffic,
+        reset: None,
+    }
+}
+
+#[test]
+fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
+    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
+        for k in 0..4 {
+            let s = seed(100 + 10 * i as u64 + k);
+            let case = random_case(cfg, s, 300);
+            let r = must(variant, cfg, s, &case);
+            assert!(
+                r.beats > 1000,
+                "{variant}: the case reads enough beats (seed {s})"
+            );
+            assert_eq!(
+                r.rready_low, 0,
+                "{variant}: RREADY never holds the bus (seed {s})"
+            );
+        }
+    }
+}
+
+/// The acceptance figure (docs/adding-a-unit.md): at least 1,000,000 random beats per
+/// configuration, in cases of 2,000 commands each with its own latency, gaps, bandwidth and
+/// back-pressure, the third of them reset in mid-stream.
+#[test]
+fn a_million_random_beats_per_config() {
+    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
+        let mut beats = 0u64;
+        let mut k = 0u64;
+        while beats < 1_000_000 {
+            let s = seed(600 + 100 * i as u64 + k);
+            let mut case = random_case(cfg, s, 2000);
+            if k == 2 {
+                let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+                let after = random_cmds(cfg, &case.mem, 2000, &mut rng);
+                case.reset = Some((rng.random_range(1000..100_000), after));
+            }
+            let r = must(variant, cfg, s, &case);
+            assert_eq!(
+                r.rready_low, 0,
+                "{variant}: RREADY never holds the bus (seed {s})"
+            );
+            beats += r.beats;
+            k += 1;
+        }
+    }
+}
+
+/// Length 1, 4 KB crossings, the longest command, the top of the image and of the address space,
+/// zero lengths between commands.
+fn directed_cmds(cfg: AxiRdConfig, mem: &AxiMemImage) -> Vec<AxiRdCmd> {
+    let b = u64::from(cfg.bytes());
+    let top = mem.base + mem.bytes.len() as u64;
+    let mb = cfg.max_burst;
+    let mut c = vec![
+        AxiRdCmd {
+            addr: mem.base,
+            len: 1,
+        },
+        AxiRdCmd {
+            addr: mem.base + 4096 - b,
+            len: 1,
+        },
+        AxiRdCmd {
+            addr: mem.base + 4096 - b,
+            len: 2,
+        },
+        AxiRdCmd {
+            addr: mem.base + 8192 - 3 * b,
+            len: 3 * mb + 1,
+        },
+        AxiRdCmd {
+            addr: mem.base + 4096,
+            len: 0,
+        },
+        AxiRdCmd {
+            addr: mem.base + 4096,
+            len: mb,
+        },
+        AxiRdCmd {
+            addr: mem.base + 4096 + b,
+            len: mb,
+        },
+        AxiRdCmd {
+            addr: mem.base + 4096 - b * u64::from(mb),
+            len: 2 * mb,
+        },
+        AxiRdCmd {
+            addr: top - b,
+            len: 1,
+        },
+        AxiRdCmd {
+            addr: top - 4 * b,
+            len: 4,
+        },
+        AxiRdCmd {
+            addr: top - 2 * b,
+            len: 4,
+        }, // runs off the image: DECERR beats
+        AxiRdCmd {
+            addr: mem.base,
+            len: 0,
+        },
+        AxiRdCmd {
+            addr: mem.base + 16,
+            len: 1,
+        },
+    ];
+    if let Some(space) = cfg.address_space() {
+        c.push(AxiRdCmd {
+            addr: space - b,
+            len: 1,
+        });
+        c.push(AxiRdCmd {
+            addr: space - 4096,
+            len: (4096 / b) as u32,
+        });
+        if cfg.addr_w <= 16 {
+            // Wraps from the top of the address space to 0 (a 4 KB boundary).
+            c.push(AxiRdCmd {
+                addr: space - 2 * b,
+                len: 2 * mb + 3,
+            });
+        }
+    }
+    // The longest command, 2^LenW - 1 beats, when it stays below 1 M beats.
+    if cfg.len_w <= 20 {
+        c.push(AxiRdCmd {
+            addr: mem.base,
+            len: (1u32 << cfg.len_w) - 1,
+        });
+    }
+    c.push(AxiRdCmd {
+        addr: mem.base + 8,
+        len: 1,
+    });
+    c.retain(|x| cfg.check_cmd(x).is_ok());
+    c
+}
+
+#[test]
+fn directed_extremes() {
+    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
+        let s = seed(300 + i as u64);
+        let mut rng = ChaCha8Rng::seed_from_u64(s);
+        let mem = random_image(cfg, &mut rng);
+        let cmds = directed_cmds(cfg, &mem);
+        for (lat, gaps, stall) in [((10, 0), (0, 0), 0.0), ((10, 190), (300, 300), 0.4)] {
+            let case = Case {
+                setup: mem_setup(cfg, &mem, lat, gaps, (0, 1), s),
+                traffic: Traffic::random(&mut rng, 0.3, stall),
+                cmds: cmds.clone(),
+                mem: mem.clone(),
+                reset: None,
+            };
+            must(variant, cfg, s, &case);
+        }
+    }
+}
+
+#[test]
+fn reset_in_mid_stream_leaves_nothing_outstanding_and_the_next_commands_are_exact() {
+    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
+        let mut dropped = 0;
+        for k in 0..3 {
+            let s = seed(400 + 10 * i as u64 + k);
+            let mut case = random_case(cfg, s, 100);
+            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+            let after = random_cmds(cfg, &case.mem, 100, &mut rng);
+            // Early enough that bursts are in flight (latency >= 10 cycles).
+            case.reset = Some((rng.random_range(30..3000), after));
+            let r = must(variant, cfg, s, &case);
+            assert!(r.beats > 0);
+            dropped += r.dropped_at_reset;
+        }
+        assert!(
+            dropped > 0,
+            "{variant}: some reset landed with bursts in flight"
+        );
+    }
+}
+
+/// Throughput: fixed latency 100, no gaps, output always taken, long commands. Where the credit
+/// pool covers the round trip (`Outstanding * MaxBurst >= latency + MaxBurst + 8` beats: a burst
+/// holds its slot from issue to its last beat) the unit must sustain >= 0.95 beats per cycle;
+/// every configuration's figure is printed (docs/measurements.md).
+#[test]
+fn throughput_at_fixed_latency_100() {
+    for (variant, cfg) in configs::<AxiRdConfig>() {
+        let r = throughput(variant, cfg, 100, (0, 1));
+        let covers = cfg.fifo_depth() >= 100 + cfg.max_burst + 8;
+        eprintln!(
+            "{variant}: latency 100, Outstanding x MaxBurst = {}: {:.4} beats/cycle",
+            cfg.fifo_depth(),
+            r
+        );
+        if covers {
+            assert!(
+                r >= 0.95,
+                "{variant}: {r:.4} beats/cycle at latency 100 (want >= 0.95)"
+            );
+        }
+    }
+}
+
+/// Beats per cycle over 64 commands of 256 beats at fixed latency `lat` and bandwidth `bw`.
+fn throughput(variant: &'static Variant, cfg: AxiRdConfig, lat: u32, bw: (u32, u32)) -> f64 {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mem = random_image(cfg, &mut rng);
+    let b = u64::from(cfg.bytes());
+    let span = (mem.bytes.len() as u64 / b / 256).max(1);
+    let cmds: Vec<AxiRdCmd> = (0..64)
+        .map(|k| AxiRdCmd {
+            addr: mem.base + (k % span) * 256 * b % mem.bytes.len() as u64,
+            len: 256,
+        })
+        .filter(|c| c.addr + u64::from(c.len) * b <= mem.base + mem.bytes.len() as u64)
+        .collect();
+    let case = Case {
+        setup: mem_setup(cfg, &mem, (lat, 0), (0, 0), bw, 1),
+        traffic: Traffic::full_speed(),
+        cmds,
+        mem,
+        reset: None,
+    };
+    let r = must(variant, cfg, 1, &case);
+    r.beats_per_cycle()
+}
+
+/// The table in docs/measurements.md: beats/cycle against latency, and under a bandwidth limit
+/// (which the measured rate must meet but not exceed).
+#[test]
+fn throughput_against_latency_and_bandwidth() {
+    for (variant, cfg) in configs::<AxiRdConfig>() {
+        let row: Vec<String> = [10u32, 50, 100, 200]
+            .iter()
+            .map(|&lat| format!("{lat}: {:.3}", throughput(variant, cfg, lat, (0, 1))))
+            .collect();
+        eprintln!("{variant}: beats/cycle by latency {}", row.join(", "));
+        // Half the bus width per cycle: at most 0.5 beats/cycle, and close to it.
+        let limited = throughput(variant, cfg, 20, (cfg.bytes(), 2));
+        eprintln!(
+            "{variant}: bandwidth {} bytes/cycle: {limited:.4} beats/cycle",
+            cfg.bytes() / 2
+        );
+        assert!(
+            limited <= 0.5 + 1e-9,
+            "{variant}: the bandwidth limit holds ({limited})"
+        );
+        if cfg.fifo_depth() >= 16 {
+            assert!(
+                limited >= 0.45,
+                "{variant}: the unit keeps up with a limited bus ({limited})"
+            );
+        }
+    }
+}
+
+#[test]
+fn gate_level_netlist_smoke() {
+    for (variant, cfg) in gate_configs::<AxiRdConfig>() {
+        let s = seed(500);
+        let case = random_case(cfg, s, 60);
+        must(variant, cfg, s, &case);
+        let mut case = random_case(cfg, s + 1, 30);
+        let mut rng = ChaCha8Rng::seed_from_u64(s);
+        case.reset = Some((
+            rng.random_range(30..500),
+            random_cmds(cfg, &case.mem, 30, &mut rng),
+        ));
+        must(variant, cfg, s + 1, &case);
+    }
+}
+
+/// The checks bite: a model whose image differs in one byte disagrees on the beat holding it (the
+/// report names the command and beat), and one that splits differently disagrees on AR.
+#[test]
+fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
+    let (variant, cfg) = configs::<AxiRdConfig>()[0];
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    let mem = random_image(cfg, &mut rng);
+    let b = u64::from(cfg.bytes());
+    let cmds = vec![AxiRdCmd {
+        addr: mem.base + 4096 - b,
+        len: 3,
+    }];
+    let case = Case {
+        setup: mem_setup(cfg, &mem, (10, 0), (0, 0), (0, 1), 1),
+        traffic: Traffic::full_speed(),
+        cmds: cmds.clone(),
+        mem: mem.clone(),
+        reset: None,
+    };
+    // The model with one byte of the image changed: the beat differs, and the report names it.
+    let mut wrong = case.clone();
+    wrong.mem.bytes[(4096 - b) as usize] ^= 1;
+    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
+    dut.axi_setup(&case.setup).unwrap();
+    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
+    let err = drive_and_compare(
+        &mut dut,
+        variant,
+        cfg,
+        1,
+        &cmds,
+        &wrong.mem,
+        &case.traffic,
+        None,
+        &mut Report::default(),
+    )
+    .unwrap_err();
+    let m = err.mismatch().expect("a mismatch");
+    assert_eq!(m.item, 0);
+    assert!(m.input.contains("command #0"), "{}", m.input);
+    // The AR of a 4 KB crossing is two bursts: one beat to the boundary, two after it.
+    let (_, bursts) = cfg.expected(&cmds, &mem);
+    assert_eq!(bursts.len(), 2);
+
+    // A model that splits at half the RTL's MaxBurst disagrees on the first AR burst.
+    let half = AxiRdConfig {
+        max_burst: cfg.max_burst / 2,
+        ..cfg
+    };
+    let long = vec![AxiRdCmd {
+        addr: mem.base,
+        len: cfg.max_burst,
+    }];
+    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
+    dut.axi_setup(&case.setup).unwrap();
+    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
+    let err = drive_and_compare(
+        &mut dut,
+        variant,
+        half,
+        1,
+        &long,
+        &mem,
+        &case.traffic,
+        None,
+        &mut Report::default(),
+    )
+    .unwrap_err();
+    let m = err.mismatch().expect("a mismatch");
+    assert!(m.what.starts_with("AR burst differs"), "{err}");
+    assert_eq!(m.item, 0);
+}
+
+/// The subordinate's protocol checker bites, and its report reaches the test: told the bus is
+/// twice as wide as it is, it refuses the unit's ARSIZE; told the address space is 8 KB, it
+/// refuses a burst above it. Both fail as protocol errors naming the rule and the seed.
+#[test]
+fn the_axi_checker_reports_a_violation() {
+    let (variant, cfg) = configs::<AxiRdConfig>()[0];
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mem = random_image(cfg, &mut rng);
+    let good = mem_setup(cfg, &mem, (10, 0), (200, 0), (0, 1), 1);
+    let cmds = vec![AxiRdCmd {
+        addr: mem.base + 0x3000,
+        len: 4,
+    }];
+    for (setup, rule) in [
+        (
+            AxiMemSetup {
+                data_bytes: 2 * cfg.bytes(),
+                ..good
+            },
+            "ARSIZE",
+        ),
+        (
+            AxiMemSetup {
+                addr_bits: 13,
+                ..good
+            },
+            "past the address space",
+        ),
+    ] {
+        let case = Case {
+            setup,
+            traffic: Traffic::full_speed(),
+            cmds: cmds.clone(),
+            mem: mem.clone(),
+            reset: None,
+        };
+        match check(variant, cfg, 77, &case) {
+            Err(e @ TbError::Protocol { .. }) => {
+                let text = e.to_string();
+                assert!(text.contains(rule), "{text}");
+                assert!(text.contains("CUBE5_SEED=77"), "{text}");
+            }
+            Err(e) => panic!("{variant}: expected a protocol error about {rule}, got {e}"),
+            Ok(r) => panic!("{variant}: the checker let it pass ({r:?})"),
+        }
+    }
+}
