@@ -5,13 +5,14 @@
 // saturated to U(ImpW.0)); an update to the active queue (S[0]) only changes its count and, when it
 // reaches zero, empties it; an update to any other queue wipes that queue's old entry from every
 // buffer and enters the new importance at the top (C[0]). In every other cycle (a slot cycle) a
-// background scan of the counters re-offers its queue at the top if that queue is non-empty and
-// not held, so no queue that fell off the last rank is forgotten. Every rank compares its
+// background scan of the counters re-offers its queue at the top if that queue is non-empty, not
+// held, and would fit (larger than the last rank's entry, or that is empty), so no queue that fell
+// off the last rank is forgotten. Every rank compares its
 // comparison buffer with its selected buffer: the larger stays, the smaller moves to the next
 // rank's comparison buffer, so entries filter down one rank per cycle, several in flight at once.
 // S[0] is the active queue and counts as infinite. An empty selected buffer with entries below it
-// (an open hole) lets entries in flight pass, and the topmost hole that can close does: the ranks
-// from it down move up one (from rank 0 when the active queue empties or none is active).
+// (an open hole) lets entries in flight pass, and the topmost hole closes in the same cycle: the
+// ranks from it down move up one (from rank 0 when the active queue empties or none is active).
 //
 // Lockstep wrapper: the state advances only on an input transfer and the registered state is the
 // output item (one per input, latency 1); in_ready is low while that output is stalled, so random
@@ -158,8 +159,12 @@ module gicube_sorter #(
     end
   end
 
-  assign slot   = !touch && !emptied;
-  assign offer  = slot && (scan_cnt != '0) && !scan_held;
+  // It would fit: the last rank's selected buffer is empty or holds a smaller importance.
+  logic scan_fits;
+
+  assign scan_fits = !sv_q[Ranks-1] || (scan_cnt > si_q[(Ranks-1)*ImpW +: ImpW]);
+  assign slot      = !touch && !emptied;
+  assign offer     = slot && (scan_cnt != '0) && !scan_held && scan_fits;
   assign scan_d = slot ? scan_q + QueueW'(1) : scan_q;  // wraps at Q = 2^QueueW
 
   // The token entering C[0]: the update's new importance, or the re-offered queue.
@@ -232,10 +237,9 @@ module gicube_sorter #(
   end
 
   // ---------------------------------------------------------------------------
-  // Shift up from rank h: rank 0 when S'[0] is empty, else the topmost open hole where the two
-  // entries that would share its comparison buffer are not both present
+  // Shift up from rank h: rank 0 when S'[0] is empty, else the topmost open hole
   // ---------------------------------------------------------------------------
-  logic [Ranks-1:0] closable;  // rank r could be h
+  logic [Ranks-1:0] closable;  // rank r can be h
   logic [Ranks-1:0] up;        // r >= h: rank r takes the results of rank r + 1
   logic [Ranks-1:0] at_h;      // r == h
   logic             shift, dropped;
@@ -249,12 +253,7 @@ module gicube_sorter #(
   assign above_q = {down_q[(Ranks-1)*QueueW-1:0], QueueW'(0)};
   assign above_i = {down_i[(Ranks-1)*ImpW-1:0], ImpW'(0)};
 
-  always_comb begin
-    closable[0] = !keep_v[0];
-    for (int unsigned r = 1; r < Ranks; r++) begin
-      closable[r] = hole[r] && !(above_v[r] && down_v[r]);
-    end
-  end
+  assign closable = {hole[Ranks-1:1], !keep_v[0]};
 
   for (genvar r = 0; r < Ranks; r++) begin : gen_up
     assign up[r] = |closable[r:0];
@@ -263,7 +262,9 @@ module gicube_sorter #(
   assign at_h = up & ~{up[Ranks-2:0], 1'b0};
 
   assign shift   = up[Ranks-1];
-  assign dropped = down_v[Ranks-1] && !shift;
+  // An entry leaves: off the last rank without a shift, or at the hole when two entries in flight
+  // would share its comparison buffer (the one that passed the hole leaves; the scan re-offers it).
+  assign dropped = (down_v[Ranks-1] && !shift) || |(at_h & above_v & down_v);
 
   always_comb begin
     sv_d = '0;
@@ -287,7 +288,7 @@ module gicube_sorter #(
           si_d[r*ImpW +: ImpW]     = keep_i[(r+1)*ImpW +: ImpW];
         end
         if (at_h[r] && above_v[r]) begin
-          // The hole's comparison buffer takes the entry from above (its own D[r] is empty).
+          // The hole's comparison buffer takes the entry from above; D[r], if any, leaves.
           cv_d[r]                  = 1'b1;
           cq_d[r*QueueW +: QueueW] = above_q[r*QueueW +: QueueW];
           ci_d[r*ImpW +: ImpW]     = above_i[r*ImpW +: ImpW];

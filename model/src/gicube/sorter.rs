@@ -343,8 +343,10 @@ impl Sorter {
         let hit_active = upd && self.sel[0].is_some_and(|e| e.queue as usize == q);
         let emptied = hit_active && new == 0;
         let touch = upd && !hit_active;
-        // Held at the start of the cycle (a slot cycle wipes nothing, so after the wipe is the same).
+        // Held at the start of the cycle (a slot cycle wipes nothing, so after the wipe is the same),
+        // and whether it would fit: the last rank's selected buffer is empty or smaller.
         let scan_held = self.holds(self.scan);
+        let scan_fits = self.sel[r_n - 1].is_none_or(|e| self.imp[self.scan as usize] > e.imp);
         if hit_active {
             if let Some(e) = self.sel[0].as_mut() {
                 e.imp = new;
@@ -370,7 +372,7 @@ impl Sorter {
         let mut offered = false;
         if slot {
             let p = self.scan;
-            if self.imp[p as usize] != 0 && !scan_held {
+            if self.imp[p as usize] != 0 && !scan_held && scan_fits {
                 token = Some(Entry {
                     queue: p,
                     imp: self.imp[p as usize],
@@ -416,18 +418,20 @@ impl Sorter {
         let h = if s1[0].is_none() {
             Some(0)
         } else {
-            (1..r_n).find(|&r| hole(r) && !(d[r - 1].is_some() && d[r].is_some()))
+            (1..r_n).find(|&r| hole(r))
         };
-        let mut dropped = false;
+        let dropped;
         match h {
             Some(h) => {
+                // Two entries in flight for the hole's comparison buffer: the one that passed the
+                // hole leaves (its queue is re-offered by the scan).
+                dropped = h > 0 && d[h - 1].is_some() && d[h].is_some();
                 for r in 0..r_n {
                     if r < h {
                         self.sel[r] = s1[r];
                         self.cmp[r] = if r == 0 { None } else { d[r - 1] };
                     } else {
                         self.sel[r] = if r + 1 < r_n { s1[r + 1] } else { None };
-                        debug_assert!(r != h || h == 0 || d[r - 1].is_none() || d[r].is_none());
                         self.cmp[r] = if r > h || r == 0 {
                             d[r]
                         } else {
@@ -1029,8 +1033,10 @@ pub struct SorterWatch {
     cfg: SorterConfig,
     /// Cycles since a token last entered.
     quiet: u32,
-    /// Per queue: slot cycles spent non-empty and not held.
+    /// Per queue: consecutive slot cycles spent non-empty, not held and fitting.
     wait: Vec<u32>,
+    /// `S[R-1]` after the previous cycle (what the next cycle's offer compares with).
+    last: Option<Entry>,
     /// Settled states checked, and the longest wait seen.
     pub settled_checks: u64,
     pub max_wait: u32,
@@ -1045,6 +1051,7 @@ impl SorterWatch {
             cfg,
             quiet: 0,
             wait: vec![0; cfg.queues() as usize],
+            last: None,
             settled_checks: 0,
             max_wait: 0,
             drops_with_room: 0,
@@ -1056,6 +1063,7 @@ impl SorterWatch {
     pub fn reset(&mut self) {
         self.quiet = 0;
         self.wait.fill(0);
+        self.last = None;
     }
 
     pub fn observe(
@@ -1082,8 +1090,11 @@ impl SorterWatch {
         for e in st.ranks.iter().flat_map(|r| [r.sel, r.cmp]).flatten() {
             held[e.queue as usize] = true;
         }
+        // A queue is waiting while it is non-empty, not held, and would fit (the last rank's
+        // selected buffer is empty or smaller): the scan owes it an offer.
+        let last = self.last;
         for (k, (&c, &h)) in counters.iter().zip(&held).enumerate() {
-            if c == 0 || h {
+            if c == 0 || h || last.is_some_and(|e| c <= e.imp) {
                 self.wait[k] = 0;
             } else if slot {
                 self.wait[k] += 1;
@@ -1099,6 +1110,7 @@ impl SorterWatch {
         if st.dropped && counters.iter().filter(|&&c| c > 0).count() <= self.cfg.ranks as usize {
             self.drops_with_room += 1;
         }
+        self.last = st.ranks[st.ranks.len() - 1].sel;
         Ok(())
     }
 }
