@@ -1141,7 +1141,13 @@ impl DrainFrame {
 
     /// Runs a frame on the model from reset. `counts[q]` rays in queue `q`, preloaded in `order`.
     pub fn run(cfg: SorterConfig, counts: &[u32], order: &[u32]) -> Result<Self> {
-        let mut s = Sorter::new(cfg)?;
+        Ok(Self::run_on(&mut Sorter::new(cfg)?, counts, order))
+    }
+
+    /// Runs a frame on `s` from its current state (frames back to back: the previous frame left
+    /// it empty, with its scan pointer wherever it stopped).
+    pub fn run_on(s: &mut Sorter, counts: &[u32], order: &[u32]) -> Self {
+        let cfg = s.config();
         let mut items: Vec<SorterIn> = order
             .iter()
             .map(|&q| SorterIn::set(q, counts[q as usize] as i32))
@@ -1177,19 +1183,25 @@ impl DrainFrame {
             };
         }
         let rays_left = s.counters().iter().map(|&c| u64::from(c)).sum();
-        Ok(Self {
+        Self {
             items,
             rays,
             nonempty,
             drain_cycles: last_ray,
             rays_left,
             longest_idle: longest,
-        })
+        }
     }
 
     /// A random frame: about 40 % of the queues empty, the others 1..=max(6, 512 / Q) rays, and in
     /// one frame of ten one queue full (`QueueLen`); preloaded in a random order.
     pub fn random(cfg: SorterConfig, rng: &mut impl Rng) -> Result<Self> {
+        Ok(Self::random_on(&mut Sorter::new(cfg)?, rng))
+    }
+
+    /// [`DrainFrame::random`] on `s` from its current state.
+    pub fn random_on(s: &mut Sorter, rng: &mut impl Rng) -> Self {
+        let cfg = s.config();
         let q_n = cfg.queues();
         let small = (512 / q_n).max(6).min(cfg.queue_len);
         let mut counts: Vec<u32> = (0..q_n)
@@ -1208,7 +1220,7 @@ impl DrainFrame {
         for k in (1..order.len()).rev() {
             order.swap(k, rng.random_range(0..=k));
         }
-        Self::run(cfg, &counts, &order)
+        Self::run_on(s, &counts, &order)
     }
 }
 
