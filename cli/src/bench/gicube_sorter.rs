@@ -101,7 +101,7 @@ fn accuracy_table(n_items: usize) -> Result<()> {
     // Other rank counts at the RTL's default queues and widths (model only).
     let sweep = [4, 8, 16, 64].map(|ranks| SorterConfig {
         ranks,
-        ..SorterConfig::R32
+        ..SorterConfig::DEFAULT
     });
     for cfg in &sweep {
         cfg.validate()?;

@@ -26,15 +26,11 @@ pub struct SorterConfig {
 impl SorterConfig {
     /// Rays per queue in the patent's reference design [371].
     pub const PATENT_QUEUE_LEN: u32 = 256;
-    /// Narrow: 8 ranks, 16 queues, 9-bit importances (a full queue of 256 rays counts exactly).
-    pub const R8: Self = Self {
-        ranks: 8,
-        queue_w: 4,
-        imp_w: 9,
-        queue_len: Self::PATENT_QUEUE_LEN,
-    };
-    /// Default: 32 ranks over the 128 queues of [371], 16-bit importances.
-    pub const R32: Self = Self {
+    /// The RTL's parameter defaults: 32 ranks over the 128 queues of [371], 16-bit importances.
+    /// The verified configurations are the lines of `rtl/gicube/gicube_sorter.variants`: tests
+    /// and benches build theirs from the variant table (`UnitConfig::from_params`), never from a
+    /// copy here.
+    pub const DEFAULT: Self = Self {
         ranks: 32,
         queue_w: 7,
         imp_w: 16,
@@ -1224,8 +1220,8 @@ impl DrainFrame {
     }
 }
 
-// The RTL parameters of this unit (the RTL defaults are the model's `R32`).
-crate::unit_config!(SorterConfig, "gicube_sorter", R32, {
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(SorterConfig, "gicube_sorter", DEFAULT, {
     "Ranks" => ranks,
     "QueueW" => queue_w,
     "ImpW" => imp_w,
@@ -1237,6 +1233,16 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
+
+    /// A narrow configuration for these tests: 8 ranks, 16 queues, the smallest `ImpW` that
+    /// counts a full queue of 256 rays. (The verified configurations are the `.variants` lines,
+    /// held to the RTL by `tb-rs/tests/variant_table.rs`.)
+    const NARROW: SorterConfig = SorterConfig {
+        ranks: 8,
+        queue_w: 4,
+        imp_w: 9,
+        queue_len: SorterConfig::PATENT_QUEUE_LEN,
+    };
 
     fn sorter(ranks: u32) -> Sorter {
         Sorter::new(SorterConfig::new(ranks, 4, 8, 255).unwrap()).unwrap()
@@ -1275,10 +1281,10 @@ mod tests {
 
     #[test]
     fn widths_match_the_contract_table() {
-        assert_eq!(SorterConfig::R8.in_width(), 16);
-        assert_eq!(SorterConfig::R8.out_width(), 241);
-        assert_eq!(SorterConfig::R32.in_width(), 26);
-        assert_eq!(SorterConfig::R32.out_width(), 1563);
+        assert_eq!(NARROW.in_width(), 16);
+        assert_eq!(NARROW.out_width(), 241);
+        assert_eq!(SorterConfig::DEFAULT.in_width(), 26);
+        assert_eq!(SorterConfig::DEFAULT.out_width(), 1563);
     }
 
     #[test]
@@ -1464,8 +1470,8 @@ mod tests {
     #[test]
     fn a_full_queue_is_counted_exactly() {
         // Issue 18: with ImpW = 8, 256 arrivals saturated at 255 and 255 departures emptied a
-        // queue that still held a ray. r8 now has ImpW = 9 and QueueLen = 256.
-        let cfg = SorterConfig::R8;
+        // queue that still held a ray. ImpW = 9 counts QueueLen = 256 exactly.
+        let cfg = NARROW;
         let mut s = Sorter::new(cfg).unwrap();
         s.step(&SorterIn::add(6, 1));
         let mut st = s.step(&noop());
@@ -1489,7 +1495,7 @@ mod tests {
 
     #[test]
     fn end_of_frame_drains_every_ray() {
-        for cfg in [SorterConfig::R8, SorterConfig::R32] {
+        for cfg in [NARROW, SorterConfig::DEFAULT] {
             let mut rng = ChaCha8Rng::seed_from_u64(18);
             let (mut overhead, mut worst) = (0, 0);
             for frame in 0..1000 {
@@ -1527,7 +1533,7 @@ mod tests {
 
     #[test]
     fn random_traffic_keeps_the_invariants_and_reaches_every_corner() {
-        for cfg in [SorterConfig::R8, SorterConfig::R32] {
+        for cfg in [NARROW, SorterConfig::DEFAULT] {
             let mut rng = ChaCha8Rng::seed_from_u64(9);
             let mut traffic = SorterTraffic::new(cfg).unwrap();
             let mut s = Sorter::new(cfg).unwrap();
@@ -1568,7 +1574,7 @@ mod tests {
 
     #[test]
     fn codec_round_trips_states() {
-        let cfg = SorterConfig::R8;
+        let cfg = NARROW;
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         let mut traffic = SorterTraffic::new(cfg).unwrap();
         let mut s = Sorter::new(cfg).unwrap();
@@ -1639,13 +1645,13 @@ mod tests {
 
     #[test]
     fn workload_is_valid_traffic() {
-        let cfg = SorterConfig::R32;
+        let cfg = SorterConfig::DEFAULT;
         let mut w = Workload::new(cfg, 1000, 0.5, 0.5, 8, 1).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let items: Vec<SorterIn> = (0..20_000).map(|_| w.next_item(&mut rng)).collect();
         let rep = measure_accuracy(cfg, items).unwrap();
         assert!(rep.emptied > 10 && rep.selections > 10);
         assert!(Workload::new(cfg, 0, 1.5, 0.5, 8, 1).is_err());
-        assert!(Workload::new(SorterConfig::R8, 0, 0.5, 0.5, 8, 512).is_err());
+        assert!(Workload::new(NARROW, 0, 0.5, 0.5, 8, 512).is_err());
     }
 }
