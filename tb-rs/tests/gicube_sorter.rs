@@ -22,7 +22,8 @@ use support::{
     must_match_items, random_items, seed, MILLION,
 };
 
-/// Items per batch: a state item of r32 is 1555 bits, so keep the batches small.
+/// Items per batch: a state item of the default configuration is 1563 bits, so keep the batches
+/// small.
 const BATCH: usize = 16_384;
 
 /// The configuration with the fewest ranks: the tests that need one configuration pick it by that
