@@ -224,7 +224,7 @@ fn frame_end_table(n_items: usize) -> Result<()> {
 /// The drain test's frames (`DrainFrame::random`): every queue preloaded with a random count.
 fn drain_frames_table() -> Result<()> {
     const FRAMES: u64 = 1000;
-    println!("Drain frames of the co-simulation test (`DrainFrame::random`, {FRAMES} frames per config):");
+    println!("Drain frames like the co-simulation test's (`DrainFrame::random`, {FRAMES} frames per config):");
     println!("each queue empty (40 %) or 1..=max(6, 512/Q) rays, one full queue (256) in a frame of ten,");
     println!(
         "preloaded with `Set`, then drained one ray per cycle. Overhead = drain cycles - rays.\n"
