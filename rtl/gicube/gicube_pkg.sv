@@ -103,10 +103,10 @@ package gicube_pkg;
     sorter_entry_w = 1 + queue_w + imp_w;
   endfunction
 
-  /// Bits of the state output: three flags, imp_q, and S then C of every rank.
+  /// Bits of the state output: four flags, imp_q, the scan pointer, and S then C of every rank.
   function automatic int unsigned sorter_out_w(int unsigned ranks, int unsigned queue_w,
                                                int unsigned imp_w);
-    sorter_out_w = 3 + imp_w + 2 * ranks * sorter_entry_w(queue_w, imp_w);
+    sorter_out_w = 4 + imp_w + queue_w + 2 * ranks * sorter_entry_w(queue_w, imp_w);
   endfunction
 
 endpackage

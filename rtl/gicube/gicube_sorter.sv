@@ -1,14 +1,18 @@
 // gicube_sorter: per-queue importance counters and the pipelined insertion queue sorter of the
-// GI-Cube block processor (patent [29], [373], [374]; docs/numerics/gicube_sorter.md).
+// GI-Cube block processor (patent [29], [370]-[374]; docs/numerics/gicube_sorter.md).
 //
 // Each accepted update item is one logical cycle: the item's queue counter is updated (add or set,
 // saturated to U(ImpW.0)); an update to the active queue (S[0]) only changes its count and, when it
 // reaches zero, empties it; an update to any other queue wipes that queue's old entry from every
-// buffer and enters the new importance at the top (C[0]). Every rank compares its comparison
-// buffer with its selected buffer: the larger stays, the smaller moves to the next rank's
-// comparison buffer, so entries filter down one rank per cycle, several in flight at once. S[0] is
-// the active queue and counts as infinite. Whenever S[0] is left empty (the active queue emptied,
-// or none is active) all ranks move up one.
+// buffer and enters the new importance at the top (C[0]). In every other cycle (a slot cycle) a
+// background scan of the counters re-offers its queue at the top if that queue is non-empty, not
+// held, and would fit (larger than the last rank's entry, or that is empty), so no queue that fell
+// off the last rank is forgotten. Every rank compares its
+// comparison buffer with its selected buffer: the larger stays, the smaller moves to the next
+// rank's comparison buffer, so entries filter down one rank per cycle, several in flight at once.
+// S[0] is the active queue and counts as infinite. An empty selected buffer with entries below it
+// (an open hole) lets entries in flight pass, and the topmost hole closes in the same cycle: the
+// ranks from it down move up one (from rank 0 when the active queue empties or none is active).
 //
 // Lockstep wrapper: the state advances only on an input transfer and the registered state is the
 // output item (one per input, latency 1); in_ready is low while that output is stalled, so random
@@ -19,7 +23,9 @@ module gicube_sorter #(
   /// Queue number width, 1..8; 2^QueueW queues.
   parameter int unsigned QueueW = 7,
   /// Importance width, 2..24, U(ImpW.0).
-  parameter int unsigned ImpW   = 16
+  parameter int unsigned ImpW   = 16,
+  /// Importance of a full queue (256 rays in [371]); 1..2^ImpW-1, so a full queue never saturates.
+  parameter int unsigned QueueLen = 256
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -35,8 +41,8 @@ module gicube_sorter #(
   output logic out_valid_o,
   /// Consumer takes the state this cycle.
   input  logic out_ready_i,
-  /// emptied, shifted, dropped, imp_q (ImpW), then S[r], C[r] for r = 0..Ranks-1, each valid,
-  /// queue, importance (LSB first); empty buffers are all zeros.
+  /// emptied, shifted, dropped, offered, imp_q (ImpW), scan (QueueW), then S[r], C[r] for
+  /// r = 0..Ranks-1, each valid, queue, importance (LSB first); empty buffers are all zeros.
   output logic [gicube_pkg::sorter_out_w(Ranks, QueueW, ImpW)-1:0] out_data_o
 );
 
@@ -45,7 +51,7 @@ module gicube_sorter #(
   localparam int unsigned SumW   = ImpW + 2;
   localparam int unsigned EntryW = gicube_pkg::sorter_entry_w(QueueW, ImpW);
   localparam int unsigned OutW   = gicube_pkg::sorter_out_w(Ranks, QueueW, ImpW);
-  localparam int unsigned RankLsb = 3 + ImpW;  // first bit of S[0] in the output
+  localparam int unsigned RankLsb = 4 + ImpW + QueueW;  // first bit of S[0] in the output
 
   // Elaboration checks mirror SorterConfig::validate in the model.
   if (QueueW < 1 || QueueW > 8) begin : gen_bad_queue_w
@@ -59,6 +65,9 @@ module gicube_sorter #(
   end
   if (ImpW < 2 || ImpW > 24) begin : gen_bad_imp_w
     $fatal(1, "gicube_sorter: ImpW must be 2..24");
+  end
+  if (QueueLen < 1 || QueueLen > (1 << ImpW) - 1) begin : gen_bad_queue_len
+    $fatal(1, "gicube_sorter: ImpW cannot count a full queue of QueueLen (QueueLen > 2^ImpW - 1)");
   end
 
   // ---------------------------------------------------------------------------
@@ -80,13 +89,14 @@ module gicube_sorter #(
   assign val = in_data_i[2 + QueueW +: ValW];
 
   // ---------------------------------------------------------------------------
-  // State: counters, and per rank the selected (s*) and comparison (c*) buffers
+  // State: counters, the scan pointer, and per rank the selected (s*) and comparison (c*) buffers
   // ---------------------------------------------------------------------------
   logic [Queues*ImpW-1:0] cnt_q, cnt_d;
+  logic [QueueW-1:0]       scan_q, scan_d;
   logic [Ranks-1:0]        sv_q, sv_d, cv_q, cv_d;          // valids
   logic [Ranks*QueueW-1:0] sq_q, sq_d, cq_q, cq_d;          // queue numbers
   logic [Ranks*ImpW-1:0]   si_q, si_d, ci_q, ci_d;          // importances
-  logic                    emptied_q, shifted_q, dropped_q;
+  logic                    emptied_q, shifted_q, dropped_q, offered_q;
   logic [ImpW-1:0]         impq_q, impq_d;
 
   // ---------------------------------------------------------------------------
@@ -121,7 +131,7 @@ module gicube_sorter #(
   // ---------------------------------------------------------------------------
   // Classify: the active queue's own update, or a modified importance for another queue
   // ---------------------------------------------------------------------------
-  logic hit_active, emptied, touch, tok_v;
+  logic hit_active, emptied, touch;
 
   // For the active queue the counter is also in S[0] (its entry shows the live count), so whether
   // it empties is decided from si_q[0], off the path through the counter read multiplexer.
@@ -131,15 +141,49 @@ module gicube_sorter #(
                     + {val[ValW-1], val};
   assign hit_active = upd && sv_q[0] && (sq_q[0 +: QueueW] == qin);
   assign emptied    = hit_active && (sum_active[SumW-1] || sum_active == '0);
-  assign touch      = upd && !hit_active;     // wipe the old copy ...
-  assign tok_v      = touch && (newv != '0);  // ... and enter the new importance at the top
+  assign touch      = upd && !hit_active;     // wipe the old copy, maybe enter the new importance
 
   // ---------------------------------------------------------------------------
-  // Every rank: wipe, then compare C[r] with S[r]
+  // Re-offer: in a slot cycle the scan offers its queue if it is non-empty and not held
+  // ---------------------------------------------------------------------------
+  logic            slot, scan_held, offer;
+  logic [ImpW-1:0] scan_cnt;
+
+  assign scan_cnt = cnt_q[scan_q*ImpW +: ImpW];  // second read port on the counters
+
+  always_comb begin
+    scan_held = 1'b0;
+    for (int unsigned r = 0; r < Ranks; r++) begin
+      scan_held = scan_held || (sv_q[r] && sq_q[r*QueueW +: QueueW] == scan_q)
+                            || (cv_q[r] && cq_q[r*QueueW +: QueueW] == scan_q);
+    end
+  end
+
+  // It would fit: the last rank's selected buffer is empty or holds a smaller importance.
+  logic scan_fits;
+
+  assign scan_fits = !sv_q[Ranks-1] || (scan_cnt > si_q[(Ranks-1)*ImpW +: ImpW]);
+  assign slot      = !touch && !emptied;
+  assign offer     = slot && (scan_cnt != '0) && !scan_held && scan_fits;
+  assign scan_d = slot ? scan_q + QueueW'(1) : scan_q;  // wraps at Q = 2^QueueW
+
+  // The token entering C[0]: the update's new importance, or the re-offered queue.
+  logic              tok_v;
+  logic [QueueW-1:0] tok_q;
+  logic [ImpW-1:0]   tok_i;
+
+  assign tok_v = (touch && newv != '0) || offer;
+  assign tok_q = touch ? qin  : scan_q;
+  assign tok_i = touch ? newv : scan_cnt;
+
+  // ---------------------------------------------------------------------------
+  // Every rank: wipe, then compare C[r] with S[r]; open holes pass their entry down
   // ---------------------------------------------------------------------------
   logic [Ranks-1:0]        s_live, c_live;   // valids after the wipe
+  logic [Ranks-1:0]        below;            // some buffer below rank r holds an entry
+  logic [Ranks-1:0]        hole;             // open hole: S[r] empty with entries below
   logic [Ranks-1:0]        c_wins;           // C[r] takes S'[r]
-  logic [Ranks-1:0]        keep_v, down_v;   // S'[r] and the entry sent to C'[r+1]
+  logic [Ranks-1:0]        keep_v, down_v;   // S'[r] and the entry D[r] sent down
   logic [Ranks*QueueW-1:0] keep_q, down_q;
   logic [Ranks*ImpW-1:0]   keep_i, down_i;
 
@@ -147,17 +191,39 @@ module gicube_sorter #(
     for (int unsigned r = 0; r < Ranks; r++) begin
       s_live[r] = sv_q[r] && !(touch && sq_q[r*QueueW +: QueueW] == qin);
       c_live[r] = cv_q[r] && !(touch && cq_q[r*QueueW +: QueueW] == qin);
+    end
+  end
+
+  for (genvar r = 0; r < Ranks; r++) begin : gen_below
+    if (r + 1 < Ranks) begin : gen_some
+      assign below[r] = |(s_live[Ranks-1:r+1] | c_live[Ranks-1:r+1]);
+    end else begin : gen_last
+      assign below[r] = 1'b0;
+    end
+  end
+
+  always_comb begin
+    for (int unsigned r = 0; r < Ranks; r++) begin
+      hole[r] = (r != 0) && !s_live[r] && below[r];
       if (r == 0) begin
-        // S[0] is the active queue (infinite): C[0] takes S'[0] only if S[0] is empty.
+        // S[0] is the active queue (infinite): C[0] takes S'[0] only if S[0] is empty, and
+        // otherwise goes down uncompared.
         c_wins[r] = !s_live[r];
+        keep_v[r] = s_live[r] || c_live[r];
+        down_v[r] = s_live[r] && c_live[r];
+      end else if (hole[r]) begin
+        c_wins[r] = 1'b0;
+        keep_v[r] = 1'b0;
+        down_v[r] = c_live[r];
       end else begin
         // Ties keep the incumbent: C wins only when strictly larger.
         c_wins[r] = !s_live[r] || (c_live[r] && ci_q[r*ImpW +: ImpW] > si_q[r*ImpW +: ImpW]);
+        keep_v[r] = s_live[r] || c_live[r];
+        down_v[r] = s_live[r] && c_live[r];
       end
-      keep_v[r] = s_live[r] || c_live[r];
-      down_v[r] = s_live[r] && c_live[r];
       keep_q[r*QueueW +: QueueW] = c_wins[r] ? cq_q[r*QueueW +: QueueW] : sq_q[r*QueueW +: QueueW];
       keep_i[r*ImpW +: ImpW]     = c_wins[r] ? ci_q[r*ImpW +: ImpW]     : si_q[r*ImpW +: ImpW];
+      // An open hole sends its C down (c_wins is 0 there, so the C data are picked).
       down_q[r*QueueW +: QueueW] = c_wins[r] ? sq_q[r*QueueW +: QueueW] : cq_q[r*QueueW +: QueueW];
       down_i[r*ImpW +: ImpW]     = c_wins[r] ? si_q[r*ImpW +: ImpW]     : ci_q[r*ImpW +: ImpW];
     end
@@ -171,12 +237,34 @@ module gicube_sorter #(
   end
 
   // ---------------------------------------------------------------------------
-  // Next state: shift up one rank when S'[0] is empty, else entries move down one rank
+  // Shift up from rank h: rank 0 when S'[0] is empty, else the topmost open hole
   // ---------------------------------------------------------------------------
-  logic shift, dropped;
+  logic [Ranks-1:0] closable;  // rank r can be h
+  logic [Ranks-1:0] up;        // r >= h: rank r takes the results of rank r + 1
+  logic [Ranks-1:0] at_h;      // r == h
+  logic             shift, dropped;
 
-  assign shift   = !keep_v[0];
-  assign dropped = down_v[Ranks-1] && !shift;
+  // D[r-1] at position r (nothing comes from above rank 0).
+  logic [Ranks-1:0]        above_v;
+  logic [Ranks*QueueW-1:0] above_q;
+  logic [Ranks*ImpW-1:0]   above_i;
+
+  assign above_v = {down_v[Ranks-2:0], 1'b0};
+  assign above_q = {down_q[(Ranks-1)*QueueW-1:0], QueueW'(0)};
+  assign above_i = {down_i[(Ranks-1)*ImpW-1:0], ImpW'(0)};
+
+  assign closable = {hole[Ranks-1:1], !keep_v[0]};
+
+  for (genvar r = 0; r < Ranks; r++) begin : gen_up
+    assign up[r] = |closable[r:0];
+  end
+
+  assign at_h = up & ~{up[Ranks-2:0], 1'b0};
+
+  assign shift   = up[Ranks-1];
+  // An entry leaves: off the last rank without a shift, or at the hole when two entries in flight
+  // would share its comparison buffer (the one that passed the hole leaves; the scan re-offers it).
+  assign dropped = (down_v[Ranks-1] && !shift) || |(at_h & above_v & down_v);
 
   always_comb begin
     sv_d = '0;
@@ -186,46 +274,42 @@ module gicube_sorter #(
     cq_d = down_q;
     ci_d = down_i;
     for (int unsigned r = 0; r < Ranks; r++) begin
-      if (shift) begin
+      if (!up[r]) begin
+        sv_d[r]                  = keep_v[r];
+        sq_d[r*QueueW +: QueueW] = keep_q[r*QueueW +: QueueW];
+        si_d[r*ImpW +: ImpW]     = keep_i[r*ImpW +: ImpW];
+        cv_d[r]                  = above_v[r];
+        cq_d[r*QueueW +: QueueW] = above_q[r*QueueW +: QueueW];
+        ci_d[r*ImpW +: ImpW]     = above_i[r*ImpW +: ImpW];
+      end else begin
         if (r + 1 < Ranks) begin
           sv_d[r]                  = keep_v[r+1];
           sq_d[r*QueueW +: QueueW] = keep_q[(r+1)*QueueW +: QueueW];
           si_d[r*ImpW +: ImpW]     = keep_i[(r+1)*ImpW +: ImpW];
-        end else begin
-          sv_d[r]                  = 1'b0;
-          sq_d[r*QueueW +: QueueW] = keep_q[r*QueueW +: QueueW];
-          si_d[r*ImpW +: ImpW]     = keep_i[r*ImpW +: ImpW];
         end
-        cv_d[r]                  = down_v[r];
-        cq_d[r*QueueW +: QueueW] = down_q[r*QueueW +: QueueW];
-        ci_d[r*ImpW +: ImpW]     = down_i[r*ImpW +: ImpW];
-      end else begin
-        sv_d[r]                  = keep_v[r];
-        sq_d[r*QueueW +: QueueW] = keep_q[r*QueueW +: QueueW];
-        si_d[r*ImpW +: ImpW]     = keep_i[r*ImpW +: ImpW];
-        if (r == 0) begin
-          cv_d[r]                  = 1'b0;
+        if (at_h[r] && above_v[r]) begin
+          // The hole's comparison buffer takes the entry from above; D[r], if any, leaves.
+          cv_d[r]                  = 1'b1;
+          cq_d[r*QueueW +: QueueW] = above_q[r*QueueW +: QueueW];
+          ci_d[r*ImpW +: ImpW]     = above_i[r*ImpW +: ImpW];
+        end else begin
+          cv_d[r]                  = down_v[r];
           cq_d[r*QueueW +: QueueW] = down_q[r*QueueW +: QueueW];
           ci_d[r*ImpW +: ImpW]     = down_i[r*ImpW +: ImpW];
-        end else begin
-          cv_d[r]                  = down_v[r-1];
-          cq_d[r*QueueW +: QueueW] = down_q[(r-1)*QueueW +: QueueW];
-          ci_d[r*ImpW +: ImpW]     = down_i[(r-1)*ImpW +: ImpW];
         end
       end
     end
-    // The token enters C[0] (never together with an entry shifted up from C'[1]). Its data are
-    // loaded on every update to a non-active queue (C[0] then holds nothing else: rank 0 sends an
-    // entry down only while a queue is active), its valid only when the new importance is not 0.
-    if (touch) begin
-      cv_d[0]           = tok_v;
-      cq_d[0 +: QueueW] = qin;
-      ci_d[0 +: ImpW]   = newv;
+    // The token enters C[0] (never together with D[0], which reaches C[0] only in the cycle
+    // the active queue empties: no update token then, and not a slot cycle).
+    if (tok_v) begin
+      cv_d[0]           = 1'b1;
+      cq_d[0 +: QueueW] = tok_q;
+      ci_d[0 +: ImpW]   = tok_i;
     end
   end
 
   // ---------------------------------------------------------------------------
-  // Registers: valids, counters and the output valid reset; datapath not
+  // Registers: valids, counters, the scan pointer and the output valid reset; datapath not
   // ---------------------------------------------------------------------------
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -233,12 +317,14 @@ module gicube_sorter #(
       sv_q        <= '0;
       cv_q        <= '0;
       cnt_q       <= '0;
+      scan_q      <= '0;
     end else begin
       out_valid_q <= out_valid_d;
       if (in_fire) begin
-        sv_q  <= sv_d;
-        cv_q  <= cv_d;
-        cnt_q <= cnt_d;
+        sv_q   <= sv_d;
+        cv_q   <= cv_d;
+        cnt_q  <= cnt_d;
+        scan_q <= scan_d;
       end
     end
   end
@@ -252,6 +338,7 @@ module gicube_sorter #(
       emptied_q <= emptied;
       shifted_q <= shift;
       dropped_q <= dropped;
+      offered_q <= offer;
       impq_q    <= impq_d;
     end
   end
@@ -266,7 +353,9 @@ module gicube_sorter #(
     state[0] = emptied_q;
     state[1] = shifted_q;
     state[2] = dropped_q;
-    state[3 +: ImpW] = impq_q;
+    state[3] = offered_q;
+    state[4 +: ImpW] = impq_q;
+    state[4 + ImpW +: QueueW] = scan_q;
     for (int unsigned r = 0; r < Ranks; r++) begin
       state[RankLsb + (2*r)*EntryW +: EntryW] =
           sv_q[r] ? {si_q[r*ImpW +: ImpW], sq_q[r*QueueW +: QueueW], 1'b1} : '0;
@@ -303,16 +392,20 @@ module gicube_sorter #(
     end
   end
 
-  // Rank 0 sends an entry down only while a queue is active; S'[0] is then empty only if that
-  // queue emptied, which is an update to it and makes no token.
+  // D[0] reaches C[0] only in the cycle the active queue empties, which makes no token.
   TokenNeverMeetsShiftedEntry: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      in_fire |-> !(shift && tok_v && down_v[0]))
+      in_fire |-> !(up[0] && down_v[0] && tok_v))
     else $error("gicube_sorter: a token and a shifted-up entry collide in C[0]");
 
   // An active queue is never wiped: its updates make no token.
   ActiveQueueNeverWiped: assert property (@(posedge clk_i) disable iff (!rst_ni)
       in_fire && sv_q[0] |-> s_live[0])
     else $error("gicube_sorter: the active queue was wiped");
+
+  // The scan only offers a queue that no buffer holds: every queue is held at most once.
+  OfferIsNotHeld: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      in_fire && offer |-> !touch && !scan_held)
+    else $error("gicube_sorter: the scan offered a queue that is held");
 `endif
 
 endmodule

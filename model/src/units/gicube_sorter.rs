@@ -19,27 +19,30 @@ pub struct SorterConfig {
     pub queue_w: u32,
     /// Importance width, `U(ImpW.0)`.
     pub imp_w: u32,
+    /// Importance of a full queue (256 rays in [371]); must not exceed `ImpMax`.
+    pub queue_len: u32,
 }
 
 impl SorterConfig {
-    /// Narrow: 8 ranks, 16 queues, 8-bit importances.
-    pub const R8: Self = Self {
-        ranks: 8,
-        queue_w: 4,
-        imp_w: 8,
-    };
-    /// Default: 32 ranks over the 128 queues of [371], 16-bit importances.
-    pub const R32: Self = Self {
+    /// Rays per queue in the patent's reference design [371].
+    pub const PATENT_QUEUE_LEN: u32 = 256;
+    /// The RTL's parameter defaults: 32 ranks over the 128 queues of [371], 16-bit importances.
+    /// The verified configurations are the lines of `rtl/gicube/gicube_sorter.variants`: tests
+    /// and benches build theirs from the variant table (`UnitConfig::from_params`), never from a
+    /// copy here.
+    pub const DEFAULT: Self = Self {
         ranks: 32,
         queue_w: 7,
         imp_w: 16,
+        queue_len: Self::PATENT_QUEUE_LEN,
     };
 
-    pub fn new(ranks: u32, queue_w: u32, imp_w: u32) -> Result<Self> {
+    pub fn new(ranks: u32, queue_w: u32, imp_w: u32, queue_len: u32) -> Result<Self> {
         let cfg = Self {
             ranks,
             queue_w,
             imp_w,
+            queue_len,
         };
         cfg.validate()?;
         Ok(cfg)
@@ -62,6 +65,14 @@ impl SorterConfig {
         }
         if !(2..=24).contains(&self.imp_w) {
             return bad(format!("ImpW {} outside 2..=24", self.imp_w));
+        }
+        if !(1..=self.imp_max()).contains(&self.queue_len) {
+            return bad(format!(
+                "QueueLen {} outside 1..={} (ImpW {} cannot count a full queue)",
+                self.queue_len,
+                self.imp_max(),
+                self.imp_w
+            ));
         }
         Ok(())
     }
@@ -89,6 +100,17 @@ impl SorterConfig {
     /// Bits of one buffer in the output: valid, queue, importance.
     pub fn entry_w(&self) -> u32 {
         1 + self.queue_w + self.imp_w
+    }
+
+    /// `Settle = 2R`: cycles without a token after which nothing is in flight and the list has
+    /// no gap.
+    pub fn settle(&self) -> u32 {
+        2 * self.ranks
+    }
+
+    /// The documented bound on the idle cycles of one idle stretch while rays remain: `Q + R + 1`.
+    pub fn idle_stretch_bound(&self) -> u32 {
+        self.queues() + self.ranks + 1
     }
 }
 
@@ -169,8 +191,12 @@ pub struct SorterState {
     pub emptied: bool,
     pub shifted: bool,
     pub dropped: bool,
+    /// The scan re-offered a queue that was not held (its token is in `C[0]`).
+    pub offered: bool,
     /// The counter of the item's queue after the cycle.
     pub imp_q: u32,
+    /// The re-offer pointer after the cycle.
+    pub scan: u32,
     pub ranks: Vec<RankState>,
 }
 
@@ -178,6 +204,46 @@ impl SorterState {
     /// The active queue (`S[0]`).
     pub fn active(&self) -> Option<Entry> {
         self.ranks[0].sel
+    }
+
+    /// Whether some buffer holds queue `q`.
+    pub fn holds(&self, q: u32) -> bool {
+        self.ranks
+            .iter()
+            .flat_map(|r| [r.sel, r.cmp])
+            .any(|b| b.is_some_and(|e| e.queue == q))
+    }
+
+    /// Nothing in flight and the selected list gap-free from `S[0]` (the settled shape).
+    pub fn settled_shape(&self) -> std::result::Result<(), String> {
+        if let Some(r) = self.ranks.iter().position(|r| r.cmp.is_some()) {
+            return Err(format!("C[{r}] still in flight"));
+        }
+        for r in 0..self.ranks.len().saturating_sub(1) {
+            if self.ranks[r].sel.is_none() && self.ranks[r + 1].sel.is_some() {
+                return Err(format!("gap at S[{r}]"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The non-empty `S[1..R)` in non-increasing order of importance.
+    pub fn list_sorted(&self) -> std::result::Result<(), String> {
+        let mut prev: Option<Entry> = None;
+        for (r, e) in self.ranks.iter().enumerate().skip(1) {
+            if let Some(e) = e.sel {
+                if let Some(p) = prev {
+                    if e.imp > p.imp {
+                        return Err(format!(
+                            "S[{r}] = queue {} ({}) below a smaller queue {} ({})",
+                            e.queue, e.imp, p.queue, p.imp
+                        ));
+                    }
+                }
+                prev = Some(e);
+            }
+        }
+        Ok(())
     }
 }
 
@@ -188,6 +254,7 @@ pub struct Sorter {
     imp: Vec<u32>,
     sel: Vec<Option<Entry>>,
     cmp: Vec<Option<Entry>>,
+    scan: u32,
 }
 
 impl Sorter {
@@ -199,6 +266,7 @@ impl Sorter {
             imp: vec![0; cfg.queues() as usize],
             sel: vec![None; r],
             cmp: vec![None; r],
+            scan: 0,
         })
     }
 
@@ -211,9 +279,32 @@ impl Sorter {
         self.imp[(q & (self.cfg.queues() - 1)) as usize]
     }
 
+    /// All counters.
+    pub fn counters(&self) -> &[u32] {
+        &self.imp
+    }
+
     /// The active queue (`S[0]`), if any.
     pub fn active(&self) -> Option<Entry> {
         self.sel[0]
+    }
+
+    /// The re-offer pointer.
+    pub fn scan(&self) -> u32 {
+        self.scan
+    }
+
+    /// Whether some buffer holds queue `q`.
+    pub fn holds(&self, q: u32) -> bool {
+        self.sel
+            .iter()
+            .chain(&self.cmp)
+            .any(|b| b.is_some_and(|e| e.queue == q))
+    }
+
+    /// No buffer holds anything.
+    pub fn is_empty(&self) -> bool {
+        self.sel.iter().chain(&self.cmp).all(Option::is_none)
     }
 
     /// `clamp(x) = min(max(x, 0), ImpMax)`.
@@ -221,10 +312,11 @@ impl Sorter {
         x.clamp(0, i64::from(self.cfg.imp_max())) as u32
     }
 
-    /// One logical cycle (steps 1-5 of the contract).
+    /// One logical cycle (steps 1-6 of the contract).
     pub fn step(&mut self, item: &SorterIn) -> SorterState {
         let r_n = self.cfg.ranks as usize;
-        let q = (item.queue & (self.cfg.queues() - 1)) as usize;
+        let q_n = self.cfg.queues();
+        let q = (item.queue & (q_n - 1)) as usize;
         let value = item
             .value
             .clamp(self.cfg.val_range().0, self.cfg.val_range().1);
@@ -242,18 +334,22 @@ impl Sorter {
             self.imp[q] = new;
         }
 
-        // 2. Classify: the active queue's own update, or a modified importance that wipes and
-        //    enters at the top.
+        // 2. Classify: the active queue's own update, or a modified importance that wipes its old
+        //    copy and makes an update token.
         let hit_active = upd && self.sel[0].is_some_and(|e| e.queue as usize == q);
-        let mut emptied = false;
-        let mut token = None;
+        let emptied = hit_active && new == 0;
+        let touch = upd && !hit_active;
+        // Held at the start of the cycle (a slot cycle wipes nothing, so after the wipe is the same),
+        // and whether it would fit: the last rank's selected buffer is empty or smaller.
+        let scan_held = self.holds(self.scan);
+        let scan_fits = self.sel[r_n - 1].is_none_or(|e| self.imp[self.scan as usize] > e.imp);
         if hit_active {
-            if new == 0 {
-                emptied = true;
-            } else if let Some(e) = self.sel[0].as_mut() {
+            if let Some(e) = self.sel[0].as_mut() {
                 e.imp = new;
             }
-        } else if upd {
+        }
+        let mut token = None;
+        if touch {
             for buf in self.sel.iter_mut().chain(self.cmp.iter_mut()) {
                 if buf.is_some_and(|e| e.queue as usize == q) {
                     *buf = None;
@@ -267,56 +363,98 @@ impl Sorter {
             }
         }
 
-        // 3. Compare at every rank; `down[r]` is what rank r sends to C'[r+1].
-        let mut sel_next = vec![None; r_n];
-        let mut down = vec![None; r_n];
+        // 3. Re-offer: in a slot cycle the scan offers its queue if it is non-empty and not held.
+        let slot = !touch && !emptied;
+        let mut offered = false;
+        if slot {
+            let p = self.scan;
+            if self.imp[p as usize] != 0 && !scan_held && scan_fits {
+                token = Some(Entry {
+                    queue: p,
+                    imp: self.imp[p as usize],
+                });
+                offered = true;
+            }
+            self.scan = (p + 1) % q_n;
+        }
+
+        // 4. Compare at every rank; open holes pass their entry in flight down.
+        let mut below = vec![false; r_n]; // some Sw[j] or Cw[j], j > r, holds an entry
+        for r in (0..r_n - 1).rev() {
+            below[r] = below[r + 1] || self.sel[r + 1].is_some() || self.cmp[r + 1].is_some();
+        }
+        let hole = |r: usize| r >= 1 && self.sel[r].is_none() && below[r];
+        let mut s1 = vec![None; r_n];
+        let mut d = vec![None; r_n];
         if self.sel[0].is_some() {
-            sel_next[0] = self.sel[0];
-            down[0] = self.cmp[0];
+            s1[0] = self.sel[0];
+            d[0] = self.cmp[0];
         } else {
-            sel_next[0] = self.cmp[0];
+            s1[0] = self.cmp[0];
         }
         for r in 1..r_n {
-            (sel_next[r], down[r]) = match (self.cmp[r], self.sel[r]) {
-                (Some(c), Some(s)) if c.imp > s.imp => (Some(c), Some(s)),
-                (Some(c), Some(s)) => (Some(s), Some(c)),
-                (Some(c), None) => (Some(c), None),
-                (None, s) => (s, None),
+            (s1[r], d[r]) = if hole(r) {
+                (None, self.cmp[r])
+            } else {
+                match (self.cmp[r], self.sel[r]) {
+                    (Some(c), Some(s)) if c.imp > s.imp => (Some(c), Some(s)),
+                    (Some(c), Some(s)) => (Some(s), Some(c)),
+                    (Some(c), None) => (Some(c), None),
+                    (None, s) => (s, None),
+                }
             };
         }
 
-        // 4. Emptied.
+        // 5. Emptied.
         if emptied {
-            sel_next[0] = None;
+            s1[0] = None;
         }
 
-        // 5. Shift up when the top is empty; otherwise the bottom's loser falls off.
-        let shifted = sel_next[0].is_none();
-        let mut dropped = false;
-        if shifted {
-            debug_assert!(
-                down[0].is_none() || token.is_none(),
-                "C'[1] and a token at once"
-            );
-            for r in 0..r_n {
-                self.sel[r] = if r + 1 < r_n { sel_next[r + 1] } else { None };
-                self.cmp[r] = down[r];
-            }
-            if token.is_some() {
-                self.cmp[0] = token;
-            }
+        // 6. Close a hole: shift up from rank h.
+        let h = if s1[0].is_none() {
+            Some(0)
         } else {
-            dropped = down[r_n - 1].is_some();
-            self.sel.copy_from_slice(&sel_next);
+            (1..r_n).find(|&r| hole(r))
+        };
+        let dropped;
+        match h {
+            Some(h) => {
+                // Two entries in flight for the hole's comparison buffer: the one that passed the
+                // hole leaves (its queue is re-offered by the scan).
+                dropped = h > 0 && d[h - 1].is_some() && d[h].is_some();
+                for r in 0..r_n {
+                    if r < h {
+                        self.sel[r] = s1[r];
+                        self.cmp[r] = if r == 0 { None } else { d[r - 1] };
+                    } else {
+                        self.sel[r] = if r + 1 < r_n { s1[r + 1] } else { None };
+                        self.cmp[r] = if r > h || r == 0 {
+                            d[r]
+                        } else {
+                            d[r - 1].or(d[r])
+                        };
+                    }
+                }
+            }
+            None => {
+                dropped = d[r_n - 1].is_some();
+                self.sel.copy_from_slice(&s1);
+                self.cmp[0] = None;
+                self.cmp[1..r_n].copy_from_slice(&d[..r_n - 1]);
+            }
+        }
+        if token.is_some() {
+            debug_assert!(self.cmp[0].is_none(), "a token meets D[0] in C[0]");
             self.cmp[0] = token;
-            self.cmp[1..r_n].copy_from_slice(&down[..r_n - 1]);
         }
 
         SorterState {
             emptied,
-            shifted,
+            shifted: h.is_some(),
             dropped,
+            offered,
             imp_q: self.imp[q],
+            scan: self.scan,
             ranks: self
                 .sel
                 .iter()
@@ -348,6 +486,15 @@ impl Sorter {
                 ));
             }
         }
+        let mut prev: Option<Entry> = None;
+        for (r, e) in self.sel.iter().enumerate().skip(1) {
+            if let Some(e) = *e {
+                if prev.is_some_and(|p| e.imp > p.imp) {
+                    return Err(format!("S[{r}] (queue {}) above its rank's order", e.queue));
+                }
+                prev = Some(e);
+            }
+        }
         Ok(())
     }
 }
@@ -364,6 +511,7 @@ impl StreamUnit for Sorter {
         self.imp.fill(0);
         self.sel.fill(None);
         self.cmp.fill(None);
+        self.scan = 0;
     }
 }
 
@@ -376,7 +524,7 @@ impl StreamCodec for SorterConfig {
     }
 
     fn out_width(&self) -> u32 {
-        3 + self.imp_w + 2 * self.ranks * self.entry_w()
+        4 + self.imp_w + self.queue_w + 2 * self.ranks * self.entry_w()
     }
 
     fn pack_in(&self, item: &SorterIn) -> Vec<u32> {
@@ -399,7 +547,9 @@ impl StreamCodec for SorterConfig {
         let emptied = r.get_bool();
         let shifted = r.get_bool();
         let dropped = r.get_bool();
+        let offered = r.get_bool();
         let imp_q = r.get(self.imp_w) as u32;
+        let scan = r.get(self.queue_w) as u32;
         let entry = |r: &mut BitReader| {
             let valid = r.get_bool();
             let queue = r.get(self.queue_w) as u32;
@@ -429,7 +579,9 @@ impl StreamCodec for SorterConfig {
             emptied,
             shifted,
             dropped,
+            offered,
             imp_q,
+            scan,
             ranks,
         }
     }
@@ -620,6 +772,10 @@ enum Phase {
     Max,
     /// Every queue set to 0 in turn (then the sorter is empty).
     Clear(u32),
+    /// No updates (no-ops probing the counters): the sorter settles.
+    Quiet,
+    /// End of a frame: no arrivals, the active queue loses rays until every queue is empty.
+    Frame,
 }
 
 /// Random update traffic for the co-simulation: phases of mixed updates, bursts on one queue,
@@ -660,7 +816,15 @@ impl SorterTraffic {
                 40..=54 => Phase::Burst(rng.random_range(0..q_n)),
                 55..=74 => Phase::Drain,
                 75..=84 => Phase::Ties(rng.random_range(1..=4)),
-                85..=94 => Phase::Max,
+                85..=89 => Phase::Max,
+                90..=93 => {
+                    self.left = 2 * self.cfg.settle() + rng.random_range(0..8);
+                    Phase::Quiet
+                }
+                94..=95 => {
+                    self.left = 8 * q_n + rng.random_range(0..64);
+                    Phase::Frame
+                }
                 _ => {
                     self.left = q_n + rng.random_range(0..8);
                     Phase::Clear(0)
@@ -720,6 +884,17 @@ impl SorterTraffic {
                 4 => SorterIn::set(any_q(rng), vmax),
                 _ => SorterIn::add(active.unwrap_or(any_q(rng)), -1),
             },
+            Phase::Quiet => SorterIn {
+                queue: any_q(rng),
+                ..SorterIn::NOOP
+            },
+            Phase::Frame => match active {
+                Some(a) => SorterIn::add(a, if rng.random_bool(0.9) { -1 } else { -2 }),
+                None => SorterIn {
+                    queue: any_q(rng),
+                    ..SorterIn::NOOP
+                },
+            },
             Phase::Clear(next) => {
                 if next < q_n {
                     self.phase = Phase::Clear(next + 1);
@@ -758,6 +933,9 @@ pub struct Workload {
     pub hot: f64,
     pub hot_queues: u32,
     pub weight: i32,
+    /// End of the frame: from this cycle on no ray arrives and the active queue loses a ray
+    /// every cycle (a `Noop` when no queue is active).
+    pub stop: Option<u64>,
 }
 
 impl Workload {
@@ -789,12 +967,36 @@ impl Workload {
             hot,
             hot_queues: hot_queues.clamp(1, cfg.queues()),
             weight,
+            stop: None,
         })
+    }
+
+    /// Arrivals stop at cycle `stop` (the end of the frame).
+    pub fn with_stop(mut self, stop: u64) -> Self {
+        self.stop = Some(stop);
+        self
+    }
+
+    /// The shadow model that steers the workload (the sorter's state after the last item).
+    pub fn shadow(&self) -> &Sorter {
+        &self.shadow
     }
 
     pub fn next_item(&mut self, rng: &mut impl Rng) -> SorterIn {
         let loading = self.cycle < self.preload;
+        let stopped = self.stop.is_some_and(|s| self.cycle >= s);
         self.cycle += 1;
+        if stopped {
+            let item = match self.shadow.active() {
+                Some(a) => {
+                    let left = self.shadow.importance(a.queue) as i32;
+                    SorterIn::add(a.queue, -left.min((self.weight + 1) / 2))
+                }
+                None => SorterIn::NOOP,
+            };
+            self.shadow.step(&item);
+            return item;
+        }
         let item = match self.shadow.active() {
             Some(a) if !loading && rng.random_bool(self.drain) => {
                 let left = self.shadow.importance(a.queue) as i32;
@@ -814,11 +1016,216 @@ impl Workload {
     }
 }
 
-// The RTL parameters of this unit (the RTL defaults are the model's `R32`).
-crate::unit_config!(SorterConfig, "gicube_sorter", R32, {
+// ---------------------------------------------------------------------------------------------
+// The guarantees of the contract, checked every cycle; end-of-frame drains
+// ---------------------------------------------------------------------------------------------
+
+/// Checks the contract's guarantees on the state after every cycle: the selected list in order,
+/// the settled shape after `Settle` cycles without a token, and every non-empty queue that is not
+/// held re-offered within `Q` slot cycles. Fed the item, the active queue before the cycle, the
+/// state after it and the counters after it.
+#[derive(Debug, Clone)]
+pub struct SorterWatch {
+    cfg: SorterConfig,
+    /// Cycles since a token last entered.
+    quiet: u32,
+    /// Per queue: consecutive slot cycles spent non-empty, not held and fitting.
+    wait: Vec<u32>,
+    /// `S[R-1]` after the previous cycle (what the next cycle's offer compares with).
+    last: Option<Entry>,
+    /// Settled states checked, and the longest wait seen.
+    pub settled_checks: u64,
+    pub max_wait: u32,
+    /// Drops while at most `R` queues were non-empty.
+    pub drops_with_room: u64,
+    pub cycles: u64,
+}
+
+impl SorterWatch {
+    pub fn new(cfg: SorterConfig) -> Self {
+        Self {
+            cfg,
+            quiet: 0,
+            wait: vec![0; cfg.queues() as usize],
+            last: None,
+            settled_checks: 0,
+            max_wait: 0,
+            drops_with_room: 0,
+            cycles: 0,
+        }
+    }
+
+    /// After a reset of the unit.
+    pub fn reset(&mut self) {
+        self.quiet = 0;
+        self.wait.fill(0);
+        self.last = None;
+    }
+
+    pub fn observe(
+        &mut self,
+        item: &SorterIn,
+        active_before: Option<Entry>,
+        st: &SorterState,
+        counters: &[u32],
+    ) -> std::result::Result<(), String> {
+        self.cycles += 1;
+        let q = item.queue & (self.cfg.queues() - 1);
+        let upd = matches!(item.op, SorterOp::Add | SorterOp::Set);
+        let touch = upd && active_before.is_none_or(|a| a.queue != q);
+        let slot = !touch && !st.emptied;
+        let token = (touch && st.imp_q > 0) || st.offered;
+        st.list_sorted()?;
+        self.quiet = if token { 0 } else { self.quiet + 1 };
+        if self.quiet >= self.cfg.settle() {
+            self.settled_checks += 1;
+            st.settled_shape()
+                .map_err(|e| format!("{} cycles without a token: {e}", self.quiet))?;
+        }
+        let mut held = vec![false; counters.len()];
+        for e in st.ranks.iter().flat_map(|r| [r.sel, r.cmp]).flatten() {
+            held[e.queue as usize] = true;
+        }
+        // A queue is waiting while it is non-empty, not held, and would fit (the last rank's
+        // selected buffer is empty or smaller): the scan owes it an offer.
+        let last = self.last;
+        for (k, (&c, &h)) in counters.iter().zip(&held).enumerate() {
+            if c == 0 || h || last.is_some_and(|e| c <= e.imp) {
+                self.wait[k] = 0;
+            } else if slot {
+                self.wait[k] += 1;
+                self.max_wait = self.max_wait.max(self.wait[k]);
+                if self.wait[k] > self.cfg.queues() {
+                    return Err(format!(
+                        "queue {k} (count {c}) not held for {} slot cycles",
+                        self.wait[k]
+                    ));
+                }
+            }
+        }
+        if st.dropped && counters.iter().filter(|&&c| c > 0).count() <= self.cfg.ranks as usize {
+            self.drops_with_room += 1;
+        }
+        self.last = st.ranks[st.ranks.len() - 1].sel;
+        Ok(())
+    }
+}
+
+/// One end-of-frame drain: every queue preloaded (`Set`) with a count, then no arrivals; each
+/// cycle the active queue gives one ray to the pipeline (a `Noop` when none is active), until
+/// the sorter has held nothing and had no active queue for `Q + R + 1` cycles.
+#[derive(Debug, Clone)]
+pub struct DrainFrame {
+    /// Every item of the frame (preload, drain, idle tail), as fed to the unit.
+    pub items: Vec<SorterIn>,
+    /// Rays preloaded, and queues that were not empty.
+    pub rays: u64,
+    pub nonempty: u32,
+    /// Cycles from the first drain item to the departure of the last ray (`rays` if ideal).
+    pub drain_cycles: u64,
+    /// Rays still counted when the sorter went idle (0 by contract).
+    pub rays_left: u64,
+    /// Longest idle stretch while rays remained.
+    pub longest_idle: u64,
+}
+
+impl DrainFrame {
+    /// Cycles beyond one ray per cycle.
+    pub fn overhead(&self) -> u64 {
+        self.drain_cycles - (self.rays - self.rays_left)
+    }
+
+    /// Runs a frame on the model from reset. `counts[q]` rays in queue `q`, preloaded in `order`.
+    pub fn run(cfg: SorterConfig, counts: &[u32], order: &[u32]) -> Result<Self> {
+        Ok(Self::run_on(&mut Sorter::new(cfg)?, counts, order))
+    }
+
+    /// Runs a frame on `s` from its current state (frames back to back: the previous frame left
+    /// it empty, with its scan pointer wherever it stopped).
+    pub fn run_on(s: &mut Sorter, counts: &[u32], order: &[u32]) -> Self {
+        let cfg = s.config();
+        let mut items: Vec<SorterIn> = order
+            .iter()
+            .map(|&q| SorterIn::set(q, counts[q as usize] as i32))
+            .collect();
+        for it in &items {
+            s.step(it);
+        }
+        let rays: u64 = counts.iter().map(|&c| u64::from(c)).sum();
+        let nonempty = counts.iter().filter(|&&c| c > 0).count() as u32;
+        let idle_limit = u64::from(cfg.idle_stretch_bound());
+        let cap = rays + u64::from(nonempty + 1) * idle_limit + 1;
+        let (mut cycles, mut last_ray, mut idle, mut longest, mut quiet) = (0u64, 0, 0u64, 0, 0);
+        while quiet < idle_limit && cycles < cap {
+            let item = match s.active() {
+                Some(a) => SorterIn::add(a.queue, -1),
+                None => SorterIn::NOOP,
+            };
+            let left_before: u64 = s.counters().iter().map(|&c| u64::from(c)).sum();
+            s.step(&item);
+            items.push(item);
+            cycles += 1;
+            if item.op == SorterOp::Add {
+                last_ray = cycles;
+                idle = 0;
+            } else if left_before > 0 {
+                idle += 1;
+                longest = longest.max(idle);
+            }
+            quiet = if s.active().is_none() && s.is_empty() {
+                quiet + 1
+            } else {
+                0
+            };
+        }
+        let rays_left = s.counters().iter().map(|&c| u64::from(c)).sum();
+        Self {
+            items,
+            rays,
+            nonempty,
+            drain_cycles: last_ray,
+            rays_left,
+            longest_idle: longest,
+        }
+    }
+
+    /// A random frame: about 40 % of the queues empty, the others 1..=max(6, 512 / Q) rays, and in
+    /// one frame of ten one queue full (`QueueLen`); preloaded in a random order.
+    pub fn random(cfg: SorterConfig, rng: &mut impl Rng) -> Result<Self> {
+        Ok(Self::random_on(&mut Sorter::new(cfg)?, rng))
+    }
+
+    /// [`DrainFrame::random`] on `s` from its current state.
+    pub fn random_on(s: &mut Sorter, rng: &mut impl Rng) -> Self {
+        let cfg = s.config();
+        let q_n = cfg.queues();
+        let small = (512 / q_n).max(6).min(cfg.queue_len);
+        let mut counts: Vec<u32> = (0..q_n)
+            .map(|_| {
+                if rng.random_bool(0.4) {
+                    0
+                } else {
+                    rng.random_range(1..=small)
+                }
+            })
+            .collect();
+        if rng.random_bool(0.1) {
+            counts[rng.random_range(0..q_n) as usize] = cfg.queue_len;
+        }
+        let mut order: Vec<u32> = (0..q_n).collect();
+        for k in (1..order.len()).rev() {
+            order.swap(k, rng.random_range(0..=k));
+        }
+        Self::run_on(s, &counts, &order)
+    }
+}
+
+// The RTL parameters of this unit (the RTL defaults are the model's `DEFAULT`).
+crate::unit_config!(SorterConfig, "gicube_sorter", DEFAULT, {
     "Ranks" => ranks,
     "QueueW" => queue_w,
     "ImpW" => imp_w,
+    "QueueLen" => queue_len,
 });
 
 #[cfg(test)]
@@ -827,8 +1234,18 @@ mod tests {
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
+    /// A narrow configuration for these tests: 8 ranks, 16 queues, the smallest `ImpW` that
+    /// counts a full queue of 256 rays. (The verified configurations are the `.variants` lines,
+    /// held to the RTL by `tb-rs/tests/variant_table.rs`.)
+    const NARROW: SorterConfig = SorterConfig {
+        ranks: 8,
+        queue_w: 4,
+        imp_w: 9,
+        queue_len: SorterConfig::PATENT_QUEUE_LEN,
+    };
+
     fn sorter(ranks: u32) -> Sorter {
-        Sorter::new(SorterConfig::new(ranks, 4, 8).unwrap()).unwrap()
+        Sorter::new(SorterConfig::new(ranks, 4, 8, 255).unwrap()).unwrap()
     }
 
     fn noop() -> SorterIn {
@@ -845,25 +1262,29 @@ mod tests {
 
     #[test]
     fn config_validation() {
-        assert!(SorterConfig::new(8, 4, 8).is_ok());
-        assert!(SorterConfig::new(1, 4, 8).is_err());
+        assert!(SorterConfig::new(8, 4, 8, 200).is_ok());
+        assert!(SorterConfig::new(1, 4, 8, 200).is_err());
         assert!(
-            SorterConfig::new(17, 4, 8).is_err(),
+            SorterConfig::new(17, 4, 8, 200).is_err(),
             "more ranks than queues"
         );
-        assert!(SorterConfig::new(65, 8, 8).is_err());
-        assert!(SorterConfig::new(8, 0, 8).is_err());
-        assert!(SorterConfig::new(8, 9, 8).is_err());
-        assert!(SorterConfig::new(8, 4, 1).is_err());
-        assert!(SorterConfig::new(8, 4, 25).is_err());
+        assert!(SorterConfig::new(65, 8, 8, 200).is_err());
+        assert!(SorterConfig::new(8, 0, 8, 200).is_err());
+        assert!(SorterConfig::new(8, 9, 8, 200).is_err());
+        assert!(SorterConfig::new(8, 4, 1, 200).is_err());
+        assert!(SorterConfig::new(8, 4, 25, 200).is_err());
+        // A full queue of 256 rays needs 9 bits: ImpW = 8 is refused (issue 18).
+        assert!(SorterConfig::new(8, 4, 8, 256).is_err());
+        assert!(SorterConfig::new(8, 4, 9, 256).is_ok());
+        assert!(SorterConfig::new(8, 4, 9, 0).is_err());
     }
 
     #[test]
     fn widths_match_the_contract_table() {
-        assert_eq!(SorterConfig::R8.in_width(), 15);
-        assert_eq!(SorterConfig::R8.out_width(), 219);
-        assert_eq!(SorterConfig::R32.in_width(), 26);
-        assert_eq!(SorterConfig::R32.out_width(), 1555);
+        assert_eq!(NARROW.in_width(), 16);
+        assert_eq!(NARROW.out_width(), 241);
+        assert_eq!(SorterConfig::DEFAULT.in_width(), 26);
+        assert_eq!(SorterConfig::DEFAULT.out_width(), 1563);
     }
 
     #[test]
@@ -974,7 +1395,7 @@ mod tests {
     }
 
     #[test]
-    fn a_full_list_drops_its_smallest_off_the_bottom() {
+    fn a_full_list_drops_its_smallest_and_the_scan_re_offers_it() {
         let mut s = sorter(3);
         s.step(&SorterIn::add(0, 100));
         s.step(&noop());
@@ -982,7 +1403,7 @@ mod tests {
         for q in 1..=5 {
             drops += u32::from(s.step(&SorterIn::add(q, q as i32)).dropped);
         }
-        for _ in 0..6 {
+        for _ in 0..4 {
             drops += u32::from(s.step(&noop()).dropped);
         }
         assert_eq!(
@@ -991,6 +1412,106 @@ mod tests {
         );
         let st = s.step(&noop());
         assert_eq!(sel_list(&st), vec![(5, 5), (4, 4)]);
+        // The active queue drains; the dropped queues 3, 2, 1 are re-offered by the scan and
+        // every one becomes active in turn, largest first.
+        let mut order = vec![];
+        for _ in 0..400 {
+            match s.active() {
+                Some(a) => {
+                    if order.last() != Some(&a.queue) {
+                        order.push(a.queue);
+                    }
+                    s.step(&SorterIn::add(a.queue, -1));
+                }
+                None => {
+                    s.step(&noop());
+                }
+            }
+            s.check_invariants().unwrap();
+        }
+        assert_eq!(order[..3], [0, 5, 4]);
+        order.sort_unstable();
+        assert_eq!(order, vec![0, 1, 2, 3, 4, 5]);
+        assert!(s.counters().iter().all(|&c| c == 0));
+    }
+
+    #[test]
+    fn a_wiped_entry_leaves_no_hole_and_the_list_stays_sorted() {
+        // Issue 18: [50, 40, 30], then `Set` of the first to 5, used to settle as [5, 40, 30].
+        let mut s = sorter(6);
+        s.step(&SorterIn::add(0, 1));
+        s.step(&noop());
+        for (q, v) in [(1, 50), (2, 40), (3, 30)] {
+            s.step(&SorterIn::add(q, v));
+        }
+        let mut st = s.step(&noop());
+        for _ in 0..8 {
+            st = s.step(&noop());
+        }
+        assert_eq!(sel_list(&st), vec![(1, 50), (2, 40), (3, 30)]);
+        let st = s.step(&SorterIn::set(1, 5));
+        assert!(
+            st.shifted,
+            "the ranks below the wiped entry move up at once"
+        );
+        assert_eq!(sel_list(&st), vec![(2, 40), (3, 30)]);
+        let mut st = st;
+        for _ in 0..8 {
+            st = s.step(&noop());
+            s.check_invariants().unwrap();
+        }
+        assert_eq!(sel_list(&st), vec![(2, 40), (3, 30), (1, 5)]);
+        // The active queue empties: the largest waiting queue takes over.
+        let st = s.step(&SorterIn::set(0, 0));
+        assert!(st.emptied && st.shifted);
+        assert_eq!(st.active(), Some(Entry { queue: 2, imp: 40 }));
+    }
+
+    #[test]
+    fn a_full_queue_is_counted_exactly() {
+        // Issue 18: with ImpW = 8, 256 arrivals saturated at 255 and 255 departures emptied a
+        // queue that still held a ray. ImpW = 9 counts QueueLen = 256 exactly.
+        let cfg = NARROW;
+        let mut s = Sorter::new(cfg).unwrap();
+        s.step(&SorterIn::add(6, 1));
+        let mut st = s.step(&noop());
+        for _ in 1..cfg.queue_len {
+            st = s.step(&SorterIn::add(6, 1));
+        }
+        assert_eq!(st.imp_q, 256);
+        assert_eq!(s.active().map(|e| e.queue), Some(6));
+        for _ in 0..255 {
+            st = s.step(&SorterIn::add(6, -1));
+            assert!(!st.emptied);
+        }
+        assert_eq!(st.active(), Some(Entry { queue: 6, imp: 1 }));
+        let st = s.step(&SorterIn::add(6, -1));
+        assert!(st.emptied && st.imp_q == 0);
+        // Past QueueLen the counter still counts, and saturates only at ImpMax.
+        let st = s.step(&SorterIn::add(6, 511));
+        assert_eq!(st.imp_q, 511);
+        assert_eq!(s.step(&SorterIn::add(6, 1)).imp_q, 511);
+    }
+
+    #[test]
+    fn end_of_frame_drains_every_ray() {
+        for cfg in [NARROW, SorterConfig::DEFAULT] {
+            let mut rng = ChaCha8Rng::seed_from_u64(18);
+            let (mut overhead, mut worst) = (0, 0);
+            for frame in 0..1000 {
+                let f = DrainFrame::random(cfg, &mut rng).unwrap();
+                assert_eq!(f.rays_left, 0, "{cfg:?} frame {frame}: rays stranded");
+                let bound = u64::from(f.nonempty) * u64::from(cfg.idle_stretch_bound());
+                assert!(f.overhead() <= bound, "{cfg:?} frame {frame}");
+                assert!(f.longest_idle <= u64::from(cfg.idle_stretch_bound()));
+                overhead += f.overhead();
+                worst = worst.max(f.overhead());
+            }
+            eprintln!(
+                "{cfg:?}: drain overhead mean {} max {worst}",
+                overhead as f64 / 1000.0
+            );
+        }
     }
 
     #[test]
@@ -1012,15 +1533,18 @@ mod tests {
 
     #[test]
     fn random_traffic_keeps_the_invariants_and_reaches_every_corner() {
-        for cfg in [SorterConfig::R8, SorterConfig::R32] {
+        for cfg in [NARROW, SorterConfig::DEFAULT] {
             let mut rng = ChaCha8Rng::seed_from_u64(9);
             let mut traffic = SorterTraffic::new(cfg).unwrap();
             let mut s = Sorter::new(cfg).unwrap();
             let (mut emptied, mut dropped, mut all_empty, mut at_max, mut ties) = (0, 0, 0, 0, 0);
+            let mut watch = SorterWatch::new(cfg);
             for _ in 0..200_000 {
                 let item = traffic.next_item(&mut rng);
+                let before = s.active();
                 let st = s.step(&item);
                 s.check_invariants().unwrap();
+                watch.observe(&item, before, &st, s.counters()).unwrap();
                 emptied += u32::from(st.emptied);
                 dropped += u32::from(st.dropped);
                 all_empty += u32::from(s.imp.iter().all(|&v| v == 0));
@@ -1031,6 +1555,11 @@ mod tests {
                         .any(|r| matches!((r.sel, r.cmp), (Some(a), Some(b)) if a.imp == b.imp)),
                 );
             }
+            assert!(watch.settled_checks > 1000, "{cfg:?}: {watch:?}");
+            eprintln!(
+                "{cfg:?}: {} settled states checked, longest wait {} slot cycles, {} drops with room",
+                watch.settled_checks, watch.max_wait, watch.drops_with_room
+            );
             for (what, n) in [
                 ("emptied", emptied),
                 ("dropped", dropped),
@@ -1045,7 +1574,7 @@ mod tests {
 
     #[test]
     fn codec_round_trips_states() {
-        let cfg = SorterConfig::R8;
+        let cfg = NARROW;
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         let mut traffic = SorterTraffic::new(cfg).unwrap();
         let mut s = Sorter::new(cfg).unwrap();
@@ -1056,7 +1585,9 @@ mod tests {
             w.put_bool(st.emptied)
                 .put_bool(st.shifted)
                 .put_bool(st.dropped)
-                .put(u64::from(st.imp_q), cfg.imp_w);
+                .put_bool(st.offered)
+                .put(u64::from(st.imp_q), cfg.imp_w)
+                .put(u64::from(st.scan), cfg.queue_w);
             for r in &st.ranks {
                 for b in [r.sel, r.cmp] {
                     let e = b.unwrap_or(Entry { queue: 0, imp: 0 });
@@ -1086,7 +1617,7 @@ mod tests {
         assert_eq!(q.best_excluding(Some(3)), Some((5, 5.0)));
         assert_eq!(q.non_empty(), 2);
         // Enough ranks for all queues and slow updates: the sorter's choices are ideal.
-        let cfg = SorterConfig::new(16, 4, 16).unwrap();
+        let cfg = SorterConfig::new(16, 4, 16, 200).unwrap();
         let mut items = Vec::new();
         for q in 0..16 {
             items.push(SorterIn::add(q, 10 + q as i32));
@@ -1114,13 +1645,13 @@ mod tests {
 
     #[test]
     fn workload_is_valid_traffic() {
-        let cfg = SorterConfig::R32;
+        let cfg = SorterConfig::DEFAULT;
         let mut w = Workload::new(cfg, 1000, 0.5, 0.5, 8, 1).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let items: Vec<SorterIn> = (0..20_000).map(|_| w.next_item(&mut rng)).collect();
         let rep = measure_accuracy(cfg, items).unwrap();
         assert!(rep.emptied > 10 && rep.selections > 10);
         assert!(Workload::new(cfg, 0, 1.5, 0.5, 8, 1).is_err());
-        assert!(Workload::new(SorterConfig::R8, 0, 0.5, 0.5, 8, 256).is_err());
+        assert!(Workload::new(NARROW, 0, 0.5, 0.5, 8, 512).is_err());
     }
 }
