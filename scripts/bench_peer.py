@@ -99,6 +99,14 @@ def cpu_model() -> str:
     return platform.processor() or platform.machine()
 
 
+def load_average() -> str:
+    """The 1-minute load average (other jobs on the machine slow both renderers alike)."""
+    try:
+        return Path("/proc/loadavg").read_text().split()[0]
+    except OSError:
+        return "n/a"
+
+
 def view_direction(azimuth: float, elevation: float) -> tuple[float, float, float]:
     """cube5's View::direction (model/src/render.rs): unit vector from the eye into the scene."""
     a, e = math.radians(azimuth), math.radians(elevation)
@@ -345,6 +353,16 @@ def render_vtk(
     ren.SetBackground(0.0, 0.0, 0.0)
     ren.AddVolume(volume)
     ren.SetTwoSidedLighting(1)  # cube5 shades two-sided (|n.l|)
+    # cube5's light: one white headlight along the view. VTK's default light has a black ambient
+    # colour, and its volume shading scales the ambient term by it, so say white.
+    light = R.vtkLight()
+    light.SetLightTypeToHeadlight()
+    light.SetAmbientColor(1.0, 1.0, 1.0)
+    light.SetDiffuseColor(1.0, 1.0, 1.0)
+    light.SetSpecularColor(1.0, 1.0, 1.0)
+    light.SetIntensity(1.0)
+    ren.AutomaticLightCreationOff()
+    ren.AddLight(light)
     win = R.vtkRenderWindow()
     win.SetOffScreenRendering(1)
     win.SetMultiSamples(0)
@@ -465,6 +483,7 @@ def main() -> int:
     img, max_value = vtk_volume(v, raw, args.size, args.bits)
     repeat = cube5_has_repeat(cube5)
     machine = f"{cpu_model()}, {os.cpu_count()} cores"
+    load_start = load_average()
     say(f"machine: {machine}; VTK {v['version']} ({window}); volume {raw.name} "
         f"({args.size}^3, {args.bits}-bit); view azimuth {AZIMUTH} elevation {ELEVATION}, parallel")
     say(f"cube5: {cube5} ({'--repeat' if repeat else 'no --repeat: one frame per process, best of'} "
@@ -490,6 +509,7 @@ def main() -> int:
                         f"cube5 {ct.ms:.1f} ms, ratio {vt.best_ms / ct.ms:.3f}")
 
     say("")
+    say(f"load average (1 min) at the start {load_start}, at the end {load_average()}")
     say(f"Machine: {machine}. VTK {v['version']} `vtkFixedPointVolumeRayCastMapper`, "
         f"head phantom {args.size}^3 ({args.bits}-bit), view azimuth {AZIMUTH:g} elevation "
         f"{ELEVATION:g}, parallel. Ratio = VTK ms / cube5 ms (> 1: cube5 faster).")
