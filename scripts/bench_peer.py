@@ -405,8 +405,10 @@ def render_vtk(
     return VtkTime(times[best], statistics.median(times), mapper_times[best])
 
 
-def side_by_side(v, left: Path, right: Path, out: Path) -> None:
-    """VTK's image | 8 grey pixels | cube5's image, as one PNG (both read back through VTK)."""
+def side_by_side(v, left: Path, right: Path, out: Path) -> float:
+    """VTK's image | 8 grey pixels | cube5's image, as one PNG (both read back through VTK).
+    Returns the mean absolute difference of the two images in 8-bit codes (a check that both
+    render the same scene, not a measure of either's accuracy)."""
     np, ns = v["np"], v["numpy_support"]
     imgs = []
     for p in (left, right):
@@ -428,6 +430,9 @@ def side_by_side(v, left: Path, right: Path, out: Path) -> None:
     w.SetFileName(str(out))
     w.SetInputData(img)
     w.Write()
+    if imgs[0].shape != imgs[1].shape:
+        return float("nan")
+    return float(np.abs(imgs[0].astype(np.int32) - imgs[1].astype(np.int32)).mean())
 
 
 # =================================================================================================
@@ -501,12 +506,13 @@ def main() -> int:
                     vt = render_vtk(v, img, max_value, mode, shading, px, t,
                                     args.warmup, args.frames, vtk_png)
                     ct = run_cube5(cube5, scene, c5_png, t, args.cube5_frames, repeat)
-                    side_by_side(v, vtk_png, c5_png, out / f"{stem}.png")
+                    diff = side_by_side(v, vtk_png, c5_png, out / f"{stem}.png")
                     row = (name, f"{px}x{px}", t, vt, ct)
                     rows.append(row)
                     say(f"{name}, {px}^2, {t} thread(s): VTK {vt.best_ms:.1f} ms "
                         f"(median {vt.median_ms:.1f}, mapper {vt.mapper_ms:.1f}), "
-                        f"cube5 {ct.ms:.1f} ms, ratio {vt.best_ms / ct.ms:.3f}")
+                        f"cube5 {ct.ms:.1f} ms, ratio {vt.best_ms / ct.ms:.3f}; images differ by "
+                        f"{diff:.1f}/255 on average")
 
     say("")
     say(f"load average (1 min) at the start {load_start}, at the end {load_average()}")
