@@ -2,7 +2,7 @@
 CARGO ?= cargo
 DEMO_DIR ?= out
 
-.PHONY: setup demo test sim sim-full lint synth bench tradeoff regs fmt clippy clean clean-cache
+.PHONY: setup demo test sim sim-full lint synth bench bench-peer tradeoff regs fmt clippy clean clean-cache
 
 # The build cache of verilated and compiled RTL variants (shared by every clone on the machine).
 CUBE5_CACHE ?= $(if $(XDG_CACHE_HOME),$(XDG_CACHE_HOME),$(HOME)/.cache)/cube5
@@ -46,6 +46,16 @@ synth:
 ## builds twice as fast; docs/ci.md). The -O2 objects are cached beside the -O1 ones.
 bench: setup
 	CUBE5_RTL_CXX_OPT=-O2 $(CARGO) run --release -q -p cube5-cli -- bench
+
+## The peer benchmark (issue 13): cube5's model against VTK's vtkFixedPointVolumeRayCastMapper on
+## the same 256^3 volume, transfer function and view, with both times and their ratio
+## (docs/measurements.md, "Peer"). Makes .venv-peer with the pinned VTK from PyPI (and Mesa's EGL
+## with apt-get if VTK cannot render offscreen); images go to target/bench-peer/. Options of the
+## script: `make bench-peer PEER_ARGS="--pixels 256 --threads 2"`.
+bench-peer: setup
+	@scripts/setup_peer.sh
+	CUBE5_TOPS=$${CUBE5_TOPS:-cube5_trilin} $(CARGO) build --release -q -p cube5-cli
+	.venv-peer/bin/python scripts/bench_peer.py --cube5 $${CARGO_TARGET_DIR:-target}/release/cube5 $(PEER_ARGS)
 
 ## Regenerates docs/tradeoffs.md and its plots (speed/area against accuracy sweeps).
 tradeoff: setup

@@ -177,7 +177,7 @@ fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
         "cosim-xray.toml",
         "[volume]\nsize = 16\n[render]\nmode = \"xray\"\n",
         &[],
-        "renders \"composite\" and \"mip\"",
+        "render.mode = \"xray\" (the frame composites and takes maxima)",
     );
     bad(
         "cosim-big.toml",
