@@ -7,7 +7,7 @@ use crate::{load_scene, write_png_atomically};
 use anyhow::{anyhow, bail, Context, Result};
 use cube5_model::render::ImageF64;
 use cube5_model::scene::Scene;
-use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
+use cube5_model::scene_render::{at_voxel_width, frame_config, not_expressible, FrameJob};
 use cube5_model::units::cube5_compos::{ComposConfig, Coxel};
 use cube5_model::units::cube5_frame::{BasePlane, FrameConfig};
 use cube5_tb::frame::{Expected, FrameBench, FrameRtl};
@@ -106,10 +106,11 @@ pub fn cosim_scene(
         );
     }
     let raw = scene.build_volume()?;
+    // The variant's limits first (memory size, multiples of P), named by the variant.
+    rtl.check_volume(&at_voxel_width(&raw, rtl.trilin.voxel_w)?)
+        .map_err(|e| anyhow!("{origin}: volume: {e}"))?;
     let job = FrameJob::new(scene, &raw, rtl.cfg, rtl.p)?;
     let vol = &job.seen;
-    rtl.check_volume(vol)
-        .map_err(|e| anyhow!("{origin}: volume: {e}"))?;
     say!(
         "cosim: {} volume {}x{}x{} ({}-bit, as {}-bit), {} on {} ({} pipelines), view {:.4?}",
         origin,

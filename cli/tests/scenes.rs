@@ -316,24 +316,13 @@ fn two_example_scenes_are_the_rtl_frame() {
     }
 }
 
-/// Frame scenes at widths no `cube5_frame` variant is built with: the model renders them, and
-/// `--target both` refuses in one line.
-const WIDTHS_NOT_BUILT: &[&str] = &["head-narrow"];
-
 #[test]
-#[ignore = "sim-full: every example scene the frame renders, co-simulated (about a minute)"]
+#[ignore = "sim-full: every example scene the frame renders, co-simulated on the variant with its widths (about a minute)"]
 fn every_frame_example_scene_is_the_rtl_frame() {
     let frame = frame_scenes();
     assert!(frame.len() >= 4, "{frame:?}");
     for name in frame {
-        if !WIDTHS_NOT_BUILT.contains(&name.as_str()) {
-            example_scene_is_the_rtl_frame(&name);
-            continue;
-        }
-        let scene = cube5_model::repo_root().join(format!("scenes/{name}.toml"));
-        let png = scratch(&format!("cosim-{name}.png"));
-        let out = cube5(&["render", s(&scene), "-o", s(&png), "--target", "both"]);
-        assert_refused(&out, &["no cube5_frame variant", "widths"]);
+        example_scene_is_the_rtl_frame(&name);
     }
 }
 

@@ -76,7 +76,7 @@ impl FrameRtl {
     pub fn with_pipelines(p: usize) -> Option<FrameRtl> {
         Self::all()
             .into_iter()
-            .filter(|r| r.p == p)
+            .filter(|r| r.p == p && r.default_widths())
             .max_by_key(|r| r.max_dim_log2)
     }
 
@@ -89,9 +89,14 @@ impl FrameRtl {
             .min_by_key(|r| r.max_dim_log2)
     }
 
-    /// The pipeline counts of the largest-memory configurations, ascending.
+    /// The pipeline counts of the default-width configurations ([`FrameRtl::with_pipelines`]),
+    /// ascending.
     pub fn pipeline_counts() -> Vec<usize> {
-        let mut ps: Vec<usize> = Self::all().iter().map(|r| r.p).collect();
+        let mut ps: Vec<usize> = Self::all()
+            .iter()
+            .filter(|r| r.default_widths())
+            .map(|r| r.p)
+            .collect();
         ps.sort_unstable();
         ps.dedup();
         ps
