@@ -70,6 +70,7 @@ fmt:
 
 clippy:
 	$(CARGO) clippy --workspace --all-targets --release -- -D warnings
+	$(CARGO) clippy -p cube5-cli --all-targets --release --no-default-features -- -D warnings
 
 clean:
 	$(CARGO) clean
