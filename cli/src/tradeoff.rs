@@ -483,8 +483,8 @@ fn document(
     w(
         &mut s,
         &format!(
-            "- The data. The phantom's ellipsoids have hard edges (2x2x2 supersampled), where a CT \
-             head is smooth, so every difference of interpolation lands on a sharp edge; and at \
+            "- The data. The phantom's edges are 1.5 voxels wide (band-limited, docs/scenes.md), \
+             steeper than a CT head's at this size, so differences of interpolation land on them; and at \
              {}^3 against 256 x 256 x 225 a voxel covers more of the image. Smoothing the phantom \
              with [1 2 1]/4 along each axis (roughly a scanner's point-spread) lowers the errors to \
              {s_peak:.2}% and {s_max_st:.2}%.",
