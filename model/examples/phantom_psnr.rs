@@ -3,8 +3,8 @@
 //!
 //! ```text
 //! cargo run --release -p cube5-model --example phantom_psnr -- [--sizes 96,128] [--images 384]
-//!     [--tf head|proposed|PRESET] [--what frame,pipeline,ss2,spp4,precise,g6,g26,refstep]
-//!     [--azimuth DEG] [--unlit] [--no-specular] [--rm-log2 N] [--old] [--gen-only] [--png DIR] [--scene FILE]
+//!     [--tf PRESET] [--what frame,pipeline,ss2,spp4,precise,g6,g26,refstep]
+//!     [--azimuth DEG] [--unlit] [--no-specular] [--rm-log2 N] [--gen-only] [--png DIR] [--scene FILE]
 //! ```
 //!
 //! `frame` is what the hardware makes; the `pipeline` rows are `render_pipeline`'s what-if knobs
@@ -27,7 +27,6 @@ use cube5_model::units::cube5_shader::{
     ClassLut, Phong, ReflectanceMap, Shader, ShaderConfig, ShaderTables,
 };
 use cube5_model::volume::Volume;
-use rayon::prelude::*;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -38,82 +37,6 @@ fn list(s: &str) -> Vec<usize> {
 }
 
 // ---- main's head phantom, for comparison
-
-/// One ellipsoid of constant density in normalized coordinates ([-1, 1] across the volume).
-struct Blob {
-    centre: [f64; 3],
-    radii: [f64; 3],
-    density: f64,
-}
-
-impl Blob {
-    fn inside(&self, p: [f64; 3]) -> bool {
-        (0..3)
-            .map(|a| ((p[a] - self.centre[a]) / self.radii[a]).powi(2))
-            .sum::<f64>()
-            <= 1.0
-    }
-}
-
-/// A CT-like head: skin, skull shell, brain, two ventricles and lesions of different densities.
-/// Later blobs overwrite earlier ones, so the list reads from the outside in.
-fn head_blobs() -> Vec<Blob> {
-    let b = |centre, radii, density| Blob {
-        centre,
-        radii,
-        density,
-    };
-    vec![
-        b([0.0, 0.0, 0.0], [0.80, 0.90, 0.95], 0.22), // skin and scalp
-        b([0.0, 0.0, 0.0], [0.76, 0.86, 0.91], 0.86), // skull
-        b([0.0, 0.0, 0.02], [0.69, 0.79, 0.84], 0.36), // brain
-        b([-0.3, -0.8, -0.25], [0.16, 0.16, 0.14], 0.0), // left eye orbit
-        b([0.3, -0.8, -0.25], [0.16, 0.16, 0.14], 0.0), // right eye orbit
-        b([-0.16, 0.05, 0.1], [0.08, 0.28, 0.12], 0.12), // left ventricle
-        b([0.16, 0.05, 0.1], [0.08, 0.28, 0.12], 0.12), // right ventricle
-        b([0.32, -0.25, 0.28], [0.15, 0.15, 0.15], 0.50), // lesion
-        b([-0.35, -0.2, -0.15], [0.12, 0.12, 0.12], 0.61), // lesion
-        b([0.05, 0.42, -0.35], [0.11, 0.11, 0.11], 0.75), // calcification
-        b([0.0, -0.5, 0.45], [0.05, 0.05, 0.05], 1.00), // metal marker
-    ]
-}
-
-/// main's head phantom (before issue 13), `n^3` voxels of `bits` bits, edges anti-aliased by 2x2x2 supersampling.
-fn old_head_phantom(n: usize, bits: u32) -> Volume {
-    let blobs = head_blobs();
-    supersampled(n, bits, |p| {
-        blobs
-            .iter()
-            .rev()
-            .find(|b| b.inside(p))
-            .map_or(0.0, |b| b.density)
-    })
-}
-
-/// An `n^3` volume of `bits` bits whose voxels are the density `f` (0..=1, at points of the
-/// normalized cube -1..1) averaged over 2x2x2 samples at +-1/4 voxel: anti-aliased edges.
-fn supersampled(n: usize, bits: u32, f: impl Fn([f64; 3]) -> f64 + Sync) -> Volume {
-    let max = f64::from((1u32 << bits) - 1);
-    let to_norm = |i: f64| (i + 0.5) / n as f64 * 2.0 - 1.0;
-    let data: Vec<u16> = (0..n * n * n)
-        .into_par_iter()
-        .map(|idx| {
-            let (x, y, z) = (idx % n, (idx / n) % n, idx / (n * n));
-            let mut acc = 0.0;
-            for s in 0..8 {
-                let off = |bit: usize| if (s >> bit) & 1 == 1 { 0.25 } else { -0.25 };
-                let p = [
-                    to_norm(x as f64 + off(0)),
-                    to_norm(y as f64 + off(1)),
-                    to_norm(z as f64 + off(2)),
-                ];
-                acc += f(p) / 8.0;
-            }
-            (acc * max).round() as u16
-        })
-        .collect();
-    Volume::new([n; 3], [1.0; 3], bits, data).unwrap()
-}
 
 /// The frame model's image of `vol` at `params`: base plane (bit-exact) warped onto the image.
 fn frame_image(
@@ -185,11 +108,6 @@ fn slices(vol: &Volume) -> image::GrayImage {
     img
 }
 
-/// The head transfer function of main (`TransferFunction::head_default`, this study's proposal).
-fn proposed_tf() -> TransferFunction {
-    TransferFunction::head_default()
-}
-
 /// `--scene FILE`: renders a scene file as `cube5 render` does (the pipeline model, or the
 /// reference where the scene asks for it) into the `--png` directory (given before it).
 fn render_scene(file: &str, png: Option<&std::path::Path>) {
@@ -222,7 +140,6 @@ fn main() {
     let mut what = vec!["frame".to_string(), "pipeline".to_string()];
     let mut png: Option<PathBuf> = None;
     let mut azimuth: Option<f64> = None;
-    let mut old = false;
     let mut gen_only = false;
     let mut unlit = false;
     let mut no_specular = false;
@@ -236,7 +153,6 @@ fn main() {
             "--tf" => tf_name = val(),
             "--what" => what = val().split(',').map(str::to_string).collect(),
             "--png" => png = Some(PathBuf::from(val())),
-            "--old" => old = true,
             "--scene" => {
                 render_scene(&val(), png.as_deref());
                 return;
@@ -249,13 +165,8 @@ fn main() {
             other => panic!("unknown argument {other}"),
         }
     }
-    let tf = if tf_name == "proposed" {
-        proposed_tf()
-    } else {
-        TransferFunction::preset(&tf_name).unwrap()
-    };
+    let tf = TransferFunction::preset(&tf_name).unwrap();
     let scene = Scene::default();
-    let tag = if old { "old-" } else { "" };
     println!(
         "| phantom+TF | edge | image | model | PSNR (dB) | rel. Eucl. (%) | max abs | time (s) |"
     );
@@ -264,11 +175,7 @@ fn main() {
         let mut s = scene.clone();
         s.volume.size = n;
         let t = Instant::now();
-        let vol = if old {
-            old_head_phantom(n, 12)
-        } else {
-            s.build_volume().unwrap()
-        };
+        let vol = s.build_volume().unwrap();
         let gen = t.elapsed().as_secs_f64();
         eprintln!("phantom {n}^3 built in {gen:.2} s");
         if let Some(dir) = &png {
@@ -297,7 +204,7 @@ fn main() {
             let row = |name: &str, img: &ImageF64, secs: f64| {
                 let e = image_error(img, &reference);
                 println!(
-                    "| {tag}{tf_name} | {n} | {px} | {name} | {:.1} | {:.2} | {:.3} | {secs:.2} |",
+                    "| {tf_name} | {n} | {px} | {name} | {:.1} | {:.2} | {:.3} | {secs:.2} |",
                     e.psnr_db, e.rel_euclid, e.max_abs
                 );
             };
@@ -306,7 +213,7 @@ fn main() {
                 std::fs::create_dir_all(dir).unwrap();
                 reference
                     .to_rgb8()
-                    .save(dir.join(format!("{tag}{tf_name}-{n}-{px}-reference.png")))
+                    .save(dir.join(format!("{tf_name}-{n}-{px}-reference.png")))
                     .unwrap();
             }
             for w in &what {
@@ -328,10 +235,10 @@ fn main() {
                                 ..img.clone()
                             };
                             diff.to_rgb8()
-                                .save(dir.join(format!("{tag}{tf_name}-{n}-{px}-diff4.png")))
+                                .save(dir.join(format!("{tf_name}-{n}-{px}-diff4.png")))
                                 .unwrap();
                             img.to_rgb8()
-                                .save(dir.join(format!("{tag}{tf_name}-{n}-{px}-frame.png")))
+                                .save(dir.join(format!("{tf_name}-{n}-{px}-frame.png")))
                                 .unwrap();
                         }
                         continue;

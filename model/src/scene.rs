@@ -966,19 +966,13 @@ fn frame_entries(entries: &mut [PlanEntry], scene: &Scene, vol: &Volume) {
 /// Fraction of `SKIP_BLOCK`^3 blocks whose voxels are all 0 (the frame's block LUT marks them
 /// empty).
 pub fn zero_block_fraction(vol: &Volume) -> f64 {
-    let nb = vol.dims.map(|d| d.div_ceil(SKIP_BLOCK));
-    let mut zero = vec![true; nb[0] * nb[1] * nb[2]];
-    for z in 0..vol.dims[2] {
-        for y in 0..vol.dims[1] {
-            for x in 0..vol.dims[0] {
-                if vol.data[x + vol.dims[0] * (y + vol.dims[1] * z)] != 0 {
-                    let b = [x, y, z].map(|v| v / SKIP_BLOCK);
-                    zero[b[0] + nb[0] * (b[1] + nb[1] * b[2])] = false;
-                }
-            }
+    match crate::units::cube5_skewmem::BlockLut::from_volume(vol, SKIP_BLOCK, 0) {
+        Ok(lut) => {
+            let empty = lut.entries.iter().filter(|e| e.empty).count();
+            empty as f64 / lut.entries.len().max(1) as f64
         }
+        Err(_) => 0.0,
     }
-    zero.iter().filter(|z| **z).count() as f64 / zero.len() as f64
 }
 
 /// Fraction of `SKIP_BLOCK`^3 blocks (with a one-voxel apron, as interpolation reads it) whose
