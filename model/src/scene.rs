@@ -80,6 +80,17 @@ pub enum FormatSpec {
     Nifti,
 }
 
+impl FormatSpec {
+    /// The name a scene spells it with.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Raw => "raw",
+            Self::Nrrd => "nrrd",
+            Self::Nifti => "nifti",
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum RawType {
@@ -589,7 +600,12 @@ impl Scene {
                     Format::Nrrd => volume_io::read_nrrd(&path, v.bits),
                     Format::Nifti => volume_io::read_nifti(&path, v.bits),
                 };
-                read.map_err(|e| scene_err("volume.file", inner(&e)))?
+                // An explicit format is named: it decided how the file was read.
+                let field = match v.format {
+                    Some(f) => format!("volume.file (as volume.format = \"{}\")", f.name()),
+                    None => "volume.file".to_string(),
+                };
+                read.map_err(|e| scene_err(&field, inner(&e)))?
             }
         };
         if let Some(s) = v.spacing {

@@ -35,7 +35,7 @@ pub fn not_expressible(scene: &Scene) -> Vec<String> {
         )),
     }
     if scene.view.projection != Projection::Parallel {
-        why.push("perspective projection (the frame is parallel only)".into());
+        why.push("view.projection = \"perspective\" (the frame is parallel only)".into());
     }
     if q.interpolation != Interpolation::BilinearSlice {
         why.push(format!(
@@ -82,20 +82,35 @@ pub fn not_expressible(scene: &Scene) -> Vec<String> {
 pub fn frame_config(scene: &Scene) -> Result<FrameConfig> {
     let q = scene.quality();
     let mut params = FrameConfig::DEFAULT.to_params();
-    for (name, value) in [
-        ("VoxelW", q.voxel_bits),
-        ("WeightW", Some(q.weight_bits)),
-        ("FracW", Some(q.frac_bits)),
-        ("ColorW", Some(q.colour_bits)),
-        ("AlphaW", Some(q.alpha_bits)),
-        ("AccW", Some(q.acc_bits)),
-    ] {
+    let widths = [
+        ("VoxelW", "voxel_bits", q.voxel_bits),
+        ("WeightW", "weight_bits", Some(q.weight_bits)),
+        ("FracW", "frac_bits", Some(q.frac_bits)),
+        ("ColorW", "colour_bits", Some(q.colour_bits)),
+        ("AlphaW", "alpha_bits", Some(q.alpha_bits)),
+        ("AccW", "acc_bits", Some(q.acc_bits)),
+    ];
+    for (name, _, value) in widths {
         if let (Some(v), Some(slot)) = (value, params.iter_mut().find(|(n, _)| *n == name)) {
             slot.1 = i64::from(v);
         }
     }
-    FrameConfig::from_params(&params)
-        .map_err(|e| ModelError::Config(format!("the frame cannot take these widths: {e}")))
+    FrameConfig::from_params(&params).map_err(|e| {
+        // Name the scene's fields behind the parameters the frame refuses.
+        let e = e.to_string();
+        let fields: Vec<String> = widths
+            .iter()
+            .filter(|(name, _, _)| e.contains(name))
+            .map(|(name, field, v)| match v {
+                Some(v) => format!("quality.{field} = {v} ({name})"),
+                None => format!("quality.{field} unset ({name})"),
+            })
+            .collect();
+        ModelError::Config(format!(
+            "{}: the frame cannot take these widths: {e}",
+            fields.join(", ")
+        ))
+    })
 }
 
 /// The volume at voxel width `w`: `v << (w - bits)` or `v >> (bits - w)`, the same integers the
