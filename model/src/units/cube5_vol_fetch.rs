@@ -13,9 +13,10 @@ use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
 use crate::unit::StreamCodec;
 use crate::units::cube5_axi_rd::{AxiMemImage, AxiRdCmd, AxiRdConfig, RESP_OKAY};
-use crate::units::cube5_frame::FrameParams;
+use crate::units::cube5_frame::{FrameParams, FrameSetup};
 use crate::units::cube5_skewmem::{BlockEntry, BlockLut};
 use crate::volume::Volume;
+use glam::DVec3;
 
 /// The RTL parameters of one `cube5_vol_fetch` configuration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -278,6 +279,19 @@ impl Sweep {
             sec_lo: 0,
             sec_hi: blocks[params.axis_i],
         }
+    }
+
+    /// The whole-face sweep of the parallel view `view` (voxel units, unit spacing) for `p`
+    /// pipelines: the frame set-up's slice axis and direction (`FrameSetup`).
+    pub fn of_view(
+        dims: [usize; 3],
+        view: [f64; 3],
+        p: u32,
+        block: u32,
+        base: u64,
+    ) -> Result<(Self, FrameParams)> {
+        let params = FrameSetup::new(dims, [1.0; 3], DVec3::from(view), p as usize)?.params;
+        Ok((Self::of_frame(&params, dims, block, base), params))
     }
 
     /// The block columns a section of anchors `[a0, a0 + s)` needs (docs/accel.md): `(a0 - 1)
@@ -566,9 +580,7 @@ crate::unit_config!(VolFetchConfig, "cube5_vol_fetch", DEFAULT, {
 mod tests {
     use super::*;
     use crate::phantom::head_phantom;
-    use crate::units::cube5_frame::FrameSetup;
     use crate::units::cube5_skewmem::{Axis, SkewConfig, SkewDims, SkewIn, SkewMem};
-    use glam::DVec3;
     use std::collections::{HashMap, HashSet};
 
     const C: VolFetchConfig = VolFetchConfig::DEFAULT;
@@ -618,7 +630,7 @@ mod tests {
             let n: u32 = blocks.iter().product();
             // A scrambled pointer assignment: ptr = (index * 7 + 3) mod n, a permutation when
             // gcd(7, n) = 1; else the identity.
-            let mul = if n % 7 == 0 { 1 } else { 7 };
+            let mul = if n.is_multiple_of(7) { 1 } else { 7 };
             let mut seen = HashSet::new();
             let base = 0x4000;
             for z in 0..blocks[2] * b {
@@ -730,6 +742,9 @@ mod tests {
         }
     }
 
+    /// One slab of the test's section buffer: the voxels of each block delivered, by block.
+    type Slab = HashMap<[u32; 3], Vec<u32>>;
+
     fn check_against_frame(
         c: VolFetchConfig,
         params: &FrameParams,
@@ -742,7 +757,7 @@ mod tests {
         let (b, p) = (c.block_dim, c.p);
         // Group the items by slab (the block's coordinate along k), in arrival order.
         let ak = params.axis_k;
-        let mut slabs: Vec<(u32, HashMap<[u32; 3], Vec<u32>>)> = Vec::new();
+        let mut slabs: Vec<(u32, Slab)> = Vec::new();
         for it in &run.items {
             assert!(!it.error && !it.resp_err, "{view:?}: {it:?}");
             let bk = it.blk[ak];
