@@ -16,7 +16,7 @@ use cube5_tb::{Mismatch, TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{configs, gate_configs, seed};
+use support::{axi_protocol_clean, compare_ar, configs, gate_configs, seed, with_waves};
 
 /// One run: LUT writes (loaded first, in full), then commands (sweeps and more LUT writes), the
 /// memory, how the subordinate behaves, the output traffic, and optionally a reset after
@@ -133,6 +133,16 @@ fn random_lut(cfg: VolFetchConfig, blocks: [u32; 3], rng: &mut ChaCha8Rng) -> Ve
     out
 }
 
+/// Marks every block of LUT writes present (neither empty nor masked).
+fn all_present(lut: &mut [FetchCmd]) {
+    for c in lut {
+        if let FetchCmd::Lut { entry, .. } = c {
+            entry.empty = false;
+            entry.masked = false;
+        }
+    }
+}
+
 fn random_sweep(blocks: [u32; 3], base: u64, rng: &mut ChaCha8Rng) -> Sweep {
     let axis_k = rng.random_range(0..3u32);
     let (ai, _) = frame_axes(axis_k);
@@ -207,21 +217,7 @@ fn check(
     seed: u64,
     case: &Case,
 ) -> Result<Report, TbError> {
-    match run(variant, cfg, seed, case, None) {
-        Err(TbError::Mismatch(mut m)) if std::env::var_os("CUBE5_NO_WAVES").is_none() => {
-            let dir = PathBuf::from(
-                std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".into()),
-            )
-            .join("cube5-waves");
-            let _ = std::fs::create_dir_all(&dir);
-            let path = dir.join(format!("{variant}-seed{seed}.vcd"));
-            let window = (m.cycle.saturating_sub(64), m.cycle + 8);
-            let _ = run(variant, cfg, seed, case, Some((path.clone(), window)));
-            m.waveform = path.exists().then_some(path);
-            Err(TbError::Mismatch(m))
-        }
-        other => other,
-    }
+    with_waves(variant, seed, |trace| run(variant, cfg, seed, case, trace))
 }
 
 fn must(variant: &'static Variant, cfg: VolFetchConfig, seed: u64, case: &Case) -> Report {
@@ -286,29 +282,11 @@ fn drive_and_compare(
     let exact = max_cycles.is_none();
     let limit = max_cycles.unwrap_or(100_000 + 8 * want.len() as u64 + 400 * bursts.len() as u64);
     let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
-    let protocol = |cycle: u64, what: String| TbError::Protocol {
-        variant: variant.name.to_string(),
-        seed,
-        cycle,
-        what,
-    };
-    if driven.stats.protocol_errors > 0 {
-        return Err(protocol(
-            driven.stats.first_protocol_error_cycle,
-            "a stalled output item dropped valid or changed".into(),
-        ));
-    }
-    let counters = dut.axi_counters();
-    if counters.protocol_errors > 0 {
-        return Err(protocol(
-            counters.first_error_cycle,
-            format!(
-                "AXI checker: {} ({} violations)",
-                dut.axi_first_error(),
-                counters.protocol_errors
-            ),
-        ));
-    }
+    axi_protocol_clean(dut, &driven.stats, variant, seed)?;
+    // AR first: a wrong burst explains a wrong item.
+    let n_ars = compare_ar(dut, &bursts, cfg.axi_rd().size(), variant, seed, |k| {
+        format!("burst #{k} of {} read commands", run.reads.len())
+    })?;
     let fail = |item: u64, cycle: u64, what: &str, input: String, rtl: String, model: String| {
         TbError::from(Mismatch {
             variant: variant.name.to_string(),
@@ -322,24 +300,6 @@ fn drive_and_compare(
             ..Default::default()
         })
     };
-    let ars = dut.axi_take_ar()?;
-    for (k, ar) in ars.iter().enumerate() {
-        let model = bursts.get(k);
-        let got = Burst {
-            addr: ar.addr,
-            beats: ar.len + 1,
-        };
-        if model != Some(&got) {
-            return Err(fail(
-                k as u64,
-                ar.cycle,
-                "AR burst differs (address, beats)",
-                format!("burst #{k} of {} read commands", run.reads.len()),
-                format!("{got:?}"),
-                model.map_or("(no burst expected)".into(), |b| format!("{b:?}")),
-            ));
-        }
-    }
     for (k, taken) in driven.outputs.iter().enumerate() {
         if want.get(k) != Some(&taken.value) {
             return Err(fail(
@@ -367,10 +327,10 @@ fn drive_and_compare(
                 want.len()
             )));
         }
-        if ars.len() != bursts.len() {
+        if n_ars != bursts.len() {
             return Err(missing(format!(
                 "{} of {} bursts issued",
-                ars.len(),
+                n_ars,
                 bursts.len()
             )));
         }
@@ -396,7 +356,7 @@ fn drive_and_compare(
         .filter(|t| !t.value.skip && !t.value.error)
         .count() as u64
         * u64::from(cfg.p);
-    report.bursts += ars.len() as u64;
+    report.bursts += n_ars as u64;
     report.cycles += driven.stats.cycles;
     if exact {
         report.blocks_read += run.blocks_read;
@@ -471,7 +431,7 @@ fn random_sweeps_with_latency_gaps_backpressure_and_bandwidth_limits() {
 /// The acceptance figure (docs/adding-a-unit.md): at least 1,000,000 random items per
 /// configuration, every third case reset in mid-stream.
 #[test]
-#[ignore = "sim-full: a million items per configuration take minutes"]
+#[ignore = "sim-full: a million items per configuration, about 40 s of simulation"]
 fn a_million_random_items_per_config() {
     for (i, (variant, cfg)) in configs::<VolFetchConfig>().into_iter().enumerate() {
         let mut items = 0u64;
@@ -631,12 +591,7 @@ fn throughput(variant: &'static Variant, cfg: VolFetchConfig, lat: u32, bw: (u32
     let nb = cfg.nb().min(4);
     let blocks = [nb, nb, nb.min(4)];
     let mut lut = random_lut(cfg, blocks, &mut rng);
-    for c in &mut lut {
-        if let FetchCmd::Lut { entry, .. } = c {
-            entry.empty = false;
-            entry.masked = false;
-        }
-    }
+    all_present(&mut lut);
     let mut mem = random_image(cfg, blocks.iter().product(), &mut rng);
     mem.base = 0x1000 * u64::from(cfg.addr_w > 16);
     (mem.slverr_lo, mem.slverr_hi) = (0, 0);
@@ -770,12 +725,7 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_skip() {
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let blocks = [2, 2, 2];
     let mut lut = random_lut(cfg, blocks, &mut rng);
-    for c in &mut lut {
-        if let FetchCmd::Lut { entry, .. } = c {
-            entry.empty = false;
-            entry.masked = false;
-        }
-    }
+    all_present(&mut lut);
     let mut mem = random_image(cfg, 8, &mut rng);
     (mem.slverr_lo, mem.slverr_hi) = (0, 0);
     let sweep = Sweep {
