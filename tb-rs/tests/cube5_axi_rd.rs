@@ -5,13 +5,13 @@
 
 mod support;
 
-use cube5_model::units::cube5_axi_rd::{AxiMemImage, AxiRdCmd, AxiRdConfig, Burst};
+use cube5_model::units::cube5_axi_rd::{AxiMemImage, AxiRdCmd, AxiRdConfig};
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::{Mismatch, TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{configs, gate_configs, seed};
+use support::{axi_protocol_clean, compare_ar, configs, gate_configs, seed, with_waves};
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
 /// optionally a reset after `reset_at` cycles followed by `after` commands.
@@ -115,21 +115,7 @@ fn check(
     seed: u64,
     case: &Case,
 ) -> Result<Report, TbError> {
-    match run(variant, cfg, seed, case, None) {
-        Err(TbError::Mismatch(mut m)) if std::env::var_os("CUBE5_NO_WAVES").is_none() => {
-            let dir = PathBuf::from(
-                std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".into()),
-            )
-            .join("cube5-waves");
-            let _ = std::fs::create_dir_all(&dir);
-            let path = dir.join(format!("{variant}-seed{seed}.vcd"));
-            let window = (m.cycle.saturating_sub(64), m.cycle + 8);
-            let _ = run(variant, cfg, seed, case, Some((path.clone(), window)));
-            m.waveform = path.exists().then_some(path);
-            Err(TbError::Mismatch(m))
-        }
-        other => other,
-    }
+    with_waves(variant, seed, |trace| run(variant, cfg, seed, case, trace))
 }
 
 fn must(variant: &'static Variant, cfg: AxiRdConfig, seed: u64, case: &Case) -> Report {
@@ -183,29 +169,11 @@ fn drive_and_compare(
     let exact = max_cycles.is_none();
     let limit = max_cycles.unwrap_or(200_000 + 40 * want.len() as u64 + 300 * bursts.len() as u64);
     let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
-    let protocol = |cycle: u64, what: String| TbError::Protocol {
-        variant: variant.name.to_string(),
-        seed,
-        cycle,
-        what,
-    };
-    if driven.stats.protocol_errors > 0 {
-        return Err(protocol(
-            driven.stats.first_protocol_error_cycle,
-            "a stalled output beat dropped valid or changed".into(),
-        ));
-    }
-    let counters = dut.axi_counters();
-    if counters.protocol_errors > 0 {
-        return Err(protocol(
-            counters.first_error_cycle,
-            format!(
-                "AXI checker: {} ({} violations)",
-                dut.axi_first_error(),
-                counters.protocol_errors
-            ),
-        ));
-    }
+    axi_protocol_clean(dut, &driven.stats, variant, seed)?;
+    // AR first: a wrong burst explains a wrong beat.
+    let n_ars = compare_ar(dut, &bursts, cfg.size(), variant, seed, |k| {
+        format!("burst #{k} of commands {cmds:?}")
+    })?;
     let fail = |item: u64, cycle: u64, what: &str, input: String, rtl: String, model: String| {
         TbError::from(Mismatch {
             variant: variant.name.to_string(),
@@ -219,27 +187,6 @@ fn drive_and_compare(
             ..Default::default()
         })
     };
-    // AR first: a wrong burst explains a wrong beat.
-    let ars = dut.axi_take_ar()?;
-    for (k, ar) in ars.iter().enumerate() {
-        let model = bursts.get(k);
-        let got = Burst {
-            addr: ar.addr,
-            beats: ar.len + 1,
-        };
-        if model != Some(&got) || ar.size != cfg.size() || ar.burst != 1 || ar.id != 0 {
-            return Err(fail(
-                k as u64,
-                ar.cycle,
-                "AR burst differs (address, beats; ARSIZE, ARBURST = INCR, ARID = 0)",
-                format!("burst #{k} of commands {cmds:?}"),
-                format!("{got:?} size {} burst {} id {}", ar.size, ar.burst, ar.id),
-                model.map_or("(no burst expected)".into(), |b| {
-                    format!("{b:?} size {} burst 1 id 0", cfg.size())
-                }),
-            ));
-        }
-    }
     for (k, taken) in driven.outputs.iter().enumerate() {
         if want.get(k) != Some(&taken.value) {
             return Err(fail(
@@ -267,10 +214,10 @@ fn drive_and_compare(
                 want.len()
             )));
         }
-        if ars.len() != bursts.len() {
+        if n_ars != bursts.len() {
             return Err(missing(format!(
                 "{} of {} bursts issued",
-                ars.len(),
+                n_ars,
                 bursts.len()
             )));
         }
@@ -287,7 +234,7 @@ fn drive_and_compare(
         }
     }
     report.beats += driven.outputs.len() as u64;
-    report.bursts += ars.len() as u64;
+    report.bursts += n_ars as u64;
     report.cycles += driven.stats.cycles;
     Ok(())
 }

@@ -207,3 +207,96 @@ where
         .map(|(v, _)| v)
         .unwrap_or_else(|| panic!("no variant of {} has the configuration {cfg:?}", C::TOP))
 }
+
+/// Tops with an AXI4 read port (tb/axi_mem.h): `run(None)`, and on a mismatch the same run again
+/// with a VCD window of the 64 cycles before the first difference (`CUBE5_NO_WAVES=1`: not).
+pub fn with_waves<R>(
+    variant: &'static Variant,
+    seed: u64,
+    run: impl Fn(Option<(std::path::PathBuf, (u64, u64))>) -> Result<R, cube5_tb::TbError>,
+) -> Result<R, cube5_tb::TbError> {
+    match run(None) {
+        Err(cube5_tb::TbError::Mismatch(mut m)) if std::env::var_os("CUBE5_NO_WAVES").is_none() => {
+            let dir = std::path::PathBuf::from(
+                std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".into()),
+            )
+            .join("cube5-waves");
+            let _ = std::fs::create_dir_all(&dir);
+            let path = dir.join(format!("{variant}-seed{seed}.vcd"));
+            let window = (m.cycle.saturating_sub(64), m.cycle + 8);
+            let _ = run(Some((path.clone(), window)));
+            m.waveform = path.exists().then_some(path);
+            Err(cube5_tb::TbError::Mismatch(m))
+        }
+        other => other,
+    }
+}
+
+/// After a run of an AXI top: the output's stall rule and the subordinate's protocol checker.
+pub fn axi_protocol_clean<C: StreamCodec>(
+    dut: &RtlStream<C>,
+    stats: &cube5_tb::ffi::bridge::RunResult,
+    variant: &'static Variant,
+    seed: u64,
+) -> Result<(), cube5_tb::TbError> {
+    let protocol = |cycle: u64, what: String| cube5_tb::TbError::Protocol {
+        variant: variant.name.to_string(),
+        seed,
+        cycle,
+        what,
+    };
+    if stats.protocol_errors > 0 {
+        return Err(protocol(
+            stats.first_protocol_error_cycle,
+            "a stalled output dropped valid or changed".into(),
+        ));
+    }
+    let counters = dut.axi_counters();
+    if counters.protocol_errors > 0 {
+        return Err(protocol(
+            counters.first_error_cycle,
+            format!(
+                "AXI checker: {} ({} violations)",
+                dut.axi_first_error(),
+                counters.protocol_errors
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The AR handshakes since the last call against the model's bursts, in order (address, beats,
+/// ARSIZE = `size`, INCR, ID 0); `context` names burst `k` for the report. Returns the count.
+pub fn compare_ar<C: StreamCodec>(
+    dut: &mut RtlStream<C>,
+    bursts: &[cube5_model::units::cube5_axi_rd::Burst],
+    size: u32,
+    variant: &'static Variant,
+    seed: u64,
+    context: impl Fn(usize) -> String,
+) -> Result<usize, cube5_tb::TbError> {
+    let ars = dut.axi_take_ar()?;
+    for (k, ar) in ars.iter().enumerate() {
+        let model = bursts.get(k);
+        let got = cube5_model::units::cube5_axi_rd::Burst {
+            addr: ar.addr,
+            beats: ar.len + 1,
+        };
+        if model != Some(&got) || ar.size != size || ar.burst != 1 || ar.id != 0 {
+            return Err(cube5_tb::TbError::from(cube5_tb::Mismatch {
+                variant: variant.name.to_string(),
+                seed,
+                item: k as u64,
+                cycle: ar.cycle,
+                input: context(k),
+                rtl: format!("{got:?} size {} burst {} id {}", ar.size, ar.burst, ar.id),
+                model: model.map_or("(no burst expected)".into(), |b| {
+                    format!("{b:?} size {size} burst 1 id 0")
+                }),
+                what: "AR burst differs (address, beats; ARSIZE, ARBURST = INCR, ARID = 0)".into(),
+                ..Default::default()
+            }));
+        }
+    }
+    Ok(ars.len())
+}
