@@ -17,5 +17,6 @@ pub mod cube5_skewmem;
 pub mod cube5_trilin;
 pub mod gicube_bucket;
 pub mod gicube_packet_loop;
+pub mod gicube_processor;
 pub mod gicube_scatter;
 pub mod gicube_sorter;

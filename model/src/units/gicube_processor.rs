@@ -1,0 +1,809 @@
+//! The GI-Cube block processor's renderer (direct volume rendering), written from
+//! `docs/numerics/gicube_processor.md` (patent [347]-[357], [369]-[374]): ray packets made by the
+//! host, bucketed into fixed-size queues per block (overflow returned to the host, never dropped),
+//! the active queue chosen by the pipelined insertion sorter (`gicube_sorter`, cycle-accurate) or
+//! by the ascending scan, one sample per cycle (tri-linear `cube5_trilin`, classification
+//! `cube5_shader`, front-to-back `cube5_compos`), re-queueing to the block the ray enters, space
+//! leaping over empty blocks and early ray termination. Plus the f64 reference of the same
+//! algorithm (no queues, exact arithmetic).
+//!
+//! The image is a function of the rays alone: a ray's packet carries its whole state, so the queue
+//! order (and which rays overflow to the host and come back) changes the counts, never a pixel.
+
+use std::collections::VecDeque;
+
+use glam::DVec3;
+
+use crate::camera::Camera;
+use crate::error::{ModelError, Result};
+use crate::transfer::TransferFunction;
+use crate::units::cube5_compos::{
+    corrected_alpha, Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
+};
+use crate::units::cube5_shader::{
+    ClassLut, ReflectanceMap, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables, Texel,
+};
+use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
+use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, DIR_FRAC_W, POS_FRAC_W};
+use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
+use crate::volume::Volume;
+
+/// Largest value of a `U(0.12)` packet channel.
+pub const CHAN_MAX: u32 = 4095;
+/// Fraction bits of the tri-linear sample (`cube5_trilin` `FracW`).
+pub const SAMPLE_FRAC_W: u32 = 4;
+/// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
+pub const SORTER_SLOTS: usize = 2;
+
+/// How the processor picks the next active queue.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum QueueOrder {
+    /// The pipelined insertion sorter (`gicube_sorter`, cycle-accurate): importance = rays in the
+    /// queue ([373] criterion 1); the active queue is the sorter's `S[0]`.
+    Sorter,
+    /// Keep the active queue until it is empty, then take the next non-empty queue in ascending
+    /// cyclic order (a rule without a sorter, for the order-independence test and for small RTL).
+    Scan,
+}
+
+/// The order in which the host first offers the rays of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HostOrder {
+    /// Row by row from the top, left to right.
+    RowMajor,
+    /// The reverse.
+    Reversed,
+}
+
+/// Projection of the rendering rays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Rays along `camera.dir` from `camera.ray_origin(px, py)`.
+    Parallel,
+    /// Rays from one eye through `camera.ray_origin(px, py)`; the top row's pixel centres are
+    /// `fov_deg / 2` off the axis.
+    Perspective { fov_deg: f64 },
+}
+
+/// One processor configuration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProcessorConfig {
+    /// Block side `n = 2^block_log2` voxels.
+    pub block_log2: u32,
+    /// Rays per queue (the fixed hardware queue length, 256 in [371]).
+    pub queue_len: u32,
+    /// Ranks of the sorter (clamped to the number of queues).
+    pub ranks: u32,
+    /// Step `dr` along the ray, `U(4.8)` voxels: 16..=1024 (1/16 to 4 voxels).
+    pub step: u32,
+    /// Early ray termination threshold on the packet opacity, `U(0.12)`; `None`: off.
+    pub et_threshold: Option<u32>,
+    /// Space leaping over empty blocks ([357]).
+    pub space_leap: bool,
+    pub order: QueueOrder,
+    pub host_order: HostOrder,
+}
+
+impl ProcessorConfig {
+    /// 16^3 blocks, 256-ray queues, 16 ranks, one sample per voxel, termination at
+    /// `1 - 2^-8`, space leaping, the sorter.
+    pub const DEFAULT: Self = Self {
+        block_log2: 4,
+        queue_len: 256,
+        ranks: 16,
+        step: 256,
+        et_threshold: Some(CHAN_MAX + 1 - 16),
+        space_leap: true,
+        order: QueueOrder::Sorter,
+        host_order: HostOrder::RowMajor,
+    };
+
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(ModelError::Config(format!("gicube processor: {m}")));
+        if !(2..=8).contains(&self.block_log2) {
+            return bad(format!("block_log2 {} outside 2..=8", self.block_log2));
+        }
+        if !(1..=65535).contains(&self.queue_len) {
+            return bad(format!("queue_len {} outside 1..=65535", self.queue_len));
+        }
+        if !(2..=64).contains(&self.ranks) {
+            return bad(format!("ranks {} outside 2..=64", self.ranks));
+        }
+        if !(16..=1024).contains(&self.step) {
+            return bad(format!(
+                "step {} (1/256 voxel) outside 16..=1024",
+                self.step
+            ));
+        }
+        if let Some(t) = self.et_threshold {
+            if !(1..=CHAN_MAX + 1).contains(&t) {
+                return bad(format!("et_threshold {t} outside 1..=4096"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The step in voxels.
+    pub fn step_voxels(&self) -> f64 {
+        f64::from(self.step) / f64::from(1u32 << POS_FRAC_W)
+    }
+}
+
+/// The counts of one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ProcessorCounts {
+    /// Pixels whose ray meets the volume (the host makes one ray for each).
+    pub rays_made: u64,
+    /// Ray packets the processor accepted from the host (first offers and re-offers).
+    pub rays_in: u64,
+    /// Cycles in which the host's next ray was not accepted because its queue was full.
+    pub host_stalls: u64,
+    /// Rays that left the processor finished (exited the volume or terminated).
+    pub rays_finished: u64,
+    /// Rays returned to the host because the queue of the block they entered was full ([372]);
+    /// the host offers them again after the rays it holds.
+    pub rays_overflowed: u64,
+    /// Finished rays that stopped by early termination.
+    pub rays_terminated: u64,
+    /// Samples taken (one per busy pipeline cycle that does not leap).
+    pub samples: u64,
+    /// Block visits that leapt over an empty block.
+    pub leaps: u64,
+    /// Times a queue became active (blocks processed).
+    pub activations: u64,
+    pub cycles: u64,
+    /// Cycles with no ray in the pipeline while rays remained.
+    pub idle_cycles: u64,
+    /// Sum over cycles of the rays held in all queues (mean occupancy = this / cycles).
+    pub occupancy_sum: u64,
+    /// Largest number of rays one queue held.
+    pub max_queue: u32,
+}
+
+impl ProcessorCounts {
+    pub fn mean_occupancy(&self) -> f64 {
+        self.occupancy_sum as f64 / self.cycles.max(1) as f64
+    }
+}
+
+/// A rendered frame: the raw `U(0.12)` colour of every pixel (0 where no ray was made), row-major
+/// from the top, and the counts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProcessorFrame {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Vec<[u16; 3]>,
+    pub counts: ProcessorCounts,
+}
+
+impl ProcessorFrame {
+    /// Colours as reals, `raw / 4096`.
+    pub fn to_f64(&self) -> Vec<[f64; 3]> {
+        self.rgb
+            .iter()
+            .map(|c| c.map(|v| f64::from(v) / 4096.0))
+            .collect()
+    }
+}
+
+/// One ray of the host, before quantization (shared by the processor and the f64 reference).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HostRay {
+    pub px: u32,
+    pub py: u32,
+    /// Entry point into the volume's voxel-centre box, voxel coordinates.
+    pub entry: DVec3,
+    /// Unit direction, voxel coordinates.
+    pub dir: DVec3,
+}
+
+/// Domain of a volume on the processor: blocks a side `B`, side `N = B n`.
+fn domain(vol: &Volume, block_log2: u32) -> Result<(u32, u32)> {
+    let n = 1usize << block_log2;
+    let edge = *vol.dims.iter().max().unwrap_or(&1);
+    let b = edge.div_ceil(n);
+    if b > 64 || b * n > 4096 {
+        return Err(ModelError::Config(format!(
+            "gicube processor: {edge} voxels a side need {b} blocks of {n} (at most 64 blocks and 4096 voxels)"
+        )));
+    }
+    if b * b * b > 256 {
+        return Err(ModelError::Config(format!(
+            "gicube processor: {b}^3 = {} blocks exceed the sorter's 256 queues; use blocks of at least {} voxels",
+            b * b * b,
+            edge.div_ceil(6).next_power_of_two()
+        )));
+    }
+    Ok((b as u32, (b * n) as u32))
+}
+
+/// The rays of a frame, one per pixel whose ray meets the box `[0, dims - 1]` (voxel centres), in
+/// the host's order.
+pub fn host_rays(
+    vol: &Volume,
+    cam: &Camera,
+    proj: Projection,
+    order: HostOrder,
+) -> Result<Vec<HostRay>> {
+    let s = vol.spacing[0];
+    if vol.spacing.iter().any(|&x| x != s) {
+        return Err(ModelError::Config(format!(
+            "gicube processor: anisotropic spacing {:?} is not supported (resample the volume)",
+            vol.spacing
+        )));
+    }
+    if cam.width == 0 || cam.height == 0 || cam.width > 4096 || cam.height > 4096 {
+        return Err(ModelError::Config(format!(
+            "gicube processor: image {}x{} outside 1..=4096 a side (the packet's u, v)",
+            cam.width, cam.height
+        )));
+    }
+    let dir = cam.dir;
+    if !dir.is_finite() || (dir.length() - 1.0).abs() > 1e-6 {
+        return Err(ModelError::Config(format!(
+            "gicube processor: camera direction {dir} is not a unit vector"
+        )));
+    }
+    let eye = match proj {
+        Projection::Parallel => None,
+        Projection::Perspective { fov_deg } => {
+            if !(fov_deg > 0.0 && fov_deg < 170.0) {
+                return Err(ModelError::Config(format!(
+                    "gicube processor: field of view {fov_deg} degrees outside (0, 170)"
+                )));
+            }
+            let (u, v) = cam.pixel_offset(0, 0);
+            let c0 = cam.ray_origin(0, 0) - cam.right * u - cam.up * v;
+            let focal = v.abs() / (fov_deg.to_radians() * 0.5).tan();
+            Some(c0 - dir * focal)
+        }
+    };
+    let hi = DVec3::new(
+        vol.dims[0] as f64 - 1.0,
+        vol.dims[1] as f64 - 1.0,
+        vol.dims[2] as f64 - 1.0,
+    );
+    let mut rays = Vec::new();
+    let mut push = |px: u32, py: u32| {
+        let p = cam.ray_origin(px, py) / s;
+        let d = match eye {
+            None => dir,
+            Some(e) => (p - e / s).normalize(),
+        };
+        if let Some(t) = clip(p, d, hi) {
+            rays.push(HostRay {
+                px,
+                py,
+                entry: p + d * t,
+                dir: d,
+            });
+        }
+    };
+    match order {
+        HostOrder::RowMajor => {
+            for py in 0..cam.height {
+                for px in 0..cam.width {
+                    push(px, py);
+                }
+            }
+        }
+        HostOrder::Reversed => {
+            for py in (0..cam.height).rev() {
+                for px in (0..cam.width).rev() {
+                    push(px, py);
+                }
+            }
+        }
+    }
+    Ok(rays)
+}
+
+/// Entry parameter `t >= 0` of the ray `p + t d` into the box `[0, hi]`, or `None` if it misses.
+fn clip(p: DVec3, d: DVec3, hi: DVec3) -> Option<f64> {
+    let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+    for a in 0..3 {
+        if d[a].abs() < 1e-12 {
+            if p[a] < 0.0 || p[a] > hi[a] {
+                return None;
+            }
+        } else {
+            let (ta, tb) = ((0.0 - p[a]) / d[a], (hi[a] - p[a]) / d[a]);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+    }
+    (t0 <= t1).then_some(t0)
+}
+
+/// `rnd` of a signed product: `(x + 2^(s-1)) >> s`, arithmetic (round half up, toward +inf).
+#[inline]
+fn rnd_signed(x: i64, s: u32) -> i64 {
+    (x + (1 << (s - 1))) >> s
+}
+
+/// What one pipeline cycle did to a ray.
+enum Outcome {
+    /// Still in the same block: back to the tail of the same queue.
+    Stay(RayPacket),
+    /// Entered another block (queue number).
+    Move(RayPacket, u32),
+    /// Finished: exited the volume or terminated.
+    Done(RayPacket),
+}
+
+/// The block processor's renderer.
+#[derive(Debug, Clone)]
+pub struct Processor {
+    cfg: ProcessorConfig,
+    vol: Volume,
+    trilin: Trilin,
+    shader: Shader,
+    compos: Compos,
+    bucket: BucketUnit,
+    /// Blocks a side, domain side in voxels.
+    blocks: u32,
+    side: u32,
+    /// Empty flag of each queue's block.
+    empty: Vec<bool>,
+}
+
+impl Processor {
+    /// Loads the volume and the tables for `tf`.
+    pub fn new(cfg: ProcessorConfig, vol: &Volume, tf: &TransferFunction) -> Result<Self> {
+        cfg.validate()?;
+        tf.validate()?;
+        if vol.bits < 4 {
+            return Err(ModelError::Config(format!(
+                "gicube processor: {}-bit voxels (4..=16 supported)",
+                vol.bits
+            )));
+        }
+        let (blocks, side) = domain(vol, cfg.block_log2)?;
+        let trilin = Trilin::new(TrilinConfig::new(vol.bits, POS_FRAC_W, SAMPLE_FRAC_W)?)?;
+        let scfg = shader_config(vol.bits);
+        let class = ClassLut::from_transfer(&scfg, tf)?;
+        let rmap = ReflectanceMap::from_fn(&scfg, |_, _, _| Texel::default(), Texel::default())?;
+        let shader = Shader::new(scfg, ShaderTables { class, rmap })?;
+        let ccfg = compos_config();
+        let lut = OpacityLut::new(cfg.step_voxels(), &ccfg)?;
+        let regs = match cfg.et_threshold {
+            Some(t) => ComposRegs {
+                et_threshold: u64::from(t),
+                ..ComposRegs::defaults(&ccfg)
+            },
+            None => ComposRegs::without_termination(&ccfg),
+        };
+        let compos = Compos::new(ccfg, lut, regs)?;
+        let bucket = BucketUnit::new(BucketConfig {
+            block_log2: cfg.block_log2,
+            vol_blocks: blocks,
+            proc_log2: 0,
+            dist: Distribution::Slab,
+            lanes: 1,
+        })?;
+        let mut p = Self {
+            cfg,
+            vol: vol.clone(),
+            trilin,
+            shader,
+            compos,
+            bucket,
+            blocks,
+            side,
+            empty: Vec::new(),
+        };
+        p.empty = (0..blocks * blocks * blocks)
+            .map(|q| p.block_is_empty(q))
+            .collect();
+        Ok(p)
+    }
+
+    pub fn config(&self) -> ProcessorConfig {
+        self.cfg
+    }
+
+    /// Number of queues (blocks).
+    pub fn queues(&self) -> u32 {
+        self.blocks * self.blocks * self.blocks
+    }
+
+    /// Empty flags of the blocks, by queue number.
+    pub fn empty_flags(&self) -> &[bool] {
+        &self.empty
+    }
+
+    /// The host's empty flag ([357]): every classification entry between the smallest and the
+    /// largest voxel the block's samples can read (its `n + 1` voxels a side) has alpha 0.
+    fn block_is_empty(&self, q: u32) -> bool {
+        let [bx, by, bz] = self.bucket.block_of(0, q);
+        let n = 1i64 << self.cfg.block_log2;
+        let (mut lo, mut hi) = (u32::MAX, 0u32);
+        for z in 0..=n {
+            for y in 0..=n {
+                for x in 0..=n {
+                    let v = self.vol.get(
+                        i64::from(bx) * n + x,
+                        i64::from(by) * n + y,
+                        i64::from(bz) * n + z,
+                    );
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+            }
+        }
+        let idx = |v: u32| {
+            self.shader.class_index(&ShaderIn {
+                sample: v << SAMPLE_FRAC_W,
+                grad: [0; 3],
+                mag: 0,
+                mode: unlit(),
+            })
+        };
+        self.shader.tables().class.entries()[idx(lo)..=idx(hi)]
+            .iter()
+            .all(|e| e.a == 0)
+    }
+
+    /// The packet the host makes for a ray (`RayPacket::from_real`: round half up, saturate).
+    pub fn packet(ray: &HostRay) -> Result<RayPacket> {
+        RayPacket::from_real(&RayReal {
+            u: ray.px as u16,
+            v: ray.py as u16,
+            start: ray.entry.to_array(),
+            dir: ray.dir.to_array(),
+            color: [0.0; 3],
+            opacity: 0.0,
+            contribution: 1.0,
+            interaction: 0.0,
+            lifetime: 0,
+            generation: 0,
+            ray_type: RayType::Rendering,
+            flags: 0,
+        })
+    }
+
+    fn queue_of(&self, pos: [u32; 3]) -> Option<u32> {
+        let b = self.bucket.bucket(Position(pos));
+        (!b.outside).then_some(b.queue)
+    }
+
+    /// The per-ray step `delta = rnd(dir * step, 14)`, `S(.8)` voxels per axis.
+    pub fn delta(&self, ray: &RayPacket) -> [i64; 3] {
+        ray.dir
+            .map(|d| rnd_signed(i64::from(d) * i64::from(self.cfg.step), DIR_FRAC_W))
+    }
+
+    /// The classified, composited sample at the ray's position (the pipeline's datapath).
+    fn sample(&self, ray: &mut RayPacket) -> bool {
+        let p = ray.start;
+        let base = p.map(|c| i64::from(c >> POS_FRAC_W));
+        let mut voxels = [0u32; 8];
+        for (c, v) in voxels.iter_mut().enumerate() {
+            *v = self.vol.get(
+                base[0] + (c & 1) as i64,
+                base[1] + ((c >> 1) & 1) as i64,
+                base[2] + ((c >> 2) & 1) as i64,
+            );
+        }
+        let mask = (1u32 << POS_FRAC_W) - 1;
+        let s = self.trilin.sample(&TrilinIn {
+            voxels,
+            weights: p.map(|c| c & mask),
+            mode: TrilinMode::Lerp,
+        });
+        let e = self.shader.classify(&ShaderIn {
+            sample: s,
+            grad: [0; 3],
+            mag: 0,
+            mode: unlit(),
+        });
+        let coxel = Coxel {
+            rgba: [
+                u64::from(ray.color[0]),
+                u64::from(ray.color[1]),
+                u64::from(ray.color[2]),
+                u64::from(ray.opacity),
+            ],
+            z: 1,
+            geo: [0; 3],
+            terminated: false,
+        };
+        let out = self.compos.step(
+            &coxel,
+            &Sample {
+                rgb: [e.r, e.g, e.b],
+                alpha: e.a,
+                depth: 0,
+                mode: ComposMode::FrontToBack,
+            },
+        );
+        let sat = |x: u64| x.min(u64::from(CHAN_MAX)) as u16;
+        ray.color = [sat(out.rgba[0]), sat(out.rgba[1]), sat(out.rgba[2])];
+        ray.opacity = sat(out.rgba[3]);
+        out.terminated
+    }
+
+    /// Steps to leave the block `[lo, lo + n)` (raw positions) from `pos` with `delta`: the
+    /// smallest `k >= 1` with `pos + k delta` outside on some axis.
+    fn steps_to_exit(&self, pos: [u32; 3], delta: [i64; 3], block: [u32; 3]) -> i64 {
+        let n = (1i64 << self.cfg.block_log2) << POS_FRAC_W;
+        let mut k = i64::MAX;
+        for a in 0..3 {
+            let p = i64::from(pos[a]);
+            let lo = i64::from(block[a]) * n;
+            let d = delta[a];
+            if d > 0 {
+                k = k.min((lo + n - p + d - 1) / d);
+            } else if d < 0 {
+                k = k.min((p - lo - d) / -d);
+            }
+        }
+        k.max(1)
+    }
+
+    /// One pipeline cycle on a ray of queue `q`: a sample (or a leap), then the advance.
+    fn advance(&self, mut ray: RayPacket, q: u32, counts: &mut ProcessorCounts) -> Outcome {
+        let delta = self.delta(&ray);
+        let k = if self.cfg.space_leap && self.empty[q as usize] {
+            counts.leaps += 1;
+            self.steps_to_exit(ray.start, delta, self.bucket.block_of(0, q))
+        } else {
+            counts.samples += 1;
+            if self.sample(&mut ray) && self.cfg.et_threshold.is_some() {
+                ray.flags |= flag::TERMINATED;
+                counts.rays_terminated += 1;
+                return Outcome::Done(ray);
+            }
+            1
+        };
+        let limit = i64::from(self.side) << POS_FRAC_W;
+        let next: [i64; 3] = std::array::from_fn(|a| i64::from(ray.start[a]) + k * delta[a]);
+        if next.iter().any(|&c| c < 0 || c >= limit) {
+            return Outcome::Done(ray);
+        }
+        ray.start = next.map(|c| c as u32);
+        match self.queue_of(ray.start) {
+            Some(q2) if q2 == q => Outcome::Stay(ray),
+            Some(q2) => Outcome::Move(ray, q2),
+            None => Outcome::Done(ray),
+        }
+    }
+
+    /// Renders a frame: the host makes the rays (`host_rays`), offers the head of its list in
+    /// every cycle with a free sorter slot (accepted when its queue has room), and takes back
+    /// finished and overflowed rays (appending the latter to its list) until every ray finished.
+    pub fn render(&self, cam: &Camera, proj: Projection) -> Result<ProcessorFrame> {
+        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
+        let mut feed: VecDeque<RayPacket> = rays
+            .iter()
+            .map(Self::packet)
+            .collect::<Result<VecDeque<_>>>()?;
+        let nq = self.queues();
+        let queue_w = (32 - (nq - 1).leading_zeros()).max(1);
+        let imp_w = (32 - self.cfg.queue_len.leading_zeros()).max(2);
+        let scfg = SorterConfig::new(
+            self.cfg.ranks.min(1 << queue_w),
+            queue_w,
+            imp_w,
+            self.cfg.queue_len,
+        )?;
+        let mut sorter = Sorter::new(scfg)?;
+        let mut queues: Vec<VecDeque<RayPacket>> = vec![VecDeque::new(); nq as usize];
+        let cap = self.cfg.queue_len as usize;
+        let mut counts = ProcessorCounts {
+            rays_made: rays.len() as u64,
+            ..Default::default()
+        };
+        let (w, h) = (cam.width, cam.height);
+        let mut rgb = vec![[0u16; 3]; (w * h) as usize];
+        let mut done = vec![false; (w * h) as usize];
+        let mut held = 0u64;
+        let mut scan_active: Option<u32> = None;
+        let mut last_active: Option<u32> = None;
+        // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
+        let bound = 64 + 8 * rays.len() as u64 * (u64::from(self.side) * 4 + u64::from(nq) + 64);
+
+        while !feed.is_empty() || held > 0 {
+            counts.cycles += 1;
+            if counts.cycles > bound {
+                return Err(ModelError::Config(format!(
+                    "gicube processor: no progress after {bound} cycles ({held} rays queued)"
+                )));
+            }
+            counts.occupancy_sum += held;
+            let mut updates: Vec<SorterIn> = Vec::with_capacity(SORTER_SLOTS);
+            // The active queue.
+            let active = match self.cfg.order {
+                QueueOrder::Sorter => sorter.active().map(|e| e.queue),
+                QueueOrder::Scan => {
+                    if scan_active.is_none_or(|q| queues[q as usize].is_empty()) && held > 0 {
+                        let from = scan_active.map_or(0, |q| q + 1);
+                        scan_active = (0..nq)
+                            .map(|i| (from + i) % nq)
+                            .find(|&q| !queues[q as usize].is_empty());
+                    }
+                    scan_active
+                }
+            };
+            if active.is_some() && active != last_active {
+                counts.activations += 1;
+            }
+            last_active = active;
+            match active.and_then(|q| queues[q as usize].pop_front().map(|r| (q, r))) {
+                Some((q, ray)) => match self.advance(ray, q, &mut counts) {
+                    Outcome::Stay(ray) => queues[q as usize].push_back(ray),
+                    Outcome::Move(mut ray, q2) => {
+                        updates.push(SorterIn::add(q, -1));
+                        if queues[q2 as usize].len() < cap {
+                            queues[q2 as usize].push_back(ray);
+                            updates.push(SorterIn::add(q2, 1));
+                        } else {
+                            held -= 1;
+                            counts.rays_overflowed += 1;
+                            ray.flags |= flag::OVERFLOW;
+                            feed.push_back(ray);
+                        }
+                    }
+                    Outcome::Done(ray) => {
+                        updates.push(SorterIn::add(q, -1));
+                        held -= 1;
+                        counts.rays_finished += 1;
+                        let i = (u32::from(ray.v) * w + u32::from(ray.u)) as usize;
+                        if done[i] {
+                            return Err(ModelError::Config(format!(
+                                "gicube processor: pixel ({}, {}) finished twice",
+                                ray.u, ray.v
+                            )));
+                        }
+                        done[i] = true;
+                        rgb[i] = ray.color;
+                    }
+                },
+                None => {
+                    if held > 0 {
+                        counts.idle_cycles += 1;
+                    }
+                }
+            }
+            // The host's offer, in a free sorter slot. A ray whose queue is full is not accepted
+            // (the port's ready is low): it stays at the head of the host's list.
+            if updates.len() < SORTER_SLOTS {
+                if let Some(&ray) = feed.front() {
+                    let qh = self.queue_of(ray.start).ok_or_else(|| {
+                        // The host clips rays to the volume: a packet outside it is a bug.
+                        ModelError::Config(format!(
+                            "gicube processor: host ray of pixel ({}, {}) starts outside the volume",
+                            ray.u, ray.v
+                        ))
+                    })?;
+                    if queues[qh as usize].len() < cap {
+                        let mut ray = ray;
+                        feed.pop_front();
+                        ray.flags &= !flag::OVERFLOW;
+                        counts.rays_in += 1;
+                        queues[qh as usize].push_back(ray);
+                        held += 1;
+                        updates.push(SorterIn::add(qh, 1));
+                    } else {
+                        counts.host_stalls += 1;
+                    }
+                }
+            }
+            for u in &updates {
+                counts.max_queue = counts.max_queue.max(queues[u.queue as usize].len() as u32);
+            }
+            if self.cfg.order == QueueOrder::Sorter {
+                for s in 0..SORTER_SLOTS {
+                    sorter.step(updates.get(s).unwrap_or(&SorterIn::NOOP));
+                }
+                // The sorter's counters are the queue lengths (criterion 1 of [373]).
+                for u in &updates {
+                    let len = queues[u.queue as usize].len();
+                    if sorter.importance(u.queue) as usize != len {
+                        return Err(ModelError::Config(format!(
+                            "gicube processor: sorter counter {} of queue {} holds {len} rays",
+                            sorter.importance(u.queue),
+                            u.queue
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(ProcessorFrame {
+            width: w,
+            height: h,
+            rgb,
+            counts,
+        })
+    }
+
+    /// The f64 reference of the same algorithm: the host's rays before quantization, samples at
+    /// `entry + k dr dir` until the point leaves `[0, N)^3`, f64 tri-linear density, the transfer
+    /// function itself, `alpha' = 1 - (1 - alpha)^dr`, front-to-back over in f64, termination at
+    /// the same threshold. No queues, no leaping (leaping is exact).
+    pub fn reference(
+        &self,
+        tf: &TransferFunction,
+        cam: &Camera,
+        proj: Projection,
+    ) -> Result<Vec<[f64; 3]>> {
+        let rays = host_rays(&self.vol, cam, proj, HostOrder::RowMajor)?;
+        let mut img = vec![[0.0; 3]; (cam.width * cam.height) as usize];
+        let dr = self.cfg.step_voxels();
+        let n = f64::from(self.side);
+        let max = f64::from(self.vol.max_value());
+        let thr = self.cfg.et_threshold.map(|t| f64::from(t) / 4096.0);
+        for r in &rays {
+            let (mut c, mut a) = ([0.0f64; 3], 0.0f64);
+            for k in 0.. {
+                let p = r.entry + r.dir * (k as f64 * dr);
+                if p.to_array().iter().any(|&x| !(0.0..n).contains(&x)) {
+                    break;
+                }
+                let rgba = tf.lookup(self.vol.sample_f64(p.to_array()) / max);
+                let w = (1.0 - a) * corrected_alpha(rgba[3], dr);
+                for i in 0..3 {
+                    c[i] += w * rgba[i];
+                }
+                a += w;
+                if thr.is_some_and(|t| a >= t) {
+                    break;
+                }
+            }
+            img[(r.py * cam.width + r.px) as usize] = c;
+        }
+        Ok(img)
+    }
+}
+
+fn unlit() -> ShaderMode {
+    ShaderMode {
+        tf2d: false,
+        unlit: true,
+    }
+}
+
+/// The classification the processor uses: `cube5_shader` on the `U(VoxelW.4)` sample, 1-D,
+/// `min(12, VoxelW + 4)` index bits, 8-bit colour, 12-bit alpha.
+pub fn shader_config(voxel_w: u32) -> ShaderConfig {
+    ShaderConfig {
+        voxel_w,
+        frac_w: SAMPLE_FRAC_W,
+        class_idx_w: 12.min(voxel_w + SAMPLE_FRAC_W),
+        mag_shift: 10.min(voxel_w + 1 + SAMPLE_FRAC_W),
+        ..ShaderConfig::DEFAULT
+    }
+}
+
+/// The compositing the processor uses: `cube5_compos` with the packet's widths, coxel `U(1.12)`,
+/// corrected alpha `U(1.12)`, 8-bit sample colour, no depth.
+pub fn compos_config() -> ComposConfig {
+    ComposConfig {
+        color_w: 8,
+        alpha_w: 12,
+        extra_w: 0,
+        acc_w: 12,
+        z_w: 1,
+    }
+}
+
+/// PSNR (dB, peak 1.0) and largest channel error of `a` against `b`.
+pub fn psnr(a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
+    let mut se = 0.0;
+    let mut max = 0.0f64;
+    for (x, y) in a.iter().zip(b) {
+        for i in 0..3 {
+            let d = x[i] - y[i];
+            se += d * d;
+            max = max.max(d.abs());
+        }
+    }
+    let mse = se / (3 * a.len().max(1)) as f64;
+    let p = if mse > 0.0 {
+        -10.0 * mse.log10()
+    } else {
+        f64::INFINITY
+    };
+    (p, max)
+}

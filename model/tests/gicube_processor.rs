@@ -1,0 +1,309 @@
+//! The GI-Cube block processor's renderer (docs/numerics/gicube_processor.md): accuracy against
+//! its f64 reference on the head phantom, no ray lost under queue overflow, the image independent
+//! of queue order, space leaping exact, early termination, bad input refused.
+
+use cube5_model::camera::Camera;
+use cube5_model::phantom::head_phantom;
+use cube5_model::transfer::TransferFunction;
+use cube5_model::units::gicube_processor::{
+    host_rays, psnr, HostOrder, Processor, ProcessorConfig, ProcessorFrame, Projection, QueueOrder,
+};
+use cube5_model::volume::Volume;
+use glam::DVec3;
+
+/// The head scene's view (azimuth 65, elevation 20 degrees).
+fn view_dir() -> DVec3 {
+    let (a, e) = (65f64.to_radians(), 20f64.to_radians());
+    -DVec3::new(e.cos() * a.cos(), e.cos() * a.sin(), e.sin())
+}
+
+fn camera(vol: &Volume, px: u32) -> Camera {
+    Camera::new(view_dir(), vol.dims, vol.spacing, px, px)
+}
+
+fn cfg_for(n: usize) -> ProcessorConfig {
+    ProcessorConfig {
+        block_log2: if n <= 32 { 3 } else { 4 },
+        ..ProcessorConfig::DEFAULT
+    }
+}
+
+/// The rays are conserved and every pixel with a ray got exactly one result.
+fn check_conservation(f: &ProcessorFrame) {
+    let c = &f.counts;
+    assert_eq!(
+        c.rays_in,
+        c.rays_finished + c.rays_overflowed,
+        "rays in = finished + overflowed: {c:?}"
+    );
+    assert_eq!(
+        c.rays_finished, c.rays_made,
+        "every ray finished once: {c:?}"
+    );
+}
+
+fn psnr_case(n: usize, px: u32, proj: Projection, min_db: f64) -> (f64, f64, ProcessorFrame) {
+    let vol = head_phantom(n, 12).unwrap();
+    let tf = TransferFunction::head_default();
+    let cam = camera(&vol, px);
+    let p = Processor::new(cfg_for(n), &vol, &tf).unwrap();
+    let f = p.render(&cam, proj).unwrap();
+    check_conservation(&f);
+    let r = p.reference(&tf, &cam, proj).unwrap();
+    let (db, max) = psnr(&f.to_f64(), &r);
+    let mean = r.iter().map(|c| c[0] + c[1] + c[2]).sum::<f64>() / (3 * r.len()) as f64;
+    println!(
+        "n={n} {proj:?}: PSNR {db:.2} dB, max {max:.4}, reference mean {mean:.3}, {:?}",
+        f.counts
+    );
+    assert!(
+        mean > 0.02,
+        "the reference image is not empty (mean {mean})"
+    );
+    assert!(db >= min_db, "PSNR {db:.2} dB below {min_db} dB");
+    (db, max, f)
+}
+
+#[test]
+fn head_parallel_32_within_psnr_of_f64() {
+    psnr_case(32, 64, Projection::Parallel, 45.0);
+}
+
+#[test]
+fn head_parallel_64_within_psnr_of_f64() {
+    psnr_case(64, 96, Projection::Parallel, 45.0);
+}
+
+#[test]
+fn head_perspective_32_and_64_within_psnr_of_f64() {
+    psnr_case(32, 64, Projection::Perspective { fov_deg: 30.0 }, 45.0);
+    psnr_case(64, 96, Projection::Perspective { fov_deg: 30.0 }, 45.0);
+}
+
+fn render(vol: &Volume, cfg: ProcessorConfig, px: u32, proj: Projection) -> ProcessorFrame {
+    let tf = TransferFunction::head_default();
+    let p = Processor::new(cfg, vol, &tf).unwrap();
+    let f = p.render(&camera(vol, px), proj).unwrap();
+    check_conservation(&f);
+    f
+}
+
+#[test]
+fn forced_overflow_loses_no_ray_and_changes_no_pixel() {
+    let vol = head_phantom(32, 12).unwrap();
+    for proj in [
+        Projection::Parallel,
+        Projection::Perspective { fov_deg: 40.0 },
+    ] {
+        let base = render(&vol, cfg_for(32), 48, proj);
+        assert_eq!(base.counts.rays_overflowed, 0, "{:?}", base.counts);
+        for queue_len in [1, 3, 16] {
+            let cfg = ProcessorConfig {
+                queue_len,
+                ..cfg_for(32)
+            };
+            let f = render(&vol, cfg, 48, proj);
+            println!("queue_len {queue_len} {proj:?}: {:?}", f.counts);
+            assert!(
+                f.counts.rays_overflowed > 0,
+                "queue_len {queue_len} forces overflow"
+            );
+            assert!(f.counts.max_queue <= queue_len);
+            assert_eq!(f.rgb, base.rgb, "queue_len {queue_len}: the image changed");
+        }
+    }
+}
+
+#[test]
+fn image_does_not_depend_on_queue_order() {
+    let vol = head_phantom(32, 12).unwrap();
+    let proj = Projection::Perspective { fov_deg: 30.0 };
+    let base = render(&vol, cfg_for(32), 48, proj);
+    let mut activations = vec![base.counts.activations];
+    for (order, host_order, ranks) in [
+        (QueueOrder::Scan, HostOrder::RowMajor, 16),
+        (QueueOrder::Scan, HostOrder::Reversed, 16),
+        (QueueOrder::Sorter, HostOrder::Reversed, 16),
+        (QueueOrder::Sorter, HostOrder::RowMajor, 2),
+    ] {
+        let cfg = ProcessorConfig {
+            order,
+            host_order,
+            ranks,
+            queue_len: 24,
+            ..cfg_for(32)
+        };
+        let f = render(&vol, cfg, 48, proj);
+        println!("{order:?} {host_order:?} ranks {ranks}: {:?}", f.counts);
+        activations.push(f.counts.activations);
+        assert_eq!(
+            f.rgb, base.rgb,
+            "{order:?} {host_order:?}: the image changed"
+        );
+        assert_eq!(f.counts.samples, base.counts.samples);
+    }
+    // The orders really differ (the test is not comparing one schedule with itself).
+    activations.sort_unstable();
+    activations.dedup();
+    assert!(activations.len() > 1, "every order activated queues alike");
+}
+
+#[test]
+fn space_leaping_is_exact_and_saves_samples() {
+    let vol = head_phantom(32, 12).unwrap();
+    for proj in [
+        Projection::Parallel,
+        Projection::Perspective { fov_deg: 30.0 },
+    ] {
+        let on = render(&vol, cfg_for(32), 48, proj);
+        let off = render(
+            &vol,
+            ProcessorConfig {
+                space_leap: false,
+                ..cfg_for(32)
+            },
+            48,
+            proj,
+        );
+        assert_eq!(on.rgb, off.rgb, "{proj:?}: leaping changed the image");
+        assert_eq!(off.counts.leaps, 0);
+        assert!(on.counts.leaps > 0);
+        println!(
+            "{proj:?}: samples {} with leaping, {} without",
+            on.counts.samples, off.counts.samples
+        );
+        assert!(on.counts.samples < off.counts.samples);
+    }
+}
+
+#[test]
+fn empty_flags_follow_the_transfer_function() {
+    let vol = head_phantom(32, 12).unwrap();
+    let tf = TransferFunction::head_default();
+    let p = Processor::new(cfg_for(32), &vol, &tf).unwrap();
+    let empty = p.empty_flags();
+    assert_eq!(empty.len(), 64);
+    // Corner blocks are air; the centre of the head is not.
+    assert!(empty[0], "the corner block (0,0,0) is air");
+    assert!(empty.iter().any(|&e| !e));
+    // A transfer function opaque everywhere leaves no block empty.
+    let opaque = TransferFunction::preset("grey").unwrap();
+    let mut tf2 = opaque.clone();
+    tf2.points[0].rgba[3] = 0.1;
+    let p2 = Processor::new(cfg_for(32), &vol, &tf2).unwrap();
+    assert!(p2.empty_flags().iter().all(|&e| !e));
+}
+
+#[test]
+fn early_termination_stops_opaque_rays() {
+    let vol = head_phantom(32, 12).unwrap();
+    // Skin and everything denser nearly opaque.
+    let pt = |density, a| cube5_model::transfer::TfPoint {
+        density,
+        rgba: [0.9, 0.7, 0.6, a],
+    };
+    let tf = TransferFunction::new(vec![
+        pt(0.0, 0.0),
+        pt(0.15, 0.0),
+        pt(0.25, 0.6),
+        pt(1.0, 0.6),
+    ])
+    .unwrap();
+    let cam = camera(&vol, 48);
+    let run = |et: Option<u32>| {
+        let cfg = ProcessorConfig {
+            et_threshold: et,
+            ..cfg_for(32)
+        };
+        let p = Processor::new(cfg, &vol, &tf).unwrap();
+        let f = p.render(&cam, Projection::Parallel).unwrap();
+        check_conservation(&f);
+        let r = p.reference(&tf, &cam, Projection::Parallel).unwrap();
+        (f, r)
+    };
+    let (on, ref_on) = run(Some(4096 - 16));
+    let (off, ref_off) = run(None);
+    println!("termination: {:?}\nnone: {:?}", on.counts, off.counts);
+    assert!(on.counts.rays_terminated > 0);
+    assert_eq!(off.counts.rays_terminated, 0);
+    assert!(on.counts.samples < off.counts.samples);
+    let (db_on, _) = psnr(&on.to_f64(), &ref_on);
+    let (db_off, _) = psnr(&off.to_f64(), &ref_off);
+    let (db_et, _) = psnr(&on.to_f64(), &off.to_f64());
+    println!("PSNR vs f64: {db_on:.1} dB with termination, {db_off:.1} dB without; {db_et:.1} dB between");
+    assert!(db_on > 40.0 && db_off > 40.0 && db_et > 40.0);
+}
+
+#[test]
+fn host_rays_hit_the_volume_and_diverge_in_perspective() {
+    let vol = head_phantom(32, 12).unwrap();
+    let cam = camera(&vol, 32);
+    let par = host_rays(&vol, &cam, Projection::Parallel, HostOrder::RowMajor).unwrap();
+    assert!(par.iter().all(|r| (r.dir - cam.dir).length() < 1e-12));
+    let per = host_rays(
+        &vol,
+        &cam,
+        Projection::Perspective { fov_deg: 60.0 },
+        HostOrder::RowMajor,
+    )
+    .unwrap();
+    for r in par.iter().chain(&per) {
+        assert!(r.entry.min_element() >= -1e-9 && r.entry.max_element() <= 31.0 + 1e-9);
+    }
+    let left = per.iter().min_by_key(|r| r.px).unwrap();
+    let right = per.iter().max_by_key(|r| r.px).unwrap();
+    assert!(left.px + 8 < right.px);
+    assert!(left.dir.dot(cam.right) < right.dir.dot(cam.right));
+}
+
+#[test]
+fn bad_input_is_refused_with_one_line() {
+    let tf = TransferFunction::head_default();
+    let vol = head_phantom(16, 12).unwrap();
+    let msg = |e: cube5_model::ModelError| {
+        let s = e.to_string();
+        assert!(!s.contains('\n'), "{s}");
+        s
+    };
+    let aniso = Volume::new([8, 8, 8], [1.0, 1.0, 2.0], 8, vec![0; 512]).unwrap();
+    let p = Processor::new(cfg_for(16), &aniso, &tf).unwrap();
+    let cam = Camera::new(view_dir(), aniso.dims, aniso.spacing, 8, 8);
+    assert!(msg(p.render(&cam, Projection::Parallel).unwrap_err()).contains("anisotropic"));
+    for bad in [
+        ProcessorConfig {
+            step: 0,
+            ..cfg_for(16)
+        },
+        ProcessorConfig {
+            queue_len: 0,
+            ..cfg_for(16)
+        },
+        ProcessorConfig {
+            block_log2: 1,
+            ..cfg_for(16)
+        },
+        ProcessorConfig {
+            et_threshold: Some(0),
+            ..cfg_for(16)
+        },
+    ] {
+        msg(Processor::new(bad, &vol, &tf).unwrap_err());
+    }
+    // 64^3 in blocks of 8: 512 blocks, more than the sorter's 256 queues.
+    let big = head_phantom(64, 12).unwrap();
+    let e = msg(Processor::new(cfg_for(32), &big, &tf).unwrap_err());
+    assert!(e.contains("256 queues"), "{e}");
+    let p = Processor::new(cfg_for(16), &vol, &tf).unwrap();
+    for proj in [
+        Projection::Perspective { fov_deg: 0.0 },
+        Projection::Perspective { fov_deg: f64::NAN },
+    ] {
+        msg(p.render(&camera(&vol, 8), proj).unwrap_err());
+    }
+    let mut cam = camera(&vol, 8);
+    cam.dir = DVec3::ZERO;
+    msg(p.render(&cam, Projection::Parallel).unwrap_err());
+    cam = camera(&vol, 8);
+    cam.width = 5000;
+    msg(p.render(&cam, Projection::Parallel).unwrap_err());
+}
