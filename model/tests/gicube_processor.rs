@@ -307,3 +307,141 @@ fn bad_input_is_refused_with_one_line() {
     cam.width = 5000;
     msg(p.render(&cam, Projection::Parallel).unwrap_err());
 }
+
+mod gi {
+    use super::*;
+    use cube5_model::units::gicube_processor::{
+        monte_carlo_single_scatter, shadow_scene, GiLight, IRR_FRAC_W,
+    };
+
+    fn scene_camera(vol: &Volume, px: u32) -> Camera {
+        Camera::new(
+            DVec3::new(0.35, 0.75, -0.55).normalize(),
+            vol.dims,
+            vol.spacing,
+            px,
+            px,
+        )
+    }
+
+    /// Irradiance (real) of the voxel nearest `p`.
+    fn irr_at(field: &[u16], n: usize, p: DVec3) -> f64 {
+        let v = p.round().as_ivec3();
+        f64::from(field[v.x as usize + n * (v.y as usize + n * v.z as usize)])
+            / f64::from(1u32 << IRR_FRAC_W)
+    }
+
+    #[test]
+    fn lighting_pass_casts_a_shadow_and_gi_matches_its_f64_reference() {
+        let n = 32;
+        let (vol, tf, light) = shadow_scene(n).unwrap();
+        let cfg = ProcessorConfig {
+            block_log2: 3,
+            ..ProcessorConfig::DEFAULT
+        };
+        let mut p = Processor::new(cfg, &vol, &tf).unwrap();
+        let lc = p.light(&light).unwrap();
+        check_conservation(&lc);
+        println!("lighting pass: {:?}", lc.counts);
+        let field = p.irradiance().unwrap().to_vec();
+        // The floor under the sphere, along the light, against the floor on the other side.
+        let nf = n as f64;
+        let centre = DVec3::new(0.5, 0.5, 0.58) * (nf - 1.0);
+        let floor_z = (0.22 * nf - 1.0).round();
+        let t = (centre.z - floor_z) / -light.dir.z;
+        let shadow = centre + light.dir * t;
+        let lit = DVec3::new(nf - 1.0 - shadow.x, nf - 1.0 - shadow.y, floor_z);
+        let (e_shadow, e_lit) = (irr_at(&field, n, shadow), irr_at(&field, n, lit));
+        println!("irradiance in the shadow {e_shadow:.3}, in the light {e_lit:.3}");
+        assert!(e_lit > 0.3, "the lit floor gets light: {e_lit}");
+        assert!(e_shadow < 0.5 * e_lit, "the sphere shadows the floor");
+        // Against the f64 irradiance.
+        let rf = p.reference_irradiance(&tf, &light).unwrap();
+        let scale = f64::from(1u32 << IRR_FRAC_W);
+        // Voxels on the volume's faces are left out of the maximum: they get deposits from one
+        // side only, and whether a ray's last sample falls before the face or past it differs
+        // between the fixed-point and the exact position (a whole sample's deposit).
+        let (mut max_err, mut sum) = (0.0f64, 0.0);
+        for (i, (&a, &b)) in field.iter().zip(&rf).enumerate() {
+            let e = (f64::from(a) / scale - b).abs();
+            sum += e;
+            if [i % n, (i / n) % n, i / (n * n)]
+                .iter()
+                .all(|&c| c > 0 && c < n - 1)
+            {
+                max_err = max_err.max(e);
+            }
+        }
+        let mean = sum / field.len() as f64;
+        println!("irradiance vs f64: interior max {max_err:.4}, mean {mean:.5}");
+        assert!(
+            max_err < 0.1 && mean < 0.01,
+            "irradiance error {max_err} / {mean}"
+        );
+        let cam = scene_camera(&vol, 64);
+        let f = p.render(&cam, Projection::Parallel).unwrap();
+        check_conservation(&f);
+        let r = p
+            .reference_gi(&tf, &light, &cam, Projection::Parallel)
+            .unwrap();
+        let (db, max) = psnr(&f.to_f64(), &r);
+        println!("GI image vs f64 GI: PSNR {db:.2} dB, max {max:.4}");
+        assert!(db > 45.0, "GI PSNR {db}");
+        let mc =
+            monte_carlo_single_scatter(&vol, &tf, &light, &cam, Projection::Parallel, 3, 64, 1)
+                .unwrap();
+        let (db_mc, max_mc) = psnr(&r, &mc);
+        let (db_mc_fx, _) = psnr(&f.to_f64(), &mc);
+        println!("f64 GI vs Monte Carlo (64 paths): PSNR {db_mc:.2} dB, max {max_mc:.4}; fixed point vs MC {db_mc_fx:.2} dB");
+        assert!(db_mc > 25.0, "GI method vs MC {db_mc}");
+    }
+
+    #[test]
+    fn irradiance_does_not_depend_on_queue_order() {
+        let (vol, tf, light) = shadow_scene(24).unwrap();
+        let field = |order, host_order, queue_len| {
+            let cfg = ProcessorConfig {
+                block_log2: 3,
+                order,
+                host_order,
+                queue_len,
+                ..ProcessorConfig::DEFAULT
+            };
+            let mut p = Processor::new(cfg, &vol, &tf).unwrap();
+            let f = p.light(&light).unwrap();
+            check_conservation(&f);
+            (p.irradiance().unwrap().to_vec(), f.counts)
+        };
+        let (base, c0) = field(QueueOrder::Sorter, HostOrder::RowMajor, 256);
+        assert!(base.iter().any(|&v| v > 0));
+        for (o, h, len) in [
+            (QueueOrder::Scan, HostOrder::Reversed, 256),
+            (QueueOrder::Sorter, HostOrder::Reversed, 5),
+        ] {
+            let (f, c) = field(o, h, len);
+            println!("{o:?} {h:?} {len}: {c:?} (base {c0:?})");
+            assert_eq!(f, base, "{o:?} {h:?} queue_len {len}");
+        }
+    }
+
+    #[test]
+    fn bad_light_is_refused() {
+        let (vol, tf, light) = shadow_scene(16).unwrap();
+        let mut p = Processor::new(cfg_for(16), &vol, &tf).unwrap();
+        for bad in [
+            GiLight {
+                dir: DVec3::ZERO,
+                ..light
+            },
+            GiLight { grid: 0, ..light },
+            GiLight { grid: 4, ..light },
+            GiLight {
+                energy: f64::NAN,
+                ..light
+            },
+        ] {
+            let e = p.light(&bad).unwrap_err().to_string();
+            assert!(!e.contains('\n') && e.contains("lighting pass"), "{e}");
+        }
+    }
+}
