@@ -141,6 +141,10 @@ fn image_does_not_depend_on_queue_order() {
             "{order:?} {host_order:?}: the image changed"
         );
         assert_eq!(f.counts.samples, base.counts.samples);
+        // The cache misses at most once per voxel of a block per activation ([351]).
+        let side = (1u64 << cfg.block_log2) + 1;
+        assert!(f.counts.cache_misses <= f.counts.activations * side.pow(3));
+        assert!(f.counts.cache_hit_rate() > 0.5, "{:?}", f.counts);
     }
     // The orders really differ (the test is not comparing one schedule with itself).
     activations.sort_unstable();
@@ -311,7 +315,7 @@ fn bad_input_is_refused_with_one_line() {
 mod gi {
     use super::*;
     use cube5_model::units::gicube_processor::{
-        monte_carlo_single_scatter, shadow_scene, GiLight, IRR_FRAC_W,
+        irradiance_error, monte_carlo_single_scatter, shadow_scene, GiLight, IRR_FRAC_W,
     };
 
     fn scene_camera(vol: &Volume, px: u32) -> Camera {
@@ -357,22 +361,7 @@ mod gi {
         assert!(e_shadow < 0.5 * e_lit, "the sphere shadows the floor");
         // Against the f64 irradiance.
         let rf = p.reference_irradiance(&tf, &light).unwrap();
-        let scale = f64::from(1u32 << IRR_FRAC_W);
-        // Voxels on the volume's faces are left out of the maximum: they get deposits from one
-        // side only, and whether a ray's last sample falls before the face or past it differs
-        // between the fixed-point and the exact position (a whole sample's deposit).
-        let (mut max_err, mut sum) = (0.0f64, 0.0);
-        for (i, (&a, &b)) in field.iter().zip(&rf).enumerate() {
-            let e = (f64::from(a) / scale - b).abs();
-            sum += e;
-            if [i % n, (i / n) % n, i / (n * n)]
-                .iter()
-                .all(|&c| c > 0 && c < n - 1)
-            {
-                max_err = max_err.max(e);
-            }
-        }
-        let mean = sum / field.len() as f64;
+        let (max_err, mean) = irradiance_error(&field, &rf, vol.dims);
         println!("irradiance vs f64: interior max {max_err:.4}, mean {mean:.5}");
         assert!(
             max_err < 0.1 && mean < 0.01,
@@ -387,6 +376,11 @@ mod gi {
         let (db, max) = psnr(&f.to_f64(), &r);
         println!("GI image vs f64 GI: PSNR {db:.2} dB, max {max:.4}");
         assert!(db > 45.0, "GI PSNR {db}");
+        // The lighting matters: the GI image is far from the unlit one.
+        let unlit = p.reference(&tf, &cam, Projection::Parallel).unwrap();
+        let (db_unlit, _) = psnr(&f.to_f64(), &unlit);
+        println!("GI image vs unlit f64: {db_unlit:.2} dB");
+        assert!(db_unlit < 30.0, "GI changed little: {db_unlit} dB");
         let mc =
             monte_carlo_single_scatter(&vol, &tf, &light, &cam, Projection::Parallel, 3, 64, 1)
                 .unwrap();

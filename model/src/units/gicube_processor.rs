@@ -163,11 +163,18 @@ pub struct ProcessorCounts {
     pub occupancy_sum: u64,
     /// Largest number of rays one queue held.
     pub max_queue: u32,
+    /// Voxel reads (eight per sample) found in the block cache, and not found (fetched).
+    pub cache_hits: u64,
+    pub cache_misses: u64,
 }
 
 impl ProcessorCounts {
     pub fn mean_occupancy(&self) -> f64 {
         self.occupancy_sum as f64 / self.cycles.max(1) as f64
+    }
+
+    pub fn cache_hit_rate(&self) -> f64 {
+        self.cache_hits as f64 / (self.cache_hits + self.cache_misses).max(1) as f64
     }
 }
 
@@ -342,6 +349,47 @@ fn voxel_index(dims: [usize; 3], v: [i64; 3]) -> Option<usize> {
 #[inline]
 fn rnd_signed(x: i64, s: u32) -> i64 {
     (x + (1 << (s - 1))) >> s
+}
+
+/// The volume cache as counted here ([351]): it holds the `(n + 1)^3` voxels a block's samples
+/// read; a voxel read is a miss the first time after the block's queue became the cache's block,
+/// a hit after that; sampling a ray of another block empties it. (Counts only: no timing.)
+struct BlockCache {
+    block: Option<u32>,
+    /// `n + 1`.
+    side: i64,
+    loaded: Vec<bool>,
+}
+
+impl BlockCache {
+    fn new(block_log2: u32) -> Self {
+        let side = (1usize << block_log2) + 1;
+        Self {
+            block: None,
+            side: side as i64,
+            loaded: vec![false; side * side * side],
+        }
+    }
+
+    /// Counts the eight reads of the cell at `base` for a sample of block `q` at `origin`.
+    fn read(&mut self, q: u32, origin: [u32; 3], base: [i64; 3], counts: &mut ProcessorCounts) {
+        if self.block != Some(q) {
+            self.block = Some(q);
+            self.loaded.fill(false);
+        }
+        let side = self.side;
+        for c in 0..8 {
+            let v = corner(base, c);
+            let l: [i64; 3] = std::array::from_fn(|a| v[a] - i64::from(origin[a]));
+            let i = (l[0] + side * (l[1] + side * l[2])) as usize;
+            if self.loaded[i] {
+                counts.cache_hits += 1;
+            } else {
+                self.loaded[i] = true;
+                counts.cache_misses += 1;
+            }
+        }
+    }
 }
 
 /// What one pipeline cycle did to a ray.
@@ -621,6 +669,7 @@ impl Processor {
         mut ray: RayPacket,
         q: u32,
         counts: &mut ProcessorCounts,
+        cache: &mut BlockCache,
         irr: Option<&mut [u16]>,
     ) -> Outcome {
         let delta = self.delta(&ray);
@@ -630,6 +679,10 @@ impl Processor {
             self.steps_to_exit(ray.start, delta, self.bucket.block_of(0, q))
         } else {
             counts.samples += 1;
+            let n = 1u32 << self.cfg.block_log2;
+            let origin = self.bucket.block_of(0, q).map(|b| b * n);
+            let base = ray.start.map(|c| i64::from(c >> POS_FRAC_W));
+            cache.read(q, origin, base, counts);
             if self.sample(&mut ray, irr) && self.cfg.et_threshold.is_some() {
                 ray.flags |= flag::TERMINATED;
                 counts.rays_terminated += 1;
@@ -724,6 +777,7 @@ impl Processor {
         let mut done = vec![false; (w * h) as usize];
         let mut held = 0u64;
         let mut scan_active: Option<u32> = None;
+        let mut cache = BlockCache::new(self.cfg.block_log2);
         let mut last_active: Option<u32> = None;
         // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
         let bound = 64 + 8 * rays as u64 * (u64::from(self.side) * 4 + u64::from(nq) + 64);
@@ -759,6 +813,7 @@ impl Processor {
                     ray,
                     q,
                     &mut counts,
+                    &mut cache,
                     irr.as_deref_mut().map(|v| v.as_mut_slice()),
                 ) {
                     Outcome::Stay(ray) => queues[q as usize].push_back(ray),
@@ -1091,6 +1146,28 @@ impl Processor {
         let field = self.reference_irradiance(tf, light)?;
         self.reference_with(tf, cam, proj, Some(&field))
     }
+}
+
+/// The error of a fixed-point irradiance field (`U(2.14)`) against the f64 one: the largest
+/// absolute error over the voxels not on the volume's faces (a face voxel gets deposits from one
+/// side only, and whether a ray's last sample falls before the face or past it differs between
+/// the fixed-point and the exact position: a whole sample's deposit), and the mean over all.
+pub fn irradiance_error(field: &[u16], reference: &[f64], dims: [usize; 3]) -> (f64, f64) {
+    let scale = f64::from(1u32 << IRR_FRAC_W);
+    let (mut max, mut sum) = (0.0f64, 0.0);
+    for (i, (&a, &b)) in field.iter().zip(reference).enumerate() {
+        let e = (f64::from(a) / scale - b).abs();
+        sum += e;
+        let v = [
+            i % dims[0],
+            (i / dims[0]) % dims[1],
+            i / (dims[0] * dims[1]),
+        ];
+        if (0..3).all(|k| v[k] > 0 && v[k] + 1 < dims[k]) {
+            max = max.max(e);
+        }
+    }
+    (max, sum / field.len().max(1) as f64)
 }
 
 /// Extinction per voxel of a transfer function's opacity: `sigma = -ln(1 - alpha)` (alpha is the
