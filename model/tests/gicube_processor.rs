@@ -315,7 +315,7 @@ fn bad_input_is_refused_with_one_line() {
 mod gi {
     use super::*;
     use cube5_model::units::gicube_processor::{
-        irradiance_error, monte_carlo_single_scatter, shadow_scene, GiLight, IRR_FRAC_W,
+        irradiance_error, monte_carlo_gi, shadow_scene, GiLight, IRR_FRAC_W,
     };
 
     fn scene_camera(vol: &Volume, px: u32) -> Camera {
@@ -381,9 +381,7 @@ mod gi {
         let (db_unlit, _) = psnr(&f.to_f64(), &unlit);
         println!("GI image vs unlit f64: {db_unlit:.2} dB");
         assert!(db_unlit < 30.0, "GI changed little: {db_unlit} dB");
-        let mc =
-            monte_carlo_single_scatter(&vol, &tf, &light, &cam, Projection::Parallel, 3, 64, 1)
-                .unwrap();
+        let mc = monte_carlo_gi(&vol, &tf, &light, &cam, Projection::Parallel, 3, 64, 1).unwrap();
         let (db_mc, max_mc) = psnr(&r, &mc);
         let (db_mc_fx, _) = psnr(&f.to_f64(), &mc);
         println!("f64 GI vs Monte Carlo (64 paths): PSNR {db_mc:.2} dB, max {max_mc:.4}; fixed point vs MC {db_mc_fx:.2} dB");
@@ -437,5 +435,94 @@ mod gi {
             let e = p.light(&bad).unwrap_err().to_string();
             assert!(!e.contains('\n') && e.contains("lighting pass"), "{e}");
         }
+    }
+}
+
+mod high_albedo {
+    use super::*;
+    use cube5_model::units::gicube_processor::{monte_carlo_gi, shadow_scene, GiLight, GiMode};
+
+    fn photons(light: GiLight) -> GiLight {
+        GiLight {
+            mode: GiMode::HighAlbedo {
+                albedo: 0.8,
+                lifetime: 8,
+            },
+            ..light
+        }
+    }
+
+    #[test]
+    fn photons_scatter_into_the_shadow_deterministically_and_in_any_order() {
+        let n = 32;
+        let (vol, tf, light) = shadow_scene(n).unwrap();
+        let run = |light: &GiLight, order, host_order, queue_len| {
+            let cfg = ProcessorConfig {
+                block_log2: 3,
+                order,
+                host_order,
+                queue_len,
+                ..ProcessorConfig::DEFAULT
+            };
+            let mut p = Processor::new(cfg, &vol, &tf).unwrap();
+            let f = p.light(light).unwrap();
+            check_conservation(&f);
+            (p, f.counts)
+        };
+        let hi = photons(light);
+        let (p_hi, c_hi) = run(&hi, QueueOrder::Sorter, HostOrder::RowMajor, 256);
+        println!("high albedo: {c_hi:?}");
+        assert!(c_hi.scatterings > 0 && c_hi.absorbed > 0);
+        assert_eq!(
+            c_hi.rays_terminated, 0,
+            "photons end by absorption or by leaving"
+        );
+        let f_hi = p_hi.irradiance().unwrap().to_vec();
+        // Hash-drawn randomness: the same field in another order, with overflow.
+        let (p2, c2) = run(&hi, QueueOrder::Scan, HostOrder::Reversed, 7);
+        assert!(c2.rays_overflowed > 0);
+        assert_eq!(p2.irradiance().unwrap(), &f_hi[..]);
+        // Scattered light brightens the shadow (and everything else a little).
+        let (p_lo, _) = run(&light, QueueOrder::Sorter, HostOrder::RowMajor, 256);
+        let f_lo = p_lo.irradiance().unwrap();
+        let sum = |f: &[u16]| f.iter().map(|&v| u64::from(v)).sum::<u64>();
+        println!(
+            "total irradiance: low albedo {}, high albedo {}",
+            sum(f_lo),
+            sum(&f_hi)
+        );
+        assert!(sum(&f_hi) > sum(f_lo));
+        // The high-albedo pass has no f64 reference of its own (stochastic): a clear error.
+        let e = p_hi.reference_irradiance(&tf, &hi).unwrap_err().to_string();
+        assert!(e.contains("Monte Carlo"), "{e}");
+    }
+
+    #[test]
+    fn high_albedo_gi_is_near_its_monte_carlo_reference() {
+        let n = 32;
+        let (vol, tf, light) = shadow_scene(n).unwrap();
+        let hi = photons(light);
+        let cfg = ProcessorConfig {
+            block_log2: 3,
+            ..ProcessorConfig::DEFAULT
+        };
+        let mut p = Processor::new(cfg, &vol, &tf).unwrap();
+        p.light(&hi).unwrap();
+        let cam = Camera::new(
+            DVec3::new(0.35, 0.75, -0.55).normalize(),
+            vol.dims,
+            vol.spacing,
+            48,
+            48,
+        );
+        let f = p.render(&cam, Projection::Parallel).unwrap();
+        let mc = monte_carlo_gi(&vol, &tf, &hi, &cam, Projection::Parallel, 3, 64, 7).unwrap();
+        let mc_single =
+            monte_carlo_gi(&vol, &tf, &light, &cam, Projection::Parallel, 3, 64, 7).unwrap();
+        let (db, _) = psnr(&f.to_f64(), &mc);
+        let (db_single, _) = psnr(&f.to_f64(), &mc_single);
+        println!("high-albedo GI vs MC (high albedo) {db:.1} dB, vs MC single scattering {db_single:.1} dB");
+        assert!(db > 22.0, "{db}");
+        assert!(db > db_single, "the photons' scattered light is real");
     }
 }

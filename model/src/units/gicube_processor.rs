@@ -26,6 +26,7 @@ use crate::units::cube5_shader::{
 use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, DIR_FRAC_W, POS_FRAC_W};
+use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
 use crate::volume::Volume;
 
@@ -163,6 +164,9 @@ pub struct ProcessorCounts {
     pub occupancy_sum: u64,
     /// Largest number of rays one queue held.
     pub max_queue: u32,
+    /// High-albedo photons: interactions that scattered, and that absorbed the photon.
+    pub scatterings: u64,
+    pub absorbed: u64,
     /// Voxel reads (eight per sample) found in the block cache, and not found (fetched).
     pub cache_hits: u64,
     pub cache_misses: u64,
@@ -345,6 +349,26 @@ fn voxel_index(dims: [usize; 3], v: [i64; 3]) -> Option<usize> {
     inside.then(|| (v[0] + nx * (v[1] + ny * v[2])) as usize)
 }
 
+/// Key of the albedo draw (`jenkins_hash(ray_bits ^ ALBEDO_KEY)`, low 16 bits).
+pub const ALBEDO_KEY: u32 = 0x2545_f491;
+/// Key of the interaction-value draw.
+pub const INTERACTION_KEY: u32 = 0x5bd1_e995;
+
+/// A ray's mangling source ([380], [385]): destination and generation bits
+/// `u + 2^12 v + 2^24 generation` XOR the position bits `x ^ rotl(y, 10) ^ rotl(z, 20)`.
+pub fn ray_bits(r: &RayPacket) -> u32 {
+    (u32::from(r.u) | u32::from(r.v) << 12 | u32::from(r.generation) << 24)
+        ^ r.start[0]
+        ^ r.start[1].rotate_left(10)
+        ^ r.start[2].rotate_left(20)
+}
+
+/// A fresh interaction value, `U(0.16)`: `min(jenkins_hash(bits ^ INTERACTION_KEY) >> 16, 65520)`
+/// (65520 = the largest opacity, 4095, on the interaction's scale, so every photon can interact).
+pub fn interaction_draw(bits: u32) -> u16 {
+    (jenkins_hash(bits ^ INTERACTION_KEY) >> 16).min(65520) as u16
+}
+
 /// `rnd` of a signed product: `(x + 2^(s-1)) >> s`, arithmetic (round half up, toward +inf).
 #[inline]
 fn rnd_signed(x: i64, s: u32) -> i64 {
@@ -420,6 +444,10 @@ pub struct Processor {
     irr_trilin: Trilin,
     /// The irradiance field of the last lighting pass, `U(2.14)` per voxel.
     irradiance: Option<Vec<u16>>,
+    /// The scattering unit (isotropic scattering of high-albedo photons).
+    scatter: Scatter,
+    /// During a high-albedo lighting pass: the albedo, `U(0.16)` raw.
+    photon_albedo: Option<u32>,
 }
 
 impl Processor {
@@ -468,6 +496,8 @@ impl Processor {
             empty: Vec::new(),
             irr_trilin: Trilin::new(TrilinConfig::new(16, POS_FRAC_W, 0)?)?,
             irradiance: None,
+            scatter: Scatter::new(ScatterConfig::DEFAULT)?,
+            photon_albedo: None,
         };
         p.empty = (0..blocks * blocks * blocks)
             .map(|q| p.block_is_empty(q))
@@ -630,7 +660,11 @@ impl Processor {
     /// volume are dropped.
     fn deposit(&self, ray: &RayPacket, base: [i64; 3], f: [u32; 3], irr: &mut [u16]) {
         let e = u64::from(ray.color[0]);
-        let t = u64::from(CHAN_MAX + 1 - u32::from(ray.opacity));
+        let t = if self.photon_albedo.is_some() {
+            u64::from(CHAN_MAX + 1)
+        } else {
+            u64::from(CHAN_MAX + 1 - u32::from(ray.opacity))
+        };
         let ets = e * t * u64::from(self.cfg.step);
         for c in 0..8usize {
             let Some(i) = voxel_index(self.vol.dims, corner(base, c)) else {
@@ -672,24 +706,51 @@ impl Processor {
         cache: &mut BlockCache,
         irr: Option<&mut [u16]>,
     ) -> Outcome {
-        let delta = self.delta(&ray);
         let leap = ray.ray_type == RayType::Rendering && self.cfg.space_leap;
         let k = if leap && self.empty[q as usize] {
             counts.leaps += 1;
-            self.steps_to_exit(ray.start, delta, self.bucket.block_of(0, q))
+            self.steps_to_exit(ray.start, self.delta(&ray), self.bucket.block_of(0, q))
         } else {
             counts.samples += 1;
             let n = 1u32 << self.cfg.block_log2;
             let origin = self.bucket.block_of(0, q).map(|b| b * n);
             let base = ray.start.map(|c| i64::from(c >> POS_FRAC_W));
             cache.read(q, origin, base, counts);
-            if self.sample(&mut ray, irr) && self.cfg.et_threshold.is_some() {
+            let terminated = self.sample(&mut ray, irr);
+            if let Some(albedo) = self.photon_albedo {
+                // A photon interacts when its opacity reaches its interaction value [364].
+                if u32::from(ray.opacity) << 4 >= u32::from(ray.interaction) {
+                    let bits = ray_bits(&ray);
+                    if jenkins_hash(bits ^ ALBEDO_KEY) & 0xffff < albedo && ray.lifetime > 0 {
+                        let out = self.scatter.scatter(&ScatterIn {
+                            dir: ray.dir.map(i32::from),
+                            grad: [0; 3],
+                            refl: 0,
+                            refr: 0,
+                            iso: 1 << ScatterConfig::DEFAULT.mat_w,
+                            gloss: 0,
+                            eta: 1 << ScatterConfig::DEFAULT.mat_w,
+                            ray_bits: bits,
+                        });
+                        ray.dir = out.dir.map(|d| d as i16);
+                        ray.opacity = 0;
+                        ray.generation = ray.generation.saturating_add(1);
+                        ray.lifetime -= 1;
+                        ray.interaction = interaction_draw(ray_bits(&ray));
+                        counts.scatterings += 1;
+                    } else {
+                        counts.absorbed += 1;
+                        return Outcome::Done(ray);
+                    }
+                }
+            } else if terminated && self.cfg.et_threshold.is_some() {
                 ray.flags |= flag::TERMINATED;
                 counts.rays_terminated += 1;
                 return Outcome::Done(ray);
             }
             1
         };
+        let delta = self.delta(&ray);
         let limit = i64::from(self.side) << POS_FRAC_W;
         let next: [i64; 3] = std::array::from_fn(|a| i64::from(ray.start[a]) + k * delta[a]);
         if next.iter().any(|&c| c < 0 || c >= limit) {
@@ -718,15 +779,26 @@ impl Processor {
     /// `light`). Returns the pass's counts (its image is the lighting grid, all 0).
     pub fn light(&mut self, light: &GiLight) -> Result<ProcessorFrame> {
         let (rays, energy) = light_rays(&self.vol, light, self.cfg.host_order)?;
-        let packets = rays
+        let mut packets = rays
             .iter()
             .map(|r| Self::light_packet(r, energy))
             .collect::<Result<Vec<_>>>()?;
+        self.photon_albedo = match light.mode {
+            GiMode::LowAlbedo => None,
+            GiMode::HighAlbedo { albedo, lifetime } => {
+                for p in &mut packets {
+                    p.lifetime = lifetime;
+                    p.interaction = interaction_draw(ray_bits(p));
+                }
+                Some((albedo * 65536.0).round().min(65536.0) as u32)
+            }
+        };
         let mut field = vec![0u16; self.vol.len()];
         self.irradiance = None;
-        let f = self.run(packets, light.grid, light.grid, Some(&mut field))?;
+        let f = self.run(packets, light.grid, light.grid, Some(&mut field));
+        self.photon_albedo = None;
         self.irradiance = Some(field);
-        Ok(f)
+        f
     }
 
     /// The loaded irradiance field (`U(2.14)` per voxel, x fastest), if a lighting pass ran.
@@ -1004,6 +1076,17 @@ pub fn psnr(a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
     (p, max)
 }
 
+/// How lighting rays carry energy ([363], [364]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GiMode {
+    /// Bundles that deposit along the whole ray, attenuated by their opacity; no scattering.
+    LowAlbedo,
+    /// Photons of indivisible energy: they deposit unattenuated until their opacity reaches their
+    /// interaction value, then scatter isotropically with probability `albedo` (at most
+    /// `lifetime` times) or are absorbed.
+    HighAlbedo { albedo: f64, lifetime: u8 },
+}
+
 /// A distant light for the lighting pass: a square grid of parallel lighting rays.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GiLight {
@@ -1014,6 +1097,7 @@ pub struct GiLight {
     pub energy: f64,
     /// Lighting rays per side of the grid (the grid covers the volume's bounding sphere).
     pub grid: u32,
+    pub mode: GiMode,
 }
 
 /// The lighting rays of `light` that meet the voxel-centre box, and the energy of each,
@@ -1032,6 +1116,11 @@ pub fn light_rays(vol: &Volume, light: &GiLight, order: HostOrder) -> Result<(Ve
     }
     if !(light.energy.is_finite() && light.energy >= 0.0) {
         return bad(format!("energy {} must be finite and >= 0", light.energy));
+    }
+    if let GiMode::HighAlbedo { albedo, .. } = light.mode {
+        if !(0.0..=1.0).contains(&albedo) {
+            return bad(format!("albedo {albedo} outside 0..=1"));
+        }
     }
     let dims = DVec3::new(vol.dims[0] as f64, vol.dims[1] as f64, vol.dims[2] as f64);
     let c = (dims - DVec3::ONE) * 0.5;
@@ -1103,6 +1192,11 @@ impl Processor {
     /// samples at `entry + k dr dir` in `[0, N)^3`, each splatting `E T dr w_c` (exact weights)
     /// into the voxels of its cell, then `T *= 1 - alpha'`, stopping at the termination threshold.
     pub fn reference_irradiance(&self, tf: &TransferFunction, light: &GiLight) -> Result<Vec<f64>> {
+        if light.mode != GiMode::LowAlbedo {
+            return Err(ModelError::Config(
+                "gicube lighting pass: the f64 reference is low albedo only (high albedo: compare with the Monte Carlo reference)".into(),
+            ));
+        }
         let (rays, energy) = light_rays(&self.vol, light, HostOrder::RowMajor)?;
         let mut field = vec![0.0; self.vol.len()];
         let dr = self.cfg.step_voxels();
@@ -1176,15 +1270,17 @@ fn extinction(alpha: f64) -> f64 {
     -(-alpha.min(1.0 - 1e-12)).ln_1p()
 }
 
-/// A Monte Carlo reference in f64 of single scattering with shadows (the physics the GI method
-/// approximates), per pixel the mean of `paths` estimates of
-/// `L = int T_eye(s) sigma(x) rgb(x) E0 T_light(x) ds` over the rendering ray from its entry to
-/// `[0, N)^3`'s exit (the phase function and the albedo are folded into `rgb`), with
-/// `sigma = -ln(1 - alpha)` of the continuous tri-linear density: delta tracking along the eye
-/// ray with the majorant `max sigma` of the transfer function's points, and at the collision
-/// ratio tracking of `T_light` toward the light. Seeded: the same seed gives the same image.
+/// A Monte Carlo reference in f64 of the physics the GI method approximates, per pixel the mean
+/// of `paths` estimates of `L = int T_eye(s) sigma(x) rgb(x) phi(x) ds` over the rendering ray
+/// from its entry to `[0, N)^3`'s exit (the eye-side phase function and albedo folded into
+/// `rgb`), with `sigma = -ln(1 - alpha)` of the continuous tri-linear density and `phi` the
+/// fluence: low albedo (single scattering with shadows) `phi = E0 T_light(x)`; high albedo
+/// `phi(x) = E0 T_light(x) + albedo * phi(y)`, `y` the next collision along a uniformly random
+/// direction (isotropic scattering), at most `lifetime` bounces. Delta tracking with the majorant
+/// `max sigma` of the transfer function's points; ratio tracking of `T_light` toward the light.
+/// Seeded: the same seed gives the same image.
 #[allow(clippy::too_many_arguments)]
-pub fn monte_carlo_single_scatter(
+pub fn monte_carlo_gi(
     vol: &Volume,
     tf: &TransferFunction,
     light: &GiLight,
@@ -1209,6 +1305,27 @@ pub fn monte_carlo_single_scatter(
         return Ok(img);
     }
     let inside = |p: DVec3| p.to_array().iter().all(|&x| (0.0..n).contains(&x));
+    let sigma = |p: DVec3| extinction(tf.lookup(vol.sample_f64(p.to_array()) / max)[3]);
+    // From `p` along `w`: with `collide`, delta tracking to the next collision (`None` if the
+    // path leaves the volume first); without, ratio tracking of the transmittance to the exit.
+    let track = |rng: &mut rand_chacha::ChaCha8Rng, p: DVec3, w: DVec3, collide: Option<()>| {
+        let (mut s, mut t) = (0.0, 1.0);
+        loop {
+            s -= (1.0 - rng.random::<f64>()).ln() / sigma_max;
+            let y = p + w * s;
+            if !inside(y) {
+                return (None, t);
+            }
+            let ratio = sigma(y) / sigma_max;
+            if collide.is_some() {
+                if rng.random::<f64>() < ratio {
+                    return (Some(y), 0.0);
+                }
+            } else {
+                t *= 1.0 - ratio;
+            }
+        }
+    };
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     for r in &rays {
         let mut acc = [0.0; 3];
@@ -1222,19 +1339,32 @@ pub fn monte_carlo_single_scatter(
                 }
                 let rgba = tf.lookup(vol.sample_f64(x.to_array()) / max);
                 if rng.random::<f64>() * sigma_max < extinction(rgba[3]) {
-                    let mut tl = 1.0;
-                    let mut s = 0.0;
+                    // The fluence at the collision, in units of E0: the light left on the
+                    // straight path, plus (high albedo) `albedo` times the fluence at the next
+                    // collision along an isotropic direction, up to `lifetime` bounces.
+                    let mut fluence = 0.0;
+                    let mut y = x;
+                    let mut bounce = 0u32;
                     loop {
-                        s -= (1.0 - rng.random::<f64>()).ln() / sigma_max;
-                        let y = x - light.dir * s;
-                        if !inside(y) {
+                        fluence += track(&mut rng, y, -light.dir, None).1;
+                        let GiMode::HighAlbedo { albedo, lifetime } = light.mode else {
+                            break;
+                        };
+                        if bounce >= u32::from(lifetime) || rng.random::<f64>() >= albedo {
                             break;
                         }
-                        let a = tf.lookup(vol.sample_f64(y.to_array()) / max)[3];
-                        tl *= 1.0 - extinction(a) / sigma_max;
+                        bounce += 1;
+                        let z = 2.0 * rng.random::<f64>() - 1.0;
+                        let phi = std::f64::consts::TAU * rng.random::<f64>();
+                        let s = (1.0 - z * z).max(0.0).sqrt();
+                        let w = DVec3::new(s * phi.cos(), s * phi.sin(), z);
+                        match track(&mut rng, y, w, Some(())).0 {
+                            Some(next) => y = next,
+                            None => break,
+                        }
                     }
                     for c in 0..3 {
-                        acc[c] += rgba[c] * light.energy * tl;
+                        acc[c] += rgba[c] * light.energy * fluence;
                     }
                     break;
                 }
@@ -1281,6 +1411,7 @@ pub fn shadow_scene(n: usize) -> Result<(Volume, TransferFunction, GiLight)> {
         dir: DVec3::new(0.55, 0.25, -0.8).normalize(),
         energy: 0.95,
         grid: (2.0 * nf * 3f64.sqrt()).ceil() as u32,
+        mode: GiMode::LowAlbedo,
     };
     Ok((vol, tf, light))
 }
