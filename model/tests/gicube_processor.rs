@@ -21,6 +21,17 @@ fn camera(vol: &Volume, px: u32) -> Camera {
     Camera::new(view_dir(), vol.dims, vol.spacing, px, px)
 }
 
+/// The GI shadow scene's view.
+fn scene_camera(vol: &Volume, px: u32) -> Camera {
+    Camera::new(
+        DVec3::new(0.35, 0.75, -0.55).normalize(),
+        vol.dims,
+        vol.spacing,
+        px,
+        px,
+    )
+}
+
 fn cfg_for(n: usize) -> ProcessorConfig {
     ProcessorConfig {
         block_log2: if n <= 32 { 3 } else { 4 },
@@ -318,16 +329,6 @@ mod gi {
         irradiance_error, monte_carlo_gi, shadow_scene, GiLight, IRR_FRAC_W,
     };
 
-    fn scene_camera(vol: &Volume, px: u32) -> Camera {
-        Camera::new(
-            DVec3::new(0.35, 0.75, -0.55).normalize(),
-            vol.dims,
-            vol.spacing,
-            px,
-            px,
-        )
-    }
-
     /// Irradiance (real) of the voxel nearest `p`.
     fn irr_at(field: &[u16], n: usize, p: DVec3) -> f64 {
         let v = p.round().as_ivec3();
@@ -508,13 +509,7 @@ mod high_albedo {
         };
         let mut p = Processor::new(cfg, &vol, &tf).unwrap();
         p.light(&hi).unwrap();
-        let cam = Camera::new(
-            DVec3::new(0.35, 0.75, -0.55).normalize(),
-            vol.dims,
-            vol.spacing,
-            48,
-            48,
-        );
+        let cam = scene_camera(&vol, 48);
         let f = p.render(&cam, Projection::Parallel).unwrap();
         let mc = monte_carlo_gi(&vol, &tf, &hi, &cam, Projection::Parallel, 3, 64, 7).unwrap();
         let mc_single =
