@@ -828,6 +828,11 @@ impl Processor {
         mut irr: Option<&mut Vec<u16>>,
     ) -> Result<ProcessorFrame> {
         let rays = packets.len();
+        let packets_lives = packets
+            .iter()
+            .map(|p| u64::from(p.lifetime) + 1)
+            .max()
+            .unwrap_or(1);
         let mut feed: VecDeque<RayPacket> = packets.into();
         let nq = self.queues();
         let queue_w = (32 - (nq - 1).leading_zeros()).max(1);
@@ -852,7 +857,12 @@ impl Processor {
         let mut cache = BlockCache::new(self.cfg.block_log2);
         let mut last_active: Option<u32> = None;
         // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
-        let bound = 64 + 8 * rays as u64 * (u64::from(self.side) * 4 + u64::from(nq) + 64);
+        // Per ray and life: at most 2 N 256 / step samples along a path (sqrt 3 N < 2 N), plus
+        // waiting for the queues; a photon has `lifetime + 1` paths.
+        let lives = packets_lives;
+        let per_path =
+            2 * u64::from(self.side) * 256 / u64::from(self.cfg.step) + u64::from(nq) + 64;
+        let bound = 64 + 8 * rays as u64 * lives * per_path;
 
         while !feed.is_empty() || held > 0 {
             counts.cycles += 1;
