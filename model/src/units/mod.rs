@@ -18,5 +18,6 @@ pub mod cube5_trilin;
 pub mod cube5_vol_fetch;
 pub mod gicube_bucket;
 pub mod gicube_packet_loop;
+pub mod gicube_processor;
 pub mod gicube_scatter;
 pub mod gicube_sorter;

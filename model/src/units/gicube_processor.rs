@@ -1,0 +1,1427 @@
+//! The GI-Cube block processor's renderer (direct volume rendering), written from
+//! `docs/numerics/gicube_processor.md` (patent [347]-[357], [369]-[374]): ray packets made by the
+//! host, bucketed into fixed-size queues per block (overflow returned to the host, never dropped),
+//! the active queue chosen by the pipelined insertion sorter (`gicube_sorter`, cycle-accurate) or
+//! by the ascending scan, one sample per cycle (tri-linear `cube5_trilin`, classification
+//! `cube5_shader`, front-to-back `cube5_compos`), re-queueing to the block the ray enters, space
+//! leaping over empty blocks and early ray termination. Plus the f64 reference of the same
+//! algorithm (no queues, exact arithmetic).
+//!
+//! The image is a function of the rays alone: a ray's packet carries its whole state, so the queue
+//! order (and which rays overflow to the host and come back) changes the counts, never a pixel.
+
+use std::collections::VecDeque;
+
+use glam::DVec3;
+
+use crate::camera::Camera;
+use crate::error::{ModelError, Result};
+use crate::transfer::TransferFunction;
+use crate::units::cube5_compos::{
+    corrected_alpha, rnd, Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
+};
+use crate::units::cube5_shader::{
+    ClassLut, ReflectanceMap, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables, Texel,
+};
+use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
+use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, DIR_FRAC_W, POS_FRAC_W};
+use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
+use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
+use crate::volume::Volume;
+
+/// Largest value of a `U(0.12)` packet channel.
+pub const CHAN_MAX: u32 = 4095;
+/// Fraction bits of the tri-linear sample (`cube5_trilin` `FracW`).
+pub const SAMPLE_FRAC_W: u32 = 4;
+/// Fraction bits of the irradiance, `U(2.14)`.
+pub const IRR_FRAC_W: u32 = 14;
+/// `E (12) + T (12) + dr (8) + w_c (24) - IRR_FRAC_W`: the splat's rounding shift.
+pub const DEPOSIT_SHIFT: u32 = 12 + 12 + POS_FRAC_W + 3 * POS_FRAC_W - IRR_FRAC_W;
+/// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
+pub const SORTER_SLOTS: usize = 2;
+
+/// How the processor picks the next active queue.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum QueueOrder {
+    /// The pipelined insertion sorter (`gicube_sorter`, cycle-accurate): importance = rays in the
+    /// queue ([373] criterion 1); the active queue is the sorter's `S[0]`.
+    Sorter,
+    /// Keep the active queue until it is empty, then take the next non-empty queue in ascending
+    /// cyclic order (a rule without a sorter, for the order-independence test and for small RTL).
+    Scan,
+}
+
+/// The order in which the host first offers the rays of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HostOrder {
+    /// Row by row from the top, left to right.
+    RowMajor,
+    /// The reverse.
+    Reversed,
+}
+
+/// Projection of the rendering rays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Rays along `camera.dir` from `camera.ray_origin(px, py)`.
+    Parallel,
+    /// Rays from one eye through `camera.ray_origin(px, py)`; the top row's pixel centres are
+    /// `fov_deg / 2` off the axis.
+    Perspective { fov_deg: f64 },
+}
+
+/// One processor configuration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProcessorConfig {
+    /// Block side `n = 2^block_log2` voxels.
+    pub block_log2: u32,
+    /// Rays per queue (the fixed hardware queue length, 256 in [371]).
+    pub queue_len: u32,
+    /// Ranks of the sorter (clamped to the number of queues).
+    pub ranks: u32,
+    /// Step `dr` along the ray, `U(4.8)` voxels: 16..=1024 (1/16 to 4 voxels).
+    pub step: u32,
+    /// Early ray termination threshold on the packet opacity, `U(0.12)`; `None`: off.
+    pub et_threshold: Option<u32>,
+    /// Space leaping over empty blocks ([357]).
+    pub space_leap: bool,
+    pub order: QueueOrder,
+    pub host_order: HostOrder,
+}
+
+impl ProcessorConfig {
+    /// 16^3 blocks, 256-ray queues, 16 ranks, one sample per voxel, termination at
+    /// `1 - 2^-8`, space leaping, the sorter.
+    pub const DEFAULT: Self = Self {
+        block_log2: 4,
+        queue_len: 256,
+        ranks: 16,
+        step: 256,
+        et_threshold: Some(CHAN_MAX + 1 - 16),
+        space_leap: true,
+        order: QueueOrder::Sorter,
+        host_order: HostOrder::RowMajor,
+    };
+
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(ModelError::Config(format!("gicube processor: {m}")));
+        if !(2..=8).contains(&self.block_log2) {
+            return bad(format!("block_log2 {} outside 2..=8", self.block_log2));
+        }
+        if !(1..=65535).contains(&self.queue_len) {
+            return bad(format!("queue_len {} outside 1..=65535", self.queue_len));
+        }
+        if !(2..=64).contains(&self.ranks) {
+            return bad(format!("ranks {} outside 2..=64", self.ranks));
+        }
+        if !(16..=1024).contains(&self.step) {
+            return bad(format!(
+                "step {} (1/256 voxel) outside 16..=1024",
+                self.step
+            ));
+        }
+        if let Some(t) = self.et_threshold {
+            if !(1..=CHAN_MAX + 1).contains(&t) {
+                return bad(format!("et_threshold {t} outside 1..=4096"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The step in voxels.
+    pub fn step_voxels(&self) -> f64 {
+        f64::from(self.step) / f64::from(1u32 << POS_FRAC_W)
+    }
+}
+
+/// The counts of one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ProcessorCounts {
+    /// Pixels whose ray meets the volume (the host makes one ray for each).
+    pub rays_made: u64,
+    /// Ray packets the processor accepted from the host (first offers and re-offers).
+    pub rays_in: u64,
+    /// Cycles in which the host's next ray was not accepted because its queue was full.
+    pub host_stalls: u64,
+    /// Rays that left the processor finished (exited the volume or terminated).
+    pub rays_finished: u64,
+    /// Rays returned to the host because the queue of the block they entered was full ([372]);
+    /// the host offers them again after the rays it holds.
+    pub rays_overflowed: u64,
+    /// Finished rays that stopped by early termination.
+    pub rays_terminated: u64,
+    /// Samples taken (one per busy pipeline cycle that does not leap).
+    pub samples: u64,
+    /// Block visits that leapt over an empty block.
+    pub leaps: u64,
+    /// Times a queue became active (blocks processed).
+    pub activations: u64,
+    pub cycles: u64,
+    /// Cycles with no ray in the pipeline while rays remained.
+    pub idle_cycles: u64,
+    /// Sum over cycles of the rays held in all queues (mean occupancy = this / cycles).
+    pub occupancy_sum: u64,
+    /// Largest number of rays one queue held.
+    pub max_queue: u32,
+    /// High-albedo photons: interactions that scattered, and that absorbed the photon.
+    pub scatterings: u64,
+    pub absorbed: u64,
+    /// Voxel reads (eight per sample) found in the block cache, and not found (fetched).
+    pub cache_hits: u64,
+    pub cache_misses: u64,
+}
+
+impl ProcessorCounts {
+    pub fn mean_occupancy(&self) -> f64 {
+        self.occupancy_sum as f64 / self.cycles.max(1) as f64
+    }
+
+    pub fn cache_hit_rate(&self) -> f64 {
+        self.cache_hits as f64 / (self.cache_hits + self.cache_misses).max(1) as f64
+    }
+}
+
+/// A rendered frame: the raw `U(0.12)` colour of every pixel (0 where no ray was made), row-major
+/// from the top, and the counts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProcessorFrame {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Vec<[u16; 3]>,
+    pub counts: ProcessorCounts,
+}
+
+impl ProcessorFrame {
+    /// Colours as reals, `raw / 4096`.
+    pub fn to_f64(&self) -> Vec<[f64; 3]> {
+        self.rgb
+            .iter()
+            .map(|c| c.map(|v| f64::from(v) / 4096.0))
+            .collect()
+    }
+}
+
+/// One ray of the host, before quantization (shared by the processor and the f64 reference).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HostRay {
+    pub px: u32,
+    pub py: u32,
+    /// Entry point into the volume's voxel-centre box, voxel coordinates.
+    pub entry: DVec3,
+    /// Unit direction, voxel coordinates.
+    pub dir: DVec3,
+}
+
+/// Domain of a volume on the processor: blocks a side `B`, side `N = B n`.
+fn domain(vol: &Volume, block_log2: u32) -> Result<(u32, u32)> {
+    let n = 1usize << block_log2;
+    let edge = *vol.dims.iter().max().unwrap_or(&1);
+    let b = edge.div_ceil(n);
+    if b > 64 || b * n > 4096 {
+        return Err(ModelError::Config(format!(
+            "gicube processor: {edge} voxels a side need {b} blocks of {n} (at most 64 blocks and 4096 voxels)"
+        )));
+    }
+    if b * b * b > 256 {
+        return Err(ModelError::Config(format!(
+            "gicube processor: {b}^3 = {} blocks exceed the sorter's 256 queues; use blocks of at least {} voxels",
+            b * b * b,
+            edge.div_ceil(6).next_power_of_two()
+        )));
+    }
+    Ok((b as u32, (b * n) as u32))
+}
+
+/// The rays of a frame, one per pixel whose ray meets the box `[0, dims - 1]` (voxel centres), in
+/// the host's order.
+pub fn host_rays(
+    vol: &Volume,
+    cam: &Camera,
+    proj: Projection,
+    order: HostOrder,
+) -> Result<Vec<HostRay>> {
+    let s = vol.spacing[0];
+    if vol.spacing.iter().any(|&x| x != s) {
+        return Err(ModelError::Config(format!(
+            "gicube processor: anisotropic spacing {:?} is not supported (resample the volume)",
+            vol.spacing
+        )));
+    }
+    if cam.width == 0 || cam.height == 0 || cam.width > 4096 || cam.height > 4096 {
+        return Err(ModelError::Config(format!(
+            "gicube processor: image {}x{} outside 1..=4096 a side (the packet's u, v)",
+            cam.width, cam.height
+        )));
+    }
+    let dir = cam.dir;
+    if !dir.is_finite() || (dir.length() - 1.0).abs() > 1e-6 {
+        return Err(ModelError::Config(format!(
+            "gicube processor: camera direction {dir} is not a unit vector"
+        )));
+    }
+    let eye = match proj {
+        Projection::Parallel => None,
+        Projection::Perspective { fov_deg } => {
+            if !(fov_deg > 0.0 && fov_deg < 170.0) {
+                return Err(ModelError::Config(format!(
+                    "gicube processor: field of view {fov_deg} degrees outside (0, 170)"
+                )));
+            }
+            let (u, v) = cam.pixel_offset(0, 0);
+            let c0 = cam.ray_origin(0, 0) - cam.right * u - cam.up * v;
+            let focal = v.abs() / (fov_deg.to_radians() * 0.5).tan();
+            Some(c0 - dir * focal)
+        }
+    };
+    let hi = DVec3::new(
+        vol.dims[0] as f64 - 1.0,
+        vol.dims[1] as f64 - 1.0,
+        vol.dims[2] as f64 - 1.0,
+    );
+    let mut rays = Vec::new();
+    let mut push = |px: u32, py: u32| {
+        let p = cam.ray_origin(px, py) / s;
+        let d = match eye {
+            None => dir,
+            Some(e) => (p - e / s).normalize(),
+        };
+        if let Some(t) = clip(p, d, hi) {
+            rays.push(HostRay {
+                px,
+                py,
+                entry: (p + d * t).clamp(DVec3::ZERO, hi),
+                dir: d,
+            });
+        }
+    };
+    match order {
+        HostOrder::RowMajor => {
+            for py in 0..cam.height {
+                for px in 0..cam.width {
+                    push(px, py);
+                }
+            }
+        }
+        HostOrder::Reversed => {
+            for py in (0..cam.height).rev() {
+                for px in (0..cam.width).rev() {
+                    push(px, py);
+                }
+            }
+        }
+    }
+    Ok(rays)
+}
+
+/// Entry parameter `t >= 0` of the ray `p + t d` into the box `[0, hi]`, or `None` if it misses.
+fn clip(p: DVec3, d: DVec3, hi: DVec3) -> Option<f64> {
+    let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+    for a in 0..3 {
+        if d[a].abs() < 1e-12 {
+            if p[a] < 0.0 || p[a] > hi[a] {
+                return None;
+            }
+        } else {
+            let (ta, tb) = ((0.0 - p[a]) / d[a], (hi[a] - p[a]) / d[a]);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+    }
+    (t0 <= t1).then_some(t0)
+}
+
+/// Corner `c` (`x + 2y + 4z`) of the cell whose lowest voxel is `base`.
+#[inline]
+fn corner(base: [i64; 3], c: usize) -> [i64; 3] {
+    [
+        base[0] + (c & 1) as i64,
+        base[1] + ((c >> 1) & 1) as i64,
+        base[2] + ((c >> 2) & 1) as i64,
+    ]
+}
+
+/// Index of voxel `v` in a field of `dims` (x fastest), `None` outside.
+#[inline]
+fn voxel_index(dims: [usize; 3], v: [i64; 3]) -> Option<usize> {
+    let [nx, ny, nz] = dims.map(|d| d as i64);
+    let inside = (0..3).all(|a| v[a] >= 0) && v[0] < nx && v[1] < ny && v[2] < nz;
+    inside.then(|| (v[0] + nx * (v[1] + ny * v[2])) as usize)
+}
+
+/// Key of the albedo draw (`jenkins_hash(ray_bits ^ ALBEDO_KEY)`, low 16 bits).
+pub const ALBEDO_KEY: u32 = 0x2545_f491;
+/// Key of the interaction-value draw.
+pub const INTERACTION_KEY: u32 = 0x5bd1_e995;
+
+/// A ray's mangling source ([380], [385]): destination and generation bits
+/// `u + 2^12 v + 2^24 generation` XOR the position bits `x ^ rotl(y, 10) ^ rotl(z, 20)`.
+pub fn ray_bits(r: &RayPacket) -> u32 {
+    (u32::from(r.u) | u32::from(r.v) << 12 | u32::from(r.generation) << 24)
+        ^ r.start[0]
+        ^ r.start[1].rotate_left(10)
+        ^ r.start[2].rotate_left(20)
+}
+
+/// A fresh interaction value, `U(0.16)`: `min(jenkins_hash(bits ^ INTERACTION_KEY) >> 16, 65520)`
+/// (65520 = the largest opacity, 4095, on the interaction's scale, so every photon can interact).
+pub fn interaction_draw(bits: u32) -> u16 {
+    (jenkins_hash(bits ^ INTERACTION_KEY) >> 16).min(65520) as u16
+}
+
+/// `rnd` of a signed product: `(x + 2^(s-1)) >> s`, arithmetic (round half up, toward +inf).
+#[inline]
+fn rnd_signed(x: i64, s: u32) -> i64 {
+    (x + (1 << (s - 1))) >> s
+}
+
+/// The volume cache as counted here ([351]): it holds the `(n + 1)^3` voxels a block's samples
+/// read; a voxel read is a miss the first time after the block's queue became the cache's block,
+/// a hit after that; sampling a ray of another block empties it. (Counts only: no timing.)
+struct BlockCache {
+    block: Option<u32>,
+    /// `n + 1`.
+    side: i64,
+    loaded: Vec<bool>,
+}
+
+impl BlockCache {
+    fn new(block_log2: u32) -> Self {
+        let side = (1usize << block_log2) + 1;
+        Self {
+            block: None,
+            side: side as i64,
+            loaded: vec![false; side * side * side],
+        }
+    }
+
+    /// Counts the eight reads of the cell at `base` for a sample of block `q` at `origin`.
+    fn read(&mut self, q: u32, origin: [u32; 3], base: [i64; 3], counts: &mut ProcessorCounts) {
+        if self.block != Some(q) {
+            self.block = Some(q);
+            self.loaded.fill(false);
+        }
+        let side = self.side;
+        for c in 0..8 {
+            let v = corner(base, c);
+            let l: [i64; 3] = std::array::from_fn(|a| v[a] - i64::from(origin[a]));
+            let i = (l[0] + side * (l[1] + side * l[2])) as usize;
+            if self.loaded[i] {
+                counts.cache_hits += 1;
+            } else {
+                self.loaded[i] = true;
+                counts.cache_misses += 1;
+            }
+        }
+    }
+}
+
+/// What one pipeline cycle did to a ray.
+enum Outcome {
+    /// Still in the same block: back to the tail of the same queue.
+    Stay(RayPacket),
+    /// Entered another block (queue number).
+    Move(RayPacket, u32),
+    /// Finished: exited the volume or terminated.
+    Done(RayPacket),
+}
+
+/// The block processor's renderer.
+#[derive(Debug, Clone)]
+pub struct Processor {
+    cfg: ProcessorConfig,
+    vol: Volume,
+    trilin: Trilin,
+    shader: Shader,
+    compos: Compos,
+    bucket: BucketUnit,
+    /// Blocks a side, domain side in voxels.
+    blocks: u32,
+    side: u32,
+    /// Empty flag of each queue's block.
+    empty: Vec<bool>,
+    /// Tri-linear interpolation of the irradiance, `U(16.0)` corners, `WeightW = 8`, `FracW = 0`.
+    irr_trilin: Trilin,
+    /// The irradiance field of the last lighting pass, `U(2.14)` per voxel.
+    irradiance: Option<Vec<u16>>,
+    /// The scattering unit (isotropic scattering of high-albedo photons).
+    scatter: Scatter,
+    /// During a high-albedo lighting pass: the albedo, `U(0.16)` raw.
+    photon_albedo: Option<u32>,
+}
+
+impl Processor {
+    /// Loads the volume and the tables for `tf`.
+    pub fn new(cfg: ProcessorConfig, vol: &Volume, tf: &TransferFunction) -> Result<Self> {
+        cfg.validate()?;
+        tf.validate()?;
+        if vol.bits < 4 {
+            return Err(ModelError::Config(format!(
+                "gicube processor: {}-bit voxels (4..=16 supported)",
+                vol.bits
+            )));
+        }
+        let (blocks, side) = domain(vol, cfg.block_log2)?;
+        let trilin = Trilin::new(TrilinConfig::new(vol.bits, POS_FRAC_W, SAMPLE_FRAC_W)?)?;
+        let scfg = shader_config(vol.bits);
+        let class = ClassLut::from_transfer(&scfg, tf)?;
+        let rmap = ReflectanceMap::from_fn(&scfg, |_, _, _| Texel::default(), Texel::default())?;
+        let shader = Shader::new(scfg, ShaderTables { class, rmap })?;
+        let ccfg = compos_config();
+        let lut = OpacityLut::new(cfg.step_voxels(), &ccfg)?;
+        let regs = match cfg.et_threshold {
+            Some(t) => ComposRegs {
+                et_threshold: u64::from(t),
+                ..ComposRegs::defaults(&ccfg)
+            },
+            None => ComposRegs::without_termination(&ccfg),
+        };
+        let compos = Compos::new(ccfg, lut, regs)?;
+        let bucket = BucketUnit::new(BucketConfig {
+            block_log2: cfg.block_log2,
+            vol_blocks: blocks,
+            proc_log2: 0,
+            dist: Distribution::Slab,
+            lanes: 1,
+        })?;
+        let mut p = Self {
+            cfg,
+            vol: vol.clone(),
+            trilin,
+            shader,
+            compos,
+            bucket,
+            blocks,
+            side,
+            empty: Vec::new(),
+            irr_trilin: Trilin::new(TrilinConfig::new(16, POS_FRAC_W, 0)?)?,
+            irradiance: None,
+            scatter: Scatter::new(ScatterConfig::DEFAULT)?,
+            photon_albedo: None,
+        };
+        p.empty = (0..blocks * blocks * blocks)
+            .map(|q| p.block_is_empty(q))
+            .collect();
+        Ok(p)
+    }
+
+    pub fn config(&self) -> ProcessorConfig {
+        self.cfg
+    }
+
+    /// Number of queues (blocks).
+    pub fn queues(&self) -> u32 {
+        self.blocks * self.blocks * self.blocks
+    }
+
+    /// Empty flags of the blocks, by queue number.
+    pub fn empty_flags(&self) -> &[bool] {
+        &self.empty
+    }
+
+    /// The host's empty flag ([357]): every classification entry between the smallest and the
+    /// largest voxel the block's samples can read (its `n + 1` voxels a side) has alpha 0.
+    fn block_is_empty(&self, q: u32) -> bool {
+        let [bx, by, bz] = self.bucket.block_of(0, q);
+        let n = 1i64 << self.cfg.block_log2;
+        let (mut lo, mut hi) = (u32::MAX, 0u32);
+        for z in 0..=n {
+            for y in 0..=n {
+                for x in 0..=n {
+                    let v = self.vol.get(
+                        i64::from(bx) * n + x,
+                        i64::from(by) * n + y,
+                        i64::from(bz) * n + z,
+                    );
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+            }
+        }
+        let idx = |v: u32| {
+            self.shader.class_index(&ShaderIn {
+                sample: v << SAMPLE_FRAC_W,
+                grad: [0; 3],
+                mag: 0,
+                mode: unlit(),
+            })
+        };
+        self.shader.tables().class.entries()[idx(lo)..=idx(hi)]
+            .iter()
+            .all(|e| e.a == 0)
+    }
+
+    /// The packet the host makes for a ray (`RayPacket::from_real`: round half up, saturate).
+    pub fn packet(ray: &HostRay) -> Result<RayPacket> {
+        RayPacket::from_real(&RayReal {
+            u: ray.px as u16,
+            v: ray.py as u16,
+            start: ray.entry.to_array(),
+            dir: ray.dir.to_array(),
+            color: [0.0; 3],
+            opacity: 0.0,
+            contribution: 1.0,
+            interaction: 0.0,
+            lifetime: 0,
+            generation: 0,
+            ray_type: RayType::Rendering,
+            flags: 0,
+        })
+    }
+
+    fn queue_of(&self, pos: [u32; 3]) -> Option<u32> {
+        let b = self.bucket.bucket(Position(pos));
+        (!b.outside).then_some(b.queue)
+    }
+
+    /// The per-ray step `delta = rnd(dir * step, 14)`, `S(.8)` voxels per axis.
+    pub fn delta(&self, ray: &RayPacket) -> [i64; 3] {
+        ray.dir
+            .map(|d| rnd_signed(i64::from(d) * i64::from(self.cfg.step), DIR_FRAC_W))
+    }
+
+    /// The classified, composited sample at the ray's position (the pipeline's datapath). A
+    /// lighting ray deposits into `irr` first; a rendering ray is lit by the loaded irradiance.
+    fn sample(&self, ray: &mut RayPacket, irr: Option<&mut [u16]>) -> bool {
+        let p = ray.start;
+        let base = p.map(|c| i64::from(c >> POS_FRAC_W));
+        let mut voxels = [0u32; 8];
+        for (c, v) in voxels.iter_mut().enumerate() {
+            let [x, y, z] = corner(base, c);
+            *v = self.vol.get(x, y, z);
+        }
+        let mask = (1u32 << POS_FRAC_W) - 1;
+        let s = self.trilin.sample(&TrilinIn {
+            voxels,
+            weights: p.map(|c| c & mask),
+            mode: TrilinMode::Lerp,
+        });
+        let e = self.shader.classify(&ShaderIn {
+            sample: s,
+            grad: [0; 3],
+            mag: 0,
+            mode: unlit(),
+        });
+        let weights = p.map(|c| c & mask);
+        let lighting = ray.ray_type == RayType::Lighting;
+        if lighting {
+            if let Some(irr) = irr {
+                self.deposit(ray, base, weights, irr);
+            }
+        }
+        let rgb = if lighting {
+            [0; 3]
+        } else if let Some(field) = &self.irradiance {
+            let mut corners = [0u32; 8];
+            for (c, v) in corners.iter_mut().enumerate() {
+                *v = voxel_index(self.vol.dims, corner(base, c)).map_or(0, |i| u32::from(field[i]));
+            }
+            let irr_s = u64::from(self.irr_trilin.sample(&TrilinIn {
+                voxels: corners,
+                weights,
+                mode: TrilinMode::Lerp,
+            }));
+            [e.r, e.g, e.b].map(|c| (rnd(u64::from(c) * irr_s, IRR_FRAC_W) as u32).min(255))
+        } else {
+            [e.r, e.g, e.b]
+        };
+        let coxel = Coxel {
+            rgba: [
+                u64::from(ray.color[0]),
+                u64::from(ray.color[1]),
+                u64::from(ray.color[2]),
+                u64::from(ray.opacity),
+            ],
+            z: 1,
+            geo: [0; 3],
+            terminated: false,
+        };
+        let out = self.compos.step(
+            &coxel,
+            &Sample {
+                rgb,
+                alpha: e.a,
+                depth: 0,
+                mode: ComposMode::FrontToBack,
+            },
+        );
+        let sat = |x: u64| x.min(u64::from(CHAN_MAX)) as u16;
+        if !lighting {
+            ray.color = [sat(out.rgba[0]), sat(out.rgba[1]), sat(out.rgba[2])];
+        }
+        ray.opacity = sat(out.rgba[3]);
+        out.terminated
+    }
+
+    /// The splat of a lighting ray's sample ([362], [381]): corner `c` of the sample's cell gets
+    /// `rnd(E * T * dr * w_c, 42)` (`U(2.14)`), `E` the ray's energy (`red`), `T = 4096 - opacity`
+    /// the light left before this sample, `w_c` the product of the corner's three weights
+    /// (`256 - f` or `f`, `U(1.8)` each); added saturating at `2^16 - 1`; corners outside the
+    /// volume are dropped.
+    fn deposit(&self, ray: &RayPacket, base: [i64; 3], f: [u32; 3], irr: &mut [u16]) {
+        let e = u64::from(ray.color[0]);
+        let t = if self.photon_albedo.is_some() {
+            u64::from(CHAN_MAX + 1)
+        } else {
+            u64::from(CHAN_MAX + 1 - u32::from(ray.opacity))
+        };
+        let ets = e * t * u64::from(self.cfg.step);
+        for c in 0..8usize {
+            let Some(i) = voxel_index(self.vol.dims, corner(base, c)) else {
+                continue;
+            };
+            let w = (0..3).fold(1u64, |acc, a| {
+                let fa = u64::from(f[a]);
+                acc * if (c >> a) & 1 == 1 { fa } else { 256 - fa }
+            });
+            let d = rnd(ets * w, DEPOSIT_SHIFT);
+            irr[i] = (u64::from(irr[i]) + d).min(u64::from(u16::MAX)) as u16;
+        }
+    }
+
+    /// Steps to leave the block `[lo, lo + n)` (raw positions) from `pos` with `delta`: the
+    /// smallest `k >= 1` with `pos + k delta` outside on some axis.
+    fn steps_to_exit(&self, pos: [u32; 3], delta: [i64; 3], block: [u32; 3]) -> i64 {
+        let n = (1i64 << self.cfg.block_log2) << POS_FRAC_W;
+        let mut k = i64::MAX;
+        for a in 0..3 {
+            let p = i64::from(pos[a]);
+            let lo = i64::from(block[a]) * n;
+            let d = delta[a];
+            if d > 0 {
+                k = k.min((lo + n - p + d - 1) / d);
+            } else if d < 0 {
+                k = k.min((p - lo - d) / -d);
+            }
+        }
+        k.max(1)
+    }
+
+    /// One pipeline cycle on a ray of queue `q`: a sample (or a leap), then the advance.
+    fn advance(
+        &self,
+        mut ray: RayPacket,
+        q: u32,
+        counts: &mut ProcessorCounts,
+        cache: &mut BlockCache,
+        irr: Option<&mut [u16]>,
+    ) -> Outcome {
+        let leap = ray.ray_type == RayType::Rendering && self.cfg.space_leap;
+        let k = if leap && self.empty[q as usize] {
+            counts.leaps += 1;
+            self.steps_to_exit(ray.start, self.delta(&ray), self.bucket.block_of(0, q))
+        } else {
+            counts.samples += 1;
+            let n = 1u32 << self.cfg.block_log2;
+            let origin = self.bucket.block_of(0, q).map(|b| b * n);
+            let base = ray.start.map(|c| i64::from(c >> POS_FRAC_W));
+            cache.read(q, origin, base, counts);
+            let terminated = self.sample(&mut ray, irr);
+            if let Some(albedo) = self.photon_albedo {
+                // A photon interacts when its opacity reaches its interaction value [364].
+                if u32::from(ray.opacity) << 4 >= u32::from(ray.interaction) {
+                    let bits = ray_bits(&ray);
+                    if jenkins_hash(bits ^ ALBEDO_KEY) & 0xffff < albedo && ray.lifetime > 0 {
+                        let out = self.scatter.scatter(&ScatterIn {
+                            dir: ray.dir.map(i32::from),
+                            grad: [0; 3],
+                            refl: 0,
+                            refr: 0,
+                            iso: 1 << ScatterConfig::DEFAULT.mat_w,
+                            gloss: 0,
+                            eta: 1 << ScatterConfig::DEFAULT.mat_w,
+                            ray_bits: bits,
+                        });
+                        ray.dir = out.dir.map(|d| d as i16);
+                        ray.opacity = 0;
+                        ray.generation = ray.generation.saturating_add(1);
+                        ray.lifetime -= 1;
+                        ray.interaction = interaction_draw(ray_bits(&ray));
+                        counts.scatterings += 1;
+                    } else {
+                        counts.absorbed += 1;
+                        return Outcome::Done(ray);
+                    }
+                }
+            } else if terminated && self.cfg.et_threshold.is_some() {
+                ray.flags |= flag::TERMINATED;
+                counts.rays_terminated += 1;
+                return Outcome::Done(ray);
+            }
+            1
+        };
+        let delta = self.delta(&ray);
+        let limit = i64::from(self.side) << POS_FRAC_W;
+        let next: [i64; 3] = std::array::from_fn(|a| i64::from(ray.start[a]) + k * delta[a]);
+        if next.iter().any(|&c| c < 0 || c >= limit) {
+            return Outcome::Done(ray);
+        }
+        ray.start = next.map(|c| c as u32);
+        match self.queue_of(ray.start) {
+            Some(q2) if q2 == q => Outcome::Stay(ray),
+            Some(q2) => Outcome::Move(ray, q2),
+            None => Outcome::Done(ray),
+        }
+    }
+
+    /// Renders a frame: the host makes the rays (`host_rays`), offers the head of its list in
+    /// every cycle with a free sorter slot (accepted when its queue has room), and takes back
+    /// finished and overflowed rays (appending the latter to its list) until every ray finished.
+    pub fn render(&self, cam: &Camera, proj: Projection) -> Result<ProcessorFrame> {
+        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
+        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        self.run(packets, cam.width, cam.height, None)
+    }
+
+    /// The lighting pass of volumetric GI ([358]-[363], low albedo, single scattering): lighting
+    /// rays from `light` through the same queues and pipeline, each splatting into a fresh
+    /// irradiance field, which then lights every rendering ray of `render` (until the next
+    /// `light`). Returns the pass's counts (its image is the lighting grid, all 0).
+    pub fn light(&mut self, light: &GiLight) -> Result<ProcessorFrame> {
+        let (rays, energy) = light_rays(&self.vol, light, self.cfg.host_order)?;
+        let mut packets = rays
+            .iter()
+            .map(|r| Self::light_packet(r, energy))
+            .collect::<Result<Vec<_>>>()?;
+        self.photon_albedo = match light.mode {
+            GiMode::LowAlbedo => None,
+            GiMode::HighAlbedo { albedo, lifetime } => {
+                for p in &mut packets {
+                    p.lifetime = lifetime;
+                    p.interaction = interaction_draw(ray_bits(p));
+                }
+                Some((albedo * 65536.0).round().min(65536.0) as u32)
+            }
+        };
+        let mut field = vec![0u16; self.vol.len()];
+        self.irradiance = None;
+        let f = self.run(packets, light.grid, light.grid, Some(&mut field));
+        self.photon_albedo = None;
+        self.irradiance = Some(field);
+        f
+    }
+
+    /// The loaded irradiance field (`U(2.14)` per voxel, x fastest), if a lighting pass ran.
+    pub fn irradiance(&self) -> Option<&[u16]> {
+        self.irradiance.as_deref()
+    }
+
+    /// The packet of a lighting ray: type `Lighting`, energy in `red` (`U(0.12)`).
+    pub fn light_packet(ray: &HostRay, energy: f64) -> Result<RayPacket> {
+        let mut p = Self::packet(ray)?;
+        p.ray_type = RayType::Lighting;
+        p.color = [0; 3];
+        p.color[0] = RayPacket::from_real(&RayReal {
+            color: [energy, 0.0, 0.0],
+            ..p.to_real()
+        })?
+        .color[0];
+        Ok(p)
+    }
+
+    /// The frame loop (contract § The frame) over the host's packets.
+    fn run(
+        &self,
+        packets: Vec<RayPacket>,
+        w: u32,
+        h: u32,
+        mut irr: Option<&mut Vec<u16>>,
+    ) -> Result<ProcessorFrame> {
+        let rays = packets.len();
+        let packets_lives = packets
+            .iter()
+            .map(|p| u64::from(p.lifetime) + 1)
+            .max()
+            .unwrap_or(1);
+        let mut feed: VecDeque<RayPacket> = packets.into();
+        let nq = self.queues();
+        let queue_w = (32 - (nq - 1).leading_zeros()).max(1);
+        let imp_w = (32 - self.cfg.queue_len.leading_zeros()).max(2);
+        let scfg = SorterConfig::new(
+            self.cfg.ranks.min(1 << queue_w),
+            queue_w,
+            imp_w,
+            self.cfg.queue_len,
+        )?;
+        let mut sorter = Sorter::new(scfg)?;
+        let mut queues: Vec<VecDeque<RayPacket>> = vec![VecDeque::new(); nq as usize];
+        let cap = self.cfg.queue_len as usize;
+        let mut counts = ProcessorCounts {
+            rays_made: rays as u64,
+            ..Default::default()
+        };
+        let mut rgb = vec![[0u16; 3]; (w * h) as usize];
+        let mut done = vec![false; (w * h) as usize];
+        let mut held = 0u64;
+        let mut scan_active: Option<u32> = None;
+        let mut cache = BlockCache::new(self.cfg.block_log2);
+        let mut last_active: Option<u32> = None;
+        // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
+        // Per ray and life: at most 2 N 256 / step samples along a path (sqrt 3 N < 2 N), plus
+        // waiting for the queues; a photon has `lifetime + 1` paths.
+        let lives = packets_lives;
+        let per_path =
+            2 * u64::from(self.side) * 256 / u64::from(self.cfg.step) + u64::from(nq) + 64;
+        let bound = 64 + 8 * rays as u64 * lives * per_path;
+
+        while !feed.is_empty() || held > 0 {
+            counts.cycles += 1;
+            if counts.cycles > bound {
+                return Err(ModelError::Config(format!(
+                    "gicube processor: no progress after {bound} cycles ({held} rays queued)"
+                )));
+            }
+            counts.occupancy_sum += held;
+            let mut updates: Vec<SorterIn> = Vec::with_capacity(SORTER_SLOTS);
+            // The active queue.
+            let active = match self.cfg.order {
+                QueueOrder::Sorter => sorter.active().map(|e| e.queue),
+                QueueOrder::Scan => {
+                    if scan_active.is_none_or(|q| queues[q as usize].is_empty()) && held > 0 {
+                        let from = scan_active.map_or(0, |q| q + 1);
+                        scan_active = (0..nq)
+                            .map(|i| (from + i) % nq)
+                            .find(|&q| !queues[q as usize].is_empty());
+                    }
+                    scan_active
+                }
+            };
+            if active.is_some() && active != last_active {
+                counts.activations += 1;
+            }
+            last_active = active;
+            match active.and_then(|q| queues[q as usize].pop_front().map(|r| (q, r))) {
+                Some((q, ray)) => match self.advance(
+                    ray,
+                    q,
+                    &mut counts,
+                    &mut cache,
+                    irr.as_deref_mut().map(|v| v.as_mut_slice()),
+                ) {
+                    Outcome::Stay(ray) => queues[q as usize].push_back(ray),
+                    Outcome::Move(mut ray, q2) => {
+                        updates.push(SorterIn::add(q, -1));
+                        if queues[q2 as usize].len() < cap {
+                            queues[q2 as usize].push_back(ray);
+                            updates.push(SorterIn::add(q2, 1));
+                        } else {
+                            held -= 1;
+                            counts.rays_overflowed += 1;
+                            ray.flags |= flag::OVERFLOW;
+                            feed.push_back(ray);
+                        }
+                    }
+                    Outcome::Done(ray) => {
+                        updates.push(SorterIn::add(q, -1));
+                        held -= 1;
+                        counts.rays_finished += 1;
+                        let i = (u32::from(ray.v) * w + u32::from(ray.u)) as usize;
+                        if done[i] {
+                            return Err(ModelError::Config(format!(
+                                "gicube processor: pixel ({}, {}) finished twice",
+                                ray.u, ray.v
+                            )));
+                        }
+                        done[i] = true;
+                        rgb[i] = ray.color;
+                    }
+                },
+                None => {
+                    if held > 0 {
+                        counts.idle_cycles += 1;
+                    }
+                }
+            }
+            // The host's offer, in a free sorter slot. A ray whose queue is full is not accepted
+            // (the port's ready is low): it stays at the head of the host's list.
+            if updates.len() < SORTER_SLOTS {
+                if let Some(&ray) = feed.front() {
+                    let qh = self.queue_of(ray.start).ok_or_else(|| {
+                        // The host clips rays to the volume: a packet outside it is a bug.
+                        ModelError::Config(format!(
+                            "gicube processor: host ray of pixel ({}, {}) starts outside the volume",
+                            ray.u, ray.v
+                        ))
+                    })?;
+                    if queues[qh as usize].len() < cap {
+                        let mut ray = ray;
+                        feed.pop_front();
+                        ray.flags &= !flag::OVERFLOW;
+                        counts.rays_in += 1;
+                        queues[qh as usize].push_back(ray);
+                        held += 1;
+                        updates.push(SorterIn::add(qh, 1));
+                    } else {
+                        counts.host_stalls += 1;
+                    }
+                }
+            }
+            for u in &updates {
+                counts.max_queue = counts.max_queue.max(queues[u.queue as usize].len() as u32);
+            }
+            if self.cfg.order == QueueOrder::Sorter {
+                for s in 0..SORTER_SLOTS {
+                    sorter.step(updates.get(s).unwrap_or(&SorterIn::NOOP));
+                }
+                // The sorter's counters are the queue lengths (criterion 1 of [373]).
+                for u in &updates {
+                    let len = queues[u.queue as usize].len();
+                    if sorter.importance(u.queue) as usize != len {
+                        return Err(ModelError::Config(format!(
+                            "gicube processor: sorter counter {} of queue {} holds {len} rays",
+                            sorter.importance(u.queue),
+                            u.queue
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(ProcessorFrame {
+            width: w,
+            height: h,
+            rgb,
+            counts,
+        })
+    }
+
+    /// The f64 reference of the same algorithm: the host's rays before quantization, samples at
+    /// `entry + k dr dir` until the point leaves `[0, N)^3`, f64 tri-linear density, the transfer
+    /// function itself, `alpha' = 1 - (1 - alpha)^dr`, front-to-back over in f64, termination at
+    /// the same threshold. No queues, no leaping (leaping is exact).
+    pub fn reference(
+        &self,
+        tf: &TransferFunction,
+        cam: &Camera,
+        proj: Projection,
+    ) -> Result<Vec<[f64; 3]>> {
+        self.reference_with(tf, cam, proj, None)
+    }
+
+    /// `reference`, each sample's colour multiplied by the f64 irradiance `irr` (clamped to 1).
+    fn reference_with(
+        &self,
+        tf: &TransferFunction,
+        cam: &Camera,
+        proj: Projection,
+        irr: Option<&[f64]>,
+    ) -> Result<Vec<[f64; 3]>> {
+        let rays = host_rays(&self.vol, cam, proj, HostOrder::RowMajor)?;
+        let mut img = vec![[0.0; 3]; (cam.width * cam.height) as usize];
+        let dr = self.cfg.step_voxels();
+        let n = f64::from(self.side);
+        let max = f64::from(self.vol.max_value());
+        let thr = self.cfg.et_threshold.map(|t| f64::from(t) / 4096.0);
+        for r in &rays {
+            let (mut c, mut a) = ([0.0f64; 3], 0.0f64);
+            for k in 0.. {
+                let p = r.entry + r.dir * (k as f64 * dr);
+                if p.to_array().iter().any(|&x| !(0.0..n).contains(&x)) {
+                    break;
+                }
+                let rgba = tf.lookup(self.vol.sample_f64(p.to_array()) / max);
+                let w = (1.0 - a) * corrected_alpha(rgba[3], dr);
+                let light = irr.map_or(1.0, |f| field_f64(f, self.vol.dims, p));
+                for i in 0..3 {
+                    c[i] += w * (rgba[i] * light).min(1.0);
+                }
+                a += w;
+                if thr.is_some_and(|t| a >= t) {
+                    break;
+                }
+            }
+            img[(r.py * cam.width + r.px) as usize] = c;
+        }
+        Ok(img)
+    }
+}
+
+fn unlit() -> ShaderMode {
+    ShaderMode {
+        tf2d: false,
+        unlit: true,
+    }
+}
+
+/// The classification the processor uses: `cube5_shader` on the `U(VoxelW.4)` sample, 1-D,
+/// `min(12, VoxelW + 4)` index bits, 8-bit colour, 12-bit alpha.
+pub fn shader_config(voxel_w: u32) -> ShaderConfig {
+    ShaderConfig {
+        voxel_w,
+        frac_w: SAMPLE_FRAC_W,
+        class_idx_w: 12.min(voxel_w + SAMPLE_FRAC_W),
+        mag_shift: 10.min(voxel_w + 1 + SAMPLE_FRAC_W),
+        ..ShaderConfig::DEFAULT
+    }
+}
+
+/// The compositing the processor uses: `cube5_compos` with the packet's widths, coxel `U(1.12)`,
+/// corrected alpha `U(1.12)`, 8-bit sample colour, no depth.
+pub fn compos_config() -> ComposConfig {
+    ComposConfig {
+        color_w: 8,
+        alpha_w: 12,
+        extra_w: 0,
+        acc_w: 12,
+        z_w: 1,
+    }
+}
+
+/// PSNR (dB, peak 1.0) and largest channel error of `a` against `b`.
+pub fn psnr(a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
+    let mut se = 0.0;
+    let mut max = 0.0f64;
+    for (x, y) in a.iter().zip(b) {
+        for i in 0..3 {
+            let d = x[i] - y[i];
+            se += d * d;
+            max = max.max(d.abs());
+        }
+    }
+    let mse = se / (3 * a.len().max(1)) as f64;
+    let p = if mse > 0.0 {
+        -10.0 * mse.log10()
+    } else {
+        f64::INFINITY
+    };
+    (p, max)
+}
+
+/// How lighting rays carry energy ([363], [364]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GiMode {
+    /// Bundles that deposit along the whole ray, attenuated by their opacity; no scattering.
+    LowAlbedo,
+    /// Photons of indivisible energy: they deposit unattenuated until their opacity reaches their
+    /// interaction value, then scatter isotropically with probability `albedo` (at most
+    /// `lifetime` times) or are absorbed.
+    HighAlbedo { albedo: f64, lifetime: u8 },
+}
+
+/// A distant light for the lighting pass: a square grid of parallel lighting rays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GiLight {
+    /// Unit direction the light travels (from the light into the volume), voxel coordinates.
+    pub dir: DVec3,
+    /// Irradiance `E0` on a plane facing the light; 1.0 lights a sample at its full classified
+    /// colour.
+    pub energy: f64,
+    /// Lighting rays per side of the grid (the grid covers the volume's bounding sphere).
+    pub grid: u32,
+    pub mode: GiMode,
+}
+
+/// The lighting rays of `light` that meet the voxel-centre box, and the energy of each,
+/// `E0 h^2` (`h` = the grid spacing in voxels: each ray stands for `h^2` of the light's area).
+/// The grid: `c` = the volume's centre, `r` = half its diagonal, `h = 2r / grid`; axes
+/// `right = normalize(dir x z)` (`x y` when `|dir.z| > 0.999`) and `up = right x dir`; ray
+/// `(i, j)` starts at `c + right ((i + 1/2) h - r) + up (r - (j + 1/2) h) - dir (r + 1)`.
+pub fn light_rays(vol: &Volume, light: &GiLight, order: HostOrder) -> Result<(Vec<HostRay>, f64)> {
+    let bad = |m: String| Err(ModelError::Config(format!("gicube lighting pass: {m}")));
+    let d = light.dir;
+    if !d.is_finite() || (d.length() - 1.0).abs() > 1e-6 {
+        return bad(format!("light direction {d} is not a unit vector"));
+    }
+    if !(1..=4096).contains(&light.grid) {
+        return bad(format!("grid {} outside 1..=4096", light.grid));
+    }
+    if !(light.energy.is_finite() && light.energy >= 0.0) {
+        return bad(format!("energy {} must be finite and >= 0", light.energy));
+    }
+    if let GiMode::HighAlbedo { albedo, .. } = light.mode {
+        if !(0.0..=1.0).contains(&albedo) {
+            return bad(format!("albedo {albedo} outside 0..=1"));
+        }
+    }
+    let dims = DVec3::new(vol.dims[0] as f64, vol.dims[1] as f64, vol.dims[2] as f64);
+    let c = (dims - DVec3::ONE) * 0.5;
+    let r = dims.length() * 0.5;
+    let h = 2.0 * r / f64::from(light.grid);
+    let energy = light.energy * h * h;
+    if energy >= 1.0 {
+        return bad(format!(
+            "energy per ray E0 h^2 = {energy:.3} is not below 1 (the packet's U(0.12)): use a grid of at least {} rays",
+            (2.0 * r * light.energy.sqrt()).floor() as u32 + 1
+        ));
+    }
+    let a = if d.z.abs() > 0.999 {
+        DVec3::Y
+    } else {
+        DVec3::Z
+    };
+    let right = d.cross(a).normalize();
+    let up = right.cross(d);
+    let hi = dims - DVec3::ONE;
+    let mut rays = Vec::new();
+    let mut push = |i: u32, j: u32| {
+        let o = c + right * ((f64::from(i) + 0.5) * h - r) + up * (r - (f64::from(j) + 0.5) * h)
+            - d * (r + 1.0);
+        if let Some(t) = clip(o, d, hi) {
+            rays.push(HostRay {
+                px: i,
+                py: j,
+                entry: (o + d * t).clamp(DVec3::ZERO, hi),
+                dir: d,
+            });
+        }
+    };
+    let n = light.grid;
+    match order {
+        HostOrder::RowMajor => (0..n).for_each(|j| (0..n).for_each(|i| push(i, j))),
+        HostOrder::Reversed => (0..n)
+            .rev()
+            .for_each(|j| (0..n).rev().for_each(|i| push(i, j))),
+    }
+    Ok((rays, energy))
+}
+
+/// The eight corners' exact tri-linear weights for the fraction `t`.
+fn corner_weights(t: DVec3) -> impl Iterator<Item = (usize, f64)> {
+    (0..8usize).map(move |c| {
+        let w = (0..3).fold(1.0, |acc, a| {
+            acc * if (c >> a) & 1 == 1 { t[a] } else { 1.0 - t[a] }
+        });
+        (c, w)
+    })
+}
+
+/// Tri-linear interpolation of an f64 field over the volume's voxels (0 outside).
+fn field_f64(field: &[f64], dims: [usize; 3], p: DVec3) -> f64 {
+    let f = p.floor();
+    let t = p - f;
+    let mut acc = 0.0;
+    for (c, w) in corner_weights(t) {
+        if let Some(i) = voxel_index(dims, corner(f.as_i64vec3().to_array(), c)) {
+            acc += w * field[i];
+        }
+    }
+    acc
+}
+
+impl Processor {
+    /// The f64 reference of the lighting pass: the same lighting rays before quantization,
+    /// samples at `entry + k dr dir` in `[0, N)^3`, each splatting `E T dr w_c` (exact weights)
+    /// into the voxels of its cell, then `T *= 1 - alpha'`, stopping at the termination threshold.
+    pub fn reference_irradiance(&self, tf: &TransferFunction, light: &GiLight) -> Result<Vec<f64>> {
+        if light.mode != GiMode::LowAlbedo {
+            return Err(ModelError::Config(
+                "gicube lighting pass: the f64 reference is low albedo only (high albedo: compare with the Monte Carlo reference)".into(),
+            ));
+        }
+        let (rays, energy) = light_rays(&self.vol, light, HostOrder::RowMajor)?;
+        let mut field = vec![0.0; self.vol.len()];
+        let dr = self.cfg.step_voxels();
+        let n = f64::from(self.side);
+        let max = f64::from(self.vol.max_value());
+        let thr = self.cfg.et_threshold.map(|t| f64::from(t) / 4096.0);
+        for r in &rays {
+            let mut t_left = 1.0f64;
+            for k in 0.. {
+                let p = r.entry + r.dir * (k as f64 * dr);
+                if p.to_array().iter().any(|&x| !(0.0..n).contains(&x)) {
+                    break;
+                }
+                let f = p.floor();
+                for (c, w) in corner_weights(p - f) {
+                    if let Some(i) =
+                        voxel_index(self.vol.dims, corner(f.as_i64vec3().to_array(), c))
+                    {
+                        field[i] += energy * t_left * dr * w;
+                    }
+                }
+                let a = corrected_alpha(tf.lookup(self.vol.sample_f64(p.to_array()) / max)[3], dr);
+                t_left *= 1.0 - a;
+                if thr.is_some_and(|t| 1.0 - t_left >= t) {
+                    break;
+                }
+            }
+        }
+        Ok(field)
+    }
+
+    /// The f64 reference of a GI frame: `reference_irradiance`, then the rendering rays of
+    /// `reference` with each sample's colour `min(1, rgb * irradiance(p))`.
+    pub fn reference_gi(
+        &self,
+        tf: &TransferFunction,
+        light: &GiLight,
+        cam: &Camera,
+        proj: Projection,
+    ) -> Result<Vec<[f64; 3]>> {
+        let field = self.reference_irradiance(tf, light)?;
+        self.reference_with(tf, cam, proj, Some(&field))
+    }
+}
+
+/// The error of a fixed-point irradiance field (`U(2.14)`) against the f64 one: the largest
+/// absolute error over the voxels not on the volume's faces (a face voxel gets deposits from one
+/// side only, and whether a ray's last sample falls before the face or past it differs between
+/// the fixed-point and the exact position: a whole sample's deposit), and the mean over all.
+pub fn irradiance_error(field: &[u16], reference: &[f64], dims: [usize; 3]) -> (f64, f64) {
+    let scale = f64::from(1u32 << IRR_FRAC_W);
+    let (mut max, mut sum) = (0.0f64, 0.0);
+    for (i, (&a, &b)) in field.iter().zip(reference).enumerate() {
+        let e = (f64::from(a) / scale - b).abs();
+        sum += e;
+        let v = [
+            i % dims[0],
+            (i / dims[0]) % dims[1],
+            i / (dims[0] * dims[1]),
+        ];
+        if (0..3).all(|k| v[k] > 0 && v[k] + 1 < dims[k]) {
+            max = max.max(e);
+        }
+    }
+    (max, sum / field.len().max(1) as f64)
+}
+
+/// Extinction per voxel of a transfer function's opacity: `sigma = -ln(1 - alpha)` (alpha is the
+/// opacity of one voxel of path, so `1 - exp(-sigma d) = 1 - (1 - alpha)^d`).
+fn extinction(alpha: f64) -> f64 {
+    -(-alpha.min(1.0 - 1e-12)).ln_1p()
+}
+
+/// A Monte Carlo reference in f64 of the physics the GI method approximates, per pixel the mean
+/// of `paths` estimates of `L = int T_eye(s) sigma(x) rgb(x) phi(x) ds` over the rendering ray
+/// from its entry to `[0, N)^3`'s exit (the eye-side phase function and albedo folded into
+/// `rgb`), with `sigma = -ln(1 - alpha)` of the continuous tri-linear density and `phi` the
+/// fluence: low albedo (single scattering with shadows) `phi = E0 T_light(x)`; high albedo
+/// `phi(x) = E0 T_light(x) + albedo * phi(y)`, `y` the next collision along a uniformly random
+/// direction (isotropic scattering), at most `lifetime` bounces. Delta tracking with the majorant
+/// `max sigma` of the transfer function's points; ratio tracking of `T_light` toward the light.
+/// Seeded: the same seed gives the same image.
+#[allow(clippy::too_many_arguments)]
+pub fn monte_carlo_gi(
+    vol: &Volume,
+    tf: &TransferFunction,
+    light: &GiLight,
+    cam: &Camera,
+    proj: Projection,
+    block_log2: u32,
+    paths: u32,
+    seed: u64,
+) -> Result<Vec<[f64; 3]>> {
+    use rand::{Rng, SeedableRng};
+    let (_, side) = domain(vol, block_log2)?;
+    let n = f64::from(side);
+    let rays = host_rays(vol, cam, proj, HostOrder::RowMajor)?;
+    let max = f64::from(vol.max_value());
+    let sigma_max = tf
+        .points
+        .iter()
+        .map(|p| extinction(p.rgba[3]))
+        .fold(0.0, f64::max);
+    let mut img = vec![[0.0; 3]; (cam.width * cam.height) as usize];
+    if sigma_max <= 0.0 || paths == 0 {
+        return Ok(img);
+    }
+    let inside = |p: DVec3| p.to_array().iter().all(|&x| (0.0..n).contains(&x));
+    let sigma = |p: DVec3| extinction(tf.lookup(vol.sample_f64(p.to_array()) / max)[3]);
+    // From `p` along `w`: with `collide`, delta tracking to the next collision (`None` if the
+    // path leaves the volume first); without, ratio tracking of the transmittance to the exit.
+    let track = |rng: &mut rand_chacha::ChaCha8Rng, p: DVec3, w: DVec3, collide: Option<()>| {
+        let (mut s, mut t) = (0.0, 1.0);
+        loop {
+            s -= (1.0 - rng.random::<f64>()).ln() / sigma_max;
+            let y = p + w * s;
+            if !inside(y) {
+                return (None, t);
+            }
+            let ratio = sigma(y) / sigma_max;
+            if collide.is_some() {
+                if rng.random::<f64>() < ratio {
+                    return (Some(y), 0.0);
+                }
+            } else {
+                t *= 1.0 - ratio;
+            }
+        }
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    for r in &rays {
+        let mut acc = [0.0; 3];
+        for _ in 0..paths {
+            let mut t = 0.0;
+            loop {
+                t -= (1.0 - rng.random::<f64>()).ln() / sigma_max;
+                let x = r.entry + r.dir * t;
+                if !inside(x) {
+                    break;
+                }
+                let rgba = tf.lookup(vol.sample_f64(x.to_array()) / max);
+                if rng.random::<f64>() * sigma_max < extinction(rgba[3]) {
+                    // The fluence at the collision, in units of E0: the light left on the
+                    // straight path, plus (high albedo) `albedo` times the fluence at the next
+                    // collision along an isotropic direction, up to `lifetime` bounces.
+                    let mut fluence = 0.0;
+                    let mut y = x;
+                    let mut bounce = 0u32;
+                    loop {
+                        fluence += track(&mut rng, y, -light.dir, None).1;
+                        let GiMode::HighAlbedo { albedo, lifetime } = light.mode else {
+                            break;
+                        };
+                        if bounce >= u32::from(lifetime) || rng.random::<f64>() >= albedo {
+                            break;
+                        }
+                        bounce += 1;
+                        let z = 2.0 * rng.random::<f64>() - 1.0;
+                        let phi = std::f64::consts::TAU * rng.random::<f64>();
+                        let s = (1.0 - z * z).max(0.0).sqrt();
+                        let w = DVec3::new(s * phi.cos(), s * phi.sin(), z);
+                        match track(&mut rng, y, w, Some(())).0 {
+                            Some(next) => y = next,
+                            None => break,
+                        }
+                    }
+                    for c in 0..3 {
+                        acc[c] += rgba[c] * light.energy * fluence;
+                    }
+                    break;
+                }
+            }
+        }
+        img[(r.py * cam.width + r.px) as usize] = acc.map(|a| a / f64::from(paths));
+    }
+    Ok(img)
+}
+
+/// The example GI scene: a translucent floor slab and a denser sphere above it, on `n^3` voxels of
+/// 12 bits (boundaries 1.5 voxels wide), its transfer function, and a light from the upper left
+/// that casts the sphere's shadow onto the floor.
+pub fn shadow_scene(n: usize) -> Result<(Volume, TransferFunction, GiLight)> {
+    let nf = n as f64;
+    let smooth = |d: f64| (0.5 - d / 3.0).clamp(0.0, 1.0);
+    let centre = DVec3::new(0.5, 0.5, 0.58) * (nf - 1.0);
+    let radius = 0.2 * nf;
+    let floor_top = 0.22 * nf;
+    let mut data = Vec::with_capacity(n * n * n);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let p = DVec3::new(x as f64, y as f64, z as f64);
+                let inset = |c: f64| c.min(nf - 1.0 - c);
+                let edge = inset(p.x).min(inset(p.y)) - 1.5;
+                let floor = smooth(p.z - floor_top) * smooth(-edge) * smooth(1.5 - p.z);
+                let sphere = smooth((p - centre).length() - radius);
+                let d = (0.45 * floor).max(0.9 * sphere);
+                data.push((d * 4095.0).round() as u16);
+            }
+        }
+    }
+    let vol = Volume::new([n; 3], [1.0; 3], 12, data)?;
+    let pt = |density, rgba| crate::transfer::TfPoint { density, rgba };
+    let tf = TransferFunction::new(vec![
+        pt(0.0, [0.0; 4]),
+        pt(0.25, [0.95, 0.9, 0.8, 0.0]),
+        pt(0.45, [0.95, 0.9, 0.8, 0.35]),
+        pt(0.6, [0.55, 0.75, 0.95, 0.5]),
+        pt(1.0, [0.55, 0.75, 0.95, 0.8]),
+    ])?;
+    let light = GiLight {
+        dir: DVec3::new(0.55, 0.25, -0.8).normalize(),
+        energy: 0.95,
+        grid: (2.0 * nf * 3f64.sqrt()).ceil() as u32,
+        mode: GiMode::LowAlbedo,
+    };
+    Ok((vol, tf, light))
+}
