@@ -61,12 +61,20 @@ struct RenderArgs {
     /// Output PNG.
     #[arg(short, long, default_value = "cube5-render.png")]
     output: PathBuf,
-    /// Override the view azimuth in degrees.
+    /// Override the view azimuth in degrees (replaces a scene's view.direction; the elevation not
+    /// given is the direction's).
     #[arg(long, allow_negative_numbers = true)]
     azimuth: Option<f64>,
-    /// Override the view elevation in degrees.
+    /// Override the view elevation in degrees (continuous through the poles: past 90 the eye goes
+    /// over the top; replaces a scene's view.direction).
     #[arg(long, allow_negative_numbers = true)]
     elevation: Option<f64>,
+    /// Override the view roll: degrees the picture turns counterclockwise.
+    #[arg(long, allow_negative_numbers = true)]
+    roll: Option<f64>,
+    /// Override the image up vector, `X,Y,Z` (made orthogonal to the view).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_vec3)]
+    up: Option<[f64; 3]>,
     /// Override the image width in pixels.
     #[arg(long)]
     width: Option<u32>,
@@ -151,6 +159,16 @@ fn parse_target(s: &str) -> std::result::Result<Target, String> {
     }
 }
 
+fn parse_vec3(s: &str) -> std::result::Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| format!("`{s}`: {e}; expected three numbers X,Y,Z"))?;
+    <[f64; 3]>::try_from(v)
+        .map_err(|v| format!("`{s}`: {} numbers; expected three numbers X,Y,Z", v.len()))
+}
+
 fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(match path {
         Some(p) => Scene::load(p)?,
@@ -185,11 +203,12 @@ fn check_png_path(path: &Path) -> Result<()> {
 
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = load_scene(args.scene.as_deref())?;
-    if let Some(a) = args.azimuth {
-        scene.view.azimuth = a;
+    scene.view.set_angles(args.azimuth, args.elevation);
+    if let Some(r) = args.roll {
+        scene.view.roll = r;
     }
-    if let Some(e) = args.elevation {
-        scene.view.elevation = e;
+    if let Some(u) = args.up {
+        scene.view.up = Some(u);
     }
     if let Some(w) = args.width {
         scene.image.width = w;
@@ -304,13 +323,19 @@ fn render(args: RenderArgs) -> Result<()> {
         );
     }
     write_png_atomically(&img.to_rgb8(), &args.output)?;
-    let view = match params.direction {
+    let mut view = match params.direction {
         Some(d) => format!("view direction {d:?}"),
         None => format!(
             "view azimuth {} elevation {}",
             params.view.azimuth, params.view.elevation
         ),
     };
+    if let Some(u) = params.up {
+        view += &format!(" up {u:?}");
+    }
+    if params.roll != 0.0 {
+        view += &format!(" roll {}", params.roll);
+    }
     say!(
         "rendered {}x{}x{} volume, {view}, {}x{} pixels in {:.4} s ({what})",
         vol.dims[0],

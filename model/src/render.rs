@@ -17,7 +17,7 @@
 //!   (making `cube5 render` run the frame model is issue 13); the base-plane image is warped onto
 //!   the image. See `docs/scenes.md` § Quality.
 
-use crate::camera::Camera;
+use crate::camera::{self, Camera};
 use crate::error::{ModelError, Result};
 use crate::transfer::TransferFunction;
 use crate::units::cube5_gradient::{Gradient, GradientConfig, GradientIn, GradientMode};
@@ -141,6 +141,11 @@ pub struct RenderParams {
     pub view: View,
     /// View vector (from the eye into the scene); overrides `view`'s angles when set.
     pub direction: Option<[f64; 3]>,
+    /// Image up (a hint, made orthogonal to the view); none: the orbit's or the bare direction's
+    /// (`camera` module).
+    pub up: Option<[f64; 3]>,
+    /// Degrees the picture turns counterclockwise about its centre.
+    pub roll: f64,
     pub projection: Projection,
     /// Perspective: full field of view across the shorter image side, degrees.
     pub fov: f64,
@@ -171,6 +176,8 @@ impl Default for RenderParams {
                 elevation: 20.0,
             },
             direction: None,
+            up: None,
+            roll: 0.0,
             projection: Projection::Parallel,
             fov: 30.0,
             zoom: 1.0,
@@ -275,13 +282,49 @@ impl RenderParams {
                 )));
             }
         }
-        self.direction()?;
+        let dir = self.direction()?;
+        if let Some(u) = self.up {
+            if !camera::up_is_usable(dir, DVec3::from_array(u)) {
+                return Err(ModelError::View(format!(
+                    "up {u:?} is zero, not finite or within {} degrees of the view direction {:?}: it names no image up",
+                    camera::MIN_UP_DEGREES,
+                    dir.to_array()
+                )));
+            }
+        }
+        if !self.roll.is_finite() {
+            return Err(ModelError::View(format!(
+                "roll {} is not a finite number",
+                self.roll
+            )));
+        }
         Ok(())
     }
 
-    /// The orthographic camera (shared with the warp), zoom applied.
+    /// The image up (a hint) of a view along `dir`: `up` when set (and usable), else the orbit's
+    /// when the view is given by its angles, else the bare direction's (`camera` module).
+    pub fn up_hint(&self, dir: DVec3) -> DVec3 {
+        match self.up.map(DVec3::from_array) {
+            Some(u) if camera::up_is_usable(dir, u) => u,
+            _ if self.direction.is_none() => {
+                camera::orbit_up_hint(self.view.azimuth, self.view.elevation)
+            }
+            _ => camera::default_up(dir),
+        }
+    }
+
+    /// The camera of the view along `dir` (shared with the warp and the slice set-up): its up,
+    /// roll and zoom applied.
     pub fn camera(&self, vol: &Volume, dir: DVec3) -> Camera {
-        let mut cam = Camera::new(dir, vol.dims, vol.spacing, self.width, self.height);
+        let mut cam = Camera::looking(
+            dir,
+            self.up_hint(dir),
+            vol.dims,
+            vol.spacing,
+            self.width,
+            self.height,
+        )
+        .rolled(self.roll);
         cam.half /= self.zoom;
         cam
     }

@@ -7,6 +7,7 @@
 //! (no gradient or shader for MIP or X-ray, no depth test without geometry, no opacity correction
 //! at a step of exactly one voxel, ...) and why the others are left out.
 
+use crate::camera;
 use crate::error::{ModelError, Result};
 use crate::phantom::{phantom_by_name, PHANTOMS};
 use crate::render::{
@@ -15,6 +16,7 @@ use crate::render::{
 use crate::transfer::{TfPoint, TransferFunction, TF_PRESETS};
 use crate::volume::{Volume, MAX_EDGE};
 use crate::volume_io::{self, Endian, Format, RawSpec, VoxelType};
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -101,6 +103,11 @@ pub struct ViewSpec {
     pub elevation: f64,
     /// View vector from the eye into the scene; overrides azimuth and elevation.
     pub direction: Option<[f64; 3]>,
+    /// Image up (made orthogonal to the view); none: the orbit's, or the bare direction's
+    /// (`camera` module).
+    pub up: Option<[f64; 3]>,
+    /// Degrees the picture turns counterclockwise about its centre.
+    pub roll: f64,
     pub projection: Projection,
     /// Perspective: full field of view across the shorter image side, degrees.
     pub fov: f64,
@@ -188,9 +195,42 @@ impl Default for ViewSpec {
             azimuth: p.view.azimuth,
             elevation: p.view.elevation,
             direction: p.direction,
+            up: p.up,
+            roll: p.roll,
             projection: p.projection,
             fov: p.fov,
             zoom: p.zoom,
+        }
+    }
+}
+
+impl ViewSpec {
+    /// Command-line angles (`--azimuth`, `--elevation`): they apply. A scene that gives a view
+    /// `direction` has it replaced by the orbit at the given angles, the angle not given read off
+    /// the direction (a zero or non-finite direction stays, for validation to name).
+    pub fn set_angles(&mut self, azimuth: Option<f64>, elevation: Option<f64>) {
+        if azimuth.is_none() && elevation.is_none() {
+            return;
+        }
+        if let Some(d) = self.direction {
+            let eye = -DVec3::from_array(d);
+            let len = eye.length();
+            let known = eye.is_finite() && len > 1e-12;
+            if !known && (azimuth.is_none() || elevation.is_none()) {
+                return;
+            }
+            if known {
+                let eye = eye / len;
+                self.azimuth = eye.y.atan2(eye.x).to_degrees();
+                self.elevation = eye.z.clamp(-1.0, 1.0).asin().to_degrees();
+            }
+            self.direction = None;
+        }
+        if let Some(a) = azimuth {
+            self.azimuth = a;
+        }
+        if let Some(e) = elevation {
+            self.elevation = e;
         }
     }
 }
@@ -390,6 +430,7 @@ impl Scene {
         for (field, x) in [
             ("view.azimuth", self.view.azimuth),
             ("view.elevation", self.view.elevation),
+            ("view.roll", self.view.roll),
         ] {
             if !x.is_finite() {
                 return bad(field, format!("{x} is not a finite number"));
@@ -401,6 +442,23 @@ impl Scene {
             }
             if d.iter().map(|x| x * x).sum::<f64>() < 1e-24 {
                 return bad("view.direction", format!("{d:?} is the zero vector"));
+            }
+        }
+        if let Some(u) = self.view.up {
+            if u.iter().any(|x| !x.is_finite()) || u.iter().map(|x| x * x).sum::<f64>() < 1e-24 {
+                return bad("view.up", format!("{u:?} is zero or not finite"));
+            }
+            if let Ok(dir) = self.render_params().direction() {
+                if !camera::up_is_usable(dir, DVec3::from_array(u)) {
+                    return bad(
+                        "view.up",
+                        format!(
+                            "{u:?} is within {} degrees of the view direction {:?}: it names no image up",
+                            camera::MIN_UP_DEGREES,
+                            dir.to_array()
+                        ),
+                    );
+                }
             }
         }
         if !(self.view.fov.is_finite() && self.view.fov > 0.0 && self.view.fov < 170.0) {
@@ -656,6 +714,8 @@ impl Scene {
                 elevation: self.view.elevation,
             },
             direction: self.view.direction,
+            up: self.view.up,
+            roll: self.view.roll,
             projection: self.view.projection,
             fov: self.view.fov,
             zoom: self.view.zoom,
