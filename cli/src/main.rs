@@ -18,9 +18,10 @@ mod tradeoff;
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use cube5_model::phantom::{phantom_by_name, PHANTOMS};
-use cube5_model::render::{render_pipeline, render_reference, ImageF64};
+use cube5_model::render::{render_pipeline, render_reference, ImageF64, Projection};
 use cube5_model::scene::{Plan, Renderer, Scene, Target};
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
+use cube5_model::slab_perspective::render_slabs;
 use cube5_model::studies::tradeoff::image_error;
 use cube5_model::volume_io::{self, Endian, NrrdEncoding};
 use std::path::{Path, PathBuf};
@@ -84,6 +85,10 @@ struct RenderArgs {
     /// Render with the f64 image-order reference instead of the pipeline model.
     #[arg(long)]
     reference: bool,
+    /// Perspective scenes: approximate the perspective by this many parallel slabs (the what-if
+    /// slab model, run.renderer = "slabs").
+    #[arg(long)]
+    slabs: Option<u32>,
     /// Also render the f64 reference and print the pipeline's error against it.
     #[arg(long)]
     compare: bool,
@@ -216,8 +221,15 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(h) = args.height {
         scene.image.height = h;
     }
+    if args.reference && args.slabs.is_some() {
+        bail!("--reference and --slabs name two renderers; give one");
+    }
     if args.reference {
         scene.run.renderer = Renderer::Reference;
+    }
+    if let Some(n) = args.slabs {
+        scene.run.renderer = Renderer::Slabs;
+        scene.view.slabs = n;
     }
     if let Some(t) = args.target {
         scene.run.target = t;
@@ -251,7 +263,25 @@ fn render(args: RenderArgs) -> Result<()> {
         let out = match scene.run.renderer {
             Renderer::Reference => {
                 let img = render_reference(&vol, &tf, &params)?;
-                let what = format!("f64 reference renderer, step {}", params.step);
+                let what = format!(
+                    "f64 reference renderer, step {}{}",
+                    params.step,
+                    if params.projection == Projection::Perspective {
+                        ", perspective: exact rays from the eye"
+                    } else {
+                        ""
+                    }
+                );
+                (img, what, 0)
+            }
+            Renderer::Slabs => {
+                let slabs = scene.slabs();
+                let img = render_slabs(&vol, &tf, &params, slabs)?;
+                let what = format!(
+                    "what-if slab perspective, not the hardware: {}, f64 parallel ray casts, step {}",
+                    slabs.describe(),
+                    params.step
+                );
                 (img, what, 0)
             }
             Renderer::Pipeline if let Some(job) = &job => {
@@ -312,7 +342,7 @@ fn render(args: RenderArgs) -> Result<()> {
         );
     }
     let secs = best;
-    if args.compare && scene.run.renderer == Renderer::Pipeline {
+    if args.compare && scene.run.renderer != Renderer::Reference {
         let reference = render_reference(&vol, &tf, &params)?;
         let e = image_error(&img, &reference);
         say!(

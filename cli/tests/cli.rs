@@ -298,3 +298,36 @@ fn command_line_roll_and_up() {
     let (out, _) = render_view("roll-nan", "", &["--roll", "nan"]);
     assert_refused(&out, "view.roll");
 }
+
+/// Perspective scenes say which scheme ran: the reference's exact rays, or the what-if slab model
+/// (`--slabs N` or `run.renderer = "slabs"`), whose error `--compare` prints.
+#[test]
+fn perspective_scenes_name_their_scheme() {
+    let persp = "[view]\nprojection = \"perspective\"\nfov = 40\n[run]\nrenderer = \"reference\"\n";
+    let (out, exact) = render_view("persp", persp, &[]);
+    let stdout = ok(&out);
+    assert!(
+        stdout.contains("plan: f64 reference renderer")
+            && stdout.contains("perspective (exact rays from the eye"),
+        "{stdout}"
+    );
+    let (out, slabs) = render_view("persp-slabs", persp, &["--slabs", "4", "--compare"]);
+    let stdout = ok(&out);
+    assert!(
+        stdout.contains("plan: what-if slab perspective (not the hardware: 4 equal slabs")
+            && stdout.contains("error against the f64 reference: PSNR"),
+        "{stdout}"
+    );
+    assert_ne!(exact, slabs);
+    let (out, scene_slabs) = render_view(
+        "scene-slabs",
+        "[view]\nprojection = \"perspective\"\nfov = 40\nslabs = 4\n[run]\nrenderer = \"slabs\"\n",
+        &[],
+    );
+    ok(&out);
+    assert_eq!(slabs, scene_slabs);
+    let (out, _) = render_view("slabs-parallel", "", &["--slabs", "4"]);
+    assert_refused(&out, "run.renderer");
+    let (out, _) = render_view("slabs-and-ref", persp, &["--slabs", "4", "--reference"]);
+    assert_refused(&out, "--reference and --slabs");
+}

@@ -17,6 +17,7 @@ pub mod regs;
 pub mod render;
 pub mod scene;
 pub mod scene_render;
+pub mod slab_perspective;
 pub mod studies;
 pub mod transfer;
 pub mod unit;

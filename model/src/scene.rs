@@ -13,6 +13,7 @@ use crate::phantom::{phantom_by_name, PHANTOMS};
 use crate::render::{
     CompositeMode, Light, Material, Projection, Quality, RenderParams, SliceSetup, View,
 };
+use crate::slab_perspective::{SlabSpacing, Slabs};
 use crate::transfer::{TfPoint, TransferFunction, TF_PRESETS};
 use crate::volume::{Volume, MAX_EDGE};
 use crate::volume_io::{self, Endian, Format, RawSpec, VoxelType};
@@ -109,6 +110,10 @@ pub struct ViewSpec {
     /// Degrees the picture turns counterclockwise about its centre.
     pub roll: f64,
     pub projection: Projection,
+    /// `run.renderer = "slabs"`: how many parallel slabs approximate the perspective view.
+    pub slabs: u32,
+    /// `run.renderer = "slabs"`: how the slabs' thicknesses grow along the view.
+    pub slab_spacing: SlabSpacing,
     /// Perspective: full field of view across the shorter image side, degrees.
     pub fov: f64,
     pub zoom: f64,
@@ -162,13 +167,25 @@ pub enum Target {
     Both,
 }
 
-/// Which model renders: the slice-order pipeline at the quality knobs, or the f64 reference.
+/// Which model renders: the slice-order pipeline at the quality knobs, the f64 reference, or
+/// perspective approximated by parallel slabs (a what-if, `slab_perspective`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum Renderer {
     #[default]
     Pipeline,
     Reference,
+    Slabs,
+}
+
+impl Renderer {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Pipeline => "pipeline",
+            Self::Reference => "reference",
+            Self::Slabs => "slabs",
+        }
+    }
 }
 
 impl Default for VolumeSpec {
@@ -198,6 +215,8 @@ impl Default for ViewSpec {
             up: p.up,
             roll: p.roll,
             projection: p.projection,
+            slabs: 8,
+            slab_spacing: SlabSpacing::Equal,
             fov: p.fov,
             zoom: p.zoom,
         }
@@ -567,15 +586,27 @@ impl Scene {
         {
             return bad(
                 "view.projection",
-                "perspective is rendered by the reference renderer only (the slice-order pipeline model is parallel); set `run.renderer = \"reference\"`".into(),
+                "perspective is rendered by the reference renderer (the slice-order pipeline model is parallel); set `run.renderer = \"reference\"` (exact) or `\"slabs\"` (parallel slabs, a what-if)".into(),
             );
         }
-        if self.run.target.uses_rtl() && self.run.renderer == Renderer::Reference {
+        if self.run.renderer == Renderer::Slabs {
+            if self.view.projection != Projection::Perspective {
+                return bad(
+                    "run.renderer",
+                    "`slabs` approximates a perspective view; set `view.projection = \"perspective\"`".into(),
+                );
+            }
+            if let Err(e) = self.slabs().validate() {
+                return bad("view.slabs", inner(&e));
+            }
+        }
+        if self.run.target.uses_rtl() && self.run.renderer != Renderer::Pipeline {
             return bad(
                 "run.renderer",
                 format!(
-                    "target `{}` runs the RTL pipeline, which the f64 reference renderer is not; use `renderer = \"pipeline\"`",
-                    self.run.target.name()
+                    "target `{}` runs the RTL pipeline, which renderer `{}` is not; use `renderer = \"pipeline\"`",
+                    self.run.target.name(),
+                    self.run.renderer.name()
                 ),
             );
         }
@@ -732,6 +763,14 @@ impl Scene {
 
     pub fn quality(&self) -> Quality {
         self.quality
+    }
+
+    /// The slab scheme of `run.renderer = "slabs"` (`view.slabs`, `view.slab_spacing`).
+    pub fn slabs(&self) -> Slabs {
+        Slabs {
+            count: self.view.slabs,
+            spacing: self.view.slab_spacing,
+        }
     }
 }
 
@@ -932,7 +971,10 @@ impl Plan {
             Unit::Perspective,
             params.projection == Projection::Perspective,
             if params.projection == Projection::Perspective {
-                "reference renderer only".into()
+                match scene.run.renderer {
+                    Renderer::Slabs => format!("approximated by {}", scene.slabs().describe()),
+                    _ => "exact rays from the eye (reference renderer)".into(),
+                }
             } else {
                 "parallel projection".into()
             },
@@ -940,6 +982,10 @@ impl Plan {
         let what_if = crate::scene_render::not_expressible(scene);
         let model = match scene.run.renderer {
             Renderer::Reference => "f64 reference renderer (not the hardware)".to_string(),
+            Renderer::Slabs => format!(
+                "what-if slab perspective (not the hardware: {}, each an f64 parallel ray cast along the view, textured onto its middle plane through the perspective, blended front to back; docs/numerics/slab_perspective.md)",
+                scene.slabs().describe()
+            ),
             Renderer::Pipeline if what_if.is_empty() => {
                 frame_entries(&mut entries, scene, vol);
                 "frame (cube5_frame's bits, then the warp)".to_string()
