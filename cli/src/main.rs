@@ -18,9 +18,10 @@ mod tradeoff;
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use cube5_model::phantom::{phantom_by_name, PHANTOMS};
-use cube5_model::render::{render_pipeline, render_reference, ImageF64};
+use cube5_model::render::{render_pipeline, render_reference, ImageF64, Projection};
 use cube5_model::scene::{Plan, Renderer, Scene, Target};
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
+use cube5_model::slab_perspective::render_slabs;
 use cube5_model::studies::tradeoff::image_error;
 use cube5_model::volume_io::{self, Endian, NrrdEncoding};
 use std::path::{Path, PathBuf};
@@ -61,12 +62,20 @@ struct RenderArgs {
     /// Output PNG.
     #[arg(short, long, default_value = "cube5-render.png")]
     output: PathBuf,
-    /// Override the view azimuth in degrees.
+    /// Override the view azimuth in degrees (replaces a scene's view.direction; the elevation not
+    /// given is the direction's).
     #[arg(long, allow_negative_numbers = true)]
     azimuth: Option<f64>,
-    /// Override the view elevation in degrees.
+    /// Override the view elevation in degrees (continuous through the poles: past 90 the eye goes
+    /// over the top; replaces a scene's view.direction).
     #[arg(long, allow_negative_numbers = true)]
     elevation: Option<f64>,
+    /// Override the view roll: degrees the picture turns counterclockwise.
+    #[arg(long, allow_negative_numbers = true)]
+    roll: Option<f64>,
+    /// Override the image up vector, `X,Y,Z` (made orthogonal to the view).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_vec3)]
+    up: Option<[f64; 3]>,
     /// Override the image width in pixels.
     #[arg(long)]
     width: Option<u32>,
@@ -76,6 +85,10 @@ struct RenderArgs {
     /// Render with the f64 image-order reference instead of the pipeline model.
     #[arg(long)]
     reference: bool,
+    /// Perspective scenes: approximate the perspective by this many parallel slabs (the what-if
+    /// slab model, run.renderer = "slabs").
+    #[arg(long)]
+    slabs: Option<u32>,
     /// Also render the f64 reference and print the pipeline's error against it.
     #[arg(long)]
     compare: bool,
@@ -151,6 +164,16 @@ fn parse_target(s: &str) -> std::result::Result<Target, String> {
     }
 }
 
+fn parse_vec3(s: &str) -> std::result::Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| format!("`{s}`: {e}; expected three numbers X,Y,Z"))?;
+    <[f64; 3]>::try_from(v)
+        .map_err(|v| format!("`{s}`: {} numbers; expected three numbers X,Y,Z", v.len()))
+}
+
 fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(match path {
         Some(p) => Scene::load(p)?,
@@ -185,11 +208,12 @@ fn check_png_path(path: &Path) -> Result<()> {
 
 fn render(args: RenderArgs) -> Result<()> {
     let mut scene = load_scene(args.scene.as_deref())?;
-    if let Some(a) = args.azimuth {
-        scene.view.azimuth = a;
+    scene.view.set_angles(args.azimuth, args.elevation);
+    if let Some(r) = args.roll {
+        scene.view.roll = r;
     }
-    if let Some(e) = args.elevation {
-        scene.view.elevation = e;
+    if let Some(u) = args.up {
+        scene.view.up = Some(u);
     }
     if let Some(w) = args.width {
         scene.image.width = w;
@@ -197,8 +221,15 @@ fn render(args: RenderArgs) -> Result<()> {
     if let Some(h) = args.height {
         scene.image.height = h;
     }
+    if args.reference && args.slabs.is_some() {
+        bail!("--reference and --slabs name two renderers; give one");
+    }
     if args.reference {
         scene.run.renderer = Renderer::Reference;
+    }
+    if let Some(n) = args.slabs {
+        scene.run.renderer = Renderer::Slabs;
+        scene.view.slabs = n;
     }
     if let Some(t) = args.target {
         scene.run.target = t;
@@ -232,7 +263,25 @@ fn render(args: RenderArgs) -> Result<()> {
         let out = match scene.run.renderer {
             Renderer::Reference => {
                 let img = render_reference(&vol, &tf, &params)?;
-                let what = format!("f64 reference renderer, step {}", params.step);
+                let what = format!(
+                    "f64 reference renderer, step {}{}",
+                    params.step,
+                    if params.projection == Projection::Perspective {
+                        ", perspective: exact rays from the eye"
+                    } else {
+                        ""
+                    }
+                );
+                (img, what, 0)
+            }
+            Renderer::Slabs => {
+                let slabs = scene.slabs();
+                let img = render_slabs(&vol, &tf, &params, slabs)?;
+                let what = format!(
+                    "what-if slab perspective, not the hardware: {}, f64 parallel ray casts, step {}",
+                    slabs.describe(),
+                    params.step
+                );
                 (img, what, 0)
             }
             Renderer::Pipeline if let Some(job) = &job => {
@@ -293,7 +342,7 @@ fn render(args: RenderArgs) -> Result<()> {
         );
     }
     let secs = best;
-    if args.compare && scene.run.renderer == Renderer::Pipeline {
+    if args.compare && scene.run.renderer != Renderer::Reference {
         let reference = render_reference(&vol, &tf, &params)?;
         let e = image_error(&img, &reference);
         say!(
@@ -304,13 +353,19 @@ fn render(args: RenderArgs) -> Result<()> {
         );
     }
     write_png_atomically(&img.to_rgb8(), &args.output)?;
-    let view = match params.direction {
+    let mut view = match params.direction {
         Some(d) => format!("view direction {d:?}"),
         None => format!(
             "view azimuth {} elevation {}",
             params.view.azimuth, params.view.elevation
         ),
     };
+    if let Some(u) = params.up {
+        view += &format!(" up {u:?}");
+    }
+    if params.roll != 0.0 {
+        view += &format!(" roll {}", params.roll);
+    }
     say!(
         "rendered {}x{}x{} volume, {view}, {}x{} pixels in {:.4} s ({what})",
         vol.dims[0],

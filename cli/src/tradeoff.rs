@@ -575,6 +575,23 @@ fn document(
          from the slice-order rays, not image-order ones.",
     );
     w(&mut s, "");
+    w(&mut s, "## Perspective by parallel slabs (what-if)");
+    w(&mut s, "");
+    w(
+        &mut s,
+        "The baseline view in perspective (fov 40 degrees) rendered as parallel slabs \
+         (`slab_perspective::render_slabs`, docs/numerics/slab_perspective.md: image-aligned \
+         slabs, each a parallel projection along the view textured onto its middle plane, \
+         blended front to back), against the f64 perspective reference; equal slabs and slabs \
+         bounded at exponentially growing distances from the eye (patent [23], [318]). A what-if \
+         model: the hardware has no slab pass yet. docs/measurements.md has the same sweep on \
+         the 96^3 perspective scene, with MIP, where the geometry alone is measured.",
+    );
+    w(&mut s, "");
+    s.push_str(&table("tradeoff-slabs").to_markdown());
+    w(&mut s, "");
+    w(&mut s, &format!("![slabs]({img}tradeoff-slabs.png)"));
+    w(&mut s, "");
     s
 }
 

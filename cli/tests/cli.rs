@@ -198,3 +198,136 @@ fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
         "built for P = 1, 4, 8",
     );
 }
+
+/// Renders `scene` (written to NAME.toml) with `extra` arguments at 24 x 24; the PNG's bytes.
+fn render_view(name: &str, scene: &str, extra: &[&str]) -> (Output, Vec<u8>) {
+    let toml = scratch(&format!("{name}.toml"));
+    std::fs::write(&toml, format!("[volume]\nsize = 24\n{scene}")).unwrap();
+    let png = scratch(&format!("{name}.png"));
+    let _ = std::fs::remove_file(&png);
+    let mut args = vec![
+        "render",
+        toml.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--width",
+        "24",
+        "--height",
+        "24",
+    ];
+    args.extend_from_slice(extra);
+    let out = cube5(&args);
+    let bytes = std::fs::read(&png).unwrap_or_default();
+    (out, bytes)
+}
+
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// `--azimuth` and `--elevation` apply over a scene's `view.direction` (they were silently ignored
+/// before issue 14): the image is the orbit's, the angle not given read off the direction.
+#[test]
+fn command_line_angles_apply_over_a_scene_direction() {
+    let dir = "[view]\ndirection = [0.0, -1.0, -1.0]\n";
+    let (out, with_dir) = render_view("dir", dir, &[]);
+    ok(&out);
+    let (out, both) = render_view("dir-both", dir, &["--azimuth", "10", "--elevation", "30"]);
+    let stdout = ok(&out);
+    assert!(stdout.contains("view azimuth 10 elevation 30"), "{stdout}");
+    let (out, orbit) = render_view("orbit", "[view]\nazimuth = 10\nelevation = 30\n", &[]);
+    ok(&out);
+    assert_eq!(
+        both, orbit,
+        "--azimuth/--elevation must give the orbit's image"
+    );
+    assert_ne!(both, with_dir, "the angles were ignored");
+    // Only the azimuth: the elevation is the direction's (45 degrees).
+    let (out, az) = render_view("dir-az", dir, &["--azimuth", "10"]);
+    let stdout = ok(&out);
+    let elevation = stdout
+        .split("view azimuth 10 elevation ")
+        .nth(1)
+        .and_then(|t| t.split(',').next())
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let e: f64 = elevation.parse().unwrap();
+    assert!((e - 45.0).abs() < 1e-9, "{stdout}");
+    let (out, orbit) = render_view(
+        "orbit-45",
+        &format!("[view]\nazimuth = 10\nelevation = {elevation}\n"),
+        &[],
+    );
+    ok(&out);
+    assert_eq!(az, orbit);
+}
+
+/// `--roll` and `--up` apply as the scene's `view.roll` and `view.up` do, and bad values are
+/// refused in one line.
+#[test]
+fn command_line_roll_and_up() {
+    let (out, plain) = render_view("plain", "", &[]);
+    ok(&out);
+    let (out, rolled) = render_view("rolled", "", &["--roll", "-30"]);
+    let stdout = ok(&out);
+    assert!(stdout.contains("roll -30"), "{stdout}");
+    let (out, scene_rolled) = render_view("scene-rolled", "[view]\nroll = -30\n", &[]);
+    ok(&out);
+    assert_eq!(rolled, scene_rolled);
+    assert_ne!(rolled, plain);
+    let top = "[view]\ndirection = [0, 0, -1]\n";
+    let (out, up) = render_view("up", top, &["--up", "-1,0,0"]);
+    ok(&out);
+    let (out, scene_up) = render_view("scene-up", &format!("{top}up = [-1, 0, 0]\n"), &[]);
+    ok(&out);
+    assert_eq!(up, scene_up);
+    let (out, default_up) = render_view("default-up", top, &[]);
+    ok(&out);
+    assert_ne!(up, default_up);
+    let (out, png) = render_view("up-parallel", top, &["--up", "0,0,1"]);
+    assert_refused(&out, "view.up");
+    assert!(png.is_empty());
+    let (out, _) = render_view("up-zero", "", &["--up", "0,0,0"]);
+    assert_refused(&out, "view.up");
+    let (out, _) = render_view("up-short", "", &["--up", "1,2"]);
+    assert_refused(&out, "expected three numbers X,Y,Z");
+    let (out, _) = render_view("roll-nan", "", &["--roll", "nan"]);
+    assert_refused(&out, "view.roll");
+}
+
+/// Perspective scenes say which scheme ran: the reference's exact rays, or the what-if slab model
+/// (`--slabs N` or `run.renderer = "slabs"`), whose error `--compare` prints.
+#[test]
+fn perspective_scenes_name_their_scheme() {
+    let persp = "[view]\nprojection = \"perspective\"\nfov = 40\n[run]\nrenderer = \"reference\"\n";
+    let (out, exact) = render_view("persp", persp, &[]);
+    let stdout = ok(&out);
+    assert!(
+        stdout.contains("plan: f64 reference renderer")
+            && stdout.contains("perspective (exact rays from the eye"),
+        "{stdout}"
+    );
+    let (out, slabs) = render_view("persp-slabs", persp, &["--slabs", "4", "--compare"]);
+    let stdout = ok(&out);
+    assert!(
+        stdout.contains("plan: what-if slab perspective (not the hardware: 4 equal slabs")
+            && stdout.contains("error against the f64 reference: PSNR"),
+        "{stdout}"
+    );
+    assert_ne!(exact, slabs);
+    let (out, scene_slabs) = render_view(
+        "scene-slabs",
+        "[view]\nprojection = \"perspective\"\nfov = 40\nslabs = 4\n[run]\nrenderer = \"slabs\"\n",
+        &[],
+    );
+    ok(&out);
+    assert_eq!(slabs, scene_slabs);
+    let (out, _) = render_view("slabs-parallel", "", &["--slabs", "4"]);
+    assert_refused(&out, "run.renderer");
+    let (out, _) = render_view("slabs-and-ref", persp, &["--slabs", "4", "--reference"]);
+    assert_refused(&out, "--reference and --slabs");
+}

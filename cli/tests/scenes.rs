@@ -402,6 +402,8 @@ fn tradeoff_tiny_sweep_end_to_end() {
         "tradeoff-samples.png",
         "tradeoff-interpolation.png",
         "tradeoff-gradient.png",
+        "tradeoff-slabs.csv",
+        "tradeoff-slabs.png",
     ] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }

@@ -116,6 +116,9 @@ fn render_scene(file: &str, png: Option<&std::path::Path>) {
     let (tf, params) = (scene.transfer_function(), scene.render_params());
     let img = match scene.run.renderer {
         cube5_model::scene::Renderer::Reference => render_reference(&vol, &tf, &params).unwrap(),
+        cube5_model::scene::Renderer::Slabs => {
+            cube5_model::slab_perspective::render_slabs(&vol, &tf, &params, scene.slabs()).unwrap()
+        }
         cube5_model::scene::Renderer::Pipeline => {
             render_pipeline(&vol, &tf, &params, &scene.quality())
                 .unwrap()

@@ -7,6 +7,7 @@
 //! `volume`, `transfer`, `camera`; `units` (one module per RTL top, named as the top);
 //! `phantom`, `volume_io`, `scene`, `render` (scenes, files and renderers that use the units);
 //! `scene_render` (what `cube5 render` runs: a scene on the frame model, or a named what-if);
+//! `slab_perspective` (a what-if: perspective approximated by parallel slabs);
 //! `studies` (the tradeoff sweeps, not part of the golden model).
 
 pub mod bits;
@@ -17,6 +18,7 @@ pub mod regs;
 pub mod render;
 pub mod scene;
 pub mod scene_render;
+pub mod slab_perspective;
 pub mod studies;
 pub mod transfer;
 pub mod unit;

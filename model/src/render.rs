@@ -17,7 +17,7 @@
 //!   (making `cube5 render` run the frame model is issue 13); the base-plane image is warped onto
 //!   the image. See `docs/scenes.md` § Quality.
 
-use crate::camera::Camera;
+use crate::camera::{self, Camera};
 use crate::error::{ModelError, Result};
 use crate::transfer::TransferFunction;
 use crate::units::cube5_gradient::{Gradient, GradientConfig, GradientIn, GradientMode};
@@ -141,6 +141,11 @@ pub struct RenderParams {
     pub view: View,
     /// View vector (from the eye into the scene); overrides `view`'s angles when set.
     pub direction: Option<[f64; 3]>,
+    /// Image up (a hint, made orthogonal to the view); none: the orbit's or the bare direction's
+    /// (`camera` module).
+    pub up: Option<[f64; 3]>,
+    /// Degrees the picture turns counterclockwise about its centre.
+    pub roll: f64,
     pub projection: Projection,
     /// Perspective: full field of view across the shorter image side, degrees.
     pub fov: f64,
@@ -171,6 +176,8 @@ impl Default for RenderParams {
                 elevation: 20.0,
             },
             direction: None,
+            up: None,
+            roll: 0.0,
             projection: Projection::Parallel,
             fov: 30.0,
             zoom: 1.0,
@@ -275,13 +282,49 @@ impl RenderParams {
                 )));
             }
         }
-        self.direction()?;
+        let dir = self.direction()?;
+        if let Some(u) = self.up {
+            if !camera::up_is_usable(dir, DVec3::from_array(u)) {
+                return Err(ModelError::View(format!(
+                    "up {u:?} is zero, not finite or within {} degrees of the view direction {:?}: it names no image up",
+                    camera::MIN_UP_DEGREES,
+                    dir.to_array()
+                )));
+            }
+        }
+        if !self.roll.is_finite() {
+            return Err(ModelError::View(format!(
+                "roll {} is not a finite number",
+                self.roll
+            )));
+        }
         Ok(())
     }
 
-    /// The orthographic camera (shared with the warp), zoom applied.
+    /// The image up (a hint) of a view along `dir`: `up` when set (and usable), else the orbit's
+    /// when the view is given by its angles, else the bare direction's (`camera` module).
+    pub fn up_hint(&self, dir: DVec3) -> DVec3 {
+        match self.up.map(DVec3::from_array) {
+            Some(u) if camera::up_is_usable(dir, u) => u,
+            _ if self.direction.is_none() => {
+                camera::orbit_up_hint(self.view.azimuth, self.view.elevation)
+            }
+            _ => camera::default_up(dir),
+        }
+    }
+
+    /// The camera of the view along `dir` (shared with the warp and the slice set-up): its up,
+    /// roll and zoom applied.
     pub fn camera(&self, vol: &Volume, dir: DVec3) -> Camera {
-        let mut cam = Camera::new(dir, vol.dims, vol.spacing, self.width, self.height);
+        let mut cam = Camera::looking(
+            dir,
+            self.up_hint(dir),
+            vol.dims,
+            vol.spacing,
+            self.width,
+            self.height,
+        )
+        .rolled(self.roll);
         cam.half /= self.zoom;
         cam
     }
@@ -342,52 +385,74 @@ pub fn shade(c: DVec3, gradient: DVec3, dir: DVec3, lights: &[Light], m: &Materi
 // The f64 image-order reference
 // =================================================================================================
 
-/// Renders `vol` with the f64 image-order ray caster.
-pub fn render_reference(
-    vol: &Volume,
-    tf: &TransferFunction,
-    params: &RenderParams,
-) -> Result<ImageF64> {
-    params.validate()?;
-    tf.validate()?;
-    let dir = params.direction()?;
-    let cam = params.camera(vol, dir);
-    let spacing = DVec3::from_array(vol.spacing);
-    let min_spacing = spacing.min_element();
-    let step_world = params.step * min_spacing;
-    let max_value = f64::from(vol.max_value());
-    let n = vol.dims.map(|d| d as f64);
-    let diag = (DVec3::from_array(n) * spacing).length();
-    // Perspective: the eye sits where the bounding sphere just fills the field of view.
-    let tan_half = (params.fov.to_radians() / 2.0).tan() / params.zoom;
-    let eye_dist = cam.radius * 1.02 / (params.fov.to_radians() / 2.0).sin();
-    let eye = cam.centre - dir * eye_dist;
+/// What the f64 renderers sample: the volume normalized to 0..1 (exact tri-linear), its central
+/// differences, and the box where interpolation can be non-zero, at the reference's step.
+pub(crate) struct Field<'a> {
+    vol: &'a Volume,
+    spacing: DVec3,
+    n: DVec3,
+    max_value: f64,
+    min_spacing: f64,
+    /// Sample spacing along a ray, physical units.
+    pub(crate) step_world: f64,
+    diag: f64,
+}
 
-    let sample = |w: DVec3| vol.sample_f64((w / spacing).to_array()) / max_value;
-    let gradient = |w: DVec3| {
-        let h = min_spacing;
+impl<'a> Field<'a> {
+    pub(crate) fn new(vol: &'a Volume, params: &RenderParams) -> Self {
+        let spacing = DVec3::from_array(vol.spacing);
+        let min_spacing = spacing.min_element();
+        let n = DVec3::from_array(vol.dims.map(|d| d as f64));
+        Self {
+            vol,
+            spacing,
+            n,
+            max_value: f64::from(vol.max_value()),
+            min_spacing,
+            step_world: params.step * min_spacing,
+            diag: (n * spacing).length(),
+        }
+    }
+
+    fn sample(&self, w: DVec3) -> f64 {
+        self.vol.sample_f64((w / self.spacing).to_array()) / self.max_value
+    }
+
+    fn gradient(&self, w: DVec3) -> DVec3 {
+        let h = self.min_spacing;
         DVec3::new(
-            sample(w + DVec3::X * h) - sample(w - DVec3::X * h),
-            sample(w + DVec3::Y * h) - sample(w - DVec3::Y * h),
-            sample(w + DVec3::Z * h) - sample(w - DVec3::Z * h),
+            self.sample(w + DVec3::X * h) - self.sample(w - DVec3::X * h),
+            self.sample(w + DVec3::Y * h) - self.sample(w - DVec3::Y * h),
+            self.sample(w + DVec3::Z * h) - self.sample(w - DVec3::Z * h),
         )
-    };
-    let inside = |w: DVec3| {
-        let v = w / spacing;
-        (0..3).all(|a| v[a] >= 0.0 && v[a] <= n[a] - 1.0)
-    };
-    let aspect = f64::from(params.width) / f64::from(params.height);
-    let ss = params.supersampling;
+    }
 
-    // One ray: origin, unit direction; samples at origin + dir * (k * step).
-    let trace = |origin: DVec3, rd: DVec3| -> [f64; 3] {
-        // Clip to the box where interpolation can be non-zero, keeping the sample lattice.
-        let (lo, hi) = (-spacing, DVec3::from_array(n) * spacing);
+    fn inside(&self, w: DVec3) -> bool {
+        let v = w / self.spacing;
+        (0..3).all(|a| v[a] >= 0.0 && v[a] <= self.n[a] - 1.0)
+    }
+
+    /// The corners of the box where interpolation can be non-zero (physical).
+    pub(crate) fn corners(&self) -> [DVec3; 8] {
+        let (lo, hi) = (-self.spacing, self.n * self.spacing);
+        std::array::from_fn(|c| {
+            DVec3::new(
+                if c & 1 == 0 { lo.x } else { hi.x },
+                if c & 2 == 0 { lo.y } else { hi.y },
+                if c & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+    }
+
+    /// The sample indices `k0..=k1` of the ray `origin + rd * (k * step)` inside that box (the
+    /// sample lattice kept), or none.
+    pub(crate) fn clip(&self, origin: DVec3, rd: DVec3) -> Option<(i64, i64)> {
+        let (lo, hi) = (-self.spacing, self.n * self.spacing);
         let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
         for a in 0..3 {
             if rd[a].abs() < 1e-15 {
                 if origin[a] < lo[a] || origin[a] > hi[a] {
-                    return [0.0; 3];
+                    return None;
                 }
             } else {
                 let (ta, tb) = ((lo[a] - origin[a]) / rd[a], (hi[a] - origin[a]) / rd[a]);
@@ -396,64 +461,118 @@ pub fn render_reference(
             }
         }
         if t0 > t1 {
-            return [0.0; 3];
+            return None;
         }
-        let k0 = (t0 / step_world).ceil() as i64;
-        let k1 = (t1 / step_world).floor() as i64;
-        let mut color = DVec3::ZERO;
-        let mut alpha = 0.0;
-        let mut peak: f64 = 0.0;
-        let mut low = f64::INFINITY;
-        let mut sum = 0.0;
-        for k in k0..=k1 {
-            let w = origin + rd * (k as f64 * step_world);
-            let d = sample(w);
-            match params.mode {
-                CompositeMode::Mip => peak = peak.max(d),
-                CompositeMode::Minip => {
-                    if inside(w) {
-                        low = low.min(d);
-                    }
+        Some((
+            (t0 / self.step_world).ceil() as i64,
+            (t1 / self.step_world).floor() as i64,
+        ))
+    }
+}
+
+/// One ray's projection (the mode's accumulator), fed samples front to back.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RayAcc {
+    color: DVec3,
+    alpha: f64,
+    peak: f64,
+    low: f64,
+    sum: f64,
+    hit: Option<[f64; 3]>,
+}
+
+impl Default for RayAcc {
+    fn default() -> Self {
+        Self {
+            color: DVec3::ZERO,
+            alpha: 0.0,
+            peak: 0.0,
+            low: f64::INFINITY,
+            sum: 0.0,
+            hit: None,
+        }
+    }
+}
+
+impl RayAcc {
+    /// Adds the sample at `w` (physical) seen along the unit `rd`; true once the ray is finished
+    /// (early termination, or first-opaque's hit).
+    pub(crate) fn add(
+        &mut self,
+        f: &Field,
+        tf: &TransferFunction,
+        params: &RenderParams,
+        w: DVec3,
+        rd: DVec3,
+    ) -> bool {
+        let d = f.sample(w);
+        match params.mode {
+            CompositeMode::Mip => self.peak = self.peak.max(d),
+            CompositeMode::Minip => {
+                if f.inside(w) {
+                    self.low = self.low.min(d);
                 }
-                CompositeMode::Xray => sum += d * step_world,
-                CompositeMode::FirstOpaque => {
-                    let [r, g, b, a] = tf.lookup(d);
-                    if a >= params.threshold {
-                        let mut c = DVec3::new(r, g, b);
-                        if params.shading {
-                            c = shade(c, gradient(w), rd, &params.lights, &params.material);
-                        }
-                        return c.to_array();
-                    }
-                }
-                CompositeMode::Composite => {
-                    let [r, g, b, a] = tf.lookup(d);
-                    if a <= 0.0 {
-                        continue;
-                    }
-                    // Opacity per voxel of path, corrected to the step length.
-                    let a = 1.0 - (1.0 - a).powf(params.step);
+            }
+            CompositeMode::Xray => self.sum += d * f.step_world,
+            CompositeMode::FirstOpaque => {
+                let [r, g, b, a] = tf.lookup(d);
+                if a >= params.threshold {
                     let mut c = DVec3::new(r, g, b);
                     if params.shading {
-                        c = shade(c, gradient(w), rd, &params.lights, &params.material);
+                        c = shade(c, f.gradient(w), rd, &params.lights, &params.material);
                     }
-                    color += (1.0 - alpha) * a * c;
-                    alpha += (1.0 - alpha) * a;
-                    if alpha >= params.early_termination {
-                        break;
-                    }
+                    self.hit = Some(c.to_array());
+                    return true;
+                }
+            }
+            CompositeMode::Composite => {
+                let [r, g, b, a] = tf.lookup(d);
+                if a <= 0.0 {
+                    return false;
+                }
+                // Opacity per voxel of path, corrected to the step length.
+                let a = 1.0 - (1.0 - a).powf(params.step);
+                let mut c = DVec3::new(r, g, b);
+                if params.shading {
+                    c = shade(c, f.gradient(w), rd, &params.lights, &params.material);
+                }
+                self.color += (1.0 - self.alpha) * a * c;
+                self.alpha += (1.0 - self.alpha) * a;
+                if self.alpha >= params.early_termination {
+                    return true;
                 }
             }
         }
-        match params.mode {
-            CompositeMode::Mip => [peak; 3],
-            CompositeMode::Minip => [if low.is_finite() { low } else { 0.0 }; 3],
-            CompositeMode::Xray => [(sum / diag).min(1.0); 3],
-            CompositeMode::FirstOpaque => [0.0; 3],
-            CompositeMode::Composite => color.to_array(),
-        }
-    };
+        false
+    }
 
+    /// The ray's colour.
+    pub(crate) fn finish(&self, f: &Field, mode: CompositeMode) -> [f64; 3] {
+        match mode {
+            CompositeMode::Mip => [self.peak; 3],
+            CompositeMode::Minip => [if self.low.is_finite() { self.low } else { 0.0 }; 3],
+            CompositeMode::Xray => [(self.sum / f.diag).min(1.0); 3],
+            CompositeMode::FirstOpaque => self.hit.unwrap_or([0.0; 3]),
+            CompositeMode::Composite => self.color.to_array(),
+        }
+    }
+}
+
+/// The eye of a perspective view and the tangent of half its field of view (zoom applied): the eye
+/// sits where the bounding sphere just fills the field of view.
+pub(crate) fn perspective_eye(params: &RenderParams, cam: &Camera) -> (DVec3, f64) {
+    let tan_half = (params.fov.to_radians() / 2.0).tan() / params.zoom;
+    let eye_dist = cam.radius * 1.02 / (params.fov.to_radians() / 2.0).sin();
+    (cam.centre - cam.dir * eye_dist, tan_half)
+}
+
+/// The image of `params` (supersampled as it asks), each sub-pixel's colour from `ray(ndc_x,
+/// ndc_y)`, normalized device coordinates in -1..1 (y up).
+pub(crate) fn image_of(
+    params: &RenderParams,
+    ray: impl Fn(f64, f64) -> [f64; 3] + Sync,
+) -> ImageF64 {
+    let ss = params.supersampling;
     let rgb: Vec<[f64; 3]> = (0..params.width * params.height)
         .into_par_iter()
         .map(|i| {
@@ -465,20 +584,7 @@ pub fn render_reference(
                     let fy = (f64::from(sy) + 0.5) / f64::from(ss);
                     let ndc_x = (f64::from(px) + fx) / f64::from(params.width) * 2.0 - 1.0;
                     let ndc_y = 1.0 - (f64::from(py) + fy) / f64::from(params.height) * 2.0;
-                    let c = match params.projection {
-                        Projection::Parallel => {
-                            let u = ndc_x * cam.half * aspect.max(1.0);
-                            let v = ndc_y * cam.half / aspect.min(1.0);
-                            let origin = cam.centre + cam.right * u + cam.up * v - dir * cam.radius;
-                            trace(origin, dir)
-                        }
-                        Projection::Perspective => {
-                            let u = ndc_x * tan_half * aspect.max(1.0);
-                            let v = ndc_y * tan_half / aspect.min(1.0);
-                            let rd = (dir + cam.right * u + cam.up * v).normalize();
-                            trace(eye, rd)
-                        }
-                    };
+                    let c = ray(ndc_x, ndc_y);
                     for ch in 0..3 {
                         acc[ch] += c[ch];
                     }
@@ -487,11 +593,55 @@ pub fn render_reference(
             acc.map(|v| v / f64::from(ss * ss))
         })
         .collect();
-    Ok(ImageF64 {
+    ImageF64 {
         width: params.width,
         height: params.height,
         rgb,
-    })
+    }
+}
+
+/// Renders `vol` with the f64 image-order ray caster.
+pub fn render_reference(
+    vol: &Volume,
+    tf: &TransferFunction,
+    params: &RenderParams,
+) -> Result<ImageF64> {
+    params.validate()?;
+    tf.validate()?;
+    let dir = params.direction()?;
+    let cam = params.camera(vol, dir);
+    let field = Field::new(vol, params);
+    let (eye, tan_half) = perspective_eye(params, &cam);
+    let aspect = f64::from(params.width) / f64::from(params.height);
+
+    // One ray: origin, unit direction; samples at origin + dir * (k * step).
+    let trace = |origin: DVec3, rd: DVec3| -> [f64; 3] {
+        let mut acc = RayAcc::default();
+        if let Some((k0, k1)) = field.clip(origin, rd) {
+            for k in k0..=k1 {
+                let w = origin + rd * (k as f64 * field.step_world);
+                if acc.add(&field, tf, params, w, rd) {
+                    break;
+                }
+            }
+        }
+        acc.finish(&field, params.mode)
+    };
+
+    Ok(image_of(params, |ndc_x, ndc_y| match params.projection {
+        Projection::Parallel => {
+            let u = ndc_x * cam.half * aspect.max(1.0);
+            let v = ndc_y * cam.half / aspect.min(1.0);
+            let origin = cam.centre + cam.right * u + cam.up * v - dir * cam.radius;
+            trace(origin, dir)
+        }
+        Projection::Perspective => {
+            let u = ndc_x * tan_half * aspect.max(1.0);
+            let v = ndc_y * tan_half / aspect.min(1.0);
+            let rd = (dir + cam.right * u + cam.up * v).normalize();
+            trace(eye, rd)
+        }
+    }))
 }
 
 // =================================================================================================

@@ -7,14 +7,17 @@
 //! (no gradient or shader for MIP or X-ray, no depth test without geometry, no opacity correction
 //! at a step of exactly one voxel, ...) and why the others are left out.
 
+use crate::camera;
 use crate::error::{ModelError, Result};
 use crate::phantom::{phantom_by_name, PHANTOMS};
 use crate::render::{
     CompositeMode, Light, Material, Projection, Quality, RenderParams, SliceSetup, View,
 };
+use crate::slab_perspective::{SlabSpacing, Slabs};
 use crate::transfer::{TfPoint, TransferFunction, TF_PRESETS};
 use crate::volume::{Volume, MAX_EDGE};
 use crate::volume_io::{self, Endian, Format, RawSpec, VoxelType};
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -112,7 +115,16 @@ pub struct ViewSpec {
     pub elevation: f64,
     /// View vector from the eye into the scene; overrides azimuth and elevation.
     pub direction: Option<[f64; 3]>,
+    /// Image up (made orthogonal to the view); none: the orbit's, or the bare direction's
+    /// (`camera` module).
+    pub up: Option<[f64; 3]>,
+    /// Degrees the picture turns counterclockwise about its centre.
+    pub roll: f64,
     pub projection: Projection,
+    /// `run.renderer = "slabs"`: how many parallel slabs approximate the perspective view.
+    pub slabs: u32,
+    /// `run.renderer = "slabs"`: how the slabs' thicknesses grow along the view.
+    pub slab_spacing: SlabSpacing,
     /// Perspective: full field of view across the shorter image side, degrees.
     pub fov: f64,
     pub zoom: f64,
@@ -166,13 +178,25 @@ pub enum Target {
     Both,
 }
 
-/// Which model renders: the slice-order pipeline at the quality knobs, or the f64 reference.
+/// Which model renders: the slice-order pipeline at the quality knobs, the f64 reference, or
+/// perspective approximated by parallel slabs (a what-if, `slab_perspective`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum Renderer {
     #[default]
     Pipeline,
     Reference,
+    Slabs,
+}
+
+impl Renderer {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Pipeline => "pipeline",
+            Self::Reference => "reference",
+            Self::Slabs => "slabs",
+        }
+    }
 }
 
 impl Default for VolumeSpec {
@@ -199,9 +223,44 @@ impl Default for ViewSpec {
             azimuth: p.view.azimuth,
             elevation: p.view.elevation,
             direction: p.direction,
+            up: p.up,
+            roll: p.roll,
             projection: p.projection,
+            slabs: 8,
+            slab_spacing: SlabSpacing::Equal,
             fov: p.fov,
             zoom: p.zoom,
+        }
+    }
+}
+
+impl ViewSpec {
+    /// Command-line angles (`--azimuth`, `--elevation`): they apply. A scene that gives a view
+    /// `direction` has it replaced by the orbit at the given angles, the angle not given read off
+    /// the direction (a zero or non-finite direction stays, for validation to name).
+    pub fn set_angles(&mut self, azimuth: Option<f64>, elevation: Option<f64>) {
+        if azimuth.is_none() && elevation.is_none() {
+            return;
+        }
+        if let Some(d) = self.direction {
+            let eye = -DVec3::from_array(d);
+            let len = eye.length();
+            let known = eye.is_finite() && len > 1e-12;
+            if !known && (azimuth.is_none() || elevation.is_none()) {
+                return;
+            }
+            if known {
+                let eye = eye / len;
+                self.azimuth = eye.y.atan2(eye.x).to_degrees();
+                self.elevation = eye.z.clamp(-1.0, 1.0).asin().to_degrees();
+            }
+            self.direction = None;
+        }
+        if let Some(a) = azimuth {
+            self.azimuth = a;
+        }
+        if let Some(e) = elevation {
+            self.elevation = e;
         }
     }
 }
@@ -401,6 +460,7 @@ impl Scene {
         for (field, x) in [
             ("view.azimuth", self.view.azimuth),
             ("view.elevation", self.view.elevation),
+            ("view.roll", self.view.roll),
         ] {
             if !x.is_finite() {
                 return bad(field, format!("{x} is not a finite number"));
@@ -412,6 +472,23 @@ impl Scene {
             }
             if d.iter().map(|x| x * x).sum::<f64>() < 1e-24 {
                 return bad("view.direction", format!("{d:?} is the zero vector"));
+            }
+        }
+        if let Some(u) = self.view.up {
+            if u.iter().any(|x| !x.is_finite()) || u.iter().map(|x| x * x).sum::<f64>() < 1e-24 {
+                return bad("view.up", format!("{u:?} is zero or not finite"));
+            }
+            if let Ok(dir) = self.render_params().direction() {
+                if !camera::up_is_usable(dir, DVec3::from_array(u)) {
+                    return bad(
+                        "view.up",
+                        format!(
+                            "{u:?} is within {} degrees of the view direction {:?}: it names no image up",
+                            camera::MIN_UP_DEGREES,
+                            dir.to_array()
+                        ),
+                    );
+                }
             }
         }
         if !(self.view.fov.is_finite() && self.view.fov > 0.0 && self.view.fov < 170.0) {
@@ -520,15 +597,27 @@ impl Scene {
         {
             return bad(
                 "view.projection",
-                "perspective is rendered by the reference renderer only (the slice-order pipeline model is parallel); set `run.renderer = \"reference\"`".into(),
+                "perspective is rendered by the reference renderer (the slice-order pipeline model is parallel); set `run.renderer = \"reference\"` (exact) or `\"slabs\"` (parallel slabs, a what-if)".into(),
             );
         }
-        if self.run.target.uses_rtl() && self.run.renderer == Renderer::Reference {
+        if self.run.renderer == Renderer::Slabs {
+            if self.view.projection != Projection::Perspective {
+                return bad(
+                    "run.renderer",
+                    "`slabs` approximates a perspective view; set `view.projection = \"perspective\"`".into(),
+                );
+            }
+            if let Err(e) = self.slabs().validate() {
+                return bad("view.slabs", inner(&e));
+            }
+        }
+        if self.run.target.uses_rtl() && self.run.renderer != Renderer::Pipeline {
             return bad(
                 "run.renderer",
                 format!(
-                    "target `{}` runs the RTL pipeline, which the f64 reference renderer is not; use `renderer = \"pipeline\"`",
-                    self.run.target.name()
+                    "target `{}` runs the RTL pipeline, which renderer `{}` is not; use `renderer = \"pipeline\"`",
+                    self.run.target.name(),
+                    self.run.renderer.name()
                 ),
             );
         }
@@ -672,6 +761,8 @@ impl Scene {
                 elevation: self.view.elevation,
             },
             direction: self.view.direction,
+            up: self.view.up,
+            roll: self.view.roll,
             projection: self.view.projection,
             fov: self.view.fov,
             zoom: self.view.zoom,
@@ -688,6 +779,14 @@ impl Scene {
 
     pub fn quality(&self) -> Quality {
         self.quality
+    }
+
+    /// The slab scheme of `run.renderer = "slabs"` (`view.slabs`, `view.slab_spacing`).
+    pub fn slabs(&self) -> Slabs {
+        Slabs {
+            count: self.view.slabs,
+            spacing: self.view.slab_spacing,
+        }
     }
 }
 
@@ -888,7 +987,10 @@ impl Plan {
             Unit::Perspective,
             params.projection == Projection::Perspective,
             if params.projection == Projection::Perspective {
-                "reference renderer only".into()
+                match scene.run.renderer {
+                    Renderer::Slabs => format!("approximated by {}", scene.slabs().describe()),
+                    _ => "exact rays from the eye (reference renderer)".into(),
+                }
             } else {
                 "parallel projection".into()
             },
@@ -896,6 +998,10 @@ impl Plan {
         let what_if = crate::scene_render::not_expressible(scene);
         let model = match scene.run.renderer {
             Renderer::Reference => "f64 reference renderer (not the hardware)".to_string(),
+            Renderer::Slabs => format!(
+                "what-if slab perspective (not the hardware: {}, each an f64 parallel ray cast along the view, textured onto its middle plane through the perspective, blended front to back; docs/numerics/slab_perspective.md)",
+                scene.slabs().describe()
+            ),
             Renderer::Pipeline if what_if.is_empty() => {
                 frame_entries(&mut entries, scene, vol);
                 "frame (cube5_frame's bits, then the warp)".to_string()

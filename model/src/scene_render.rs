@@ -9,7 +9,6 @@
 //! samples per slice, supersampling, the 10- and 26-neighbourhood gradients, X-ray, MinIP and
 //! first-opaque) runs on the what-if pipeline model `render::render_pipeline`, and `plan:` says so.
 
-use crate::camera::Camera;
 use crate::error::{ModelError, Result};
 use crate::render::{CompositeMode, GradientScheme, ImageF64, Interpolation, Projection};
 use crate::scene::Scene;
@@ -286,14 +285,8 @@ impl FrameJob {
 
     /// The base plane warped onto the scene's image (bilinear, model only).
     pub fn image(&self, scene: &Scene, base: &BasePlane) -> ImageF64 {
-        let mut camera = Camera::new(
-            self.dir,
-            self.seen.dims,
-            self.seen.spacing,
-            scene.image.width,
-            scene.image.height,
-        );
-        camera.half /= scene.view.zoom;
+        // The scene's camera (up, roll, zoom): the reference renderer's.
+        let camera = scene.render_params().camera(&self.seen, self.dir);
         cube5_frame::warp(
             &self.setup.params,
             self.seen.spacing,

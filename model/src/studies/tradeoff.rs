@@ -15,8 +15,9 @@ use crate::error::{ModelError, Result};
 use crate::phantom::{sphere_phantom, SphereGeometry};
 use crate::render::{
     render_pipeline, render_reference, CompositeMode, GradientScheme, ImageF64, Interpolation,
-    Quality, RenderParams, SliceSetup, View, STEP_W,
+    Projection, Quality, RenderParams, SliceSetup, View, STEP_W,
 };
+use crate::slab_perspective::{render_slabs, SlabSpacing, Slabs};
 use crate::transfer::TransferFunction;
 use crate::units::cube5_gradient::{block_index, Gradient, GradientConfig, GradientIn};
 use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
@@ -426,6 +427,8 @@ pub struct Setup {
     pub paper_step: f64,
     /// §6.2: edge of the voxelized sphere.
     pub sphere_size: usize,
+    /// Slab perspective: the slab counts (the perspective view of `params`, fov 40 degrees).
+    pub slab_counts: Vec<u32>,
     pub synth: Option<Synth>,
 }
 
@@ -452,6 +455,7 @@ impl Setup {
             paper_elevation: 20.0,
             paper_step: 0.5,
             sphere_size: 64,
+            slab_counts: vec![1, 2, 4, 8, 16, 32, 64],
             synth: None,
         }
     }
@@ -467,6 +471,7 @@ impl Setup {
             thresholds: vec![0.9, 1.0],
             angles: vec![0.0, 30.0, 45.0],
             sphere_size: 24,
+            slab_counts: vec![2, 4],
             ..Self::new(vol, tf, params, quality)
         }
     }
@@ -940,6 +945,61 @@ pub fn run(setup: &Setup, progress: &dyn Progress) -> Result<Report> {
         marks: Vec::new(),
         log_x: false,
     });
+
+    // ---- perspective by parallel slabs (what-if) -------------------------------------------------
+    let persp = RenderParams {
+        projection: Projection::Perspective,
+        fov: 40.0,
+        ..base.clone()
+    };
+    let persp_reference = render_reference(vol, tf, &persp)?;
+    let mut slab_table = Table::new(
+        "tradeoff-slabs",
+        "Perspective by parallel slabs (what-if): error against the f64 perspective reference",
+        &[
+            "slabs",
+            "spacing",
+            ERR_COLUMNS[0],
+            ERR_COLUMNS[1],
+            ERR_COLUMNS[2],
+        ],
+    );
+    let spacings = [SlabSpacing::Equal, SlabSpacing::Geometric];
+    progress.start(
+        "slab perspective",
+        (spacings.len() * setup.slab_counts.len()) as u64,
+    );
+    let mut slab_series = Vec::new();
+    for spacing in spacings {
+        let mut pts = Vec::new();
+        for &count in &setup.slab_counts {
+            let img = render_slabs(vol, tf, &persp, Slabs { count, spacing })?;
+            let e = image_error(&img, &persp_reference);
+            let [a, m, r] = fmt_err(&e);
+            slab_table
+                .rows
+                .push(vec![count.to_string(), spacing.name().into(), a, m, r]);
+            if e.psnr_db.is_finite() {
+                pts.push((f64::from(count), e.psnr_db));
+            }
+            progress.tick();
+        }
+        slab_series.push(Series {
+            name: format!("{} slabs", spacing.name()),
+            points: pts,
+        });
+    }
+    progress.finish();
+    tables.push(slab_table);
+    figures.push(Figure {
+        name: "tradeoff-slabs".into(),
+        title: "Perspective by parallel slabs: PSNR against the f64 perspective".into(),
+        x_label: "slabs".into(),
+        y_label: "PSNR (dB)".into(),
+        series: slab_series,
+        marks: Vec::new(),
+        log_x: true,
+    });
     let _ = vb0;
     Ok(Report {
         tables,
@@ -1185,8 +1245,14 @@ mod tests {
         );
         setup.sphere_size = 16;
         let report = run(&setup, &Quiet).unwrap();
-        assert_eq!(report.tables.len(), 6);
-        assert_eq!(report.figures.len(), 4);
+        assert_eq!(report.tables.len(), 7);
+        assert_eq!(report.figures.len(), 5);
+        let slabs = report
+            .tables
+            .iter()
+            .find(|t| t.name == "tradeoff-slabs")
+            .unwrap();
+        assert_eq!(slabs.rows.len(), 4, "2 counts x 2 spacings");
         assert!(report.tables.iter().all(|t| !t.rows.is_empty()));
         // At exactly 45 degrees sheared and full tri-linear agree (the offset is zero).
         let interp = &report.tables[4];
