@@ -12,6 +12,7 @@
 use cube5_model::render::{render_reference, ImageF64};
 use cube5_model::scene::{Plan, Scene};
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
+use cube5_model::slab_perspective::render_slabs;
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -28,6 +29,8 @@ enum Shows {
     /// The f64 reference renderer's image (`renderer = "reference"`, `cube5 render --compare`);
     /// the frame refuses the scene when it asks for what the field serves (named by `because`).
     Reference { because: &'static str },
+    /// The what-if slab-perspective model's image (`renderer = "slabs"`), likewise.
+    Slabs { because: &'static str },
 }
 
 struct Case {
@@ -75,6 +78,10 @@ fn cases() -> Vec<Case> {
         c("view.projection", "", "[view]\nprojection = \"perspective\"\n", Refused),
         c("view.fov", PERSPECTIVE, "[view]\nprojection = \"perspective\"\nfov = 50.0\n", Reference { because: "view.projection" }),
         c("view.zoom", "", "[view]\nzoom = 1.5\n", Frame),
+        c("view.up", "[view]\ndirection = [1.0, 0.3, -0.2]\n", "[view]\ndirection = [1.0, 0.3, -0.2]\nup = [0.0, 1.0, 0.0]\n", Frame),
+        c("view.roll", "", "[view]\nroll = 30.0\n", Frame),
+        c("view.slabs", SLABS, "[view]\nprojection = \"perspective\"\nslabs = 3\n", Slabs { because: "view.projection" }),
+        c("view.slab_spacing", SLABS, "[view]\nprojection = \"perspective\"\nslab_spacing = \"geometric\"\n", Slabs { because: "view.projection" }),
         // [image]: the warp's output.
         c("image.width", "", "[image]\nwidth = 40\n", Frame),
         c("image.height", "", "[image]\nheight = 40\n", Frame),
@@ -121,6 +128,9 @@ fn cases() -> Vec<Case> {
 
 /// A perspective scene (the f64 reference renderer's only).
 const PERSPECTIVE: &str = "[view]\nprojection = \"perspective\"\n[run]\nrenderer = \"reference\"\n";
+
+/// A perspective scene on the what-if slab model.
+const SLABS: &str = "[view]\nprojection = \"perspective\"\n[run]\nrenderer = \"slabs\"\n";
 
 /// The context of the `volume.*` file cases.
 const RAW_FILE: &str = "[volume]\nfile = \"fields.raw\"\ndims = [20, 18, 16]\ntype = \"u16\"\n";
@@ -210,10 +220,16 @@ fn frame_outcome(scene: &Scene) -> Result<Outcome, String> {
     })
 }
 
-fn reference_image(scene: &Scene) -> Result<ImageF64, String> {
+/// The image of a what-if model: the f64 reference or the slab perspective.
+fn what_if_image(scene: &Scene, slabs: bool) -> Result<ImageF64, String> {
     let vol = scene.build_volume().map_err(|e| e.to_string())?;
-    render_reference(&vol, &scene.transfer_function(), &scene.render_params())
-        .map_err(|e| e.to_string())
+    let (tf, params) = (scene.transfer_function(), scene.render_params());
+    if slabs {
+        render_slabs(&vol, &tf, &params, scene.slabs())
+    } else {
+        render_reference(&vol, &tf, &params)
+    }
+    .map_err(|e| e.to_string())
 }
 
 /// `BASE`, then `extra`, then `more`, merged table by table (a later key wins, `key = ~` removes
@@ -321,14 +337,15 @@ fn every_scene_field_changes_the_run_or_is_refused_by_name() {
                     (_, Err(m)) => Err(format!("refused without naming it: {m}")),
                 }
             }
-            Shows::Reference { because } => {
+            Shows::Reference { because } | Shows::Slabs { because } => {
+                let slabs = matches!(case.shows, Shows::Slabs { .. });
                 let after = after.unwrap_or_else(|e| panic!("{}: {e}", case.field));
                 let refused_by = frame_outcome(&after).err().unwrap_or_default();
-                let a = reference_image(&after);
-                let b = reference_image(&before);
+                let a = what_if_image(&after, slabs);
+                let b = what_if_image(&before, slabs);
                 match (a, b) {
                     (Ok(a), Ok(b)) if a.to_rgb8() == b.to_rgb8() => {
-                        Err("the reference renders the same image".into())
+                        Err("the what-if model renders the same image".into())
                     }
                     (Ok(_), Ok(_)) if !because.is_empty() && !refused_by.contains(because) => {
                         Err(format!(
@@ -336,7 +353,7 @@ fn every_scene_field_changes_the_run_or_is_refused_by_name() {
                         ))
                     }
                     (Ok(_), Ok(_)) => Ok(()),
-                    (a, b) => Err(format!("reference failed: {:?} {:?}", a.err(), b.err())),
+                    (a, b) => Err(format!("what-if model failed: {:?} {:?}", a.err(), b.err())),
                 }
             }
         };
