@@ -7,6 +7,7 @@
 //! `volume`, `transfer`, `camera`; `units` (one module per RTL top, named as the top);
 //! `phantom`, `volume_io`, `scene`, `render` (scenes, files and renderers that use the units);
 //! `scene_render` (what `cube5 render` runs: a scene on the frame model, or a named what-if);
+//! `scene_gi` (a scene with `[gi]`: the GI-Cube processor model, lighting and rendering passes);
 //! `studies` (the tradeoff sweeps, not part of the golden model).
 
 pub mod bits;
@@ -16,6 +17,7 @@ pub mod phantom;
 pub mod regs;
 pub mod render;
 pub mod scene;
+pub mod scene_gi;
 pub mod scene_render;
 pub mod studies;
 pub mod transfer;
