@@ -548,3 +548,85 @@ pub fn plan(scene: &Scene, vol: &Volume) -> Result<Plan> {
         target: scene.run.target,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        Scene::parse(text, "s.toml").unwrap_err().to_string()
+    }
+
+    #[test]
+    fn an_empty_gi_table_is_the_default_section() {
+        let s = Scene::parse("[gi]\n", "s").unwrap();
+        assert_eq!(s.gi, Some(GiSpec::default()));
+        assert_eq!(Scene::parse("", "s").unwrap().gi, None);
+    }
+
+    #[test]
+    fn bad_values_are_refused_in_one_line_naming_the_field() {
+        for (text, field) in [
+            ("[gi]\nlight = [0, 0, 0]\n", "gi.light"),
+            ("[gi]\nlight = [nan, 0, 1]\n", "gi.light"),
+            ("[gi]\nenergy = 5.0\n", "gi.energy"),
+            ("[gi]\nlight_rays = 0\n", "gi.light_rays"),
+            ("[gi]\nalbedo = -0.1\n", "gi.albedo"),
+            ("[gi]\nalbedo = 0.5\nbounces = 300\n", "gi.bounces"),
+            ("[gi]\nbounces = 3\n", "gi.bounces"),
+            ("[gi]\npasses = 0\n", "gi.passes"),
+            ("[gi]\nblock_size = 6\n", "gi.block_size"),
+            ("[gi]\nqueue_length = 70000\n", "gi.queue_length"),
+            ("[gi]\ncolour = 1\n", "colour"),
+            ("[gi]\n[run]\ntarget = \"both\"\n", "run.target"),
+            ("[gi]\n[render]\nmode = \"xray\"\n", "render.mode"),
+            ("[gi]\n[render]\nstep = 0.05\n", "render.step"),
+            ("[gi]\n[image]\nwidth = 5000\n", "image.width"),
+            ("[gi]\n[quality]\nweight_bits = 6\n", "quality.weight_bits"),
+            ("[gi]\n[shading]\nshininess = 3.0\n", "shading.shininess"),
+            (
+                "[gi]\nalbedo = 0.5\n[run]\nrenderer = \"reference\"\n",
+                "run.renderer",
+            ),
+        ] {
+            let e = err(text);
+            assert!(e.contains(field), "{text}: {e}");
+            assert_eq!(e.lines().count(), 1, "{e}");
+        }
+        // Perspective is the processor's: accepted in a GI scene.
+        Scene::parse("[gi]\n[view]\nprojection = \"perspective\"\n", "s").unwrap();
+    }
+
+    #[test]
+    fn the_scene_sets_the_processor() {
+        let s = Scene::parse(
+            "[render]\nstep = 0.3\nearly_termination = 0.5\n[gi]\nblock_size = 8\nqueue_length = 9\n",
+            "s",
+        )
+        .unwrap();
+        let c = processor_config(&s).unwrap();
+        assert_eq!((c.block_log2, c.queue_len), (3, 9));
+        assert_eq!(c.step, 77); // 0.3 x 256 = 76.8, rounded
+        assert_eq!(c.et_threshold, Some(2048));
+        let s = Scene::parse("[render]\nearly_termination = 1.0\n[gi]\n", "s").unwrap();
+        assert_eq!(processor_config(&s).unwrap().et_threshold, None);
+        // cube5 cosim refuses a GI scene in one line.
+        let why = crate::scene_render::not_expressible(&s);
+        assert!(why.len() == 1 && why[0].contains("no GI-Cube RTL"), "{why:?}");
+    }
+
+    #[test]
+    fn the_example_scene_is_the_processors_shadow_scene() {
+        // scenes/gi-shadow.toml at 64^3 is `shadow_scene(64)`: same volume, transfer function and
+        // light (the example and the measurements use it).
+        let path = crate::repo_root().join("scenes/gi-shadow.toml");
+        let scene = Scene::load(&path).unwrap();
+        let vol = scene.build_volume().unwrap();
+        let (v, tf, light) = crate::units::gicube_processor::shadow_scene(64).unwrap();
+        assert!(vol.data == v.data && vol.bits == v.bits);
+        assert_eq!(scene.transfer_function(), tf);
+        let l = gi_light(scene.gi.as_ref().unwrap(), &vol);
+        assert!((l.dir - light.dir).length() < 1e-12);
+        assert_eq!((l.energy, l.grid, l.mode), (light.energy, light.grid, light.mode));
+    }
+}
