@@ -48,7 +48,11 @@ fn assert_refused(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "expected failure; stderr: {err}");
     assert!(!err.contains("panicked"), "panic: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "one line expected:\n{err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "one line expected:\n{err}"
+    );
     for n in needles {
         assert!(err.contains(n), "error should mention `{n}`: {err}");
     }
@@ -56,7 +60,10 @@ fn assert_refused(out: &Output, needles: &[&str]) {
 
 /// The number in `text` after `key` (up to the next space).
 fn number_after(text: &str, key: &str) -> f64 {
-    let rest = &text[text.find(key).unwrap_or_else(|| panic!("no `{key}` in {text}")) + key.len()..];
+    let rest = &text[text
+        .find(key)
+        .unwrap_or_else(|| panic!("no `{key}` in {text}"))
+        + key.len()..];
     rest.split_whitespace().next().unwrap().parse().unwrap()
 }
 
@@ -90,7 +97,10 @@ fn gi_shadow_renders_on_the_processor_with_its_counts() {
     }
     assert_eq!(passes, 2, "{plan}");
     let db = number_after(&stdout, "f64 reference: PSNR ");
-    assert!(db >= 40.0, "PSNR {db} dB against the f64 reference: {stdout}");
+    assert!(
+        db >= 40.0,
+        "PSNR {db} dB against the f64 reference: {stdout}"
+    );
     assert!(lit.pixels().any(|p| p.0.iter().any(|&c| c > 60)), "black");
 
     // Without the lighting pass (gi.passes = 1) there is no shadow: the image differs, and the
@@ -155,14 +165,29 @@ fn bad_gi_fields_are_refused_in_one_line() {
         ("[gi]\nenergy = -1.0\n", "gi.energy"),
         ("[gi]\npasses = 3\n", "gi.passes"),
         ("[gi]\nblok_size = 8\n", "blok_size"),
-        ("[gi]\nlight_rays = 2\n[volume]\nsize = 16\n", "gi.light_rays"),
-        ("[gi]\nblock_size = 4\n[volume]\nsize = 64\n", "gi.block_size"),
+        (
+            "[gi]\nlight_rays = 2\n[volume]\nsize = 16\n",
+            "gi.light_rays",
+        ),
+        (
+            "[gi]\nblock_size = 4\n[volume]\nsize = 64\n",
+            "gi.block_size",
+        ),
     ] {
         let scene = scratch("gi-bad.toml");
         std::fs::write(&scene, text).unwrap();
         let png = scratch("gi-bad.png");
         let _ = std::fs::remove_file(&png);
-        let out = cube5(&["render", s(&scene), "-o", s(&png), "--width", "16", "--height", "16"]);
+        let out = cube5(&[
+            "render",
+            s(&scene),
+            "-o",
+            s(&png),
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ]);
         assert_refused(&out, &["gi-bad.toml", field]);
         assert!(!png.exists(), "{text}");
     }

@@ -9,10 +9,10 @@
 
 use crate::error::{ModelError, Result};
 use crate::phantom::{phantom_by_name, PHANTOMS};
-use crate::scene_gi::GiSpec;
 use crate::render::{
     CompositeMode, Light, Material, Projection, Quality, RenderParams, SliceSetup, View,
 };
+use crate::scene_gi::GiSpec;
 use crate::transfer::{TfPoint, TransferFunction, TF_PRESETS};
 use crate::volume::{Volume, MAX_EDGE};
 use crate::volume_io::{self, Endian, Format, RawSpec, VoxelType};

@@ -217,7 +217,9 @@ fn text(e: &ModelError) -> String {
     };
     ["gicube processor: ", "gicube lighting pass: "]
         .iter()
-        .fold(m, |m, p| m.strip_prefix(p).map_or(m.clone(), str::to_string))
+        .fold(m, |m, p| {
+            m.strip_prefix(p).map_or(m.clone(), str::to_string)
+        })
 }
 
 /// The `[gi]` section of a scene that has one.
@@ -306,7 +308,10 @@ impl GiJob {
             return Err(scene_err(
                 scene,
                 "volume.bits",
-                format!("{}-bit voxels: the GI-Cube processor takes 4..=16", vol.bits),
+                format!(
+                    "{}-bit voxels: the GI-Cube processor takes 4..=16",
+                    vol.bits
+                ),
             ));
         }
         let cfg = processor_config(scene)?;
@@ -371,12 +376,10 @@ impl GiJob {
             (false, _) => self
                 .processor
                 .reference(&self.tf, &self.camera, self.projection)?,
-            (true, GiMode::LowAlbedo) => self.processor.reference_gi(
-                &self.tf,
-                &self.light,
-                &self.camera,
-                self.projection,
-            )?,
+            (true, GiMode::LowAlbedo) => {
+                self.processor
+                    .reference_gi(&self.tf, &self.light, &self.camera, self.projection)?
+            }
             (true, GiMode::HighAlbedo { .. }) => return Ok(None),
         };
         Ok(Some(ImageF64 {
@@ -612,7 +615,10 @@ mod tests {
         assert_eq!(processor_config(&s).unwrap().et_threshold, None);
         // cube5 cosim refuses a GI scene in one line.
         let why = crate::scene_render::not_expressible(&s);
-        assert!(why.len() == 1 && why[0].contains("no GI-Cube RTL"), "{why:?}");
+        assert!(
+            why.len() == 1 && why[0].contains("no GI-Cube RTL"),
+            "{why:?}"
+        );
     }
 
     #[test]
@@ -627,6 +633,9 @@ mod tests {
         assert_eq!(scene.transfer_function(), tf);
         let l = gi_light(scene.gi.as_ref().unwrap(), &vol);
         assert!((l.dir - light.dir).length() < 1e-12);
-        assert_eq!((l.energy, l.grid, l.mode), (light.energy, light.grid, light.mode));
+        assert_eq!(
+            (l.energy, l.grid, l.mode),
+            (light.energy, light.grid, light.mode)
+        );
     }
 }

@@ -158,7 +158,8 @@ const GI: &str = "[render]\nstep = 1.0\n[gi]\npasses = 2\n";
 /// ... with photons.
 const GI_PHOTONS: &str = "[render]\nstep = 1.0\n[gi]\nalbedo = 0.8\n";
 /// ... in perspective.
-const GI_PERSPECTIVE: &str = "[view]\nprojection = \"perspective\"\n[render]\nstep = 1.0\n[gi]\npasses = 2\n";
+const GI_PERSPECTIVE: &str =
+    "[view]\nprojection = \"perspective\"\n[render]\nstep = 1.0\n[gi]\npasses = 2\n";
 
 /// A perspective scene (the f64 reference renderer's only).
 const PERSPECTIVE: &str = "[view]\nprojection = \"perspective\"\n[run]\nrenderer = \"reference\"\n";
