@@ -89,7 +89,7 @@ struct RenderArgs {
 
 #[derive(Debug, clap::Args)]
 struct PhantomArgs {
-    /// Phantom name (head, sphere, bubbles).
+    /// Phantom name (head, sphere, bubbles, sphere-floor).
     name: String,
     /// Output file: .nrrd (gzip-encoded), .nii, .nii.gz or .raw (u8/u16, little endian).
     #[arg(short, long)]
