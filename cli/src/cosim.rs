@@ -43,6 +43,9 @@ pub fn run(args: CosimArgs) -> Result<()> {
         .as_ref()
         .map_or("the default scene".to_string(), |p| p.display().to_string());
     scene.validate(&origin)?;
+    if scene.gi.is_some() {
+        bail!("{origin}: [gi]: the scene renders on the GI-Cube processor model, and there is no GI-Cube RTL yet to co-simulate (`cube5 render` renders it)");
+    }
     let rtl = FrameRtl::with_pipelines(args.pipelines).ok_or_else(|| {
         anyhow!(
             "--pipelines {}: cube5_frame is built for P = {} (rtl/cube5/cube5_frame.variants)",

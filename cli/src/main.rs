@@ -102,7 +102,7 @@ struct RenderArgs {
 
 #[derive(Debug, clap::Args)]
 struct PhantomArgs {
-    /// Phantom name (head, sphere, bubbles).
+    /// Phantom name (head, sphere, bubbles, sphere-floor).
     name: String,
     /// Output file: .nrrd (gzip-encoded), .nii, .nii.gz or .raw (u8/u16, little endian).
     #[arg(short, long)]
@@ -237,6 +237,9 @@ fn render(args: RenderArgs) -> Result<()> {
     scene.validate("command line")?;
     check_png_path(&args.output)?;
     let vol = scene.build_volume()?;
+    if scene.gi.is_some() {
+        return render_gi(&scene, &vol, &args);
+    }
     let plan = Plan::new(&scene, &vol)?;
     say!("plan: {plan}");
     if scene.run.target.uses_rtl() {
@@ -374,6 +377,80 @@ fn render(args: RenderArgs) -> Result<()> {
         params.width,
         params.height,
         secs
+    );
+    say!("wrote {}", args.output.display());
+    Ok(())
+}
+
+/// A scene with `[gi]`: the GI-Cube processor model (lighting pass, then rendering pass), or its
+/// f64 reference. The plan line follows the run, with the passes' counts.
+fn render_gi(scene: &Scene, vol: &cube5_model::volume::Volume, args: &RenderArgs) -> Result<()> {
+    use cube5_model::scene_gi::{compare, run_counts_text, GiJob};
+    let mut plan = Plan::new(scene, vol)?;
+    let mut job = GiJob::new(scene, vol)?;
+    let repeat = args.repeat.max(1);
+    let mut best = f64::INFINITY;
+    let mut run = None;
+    for _ in 0..repeat {
+        let start = Instant::now();
+        let out = match scene.run.renderer {
+            Renderer::Pipeline => job.run()?,
+            // Refused by the scene's validation; kept here so no renderer falls through.
+            Renderer::Slabs => bail!("run.renderer = \"slabs\": a [gi] scene has no slab model"),
+            Renderer::Reference => {
+                let image = job
+                    .reference()?
+                    .context("the f64 reference of photons (gi.albedo > 0) does not exist")?;
+                cube5_model::scene_gi::GiRun {
+                    image,
+                    lighting: None,
+                    rendering: Default::default(),
+                }
+            }
+        };
+        best = best.min(start.elapsed().as_secs_f64());
+        run = Some(out);
+    }
+    let run = run.context("no frame rendered")?;
+    if scene.run.renderer == Renderer::Pipeline {
+        plan.model = format!("{} [counts: {}]", plan.model, run_counts_text(&run));
+    }
+    say!("plan: {plan}");
+    let samples = run.rendering.samples + run.lighting.map_or(0, |c| c.samples);
+    if repeat > 1 {
+        say!(
+            "time: frame {:.2} ms (best of {repeat}), {:.2} M samples/s",
+            best * 1e3,
+            samples as f64 / best / 1e6
+        );
+    }
+    if args.compare && scene.run.renderer == Renderer::Pipeline {
+        match job.reference()? {
+            Some(reference) => {
+                let (db, max) = compare(&run.image, &reference);
+                say!(
+                    "error against the GI-Cube processor's f64 reference: PSNR {db:.1} dB, max abs {:.1}/255",
+                    max * 255.0
+                );
+            }
+            None => say!(
+                "no f64 reference for photons (gi.albedo > 0): their walk is random (docs/numerics/gicube_processor.md compares them with Monte Carlo)"
+            ),
+        }
+    }
+    write_png_atomically(&run.image.to_rgb8(), &args.output)?;
+    say!(
+        "rendered {}x{}x{} volume, {}x{} pixels in {:.4} s ({})",
+        vol.dims[0],
+        vol.dims[1],
+        vol.dims[2],
+        scene.image.width,
+        scene.image.height,
+        best,
+        match scene.run.renderer {
+            Renderer::Pipeline | Renderer::Slabs => "GI-Cube processor model",
+            Renderer::Reference => "f64 reference of the GI-Cube processor model",
+        }
     );
     say!("wrote {}", args.output.display());
     Ok(())

@@ -8,6 +8,7 @@
 //! `phantom`, `volume_io`, `scene`, `render` (scenes, files and renderers that use the units);
 //! `scene_render` (what `cube5 render` runs: a scene on the frame model, or a named what-if);
 //! `slab_perspective` (a what-if: perspective approximated by parallel slabs);
+//! `scene_gi` (a scene with `[gi]`: the GI-Cube processor model, lighting and rendering passes);
 //! `studies` (the tradeoff sweeps, not part of the golden model).
 
 pub mod bits;
@@ -17,6 +18,7 @@ pub mod phantom;
 pub mod regs;
 pub mod render;
 pub mod scene;
+pub mod scene_gi;
 pub mod scene_render;
 pub mod slab_perspective;
 pub mod studies;

@@ -265,7 +265,7 @@ pub fn head_phantom(n: usize, bits: u32) -> Result<Volume> {
 }
 
 /// The embedded phantoms by name (scene files say `phantom = "NAME"`).
-pub const PHANTOMS: &[&str] = &["head", "sphere", "bubbles"];
+pub const PHANTOMS: &[&str] = &["head", "sphere", "bubbles", "sphere-floor"];
 
 /// Builds the embedded phantom `name`, `n^3` voxels of `bits` bits.
 pub fn phantom_by_name(name: &str, n: usize, bits: u32) -> Result<Volume> {
@@ -273,6 +273,7 @@ pub fn phantom_by_name(name: &str, n: usize, bits: u32) -> Result<Volume> {
         "head" => head_phantom(n, bits),
         "sphere" => sphere_phantom(n, bits),
         "bubbles" => bubbles_phantom(n, bits),
+        "sphere-floor" => sphere_floor_phantom(n, bits),
         _ => Err(ModelError::Volume(format!(
             "unknown phantom `{name}` (known: {})",
             PHANTOMS.join(", ")
@@ -351,6 +352,37 @@ pub fn sphere_phantom(n: usize, bits: u32) -> Result<Volume> {
         .map(|idx| {
             let p = [idx % n, (idx / n) % n, idx / (n * n)].map(|v| v as f64);
             (g.density(p) * max).round() as u16
+        })
+        .collect();
+    Volume::new([n; 3], [1.0; 3], bits, data)
+}
+
+/// The GI shadow scene's volume (`units::gicube_processor::shadow_scene`, `scenes/gi-shadow.toml`):
+/// a translucent floor slab (density 0.45, its top at `0.22 n`, inset 1.5 voxels from the sides)
+/// and a denser sphere above it (density 0.9, radius `0.2 n`, centre `(0.5, 0.5, 0.58) (n - 1)`),
+/// boundaries ramped over 3 voxels, sampled at voxel centres. A light from above casts the
+/// sphere's shadow onto the floor.
+pub fn sphere_floor_phantom(n: usize, bits: u32) -> Result<Volume> {
+    check_phantom_args(n, bits)?;
+    let nf = n as f64;
+    let max = f64::from((1u32 << bits) - 1);
+    let smooth = |d: f64| (0.5 - d / 3.0).clamp(0.0, 1.0);
+    let centre = [0.5, 0.5, 0.58].map(|c| c * (nf - 1.0));
+    let radius = 0.2 * nf;
+    let floor_top = 0.22 * nf;
+    let inset = |c: f64| c.min(nf - 1.0 - c);
+    let data: Vec<u16> = (0..n * n * n)
+        .map(|idx| {
+            let p = [idx % n, (idx / n) % n, idx / (n * n)].map(|v| v as f64);
+            let edge = inset(p[0]).min(inset(p[1])) - 1.5;
+            let floor = smooth(p[2] - floor_top) * smooth(-edge) * smooth(1.5 - p[2]);
+            let r = (0..3)
+                .map(|a| (p[a] - centre[a]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let sphere = smooth(r - radius);
+            let d = (0.45 * floor).max(0.9 * sphere);
+            (d * max).round() as u16
         })
         .collect();
     Volume::new([n; 3], [1.0; 3], bits, data)

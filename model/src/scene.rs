@@ -13,6 +13,7 @@ use crate::phantom::{phantom_by_name, PHANTOMS};
 use crate::render::{
     CompositeMode, Light, Material, Projection, Quality, RenderParams, SliceSetup, View,
 };
+use crate::scene_gi::GiSpec;
 use crate::slab_perspective::{SlabSpacing, Slabs};
 use crate::transfer::{TfPoint, TransferFunction, TF_PRESETS};
 use crate::volume::{Volume, MAX_EDGE};
@@ -43,6 +44,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub quality: QualitySpec,
     pub run: RunSpec,
+    /// Volumetric global illumination on the GI-Cube processor model (`scene_gi`); none: the
+    /// slice-order pipeline.
+    pub gi: Option<GiSpec>,
     /// The file the scene was loaded from (relative volume paths start from its directory).
     #[serde(skip)]
     pub source: Option<PathBuf>,
@@ -592,8 +596,14 @@ impl Scene {
             let (field, rest) = m.split_once(' ').unwrap_or((&m, ""));
             return bad(field, rest.to_string());
         }
+        if let Some(gi) = &self.gi {
+            if let Err((field, m)) = crate::scene_gi::validate(self, gi) {
+                return bad(&field, m);
+            }
+        }
         if self.run.renderer == Renderer::Pipeline
             && self.view.projection == Projection::Perspective
+            && self.gi.is_none()
         {
             return bad(
                 "view.projection",
@@ -864,6 +874,9 @@ pub const SKIP_BLOCK: usize = 8;
 impl Plan {
     /// Works out the plan of `scene` for `vol` (the volume decides empty-space skipping).
     pub fn new(scene: &Scene, vol: &Volume) -> Result<Self> {
+        if scene.gi.is_some() {
+            return crate::scene_gi::plan(scene, vol);
+        }
         let params = scene.render_params();
         let q = scene.quality();
         let mode = params.mode;

@@ -26,6 +26,12 @@ use glam::DVec3;
 pub fn not_expressible(scene: &Scene) -> Vec<String> {
     let q = scene.quality();
     let mut why = Vec::new();
+    if scene.gi.is_some() {
+        // `cube5 cosim` on a GI scene: one line, and nothing else to say.
+        return vec![
+            "the scene has a [gi] section: it renders on the GI-Cube processor model, and there is no GI-Cube RTL yet".into(),
+        ];
+    }
     match scene.render.mode {
         CompositeMode::Composite | CompositeMode::Mip => {}
         m => why.push(format!(

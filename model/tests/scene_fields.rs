@@ -10,7 +10,8 @@
 //! (tb-rs/tests/cube5_frame.rs, cli/tests/scenes.rs), so the frame model stands in for the RTL here.
 
 use cube5_model::render::{render_reference, ImageF64};
-use cube5_model::scene::{Plan, Scene};
+use cube5_model::scene::{Plan, Renderer, Scene};
+use cube5_model::scene_gi::{processor_config, run_counts_text, GiJob};
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
 use cube5_model::slab_perspective::render_slabs;
 use std::collections::BTreeSet;
@@ -31,6 +32,9 @@ enum Shows {
     Reference { because: &'static str },
     /// The what-if slab-perspective model's image (`renderer = "slabs"`), likewise.
     Slabs { because: &'static str },
+    /// A `[gi]` scene's run on the GI-Cube processor model: its configuration, the counts of its
+    /// passes or its image change.
+    Processor,
 }
 
 struct Case {
@@ -123,8 +127,46 @@ fn cases() -> Vec<Case> {
         // [run]: what runs.
         c("run.target", "", "[run]\ntarget = \"rtl\"\n", Run),
         c("run.renderer", "", "[run]\nrenderer = \"reference\"\n", Run),
+        // [gi]: the GI-Cube processor model's lighting and rendering passes.
+        c("gi.light", GI, "[gi]\nlight = [-0.55, 0.25, -0.8]\n", Processor),
+        c("gi.light", GI, "[gi]\nlight = [0.0, 0.0, 0.0]\n", Refused),
+        c("gi.energy", GI, "[gi]\nenergy = 0.5\n", Processor),
+        c("gi.energy", GI, "[gi]\nenergy = 0.0\n", Refused),
+        c("gi.light_rays", GI, "[gi]\nlight_rays = 60\n", Processor),
+        c("gi.light_rays", GI, "[gi]\nlight_rays = 20\n", Refused),
+        c("gi.albedo", GI, "[gi]\nalbedo = 0.8\n", Processor),
+        c("gi.albedo", GI, "[gi]\nalbedo = 1.5\n", Refused),
+        c("gi.bounces", GI_PHOTONS, "[gi]\nbounces = 0\n", Processor),
+        c("gi.bounces", GI, "[gi]\nbounces = 2\n", Refused),
+        c("gi.passes", GI, "[gi]\npasses = 1\n", Processor),
+        c("gi.passes", GI, "[gi]\npasses = 3\n", Refused),
+        c("gi.block_size", GI, "[gi]\nblock_size = 8\n", Processor),
+        c("gi.block_size", GI, "[gi]\nblock_size = 12\n", Refused),
+        c("gi.queue_length", GI, "[gi]\nqueue_length = 3\n", Processor),
+        c("gi.queue_length", GI, "[gi]\nqueue_length = 0\n", Refused),
+        // What the rest of a scene means in a [gi] scene.
+        c("render.step", GI, "[render]\nstep = 0.5\n", Processor),
+        c("render.early_termination", GI, "[render]\nearly_termination = 0.3\n", Processor),
+        c("view.projection", GI, "[view]\nprojection = \"perspective\"\n", Processor),
+        c("view.fov", GI_PERSPECTIVE, "[view]\nfov = 50.0\n", Processor),
+        c("view.zoom", GI, "[view]\nzoom = 1.5\n", Processor),
+        c("render.mode", GI, "[render]\nmode = \"mip\"\n", Refused),
+        c("render.shading", GI, "[render]\nshading = false\n", Refused),
+        c("shading.ambient", GI, "[shading]\nambient = 0.5\n", Refused),
+        c("light", GI, "[[light]]\ndirection = [0.0, 0.0, -1.0]\n", Refused),
+        c("quality.supersampling", GI, "[quality]\nsupersampling = 2\n", Refused),
+        c("run.target", GI, "[run]\ntarget = \"rtl\"\n", Refused),
+        c("run.renderer", GI, "[run]\nrenderer = \"reference\"\n", Processor),
     ]
 }
+
+/// A GI scene (the GI-Cube processor model): the head, its default light, one sample per voxel.
+const GI: &str = "[render]\nstep = 1.0\n[gi]\npasses = 2\n";
+/// ... with photons.
+const GI_PHOTONS: &str = "[render]\nstep = 1.0\n[gi]\nalbedo = 0.8\n";
+/// ... in perspective.
+const GI_PERSPECTIVE: &str =
+    "[view]\nprojection = \"perspective\"\n[render]\nstep = 1.0\n[gi]\npasses = 2\n";
 
 /// A perspective scene (the f64 reference renderer's only).
 const PERSPECTIVE: &str = "[view]\nprojection = \"perspective\"\n[run]\nrenderer = \"reference\"\n";
@@ -166,6 +208,7 @@ fn every_field() -> BTreeSet<String> {
         ("light", "[[light]]\ndirection = [0, 0, 1]\n__probe = 1\n"),
         ("quality", "[quality]\n__probe = 1\n"),
         ("run", "[run]\n__probe = 1\n"),
+        ("gi", "[gi]\n__probe = 1\n"),
         (
             "transfer.points",
             "[transfer]\npoints = [{ density = 0.0, rgba = [0, 0, 0, 0], __probe = 1 }]\n",
@@ -201,8 +244,37 @@ fn parse(text: &str, dir: &Path) -> Result<Scene, String> {
     Scene::load(&origin).map_err(|e| e.to_string())
 }
 
-/// The hardware run of `scene` (frame model), or the refusal.
+/// The run of a `[gi]` scene on the GI-Cube processor model (or its f64 reference), or the
+/// refusal.
+fn gi_outcome(scene: &Scene) -> Result<Outcome, String> {
+    let e = |e: cube5_model::error::ModelError| e.to_string();
+    let vol = scene.build_volume().map_err(e)?;
+    let plan = Plan::new(scene, &vol).map_err(e)?;
+    let mut job = GiJob::new(scene, &vol).map_err(e)?;
+    let (counts, image) = match scene.run.renderer {
+        Renderer::Pipeline => {
+            let run = job.run().map_err(e)?;
+            (run_counts_text(&run), run.image)
+        }
+        Renderer::Reference => (
+            "f64 reference".to_string(),
+            job.reference().map_err(e)?.ok_or("no f64 reference")?,
+        ),
+        Renderer::Slabs => return Err("run.renderer = \"slabs\" in a [gi] scene".into()),
+    };
+    Ok(Outcome {
+        frame: format!("{:?} {counts}", processor_config(scene).map_err(e)?),
+        image: image.to_rgb8().into_raw(),
+        run: format!("{:?} {:?}", plan.target, plan.renderer),
+    })
+}
+
+/// The hardware run of `scene` (frame model, or the GI-Cube processor model for a `[gi]` scene),
+/// or the refusal.
 fn frame_outcome(scene: &Scene) -> Result<Outcome, String> {
+    if scene.gi.is_some() {
+        return gi_outcome(scene);
+    }
     let why = not_expressible(scene);
     if !why.is_empty() {
         return Err(why.join("; "));
@@ -314,7 +386,7 @@ fn every_scene_field_changes_the_run_or_is_refused_by_name() {
                 Err(m) | Ok(Err(m)) => Err(format!("refused without naming it: {m}")),
                 Ok(Ok(_)) => Err("accepted: the field is dropped without a word".to_string()),
             },
-            Shows::Frame | Shows::Run => {
+            Shows::Frame | Shows::Run | Shows::Processor => {
                 let after = after.map_err(|e| e.to_string());
                 match (
                     frame_outcome(&before),

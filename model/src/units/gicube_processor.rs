@@ -1386,29 +1386,11 @@ pub fn monte_carlo_gi(
 }
 
 /// The example GI scene: a translucent floor slab and a denser sphere above it, on `n^3` voxels of
-/// 12 bits (boundaries 1.5 voxels wide), its transfer function, and a light from the upper left
+/// 12 bits (`phantom::sphere_floor_phantom`, boundaries 1.5 voxels wide), its transfer function, and a light from the upper left
 /// that casts the sphere's shadow onto the floor.
 pub fn shadow_scene(n: usize) -> Result<(Volume, TransferFunction, GiLight)> {
     let nf = n as f64;
-    let smooth = |d: f64| (0.5 - d / 3.0).clamp(0.0, 1.0);
-    let centre = DVec3::new(0.5, 0.5, 0.58) * (nf - 1.0);
-    let radius = 0.2 * nf;
-    let floor_top = 0.22 * nf;
-    let mut data = Vec::with_capacity(n * n * n);
-    for z in 0..n {
-        for y in 0..n {
-            for x in 0..n {
-                let p = DVec3::new(x as f64, y as f64, z as f64);
-                let inset = |c: f64| c.min(nf - 1.0 - c);
-                let edge = inset(p.x).min(inset(p.y)) - 1.5;
-                let floor = smooth(p.z - floor_top) * smooth(-edge) * smooth(1.5 - p.z);
-                let sphere = smooth((p - centre).length() - radius);
-                let d = (0.45 * floor).max(0.9 * sphere);
-                data.push((d * 4095.0).round() as u16);
-            }
-        }
-    }
-    let vol = Volume::new([n; 3], [1.0; 3], 12, data)?;
+    let vol = crate::phantom::sphere_floor_phantom(n, 12)?;
     let pt = |density, rgba| crate::transfer::TfPoint { density, rgba };
     let tf = TransferFunction::new(vec![
         pt(0.0, [0.0; 4]),
