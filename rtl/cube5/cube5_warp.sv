@@ -7,8 +7,8 @@
 // exact coordinate steps (integer adds), the taps read, widened to U(0.16), three rounded lerps per
 // channel, 8-bit RGB out with tlast at each row end and tuser at the frame start.
 //
-//   issue (step adders, bank addresses) -> [banks' output registers, S1] -> taps, widening, two
-//   lerps along x [S2] -> lerp along y, 8-bit rounding [S3] -> out
+//   issue (step adders, bank addresses) -> [banks' output registers, S1] -> taps by parity,
+//   widening [S2] -> two lerps along x [S3] -> lerp along y, 8-bit rounding [S4] -> out
 //
 // Back-pressure stalls the whole pipeline through one enable (`adv`), the banks' read enables
 // included, so a stalled output holds and nothing is dropped.
@@ -142,8 +142,8 @@ module cube5_warp #(
 
   logic adv;          // the whole pipeline moves
   logic issue;        // a pixel enters S1 in this clock
-  logic s1_valid_q, s2_valid_q, s3_valid_q;
-  assign adv   = !s3_valid_q || out_ready_i;
+  logic s1_valid_q, s2_valid_q, s3_valid_q, s4_valid_q;
+  assign adv   = !s4_valid_q || out_ready_i;
   assign issue = busy_q && adv;
 
   logic [O:0]        px_q, px_d, py_q, py_d;
@@ -253,23 +253,31 @@ module cube5_warp #(
   end
 
   // ---------------------------------------------------------------------------------------------
-  // S1: texels read; taps, widening, lerps along x
+  // S1: texels read; taps selected by parity, masked, widened
   // ---------------------------------------------------------------------------------------------
 
   logic             s1_xpar_q, s1_ypar_q, s1_last_q, s1_user_q;
   logic [3:0]       s1_in_q;
   logic [WeightW:0] s1_wx_q, s1_wy_q;
 
-  // Tap t (x + 2y) is the texel of bank {ypar ^ y, xpar ^ x}, 0 outside.
+  logic [TexW-1:0] bank0, bank1, bank2, bank3;
+  assign bank0 = s1_in_q[0] ? rdata[0*TexW +: TexW] : '0;
+  assign bank1 = s1_in_q[1] ? rdata[1*TexW +: TexW] : '0;
+  assign bank2 = s1_in_q[2] ? rdata[2*TexW +: TexW] : '0;
+  assign bank3 = s1_in_q[3] ? rdata[3*TexW +: TexW] : '0;
+
+  // Tap t = x + 2y is the texel of bank {ypar ^ y, xpar ^ x}: plain 4:1 multiplexers.
   logic [4*TexW-1:0] tap;          // tap t at [t*TexW +: TexW]
-  for (genvar t = 0; t < 4; t++) begin : gen_tap_sel
-    logic [1:0] bank;
-    assign bank = {s1_ypar_q ^ (t >= 2), s1_xpar_q ^ (t % 2 == 1)};
-    assign tap[t*TexW +: TexW] = s1_in_q[bank] ? rdata[bank*TexW +: TexW] : '0;
+  always_comb begin
+    unique case ({s1_ypar_q, s1_xpar_q})
+      2'b00:   tap = {bank3, bank2, bank1, bank0};
+      2'b01:   tap = {bank2, bank3, bank0, bank1};
+      2'b10:   tap = {bank1, bank0, bank3, bank2};
+      default: tap = {bank0, bank1, bank2, bank3};
+    endcase
   end
 
   logic [12*ValW-1:0] u;           // tap t, channel ch at [(3 t + ch) ValW +: ValW]
-  logic [3*ValW-1:0] h0, h1;   // channel ch at [ch*ValW +: ValW]
   for (genvar t = 0; t < 4; t++) begin : gen_tap
     for (genvar ch = 0; ch < 3; ch++) begin : gen_widen
       cube5_compos_unorm #(
@@ -281,36 +289,46 @@ module cube5_warp #(
       );
     end
   end
+
+  // ---------------------------------------------------------------------------------------------
+  // S2: lerps along x
+  // ---------------------------------------------------------------------------------------------
+
+  logic [12*ValW-1:0] s2_u_q;
+  logic [WeightW:0]   s2_wx_q, s2_wy_q;
+  logic               s2_last_q, s2_user_q;
+
+  logic [3*ValW-1:0] h0, h1;       // channel ch at [ch*ValW +: ValW]
   for (genvar ch = 0; ch < 3; ch++) begin : gen_lerp_x
     cube5_lerp #(
       .ValW(ValW),
       .WeightW(WeightW)
     ) u_h0 (
-      .a_i(u[ch*ValW +: ValW]),
-      .b_i(u[(3+ch)*ValW +: ValW]),
-      .e_i(s1_wx_q),
+      .a_i(s2_u_q[ch*ValW +: ValW]),
+      .b_i(s2_u_q[(3+ch)*ValW +: ValW]),
+      .e_i(s2_wx_q),
       .y_o(h0[ch*ValW +: ValW])
     );
     cube5_lerp #(
       .ValW(ValW),
       .WeightW(WeightW)
     ) u_h1 (
-      .a_i(u[(6+ch)*ValW +: ValW]),
-      .b_i(u[(9+ch)*ValW +: ValW]),
-      .e_i(s1_wx_q),
+      .a_i(s2_u_q[(6+ch)*ValW +: ValW]),
+      .b_i(s2_u_q[(9+ch)*ValW +: ValW]),
+      .e_i(s2_wx_q),
       .y_o(h1[ch*ValW +: ValW])
     );
   end
 
   // ---------------------------------------------------------------------------------------------
-  // S2: lerp along y, 8-bit rounding
+  // S3: lerp along y, 8-bit rounding
   // ---------------------------------------------------------------------------------------------
 
-  logic [3*ValW-1:0] s2_h0_q, s2_h1_q;
-  logic [WeightW:0] s2_wy_q;
-  logic             s2_last_q, s2_user_q;
+  logic [3*ValW-1:0] s3_h0_q, s3_h1_q;
+  logic [WeightW:0]  s3_wy_q;
+  logic              s3_last_q, s3_user_q;
 
-  logic [3*CodeW-1:0]      rgb;
+  logic [3*CodeW-1:0] rgb;
   for (genvar ch = 0; ch < 3; ch++) begin : gen_lerp_y
     logic [ValW-1:0]       v;
     logic [ValW+CodeW-1:0] scaled;
@@ -318,9 +336,9 @@ module cube5_warp #(
       .ValW(ValW),
       .WeightW(WeightW)
     ) u_v (
-      .a_i(s2_h0_q[ch*ValW +: ValW]),
-      .b_i(s2_h1_q[ch*ValW +: ValW]),
-      .e_i(s2_wy_q),
+      .a_i(s3_h0_q[ch*ValW +: ValW]),
+      .b_i(s3_h1_q[ch*ValW +: ValW]),
+      .e_i(s3_wy_q),
       .y_o(v)
     );
     // v * 255 + 2^(UnormW - 1): v <= 2^UnormW, so the sum fits ValW + CodeW bits.
@@ -335,7 +353,7 @@ module cube5_warp #(
   // Pipeline registers
   // ---------------------------------------------------------------------------------------------
 
-  logic [3*CodeW+1:0] s3_data_q;
+  logic [3*CodeW+1:0] s4_data_q;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -343,6 +361,7 @@ module cube5_warp #(
       s1_valid_q <= 1'b0;
       s2_valid_q <= 1'b0;
       s3_valid_q <= 1'b0;
+      s4_valid_q <= 1'b0;
       base_w_q   <= '0;
       base_h_q   <= '0;
       out_w_q    <= '0;
@@ -373,6 +392,7 @@ module cube5_warp #(
         s1_valid_q <= issue;
         s2_valid_q <= s1_valid_q;
         s3_valid_q <= s2_valid_q;
+        s4_valid_q <= s3_valid_q;
       end
     end
   end
@@ -394,17 +414,22 @@ module cube5_warp #(
       s1_wy_q   <= wy;
       s1_last_q <= row_end;
       s1_user_q <= (px_q == '0) && (py_q == '0);
-      s2_h0_q   <= h0;
-      s2_h1_q   <= h1;
+      s2_u_q    <= u;
+      s2_wx_q   <= s1_wx_q;
       s2_wy_q   <= s1_wy_q;
       s2_last_q <= s1_last_q;
       s2_user_q <= s1_user_q;
-      s3_data_q <= {s2_user_q, s2_last_q, rgb};
+      s3_h0_q   <= h0;
+      s3_h1_q   <= h1;
+      s3_wy_q   <= s2_wy_q;
+      s3_last_q <= s2_last_q;
+      s3_user_q <= s2_user_q;
+      s4_data_q <= {s3_user_q, s3_last_q, rgb};
     end
   end
 
-  assign out_valid_o = s3_valid_q;
-  assign out_data_o  = s3_data_q;
+  assign out_valid_o = s4_valid_q;
+  assign out_data_o  = s4_data_q;
 
   // Unused: the payload above a texel's codes or a register's width, the discarded fraction bits
   // of the weights and of the 8-bit rounding, bank address bit 0 (the parity).
