@@ -317,6 +317,18 @@ impl FrameJob {
         Ok(cube5_warp::to_image(regs.out_w, regs.out_h, &pixels))
     }
 
+    /// The f64 warp of the unquantized coxel colours (`cube5_frame::warp`, what `cube5 render`
+    /// showed before the warp unit): a reference, not the hardware's image.
+    pub fn image_f64_coxels(&self, scene: &Scene, base: &BasePlane) -> ImageF64 {
+        cube5_frame::warp(
+            &self.setup.params,
+            self.seen.spacing,
+            &base.rgb(&self.cfg.compos),
+            (base.width, base.height),
+            &self.camera(scene),
+        )
+    }
+
     /// The ideal f64 bilinear warp of the same base-plane codes (the warp's reference).
     pub fn image_reference(&self, scene: &Scene, base: &BasePlane) -> Result<ImageF64> {
         let (affine, regs) = self.warp_setup(scene, base)?;

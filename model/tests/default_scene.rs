@@ -8,7 +8,6 @@ use cube5_model::render::render_reference;
 use cube5_model::scene::Scene;
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
 use cube5_model::studies::tradeoff::image_error;
-use cube5_model::units::cube5_frame;
 
 #[test]
 fn the_default_scene_is_a_frame_within_40_db_of_the_reference() {
@@ -22,13 +21,7 @@ fn the_default_scene_is_a_frame_within_40_db_of_the_reference() {
     let reference =
         render_reference(&vol, &scene.transfer_function(), &scene.render_params()).unwrap();
     let e = image_error(&img, &reference);
-    let f64_warp = cube5_frame::warp(
-        &job.setup.params,
-        job.seen.spacing,
-        &run.base.rgb(&job.cfg.compos),
-        (run.base.width, run.base.height),
-        &job.camera(&scene),
-    );
+    let f64_warp = job.image_f64_coxels(&scene, &run.base);
     let e64 = image_error(&f64_warp, &reference);
     eprintln!(
         "default scene at 192 x 192: PSNR {:.2} dB (f64 warp of the coxels: {:.2} dB)",

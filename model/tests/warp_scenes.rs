@@ -6,7 +6,7 @@
 use cube5_model::scene::Scene;
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
 use cube5_model::studies::tradeoff::image_error;
-use cube5_model::units::{cube5_frame, cube5_warp};
+use cube5_model::units::cube5_warp;
 
 #[test]
 fn every_frame_scene_is_warped_within_the_contract() {
@@ -28,13 +28,7 @@ fn every_frame_scene_is_warped_within_the_contract() {
         let run = job.render();
         let img = job.image(&scene, &run.base).unwrap();
         let ideal = job.image_reference(&scene, &run.base).unwrap();
-        let old = cube5_frame::warp(
-            &job.setup.params,
-            job.seen.spacing,
-            &run.base.rgb(&job.cfg.compos),
-            (run.base.width, run.base.height),
-            &job.camera(&scene),
-        );
+        let old = job.image_f64_coxels(&scene, &run.base);
         let (e, e_old) = (image_error(&img, &ideal), image_error(&img, &old));
         let cfg = job.warp_config();
         let w = img.width;
