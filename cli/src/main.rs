@@ -240,7 +240,7 @@ fn render(args: RenderArgs) -> Result<()> {
                 let run = job.render();
                 let img = job.image(&scene, &run.base)?;
                 let what = format!(
-                    "frame model = cube5_frame's bits, warped by cube5_warp's: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination",
+                    "frame model = cube5_frame's bits, warped by the cube5_warp model: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination",
                     run.base.width,
                     run.base.height,
                     run.samples,

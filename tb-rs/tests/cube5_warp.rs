@@ -226,14 +226,23 @@ fn traffic(rng: &mut ChaCha8Rng, idle: f64, stall: f64) -> Traffic {
     Traffic::random(rng, idle, stall)
 }
 
-/// `n` random warps per configuration, images `lo..=hi` pixels a side (bounded by `MaxOut`).
-fn random_warps(n: usize, lo: u32, hi: u32, seed_no: u64) {
+/// `n` random warps per configuration, images `lo..=hi` pixels a side (bounded by `MaxOut`),
+/// base planes up to `base_hi` texels a side but every tenth up to `MaxBase` (loading a large
+/// base plane costs a clock per texel).
+fn random_warps(n: usize, lo: u32, hi: u32, base_hi: usize, seed_no: u64) {
     for (i, (variant, cfg)) in configs::<WarpConfig>().into_iter().enumerate() {
         let s = seed(seed_no + i as u64);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let hi = hi.min(cfg.max_out);
         let frames: Vec<Frame> = (0..n)
-            .map(|_| random_frame(&mut rng, &cfg, lo.min(hi), hi))
+            .map(|k| {
+                let b = if k % 10 == 9 {
+                    cfg.max_base as usize
+                } else {
+                    base_hi
+                };
+                random_frame_within(&mut rng, &cfg, b, lo.min(hi), hi)
+            })
             .collect();
         let t = traffic(&mut rng, 0.2, 0.3);
         let cycles = check_frames(variant, cfg, &frames, &t, s, None);
@@ -247,13 +256,13 @@ fn random_warps(n: usize, lo: u32, hi: u32, seed_no: u64) {
 
 #[test]
 fn two_hundred_random_affine_warps_with_idle_and_backpressure() {
-    random_warps(200, 16, 64, 1400);
+    random_warps(200, 16, 64, 96, 1400);
 }
 
 #[test]
 #[ignore = "sim-full: 200 random warps per configuration at 64^2..512^2 pixels (minutes)"]
 fn random_affine_warps_up_to_512_squared() {
-    random_warps(200, 64, 512, 1410);
+    random_warps(200, 64, 512, 1024, 1410);
 }
 
 /// The warps of frame views: the set-up `cube5 render` does, on random base-plane codes of the
