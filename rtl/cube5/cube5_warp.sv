@@ -7,8 +7,8 @@
 // exact coordinate steps (integer adds), the taps read, widened to U(0.16), three rounded lerps per
 // channel, 8-bit RGB out with tlast at each row end and tuser at the frame start.
 //
-//   issue (step adders, bank addresses) -> [banks' output registers, S1] -> taps by parity,
-//   widening [S2] -> two lerps along x [S3] -> lerp along y, 8-bit rounding [S4] -> out
+//   issue (step adders, bank addresses) -> [banks' output registers, S1] -> [S1r] -> taps by
+//   parity, widening [S2] -> two lerps along x [S3] -> lerp along y [S4] -> 8-bit rounding [S5] -> out
 //
 // Back-pressure stalls the whole pipeline through one enable (`adv`), the banks' read enables
 // included, so a stalled output holds and nothing is dropped.
@@ -142,8 +142,8 @@ module cube5_warp #(
 
   logic adv;          // the whole pipeline moves
   logic issue;        // a pixel enters S1 in this clock
-  logic s1_valid_q, s2_valid_q, s3_valid_q, s4_valid_q;
-  assign adv   = !s4_valid_q || out_ready_i;
+  logic s1_valid_q, r_valid_q, s2_valid_q, s3_valid_q, s4_valid_q, s5_valid_q;
+  assign adv   = !s5_valid_q || out_ready_i;
   assign issue = busy_q && adv;
 
   logic [O:0]        px_q, px_d, py_q, py_d;
@@ -260,16 +260,22 @@ module cube5_warp #(
   logic [3:0]       s1_in_q;
   logic [WeightW:0] s1_wx_q, s1_wy_q;
 
+  // The banks' outputs registered once more (S1r), off the block RAM's slow clock-to-output.
+  logic [4*TexW-1:0] r_rdata_q;
+  logic              r_xpar_q, r_ypar_q, r_last_q, r_user_q;
+  logic [3:0]        r_in_q;
+  logic [WeightW:0]  r_wx_q, r_wy_q;
+
   logic [TexW-1:0] bank0, bank1, bank2, bank3;
-  assign bank0 = s1_in_q[0] ? rdata[0*TexW +: TexW] : '0;
-  assign bank1 = s1_in_q[1] ? rdata[1*TexW +: TexW] : '0;
-  assign bank2 = s1_in_q[2] ? rdata[2*TexW +: TexW] : '0;
-  assign bank3 = s1_in_q[3] ? rdata[3*TexW +: TexW] : '0;
+  assign bank0 = r_in_q[0] ? r_rdata_q[0*TexW +: TexW] : '0;
+  assign bank1 = r_in_q[1] ? r_rdata_q[1*TexW +: TexW] : '0;
+  assign bank2 = r_in_q[2] ? r_rdata_q[2*TexW +: TexW] : '0;
+  assign bank3 = r_in_q[3] ? r_rdata_q[3*TexW +: TexW] : '0;
 
   // Tap t = x + 2y is the texel of bank {ypar ^ y, xpar ^ x}: plain 4:1 multiplexers.
   logic [4*TexW-1:0] tap;          // tap t at [t*TexW +: TexW]
   always_comb begin
-    unique case ({s1_ypar_q, s1_xpar_q})
+    unique case ({r_ypar_q, r_xpar_q})
       2'b00:   tap = {bank3, bank2, bank1, bank0};
       2'b01:   tap = {bank2, bank3, bank0, bank1};
       2'b10:   tap = {bank1, bank0, bank3, bank2};
@@ -321,16 +327,19 @@ module cube5_warp #(
   end
 
   // ---------------------------------------------------------------------------------------------
-  // S3: lerp along y, 8-bit rounding
+  // S3: lerp along y; S4: 8-bit rounding
   // ---------------------------------------------------------------------------------------------
 
   logic [3*ValW-1:0] s3_h0_q, s3_h1_q;
   logic [WeightW:0]  s3_wy_q;
   logic              s3_last_q, s3_user_q;
 
+  logic [3*ValW-1:0]  v;           // channel ch at [ch*ValW +: ValW]
+  logic [3*ValW-1:0]  s4_v_q;
+  logic               s4_last_q, s4_user_q;
   logic [3*CodeW-1:0] rgb;
   for (genvar ch = 0; ch < 3; ch++) begin : gen_lerp_y
-    logic [ValW-1:0]       v;
+    logic [ValW-1:0]       vq;
     logic [ValW+CodeW-1:0] scaled;
     cube5_lerp #(
       .ValW(ValW),
@@ -339,10 +348,11 @@ module cube5_warp #(
       .a_i(s3_h0_q[ch*ValW +: ValW]),
       .b_i(s3_h1_q[ch*ValW +: ValW]),
       .e_i(s3_wy_q),
-      .y_o(v)
+      .y_o(v[ch*ValW +: ValW])
     );
     // v * 255 + 2^(UnormW - 1): v <= 2^UnormW, so the sum fits ValW + CodeW bits.
-    assign scaled = ({v, CodeW'(0)} - (ValW+CodeW)'(v)) + (ValW+CodeW)'(1 << (UnormW - 1));
+    assign vq     = s4_v_q[ch*ValW +: ValW];
+    assign scaled = ({vq, CodeW'(0)} - (ValW+CodeW)'(vq)) + (ValW+CodeW)'(1 << (UnormW - 1));
     assign rgb[ch*CodeW +: CodeW] = scaled[UnormW +: CodeW];
     // The discarded fraction and the top bit (always 0: v * 255 + 2^15 < 2^24).
     logic unused_scaled;
@@ -353,7 +363,7 @@ module cube5_warp #(
   // Pipeline registers
   // ---------------------------------------------------------------------------------------------
 
-  logic [3*CodeW+1:0] s4_data_q;
+  logic [3*CodeW+1:0] s5_data_q;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -362,6 +372,8 @@ module cube5_warp #(
       s2_valid_q <= 1'b0;
       s3_valid_q <= 1'b0;
       s4_valid_q <= 1'b0;
+      s5_valid_q <= 1'b0;
+      r_valid_q  <= 1'b0;
       base_w_q   <= '0;
       base_h_q   <= '0;
       out_w_q    <= '0;
@@ -390,9 +402,11 @@ module cube5_warp #(
       ty_q     <= ty_d;
       if (adv) begin
         s1_valid_q <= issue;
-        s2_valid_q <= s1_valid_q;
+        r_valid_q  <= s1_valid_q;
+        s2_valid_q <= r_valid_q;
         s3_valid_q <= s2_valid_q;
         s4_valid_q <= s3_valid_q;
+        s5_valid_q <= s4_valid_q;
       end
     end
   end
@@ -414,22 +428,33 @@ module cube5_warp #(
       s1_wy_q   <= wy;
       s1_last_q <= row_end;
       s1_user_q <= (px_q == '0) && (py_q == '0);
+      r_rdata_q <= rdata;
+      r_xpar_q  <= s1_xpar_q;
+      r_ypar_q  <= s1_ypar_q;
+      r_in_q    <= s1_in_q;
+      r_wx_q    <= s1_wx_q;
+      r_wy_q    <= s1_wy_q;
+      r_last_q  <= s1_last_q;
+      r_user_q  <= s1_user_q;
       s2_u_q    <= u;
-      s2_wx_q   <= s1_wx_q;
-      s2_wy_q   <= s1_wy_q;
-      s2_last_q <= s1_last_q;
-      s2_user_q <= s1_user_q;
+      s2_wx_q   <= r_wx_q;
+      s2_wy_q   <= r_wy_q;
+      s2_last_q <= r_last_q;
+      s2_user_q <= r_user_q;
       s3_h0_q   <= h0;
       s3_h1_q   <= h1;
       s3_wy_q   <= s2_wy_q;
       s3_last_q <= s2_last_q;
       s3_user_q <= s2_user_q;
-      s4_data_q <= {s3_user_q, s3_last_q, rgb};
+      s4_v_q    <= v;
+      s4_last_q <= s3_last_q;
+      s4_user_q <= s3_user_q;
+      s5_data_q <= {s4_user_q, s4_last_q, rgb};
     end
   end
 
-  assign out_valid_o = s4_valid_q;
-  assign out_data_o  = s4_data_q;
+  assign out_valid_o = s5_valid_q;
+  assign out_data_o  = s5_data_q;
 
   // Unused: the payload above a texel's codes or a register's width, the discarded fraction bits
   // of the weights and of the 8-bit rounding, bank address bit 0 (the parity).

@@ -27,7 +27,7 @@ package cube5_warp_pkg;
 
   /// Clocks from a pixel's issue (the read of its four texels) to its output
   /// (docs/numerics/warp.md, "Timing").
-  localparam int unsigned WarpLatency = 4;
+  localparam int unsigned WarpLatency = 6;
 
   /// The 2-bit `op` field of an input item.
   // write register `addr` with the low bits of `payload`; restarts the texel position at (0, 0)

@@ -27,7 +27,7 @@ pub const REG_ADDR_W: u32 = 4;
 
 /// Clocks from a pixel's issue (the read of its four texels) to its output (docs/numerics/warp.md,
 /// "Timing").
-pub const WARP_LATENCY: u64 = 4;
+pub const WARP_LATENCY: u64 = 6;
 
 // The 2-bit `op` field of an input item.
 /// write register `addr` with the low bits of `payload`; restarts the texel position at (0, 0)
