@@ -200,7 +200,7 @@ pub fn cosim_scene(
         let base = base_plane_png(bp, &cfg);
         let path = out_dir.join(format!("{who}-base-plane.png"));
         write_png_atomically(&base, &path)?;
-        let warped = job.image(scene, bp);
+        let warped = job.image(scene, bp)?;
         let path2 = out_dir.join(format!("{who}.png"));
         write_png_atomically(&warped.to_rgb8(), &path2)?;
         say!("wrote {} and {}", path.display(), path2.display());

@@ -290,9 +290,9 @@ fn render(args: RenderArgs) -> Result<()> {
             Renderer::Pipeline if let Some(job) = &job => {
                 // The one golden model: the frame the RTL computes, then the warp.
                 let run = job.render();
-                let img = job.image(&scene, &run.base);
+                let img = job.image(&scene, &run.base)?;
                 let what = format!(
-                    "frame model = cube5_frame's bits: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination",
+                    "frame model = cube5_frame's bits, warped by the cube5_warp model: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination",
                     run.base.width,
                     run.base.height,
                     run.samples,

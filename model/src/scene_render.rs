@@ -9,6 +9,7 @@
 //! samples per slice, supersampling, the 10- and 26-neighbourhood gradients, X-ray, MinIP and
 //! first-opaque) runs on the what-if pipeline model `render::render_pipeline`, and `plan:` says so.
 
+use crate::camera::Camera;
 use crate::error::{ModelError, Result};
 use crate::render::{CompositeMode, GradientScheme, ImageF64, Interpolation, Projection};
 use crate::scene::Scene;
@@ -19,6 +20,7 @@ use crate::units::cube5_frame::{
 };
 use crate::units::cube5_shader::{DistantLight, Phong};
 use crate::units::cube5_skewmem::BlockLut;
+use crate::units::cube5_warp::{self, Affine, WarpConfig, WarpRegs};
 use crate::volume::Volume;
 use glam::DVec3;
 
@@ -289,17 +291,68 @@ impl FrameJob {
         }
     }
 
-    /// The base plane warped onto the scene's image (bilinear, model only).
-    pub fn image(&self, scene: &Scene, base: &BasePlane) -> ImageF64 {
+    /// The camera of the scene's image (the view of this frame, the scene's up, roll, size and zoom).
+    pub fn camera(&self, scene: &Scene) -> Camera {
         // The scene's camera (up, roll, zoom): the reference renderer's.
-        let camera = scene.render_params().camera(&self.seen, self.dir);
+        scene.render_params().camera(&self.seen, self.dir)
+    }
+
+    /// The warp of this frame onto the scene's image: the ideal affine map and the registers the
+    /// host sets up from it (`docs/numerics/warp.md`, "Set-up").
+    pub fn warp_setup(&self, scene: &Scene, base: &BasePlane) -> Result<(Affine, WarpRegs)> {
+        let camera = self.camera(scene);
+        let affine = Affine::of_view(&self.setup.params, self.seen.spacing, &camera);
+        let size = |n: usize| {
+            u32::try_from(n)
+                .map_err(|_| ModelError::Image(format!("base plane edge {n} is too large")))
+        };
+        let regs = WarpRegs::set_up(
+            &affine,
+            (size(base.width)?, size(base.height)?),
+            (camera.width, camera.height),
+        )?;
+        Ok((affine, regs))
+    }
+
+    /// The warp unit's configuration for this frame: the frame's `ColorW`, the RTL's weights.
+    pub fn warp_config(&self) -> WarpConfig {
+        WarpConfig {
+            color_w: self.cfg.compos.color_w,
+            ..WarpConfig::DEFAULT
+        }
+    }
+
+    /// The final image: the base plane's codes through the warp model (`units::cube5_warp`, the
+    /// hardware's 8-bit pixels).
+    pub fn image(&self, scene: &Scene, base: &BasePlane) -> Result<ImageF64> {
+        let (_, regs) = self.warp_setup(scene, base)?;
+        let codes = cube5_warp::base_codes(base, &self.cfg.compos);
+        let pixels = cube5_warp::warp_image(&self.warp_config(), &regs, &codes);
+        Ok(cube5_warp::to_image(regs.out_w, regs.out_h, &pixels))
+    }
+
+    /// The f64 warp of the unquantized coxel colours (`cube5_frame::warp`, what `cube5 render`
+    /// showed before the warp unit): a reference, not the hardware's image.
+    pub fn image_f64_coxels(&self, scene: &Scene, base: &BasePlane) -> ImageF64 {
         cube5_frame::warp(
             &self.setup.params,
             self.seen.spacing,
             &base.rgb(&self.cfg.compos),
             (base.width, base.height),
-            &camera,
+            &self.camera(scene),
         )
+    }
+
+    /// The ideal f64 bilinear warp of the same base-plane codes (the warp's reference).
+    pub fn image_reference(&self, scene: &Scene, base: &BasePlane) -> Result<ImageF64> {
+        let (affine, regs) = self.warp_setup(scene, base)?;
+        let codes = cube5_warp::base_codes(base, &self.cfg.compos);
+        Ok(cube5_warp::reference(
+            &affine,
+            &codes,
+            self.cfg.compos.color_w,
+            (regs.out_w, regs.out_h),
+        ))
     }
 }
 

@@ -80,7 +80,7 @@ fn frame_image(scene_text: &str, vol: &Volume) -> (ImageF64, Camera) {
     let run = job.render();
     let params = scene.render_params();
     let cam = params.camera(vol, params.direction().unwrap());
-    (job.image(&scene, &run.base), cam)
+    (job.image(&scene, &run.base).unwrap(), cam)
 }
 
 /// The rotation taking camera frame `a` to camera frame `b`, as an angle in degrees.

@@ -284,7 +284,7 @@ fn frame_outcome(scene: &Scene) -> Result<Outcome, String> {
     let cfg = frame_config(scene).map_err(|e| e.to_string())?;
     let job = FrameJob::new(scene, &vol, cfg, 1).map_err(|e| e.to_string())?;
     let run = job.render();
-    let img = job.image(scene, &run.base);
+    let img = job.image(scene, &run.base).map_err(|e| e.to_string())?;
     Ok(Outcome {
         frame: format!("{cfg:?} {:?}", run.base.coxels),
         image: img.to_rgb8().into_raw(),

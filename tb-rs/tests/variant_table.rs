@@ -12,7 +12,7 @@ use cube5_model::units::{
     cube5_axi_rd::AxiRdConfig, cube5_compos::ComposConfig, cube5_frame::FrameConfig,
     cube5_gradient::GradientConfig, cube5_rblock::RBlockConfig, cube5_sepconv::SepconvConfig,
     cube5_shader::ShaderConfig, cube5_skewmem::SkewConfig, cube5_trilin::TrilinConfig,
-    cube5_vol_fetch::VolFetchConfig, gicube_bucket::BucketConfig,
+    cube5_vol_fetch::VolFetchConfig, cube5_warp::WarpConfig, gicube_bucket::BucketConfig,
     gicube_packet_loop::PacketLoopConfig, gicube_scatter::ScatterConfig,
     gicube_sorter::SorterConfig,
 };
@@ -62,6 +62,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == SorterConfig::TOP => agree::<SorterConfig>(v),
         t if t == AxiRdConfig::TOP => agree::<AxiRdConfig>(v),
         t if t == VolFetchConfig::TOP => agree::<VolFetchConfig>(v),
+        t if t == WarpConfig::TOP => agree::<WarpConfig>(v),
         other => Err(format!(
             "top {other} has no model configuration (UnitConfig)"
         )),

@@ -14,6 +14,7 @@ mod cube5_sepconv;
 mod cube5_shader;
 mod cube5_skewmem;
 mod cube5_trilin;
+mod cube5_warp;
 mod gicube_bucket;
 mod gicube_packet_loop;
 mod gicube_scatter;
@@ -98,6 +99,11 @@ const BENCHES: &[Bench] = &[
         top: cube5_frame::TOP,
         alias: "frame",
         run: cube5_frame::run,
+    },
+    Bench {
+        top: cube5_warp::TOP,
+        alias: "warp",
+        run: cube5_warp::run,
     },
 ];
 

@@ -4,6 +4,7 @@
 
 pub mod cube5_compos;
 pub mod cube5_frame;
+pub mod cube5_warp;
 
 /// Who may access a register on the bus.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

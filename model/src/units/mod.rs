@@ -16,6 +16,7 @@ pub mod cube5_shader;
 pub mod cube5_skewmem;
 pub mod cube5_trilin;
 pub mod cube5_vol_fetch;
+pub mod cube5_warp;
 pub mod gicube_bucket;
 pub mod gicube_packet_loop;
 pub mod gicube_processor;
