@@ -240,7 +240,7 @@ fn render(args: RenderArgs) -> Result<()> {
                 let run = job.render();
                 let img = job.image(&scene, &run.base);
                 let what = format!(
-                    "frame model = cube5_frame's bits: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination",
+                    "frame model = cube5_frame's bits: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination and {} in blocks that cannot change their rays",
                     run.base.width,
                     run.base.height,
                     run.samples,
@@ -252,7 +252,8 @@ fn render(args: RenderArgs) -> Result<()> {
                     run.base.coxels.len(),
                     run.model.shaded,
                     run.model.without_effect,
-                    run.model.after_termination
+                    run.model.after_termination,
+                    run.model.in_skipped_blocks
                 );
                 (img, what, run.samples)
             }
