@@ -24,8 +24,8 @@
 use super::{
     render_base_plane_reference, shade_n6, BasePlane, FrameMode, FrameParams, FrameUnits, STEP_W,
 };
-use crate::units::cube5_compos::{Compos, ComposMode, Coxel, Sample};
-use crate::units::cube5_shader::{Rgba, Shader, ShaderIn, ShaderMode};
+use crate::units::cube5_compos::{CodedSample, Compos, ComposMode, Coxel, Sample};
+use crate::units::cube5_shader::{Shader, ShaderIn, ShaderMode};
 use crate::volume::Volume;
 use rayon::prelude::*;
 
@@ -314,8 +314,9 @@ struct SliceWork<'a> {
     /// The corrected alpha of each class index (the compositing unit's `corrected` of the class
     /// entry's alpha): a sample's effect is known before its gradient.
     corrected: &'a [u64],
-    /// The shaded entry of each class index, when the gradient does not matter.
-    flat: Option<&'a [Rgba]>,
+    /// The shaded sample of each class index, coded for the compositing unit (depth 0), when
+    /// the gradient does not matter.
+    flat: Option<&'a [CodedSample]>,
     /// Per block of this slice: the largest corrected alpha its samples can have.
     amax: &'a [u64],
     /// Samples of corrected alpha 0 are the identity of every coxel.
@@ -445,7 +446,7 @@ impl SliceWork<'_> {
                         st.without_effect += 1;
                         continue;
                     }
-                    let sample = if lit {
+                    if lit {
                         if !neighbours {
                             neighbours = true;
                             if c > 0 {
@@ -467,20 +468,25 @@ impl SliceWork<'_> {
                             self.other(self.k_before, a, b),
                             self.other(self.k_after, a, b),
                         ];
-                        shade_n6(&units.gradient, &units.shader, &nb, smode, self.depth)
+                        let sample =
+                            shade_n6(&units.gradient, &units.shader, &nb, smode, self.depth);
+                        *cox = units.compos.step(cox, &sample);
+                    } else if let Some(flat) = self.flat {
+                        let coded = CodedSample {
+                            depth: self.depth,
+                            ..flat[idx]
+                        };
+                        *cox = units.compos.step_coded(cox, &coded);
                     } else {
-                        let e = self.flat.map_or_else(
-                            || units.shader.shade(&class_in(centre, smode)),
-                            |t| t[idx],
-                        );
-                        Sample {
+                        let e = units.shader.shade(&class_in(centre, smode));
+                        let sample = Sample {
                             rgb: [e.r, e.g, e.b],
                             alpha: e.a,
                             depth: self.depth,
                             mode: cmode,
-                        }
-                    };
-                    *cox = units.compos.step(cox, &sample);
+                        };
+                        *cox = units.compos.step(cox, &sample);
+                    }
                     st.shaded += 1;
                 }
             }
@@ -555,9 +561,19 @@ pub fn render_sweep(
         .collect();
     let range_max = RangeMax::new(&corrected);
     let lit = gradient_matters(&units.shader, smode);
-    let flat: Option<Vec<Rgba>> = (!lit).then(|| {
+    // Without the gradient, a sample's way through the shader and the compositing unit's coding
+    // is a function of its class index: the units' own outputs, once per index.
+    let flat: Option<Vec<CodedSample>> = (!lit).then(|| {
         (0..corrected.len())
-            .map(|idx| units.shader.shade(&class_in((idx as u32) << shift, smode)))
+            .map(|idx| {
+                let e = units.shader.shade(&class_in((idx as u32) << shift, smode));
+                units.compos.code(&Sample {
+                    rgb: [e.r, e.g, e.b],
+                    alpha: e.a,
+                    depth: 0,
+                    mode: cmode,
+                })
+            })
             .collect()
     });
     let zero_ok = zero_alpha_is_identity(&units.compos, &init, cmode);
@@ -593,6 +609,8 @@ pub fn render_sweep(
     };
     let nb = sv.nbi * sv.nbj;
     let mut amax = vec![0u64; nb];
+    // The plane rows of every band, made once per frame.
+    let mut bands: Vec<BandRows> = (0..nj.div_ceil(BAND)).map(|_| BandRows::new(ni)).collect();
     for s in front_zero..nk - back_zero {
         let c = params.slice(s);
         let depth = s as u32;
@@ -626,21 +644,17 @@ pub fn render_sweep(
         // that the units' mode branches fold away.
         let part = rows
             .par_chunks_mut(BAND * w)
+            .zip(bands.par_iter_mut())
             .enumerate()
-            .map_init(
-                || BandRows::new(ni),
-                |band, (n, rows)| match (units.mode, lit) {
-                    (FrameMode::Mip, _) => {
-                        work.band(n * BAND, rows, w, band, FrameMode::Mip, false)
-                    }
-                    (FrameMode::Composite, false) => {
-                        work.band(n * BAND, rows, w, band, FrameMode::Composite, false)
-                    }
-                    (FrameMode::Composite, true) => {
-                        work.band(n * BAND, rows, w, band, FrameMode::Composite, true)
-                    }
-                },
-            )
+            .map(|(n, (rows, band))| match (units.mode, lit) {
+                (FrameMode::Mip, _) => work.band(n * BAND, rows, w, band, FrameMode::Mip, false),
+                (FrameMode::Composite, false) => {
+                    work.band(n * BAND, rows, w, band, FrameMode::Composite, false)
+                }
+                (FrameMode::Composite, true) => {
+                    work.band(n * BAND, rows, w, band, FrameMode::Composite, true)
+                }
+            })
             .reduce(SweepStats::default, SweepStats::add);
         stats = stats.add(part);
     }
