@@ -350,20 +350,9 @@ impl SliceWork<'_> {
         let top = self.sv.row(self.k, b as usize);
         let bot = self.sv.row(self.k, b as usize + 1);
         let out = &mut band.rows[r * ni + a0..r * ni + a1];
-        let trilin = &self.units.trilin;
-        for (n, o) in out.iter_mut().enumerate() {
-            let a = a0 + n;
-            *o = trilin.sample_in_slice(
-                [
-                    u32::from(top[a]),
-                    u32::from(top[a + 1]),
-                    u32::from(bot[a]),
-                    u32::from(bot[a + 1]),
-                ],
-                self.wx,
-                self.wy,
-            );
-        }
+        self.units
+            .trilin
+            .row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, out);
     }
 
     /// `S'(t)` at anchor `(a, b)`: slice `k(t)`'s voxels, slice `s`'s weights (0 outside).
