@@ -459,7 +459,8 @@ impl SliceWork<'_> {
                         ];
                         let sample =
                             shade_n6(&units.gradient, &units.shader, &nb, smode, self.depth);
-                        *cox = units.compos.step(cox, &sample);
+                        // `Compos::step`, spelled out so that it inlines here.
+                        *cox = units.compos.step_coded(cox, &units.compos.code(&sample));
                     } else if let Some(flat) = self.flat {
                         let coded = CodedSample {
                             depth: self.depth,
