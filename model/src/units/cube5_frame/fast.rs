@@ -721,9 +721,7 @@ mod tests {
         cfg: &FrameConfig,
         tf: &TransferFunction,
         et: Option<f64>,
-        v: [f64; 3],
-        p: usize,
-        mode: FrameMode,
+        (v, p, mode): ([f64; 3], usize, FrameMode),
     ) -> SweepStats {
         let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), p).unwrap();
         let params = setup.params;
@@ -771,7 +769,7 @@ mod tests {
                 continue;
             }
             for mode in [FrameMode::Mip, FrameMode::Composite] {
-                let st = check_one(what, vol, cfg, tf, early_termination, *v, p, mode);
+                let st = check_one(what, vol, cfg, tf, early_termination, (*v, p, mode));
                 total = total.add(st);
                 total.slices_skipped.0 += st.slices_skipped.0 + st.slices_skipped.1;
                 total.rays_terminated += st.rays_terminated;
@@ -822,8 +820,14 @@ mod tests {
             for (name, tf) in [("head", &tf), ("head, iso", &opaque)] {
                 for (n, v) in vs.iter().enumerate() {
                     let p = [1, 4, 8][n % 3];
-                    let one =
-                        check_one(name, &head, &cfg, tf, Some(t), *v, p, FrameMode::Composite);
+                    let one = check_one(
+                        name,
+                        &head,
+                        &cfg,
+                        tf,
+                        Some(t),
+                        (*v, p, FrameMode::Composite),
+                    );
                     st = st.add(one);
                     st.rays_terminated += one.rays_terminated;
                 }
@@ -847,9 +851,7 @@ mod tests {
                 &cfg,
                 &tf,
                 None,
-                *v,
-                [1, 4, 8][n % 3],
-                FrameMode::Mip,
+                (*v, [1, 4, 8][n % 3], FrameMode::Mip),
             ));
         }
         assert!(st.in_skipped_blocks > 0 && st.shaded > 0, "{st:?}");
