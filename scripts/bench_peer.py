@@ -29,29 +29,11 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-# The benchmark's own transfer function, handed to both renderers (cube5 reads it as the scene's
-# `[transfer] points`, VTK as a vtkColorTransferFunction and a vtkPiecewiseFunction). Densities are
-# normalized to the voxel range 0 ..= 2^bits - 1; alpha is the opacity of one voxel of path. The
-# values are cube5's `head` preset (model/src/transfer.rs) when this benchmark was written; they are
-# fixed here so the workload stays the same when the preset changes.
-TF_POINTS: list[tuple[float, tuple[float, float, float, float]]] = [
-    (0.00, (0.0, 0.0, 0.0, 0.0)),
-    (0.17, (0.0, 0.0, 0.0, 0.0)),
-    (0.22, (0.85, 0.60, 0.50, 0.004)),
-    (0.28, (0.0, 0.0, 0.0, 0.0)),
-    (0.33, (0.90, 0.55, 0.55, 0.0)),
-    (0.36, (0.90, 0.55, 0.55, 0.006)),
-    (0.42, (0.0, 0.0, 0.0, 0.0)),
-    (0.50, (0.95, 0.85, 0.20, 0.45)),
-    (0.55, (0.0, 0.0, 0.0, 0.0)),
-    (0.61, (0.30, 0.90, 0.35, 0.55)),
-    (0.67, (0.0, 0.0, 0.0, 0.0)),
-    (0.75, (0.95, 0.25, 0.20, 0.7)),
-    (0.80, (0.95, 0.93, 0.88, 0.0)),
-    (0.86, (0.95, 0.93, 0.88, 0.12)),
-    (0.92, (0.95, 0.93, 0.88, 0.0)),
-    (1.00, (0.40, 0.85, 1.00, 1.0)),
-]
+# The transfer function: cube5's `head` preset (TransferFunction::head_default, the default scene's),
+# read from `cube5 transfer head` so that there is one copy. cube5's scene names the preset; VTK gets
+# the same points as a vtkColorTransferFunction and a vtkPiecewiseFunction. Densities are normalized
+# to the voxel range 0 ..= 2^bits - 1; alpha is the opacity of one voxel of path.
+TF_PRESET = "head"
 
 # Phong coefficients, the same numbers in the scene's `[shading]` and in vtkVolumeProperty.
 AMBIENT, DIFFUSE, SPECULAR, SHININESS = 0.25, 0.65, 0.35, 24.0
@@ -124,12 +106,23 @@ def slice_step(direction: tuple[float, float, float]) -> float:
 # =================================================================================================
 
 
+def transfer_points(cube5: Path) -> list[tuple[float, tuple[float, float, float, float]]]:
+    """The points of cube5's transfer function preset TF_PRESET (`cube5 transfer NAME`)."""
+    out = subprocess.run([cube5, "transfer", TF_PRESET], capture_output=True, text=True)
+    if out.returncode != 0:
+        raise BenchError(f"cube5 transfer {TF_PRESET} failed: {out.stderr.strip()}")
+    points = []
+    for line in out.stdout.splitlines():
+        d, r, g, b, a = (float(x) for x in line.split())
+        points.append((d, (r, g, b, a)))
+    if len(points) < 2:
+        raise BenchError(f"cube5 transfer {TF_PRESET} printed {len(points)} points")
+    return points
+
+
 def scene_toml(
     volume: Path, size: int, bits: int, mode: str, shading: bool, pixels: int
 ) -> str:
-    points = ",\n".join(
-        f"  {{ density = {d}, rgba = [{r}, {g}, {b}, {a}] }}" for d, (r, g, b, a) in TF_POINTS
-    )
     return f"""# Written by scripts/bench_peer.py.
 [volume]
 file = "{volume}"
@@ -152,9 +145,7 @@ mode = "{mode}"
 shading = {"true" if shading else "false"}
 
 [transfer]
-points = [
-{points}
-]
+preset = "{TF_PRESET}"
 
 [shading]
 ambient = {AMBIENT}
@@ -296,7 +287,7 @@ class VtkTime:
 
 def render_vtk(
     v, img, max_value: int, mode: str, shading: bool, pixels: int, threads: int,
-    warmup: int, frames: int, png: Path,
+    warmup: int, frames: int, png: Path, tf_points,
 ) -> VtkTime:
     R = v["render"]
     v["core"].vtkMultiThreader.SetGlobalMaximumNumberOfThreads(threads)
@@ -330,7 +321,7 @@ def render_vtk(
         prop.ShadeOff()
     else:
         mapper.SetBlendModeToComposite()
-        for d, (r, g, b, a) in TF_POINTS:
+        for d, (r, g, b, a) in tf_points:
             colour.AddRGBPoint(d * max_value, r, g, b)
             opacity.AddPoint(d * max_value, a)
         # Alpha is the opacity of one voxel of path in both (cube5 corrects it to its step).
@@ -491,11 +482,12 @@ def main() -> int:
         if r.returncode != 0:
             raise BenchError(f"cube5 phantom failed: {r.stderr.strip()}")
     img, max_value = vtk_volume(v, raw, args.size, args.bits)
+    tf_points = transfer_points(cube5)
     repeat = cube5_has_repeat(cube5)
     machine = f"{cpu_model()}, {os.cpu_count()} cores"
     load_start = load_average()
     say(f"machine: {machine}; VTK {v['version']} ({window}); volume {raw.name} "
-        f"({args.size}^3, {args.bits}-bit); view azimuth {AZIMUTH} elevation {ELEVATION}, parallel")
+        f"({args.size}^3, {args.bits}-bit); transfer function `{TF_PRESET}` ({len(tf_points)} points); view azimuth {AZIMUTH} elevation {ELEVATION}, parallel")
     say(f"cube5: {cube5} ({'--repeat' if repeat else 'no --repeat: one frame per process, best of'} "
         f"{args.cube5_frames}); VTK: best of {args.frames} frames after {args.warmup} warm-up")
 
@@ -509,7 +501,7 @@ def main() -> int:
                     stem = f"{name.replace(' ', '-')}-{px}-t{t}"
                     vtk_png, c5_png = out / f"{stem}-vtk.png", out / f"{stem}-cube5.png"
                     vt = render_vtk(v, img, max_value, mode, shading, px, t,
-                                    args.warmup, args.frames, vtk_png)
+                                    args.warmup, args.frames, vtk_png, tf_points)
                     ct = run_cube5(cube5, scene, c5_png, t, args.cube5_frames, repeat)
                     diff = side_by_side(v, vtk_png, c5_png, out / f"{stem}.png")
                     row = (name, f"{px}x{px}", t, vt, ct)
@@ -522,7 +514,7 @@ def main() -> int:
     say("")
     say(f"load average (1 min) at the start {load_start}, at the end {load_average()}")
     say(f"Machine: {machine}. VTK {v['version']} `vtkFixedPointVolumeRayCastMapper`, "
-        f"head phantom {args.size}^3 ({args.bits}-bit), view azimuth {AZIMUTH:g} elevation "
+        f"head phantom {args.size}^3 ({args.bits}-bit), transfer function `{TF_PRESET}`, view azimuth {AZIMUTH:g} elevation "
         f"{ELEVATION:g}, parallel. Ratio = VTK ms / cube5 ms (> 1: cube5 faster).")
     say("")
     say("| case | size | threads | VTK ms | VTK mapper ms | cube5 ms | cube5 M samples/s | ratio |")

@@ -47,12 +47,22 @@ enum Command {
     Tradeoff(tradeoff::TradeoffArgs),
     /// Write an embedded phantom as a volume file (.nrrd, .nii, .nii.gz or .raw).
     Phantom(PhantomArgs),
+    /// Print a built-in transfer function's points, one a line: density r g b a (densities
+    /// normalized to the voxel range, alpha the opacity of one voxel of path).
+    Transfer(TransferArgs),
     /// Co-simulate one frame of a scene: the RTL frame against the golden model, bit for bit.
     #[cfg(feature = "rtl")]
     Cosim(cosim::CosimArgs),
     /// Print speed figures: simulated RTL cycles per second and model samples per second.
     #[cfg(feature = "rtl")]
     Bench(bench::BenchArgs),
+}
+
+#[derive(Debug, clap::Args)]
+struct TransferArgs {
+    /// Preset name (`[transfer] preset` of a scene).
+    #[arg(default_value = "head")]
+    name: String,
 }
 
 #[derive(Debug, clap::Args)]
@@ -148,6 +158,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render(args),
         Command::Tradeoff(args) => tradeoff::run(args),
         Command::Phantom(args) => phantom(args),
+        Command::Transfer(args) => transfer(args),
         #[cfg(feature = "rtl")]
         Command::Bench(args) => bench::run(args),
         #[cfg(feature = "rtl")]
@@ -292,7 +303,7 @@ fn render(args: RenderArgs) -> Result<()> {
                 let run = job.render();
                 let img = job.image(&scene, &run.base)?;
                 let what = format!(
-                    "frame model = cube5_frame's bits, warped by the cube5_warp model: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination",
+                    "frame model = cube5_frame's bits, warped by the cube5_warp model: base plane {}x{}, {} samples ({} in empty blocks, not read), {} + {} of {} slices skipped (empty), {} of {} rays terminated early; the model shaded {} samples, classified {} only (no effect), skipped {} after termination and {} in blocks that cannot change their rays",
                     run.base.width,
                     run.base.height,
                     run.samples,
@@ -304,7 +315,8 @@ fn render(args: RenderArgs) -> Result<()> {
                     run.base.coxels.len(),
                     run.model.shaded,
                     run.model.without_effect,
-                    run.model.after_termination
+                    run.model.after_termination,
+                    run.model.in_skipped_blocks
                 );
                 (img, what, run.samples)
             }
@@ -495,6 +507,15 @@ fn cosim_for_render(scene: &Scene, _args: &RenderArgs) -> Result<bool> {
         "run.target = \"{}\": this cube5 was built without the RTL (cargo feature `rtl`); render with run.target = \"model\" or build with the default features",
         scene.run.target.name()
     )
+}
+
+fn transfer(args: TransferArgs) -> Result<()> {
+    let tf = cube5_model::transfer::TransferFunction::preset(&args.name)?;
+    for p in &tf.points {
+        let [r, g, b, a] = p.rgba;
+        say!("{} {r} {g} {b} {a}", p.density);
+    }
+    Ok(())
 }
 
 fn phantom(args: PhantomArgs) -> Result<()> {

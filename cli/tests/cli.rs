@@ -331,3 +331,23 @@ fn perspective_scenes_name_their_scheme() {
     let (out, _) = render_view("slabs-and-ref", persp, &["--slabs", "4", "--reference"]);
     assert_refused(&out, "--reference and --slabs");
 }
+
+/// `cube5 transfer NAME` prints the preset's points (the peer benchmark's only copy of the
+/// transfer function it hands VTK); an unknown name is refused.
+#[test]
+fn transfer_prints_a_presets_points() {
+    let out = cube5(&["transfer", "head"]);
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    let points: Vec<Vec<f64>> = text
+        .lines()
+        .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let tf = cube5_model::transfer::TransferFunction::head_default();
+    assert_eq!(points.len(), tf.points.len(), "{text}");
+    for (p, want) in points.iter().zip(&tf.points) {
+        assert_eq!(p[0], want.density, "{text}");
+        assert_eq!(&p[1..], &want.rgba[..], "{text}");
+    }
+    assert_refused(&cube5(&["transfer", "nonesuch"]), "nonesuch");
+}

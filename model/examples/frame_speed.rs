@@ -1,12 +1,13 @@
 //! The frame model's speed: samples/s of the fast path (and, with `--reference`, of the
-//! per-sample reference) on the head phantom, composite shaded and MIP, at 1 and 2 threads.
+//! per-sample reference) on the head phantom, composite shaded and MIP, at 1 and 2 threads. The
+//! fast path's frame is `render_sweep` on a `SweepVolume` made once (as `cube5 render` does).
 //! `cargo run --release -p cube5-model --example frame_speed -- [N ...] [--reference]`
 
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::units::cube5_frame::{
-    frame_phong, render_base_plane_reference, render_base_plane_stats, FrameMode, FrameSetup,
-    FrameUnits,
+    frame_phong, render_base_plane_reference, render_sweep, FrameMode, FrameSetup, FrameUnits,
+    SweepVolume,
 };
 use glam::DVec3;
 use std::time::Instant;
@@ -39,6 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let vol = head_phantom(n, 12)?;
         let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::new(-0.37, 0.81, -1.0), 4)?;
         let p = setup.params;
+        let sv = SweepVolume::new(&p, &vol).ok_or("the phantom does not fit its set-up")?;
         for mode in [FrameMode::Composite, FrameMode::Mip] {
             if args.iter().any(|a| a == "--mip") && mode != FrameMode::Mip
                 || args.iter().any(|a| a == "--composite") && mode != FrameMode::Composite
@@ -55,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     let mut runs = 0;
                     let mut st = None;
                     while runs < 3 || t.elapsed().as_secs_f64() < 1.0 {
-                        st = Some(render_base_plane_stats(&p, &vol, &units).1);
+                        st = Some(render_sweep(&p, &sv, &units).1);
                         runs += 1;
                     }
                     let r = f64::from(runs);

@@ -17,6 +17,7 @@ use crate::transfer::TransferFunction;
 use crate::unit::UnitConfig;
 use crate::units::cube5_frame::{
     self, BasePlane, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepStats,
+    SweepVolume,
 };
 use crate::units::cube5_shader::{DistantLight, Phong};
 use crate::units::cube5_skewmem::BlockLut;
@@ -190,6 +191,9 @@ pub struct FrameJob {
     pub lut: BlockLut,
     pub look: Look,
     pub units: FrameUnits,
+    /// `seen` in the sweep's axis order with its blocks' voxel ranges, made once with the job
+    /// (the model's copy; it depends on the slice axis only).
+    pub sweep: SweepVolume,
 }
 
 /// What one frame of the model computed.
@@ -246,6 +250,12 @@ impl FrameJob {
             &look.phong,
             look.early_termination,
         )?;
+        let sweep = SweepVolume::new(&setup.params, &seen).ok_or_else(|| {
+            ModelError::Volume(format!(
+                "volume of {:?} voxels does not fit the frame's set-up",
+                seen.dims
+            ))
+        })?;
         Ok(Self {
             cfg,
             seen,
@@ -254,13 +264,14 @@ impl FrameJob {
             lut,
             look,
             units,
+            sweep,
         })
     }
 
     /// The base plane, bit-exact with the RTL frame, and what the sweep did.
     pub fn render(&self) -> FrameRun {
         let params = &self.setup.params;
-        let (base, model) = cube5_frame::render_base_plane_stats(params, &self.seen, &self.units);
+        let (base, model) = cube5_frame::render_sweep(params, &self.sweep, &self.units);
         let skipped_slices = cube5_frame::empty_slices(params, &self.lut);
         let swept = params.nk - skipped_slices.0 - skipped_slices.1;
         let b = self.lut.block as usize;

@@ -222,6 +222,16 @@ pub struct Sample {
     pub mode: ComposMode,
 }
 
+/// A sample as the compositing's rule 5 reads it ([`Compos::code`]): the corrected alpha `U(1.Q)`,
+/// the colours as unit codes on the coxel's scale `2^F`, depth and mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CodedSample {
+    pub a: u64,
+    pub c_w: [u64; 3],
+    pub depth: u32,
+    pub mode: ComposMode,
+}
+
 /// One stream item: the coxel of a ray and its next sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ComposIn {
@@ -462,7 +472,7 @@ impl Compos {
 
     /// [`Compos::leaves_unchanged`] of a sample whose corrected alpha `self.corrected(alpha)` is
     /// `a` (for callers that keep the corrected alpha of each alpha code at hand).
-    #[inline]
+    #[inline(always)]
     pub fn leaves_unchanged_corrected(
         &self,
         coxel: &Coxel,
@@ -498,9 +508,29 @@ impl Compos {
         }
     }
 
+    /// A sample as rule 5 reads it: its corrected alpha and its colours on the coxel's scale.
+    #[inline(always)]
+    pub fn code(&self, s: &Sample) -> CodedSample {
+        let (f, cw) = (self.cfg.acc_w, self.cfg.color_w);
+        CodedSample {
+            a: self.corrected(s.alpha),
+            c_w: s.rgb.map(|c| unit_code(c, cw, f)),
+            depth: s.depth,
+            mode: s.mode,
+        }
+    }
+
     /// One item: the coxel after this sample.
     #[inline]
     pub fn step(&self, coxel: &Coxel, s: &Sample) -> Coxel {
+        self.step_coded(coxel, &self.code(s))
+    }
+
+    /// [`Compos::step`] of a sample already coded ([`Compos::code`]; a caller that meets the same
+    /// sample values many times codes them once). Always inlined: at a call site with a constant
+    /// mode (the frame's sweep) the other modes' rules fold away.
+    #[inline(always)]
+    pub fn step_coded(&self, coxel: &Coxel, s: &CodedSample) -> Coxel {
         let cfg = &self.cfg;
         let (f, q, cw) = (cfg.acc_w, cfg.q(), cfg.color_w);
         let mut out = *coxel;
@@ -535,9 +565,8 @@ impl Compos {
             return out;
         }
         // 5. The sample contributes.
-        let a = self.corrected(s.alpha);
+        let (a, c_w) = (s.a, s.c_w);
         let a_w = a << (f - q);
-        let c_w = s.rgb.map(|c| unit_code(c, cw, f));
         let w = rnd(t * a, q);
         match s.mode {
             ComposMode::FrontToBack => {

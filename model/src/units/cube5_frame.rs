@@ -23,7 +23,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 mod fast;
-pub use fast::{render_base_plane, render_base_plane_stats, SweepStats};
+pub use fast::{render_base_plane, render_base_plane_stats, render_sweep, SweepStats, SweepVolume};
 
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;

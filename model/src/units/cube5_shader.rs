@@ -754,8 +754,9 @@ impl Shader {
         }
     }
 
-    /// One shaded sample.
-    #[inline]
+    /// One shaded sample. Always inlined: at a call site with a constant mode (the frame's sweep)
+    /// the classification's 2-D branch and the unlit return fold away.
+    #[inline(always)]
     pub fn shade(&self, item: &ShaderIn) -> Rgba {
         let c = &self.cfg;
         let e = self.classify(item);

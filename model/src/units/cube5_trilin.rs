@@ -158,6 +158,36 @@ impl Trilin {
         self.lerp(p0, p1, ey) as u32
     }
 
+    /// [`Trilin::sample_in_slice`] along a row of anchors: `out[n]` from the corners `top[n]`,
+    /// `top[n + 1]`, `bot[n]`, `bot[n + 1]` (`top` and `bot` at least one longer than `out`). The
+    /// same three rounded lerps with the weights hoisted, in 32-bit lanes when no intermediate
+    /// can pass 2^32 (`VoxelW + FracW + WeightW <= 31`), so that the compiler vectorizes the row.
+    pub fn row_in_slice(&self, top: &[u16], bot: &[u16], wx: u32, wy: u32, out: &mut [u32]) {
+        let n = out.len();
+        let (top, bot) = (&top[..n + 1], &bot[..n + 1]);
+        let (w, f) = (self.cfg.weight_w, self.cfg.frac_w);
+        let ex = self.effective_weight(wx, TrilinMode::Lerp);
+        let ey = self.effective_weight(wy, TrilinMode::Lerp);
+        if self.cfg.sample_w() + w <= 31 {
+            let (one, half) = (1u32 << w, 1u32 << (w - 1));
+            let (ex, ey) = (ex as u32, ey as u32);
+            let (fx, fy) = (one - ex, one - ey);
+            let c = |v: u16| u32::from(v) << f;
+            for (i, o) in out.iter_mut().enumerate() {
+                let p0 = (c(top[i]) * fx + c(top[i + 1]) * ex + half) >> w;
+                let p1 = (c(bot[i]) * fx + c(bot[i + 1]) * ex + half) >> w;
+                *o = (p0 * fy + p1 * ey + half) >> w;
+            }
+        } else {
+            let c = |v: u16| u64::from(v) << f;
+            for (i, o) in out.iter_mut().enumerate() {
+                let p0 = self.lerp(c(top[i]), c(top[i + 1]), ex);
+                let p1 = self.lerp(c(bot[i]), c(bot[i + 1]), ex);
+                *o = self.lerp(p0, p1, ey) as u32;
+            }
+        }
+    }
+
     /// The seven interpolations of the contract with the effective weights `[ex, ey, ez]`.
     #[inline]
     fn interpolate(&self, voxels: &[u32; 8], [ex, ey, ez]: [u64; 3]) -> u32 {
@@ -316,6 +346,52 @@ mod tests {
             ..ramp
         };
         assert_eq!(unit.sample(&half), (9 << cfg.frac_w) / 2);
+    }
+
+    /// `row_in_slice` is `sample_in_slice` at every anchor of a row, in both lane widths.
+    #[test]
+    fn row_in_slice_is_sample_in_slice_along_a_row() {
+        let every_weight_w = (1..=12).map(|w| TrilinConfig::new(12, w, 4).unwrap());
+        for cfg in [
+            TrilinConfig::NARROW,
+            TrilinConfig::DEFAULT,
+            TrilinConfig::WIDE,
+            TrilinConfig::new(16, 12, 8).unwrap(),
+            TrilinConfig::new(16, 7, 8).unwrap(),
+            TrilinConfig::new(4, 1, 0).unwrap(),
+        ]
+        .into_iter()
+        .chain(every_weight_w)
+        {
+            let unit = Trilin::new(cfg).unwrap();
+            let mut rng = ChaCha8Rng::seed_from_u64(12);
+            for _ in 0..200 {
+                let n = rng.random_range(1..40);
+                let mut voxel = || match rng.random_range(0..4) {
+                    0 => 0,
+                    1 => cfg.voxel_max() as u16,
+                    _ => rng.random_range(0..=cfg.voxel_max()) as u16,
+                };
+                let top: Vec<u16> = (0..=n).map(|_| voxel()).collect();
+                let bot: Vec<u16> = (0..=n).map(|_| voxel()).collect();
+                let mut w = || match rng.random_range(0..4) {
+                    0 => 0,
+                    1 => cfg.weight_max(),
+                    _ => rng.random_range(0..=cfg.weight_max()),
+                };
+                let (wx, wy) = (w(), w());
+                let mut out = vec![0; n];
+                unit.row_in_slice(&top, &bot, wx, wy, &mut out);
+                for (i, &o) in out.iter().enumerate() {
+                    let c = [top[i], top[i + 1], bot[i], bot[i + 1]].map(u32::from);
+                    assert_eq!(
+                        o,
+                        unit.sample_in_slice(c, wx, wy),
+                        "{cfg:?} {c:?} {wx} {wy}"
+                    );
+                }
+            }
+        }
     }
 
     /// `sample_in_slice` is `sample` of the frame's items (`Lerp`, `wz = 0`, upper corners 0).

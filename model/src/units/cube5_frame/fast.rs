@@ -1,43 +1,55 @@
 //! The frame's fast path: the same base plane as [`render_base_plane_reference`], bit for bit,
-//! computed once per slice instead of seven interpolations per sample (`docs/numerics/frame.md`,
-//! "The model's fast path").
+//! computed once per slice instead of seven interpolations per sample, and only where a sample can
+//! change its ray (`docs/numerics/frame.md`, "The model's fast path").
 //!
-//! Per slice `s`: the plane of samples `S_s` (one bilinear sample per anchor, rows in parallel);
-//! then every row of anchors, in parallel, against its own row of coxels (anchor row `b` feeds
-//! base-plane row `b - sy(s) + max(sy)`, a different row for every `b`, so no two threads share a
-//! coxel and each ray still sees its samples in slice order). Per anchor, before any gradient:
-//! a coxel of a terminated ray, or a sample that the compositing unit would leave without effect
-//! (`Compos::leaves_unchanged` on the classified alpha), costs nothing more; otherwise the
-//! in-plane neighbours come from the plane, `B = S'(s-1)` and `A = S'(s+1)` are interpolated on
-//! demand with slice `s`'s weights, and the sample goes through [`shade_n6`] and `Compos::step`,
-//! the unit models' own functions. Leading and trailing slices whose voxels are all 0 are left
-//! out when their zero samples leave every coxel they meet unchanged (the contract's rule for
-//! skipping empty slices, checked coxel by coxel).
+//! The sweep reads a [`SweepVolume`]: the voxels in the sweep's axis order (rows along `i`
+//! contiguous, a zero column and a zero row past the far faces), and for every block of 8 x 8
+//! anchors of every slice plane the range of the voxels its samples read. Per slice `s`, per block:
+//! the largest corrected alpha any sample of the block can have (the class entries of the range's
+//! class indices); a block whose samples leave every coxel they meet unchanged (alpha 0 where a
+//! transparent sample is the identity, or every coxel of its rays terminated or already above it
+//! under `Max`) is not interpolated at all. Otherwise, rows of anchors in bands, in parallel, each
+//! against its own rows of coxels (anchor row `b` feeds base-plane row `b - sy(s) + max(sy)`, a
+//! different row for every `b`, so no two threads share a coxel and each ray still sees its
+//! samples in slice order). Per anchor, before any gradient: a coxel of a terminated ray, or a
+//! sample that the compositing unit would leave without effect (`Compos::leaves_unchanged` on the
+//! classified alpha), costs nothing more; otherwise, when the shaded colour depends on the
+//! gradient, the in-plane neighbours come from the band's plane rows, `B = S'(s-1)` and
+//! `A = S'(s+1)` are interpolated on demand with slice `s`'s weights, and the sample goes through
+//! [`shade_n6`] and `Compos::step`, the unit models' own functions; when it does not (MIP, or a
+//! uniform reflectance map), the shaded entry of its class index is the shader's own output for
+//! that index. Leading and trailing slices whose voxels are all 0 are left out when a zero sample
+//! is the identity of every coxel (the contract's rule for skipping empty slices).
 
 use super::{
     render_base_plane_reference, shade_n6, BasePlane, FrameMode, FrameParams, FrameUnits, STEP_W,
 };
-use crate::units::cube5_compos::{ComposMode, Coxel};
+use crate::units::cube5_compos::{CodedSample, Compos, ComposMode, Coxel, Sample};
 use crate::units::cube5_shader::{Shader, ShaderIn, ShaderMode};
 use crate::volume::Volume;
 use rayon::prelude::*;
 
-/// What a frame's sweep computed and what it left out (the CLI's `plan:` line).
+/// What a frame's sweep computed and what it left out (the CLI's `plan:` line). These are the
+/// model's own counts: the hardware's (samples, beams of empty blocks, terminated rays) are the
+/// frame's (`scene_render::FrameRun`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SweepStats {
     /// Anchors of the frame: one per voxel, `ni nj nk`.
     pub anchors: u64,
     /// Leading and trailing slices left out (all their voxels 0, their samples without effect).
     pub slices_skipped: (usize, usize),
-    /// Samples interpolated in the swept slices' planes (`S_s`, one per anchor).
+    /// Samples of the swept slices (one per anchor).
     pub samples: u64,
-    /// Samples that went through gradient, shader and compositing.
+    /// Samples that went through shader and compositing (and the gradient, where it matters).
     pub shaded: u64,
     /// Samples the compositing unit would leave without effect (transparent, or not above the
-    /// maximum): classified only.
+    /// maximum): interpolated and classified only.
     pub without_effect: u64,
     /// Samples of rays already terminated (early ray termination): not classified.
     pub after_termination: u64,
+    /// Samples of blocks that cannot change any coxel they meet (their voxel range classifies
+    /// transparent, or every ray they meet is terminated or above them): not interpolated.
+    pub in_skipped_blocks: u64,
     /// Rays whose coxel ends terminated.
     pub rays_terminated: u64,
 }
@@ -48,62 +60,141 @@ impl SweepStats {
         self.shaded += o.shaded;
         self.without_effect += o.without_effect;
         self.after_termination += o.after_termination;
+        self.in_skipped_blocks += o.in_skipped_blocks;
         self
     }
 }
 
-/// Voxels of the volume in frame axes: index `i si + j sj + k sk`.
-struct Frame<'a> {
-    data: &'a [u16],
+/// Anchors per block edge of the sweep's skipping (in `i` and `j`, within one slice plane).
+const BLOCK: usize = 8;
+/// Anchor rows per parallel task.
+const BAND: usize = 16;
+
+/// A volume in the order the frame sweeps it, with the voxel range of every block of anchors
+/// (made once per volume and slice axis: `scene_render::FrameJob` keeps one).
+#[derive(Clone)]
+pub struct SweepVolume {
+    /// Volume axes of `i`, `j`, `k` this copy is for, and the volume's dimensions.
+    axes: [usize; 3],
+    dims: [usize; 3],
     ni: usize,
     nj: usize,
-    si: usize,
-    sj: usize,
-    sk: usize,
+    nk: usize,
+    /// Voxel `(i, j, k)` (`k` the volume index along `axes[2]`) at `(k (nj + 1) + j) (ni + 1) + i`;
+    /// column `ni` and row `nj` of every plane are 0 (the frame's zeros past the far faces).
+    data: Vec<u16>,
+    /// Blocks per plane along `i` and `j`.
+    nbi: usize,
+    nbj: usize,
+    /// Smallest and largest voxel a block of anchors reads, at `(k nbj + bj) nbi + bi`: columns
+    /// `8 bi ..= 8 bi + 8` and rows `8 bj ..= 8 bj + 8` of plane `k` (the zeros past the far faces
+    /// included).
+    lo: Vec<u16>,
+    hi: Vec<u16>,
 }
 
-impl Frame<'_> {
-    /// The corners `(i, j)`, `(i+1, j)`, `(i, j+1)`, `(i+1, j+1)` of slice plane `k` for anchor
-    /// `(i, j)` of the face, 0 beyond the far faces (frame contract).
-    #[inline]
-    fn corners(&self, i: usize, j: usize, k: usize) -> [u32; 4] {
-        let at = i * self.si + j * self.sj + k * self.sk;
-        let v = |o: usize| u32::from(self.data[at + o]);
-        match (i + 1 < self.ni, j + 1 < self.nj) {
-            (true, true) => [v(0), v(self.si), v(self.sj), v(self.si + self.sj)],
-            (true, false) => [v(0), v(self.si), 0, 0],
-            (false, true) => [v(0), 0, v(self.sj), 0],
-            (false, false) => [v(0), 0, 0, 0],
-        }
+impl std::fmt::Debug for SweepVolume {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "SweepVolume {{ axes: {:?}, ni: {}, nj: {}, nk: {} }}",
+            self.axes, self.ni, self.nj, self.nk
+        )
     }
+}
 
-    /// Row `j` of plane `k` into `out` (`ni + 1` entries, the last one 0); zeros past the far face.
-    fn row(&self, j: usize, k: usize, out: &mut [u32]) {
-        out.fill(0);
-        if j >= self.nj {
-            return;
+impl SweepVolume {
+    /// `vol` in the sweep order of `params` (its slice axis; any view with the same axes shares
+    /// it). `None` when the volume's dimensions are not the parameters'.
+    pub fn new(params: &FrameParams, vol: &Volume) -> Option<Self> {
+        let axes = [params.axis_i, params.axis_j, params.axis_k];
+        let (ni, nj, nk) = (params.ni, params.nj, params.nk);
+        if vol.dims[axes[0]] != ni || vol.dims[axes[1]] != nj || vol.dims[axes[2]] != nk {
+            return None;
         }
-        let base = j * self.sj + k * self.sk;
-        if self.si == 1 {
-            for (o, &v) in out.iter_mut().zip(&self.data[base..base + self.ni]) {
-                *o = u32::from(v);
-            }
-        } else {
-            for (i, o) in out[..self.ni].iter_mut().enumerate() {
-                *o = u32::from(self.data[base + i * self.si]);
-            }
+        if vol.data.len() != ni * nj * nk {
+            return None;
         }
-    }
-
-    fn plane_is_zero(&self, k: usize) -> bool {
-        (0..self.nj).all(|j| {
-            let base = j * self.sj + k * self.sk;
-            if self.si == 1 {
-                self.data[base..base + self.ni].iter().all(|&v| v == 0)
-            } else {
-                (0..self.ni).all(|i| self.data[base + i * self.si] == 0)
-            }
+        let strides = [1, vol.dims[0], vol.dims[0] * vol.dims[1]];
+        let (si, sj, sk) = (strides[axes[0]], strides[axes[1]], strides[axes[2]]);
+        let (pi, pj) = (ni + 1, nj + 1);
+        let mut data = vec![0u16; pi * pj * nk];
+        data.par_chunks_mut(pi * pj)
+            .enumerate()
+            .for_each(|(k, plane)| {
+                for (j, row) in plane.chunks_mut(pi).take(nj).enumerate() {
+                    let base = j * sj + k * sk;
+                    if si == 1 {
+                        row[..ni].copy_from_slice(&vol.data[base..base + ni]);
+                    } else {
+                        for (i, v) in row[..ni].iter_mut().enumerate() {
+                            *v = vol.data[base + i * si];
+                        }
+                    }
+                }
+            });
+        let (nbi, nbj) = (ni.div_ceil(BLOCK), nj.div_ceil(BLOCK));
+        let mut lo = vec![0u16; nbi * nbj * nk];
+        let mut hi = vec![0u16; nbi * nbj * nk];
+        lo.par_chunks_mut(nbi * nbj)
+            .zip(hi.par_chunks_mut(nbi * nbj))
+            .enumerate()
+            .for_each(|(k, (lo, hi))| {
+                let plane = &data[k * pi * pj..(k + 1) * pi * pj];
+                // Per row (the zero row included), per block column: the range of its columns.
+                let mut row_lo = vec![0u16; pj * nbi];
+                let mut row_hi = vec![0u16; pj * nbi];
+                for j in 0..pj {
+                    let row = &plane[j * pi..(j + 1) * pi];
+                    for bi in 0..nbi {
+                        let cols = &row[bi * BLOCK..=(bi * BLOCK + BLOCK).min(ni)];
+                        row_lo[j * nbi + bi] = cols.iter().copied().min().unwrap_or(0);
+                        row_hi[j * nbi + bi] = cols.iter().copied().max().unwrap_or(0);
+                    }
+                }
+                for bj in 0..nbj {
+                    for bi in 0..nbi {
+                        let rows = bj * BLOCK..=(bj * BLOCK + BLOCK).min(nj);
+                        lo[bj * nbi + bi] = rows
+                            .clone()
+                            .map(|j| row_lo[j * nbi + bi])
+                            .min()
+                            .unwrap_or(0);
+                        hi[bj * nbi + bi] = rows.map(|j| row_hi[j * nbi + bi]).max().unwrap_or(0);
+                    }
+                }
+            });
+        Some(Self {
+            axes,
+            dims: vol.dims,
+            ni,
+            nj,
+            nk,
+            data,
+            nbi,
+            nbj,
+            lo,
+            hi,
         })
+    }
+
+    /// Whether this copy is `vol`'s in the sweep order of `params` (same axes and dimensions).
+    pub fn fits(&self, params: &FrameParams, vol: &Volume) -> bool {
+        self.axes == [params.axis_i, params.axis_j, params.axis_k] && self.dims == vol.dims
+    }
+
+    /// Row `j` (`0 ..= nj`, `nj` the zero row) of plane `k`: `ni + 1` voxels, the last 0.
+    #[inline(always)]
+    fn row(&self, k: usize, j: usize) -> &[u16] {
+        let pi = self.ni + 1;
+        let at = (k * (self.nj + 1) + j) * pi;
+        &self.data[at..at + pi]
+    }
+
+    /// Whether every voxel of plane `k` is 0.
+    fn plane_is_zero(&self, k: usize) -> bool {
+        let n = self.nbi * self.nbj;
+        self.hi[k * n..(k + 1) * n].iter().all(|&h| h == 0)
     }
 }
 
@@ -139,18 +230,101 @@ fn class_in(sample: u32, mode: ShaderMode) -> ShaderIn {
     }
 }
 
+/// Whether the shader's output depends on a sample's gradient: lit, and the reflectance map not
+/// one texel everywhere. A uniform map gives every gradient the zero entry's intensity (its
+/// bilinear weights sum to one, and `rnd(t 2^(2f), 2f) = t`), so the shaded colour is a function
+/// of the class index alone.
+fn gradient_matters(shader: &Shader, mode: ShaderMode) -> bool {
+    if !Shader::reads_gradient(mode) {
+        return false;
+    }
+    let rmap = &shader.tables().rmap;
+    let z = rmap.zero();
+    let side = shader.config().rm_side();
+    !(0..6).all(|f| (0..side).all(|j| (0..side).all(|i| rmap.texel(f, i, j) == z)))
+}
+
+/// Whether a sample of corrected alpha 0 leaves every coxel of a frame unchanged, whatever came
+/// before it (`Compos::step` read rule by rule). `Max`: rule 5 keeps a coxel whose alpha is at
+/// least the sample's, and every alpha is at least 0. `FrontToBack`: rule 3 could terminate a
+/// coxel whose alpha has reached the threshold without the ray being marked terminated; rule 5
+/// marks a ray terminated whenever it brings the alpha to the threshold, and every ray starts at
+/// `Coxel::empty` (alpha 0), so that coxel exists only when the threshold is 0. Rule 5's channels
+/// are saturated at every write, so a zero weight adds nothing.
+fn zero_alpha_is_identity(compos: &Compos, init: &Coxel, mode: ComposMode) -> bool {
+    match mode {
+        ComposMode::Max => true,
+        ComposMode::FrontToBack => init.rgba[3] < compos.regs().et_threshold,
+        _ => false,
+    }
+}
+
+/// Range maximum over a table (sparse table: `levels[l][i]` = max of `2^l` entries from `i`).
+struct RangeMax {
+    levels: Vec<Vec<u64>>,
+}
+
+impl RangeMax {
+    fn new(t: &[u64]) -> Self {
+        let mut levels = vec![t.to_vec()];
+        let mut len = 1;
+        while 2 * len <= t.len() {
+            let prev = levels.last().unwrap();
+            let next: Vec<u64> = (0..=t.len() - 2 * len)
+                .map(|i| prev[i].max(prev[i + len]))
+                .collect();
+            levels.push(next);
+            len *= 2;
+        }
+        Self { levels }
+    }
+
+    /// The largest entry of `lo ..= hi`.
+    #[inline]
+    fn max(&self, lo: usize, hi: usize) -> u64 {
+        let n = hi - lo + 1;
+        let l = (usize::BITS - 1 - n.leading_zeros()) as usize;
+        let t = &self.levels[l];
+        t[lo].max(t[hi + 1 - (1 << l)])
+    }
+}
+
+/// Plane rows of one band of anchor rows: rows `b0 - 1 ..= b0 + BAND` of `S_s`, each with the set
+/// of its blocks already interpolated.
+struct BandRows {
+    b0: isize,
+    rows: Vec<u32>,
+    done: Vec<u64>,
+}
+
+impl BandRows {
+    fn new(ni: usize) -> Self {
+        Self {
+            b0: 0,
+            rows: vec![0; (BAND + 2) * ni],
+            done: vec![0; BAND + 2],
+        }
+    }
+}
+
 /// What the rows of one slice share.
 struct SliceWork<'a> {
     units: &'a FrameUnits,
-    frame: &'a Frame<'a>,
-    /// `S_s`, anchor order.
-    plane: &'a [u32],
+    sv: &'a SweepVolume,
     /// The corrected alpha of each class index (the compositing unit's `corrected` of the class
     /// entry's alpha): a sample's effect is known before its gradient.
     corrected: &'a [u64],
+    /// The shaded sample of each class index, coded for the compositing unit (depth 0), when
+    /// the gradient does not matter.
+    flat: Option<&'a [CodedSample]>,
+    /// Per block of this slice: the largest corrected alpha its samples can have.
+    amax: &'a [u64],
+    /// Samples of corrected alpha 0 are the identity of every coxel.
+    zero_ok: bool,
     /// Base-plane column of anchor 0.
     r0: usize,
     depth: u32,
+    k: usize,
     wx: u32,
     wy: u32,
     /// Volume slices of `s - 1` and `s + 1` (none outside the sweep).
@@ -159,57 +333,153 @@ struct SliceWork<'a> {
 }
 
 impl SliceWork<'_> {
-    /// Anchor row `b` against its row of coxels (`row`, one base-plane row). Inlined at a
-    /// constant `mode` so that the unit functions' mode branches fold.
-    #[inline(always)]
-    fn row(&self, b: usize, row: &mut [Coxel], mode: FrameMode) -> SweepStats {
-        let (smode, cmode) = modes(mode);
-        let (units, frame, plane) = (self.units, self.frame, self.plane);
-        let (ni, nj, depth) = (frame.ni, frame.nj, self.depth);
-        let mut st = SweepStats {
-            samples: ni as u64,
-            ..SweepStats::default()
-        };
-        let at = |a: usize, b: usize| plane[b * ni + a];
-        // S'(t) at anchor (a, b): slice k(t)'s voxels, slice s's weights.
-        let other = |k: Option<usize>, a: usize| match k {
+    /// Makes sure block column `c` of anchor row `b` is in the band's plane rows (`b` within
+    /// `b0 - 1 ..= b0 + BAND`; rows outside the face are left alone: they read as 0).
+    #[inline]
+    fn ensure(&self, band: &mut BandRows, b: isize, c: usize) {
+        if b < 0 || b >= self.sv.nj as isize {
+            return;
+        }
+        let r = (b - band.b0 + 1) as usize;
+        if band.done[r] & (1 << c) != 0 {
+            return;
+        }
+        band.done[r] |= 1 << c;
+        let ni = self.sv.ni;
+        let (a0, a1) = (c * BLOCK, ((c + 1) * BLOCK).min(ni));
+        let top = self.sv.row(self.k, b as usize);
+        let bot = self.sv.row(self.k, b as usize + 1);
+        let out = &mut band.rows[r * ni + a0..r * ni + a1];
+        self.units
+            .trilin
+            .row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, out);
+    }
+
+    /// `S'(t)` at anchor `(a, b)`: slice `k(t)`'s voxels, slice `s`'s weights (0 outside).
+    #[inline]
+    fn other(&self, k: Option<usize>, a: usize, b: usize) -> u32 {
+        match k {
             None => 0,
-            Some(k) => units
-                .trilin
-                .sample_in_slice(frame.corners(a, b, k), self.wx, self.wy),
-        };
-        let lit = Shader::reads_gradient(smode);
-        for (a, cox) in row[self.r0..self.r0 + ni].iter_mut().enumerate() {
-            if cox.terminated {
-                st.after_termination += 1;
-                continue;
+            Some(k) => {
+                let (top, bot) = (self.sv.row(k, b), self.sv.row(k, b + 1));
+                self.units.trilin.sample_in_slice(
+                    [
+                        u32::from(top[a]),
+                        u32::from(top[a + 1]),
+                        u32::from(bot[a]),
+                        u32::from(bot[a + 1]),
+                    ],
+                    self.wx,
+                    self.wy,
+                )
             }
-            let centre = at(a, b);
-            let corrected = self.corrected[units.shader.class_index(&class_in(centre, smode))];
-            if units
-                .compos
-                .leaves_unchanged_corrected(cox, corrected, depth, cmode)
-            {
-                st.without_effect += 1;
-                continue;
+        }
+    }
+
+    /// Anchor rows `b0 ..` against their rows of coxels (`rows`, one base-plane row each, `w`
+    /// coxels long). Inlined at a constant `mode` and `lit` so that the unit functions' mode
+    /// branches fold.
+    #[inline(always)]
+    fn band(
+        &self,
+        b0: usize,
+        rows: &mut [Coxel],
+        w: usize,
+        band: &mut BandRows,
+        mode: FrameMode,
+        lit: bool,
+    ) -> SweepStats {
+        let (smode, cmode) = modes(mode);
+        let units = self.units;
+        let (ni, nj, nbi) = (self.sv.ni, self.sv.nj, self.sv.nbi);
+        let mut st = SweepStats::default();
+        band.b0 = b0 as isize;
+        band.done.fill(0);
+        let shift = units.shader.config().sample_w() - units.shader.config().class_idx_w;
+        for (db, row) in rows.chunks_mut(w).enumerate() {
+            let b = b0 + db;
+            st.samples += ni as u64;
+            let amax = &self.amax[(b / BLOCK) * nbi..(b / BLOCK + 1) * nbi];
+            let row = &mut row[self.r0..self.r0 + ni];
+            for (c, (&am, cox)) in amax.iter().zip(row.chunks_mut(BLOCK)).enumerate() {
+                // A block whose samples cannot change a coxel it meets: `leaves_unchanged` holds
+                // for its largest alpha, so for every smaller one (rules 1-4 do not read the
+                // alpha; rule 5 keeps alpha 0 under `FrontToBack`, anything up to the coxel's
+                // under `Max`).
+                if (am == 0 && self.zero_ok)
+                    || cox.iter().all(|x| {
+                        units
+                            .compos
+                            .leaves_unchanged_corrected(x, am, self.depth, cmode)
+                    })
+                {
+                    st.in_skipped_blocks += cox.len() as u64;
+                    continue;
+                }
+                self.ensure(band, b as isize, c);
+                let r = (b as isize - band.b0 + 1) as usize;
+                let mut neighbours = false;
+                for (n, cox) in cox.iter_mut().enumerate() {
+                    let a = c * BLOCK + n;
+                    if cox.terminated {
+                        st.after_termination += 1;
+                        continue;
+                    }
+                    let centre = band.rows[r * ni + a];
+                    let idx = (centre >> shift) as usize;
+                    let corrected = self.corrected[idx];
+                    if units
+                        .compos
+                        .leaves_unchanged_corrected(cox, corrected, self.depth, cmode)
+                    {
+                        st.without_effect += 1;
+                        continue;
+                    }
+                    if lit {
+                        if !neighbours {
+                            neighbours = true;
+                            if c > 0 {
+                                self.ensure(band, b as isize, c - 1);
+                            }
+                            if (c + 1) * BLOCK < ni {
+                                self.ensure(band, b as isize, c + 1);
+                            }
+                            self.ensure(band, b as isize - 1, c);
+                            self.ensure(band, b as isize + 1, c);
+                        }
+                        let at = |rr: usize, aa: usize| band.rows[rr * ni + aa];
+                        let nb = [
+                            centre,
+                            if a > 0 { at(r, a - 1) } else { 0 },
+                            if a + 1 < ni { at(r, a + 1) } else { 0 },
+                            if b > 0 { at(r - 1, a) } else { 0 },
+                            if b + 1 < nj { at(r + 1, a) } else { 0 },
+                            self.other(self.k_before, a, b),
+                            self.other(self.k_after, a, b),
+                        ];
+                        let sample =
+                            shade_n6(&units.gradient, &units.shader, &nb, smode, self.depth);
+                        // `Compos::step`, spelled out so that it inlines here.
+                        *cox = units.compos.step_coded(cox, &units.compos.code(&sample));
+                    } else if let Some(flat) = self.flat {
+                        let coded = CodedSample {
+                            depth: self.depth,
+                            ..flat[idx]
+                        };
+                        *cox = units.compos.step_coded(cox, &coded);
+                    } else {
+                        let e = units.shader.shade(&class_in(centre, smode));
+                        let sample = Sample {
+                            rgb: [e.r, e.g, e.b],
+                            alpha: e.a,
+                            depth: self.depth,
+                            mode: cmode,
+                        };
+                        *cox = units.compos.step(cox, &sample);
+                    }
+                    st.shaded += 1;
+                }
             }
-            // Unlit without tf2d, the shader reads no gradient: the neighbours stay 0.
-            let nb = if lit {
-                [
-                    centre,
-                    if a > 0 { at(a - 1, b) } else { 0 },
-                    if a + 1 < ni { at(a + 1, b) } else { 0 },
-                    if b > 0 { at(a, b - 1) } else { 0 },
-                    if b + 1 < nj { at(a, b + 1) } else { 0 },
-                    other(self.k_before, a),
-                    other(self.k_after, a),
-                ]
-            } else {
-                [centre, 0, 0, 0, 0, 0, 0]
-            };
-            let sample = shade_n6(&units.gradient, &units.shader, &nb, smode, depth);
-            *cox = units.compos.step(cox, &sample);
-            st.shaded += 1;
         }
         st
     }
@@ -227,32 +497,38 @@ pub fn render_base_plane_stats(
     vol: &Volume,
     units: &FrameUnits,
 ) -> (BasePlane, SweepStats) {
-    let anchors = params.samples() as u64;
-    let dims = vol.dims;
-    if dims[params.axis_i] != params.ni
-        || dims[params.axis_j] != params.nj
-        || dims[params.axis_k] != params.nk
-    {
-        // Not a volume of these parameters: only the reference reads it (as zeros outside).
-        let bp = render_base_plane_reference(params, vol, units);
-        let stats = SweepStats {
-            anchors,
-            samples: anchors,
-            shaded: anchors,
-            rays_terminated: bp.coxels.iter().filter(|c| c.terminated).count() as u64,
-            ..SweepStats::default()
-        };
-        return (bp, stats);
+    match SweepVolume::new(params, vol) {
+        Some(sv) => render_sweep(params, &sv, units),
+        None => {
+            // Not a volume of these parameters: only the reference reads it (as zeros outside).
+            let bp = render_base_plane_reference(params, vol, units);
+            let anchors = params.samples() as u64;
+            let stats = SweepStats {
+                anchors,
+                samples: anchors,
+                shaded: anchors,
+                rays_terminated: bp.coxels.iter().filter(|c| c.terminated).count() as u64,
+                ..SweepStats::default()
+            };
+            (bp, stats)
+        }
     }
-    let strides = [1, dims[0], dims[0] * dims[1]];
-    let frame = Frame {
-        data: &vol.data,
-        ni: params.ni,
-        nj: params.nj,
-        si: strides[params.axis_i],
-        sj: strides[params.axis_j],
-        sk: strides[params.axis_k],
-    };
+}
+
+/// [`render_base_plane_stats`] on a volume already in the sweep's order (`SweepVolume::new` of
+/// the frame's volume for these parameters; one with other axes or dimensions is refused by a
+/// panic, as a programming error).
+pub fn render_sweep(
+    params: &FrameParams,
+    sv: &SweepVolume,
+    units: &FrameUnits,
+) -> (BasePlane, SweepStats) {
+    assert!(
+        sv.axes == [params.axis_i, params.axis_j, params.axis_k]
+            && [sv.ni, sv.nj, sv.nk] == [params.ni, params.nj, params.nk],
+        "render_sweep: {sv:?} is not in the sweep order of {params:?}"
+    );
+    let anchors = params.samples() as u64;
     let (ni, nj, nk) = (params.ni, params.nj, params.nk);
     let (w, h) = params.base_plane_size();
     let ((_, max_sx), (_, max_sy)) = params.shift_range();
@@ -261,6 +537,8 @@ pub fn render_base_plane_stats(
     let (smode, cmode) = modes(units.mode);
     let ww = units.trilin.config().weight_w;
     let weight = |f: u32| f >> (STEP_W - ww);
+    let scfg = units.shader.config();
+    let shift = scfg.sample_w() - scfg.class_idx_w;
     // The corrected alpha of a sample, known before its gradient (no 2-D classification in the
     // frame): the compositing unit's correction of the classified alpha, per class index.
     let corrected: Vec<u64> = units
@@ -271,93 +549,101 @@ pub fn render_base_plane_stats(
         .iter()
         .map(|e| units.compos.corrected(e.a))
         .collect();
+    let range_max = RangeMax::new(&corrected);
+    let lit = gradient_matters(&units.shader, smode);
+    // Without the gradient, a sample's way through the shader and the compositing unit's coding
+    // is a function of its class index: the units' own outputs, once per index.
+    let flat: Option<Vec<CodedSample>> = (!lit).then(|| {
+        (0..corrected.len())
+            .map(|idx| {
+                let e = units.shader.shade(&class_in((idx as u32) << shift, smode));
+                units.compos.code(&Sample {
+                    rgb: [e.r, e.g, e.b],
+                    alpha: e.a,
+                    depth: 0,
+                    mode: cmode,
+                })
+            })
+            .collect()
+    });
+    let zero_ok = zero_alpha_is_identity(&units.compos, &init, cmode);
+    // A voxel range's class indices (samples lie between their corners' smallest and largest).
+    let frac = units.trilin.config().frac_w;
+    let idx_of = |v: u16| ((u32::from(v) << frac) >> shift) as usize;
 
     // Leading and trailing slices with every voxel 0 (their samples, and their neighbours' reads
-    // of them, are 0 with or without them).
-    let front_zero = (0..nk)
-        .take_while(|&s| frame.plane_is_zero(params.slice(s).k))
-        .count();
-    let back_zero = if front_zero == nk {
-        0
+    // of them, are 0 with or without them), left out when a zero sample is every coxel's identity.
+    let zero_sample = units.trilin.sample_in_slice([0; 4], 0, 0);
+    let alpha0 = corrected[(zero_sample >> shift) as usize];
+    let (front_zero, back_zero) = if zero_ok && alpha0 == 0 {
+        let front = (0..nk)
+            .take_while(|&s| sv.plane_is_zero(params.slice(s).k))
+            .count();
+        let back = if front == nk {
+            0
+        } else {
+            (0..nk)
+                .rev()
+                .take_while(|&s| sv.plane_is_zero(params.slice(s).k))
+                .count()
+        };
+        (front, back)
     } else {
-        (0..nk)
-            .rev()
-            .take_while(|&s| frame.plane_is_zero(params.slice(s).k))
-            .count()
+        (0, 0)
     };
 
     let mut stats = SweepStats {
         anchors,
+        slices_skipped: (front_zero, back_zero),
         ..SweepStats::default()
     };
-    let mut plane = vec![0u32; ni * nj];
-    for s in 0..nk {
+    let nb = sv.nbi * sv.nbj;
+    let mut amax = vec![0u64; nb];
+    // The plane rows of every band, made once per frame.
+    let mut bands: Vec<BandRows> = (0..nj.div_ceil(BAND)).map(|_| BandRows::new(ni)).collect();
+    for s in front_zero..nk - back_zero {
         let c = params.slice(s);
         let depth = s as u32;
         let r0 = (max_sx - c.shift_x) as usize;
         let q0 = (max_sy - c.shift_y) as usize;
         let rows = &mut coxels[q0 * w..(q0 + nj) * w];
         let (wx, wy) = (weight(c.frac_x), weight(c.frac_y));
-        // The sample of four zero voxels (a row of them is filled without interpolating) and
-        // its corrected alpha.
-        let zero_sample = units.trilin.sample_in_slice([0; 4], wx, wy);
-        let alpha0 = corrected[units.shader.class_index(&class_in(zero_sample, smode))];
-        let empty = s < front_zero || s >= nk - back_zero;
-        if empty
-            && rows.par_chunks(w).all(|row| {
-                row[r0..r0 + ni].iter().all(|cox| {
-                    units
-                        .compos
-                        .leaves_unchanged_corrected(cox, alpha0, depth, cmode)
-                })
-            })
-        {
-            if s < front_zero {
-                stats.slices_skipped.0 += 1;
-            } else {
-                stats.slices_skipped.1 += 1;
-            }
-            continue;
+        for (m, (&lo, &hi)) in amax.iter_mut().zip(
+            sv.lo[c.k * nb..(c.k + 1) * nb]
+                .iter()
+                .zip(&sv.hi[c.k * nb..(c.k + 1) * nb]),
+        ) {
+            *m = range_max.max(idx_of(lo), idx_of(hi));
         }
-        // 1. The plane of samples S_s.
-        plane.par_chunks_mut(ni).enumerate().for_each_init(
-            || (vec![0u32; ni + 1], vec![0u32; ni + 1]),
-            |(top, bot), (b, out)| {
-                frame.row(b, c.k, top);
-                frame.row(b + 1, c.k, bot);
-                if top.iter().chain(bot.iter()).all(|&v| v == 0) {
-                    out.fill(zero_sample);
-                    return;
-                }
-                for (a, o) in out.iter_mut().enumerate() {
-                    *o = units.trilin.sample_in_slice(
-                        [top[a], top[a + 1], bot[a], bot[a + 1]],
-                        wx,
-                        wy,
-                    );
-                }
-            },
-        );
-        // 2. Every anchor against the coxel of its ray, rows in parallel.
         let work = SliceWork {
             units,
-            frame: &frame,
-            plane: &plane,
+            sv,
             corrected: &corrected,
+            flat: flat.as_deref(),
+            amax: &amax,
+            zero_ok,
             r0,
             depth,
+            k: c.k,
             wx,
             wy,
             k_before: (s > 0).then(|| params.slice(s - 1).k),
             k_after: (s + 1 < nk).then(|| params.slice(s + 1).k),
         };
-        // One copy of the row loop per mode, so that the units' mode branches fold away.
+        // Bands of anchor rows in parallel; one copy of the band loop per mode and lighting, so
+        // that the units' mode branches fold away.
         let part = rows
-            .par_chunks_mut(w)
+            .par_chunks_mut(BAND * w)
+            .zip(bands.par_iter_mut())
             .enumerate()
-            .map(|(b, row)| match units.mode {
-                FrameMode::Mip => work.row(b, row, FrameMode::Mip),
-                FrameMode::Composite => work.row(b, row, FrameMode::Composite),
+            .map(|(n, (rows, band))| match (units.mode, lit) {
+                (FrameMode::Mip, _) => work.band(n * BAND, rows, w, band, FrameMode::Mip, false),
+                (FrameMode::Composite, false) => {
+                    work.band(n * BAND, rows, w, band, FrameMode::Composite, false)
+                }
+                (FrameMode::Composite, true) => {
+                    work.band(n * BAND, rows, w, band, FrameMode::Composite, true)
+                }
             })
             .reduce(SweepStats::default, SweepStats::add);
         stats = stats.add(part);
@@ -427,14 +713,53 @@ mod tests {
         v
     }
 
-    /// The fast path and the reference render `vol` alike from every view, P = 1, 4, 8, MIP and
-    /// composite; returns the summed stats (to check that the skips were exercised).
+    /// The fast path and the reference render `vol` alike from view `v` at `p` pipelines in
+    /// `mode`, early termination at `et` (`None`: off); returns the fast path's stats.
+    fn check_one(
+        what: &str,
+        vol: &Volume,
+        cfg: &FrameConfig,
+        tf: &TransferFunction,
+        et: Option<f64>,
+        (v, p, mode): ([f64; 3], usize, FrameMode),
+    ) -> SweepStats {
+        let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), p).unwrap();
+        let params = setup.params;
+        let units =
+            FrameUnits::with_config(cfg, mode, &setup, tf, &frame_phong(&params, &[]), et).unwrap();
+        let want = render_base_plane_reference(&params, vol, &units);
+        let (got, st) = render_base_plane_stats(&params, vol, &units);
+        assert_eq!((got.width, got.height), (want.width, want.height));
+        if let Some(i) = (0..want.coxels.len()).find(|&i| got.coxels[i] != want.coxels[i]) {
+            panic!(
+                "{what}, view {v:?}, P {p}, {mode:?}, termination {et:?} (CUBE5_SEED={}): coxel \
+                 ({}, {}) is {:?}, the reference {:?}",
+                seed(),
+                i % want.width,
+                i / want.width,
+                got.coxels[i],
+                want.coxels[i]
+            );
+        }
+        let swept = (params.nk - st.slices_skipped.0 - st.slices_skipped.1) as u64;
+        assert_eq!(st.samples, swept * (params.ni * params.nj) as u64);
+        assert_eq!(
+            st.shaded + st.without_effect + st.after_termination + st.in_skipped_blocks,
+            st.samples
+        );
+        let reached = got.coxels.iter().filter(|c| c.terminated).count() as u64;
+        assert_eq!(st.rays_terminated, reached);
+        st
+    }
+
+    /// [`check_one`] from every view, P = 1, 4, 8 in turn, MIP and composite; returns the summed
+    /// stats (to check that the skips were exercised).
     fn check_equal(
         what: &str,
         vol: &Volume,
         cfg: &FrameConfig,
         tf: &TransferFunction,
-        early_termination: bool,
+        early_termination: Option<f64>,
         views: &[[f64; 3]],
     ) -> SweepStats {
         let mut total = SweepStats::default();
@@ -443,44 +768,144 @@ mod tests {
             if vol.dims.iter().any(|d| d % p != 0) {
                 continue;
             }
-            let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(*v), p).unwrap();
-            let params = setup.params;
             for mode in [FrameMode::Mip, FrameMode::Composite] {
-                let units = FrameUnits::with_config(
-                    cfg,
-                    mode,
-                    &setup,
-                    tf,
-                    &frame_phong(&params, &[]),
-                    early_termination.then_some(ET_DEFAULT),
-                )
-                .unwrap();
-                let want = render_base_plane_reference(&params, vol, &units);
-                let (got, st) = render_base_plane_stats(&params, vol, &units);
-                assert_eq!((got.width, got.height), (want.width, want.height));
-                if let Some(i) = (0..want.coxels.len()).find(|&i| got.coxels[i] != want.coxels[i]) {
-                    panic!(
-                        "{what}, view {v:?}, P {p}, {mode:?} (CUBE5_SEED={}): coxel ({}, {}) is \
-                         {:?}, the reference {:?}",
-                        seed(),
-                        i % want.width,
-                        i / want.width,
-                        got.coxels[i],
-                        want.coxels[i]
-                    );
-                }
-                let swept = (params.nk - st.slices_skipped.0 - st.slices_skipped.1) as u64;
-                assert_eq!(st.samples, swept * (params.ni * params.nj) as u64);
-                assert_eq!(
-                    st.shaded + st.without_effect + st.after_termination,
-                    st.samples
-                );
+                let st = check_one(what, vol, cfg, tf, early_termination, (*v, p, mode));
                 total = total.add(st);
                 total.slices_skipped.0 += st.slices_skipped.0 + st.slices_skipped.1;
                 total.rays_terminated += st.rays_terminated;
             }
         }
         total
+    }
+
+    /// `vol` with every voxel at least `floor` (no block of zeros left).
+    fn lifted(vol: &Volume, floor: u16) -> Volume {
+        let data = vol.data.iter().map(|&v| v.max(floor)).collect();
+        Volume::new(vol.dims, vol.spacing, vol.bits, data).unwrap()
+    }
+
+    /// The sweep's block skipping, directed: a transfer function with transparent bands over a
+    /// volume without a zero voxel (only the classification can make a block transparent), early
+    /// termination at several thresholds, and MIP over a volume whose every block has some
+    /// alpha (only the rays' maxima can make a block skippable). Each equals the reference and
+    /// each skips blocks.
+    #[test]
+    fn block_skipping_equals_the_reference() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 2);
+        let vs = views(4, &mut rng);
+        let cfg = FrameConfig::DEFAULT;
+        let head = head_phantom(32, 12).unwrap();
+        let p = |density, rgba| crate::transfer::TfPoint { density, rgba };
+        let band = TransferFunction {
+            points: vec![
+                p(0.0, [0.0; 4]),
+                p(0.45, [0.9, 0.8, 0.7, 0.0]),
+                p(0.5, [0.9, 0.8, 0.7, 0.4]),
+                p(0.55, [0.9, 0.8, 0.7, 0.0]),
+                p(0.8, [0.9, 0.9, 0.9, 0.0]),
+                p(0.9, [0.9, 0.9, 0.9, 0.6]),
+                p(1.0, [0.9, 0.9, 0.9, 0.6]),
+            ],
+        };
+        let no_zeros = lifted(&head, 40);
+        for et in [None, Some(ET_DEFAULT)] {
+            let st = check_equal("lifted head, bands", &no_zeros, &cfg, &band, et, &vs);
+            assert!(st.in_skipped_blocks > 0 && st.shaded > 0, "{st:?}");
+        }
+        // Early termination at several thresholds (0: every ray ends at its first sample).
+        let tf = TransferFunction::head_default();
+        let opaque = TransferFunction::preset("iso").unwrap();
+        for t in [0.0, 0.05, 0.3, 0.7, 0.9, ET_DEFAULT] {
+            let mut st = SweepStats::default();
+            for (name, tf) in [("head", &tf), ("head, iso", &opaque)] {
+                for (n, v) in vs.iter().enumerate() {
+                    let p = [1, 4, 8][n % 3];
+                    let one = check_one(
+                        name,
+                        &head,
+                        &cfg,
+                        tf,
+                        Some(t),
+                        (*v, p, FrameMode::Composite),
+                    );
+                    st = st.add(one);
+                    st.rays_terminated += one.rays_terminated;
+                }
+            }
+            assert!(
+                st.rays_terminated > 0 && st.after_termination > 0,
+                "{t}: {st:?}"
+            );
+            if t > 0.0 {
+                assert!(st.in_skipped_blocks > 0, "{t}: {st:?}");
+            }
+        }
+        // MIP: every block has alpha above 0 (voxels >= 256 classify above index 0), so only the
+        // maxima already on the rays let a block go.
+        let bright = lifted(&head, 256);
+        let mut st = SweepStats::default();
+        for (n, v) in vs.iter().enumerate() {
+            st = st.add(check_one(
+                "bright head, MIP",
+                &bright,
+                &cfg,
+                &tf,
+                None,
+                (*v, [1, 4, 8][n % 3], FrameMode::Mip),
+            ));
+        }
+        assert!(st.in_skipped_blocks > 0 && st.shaded > 0, "{st:?}");
+    }
+
+    /// The block skipping's premise: `Compos::leaves_unchanged_corrected` is monotone in the
+    /// alpha (true for alpha `a` implies true for every smaller one) under the frame's modes.
+    #[test]
+    fn leaves_unchanged_is_monotone_in_alpha() {
+        use crate::units::cube5_compos::{ComposConfig, OpacityLut};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 3);
+        let cfg = ComposConfig::DEFAULT;
+        let one = cfg.one();
+        for regs in [
+            ComposRegs::defaults(&cfg),
+            ComposRegs::without_termination(&cfg),
+            ComposRegs {
+                et_threshold: 0,
+                ..ComposRegs::defaults(&cfg)
+            },
+        ] {
+            let c = Compos::new(cfg, OpacityLut::new(1.0, &cfg).unwrap(), regs).unwrap();
+            for _ in 0..50_000 {
+                let coxel = Coxel {
+                    rgba: std::array::from_fn(|_| match rng.random_range(0..3) {
+                        0 => 0,
+                        1 => rng.random_range(0..=one),
+                        _ => rng.random_range(0..=cfg.chan_max()),
+                    }),
+                    z: if rng.random_bool(0.8) {
+                        cfg.z_none()
+                    } else {
+                        rng.random_range(0..=cfg.z_none())
+                    },
+                    geo: [0; 3],
+                    terminated: rng.random_bool(0.2),
+                };
+                let depth = rng.random_range(0..=cfg.z_none());
+                let top = 1u64 << cfg.q();
+                let hi = match rng.random_range(0..3) {
+                    0 => 0,
+                    _ => rng.random_range(0..=top),
+                };
+                let lo = rng.random_range(0..=hi);
+                for mode in [ComposMode::FrontToBack, ComposMode::Max] {
+                    if c.leaves_unchanged_corrected(&coxel, hi, depth, mode) {
+                        assert!(
+                            c.leaves_unchanged_corrected(&coxel, lo, depth, mode),
+                            "{mode:?} {coxel:?} {lo} {hi}"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     /// The fast path equals the per-sample reference bit for bit: phantoms, non-cubic and
@@ -493,14 +918,14 @@ mod tests {
         let head = head_phantom(24, 12).unwrap();
         let tf = TransferFunction::head_default();
         let vs = views(6, &mut rng);
-        let mut total = check_equal("head 24^3", &head, &cfg, &tf, false, &vs);
+        let mut total = check_equal("head 24^3", &head, &cfg, &tf, None, &vs);
         let noncubic = window(&head, [0, 4, -4], [24, 16, 32], [1.0; 3]);
         total = total.add(check_equal(
             "head 24x16x32",
             &noncubic,
             &cfg,
             &tf,
-            false,
+            None,
             &vs,
         ));
         let aniso = window(&head, [4, 0, 2], [16, 24, 16], [1.0, 0.7, 1.6]);
@@ -509,7 +934,7 @@ mod tests {
             &aniso,
             &cfg,
             &tf,
-            false,
+            None,
             &vs,
         ));
         // Empty slices around the data on every side: the skipping.
@@ -519,7 +944,7 @@ mod tests {
             [24, 32, 32],
             [1.0; 3],
         );
-        let st = check_equal("head padded", &padded, &cfg, &tf, false, &vs);
+        let st = check_equal("head padded", &padded, &cfg, &tf, None, &vs);
         assert!(st.slices_skipped.0 > 0, "no slice skipped: {st:?}");
         total = total.add(st);
         let iso = TransferFunction::preset("iso").unwrap();
@@ -527,7 +952,7 @@ mod tests {
             ("sphere", sphere_phantom(16, 12).unwrap()),
             ("bubbles", bubbles_phantom(16, 12).unwrap()),
         ] {
-            total = total.add(check_equal(name, &vol, &cfg, &iso, false, &vs[..8]));
+            total = total.add(check_equal(name, &vol, &cfg, &iso, None, &vs[..8]));
         }
         // Early termination: opaque surfaces end rays.
         let mut et = SweepStats::default();
@@ -535,7 +960,7 @@ mod tests {
             ("sphere, ET", sphere_phantom(24, 12).unwrap(), &iso),
             ("head, ET", head.clone(), &tf),
         ] {
-            let st = check_equal(name, &vol, &cfg, tf, true, &vs);
+            let st = check_equal(name, &vol, &cfg, tf, Some(ET_DEFAULT), &vs);
             et.after_termination += st.after_termination;
             et.rays_terminated += st.rays_terminated;
         }
@@ -546,7 +971,7 @@ mod tests {
             .collect();
         let noise = Volume::new([16, 8, 24], [1.0; 3], 12, noise).unwrap();
         let grey = TransferFunction::preset("grey").unwrap();
-        total = total.add(check_equal("noise", &noise, &cfg, &grey, false, &vs[..8]));
+        total = total.add(check_equal("noise", &noise, &cfg, &grey, None, &vs[..8]));
         assert!(total.shaded > 0 && total.without_effect > 0, "{total:?}");
     }
 
@@ -580,7 +1005,7 @@ mod tests {
             // Narrow depth (ZW = 8) is smaller than the slice count here: samples past it fail
             // the depth test.
             let long = window(&vol, [0, 0, -4], [16, 16, 24], [1.0; 3]);
-            for et in [false, true] {
+            for et in [None, Some(ET_DEFAULT)] {
                 check_equal(name, &vol, &cfg, &tf, et, &vs);
                 check_equal(name, &long, &cfg, &tf, et, &vs[..4]);
             }
