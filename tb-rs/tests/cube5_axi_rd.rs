@@ -11,7 +11,7 @@ use cube5_tb::{Mismatch, TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{configs, gate_configs, seed};
+use support::{configs, expect_mismatch, gate_configs, seed};
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
 /// optionally a reset after `reset_at` cycles followed by `after` commands.
@@ -165,6 +165,44 @@ fn describe_beat(cfg: AxiRdConfig, cmds: &[AxiRdCmd], k: usize) -> String {
     "(no command: an extra beat)".into()
 }
 
+/// `variant` opened with Verilator seed `seed`, its AXI subordinate set up and loaded as `case` says.
+fn open_with_memory(
+    variant: &'static Variant,
+    cfg: AxiRdConfig,
+    seed: u64,
+    case: &Case,
+) -> Result<RtlStream<AxiRdConfig>, TbError> {
+    let mut dut = RtlStream::new(variant, cfg, seed as u32)?;
+    dut.axi_setup(&case.setup)?;
+    dut.axi_load(case.mem.base, &case.mem.bytes)?;
+    Ok(dut)
+}
+
+/// The mismatch of `cmds` on `variant` (its memory as `case` says) against the model `model` with
+/// the image `mem`, at full speed: panics if they agree.
+fn mismatch_against(
+    variant: &'static Variant,
+    case: &Case,
+    model: AxiRdConfig,
+    cmds: &[AxiRdCmd],
+    mem: &AxiMemImage,
+) -> Mismatch {
+    let cfg = variant.config().unwrap();
+    let mut dut = open_with_memory(variant, cfg, 1, case).unwrap();
+    let run = drive_and_compare(
+        &mut dut,
+        variant,
+        model,
+        1,
+        cmds,
+        mem,
+        &case.traffic,
+        None,
+        &mut Report::default(),
+    );
+    expect_mismatch(run, "the RTL and a different model")
+}
+
 /// Drives one list of commands (`max_cycles` bounds it) and compares what came out as a prefix
 /// (`exact = false`: a reset cuts the run) or in full.
 #[allow(clippy::too_many_arguments)]
@@ -303,61 +341,44 @@ fn run(
         cfg.check_cmd(c)
             .map_err(|e| TbError::setup(variant.name, e))?;
     }
-    let mut dut = RtlStream::new(variant, cfg, seed as u32)?;
-    dut.axi_setup(&case.setup)?;
-    dut.axi_load(case.mem.base, &case.mem.bytes)?;
+    let mut dut = open_with_memory(variant, cfg, seed, case)?;
     if let Some((path, (from, to))) = &trace {
         dut.trace_window(path, *from, *to);
     }
     let mut report = Report::default();
-    let (mem, traffic) = (&case.mem, &case.traffic);
-    match &case.reset {
-        None => drive_and_compare(
-            &mut dut,
+    let drive = |dut: &mut RtlStream<AxiRdConfig>, cmds: &[AxiRdCmd], stop, report: &mut Report| {
+        drive_and_compare(
+            dut,
             variant,
             cfg,
             seed,
-            &case.cmds,
-            mem,
-            traffic,
-            None,
-            &mut report,
-        )?,
-        Some((at, after)) => {
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
+            cmds,
+            &case.mem,
+            &case.traffic,
+            stop,
+            report,
+        )
+    };
+    // With a reset: the commands up to the reset's cycle, then the ones after it.
+    drive(
+        &mut dut,
+        &case.cmds,
+        case.reset.as_ref().map(|r| r.0),
+        &mut report,
+    )?;
+    if let Some((_, after)) = &case.reset {
+        dut.reset();
+        let c = dut.axi_counters();
+        if c.in_flight != 0 {
+            return Err(TbError::Protocol {
+                variant: variant.name.to_string(),
                 seed,
-                &case.cmds,
-                mem,
-                traffic,
-                Some(*at),
-                &mut report,
-            )?;
-            dut.reset();
-            let c = dut.axi_counters();
-            if c.in_flight != 0 {
-                return Err(TbError::Protocol {
-                    variant: variant.name.to_string(),
-                    seed,
-                    cycle: dut.cycle(),
-                    what: format!("{} bursts still in flight after the reset", c.in_flight),
-                });
-            }
-            report.dropped_at_reset = c.dropped_at_reset;
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                after,
-                mem,
-                traffic,
-                None,
-                &mut report,
-            )?;
+                cycle: dut.cycle(),
+                what: format!("{} bursts still in flight after the reset", c.in_flight),
+            });
         }
+        report.dropped_at_reset = c.dropped_at_reset;
+        drive(&mut dut, after, None, &mut report)?;
     }
     report.rready_low = dut.axi_counters().rready_low;
     Ok(report)
@@ -681,22 +702,7 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
     // The model with one byte of the image changed: the beat differs, and the report names it.
     let mut wrong = case.clone();
     wrong.mem.bytes[(4096 - b) as usize] ^= 1;
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    dut.axi_setup(&case.setup).unwrap();
-    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
-    let err = drive_and_compare(
-        &mut dut,
-        variant,
-        cfg,
-        1,
-        &cmds,
-        &wrong.mem,
-        &case.traffic,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
-    let m = err.mismatch().expect("a mismatch");
+    let m = mismatch_against(variant, &case, cfg, &cmds, &wrong.mem);
     assert_eq!(m.item, 0);
     assert!(m.input.contains("command #0"), "{}", m.input);
     // The AR of a 4 KB crossing is two bursts: one beat to the boundary, two after it.
@@ -712,23 +718,8 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
         addr: mem.base,
         len: cfg.max_burst,
     }];
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    dut.axi_setup(&case.setup).unwrap();
-    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
-    let err = drive_and_compare(
-        &mut dut,
-        variant,
-        half,
-        1,
-        &long,
-        &mem,
-        &case.traffic,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
-    let m = err.mismatch().expect("a mismatch");
-    assert!(m.what.starts_with("AR burst differs"), "{err}");
+    let m = mismatch_against(variant, &case, half, &long, &mem);
+    assert!(m.what.starts_with("AR burst differs"), "{}", m.what);
     assert_eq!(m.item, 0);
 }
 
