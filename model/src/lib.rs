@@ -4,7 +4,8 @@
 //! Pure Rust: builds and tests with no Verilator and no C++ compiler.
 //!
 //! Layering, bottom up: `bits`, `error`, `unit` (the stream trait every unit implements);
-//! `volume`, `transfer`, `camera`; `units` (one module per RTL top, named as the top);
+//! `regmap` (the register-map types) and `regs` (the generated maps); `volume`, `transfer`,
+//! `camera`; `units` (one module per RTL top, named as the top);
 //! `phantom`, `volume_io`, `scene`, `render` (scenes, files and renderers that use the units);
 //! `scene_render` (what `cube5 render` runs: a scene on the frame model, or a named what-if);
 //! `slab_perspective` (a what-if: perspective approximated by parallel slabs);
@@ -15,6 +16,7 @@ pub mod bits;
 pub mod camera;
 pub mod error;
 pub mod phantom;
+pub mod regmap;
 pub mod regs;
 pub mod render;
 pub mod scene;

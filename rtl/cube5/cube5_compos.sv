@@ -154,44 +154,20 @@ module cube5_compos #(
   // ---------------------------------------------------------------------------
   // Stage handshakes: a stage takes a new item when it is empty or its item moves on
   // ---------------------------------------------------------------------------
-  // One scalar per stage (not a vector): in a gate-level netlist the bits of a vector whose bits
-  // feed each other become a circular vector that Verilator evaluates stale (UNOPTFLAT).
-  logic valid_q1, valid_q2, valid_q3, valid_q4, valid_q5, valid_q6;
+  // The stages' valids and enables (cube5_valid_chain: no vector whose bits feed each other).
   logic ready_1, ready_2, ready_3, ready_4, ready_5, ready_6;
 
-  assign ready_6    = !valid_q6 || out_ready_i;
-  assign ready_5    = !valid_q5 || ready_6;
-  assign ready_4    = !valid_q4 || ready_5;
-  assign ready_3    = !valid_q3 || ready_4;
-  assign ready_2    = !valid_q2 || ready_3;
-  assign ready_1    = !valid_q1 || ready_2;
+  cube5_valid_chain #(
+    .Stages (6)
+  ) u_valid (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (in_valid_i),
+    .out_ready_i (out_ready_i),
+    .ready_o     ({ready_6, ready_5, ready_4, ready_3, ready_2, ready_1}),
+    .out_valid_o (out_valid_o)
+  );
   assign in_ready_o = ready_1;
-
-  logic valid_d1, valid_d2, valid_d3, valid_d4, valid_d5, valid_d6;
-  assign valid_d1 = ready_1 ? in_valid_i : valid_q1;
-  assign valid_d2 = ready_2 ? valid_q1   : valid_q2;
-  assign valid_d3 = ready_3 ? valid_q2   : valid_q3;
-  assign valid_d4 = ready_4 ? valid_q3   : valid_q4;
-  assign valid_d5 = ready_5 ? valid_q4   : valid_q5;
-  assign valid_d6 = ready_6 ? valid_q5   : valid_q6;
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      valid_q1 <= 1'b0;
-      valid_q2 <= 1'b0;
-      valid_q3 <= 1'b0;
-      valid_q4 <= 1'b0;
-      valid_q5 <= 1'b0;
-      valid_q6 <= 1'b0;
-    end else begin
-      valid_q1 <= valid_d1;
-      valid_q2 <= valid_d2;
-      valid_q3 <= valid_d3;
-      valid_q4 <= valid_d4;
-      valid_q5 <= valid_d5;
-      valid_q6 <= valid_d6;
-    end
-  end
 
   // ---------------------------------------------------------------------------
   // Stage 1, decode: depth test, early-termination compare, LUT read
@@ -560,7 +536,6 @@ module cube5_compos #(
     end
   end
 
-  assign out_valid_o = valid_q6;
   assign out_data_o  = coxel_q6;
 
   // Carries that are always 0 (see above) and the discarded fraction of the weight.

@@ -103,14 +103,18 @@ module cube5_gradient #(
   // ---------------------------------------------------------------------------
   // Stage handshakes: a stage takes a new item when it is empty or its item moves on
   // ---------------------------------------------------------------------------
-  logic valid_1_q, valid_2_q, valid_3_q, valid_4_q, valid_5_q;
   logic ready_1, ready_2, ready_3, ready_4, ready_5;
 
-  assign ready_5    = !valid_5_q || out_ready_i;
-  assign ready_4    = !valid_4_q || ready_5;
-  assign ready_3    = !valid_3_q || ready_4;
-  assign ready_2    = !valid_2_q || ready_3;
-  assign ready_1    = !valid_1_q || ready_2;
+  cube5_valid_chain #(
+    .Stages (5)
+  ) u_valid (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (in_valid_i),
+    .out_ready_i (out_ready_i),
+    .ready_o     ({ready_5, ready_4, ready_3, ready_2, ready_1}),
+    .out_valid_o (out_valid_o)
+  );
   assign in_ready_o = ready_1;
 
   // ---------------------------------------------------------------------------
@@ -346,31 +350,8 @@ module cube5_gradient #(
   logic [4*GradW-1:0] out_q;
 
   // ---------------------------------------------------------------------------
-  // Registers: valids reset (synchronously), datapath not
+  // Datapath registers (not reset; the valids are u_valid's)
   // ---------------------------------------------------------------------------
-  logic valid_1_d, valid_2_d, valid_3_d, valid_4_d, valid_5_d;
-  assign valid_1_d = ready_1 ? in_valid_i : valid_1_q;
-  assign valid_2_d = ready_2 ? valid_1_q  : valid_2_q;
-  assign valid_3_d = ready_3 ? valid_2_q  : valid_3_q;
-  assign valid_4_d = ready_4 ? valid_3_q  : valid_4_q;
-  assign valid_5_d = ready_5 ? valid_4_q  : valid_5_q;
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      valid_1_q <= 1'b0;
-      valid_2_q <= 1'b0;
-      valid_3_q <= 1'b0;
-      valid_4_q <= 1'b0;
-      valid_5_q <= 1'b0;
-    end else begin
-      valid_1_q <= valid_1_d;
-      valid_2_q <= valid_2_d;
-      valid_3_q <= valid_3_d;
-      valid_4_q <= valid_4_d;
-      valid_5_q <= valid_5_d;
-    end
-  end
-
   always_ff @(posedge clk_i) begin
     if (ready_1) begin
       g6_q     <= g6_d;
@@ -405,7 +386,6 @@ module cube5_gradient #(
     end
   end
 
-  assign out_valid_o = valid_5_q;
   assign out_data_o  = out_q;
 
 `ifndef SYNTHESIS

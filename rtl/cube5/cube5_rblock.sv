@@ -77,29 +77,18 @@ module cube5_rblock #(
   // ---------------------------------------------------------------------------
   // One register stage
   // ---------------------------------------------------------------------------
-  logic              valid_d, valid_q;
-  logic [TotalW-1:0] result_d, result_q;
-
-  assign in_ready_o = !valid_q || out_ready_i;
-  assign valid_d    = in_ready_o ? in_valid_i : valid_q;
-  assign result_d   = dir ? linear : blocked;
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      valid_q <= 1'b0;
-    end else begin
-      valid_q <= valid_d;
-    end
-  end
-
-  always_ff @(posedge clk_i) begin
-    if (in_ready_o) begin
-      result_q <= result_d;
-    end
-  end
-
-  assign out_valid_o = valid_q;
-  assign out_data_o  = result_q;
+  cube5_pipe_reg #(
+    .Width (TotalW)
+  ) u_out (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (in_valid_i),
+    .in_ready_o  (in_ready_o),
+    .in_data_i   (dir ? linear : blocked),
+    .out_valid_o (out_valid_o),
+    .out_ready_i (out_ready_i),
+    .out_data_o  (out_data_o)
+  );
 
 `ifndef SYNTHESIS
   // A stalled output holds its item (STYLE.md rule 3).

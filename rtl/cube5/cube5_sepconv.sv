@@ -73,11 +73,18 @@ module cube5_sepconv #(
   // ---------------------------------------------------------------------------
   // Stage handshakes
   // ---------------------------------------------------------------------------
-  logic valid_1_q, valid_2_q;
   logic ready_1, ready_2;
 
-  assign ready_2    = !valid_2_q || out_ready_i;
-  assign ready_1    = !valid_1_q || ready_2;
+  cube5_valid_chain #(
+    .Stages (2)
+  ) u_valid (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (in_valid_i),
+    .out_ready_i (out_ready_i),
+    .ready_o     ({ready_2, ready_1}),
+    .out_valid_o (out_valid_o)
+  );
   assign in_ready_o = ready_1;
 
   // ---------------------------------------------------------------------------
@@ -124,22 +131,8 @@ module cube5_sepconv #(
   end
 
   // ---------------------------------------------------------------------------
-  // Registers: valids reset (synchronously), datapath not
+  // Datapath registers (not reset; the valids are u_valid's)
   // ---------------------------------------------------------------------------
-  logic valid_1_d, valid_2_d;
-  assign valid_1_d = ready_1 ? in_valid_i : valid_1_q;
-  assign valid_2_d = ready_2 ? valid_1_q  : valid_2_q;
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      valid_1_q <= 1'b0;
-      valid_2_q <= 1'b0;
-    end else begin
-      valid_1_q <= valid_1_d;
-      valid_2_q <= valid_2_d;
-    end
-  end
-
   always_ff @(posedge clk_i) begin
     if (ready_1) begin
       pre_q  <= pre_d;
@@ -150,7 +143,6 @@ module cube5_sepconv #(
     end
   end
 
-  assign out_valid_o = valid_2_q;
   assign out_data_o  = out_q;
 
 `ifndef SYNTHESIS

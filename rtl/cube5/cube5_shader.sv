@@ -152,32 +152,19 @@ module cube5_shader #(
   // ---------------------------------------------------------------------------
   // Stage handshakes: stage k loads when it or any later stage is empty, or the output moves
   // ---------------------------------------------------------------------------
-  logic [NSt-1:0] valid_q, valid_d, en;
+  logic [NSt-1:0] en;
 
-  always_comb begin
-    for (int k = 0; k < NSt; k++) begin
-      en[k] = out_ready_i;
-      for (int j = 0; j < NSt; j++) begin
-        if (j >= k && !valid_q[j]) begin
-          en[k] = 1'b1;
-        end
-      end
-    end
-    valid_d[0] = en[0] ? in_valid_i : valid_q[0];
-    for (int k = 1; k < NSt; k++) begin
-      valid_d[k] = en[k] ? valid_q[k-1] : valid_q[k];
-    end
-  end
-
+  cube5_valid_chain #(
+    .Stages (NSt)
+  ) u_valid (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (in_valid_i),
+    .out_ready_i (out_ready_i),
+    .ready_o     (en),
+    .out_valid_o (out_valid_o)
+  );
   assign in_ready_o = en[0];
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      valid_q <= '0;
-    end else begin
-      valid_q <= valid_d;
-    end
-  end
 
   // ---------------------------------------------------------------------------
   // Configuration port: classification entries, texels (to the bank of their parity), zero entry
@@ -622,7 +609,6 @@ module cube5_shader #(
     end
   end
 
-  assign out_valid_o = valid_q[NSt-1];
   assign out_data_o  = out_q;
 
   // Bits read only in part: low sample bits, the remainders, the divisor after the divider,

@@ -75,12 +75,18 @@ module cube5_trilin #(
   // ---------------------------------------------------------------------------
   // Stage handshakes: a stage takes a new item when it is empty or its item moves on
   // ---------------------------------------------------------------------------
-  logic valid_x_q, valid_y_q, valid_z_q;
   logic ready_x, ready_y, ready_z;
 
-  assign ready_z    = !valid_z_q || out_ready_i;
-  assign ready_y    = !valid_y_q || ready_z;
-  assign ready_x    = !valid_x_q || ready_y;
+  cube5_valid_chain #(
+    .Stages (3)
+  ) u_valid (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (in_valid_i),
+    .out_ready_i (out_ready_i),
+    .ready_o     ({ready_z, ready_y, ready_x}),
+    .out_valid_o (out_valid_o)
+  );
   assign in_ready_o = ready_x;
 
   // ---------------------------------------------------------------------------
@@ -135,25 +141,8 @@ module cube5_trilin #(
   );
 
   // ---------------------------------------------------------------------------
-  // Registers: valids reset (synchronously, as FPGA flows prefer), datapath not
+  // Datapath registers (not reset; the valids are u_valid's)
   // ---------------------------------------------------------------------------
-  logic valid_x_d, valid_y_d, valid_z_d;
-  assign valid_x_d = ready_x ? in_valid_i : valid_x_q;
-  assign valid_y_d = ready_y ? valid_x_q  : valid_y_q;
-  assign valid_z_d = ready_z ? valid_y_q  : valid_z_q;
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      valid_x_q <= 1'b0;
-      valid_y_q <= 1'b0;
-      valid_z_q <= 1'b0;
-    end else begin
-      valid_x_q <= valid_x_d;
-      valid_y_q <= valid_y_d;
-      valid_z_q <= valid_z_d;
-    end
-  end
-
   always_ff @(posedge clk_i) begin
     if (ready_x) begin
       along_x_q <= along_x_d;
@@ -168,7 +157,6 @@ module cube5_trilin #(
     end
   end
 
-  assign out_valid_o = valid_z_q;
   assign out_data_o  = sample_q;
 
 `ifndef SYNTHESIS

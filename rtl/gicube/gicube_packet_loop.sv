@@ -43,28 +43,18 @@ module gicube_packet_loop #(
   logic [PacketW-1:0] src_data;
 
   if (Stages == 2) begin : gen_in_reg
-    logic               valid_q, valid_d;
-    logic [PacketW-1:0] data_q;
-
-    assign in_ready_o = !valid_q || src_ready;
-    assign valid_d    = in_ready_o ? in_valid_i : valid_q;
-
-    always_ff @(posedge clk_i) begin
-      if (!rst_ni) begin
-        valid_q <= 1'b0;
-      end else begin
-        valid_q <= valid_d;
-      end
-    end
-
-    always_ff @(posedge clk_i) begin
-      if (in_ready_o) begin
-        data_q <= in_data_i;
-      end
-    end
-
-    assign src_valid = valid_q;
-    assign src_data  = data_q;
+    cube5_pipe_reg #(
+      .Width (PacketW)
+    ) u_in (
+      .clk_i       (clk_i),
+      .rst_ni      (rst_ni),
+      .in_valid_i  (in_valid_i),
+      .in_ready_o  (in_ready_o),
+      .in_data_i   (in_data_i),
+      .out_valid_o (src_valid),
+      .out_ready_i (src_ready),
+      .out_data_o  (src_data)
+    );
   end else begin : gen_no_in_reg
     assign in_ready_o = src_ready;
     assign src_valid  = in_valid_i;
@@ -102,28 +92,18 @@ module gicube_packet_loop #(
   // ---------------------------------------------------------------------------
   // Output register
   // ---------------------------------------------------------------------------
-  logic                 out_valid_q, out_valid_d;
-  logic [2*PacketW-1:0] out_q;
-
-  assign src_ready   = !out_valid_q || out_ready_i;
-  assign out_valid_d = src_ready ? src_valid : out_valid_q;
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      out_valid_q <= 1'b0;
-    end else begin
-      out_valid_q <= out_valid_d;
-    end
-  end
-
-  always_ff @(posedge clk_i) begin
-    if (src_ready) begin
-      out_q <= {probe, pkt};
-    end
-  end
-
-  assign out_valid_o = out_valid_q;
-  assign out_data_o  = out_q;
+  cube5_pipe_reg #(
+    .Width (2 * PacketW)
+  ) u_out (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (src_valid),
+    .in_ready_o  (src_ready),
+    .in_data_i   ({probe, pkt}),
+    .out_valid_o (out_valid_o),
+    .out_ready_i (out_ready_i),
+    .out_data_o  (out_data_o)
+  );
 
 `ifndef SYNTHESIS
   // A stalled output holds its item (STYLE.md rule 3).

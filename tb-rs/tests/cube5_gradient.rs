@@ -8,13 +8,12 @@ use cube5_model::units::cube5_gradient::{
     GradientOut,
 };
 use cube5_tb::harness::{check_stream, StreamCheck};
-use cube5_tb::rtl::RtlStream;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
-    gate_smoke_then_directed, must_match_across_a_reset, must_match_items, random_items, seed,
-    MILLION,
+    assert_codec_and_config_port, assert_one_item_per_clock, configs, directed_on_every_config,
+    expect_mismatch, gate_smoke_then_directed, million_across_a_reset, must_match_items,
+    random_items, seed,
 };
 
 const LATENCY: u64 = 5;
@@ -132,30 +131,14 @@ fn directed_items(cfg: GradientConfig) -> Vec<GradientIn> {
 
 #[test]
 fn million_random_items_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in configs::<GradientConfig>().into_iter().enumerate() {
-        must_match_across_a_reset(
-            variant,
-            cfg,
-            &mut Gradient::new(cfg).unwrap(),
-            &mut random_item(cfg),
-            &StreamCheck::long(seed(300 + i as u64), MILLION, 5),
-            1000,
-        );
-    }
+    million_across_a_reset(Gradient::new, random_item, 300, 5, 1000);
 }
 
 #[test]
 fn directed_extremes() {
-    for (variant, cfg) in configs::<GradientConfig>() {
-        let mut gold = Gradient::new(cfg).unwrap();
-        must_match_items(
-            variant,
-            cfg,
-            &mut gold,
-            directed_items(cfg),
-            &StreamCheck::directed(seed(31)),
-        );
-    }
+    directed_on_every_config(Gradient::new, directed_items, |_| {
+        StreamCheck::directed(seed(31))
+    });
 }
 
 #[test]
@@ -322,15 +305,5 @@ fn each_mutated_contract_detail_is_caught() {
 
 #[test]
 fn codec_and_variant_are_checked_against_the_rtl() {
-    assert_foreign_codec_is_refused::<GradientConfig>();
-    let mut dut = RtlStream::new(
-        configs::<GradientConfig>()[0].0,
-        configs::<GradientConfig>()[0].1,
-        1,
-    )
-    .unwrap();
-    assert!(
-        dut.write_config(0, &[1]).is_err(),
-        "cube5_gradient has no configuration port"
-    );
+    assert_codec_and_config_port::<GradientConfig>((0, &[1]), false);
 }

@@ -8,9 +8,9 @@ use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_foreign_codec_is_refused, configs, expect_mismatch, gate_smoke_then_directed,
-    must_match_across_a_reset, must_match_items, random_items_one_per_clock, seed, variant_with,
-    MILLION,
+    assert_codec_and_config_port, directed_on_every_config, expect_mismatch,
+    gate_smoke_then_directed, million_across_a_reset, random_items_one_per_clock, seed,
+    variant_with,
 };
 
 fn random_item(cfg: RBlockConfig) -> impl FnMut(&mut ChaCha8Rng) -> RBlockIn {
@@ -48,30 +48,14 @@ fn directed_items(cfg: RBlockConfig) -> Vec<RBlockIn> {
 
 #[test]
 fn million_random_conversions_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in configs::<RBlockConfig>().into_iter().enumerate() {
-        must_match_across_a_reset(
-            variant,
-            cfg,
-            &mut RBlock::new(cfg).unwrap(),
-            &mut random_item(cfg),
-            &StreamCheck::long(seed(200 + i as u64), MILLION, 3),
-            4,
-        );
-    }
+    million_across_a_reset(RBlock::new, random_item, 200, 3, 4);
 }
 
 #[test]
 fn directed_extremes() {
-    for (variant, cfg) in configs::<RBlockConfig>() {
-        let mut gold = RBlock::new(cfg).unwrap();
-        must_match_items(
-            variant,
-            cfg,
-            &mut gold,
-            directed_items(cfg),
-            &StreamCheck::directed(seed(7)),
-        );
-    }
+    directed_on_every_config(RBlock::new, directed_items, |_| {
+        StreamCheck::directed(seed(7))
+    });
 }
 
 /// The whole `4^3` volume both ways on the RTL, checked against the patent's LUT form (not the
@@ -161,15 +145,5 @@ fn the_comparison_tells_interleave_orders_apart() {
 
 #[test]
 fn codec_is_checked_against_the_rtl() {
-    assert_foreign_codec_is_refused::<RBlockConfig>();
-    let mut dut = RtlStream::new(
-        configs::<RBlockConfig>()[0].0,
-        configs::<RBlockConfig>()[0].1,
-        1,
-    )
-    .unwrap();
-    assert!(
-        dut.write_config(0, &[1]).is_err(),
-        "rblock has no configuration port"
-    );
+    assert_codec_and_config_port::<RBlockConfig>((0, &[1]), false);
 }

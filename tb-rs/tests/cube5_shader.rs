@@ -17,7 +17,7 @@ use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
+    assert_codec_and_config_port, assert_one_item_per_clock, configs, expect_mismatch,
     gate_configs, must_match_across_a_reset, must_match_items, random_items, seed, MILLION,
 };
 
@@ -410,15 +410,5 @@ fn a_table_entry_loaded_wrong_is_caught() {
 
 #[test]
 fn codec_and_config_port_are_checked_against_the_rtl() {
-    assert_foreign_codec_is_refused::<ShaderConfig>();
-    let mut dut = RtlStream::new(
-        configs::<ShaderConfig>()[0].0,
-        configs::<ShaderConfig>()[0].1,
-        1,
-    )
-    .unwrap();
-    assert!(
-        dut.write_config(0, &[1]).is_ok(),
-        "the shader has a configuration port"
-    );
+    assert_codec_and_config_port::<ShaderConfig>((0, &[1]), true);
 }

@@ -18,7 +18,7 @@ use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_foreign_codec_is_refused, assert_one_item_per_clock, configs, expect_mismatch,
+    assert_codec_and_config_port, assert_one_item_per_clock, configs, expect_mismatch,
     gate_configs, must_match_across_a_reset, must_match_items, seed, variant_with, MILLION,
 };
 
@@ -584,12 +584,5 @@ fn the_comparison_bites_on_state_lut_and_counters() {
 
 #[test]
 fn codec_and_config_port_are_checked_against_the_rtl() {
-    assert_foreign_codec_is_refused::<SkewConfig>();
-    let mut dut = RtlStream::new(
-        configs::<SkewConfig>()[0].0,
-        configs::<SkewConfig>()[0].1,
-        1,
-    )
-    .unwrap();
-    assert!(dut.write_config(0, &[16 | 16 << 5 | 16 << 10]).is_ok());
+    assert_codec_and_config_port::<SkewConfig>((0, &[16 | 16 << 5 | 16 << 10]), true);
 }

@@ -11,8 +11,8 @@ use cube5_tb::{Mismatch, TbError, Variant};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    configs, expect_mismatch, gate_smoke_then_directed, must_match_across_a_reset,
-    must_match_items, random_items_one_per_clock, seed, MILLION,
+    configs, directed_on_every_config, expect_mismatch, gate_smoke_then_directed,
+    million_across_a_reset, random_items_one_per_clock, seed,
 };
 
 fn random_item(cfg: TrilinConfig) -> impl FnMut(&mut ChaCha8Rng) -> TrilinIn {
@@ -70,16 +70,7 @@ fn directed_items(cfg: TrilinConfig) -> Vec<TrilinIn> {
 
 #[test]
 fn million_random_samples_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in configs::<TrilinConfig>().into_iter().enumerate() {
-        must_match_across_a_reset(
-            variant,
-            cfg,
-            &mut Trilin::new(cfg).unwrap(),
-            &mut random_item(cfg),
-            &StreamCheck::long(seed(100 + i as u64), MILLION, 3),
-            1000,
-        );
-    }
+    million_across_a_reset(Trilin::new, random_item, 100, 3, 1000);
 }
 
 /// A random run that must mismatch (`why` it must): the mismatch reported.
@@ -96,12 +87,9 @@ fn random_run_mismatch(
 
 #[test]
 fn directed_extremes() {
-    for (variant, cfg) in configs::<TrilinConfig>() {
-        let mut gold = Trilin::new(cfg).unwrap();
-        let items = directed_items(cfg);
-        let check = StreamCheck::directed(seed(7));
-        must_match_items(variant, cfg, &mut gold, items, &check);
-    }
+    directed_on_every_config(Trilin::new, directed_items, |_| {
+        StreamCheck::directed(seed(7))
+    });
 }
 
 #[test]

@@ -11,8 +11,8 @@ use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::{
-    configs, expect_mismatch, gate_smoke_then_directed, must_match_across_a_reset,
-    must_match_items, random_items_one_per_clock, seed, variant_with, MILLION,
+    configs, directed_on_every_config, expect_mismatch, gate_smoke_then_directed,
+    million_across_a_reset, random_items_one_per_clock, seed, variant_with,
 };
 
 fn random_item(cfg: BucketConfig) -> impl FnMut(&mut ChaCha8Rng) -> BucketIn {
@@ -59,33 +59,15 @@ fn directed_items(cfg: BucketConfig) -> Vec<BucketIn> {
 
 #[test]
 fn million_random_positions_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in configs::<BucketConfig>().into_iter().enumerate() {
-        must_match_across_a_reset(
-            variant,
-            cfg,
-            &mut BucketUnit::new(cfg).unwrap(),
-            &mut random_item(cfg),
-            &StreamCheck::long(seed(400 + i as u64), MILLION, 3),
-            10,
-        );
-    }
+    million_across_a_reset(BucketUnit::new, random_item, 400, 3, 10);
 }
 
 #[test]
 fn directed_block_and_volume_edges() {
-    for (variant, cfg) in configs::<BucketConfig>() {
-        let items = directed_items(cfg);
-        let n = items.len();
+    directed_on_every_config(BucketUnit::new, directed_items, |n| {
         assert!(n > 20);
-        let check = StreamCheck::new(seed(410), 3 * n).with_traffic(0.3, 0.3);
-        must_match_items(
-            variant,
-            cfg,
-            &mut BucketUnit::new(cfg).unwrap(),
-            items,
-            &check,
-        );
-    }
+        StreamCheck::new(seed(410), 3 * n).with_traffic(0.3, 0.3)
+    });
 }
 
 #[test]

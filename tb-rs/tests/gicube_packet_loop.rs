@@ -14,8 +14,8 @@ use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    assert_one_item_per_clock, configs, expect_mismatch, gate_smoke_then_directed,
-    must_match_across_a_reset, must_match_items, random_items, seed, variant_with, MILLION,
+    assert_one_item_per_clock, configs, directed_on_every_config, expect_mismatch,
+    gate_smoke_then_directed, million_across_a_reset, random_items, seed, variant_with,
 };
 
 fn random_item(rng: &mut ChaCha8Rng) -> RayPacket {
@@ -24,31 +24,16 @@ fn random_item(rng: &mut ChaCha8Rng) -> RayPacket {
 
 #[test]
 fn million_random_packets_per_config_with_idle_backpressure_and_reset() {
-    for (i, (variant, cfg)) in configs::<PacketLoopConfig>().into_iter().enumerate() {
-        must_match_across_a_reset(
-            variant,
-            cfg,
-            &mut PacketLoop::new(cfg).unwrap(),
-            &mut random_item,
-            &StreamCheck::long(seed(300 + i as u64), MILLION, 3),
-            10,
-        );
-    }
+    million_across_a_reset(PacketLoop::new, |_| random_item, 300, 3, 10);
 }
 
 #[test]
 fn directed_extremes_every_field_wraps() {
-    for (variant, cfg) in configs::<PacketLoopConfig>() {
-        let items = directed_packets();
-        let check = StreamCheck::new(seed(301), 4 * items.len()).with_traffic(0.3, 0.3);
-        must_match_items(
-            variant,
-            cfg,
-            &mut PacketLoop::new(cfg).unwrap(),
-            items,
-            &check,
-        );
-    }
+    directed_on_every_config(
+        PacketLoop::new,
+        |_| directed_packets(),
+        |n| StreamCheck::new(seed(301), 4 * n).with_traffic(0.3, 0.3),
+    );
 }
 
 #[test]

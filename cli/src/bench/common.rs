@@ -2,9 +2,9 @@
 //! second, items per clock, model items per second) and error statistics.
 
 use anyhow::{ensure, Result};
-use cube5_model::unit::{StreamCodec, StreamUnit};
+use cube5_model::unit::{StreamCodec, StreamUnit, UnitConfig};
 use cube5_tb::rtl::{RtlStream, Traffic};
-use cube5_tb::Variant;
+use cube5_tb::{variants_of, Variant};
 use std::time::Instant;
 
 /// Verilator's random-reset seed of every benchmarked DUT.
@@ -99,6 +99,33 @@ where
         model_rate,
         model_rate / sim_rate
     );
+    Ok(())
+}
+
+/// What one variant's speed row runs: the model, its items and the configuration writes (tables,
+/// registers) that give the RTL the model's state.
+pub type Workload<C, M> = (M, Vec<<C as StreamCodec>::In>, Vec<(u32, Vec<u32>)>);
+
+/// The whole speed table of `C`'s top: the header, one [`speed_row`] per variant on the workload
+/// `workload` builds for its configuration, and a blank line.
+pub fn speed_table<C, M>(
+    workload: impl Fn(C) -> Result<Workload<C, M>>,
+    compare: Compare,
+) -> Result<()>
+where
+    C: StreamCodec + UnitConfig + Copy,
+    C::In: Clone + std::fmt::Debug,
+    C::Out: Clone + std::fmt::Debug + PartialEq,
+    M: StreamUnit<In = C::In, Out = C::Out>,
+{
+    speed_header();
+    for v in variants_of(C::TOP) {
+        let cfg: C = v.config()?;
+        let (mut model, items, writes) = workload(cfg)?;
+        let mut dut = open(v, cfg, &writes)?;
+        speed_row(&mut dut, &mut model, &items, compare)?;
+    }
+    println!();
     Ok(())
 }
 

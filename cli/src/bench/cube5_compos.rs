@@ -1,6 +1,6 @@
 //! Benchmark of cube5_compos: speed, and error over long rays against the f64 reference.
 
-use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
+use super::common::{speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_compos::{
@@ -58,17 +58,16 @@ fn items(cfg: &ComposConfig, n: usize, seed: u64) -> Vec<ComposIn> {
 
 pub fn run(n_items: usize) -> Result<()> {
     println!("## {TOP}\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: ComposConfig = v.config()?;
-        let mut model = Compos::new(cfg, OpacityLut::new(0.5, &cfg)?, ComposRegs::defaults(&cfg))?;
-        let items = items(&cfg, n_items, 1);
-        let mut dut = open(v, cfg, &model.config_writes())?;
-        speed_row(&mut dut, &mut model, &items, Compare::No)?;
-    }
+    speed_table(
+        |cfg: ComposConfig| {
+            let model = Compos::new(cfg, OpacityLut::new(0.5, &cfg)?, ComposRegs::defaults(&cfg))?;
+            let writes = model.config_writes();
+            Ok((model, items(&cfg, n_items, 1), writes))
+        },
+        Compare::No,
+    )?;
 
     let rays = (n_items / RAY).max(1);
-    println!();
     println!(
         "Error of {TOP} against its f64 reference: {rays} rays of {RAY} samples from an empty \
          coxel (90% of alphas below 1/8), opacity LUT for d/k = 1/2, no early termination; the \

@@ -1,7 +1,7 @@
 //! Benchmark of cube5_gradient: speed, the components' error against the f64 reference and the
 //! magnitude estimate's against the Euclidean norm.
 
-use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
+use super::common::{speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_gradient::{Gradient, GradientConfig, GradientIn, GradientMode};
@@ -67,15 +67,13 @@ fn ramp_items(cfg: &GradientConfig, n: usize, seed: u64) -> Vec<GradientIn> {
 
 pub fn run(n_items: usize) -> Result<()> {
     println!("## {TOP}\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: GradientConfig = v.config()?;
-        let items = gradient_items(&cfg, n_items, 1, None);
-        let mut dut = open(v, cfg, &[])?;
-        speed_row(&mut dut, &mut Gradient::new(cfg)?, &items, Compare::No)?;
-    }
-
-    println!();
+    speed_table(
+        |cfg: GradientConfig| {
+            let items = gradient_items(&cfg, n_items, 1, None);
+            Ok((Gradient::new(cfg)?, items, vec![]))
+        },
+        Compare::No,
+    )?;
     println!(
         "Component error of {TOP} against its f64 reference ({n_items} random items per \
          mode, uniform samples, steps in [-1, 1]), in output LSBs (2^-(FracW+5) voxel units); the \

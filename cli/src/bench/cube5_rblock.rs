@@ -1,9 +1,7 @@
 //! Benchmark of the recursive-blocking addressing unit (`cube5_rblock`): speed, exactness against
 //! the patent's LUT form, and what recursive blocking buys a cache.
 
-use super::common::{
-    exactness_header, exactness_row, open, speed_header, speed_row, Compare, ErrorStats,
-};
+use super::common::{exactness_header, exactness_row, speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_rblock::{BlockingLuts, RBlock, RBlockConfig, RBlockDir, RBlockIn};
@@ -17,25 +15,23 @@ pub const TOP: &str = RBlockConfig::TOP;
 fn speed(n_items: usize) -> Result<()> {
     println!("Speed at full rate (no idle, no back-pressure): {n_items} random addresses, half converted");
     println!("to the blocked layout, half back to the linear one.\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: RBlockConfig = v.config()?;
-        let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let items: Vec<RBlockIn> = (0..n_items)
-            .map(|_| RBlockIn {
-                value: rng.random_range(0..cfg.len()),
-                dir: if rng.random_bool(0.5) {
-                    RBlockDir::ToBlocked
-                } else {
-                    RBlockDir::ToLinear
-                },
-            })
-            .collect();
-        let mut dut = open(v, cfg, &[])?;
-        speed_row(&mut dut, &mut RBlock::new(cfg)?, &items, Compare::No)?;
-    }
-    println!();
-    Ok(())
+    speed_table(
+        |cfg: RBlockConfig| {
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            let items: Vec<RBlockIn> = (0..n_items)
+                .map(|_| RBlockIn {
+                    value: rng.random_range(0..cfg.len()),
+                    dir: if rng.random_bool(0.5) {
+                        RBlockDir::ToBlocked
+                    } else {
+                        RBlockDir::ToLinear
+                    },
+                })
+                .collect();
+            Ok((RBlock::new(cfg)?, items, vec![]))
+        },
+        Compare::No,
+    )
 }
 
 /// Exactness: the bit form of recursive blocking (the RTL's) against the patent's LUT form.

@@ -1,6 +1,6 @@
 //! Benchmark of cube5_sepconv: speed, and error against the exact real convolution.
 
-use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
+use super::common::{speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_sepconv::{Sepconv, SepconvConfig, SepconvIn, SepconvKernel};
@@ -25,15 +25,14 @@ pub fn run(n_items: usize) -> Result<()> {
     // A Gaussian of sigma = 1: w = exp(1 / (2 sigma^2)).
     let w_real = 0.5f64.exp();
     println!("## {TOP}\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: SepconvConfig = v.config()?;
-        let items = sepconv_items(&cfg, n_items, 1);
-        let mut gold = Sepconv::new(cfg, cfg.weight_from_f64(w_real))?;
-        let mut dut = open(v, cfg, &gold.config_writes())?;
-        speed_row(&mut dut, &mut gold, &items, Compare::No)?;
-    }
-    println!();
+    speed_table(
+        |cfg: SepconvConfig| {
+            let gold = Sepconv::new(cfg, cfg.weight_from_f64(w_real))?;
+            let writes = gold.config_writes();
+            Ok((gold, sepconv_items(&cfg, n_items, 1), writes))
+        },
+        Compare::No,
+    )?;
     println!(
         "Error of {TOP} against the exact real convolution ({n_items} random items, both \
          kernels, w = exp(1/2) rounded to U(4.WeightFracW)), in output LSBs; the contract: exact \

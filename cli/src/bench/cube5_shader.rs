@@ -1,7 +1,7 @@
 //! Benchmark of cube5_shader: speed, the error of the fixed-point unit against the f64 reference
 //! with the same tables, and the error of the reflectance-map approach against direct f64 Phong.
 
-use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
+use super::common::{speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::unit::UnitConfig;
@@ -67,24 +67,21 @@ fn grey_tables(cfg: &ShaderConfig, phong: &Phong) -> Result<ShaderTables> {
 pub fn run(n_items: usize) -> Result<()> {
     let phong = Phong::two_lights();
     println!("## {TOP}\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: ShaderConfig = v.config()?;
-        let tables = ShaderTables {
-            class: ClassLut::from_transfer(&cfg, &TransferFunction::head_default())?,
-            rmap: ReflectanceMap::from_lights(&cfg, &phong)?,
-        };
-        let items = lit_items(&cfg, n_items, 1);
-        let mut dut = open(v, cfg, &tables.config_writes(&cfg))?;
-        speed_row(
-            &mut dut,
-            &mut Shader::new(cfg, tables)?,
-            &items,
-            Compare::Outputs,
-        )?;
-    }
-
-    println!();
+    speed_table(
+        |cfg: ShaderConfig| {
+            let tables = ShaderTables {
+                class: ClassLut::from_transfer(&cfg, &TransferFunction::head_default())?,
+                rmap: ReflectanceMap::from_lights(&cfg, &phong)?,
+            };
+            let writes = tables.config_writes(&cfg);
+            Ok((
+                Shader::new(cfg, tables)?,
+                lit_items(&cfg, n_items, 1),
+                writes,
+            ))
+        },
+        Compare::Outputs,
+    )?;
     println!(
         "Error of {TOP} ({n_items} lit items, gradient directions uniform on the sphere, \
          1/64 zero gradients, mid-grey colour, two distant Phong lights), in output LSBs \

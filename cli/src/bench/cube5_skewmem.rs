@@ -1,9 +1,7 @@
 //! Benchmark of the skewed memory controller (`cube5_skewmem`): speed, exactness against a plain
 //! volume, and what the block LUT threshold trades (module reads saved against error).
 
-use super::common::{
-    exactness_header, exactness_row, open, speed_header, speed_row, Compare, ErrorStats,
-};
+use super::common::{exactness_header, exactness_row, speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::phantom::head_phantom;
 use cube5_model::unit::{StreamUnit, UnitConfig};
@@ -58,15 +56,14 @@ fn speed(n_items: usize) -> Result<()> {
         "then {n_items} random commands (55% beam reads, 45% writes); one command is one beam of P"
     );
     println!("voxels or one write, so voxels per clock = P x items/clock for reads.\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: SkewConfig = v.config()?;
-        let (mut model, cmds) = skew_workload(cfg, n_items, 1)?;
-        let mut dut = open(v, cfg, &model.config_writes())?;
-        speed_row(&mut dut, &mut model, &cmds, Compare::Outputs)?;
-    }
-    println!();
-    Ok(())
+    speed_table(
+        |cfg: SkewConfig| {
+            let (model, cmds) = skew_workload(cfg, n_items, 1)?;
+            let writes = model.config_writes();
+            Ok((model, cmds, writes))
+        },
+        Compare::Outputs,
+    )
 }
 
 /// Exactness: every beam the model returns against a plain `Vec<u16>` (x fastest).

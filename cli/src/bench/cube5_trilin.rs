@@ -1,6 +1,6 @@
 //! Benchmark of cube5_trilin: speed, and error against the f64 reference.
 
-use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
+use super::common::{speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
@@ -23,14 +23,10 @@ fn trilin_items(cfg: &TrilinConfig, n: usize, seed: u64) -> Vec<TrilinIn> {
 
 pub fn run(n_items: usize) -> Result<()> {
     println!("## {TOP}\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: TrilinConfig = v.config()?;
-        let items = trilin_items(&cfg, n_items, 1);
-        let mut dut = open(v, cfg, &[])?;
-        speed_row(&mut dut, &mut Trilin::new(cfg)?, &items, Compare::No)?;
-    }
-    println!();
+    speed_table(
+        |cfg: TrilinConfig| Ok((Trilin::new(cfg)?, trilin_items(&cfg, n_items, 1), vec![])),
+        Compare::No,
+    )?;
     println!("Error of {TOP} against its f64 reference ({n_items} random items, all weights, mode Lerp),");
     println!("in output LSBs (2^-FracW voxel units); the contract bound is 1.5 LSB:");
     println!();

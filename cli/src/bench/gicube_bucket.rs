@@ -1,7 +1,7 @@
 //! Benchmark of GI-Cube queue bucketing (`gicube_bucket`): speed of the RTL and the model,
 //! bucketing against its f64 reference and the load balance of the three distributions.
 
-use super::common::{open, speed_header, speed_row, Compare};
+use super::common::{speed_table, Compare};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::gicube_bucket::{
@@ -17,23 +17,22 @@ pub const TOP: &str = BucketConfig::TOP;
 pub fn run(n_items: usize) -> Result<()> {
     println!("## {TOP}\n");
     println!("One item is `Lanes` positions (2 = the two rays per cycle of [370]).\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: BucketConfig = v.config()?;
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let items: Vec<BucketIn> = (0..n_items)
-            .map(|_| {
-                BucketIn(
-                    (0..cfg.lanes)
-                        .map(|_| random_position(&mut rng, &cfg))
-                        .collect(),
-                )
-            })
-            .collect();
-        let mut dut = open(v, cfg, &[])?;
-        speed_row(&mut dut, &mut BucketUnit::new(cfg)?, &items, Compare::No)?;
-    }
-    println!();
+    speed_table(
+        |cfg: BucketConfig| {
+            let mut rng = ChaCha8Rng::seed_from_u64(3);
+            let items: Vec<BucketIn> = (0..n_items)
+                .map(|_| {
+                    BucketIn(
+                        (0..cfg.lanes)
+                            .map(|_| random_position(&mut rng, &cfg))
+                            .collect(),
+                    )
+                })
+                .collect();
+            Ok((BucketUnit::new(cfg)?, items, vec![]))
+        },
+        Compare::No,
+    )?;
 
     println!(
         "Against the f64 reference (real coordinates, floor and real division): {n_items} random"

@@ -1,13 +1,12 @@
 //! Benchmark of the GI-Cube ray packet round trip (`gicube_packet_loop`): speed of the RTL and the
 //! model, and the packet's quantization error.
 
-use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
+use super::common::{speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::gicube_packet_loop::{
     random_packet, PacketLoop, PacketLoopConfig, RayPacket, RayReal,
 };
-use cube5_tb::variants_of;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -16,15 +15,14 @@ pub const TOP: &str = PacketLoopConfig::TOP;
 pub fn run(n_items: usize) -> Result<()> {
     println!("## {TOP}\n");
     println!("The round-trip fixture (unpack into the SV struct, repack, per-field probe).\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: PacketLoopConfig = v.config()?;
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let items: Vec<RayPacket> = (0..n_items).map(|_| random_packet(&mut rng)).collect();
-        let mut dut = open(v, cfg, &[])?;
-        speed_row(&mut dut, &mut PacketLoop::new(cfg)?, &items, Compare::No)?;
-    }
-    println!();
+    speed_table(
+        |cfg: PacketLoopConfig| {
+            let mut rng = ChaCha8Rng::seed_from_u64(5);
+            let items: Vec<RayPacket> = (0..n_items).map(|_| random_packet(&mut rng)).collect();
+            Ok((PacketLoop::new(cfg)?, items, vec![]))
+        },
+        Compare::No,
+    )?;
 
     println!(
         "Quantization of real ray fields into the packet (round half up, `RayPacket::from_real`)"

@@ -1,7 +1,7 @@
 //! Benchmark of gicube_scatter: speed, and the angular error against the f64 reference
 //! (docs/numerics/gicube_scatter.md § Error) at several bit widths.
 
-use super::common::{open, speed_header, speed_row, Compare, ErrorStats};
+use super::common::{speed_table, Compare, ErrorStats};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::gicube_scatter::{
@@ -55,14 +55,14 @@ fn errors(cfg: &ScatterConfig, n: usize) -> Result<[Vec<f64>; 4]> {
 pub fn run(n_items: usize) -> Result<()> {
     let variants = variants_of(TOP);
     println!("## {TOP}\n");
-    speed_header();
-    for &v in &variants {
-        let cfg: ScatterConfig = v.config()?;
-        let its = items(&cfg, n_items, 1);
-        let mut model = Scatter::new(cfg)?;
-        let mut dut = open(v, cfg, &model.tables().config_writes(&cfg))?;
-        speed_row(&mut dut, &mut model, &its, Compare::Outputs)?;
-    }
+    speed_table(
+        |cfg: ScatterConfig| {
+            let model = Scatter::new(cfg)?;
+            let writes = model.tables().config_writes(&cfg);
+            Ok((model, items(&cfg, n_items, 1), writes))
+        },
+        Compare::Outputs,
+    )?;
 
     // The verified configurations (named) and the model at other widths (unnamed), narrowest first.
     let mut widths: Vec<(&str, ScatterConfig)> = Vec::new();
@@ -72,7 +72,6 @@ pub fn run(n_items: usize) -> Result<()> {
     widths.extend(model_widths()?.into_iter().map(|c| ("model", c)));
     widths.sort_by_key(|(_, c)| (c.f(), c.ang_w));
     let named: Vec<String> = variants.iter().map(|v| format!("`{}`", v.config)).collect();
-    println!();
     println!(
         "Angular error of {TOP} against its f64 reference ({n_items} random rays each: \
          random directions and gradients, materials with 0 and 1 well represented, eta in [0, 4)), \

@@ -2,7 +2,7 @@
 //! sorter's choices against an ideal priority queue (median and range over seeds); the end of a
 //! frame (arrivals stop, every ray must drain) and the co-simulated drain frames.
 
-use super::common::{open, speed_header, speed_row, Compare};
+use super::common::{speed_table, Compare};
 use anyhow::Result;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::gicube_sorter::{
@@ -29,16 +29,15 @@ pub fn run(n_items: usize) -> Result<()> {
         "Random update traffic (phases of mixed updates, bursts, draining, ties, maxima, clears);"
     );
     println!("one item is one update (or no-op) and one logical sorter cycle, so items/clock is updates/clock.\n");
-    speed_header();
-    for v in variants_of(TOP) {
-        let cfg: SorterConfig = v.config()?;
-        let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let mut traffic = SorterTraffic::new(cfg)?;
-        let items: Vec<SorterIn> = (0..n_items).map(|_| traffic.next_item(&mut rng)).collect();
-        let mut dut = open(v, cfg, &[])?;
-        speed_row(&mut dut, &mut Sorter::new(cfg)?, &items, Compare::No)?;
-    }
-    println!();
+    speed_table(
+        |cfg: SorterConfig| {
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            let mut traffic = SorterTraffic::new(cfg)?;
+            let items: Vec<SorterIn> = (0..n_items).map(|_| traffic.next_item(&mut rng)).collect();
+            Ok((Sorter::new(cfg)?, items, vec![]))
+        },
+        Compare::No,
+    )?;
 
     accuracy_table(n_items)?;
     frame_end_table(n_items)?;

@@ -182,6 +182,66 @@ where
     }
 }
 
+/// The foreign codec refused (`assert_foreign_codec_is_refused`), then one configuration write
+/// (`write`: address, words) on the first variant of `C`'s top: accepted when the top has a
+/// configuration port (`has_port`), refused when it has none.
+pub fn assert_codec_and_config_port<C>(write: (u32, &[u32]), has_port: bool)
+where
+    C: cube5_model::unit::UnitConfig + StreamCodec + Copy,
+{
+    assert_foreign_codec_is_refused::<C>();
+    let (variant, cfg) = configs::<C>()[0];
+    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
+    assert_eq!(
+        dut.write_config(write.0, write.1).is_ok(),
+        has_port,
+        "{variant}: a configuration port is expected: {has_port}"
+    );
+}
+
+/// On every build of `C`'s top: `MILLION` random items of `gen` with idle, back-pressure and one
+/// reset in batch `reset_batch` (seed `seed_base + ` the variant's index), on a fresh model from
+/// `new`; the reset drops at most `in_flight` items (`must_match_across_a_reset`).
+pub fn million_across_a_reset<C, G, F>(
+    new: impl Fn(C) -> cube5_model::Result<G>,
+    gen: impl Fn(C) -> F,
+    seed_base: u64,
+    reset_batch: usize,
+    in_flight: usize,
+) where
+    C: Scored + UnitConfig + Copy,
+    G: StreamUnit<In = C::In, Out = C::Out>,
+    F: FnMut(&mut ChaCha8Rng) -> C::In,
+{
+    for (i, (variant, cfg)) in configs::<C>().into_iter().enumerate() {
+        must_match_across_a_reset(
+            variant,
+            cfg,
+            &mut new(cfg).unwrap(),
+            &mut gen(cfg),
+            &StreamCheck::long(seed(seed_base + i as u64), MILLION, reset_batch),
+            in_flight,
+        );
+    }
+}
+
+/// On every build of `C`'s top: the `directed` items through `check` (given their number), on a
+/// fresh model from `new`.
+pub fn directed_on_every_config<C, G>(
+    new: impl Fn(C) -> cube5_model::Result<G>,
+    directed: impl Fn(C) -> Vec<C::In>,
+    check: impl Fn(usize) -> StreamCheck,
+) where
+    C: Scored + UnitConfig + Copy,
+    G: StreamUnit<In = C::In, Out = C::Out>,
+{
+    for (variant, cfg) in configs::<C>() {
+        let items = directed(cfg);
+        let check = check(items.len());
+        must_match_items(variant, cfg, &mut new(cfg).unwrap(), items, &check);
+    }
+}
+
 /// The mismatch a run must end in (a mutated model, a corrupted output); panics with `why` if it
 /// passed or failed in another way.
 pub fn expect_mismatch<T: Debug>(
