@@ -11,7 +11,9 @@ use cube5_tb::{Mismatch, TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{axi_protocol_clean, compare_ar, configs, gate_configs, seed, with_waves};
+use support::{
+    axi_protocol_clean, compare_ar, compare_axi_outputs, configs, gate_configs, seed, with_waves,
+};
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
 /// optionally a reset after `reset_at` cycles followed by `after` commands.
@@ -174,63 +176,30 @@ fn drive_and_compare(
     let n_ars = compare_ar(dut, &bursts, cfg.size(), variant, seed, |k| {
         format!("burst #{k} of commands {cmds:?}")
     })?;
-    let fail = |item: u64, cycle: u64, what: &str, input: String, rtl: String, model: String| {
-        TbError::from(Mismatch {
-            variant: variant.name.to_string(),
-            seed,
-            item,
-            cycle,
-            input,
-            rtl,
-            model,
-            what: what.into(),
-            ..Default::default()
-        })
-    };
-    for (k, taken) in driven.outputs.iter().enumerate() {
-        if want.get(k) != Some(&taken.value) {
-            return Err(fail(
-                k as u64,
-                taken.cycle,
-                "output beat differs",
-                describe_beat(cfg, cmds, k),
-                format!("{:?}", taken.value),
-                want.get(k)
-                    .map_or("(no beat expected)".into(), |b| format!("{b:?}")),
-            ));
-        }
-    }
+    compare_axi_outputs(
+        dut,
+        &driven,
+        &want,
+        (n_ars, bursts.len()),
+        exact,
+        limit,
+        (variant, seed),
+        "beat",
+        |k| describe_beat(cfg, cmds, k),
+    )?;
     if exact {
-        let missing = |what: String| TbError::Deadlock {
-            variant: variant.name.to_string(),
-            seed,
-            cycle: dut.cycle(),
-            what,
-        };
-        if driven.outputs.len() != want.len() {
-            return Err(missing(format!(
-                "{} of {} beats out within {limit} cycles",
-                driven.outputs.len(),
-                want.len()
-            )));
-        }
-        if n_ars != bursts.len() {
-            return Err(missing(format!(
-                "{} of {} bursts issued",
-                n_ars,
-                bursts.len()
-            )));
-        }
         let any_err = want.iter().any(|b| b.resp != 0);
         if dut.axi_counters().err_flag != any_err {
-            return Err(fail(
-                0,
-                dut.cycle(),
-                "err_o differs (sticky: some beat's RRESP != OKAY since reset)",
-                format!("{} commands", cmds.len()),
-                format!("err_o = {}", !any_err),
-                format!("err_o = {any_err}"),
-            ));
+            return Err(TbError::from(Mismatch {
+                variant: variant.name.to_string(),
+                seed,
+                cycle: dut.cycle(),
+                input: format!("{} commands", cmds.len()),
+                rtl: format!("err_o = {}", !any_err),
+                model: format!("err_o = {any_err}"),
+                what: "err_o differs (sticky: some beat's RRESP != OKAY since reset)".into(),
+                ..Default::default()
+            }));
         }
     }
     report.beats += driven.outputs.len() as u64;

@@ -12,11 +12,13 @@ use cube5_model::units::cube5_vol_fetch::{
     dram_image, frame_axes, FetchCmd, FetchItem, FetchRun, Sweep, VolFetch, VolFetchConfig,
 };
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
-use cube5_tb::{Mismatch, TbError, Variant};
+use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{axi_protocol_clean, compare_ar, configs, gate_configs, seed, with_waves};
+use support::{
+    axi_protocol_clean, compare_ar, compare_axi_outputs, configs, gate_configs, seed, with_waves,
+};
 
 /// One run: LUT writes (loaded first, in full), then commands (sweeps and more LUT writes), the
 /// memory, how the subordinate behaves, the output traffic, and optionally a reset after
@@ -287,54 +289,18 @@ fn drive_and_compare(
     let n_ars = compare_ar(dut, &bursts, cfg.axi_rd().size(), variant, seed, |k| {
         format!("burst #{k} of {} read commands", run.reads.len())
     })?;
-    let fail = |item: u64, cycle: u64, what: &str, input: String, rtl: String, model: String| {
-        TbError::from(Mismatch {
-            variant: variant.name.to_string(),
-            seed,
-            item,
-            cycle,
-            input,
-            rtl,
-            model,
-            what: what.into(),
-            ..Default::default()
-        })
-    };
-    for (k, taken) in driven.outputs.iter().enumerate() {
-        if want.get(k) != Some(&taken.value) {
-            return Err(fail(
-                k as u64,
-                taken.cycle,
-                "output item differs",
-                describe_item(cmds, want, k),
-                format!("{:?}", taken.value),
-                want.get(k)
-                    .map_or("(no item expected)".into(), |b| format!("{b:?}")),
-            ));
-        }
-    }
-    if exact {
-        let missing = |what: String| TbError::Deadlock {
-            variant: variant.name.to_string(),
-            seed,
-            cycle: dut.cycle(),
-            what,
-        };
-        if driven.outputs.len() != want.len() {
-            return Err(missing(format!(
-                "{} of {} items out within {limit} cycles",
-                driven.outputs.len(),
-                want.len()
-            )));
-        }
-        if n_ars != bursts.len() {
-            return Err(missing(format!(
-                "{} of {} bursts issued",
-                n_ars,
-                bursts.len()
-            )));
-        }
-    } else {
+    compare_axi_outputs(
+        dut,
+        &driven,
+        want,
+        (n_ars, bursts.len()),
+        exact,
+        limit,
+        (variant, seed),
+        "item",
+        |k| describe_item(cmds, want, k),
+    )?;
+    if !exact {
         // Cut by a reset: the model's LUT is what the RTL took before the cut (LUT writes apply
         // when taken; the commands taken are a prefix).
         *gold = before;

@@ -360,3 +360,59 @@ pub fn compare_ar<C: StreamCodec>(
     }
     Ok(ars.len())
 }
+
+/// After an AXI top's run, its outputs against the model's `want`, item by item (`noun` names an
+/// item, `describe` its inputs); with `exact` (no reset cut the run) also that every item came out
+/// within `limit` cycles and that `n_ars` of the model's `bursts` were issued.
+#[allow(clippy::too_many_arguments)]
+pub fn compare_axi_outputs<C: StreamCodec>(
+    dut: &RtlStream<C>,
+    driven: &Driven<C::Out>,
+    want: &[C::Out],
+    (n_ars, bursts): (usize, usize),
+    exact: bool,
+    limit: u64,
+    (variant, seed): (&'static Variant, u64),
+    noun: &str,
+    describe: impl Fn(usize) -> String,
+) -> Result<(), cube5_tb::TbError>
+where
+    C::Out: PartialEq + Debug,
+{
+    for (k, taken) in driven.outputs.iter().enumerate() {
+        if want.get(k) != Some(&taken.value) {
+            return Err(cube5_tb::TbError::from(cube5_tb::Mismatch {
+                variant: variant.name.to_string(),
+                seed,
+                item: k as u64,
+                cycle: taken.cycle,
+                input: describe(k),
+                rtl: format!("{:?}", taken.value),
+                model: want
+                    .get(k)
+                    .map_or(format!("(no {noun} expected)"), |b| format!("{b:?}")),
+                what: format!("output {noun} differs"),
+                ..Default::default()
+            }));
+        }
+    }
+    if exact {
+        let missing = |what: String| cube5_tb::TbError::Deadlock {
+            variant: variant.name.to_string(),
+            seed,
+            cycle: dut.cycle(),
+            what,
+        };
+        if driven.outputs.len() != want.len() {
+            return Err(missing(format!(
+                "{} of {} {noun}s out within {limit} cycles",
+                driven.outputs.len(),
+                want.len()
+            )));
+        }
+        if n_ars != bursts {
+            return Err(missing(format!("{n_ars} of {bursts} bursts issued")));
+        }
+    }
+    Ok(())
+}
