@@ -7,7 +7,7 @@ mod support;
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
-use support::{cube5, scratch};
+use support::{assert_refused, cube5, scratch};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -41,21 +41,6 @@ fn render(scene: &Path, name: &str, extra: &[&str]) -> (String, image::RgbImage)
         String::from_utf8_lossy(&out.stderr)
     );
     (stdout, image::open(&png).unwrap().to_rgb8())
-}
-
-/// A refusal: non-zero exit, exactly one line on stderr containing every needle.
-fn assert_refused(out: &Output, needles: &[&str]) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "expected failure; stderr: {err}");
-    assert!(!err.contains("panicked"), "panic: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "one line expected:\n{err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "error should mention `{n}`: {err}");
-    }
 }
 
 /// The number in `text` after `key` (up to the next space).

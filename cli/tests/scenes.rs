@@ -6,25 +6,10 @@ mod support;
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
-use support::{cube5, scratch};
+use support::{assert_refused, cube5, scratch};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-/// A refusal: non-zero exit, exactly one line on stderr containing every needle, no panic.
-fn assert_refused(out: &Output, needles: &[&str]) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "expected failure; stderr: {err}");
-    assert!(!err.contains("panicked"), "panic on user input: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "one-line error expected:\n{err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "error should mention `{n}`: {err}");
-    }
 }
 
 /// Writes `scene` as NAME.toml in the scratch directory and renders it; returns the output and

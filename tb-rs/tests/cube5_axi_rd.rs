@@ -12,7 +12,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi_protocol_clean, compare_ar, compare_axi_outputs, configs, gate_configs, seed, with_waves,
+    axi_mem_setup, axi_protocol_clean, compare_ar, compare_axi_outputs, configs, gate_configs,
+    seed, with_waves,
 };
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
@@ -52,20 +53,7 @@ fn mem_setup(
     bw: (u32, u32),
     seed: u64,
 ) -> AxiMemSetup {
-    AxiMemSetup {
-        data_bytes: cfg.bytes(),
-        addr_bits: cfg.addr_w,
-        latency_fixed: lat.0,
-        latency_random: lat.1,
-        ar_gap_permille: gaps.0,
-        r_gap_permille: gaps.1,
-        bw_num: bw.0,
-        bw_den: bw.1.max(1),
-        max_bursts: 64,
-        seed,
-        slverr_lo: mem.slverr_lo,
-        slverr_hi: mem.slverr_hi,
-    }
+    axi_mem_setup((cfg.bytes(), cfg.addr_w), mem, lat, gaps, bw, seed)
 }
 
 /// A 64 KB image of random bytes: at 0 for a 16-bit address space (it is the whole space, so

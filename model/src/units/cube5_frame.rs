@@ -594,22 +594,7 @@ pub fn warp(
                     p[params.axis_i] + max_sx as f64,
                     p[params.axis_j] + max_sy as f64,
                 );
-                let (x0, y0) = (x.floor(), y.floor());
-                let (fx, fy) = (x - x0, y - y0);
-                let (x0, y0) = (x0 as i64, y0 as i64);
-                let mut c = [0.0; 3];
-                for (dx, dy, wgt) in [
-                    (0, 0, (1.0 - fx) * (1.0 - fy)),
-                    (1, 0, fx * (1.0 - fy)),
-                    (0, 1, (1.0 - fx) * fy),
-                    (1, 1, fx * fy),
-                ] {
-                    let t = texel(x0 + dx, y0 + dy);
-                    for ch in 0..3 {
-                        c[ch] += wgt * t[ch];
-                    }
-                }
-                *out = c;
+                *out = crate::units::cube5_warp::bilinear_f64(x, y, &texel);
             }
         });
     ImageF64 {

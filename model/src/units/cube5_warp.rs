@@ -352,6 +352,27 @@ pub fn to_image(width: u32, height: u32, pixels: &[[u8; 3]]) -> ImageF64 {
     }
 }
 
+/// The f64 bilinear interpolation at `(x, y)` of the RGB texels `texel(x, y)` (integer texel
+/// coordinates): the ideal both f64 warps use.
+pub fn bilinear_f64(x: f64, y: f64, texel: impl Fn(i64, i64) -> [f64; 3]) -> [f64; 3] {
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (xi, yi) = (x0 as i64, y0 as i64);
+    let mut c = [0.0; 3];
+    for (dx, dy, wgt) in [
+        (0, 0, (1.0 - fx) * (1.0 - fy)),
+        (1, 0, fx * (1.0 - fy)),
+        (0, 1, (1.0 - fx) * fy),
+        (1, 1, fx * fy),
+    ] {
+        let t = texel(xi + dx, yi + dy);
+        for ch in 0..3 {
+            c[ch] += wgt * t[ch];
+        }
+    }
+    c
+}
+
 /// The ideal: the f64 bilinear warp of `base` (codes on the unit interval) under `affine`, zero
 /// outside the base plane, `out_w x out_h` pixels in 0..1.
 pub fn reference(
@@ -368,22 +389,9 @@ pub fn reference(
             .for_each(|(py, row)| {
                 for (px, o) in row.iter_mut().enumerate() {
                     let (x, y) = affine.at(px as f64, py as f64);
-                    let (x0, y0) = (x.floor(), y.floor());
-                    let (fx, fy) = (x - x0, y - y0);
-                    let (xi, yi) = (x0 as i64, y0 as i64);
-                    let mut c = [0.0; 3];
-                    for (dx, dy, wgt) in [
-                        (0, 0, (1.0 - fx) * (1.0 - fy)),
-                        (1, 0, fx * (1.0 - fy)),
-                        (0, 1, (1.0 - fx) * fy),
-                        (1, 1, fx * fy),
-                    ] {
-                        let t = base.texel(xi + dx, yi + dy);
-                        for ch in 0..3 {
-                            c[ch] += wgt * f64::from(t[ch]) / max;
-                        }
-                    }
-                    *o = c;
+                    *o = bilinear_f64(x, y, |tx, ty| {
+                        base.texel(tx, ty).map(|c| f64::from(c) / max)
+                    });
                 }
             });
     }

@@ -416,3 +416,30 @@ where
     }
     Ok(())
 }
+
+/// The test bench's AXI subordinate for a `data_bytes`-wide, `addr_bits` bus over `mem`: latency
+/// `fixed + U(0..random)`, ARREADY/RVALID gaps in per mille, bandwidth `bw` bytes per cycle as
+/// `(num, den)` (`num = 0`: unlimited), `mem`'s SLVERR window.
+pub fn axi_mem_setup(
+    (data_bytes, addr_bits): (u32, u32),
+    mem: &cube5_model::units::cube5_axi_rd::AxiMemImage,
+    lat: (u32, u32),
+    gaps: (u32, u32),
+    bw: (u32, u32),
+    seed: u64,
+) -> cube5_tb::rtl::AxiMemSetup {
+    cube5_tb::rtl::AxiMemSetup {
+        data_bytes,
+        addr_bits,
+        latency_fixed: lat.0,
+        latency_random: lat.1,
+        ar_gap_permille: gaps.0,
+        r_gap_permille: gaps.1,
+        bw_num: bw.0,
+        bw_den: bw.1.max(1),
+        max_bursts: 64,
+        seed,
+        slverr_lo: mem.slverr_lo,
+        slverr_hi: mem.slverr_hi,
+    }
+}
