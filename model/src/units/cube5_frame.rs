@@ -594,7 +594,7 @@ pub fn warp(
                     p[params.axis_i] + max_sx as f64,
                     p[params.axis_j] + max_sy as f64,
                 );
-                *out = crate::units::cube5_warp::bilinear_f64(x, y, &texel);
+                *out = crate::units::cube5_warp::bilinear_f64(x, y, texel);
             }
         });
     ImageF64 {
