@@ -6,7 +6,6 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use std::process::Output;
 use support::{assert_refused, cube5, scratch};
 
 fn s(p: &Path) -> &str {
