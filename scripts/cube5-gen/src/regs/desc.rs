@@ -42,7 +42,27 @@ pub struct Block {
     /// Bits of a register: no numeric field may reach above it.
     #[serde(default = "default_data_w")]
     pub data_w: u32,
+    /// Generate the tables of the AXI4-Lite register block `cube5_axil_regs` into the package
+    /// (one entry per word offset; docs/accel-regs.md, "The register block").
+    #[serde(default)]
+    pub axil: bool,
+    /// The interrupt of an `axil` block: `irq_o` = OR of (status & enable).
+    #[serde(default)]
+    pub irq: Option<Irq>,
 }
+
+/// The registers whose AND, ORed over the bits, is an `axil` block's level interrupt.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Irq {
+    /// A W1C register: the interrupt status.
+    pub status: String,
+    /// An RW register: the enable of each status bit.
+    pub enable: String,
+}
+
+/// Largest word offset of an `axil` block (its tables hold one entry per offset).
+pub const AXIL_MAX_WORDS: u64 = 256;
 
 fn default_word_bytes() -> u64 {
     4
@@ -319,6 +339,8 @@ pub fn parse(text: &str, rel: &Path) -> Result<Checked, String> {
         fields.push(fs);
     }
 
+    check_axil(&desc).map_err(|e| err(format!("block: {e}")))?;
+
     for d in &b.docs {
         for s in &d.show {
             let known = match s.strip_prefix("enum:") {
@@ -343,6 +365,71 @@ pub fn parse(text: &str, rel: &Path) -> Result<Checked, String> {
         exprs,
         fields,
     })
+}
+
+/// An `axil` block: 32-bit words, offsets below [`AXIL_MAX_WORDS`], an interrupt whose status is
+/// W1C and whose enable is RW. `irq` without `axil` is refused.
+fn check_axil(d: &Desc) -> Result<(), String> {
+    let b = &d.block;
+    if !b.axil {
+        return match b.irq {
+            Some(_) => Err("irq needs axil = true".into()),
+            None => Ok(()),
+        };
+    }
+    if b.data_w != 32 || b.word_bytes != 4 {
+        return Err(format!(
+            "axil needs data_w = 32 and word_bytes = 4 (has {} and {})",
+            b.data_w, b.word_bytes
+        ));
+    }
+    if let Some(r) = d.register.iter().find(|r| r.offset >= AXIL_MAX_WORDS) {
+        return Err(format!(
+            "axil: register {} at offset {} (at most {})",
+            r.name,
+            r.offset,
+            AXIL_MAX_WORDS - 1
+        ));
+    }
+    if let Some(irq) = &b.irq {
+        for (name, want) in [(&irq.status, Access::W1C), (&irq.enable, Access::RW)] {
+            match d.register.iter().find(|r| &r.name == name) {
+                Some(r) if r.access == want => {}
+                Some(r) => {
+                    return Err(format!(
+                        "irq: register {name} is {}, not {}",
+                        r.access.as_str(),
+                        want.as_str()
+                    ))
+                }
+                None => return Err(format!("irq: no register {name}")),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The bits of a register that hold state: its numeric fields, or every bit when a field's place
+/// depends on parameters or there are no fields.
+pub fn stored_mask(fs: &[Field], data_w: u32) -> u64 {
+    let all = if data_w >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << data_w) - 1
+    };
+    if fs.is_empty() {
+        return all;
+    }
+    let mut m = 0u64;
+    for f in fs {
+        match (&f.lsb, &f.width) {
+            (Resolved::Num(l), Resolved::Num(w)) => {
+                m |= (u64::MAX >> (64 - w)) << l;
+            }
+            _ => return all,
+        }
+    }
+    m
 }
 
 /// Resolve lsb and width of each field; refuse overlaps and fields above `data_w`.
