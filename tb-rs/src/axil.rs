@@ -11,6 +11,7 @@
 use crate::error::{Mismatch, TbError};
 use crate::rtl::{RtlStream, Traffic};
 use crate::variants::Variant;
+use cube5_model::accel_host::RegBus;
 use cube5_model::units::cube5_axil::{
     top_ro, top_set, top_stimulus, AxilCodec, AxilConfig, AxilRecord, AxilRecordKind, AxilTxn,
     BusWrite, RegFile, RESP_OKAY,
@@ -108,6 +109,23 @@ impl AxilBench {
         stall: &[u8],
         max_cycles: Option<u64>,
     ) -> Result<AxilRun, TbError> {
+        self.run_records(txns, stall, max_cycles).map(|(r, _)| r)
+    }
+
+    /// One transaction at full speed, checked like any other; its response.
+    pub fn transact(&mut self, txn: AxilTxn) -> Result<AxilRecord, TbError> {
+        let (_, recs) = self.run_records(&[txn], &[], None)?;
+        recs.into_iter()
+            .find(|r| r.kind != AxilRecordKind::Irq)
+            .ok_or_else(|| TbError::setup(self.dut.name(), "no response"))
+    }
+
+    fn run_records(
+        &mut self,
+        txns: &[AxilTxn],
+        stall: &[u8],
+        max_cycles: Option<u64>,
+    ) -> Result<(AxilRun, Vec<AxilRecord>), TbError> {
         let name = self.dut.name();
         let start = self.dut.cycle();
         let expect = txns.len() as u64;
@@ -140,12 +158,13 @@ impl AxilBench {
         }
         self.replay(txns, &driven.outputs, start, end, complete)?;
         self.item_base += expect;
-        Ok(AxilRun {
+        let run = AxilRun {
             issued: st.consumed,
             responses: st.produced,
             cycles: st.cycles,
             complete,
-        })
+        };
+        Ok((run, driven.outputs.into_iter().map(|t| t.value).collect()))
     }
 
     fn offset(&self, addr: u32) -> u32 {
@@ -331,6 +350,49 @@ impl AxilBench {
             format!("{r:?}"),
             model,
         )
+    }
+}
+
+/// The bench as the host driver's bus (`cube5_model::accel_host`): each access is one transaction
+/// at full speed, checked against the model; an error response is an error.
+impl RegBus for AxilBench {
+    type Error = TbError;
+
+    fn read(&mut self, addr: u64) -> Result<u32, TbError> {
+        let r = self.transact(AxilTxn {
+            read: true,
+            addr: addr as u32,
+            data: 0,
+            strb: 0,
+            delay: 0,
+            w_delay: 0,
+        })?;
+        self.okay(addr, r).map(|r| r.data)
+    }
+
+    fn write(&mut self, addr: u64, data: u32) -> Result<(), TbError> {
+        let r = self.transact(AxilTxn {
+            read: false,
+            addr: addr as u32,
+            data,
+            strb: 0xf,
+            delay: 0,
+            w_delay: 0,
+        })?;
+        self.okay(addr, r).map(|_| ())
+    }
+}
+
+impl AxilBench {
+    fn okay(&self, addr: u64, r: AxilRecord) -> Result<AxilRecord, TbError> {
+        if r.resp == RESP_OKAY {
+            Ok(r)
+        } else {
+            Err(TbError::setup(
+                self.dut.name(),
+                format!("{:?} of {addr:#x} answered {}", r.kind, r.resp),
+            ))
+        }
     }
 }
 
