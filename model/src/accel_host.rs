@@ -6,6 +6,7 @@
 //! The bus is a trait, [`RegBus`], so the same driver runs against the register-file model, the
 //! RTL in co-simulation (`cube5_tb::axil`) or a real device (a memory-mapped window).
 
+use crate::regmap::Field;
 use crate::regs::cube5_accel::{
     REG_CTRL, REG_CTRL_SOFT_RESET, REG_CTRL_START, REG_CYCLE_HI, REG_CYCLE_LO, REG_DIMS, REG_DX,
     REG_DY, REG_IMG_BASE_HI, REG_IMG_BASE_LO, REG_IRQ_ENABLE, REG_IRQ_ENABLE_DONE,
@@ -15,7 +16,6 @@ use crate::regs::cube5_accel::{
     REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO, TABLE_BLOCK, TABLE_CLASS, TABLE_OPACITY,
     TABLE_REFLECT,
 };
-use crate::regmap::Field;
 use std::fmt;
 
 /// Bytes per register: the AXI4-Lite data bus is 32 bits (`cube5-gen` refuses an `axil` map with
@@ -330,7 +330,8 @@ mod tests {
                 self.table_at = (data >> 16, data & 0xffff);
             }
             if o == REG_TABLE_DATA {
-                self.table_log.push((self.table_at.0, self.table_at.1, data));
+                self.table_log
+                    .push((self.table_at.0, self.table_at.1, data));
                 self.table_at.1 += 1;
             }
             self.tick(Some(BusWrite {

@@ -238,7 +238,13 @@ impl AxilBench {
                 let off = self.offset(t.addr);
                 let want = self.file.read(off, top_ro(off, hw));
                 if r.aux != r.at.wrapping_add(1) {
-                    return Err(self.mismatch_txn(item, taken, t, &r, "RVALID not in the cycle after AR".into()));
+                    return Err(self.mismatch_txn(
+                        item,
+                        taken,
+                        t,
+                        &r,
+                        "RVALID not in the cycle after AR".into(),
+                    ));
                 }
                 if c < exact_to {
                     let data_ok = want.data.is_none_or(|d| d == r.data);
@@ -267,7 +273,11 @@ impl AxilBench {
                 let resp = self.file.write_resp(off);
                 let hw_q = self.file.hw_word(off);
                 let late = u64::from(b.at.wrapping_sub(b.aux)) < 2;
-                if late || b.resp != resp || b.stb != (resp == RESP_OKAY) || hw_q.is_some_and(|q| q != b.data) {
+                if late
+                    || b.resp != resp
+                    || b.stb != (resp == RESP_OKAY)
+                    || hw_q.is_some_and(|q| q != b.data)
+                {
                     return Err(self.mismatch_txn(
                         item,
                         taken,
@@ -291,8 +301,7 @@ impl AxilBench {
                     strb: t.strb,
                 }
             });
-            self.file
-                .edge(write, &|o| top_set(o, hw, hw_set));
+            self.file.edge(write, &|o| top_set(o, hw, hw_set));
             c += 1;
         }
         self.next_cycle = end;

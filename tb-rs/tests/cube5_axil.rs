@@ -7,10 +7,10 @@
 
 mod support;
 
-use cube5_model::units::cube5_axil::{AxilConfig, AxilTxn, BusWrite, RESP_OKAY, RESP_SLVERR};
 use cube5_model::accel_host::{AccelHost, FrameRegs, HostError};
 use cube5_model::regs::cube5_accel::TABLE_CLASS;
 use cube5_model::regs::cube5_axil_regs::MAP_ACCEL;
+use cube5_model::units::cube5_axil::{AxilConfig, AxilTxn, BusWrite, RESP_OKAY, RESP_SLVERR};
 use cube5_tb::axil::{random_txn, stall_pattern, AxilBench, TxnMix};
 use cube5_tb::TbError;
 use rand::{Rng, SeedableRng};
@@ -125,7 +125,10 @@ fn error_responses_are_reached() {
         let past = map.words() + 1;
         assert_eq!(file.write_resp(past), RESP_SLVERR, "{v}");
         assert_eq!(file.read(past, 0).resp, RESP_SLVERR, "{v}");
-        assert!(map.registers.iter().any(|r| file.read(r.offset, 0).resp == RESP_OKAY));
+        assert!(map
+            .registers
+            .iter()
+            .any(|r| file.read(r.offset, 0).resp == RESP_OKAY));
         let mut bench = must(AxilBench::open(v, seed(3)));
         let txns = [
             AxilTxn {
@@ -214,8 +217,12 @@ fn a_model_that_disagrees_is_caught() {
             delay: 0,
             w_delay: 0,
         };
-        let e = bench.run(&[txn], &[], None).expect_err("the disagreement is found");
-        let m = e.mismatch().unwrap_or_else(|| panic!("{v}: not a mismatch: {e}"));
+        let e = bench
+            .run(&[txn], &[], None)
+            .expect_err("the disagreement is found");
+        let m = e
+            .mismatch()
+            .unwrap_or_else(|| panic!("{v}: not a mismatch: {e}"));
         assert_eq!(m.item, 0, "{v}: {m}");
         assert!(m.to_string().contains("seed"), "{m}");
     }
@@ -247,7 +254,8 @@ fn the_host_driver_runs_on_the_rtl() {
             .unwrap_or_else(|e| panic!("{e}"));
         host.load_table(TABLE_CLASS, 3, &[7, 8, 9])
             .unwrap_or_else(|e| panic!("{e}"));
-        host.enable_irq(true, false).unwrap_or_else(|e| panic!("{e}"));
+        host.enable_irq(true, false)
+            .unwrap_or_else(|e| panic!("{e}"));
         host.start().unwrap_or_else(|e| panic!("{e}"));
         // The stimulus sets IrqStatus.done sooner or later; an error bit may come first.
         match host.wait_done(10_000) {

@@ -133,28 +133,9 @@ pub const REGISTERS: [Register; 20] = [
 /// The bits each word offset keeps (AXI4-Lite register block, docs/accel-regs.md): its fields,
 /// every bit where a field's place depends on parameters, 0 where no register is.
 pub const AXIL_MASK: [u32; 22] = [
-    0x00000003,
-    0x00000007,
-    0x00000003,
-    0x00000003,
-    0xffffffff,
-    0x00000007,
-    0x0003ffff,
-    0x0003ffff,
-    0x00000007,
-    0xffffffff,
-    0xffffffff,
-    0xffffffff,
-    0xffffffff,
-    0xffffffff,
-    0x00000000,
-    0x00000000,
-    0xffffffff,
-    0xffffffff,
-    0xffffffff,
-    0xffffffff,
-    0x000fffff,
-    0xffffffff,
+    0x00000003, 0x00000007, 0x00000003, 0x00000003, 0xffffffff, 0x00000007, 0x0003ffff, 0x0003ffff,
+    0x00000007, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x00000000, 0x00000000,
+    0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x000fffff, 0xffffffff,
 ];
 
 /// The interrupt: `irq_o` is high while (status & enable) != 0, as (status, enable) offsets.

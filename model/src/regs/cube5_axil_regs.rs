@@ -76,19 +76,8 @@ pub const REGISTERS: [Register; 9] = [
 /// The bits each word offset keeps (AXI4-Lite register block, docs/accel-regs.md): its fields,
 /// every bit where a field's place depends on parameters, 0 where no register is.
 pub const AXIL_MASK: [u32; 13] = [
-    0xffffffff,
-    0x8000ff0f,
-    0x00000000,
-    0xc0fff007,
-    0xffffff01,
-    0xff0000ff,
-    0xff0000ff,
-    0x00000000,
-    0x00000000,
-    0xffffffff,
-    0xffffffff,
-    0x00000000,
-    0x000fffff,
+    0xffffffff, 0x8000ff0f, 0x00000000, 0xc0fff007, 0xffffff01, 0xff0000ff, 0xff0000ff, 0x00000000,
+    0x00000000, 0xffffffff, 0xffffffff, 0x00000000, 0x000fffff,
 ];
 
 /// The interrupt: `irq_o` is high while (status & enable) != 0, as (status, enable) offsets.

@@ -138,7 +138,9 @@ impl RegFile {
     pub fn new(map: AxilMap) -> Self {
         let words = (0..map.words())
             .map(|o| match map.at(o) {
-                Some(r) if r.access != Access::Ro => r.reset.map(|v| v as u32 & map.mask[o as usize]),
+                Some(r) if r.access != Access::Ro => {
+                    r.reset.map(|v| v as u32 & map.mask[o as usize])
+                }
                 _ => Some(0),
             })
             .collect();
@@ -233,7 +235,12 @@ impl RegFile {
                 self.words[i] = self.words[i].map(|v| v & m);
             }
         }
-        for r in self.map.registers.iter().filter(|r| r.access == Access::W1c) {
+        for r in self
+            .map
+            .registers
+            .iter()
+            .filter(|r| r.access == Access::W1c)
+        {
             let i = r.offset as usize;
             let m = self.map.mask[i];
             self.words[i] = self.words[i].map(|q| (q | set(r.offset)) & m);
@@ -371,13 +378,7 @@ mod tests {
         assert_eq!(f.write_resp(REG_ARG), RESP_OKAY);
         assert_eq!(f.read(REG_SENSE, u32::MAX).data, Some(0xc0ff_f007));
         // Byte strobes and the field mask.
-        let w = |offset, data, strb| {
-            Some(BusWrite {
-                offset,
-                data,
-                strb,
-            })
-        };
+        let w = |offset, data, strb| Some(BusWrite { offset, data, strb });
         f.edge(w(REG_LIMITS, 0xffff_ffff, 0b0010), &none);
         assert_eq!(f.read(REG_LIMITS, 0).data, Some(0xff05));
         // W1C: write 1 clears; a set in the same cycle wins.
@@ -416,7 +417,10 @@ mod tests {
         };
         assert_eq!(c.pack_in(&t), vec![0x00c8_03a1, 0x3c, 5, 0]);
         let r = c.unpack_out(&[1 | 2 << 2 | 1 << 4, 9, 10, 11]);
-        assert_eq!((r.kind, r.resp, r.stb, r.data), (AxilRecordKind::R, 2, true, 9));
+        assert_eq!(
+            (r.kind, r.resp, r.stb, r.data),
+            (AxilRecordKind::R, 2, true, 9)
+        );
         assert_eq!(top_ro(1, 1), 32);
         assert_eq!(top_set(5, 1, true), 1 << 3);
         let sets = (0..8000).filter(|&c| top_stimulus(7, c).1).count();

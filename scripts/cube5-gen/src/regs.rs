@@ -514,21 +514,36 @@ doc = "id"
             assert!(sv.contains(line), "{line} not in {sv}");
         }
         let rs = &files[Path::new("model/src/regs/cube5_t.rs")];
-        assert!(rs.contains("pub const AXIL_IRQ: Option<(u32, u32)> = Some((2, 3));"), "{rs}");
-        assert!(rs.contains("pub const AXIL_MASK: [u32; 5] = [\n    0x00000001,\n"), "{rs}");
+        assert!(
+            rs.contains("pub const AXIL_IRQ: Option<(u32, u32)> = Some((2, 3));"),
+            "{rs}"
+        );
+        assert!(
+            rs.contains("pub const AXIL_MASK: [u32; 5] = [\n    0x00000001, 0x00000000, 0xffffffff, 0x00000031, 0xffffffff,\n];"),
+            "{rs}"
+        );
 
         let e = parse(
-            &format!("{}{regs}", head.replace("axil = true", "axil = true\ndata_w = 36")),
+            &format!(
+                "{}{regs}",
+                head.replace("axil = true", "axil = true\ndata_w = 36")
+            ),
             Path::new("rtl/t.regs.toml"),
         )
         .unwrap_err();
         assert!(e.contains("axil needs data_w = 32"), "{e}");
         let e = parse(
-            &format!("{}{regs}", head.replace("status = \"Irq\"", "status = \"IrqEn\"")),
+            &format!(
+                "{}{regs}",
+                head.replace("status = \"Irq\"", "status = \"IrqEn\"")
+            ),
             Path::new("rtl/t.regs.toml"),
         )
         .unwrap_err();
-        assert_eq!(e, "rtl/t.regs.toml: block: irq: register IrqEn is RW, not W1C");
+        assert_eq!(
+            e,
+            "rtl/t.regs.toml: block: irq: register IrqEn is RW, not W1C"
+        );
         let e = parse(
             &format!("{}{regs}", head.replace("axil = true\n", "")),
             Path::new("rtl/t.regs.toml"),

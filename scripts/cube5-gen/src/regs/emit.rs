@@ -231,7 +231,11 @@ fn sv_axil(out: &mut String, b: &Checked, indent: &str) {
     ];
     for (name, v, doc) in tables {
         let _ = writeln!(out, "{indent}// {doc}");
-        let _ = writeln!(out, "{indent}localparam logic [{}:0] {name} = {n}'b{v};", n - 1);
+        let _ = writeln!(
+            out,
+            "{indent}localparam logic [{}:0] {name} = {n}'b{v};",
+            n - 1
+        );
     }
     let has_reset: String = slots
         .iter()
@@ -241,7 +245,10 @@ fn sv_axil(out: &mut String, b: &Checked, indent: &str) {
             _ => '0',
         })
         .collect();
-    let _ = writeln!(out, "{indent}// reset sets the register to its AxilReset word");
+    let _ = writeln!(
+        out,
+        "{indent}// reset sets the register to its AxilReset word"
+    );
     let _ = writeln!(
         out,
         "{indent}localparam logic [{}:0] AxilHasReset = {n}'b{has_reset};",
@@ -475,8 +482,13 @@ fn rust_axil(out: &mut String, b: &Checked) {
          fields, every bit where a field's place depends on parameters, 0 where no register is.",
     );
     let _ = writeln!(out, "pub const AXIL_MASK: [u32; {}] = [", slots.len());
-    for s in &slots {
-        let _ = writeln!(out, "    {:#010x},", s.map_or(0, |(_, m, _)| m));
+    // Eight to a line, as rustfmt lays them out.
+    let masks: Vec<String> = slots
+        .iter()
+        .map(|s| format!("{:#010x}", s.map_or(0, |(_, m, _)| m)))
+        .collect();
+    for row in masks.chunks(8) {
+        let _ = writeln!(out, "    {},", row.join(", "));
     }
     out.push_str("];\n");
     out.push('\n');
