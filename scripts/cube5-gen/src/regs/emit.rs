@@ -163,9 +163,11 @@ pub fn sv(b: &Checked, indent: &str) -> String {
     out
 }
 
-/// One entry per word offset of an `axil` block: `(access, stored mask, reset)`, `None` where no
-/// register is.
-fn axil_slots(b: &Checked) -> Vec<Option<(Access, u64, Option<u64>)>> {
+/// One word offset of an `axil` block: `(access, stored mask, reset)`, `None` where no register is.
+type Slot = Option<(Access, u64, Option<u64>)>;
+
+/// Every word offset of an `axil` block.
+fn axil_slots(b: &Checked) -> Vec<Slot> {
     let d = &b.desc;
     let words = d.register.iter().map(|r| r.offset + 1).max().unwrap_or(0);
     let mut slots = vec![None; words as usize];
@@ -254,7 +256,7 @@ fn sv_axil(out: &mut String, b: &Checked, indent: &str) {
         "{indent}localparam logic [{}:0] AxilHasReset = {n}'b{has_reset};",
         n - 1
     );
-    let words = |f: &dyn Fn(&Option<(Access, u64, Option<u64>)>) -> u64| -> String {
+    let words = |f: &dyn Fn(&Slot) -> u64| -> String {
         let w: Vec<String> = slots
             .iter()
             .rev()
