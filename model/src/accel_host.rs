@@ -55,6 +55,18 @@ pub struct FrameRegs {
 }
 
 impl FrameRegs {
+    /// An example frame for tests and docs: a 64^3 volume at `m` = 7 (8-bit dimension fields),
+    /// slices along z swept in reverse, steps -2 / 65536 and 12 / 65536, composite with the 2-D
+    /// transfer function, two empty slices skipped in front and three behind.
+    pub const EXAMPLE: Self = Self {
+        dims: 0x0040_4040,
+        view: 6,
+        dx: 0x3_fffe,
+        dy: 12,
+        mode: 5,
+        skip: 0x0302,
+    };
+
     /// (accelerator register, word) in the order the driver writes them.
     pub fn writes(&self) -> [(u32, u32); 6] {
         [
@@ -346,14 +358,7 @@ mod tests {
     #[test]
     fn a_frame_through_the_driver() {
         let mut h = AccelHost::new(FakeAccel::new(5, false), 0);
-        let f = FrameRegs {
-            dims: 0x0040_4040,
-            view: 6,
-            dx: 0x3_fffe,
-            dy: 12,
-            mode: 5,
-            skip: 0x0003_0002,
-        };
+        let f = FrameRegs::EXAMPLE;
         h.write_frame(&f).unwrap();
         assert_eq!(h.read_frame().unwrap(), f);
         h.set_bases(0x1_2345_6780, 0x8000_0000).unwrap();

@@ -240,14 +240,7 @@ fn the_host_driver_runs_on_the_rtl() {
         }
         let bench = must(AxilBench::open(v, seed(0x405)));
         let mut host = AccelHost::new(bench, 0);
-        let f = FrameRegs {
-            dims: 0x0040_4040,
-            view: 6,
-            dx: 0x3_fffe,
-            dy: 12,
-            mode: 5,
-            skip: 0x0003_0002,
-        };
+        let f = FrameRegs::EXAMPLE;
         host.write_frame(&f).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(host.read_frame().unwrap_or_else(|e| panic!("{e}")), f);
         host.set_bases(0x1_2345_6780, 0xffff_ffff_0000_0040)
