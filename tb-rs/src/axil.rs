@@ -45,6 +45,14 @@ pub struct AxilBench {
     unanswered: Vec<u32>,
     /// Transactions driven since the bench opened (numbers the items in a mismatch).
     item_base: u64,
+    /// Everything driven since the bench opened, to re-run it with a waveform after a mismatch.
+    history: Vec<Op>,
+}
+
+/// One step of a bench's history.
+enum Op {
+    Run(Vec<AxilTxn>, Vec<u8>, Option<u64>),
+    Reset,
 }
 
 impl AxilBench {
@@ -66,6 +74,7 @@ impl AxilBench {
             rtl_irq: None,
             unanswered: Vec::new(),
             item_base: 0,
+            history: Vec::new(),
         })
     }
 
@@ -93,6 +102,7 @@ impl AxilBench {
 
     /// Resets the RTL (four cycles) and the model; responses in flight are dropped.
     pub fn reset(&mut self) {
+        self.history.push(Op::Reset);
         self.dut.reset();
         for o in std::mem::take(&mut self.unanswered) {
             self.file.forget(o);
@@ -126,6 +136,8 @@ impl AxilBench {
         stall: &[u8],
         max_cycles: Option<u64>,
     ) -> Result<(AxilRun, Vec<AxilRecord>), TbError> {
+        self.history
+            .push(Op::Run(txns.to_vec(), stall.to_vec(), max_cycles));
         let name = self.dut.name();
         let start = self.dut.cycle();
         let expect = txns.len() as u64;
@@ -156,7 +168,9 @@ impl AxilBench {
                 what: format!("{} of {expect} responses after {limit} cycles", st.produced),
             });
         }
-        self.replay(txns, &driven.outputs, start, end, complete)?;
+        if let Err(e) = self.replay(txns, &driven.outputs, start, end, complete) {
+            return Err(self.with_waves(e));
+        }
         self.item_base += expect;
         let run = AxilRun {
             issued: st.consumed,
@@ -165,6 +179,44 @@ impl AxilBench {
             complete,
         };
         Ok((run, driven.outputs.into_iter().map(|t| t.value).collect()))
+    }
+
+    /// A mismatch with the waveform of the 64 cycles before it: the whole history re-run on a
+    /// fresh instance of the same variant and seed, traced around the mismatch
+    /// (`target/cube5-waves/`; `CUBE5_NO_WAVES=1` turns this off).
+    fn with_waves(&self, e: TbError) -> TbError {
+        let TbError::Mismatch(mut m) = e else {
+            return e;
+        };
+        if std::env::var_os("CUBE5_NO_WAVES").is_some() {
+            return TbError::Mismatch(m);
+        }
+        let dir = std::path::PathBuf::from(
+            std::env::var("CARGO_TARGET_DIR").unwrap_or_else(|_| "target".into()),
+        )
+        .join("cube5-waves");
+        let _ = std::fs::create_dir_all(&dir);
+        let path = dir.join(format!("{}-seed{}.vcd", m.variant, self.seed));
+        if let Ok(mut dut) = RtlStream::new(self.dut.variant(), AxilCodec, self.stim_seed) {
+            dut.trace_window(&path, m.cycle.saturating_sub(64), m.cycle + 8);
+            for op in &self.history {
+                match op {
+                    Op::Run(t, stall, max) => {
+                        let traffic = Traffic {
+                            idle: Vec::new(),
+                            stall: stall.clone(),
+                        };
+                        let n = t.len() as u64;
+                        let _ = dut.drive(t, &traffic, n, max.unwrap_or(1000 + n * 600));
+                    }
+                    Op::Reset => dut.reset(),
+                }
+            }
+            // The file is complete when the instance closes it.
+            drop(dut);
+            m.waveform = path.exists().then_some(path);
+        }
+        TbError::Mismatch(m)
     }
 
     fn offset(&self, addr: u32) -> u32 {
