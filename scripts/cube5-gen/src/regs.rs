@@ -92,10 +92,24 @@ pub fn descriptions(root: &Path) -> Result<Vec<PathBuf>, String> {
 
 /// What every generated file should hold: path relative to `root` -> content.
 pub fn generate(root: &Path) -> Result<BTreeMap<PathBuf, String>, String> {
-    let blocks = descriptions(root)?
-        .iter()
-        .map(|rel| desc::load(root, rel))
-        .collect::<Result<Vec<_>, _>>()?;
+    // Blocks whose registers take another block's fields (`like`) are checked after the others.
+    let mut texts = Vec::new();
+    for rel in descriptions(root)? {
+        let text = std::fs::read_to_string(root.join(&rel))
+            .map_err(|e| format!("{}: {e}", rel.display()))?;
+        texts.push((rel, text));
+    }
+    let mut blocks = Vec::new();
+    for (rel, text) in texts.iter().filter(|(_, t)| !desc::has_likes(t)) {
+        blocks.push(desc::parse(text, rel)?);
+    }
+    let mut liking = Vec::new();
+    for (rel, text) in texts.iter().filter(|(_, t)| desc::has_likes(t)) {
+        liking.push(desc::parse_with(text, rel, &|l| {
+            desc::like_fields(&blocks, l)
+        })?);
+    }
+    blocks.extend(liking);
     generate_from(&blocks, &|p: &Path| {
         std::fs::read_to_string(root.join(p)).map_err(|e| format!("{}: {e}", p.display()))
     })
@@ -556,6 +570,61 @@ doc = "id"
         )
         .unwrap_err();
         assert!(e.contains("register Id at offset 256"), "{e}");
+    }
+
+    #[test]
+    fn like_takes_another_blocks_fields() {
+        let src = parse(
+            &format!(
+                "{HEAD}{}",
+                r#"
+[[constant]]
+name = "StepW"
+value = 16
+doc = "s"
+[[register]]
+name = "Dx"
+offset = 2
+access = "WO"
+doc = "dx"
+field = [ { name = "n", width = "m + 1" }, { name = "dx", width = "StepW + 2", doc = "step" } ]
+"#
+            ),
+            Path::new("rtl/t.regs.toml"),
+        )
+        .unwrap();
+        let user = "[block]\nname = \"cube5_u\"\ndoc = \"u\"\nsv_package = \"u_pkg.sv\"\nrust = \"model/src/regs/cube5_u.rs\"\n[[register]]\nname = \"Dx\"\noffset = 0\naccess = \"RW\"\ndoc = \"dx\"\nlike = \"cube5_t.Dx\"\n";
+        assert!(desc::has_likes(user));
+        let blocks = [src];
+        let b = desc::parse_with(user, Path::new("rtl/u.regs.toml"), &|l| {
+            desc::like_fields(&blocks, l)
+        })
+        .unwrap();
+        let f = &b.fields[0];
+        assert_eq!(f[0].width, desc::Resolved::Sym("m + 1".into()));
+        assert_eq!(f[1].width, desc::Resolved::Num(18), "{f:?}");
+        assert_eq!(f[1].doc, "step");
+        let e = parse(user, Path::new("rtl/u.regs.toml")).unwrap_err();
+        assert_eq!(
+            e,
+            "rtl/u.regs.toml: register Dx: like cube5_t.Dx: no such register"
+        );
+        let e = desc::parse_with(
+            &user.replace("cube5_t.Dx", "cube5_t.Dy"),
+            Path::new("rtl/u.regs.toml"),
+            &|l| desc::like_fields(&blocks, l),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e,
+            "rtl/u.regs.toml: register Dx: like cube5_t.Dy: no register Dy in cube5_t"
+        );
+        let both = user.replace("like =", "field = [ { name = \"a\", width = 1 } ]\nlike =");
+        let e = desc::parse_with(&both, Path::new("rtl/u.regs.toml"), &|l| {
+            desc::like_fields(&blocks, l)
+        })
+        .unwrap_err();
+        assert_eq!(e, "rtl/u.regs.toml: register Dx: like and field both given");
     }
 
     #[test]

@@ -171,9 +171,12 @@ pub struct Register {
     pub doc: String,
     #[serde(default)]
     pub field: Vec<FieldDesc>,
+    /// `<block>.<Register>`: take that register's fields (placed as there) instead of `field`.
+    #[serde(default)]
+    pub like: Option<String>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FieldDesc {
     pub name: String,
@@ -231,8 +234,56 @@ pub fn load(root: &Path, rel: &Path) -> Result<Checked, String> {
     parse(&text, rel)
 }
 
-/// Check a description's text; errors are one line and name the file (and the item).
+/// Check a description's text; errors are one line and name the file (and the item). A register
+/// with `like` is refused: [`parse_with`] resolves it.
 pub fn parse(text: &str, rel: &Path) -> Result<Checked, String> {
+    parse_with(text, rel, &|like| {
+        Err(format!("like {like}: no such register"))
+    })
+}
+
+/// Whether a description has a register with `like` (it must be checked after the blocks it
+/// names).
+pub fn has_likes(text: &str) -> bool {
+    toml::from_str::<Desc>(text).is_ok_and(|d| d.register.iter().any(|r| r.like.is_some()))
+}
+
+/// The fields of register `<block>.<Register>` in `blocks`, placed as there, for `like`.
+pub fn like_fields(blocks: &[Checked], like: &str) -> Result<Vec<FieldDesc>, String> {
+    let (blk, name) = like
+        .split_once('.')
+        .ok_or_else(|| format!("like {like} is not <block>.<Register>"))?;
+    let b = blocks
+        .iter()
+        .find(|b| b.desc.block.name == blk)
+        .ok_or_else(|| format!("like {like}: no block {blk}"))?;
+    let i = b
+        .desc
+        .register
+        .iter()
+        .position(|r| r.name == name)
+        .ok_or_else(|| format!("like {like}: no register {name} in {blk}"))?;
+    let value = |r: &Resolved| match r {
+        Resolved::Num(n) => Value::Int(*n),
+        Resolved::Sym(s) => Value::Expr(s.clone()),
+    };
+    Ok(b.fields[i]
+        .iter()
+        .map(|f| FieldDesc {
+            name: f.name.clone(),
+            lsb: Some(value(&f.lsb)),
+            width: value(&f.width),
+            doc: f.doc.clone(),
+        })
+        .collect())
+}
+
+/// [`parse`], with `likes` giving the fields a `like` names.
+pub fn parse_with(
+    text: &str,
+    rel: &Path,
+    likes: &dyn Fn(&str) -> Result<Vec<FieldDesc>, String>,
+) -> Result<Checked, String> {
     let file = rel.display().to_string();
     let desc: Desc = toml::from_str(text)
         .map_err(|e| format!("{file}: {}", e.to_string().replace('\n', " ").trim_end()))?;
@@ -327,7 +378,19 @@ pub fn parse(text: &str, rel: &Path) -> Result<Checked, String> {
                 r.offset
             )));
         }
-        let fs = place_fields(r, &values, b.data_w).map_err(|e| err(format!("{what}: {e}")))?;
+        let liked;
+        let field_descs = match &r.like {
+            None => &r.field,
+            Some(_) if !r.field.is_empty() => {
+                return Err(err(format!("{what}: like and field both given")))
+            }
+            Some(l) => {
+                liked = likes(l).map_err(|e| err(format!("{what}: {e}")))?;
+                &liked
+            }
+        };
+        let fs = place_fields(field_descs, &values, b.data_w)
+            .map_err(|e| err(format!("{what}: {e}")))?;
         if let Some(reset) = r.reset {
             if b.data_w < 64 && reset >> b.data_w != 0 {
                 return Err(err(format!(
@@ -434,7 +497,7 @@ pub fn stored_mask(fs: &[Field], data_w: u32) -> u64 {
 
 /// Resolve lsb and width of each field; refuse overlaps and fields above `data_w`.
 fn place_fields(
-    r: &Register,
+    field: &[FieldDesc],
     values: &BTreeMap<String, u64>,
     data_w: u32,
 ) -> Result<Vec<Field>, String> {
@@ -453,7 +516,7 @@ fn place_fields(
     let mut out: Vec<Field> = Vec::new();
     let mut names = BTreeSet::new();
     let mut next = Resolved::Num(0);
-    for f in &r.field {
+    for f in field {
         if !names.insert(f.name.as_str()) {
             return Err(format!("field {} defined twice", f.name));
         }
