@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -76,10 +77,13 @@ class AxilMgr {
   uint64_t first_error_cycle() const { return first_error_cycle_; }
   const std::string& first_error() const { return first_error_; }
 
+  /// Counts a violation; the first is also printed (the bridge carries only its cycle).
   void error(uint64_t cycle, const std::string& what) {
     if (errors_++ == 0) {
       first_error_cycle_ = cycle;
       first_error_ = what;
+      std::fprintf(stderr, "axil_mgr: protocol violation at cycle %llu: %s\n",
+                   static_cast<unsigned long long>(cycle), what.c_str());
     }
   }
 
