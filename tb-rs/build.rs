@@ -246,6 +246,8 @@ fn main() {
         "stream_shim.h",
         "axi_mem.h",
         "axi_shim.h",
+        "axil_mgr.h",
+        "axil_shim.h",
         "stream_dut.h",
         "stream_dut.cpp",
     ] {
@@ -294,6 +296,12 @@ fn main() {
         .map(|f| fs::read_to_string(tb.join(f)).unwrap())
         .collect();
 
+    // Tops with an AXI4-Lite subordinate port are wrapped in AxilShim (the same arrangement).
+    let axil_text: String = ["axil_mgr.h", "axil_shim.h"]
+        .iter()
+        .map(|f| fs::read_to_string(tb.join(f)).unwrap())
+        .collect();
+
     // Runtime objects, shared by every variant.
     let runtime = build_runtime(&cache, &vl_include, &verilator_version);
 
@@ -322,6 +330,7 @@ fn main() {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(v) = selected.get(i) else { break };
                 let axi: &str = if has_axi_port(v) { &axi_text } else { "" };
+                let axi: &str = if has_axil_port(v) { &axil_text } else { axi };
                 let stamp = variant_stamp(
                     v,
                     &repo,
@@ -571,8 +580,15 @@ fn compile_variant(
     run(&mut verilate, "verilator")?;
 
     let header = fs::read_to_string(mdir.join(format!("{prefix}.h"))).map_err(|e| e.to_string())?;
-    let in_bits = port_width(&header, "in_data_i")?;
-    let out_bits = port_width(&header, "out_data_o")?;
+    // An AXI4-Lite top has no stream ports: its items are AxilShim's transactions and records.
+    let (in_bits, out_bits) = if has_axil_port(v) {
+        (AXIL_ITEM_BITS, AXIL_RECORD_BITS)
+    } else {
+        (
+            port_width(&header, "in_data_i")?,
+            port_width(&header, "out_data_o")?,
+        )
+    };
 
     let mut cpps: Vec<String> = fs::read_dir(&mdir)
         .map_err(|e| e.to_string())?
@@ -587,6 +603,8 @@ fn compile_variant(
     }
     let (header, shim) = if has_axi_port(v) {
         ("axi_shim.h", "AxiShim")
+    } else if has_axil_port(v) {
+        ("axil_shim.h", "AxilShim")
     } else {
         ("stream_shim.h", "StreamShim")
     };
@@ -630,6 +648,20 @@ fn has_axi_port(v: &Variant) -> bool {
             && fs::read_to_string(f).is_ok_and(|t| t.contains("m_axi_arvalid_o"))
     })
 }
+
+/// Whether the top has an AXI4-Lite subordinate port (`s_axil_awvalid_i` in its own file): such
+/// tops run in `AxilShim` (tb/axil_shim.h) with an AXI4-Lite manager in the clock loop.
+fn has_axil_port(v: &Variant) -> bool {
+    let own = format!("{}.sv", v.top);
+    v.files.iter().any(|f| {
+        f.file_name().is_some_and(|n| n.to_string_lossy() == own)
+            && fs::read_to_string(f).is_ok_and(|t| t.contains("s_axil_awvalid_i"))
+    })
+}
+
+/// AxilShim's transaction and record widths (tb/axil_mgr.h, `kItemWords`, `kRecordWords`).
+const AXIL_ITEM_BITS: u32 = 128;
+const AXIL_RECORD_BITS: u32 = 128;
 
 /// The bit width of a port from Verilator's header: `VL_IN*(&name,MSB,LSB...)` declarations.
 fn port_width(header: &str, port: &str) -> Result<u32, String> {

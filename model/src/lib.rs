@@ -12,6 +12,7 @@
 //! `scene_gi` (a scene with `[gi]`: the GI-Cube processor model, lighting and rendering passes);
 //! `studies` (the tradeoff sweeps, not part of the golden model).
 
+pub mod accel_host;
 pub mod bits;
 pub mod camera;
 pub mod error;

@@ -8,6 +8,7 @@
 //! - [`frame`]: driving `cube5_frame` against the frame model, pixel by pixel.
 //! - [`error`]: the one error type, `TbError` (`Setup | Protocol | Deadlock | Mismatch`).
 
+pub mod axil;
 pub mod error;
 pub mod ffi;
 pub mod frame;

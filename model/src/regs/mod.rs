@@ -2,6 +2,8 @@
 //! `rtl/**/<block>.regs.toml`: do not edit; change the descriptions and run `make regs`
 //! (docs/adding-a-unit.md, "Registers and shared constants").
 
+pub mod cube5_accel;
+pub mod cube5_axil_regs;
 pub mod cube5_compos;
 pub mod cube5_frame;
 pub mod cube5_warp;

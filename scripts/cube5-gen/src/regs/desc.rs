@@ -42,7 +42,27 @@ pub struct Block {
     /// Bits of a register: no numeric field may reach above it.
     #[serde(default = "default_data_w")]
     pub data_w: u32,
+    /// Generate the tables of the AXI4-Lite register block `cube5_axil_regs` into the package
+    /// (one entry per word offset; docs/accel-regs.md, "The register block").
+    #[serde(default)]
+    pub axil: bool,
+    /// The interrupt of an `axil` block: `irq_o` = OR of (status & enable).
+    #[serde(default)]
+    pub irq: Option<Irq>,
 }
+
+/// The registers whose AND, ORed over the bits, is an `axil` block's level interrupt.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Irq {
+    /// A W1C register: the interrupt status.
+    pub status: String,
+    /// An RW register: the enable of each status bit.
+    pub enable: String,
+}
+
+/// Largest word offset of an `axil` block (its tables hold one entry per offset).
+pub const AXIL_MAX_WORDS: u64 = 256;
 
 fn default_word_bytes() -> u64 {
     4
@@ -151,9 +171,12 @@ pub struct Register {
     pub doc: String,
     #[serde(default)]
     pub field: Vec<FieldDesc>,
+    /// `<block>.<Register>`: take that register's fields (placed as there) instead of `field`.
+    #[serde(default)]
+    pub like: Option<String>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FieldDesc {
     pub name: String,
@@ -211,8 +234,56 @@ pub fn load(root: &Path, rel: &Path) -> Result<Checked, String> {
     parse(&text, rel)
 }
 
-/// Check a description's text; errors are one line and name the file (and the item).
+/// Check a description's text; errors are one line and name the file (and the item). A register
+/// with `like` is refused: [`parse_with`] resolves it.
 pub fn parse(text: &str, rel: &Path) -> Result<Checked, String> {
+    parse_with(text, rel, &|like| {
+        Err(format!("like {like}: no such register"))
+    })
+}
+
+/// Whether a description has a register with `like` (it must be checked after the blocks it
+/// names).
+pub fn has_likes(text: &str) -> bool {
+    toml::from_str::<Desc>(text).is_ok_and(|d| d.register.iter().any(|r| r.like.is_some()))
+}
+
+/// The fields of register `<block>.<Register>` in `blocks`, placed as there, for `like`.
+pub fn like_fields(blocks: &[Checked], like: &str) -> Result<Vec<FieldDesc>, String> {
+    let (blk, name) = like
+        .split_once('.')
+        .ok_or_else(|| format!("like {like} is not <block>.<Register>"))?;
+    let b = blocks
+        .iter()
+        .find(|b| b.desc.block.name == blk)
+        .ok_or_else(|| format!("like {like}: no block {blk}"))?;
+    let i = b
+        .desc
+        .register
+        .iter()
+        .position(|r| r.name == name)
+        .ok_or_else(|| format!("like {like}: no register {name} in {blk}"))?;
+    let value = |r: &Resolved| match r {
+        Resolved::Num(n) => Value::Int(*n),
+        Resolved::Sym(s) => Value::Expr(s.clone()),
+    };
+    Ok(b.fields[i]
+        .iter()
+        .map(|f| FieldDesc {
+            name: f.name.clone(),
+            lsb: Some(value(&f.lsb)),
+            width: value(&f.width),
+            doc: f.doc.clone(),
+        })
+        .collect())
+}
+
+/// [`parse`], with `likes` giving the fields a `like` names.
+pub fn parse_with(
+    text: &str,
+    rel: &Path,
+    likes: &dyn Fn(&str) -> Result<Vec<FieldDesc>, String>,
+) -> Result<Checked, String> {
     let file = rel.display().to_string();
     let desc: Desc = toml::from_str(text)
         .map_err(|e| format!("{file}: {}", e.to_string().replace('\n', " ").trim_end()))?;
@@ -307,7 +378,19 @@ pub fn parse(text: &str, rel: &Path) -> Result<Checked, String> {
                 r.offset
             )));
         }
-        let fs = place_fields(r, &values, b.data_w).map_err(|e| err(format!("{what}: {e}")))?;
+        let liked;
+        let field_descs = match &r.like {
+            None => &r.field,
+            Some(_) if !r.field.is_empty() => {
+                return Err(err(format!("{what}: like and field both given")))
+            }
+            Some(l) => {
+                liked = likes(l).map_err(|e| err(format!("{what}: {e}")))?;
+                &liked
+            }
+        };
+        let fs = place_fields(field_descs, &values, b.data_w)
+            .map_err(|e| err(format!("{what}: {e}")))?;
         if let Some(reset) = r.reset {
             if b.data_w < 64 && reset >> b.data_w != 0 {
                 return Err(err(format!(
@@ -318,6 +401,8 @@ pub fn parse(text: &str, rel: &Path) -> Result<Checked, String> {
         }
         fields.push(fs);
     }
+
+    check_axil(&desc).map_err(|e| err(format!("block: {e}")))?;
 
     for d in &b.docs {
         for s in &d.show {
@@ -345,9 +430,74 @@ pub fn parse(text: &str, rel: &Path) -> Result<Checked, String> {
     })
 }
 
+/// An `axil` block: 32-bit words, offsets below [`AXIL_MAX_WORDS`], an interrupt whose status is
+/// W1C and whose enable is RW. `irq` without `axil` is refused.
+fn check_axil(d: &Desc) -> Result<(), String> {
+    let b = &d.block;
+    if !b.axil {
+        return match b.irq {
+            Some(_) => Err("irq needs axil = true".into()),
+            None => Ok(()),
+        };
+    }
+    if b.data_w != 32 || b.word_bytes != 4 {
+        return Err(format!(
+            "axil needs data_w = 32 and word_bytes = 4 (has {} and {})",
+            b.data_w, b.word_bytes
+        ));
+    }
+    if let Some(r) = d.register.iter().find(|r| r.offset >= AXIL_MAX_WORDS) {
+        return Err(format!(
+            "axil: register {} at offset {} (at most {})",
+            r.name,
+            r.offset,
+            AXIL_MAX_WORDS - 1
+        ));
+    }
+    if let Some(irq) = &b.irq {
+        for (name, want) in [(&irq.status, Access::W1C), (&irq.enable, Access::RW)] {
+            match d.register.iter().find(|r| &r.name == name) {
+                Some(r) if r.access == want => {}
+                Some(r) => {
+                    return Err(format!(
+                        "irq: register {name} is {}, not {}",
+                        r.access.as_str(),
+                        want.as_str()
+                    ))
+                }
+                None => return Err(format!("irq: no register {name}")),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The bits of a register that hold state: its numeric fields, or every bit when a field's place
+/// depends on parameters or there are no fields.
+pub fn stored_mask(fs: &[Field], data_w: u32) -> u64 {
+    let all = if data_w >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << data_w) - 1
+    };
+    if fs.is_empty() {
+        return all;
+    }
+    let mut m = 0u64;
+    for f in fs {
+        match (&f.lsb, &f.width) {
+            (Resolved::Num(l), Resolved::Num(w)) => {
+                m |= (u64::MAX >> (64 - w)) << l;
+            }
+            _ => return all,
+        }
+    }
+    m
+}
+
 /// Resolve lsb and width of each field; refuse overlaps and fields above `data_w`.
 fn place_fields(
-    r: &Register,
+    field: &[FieldDesc],
     values: &BTreeMap<String, u64>,
     data_w: u32,
 ) -> Result<Vec<Field>, String> {
@@ -366,7 +516,7 @@ fn place_fields(
     let mut out: Vec<Field> = Vec::new();
     let mut names = BTreeSet::new();
     let mut next = Resolved::Num(0);
-    for f in &r.field {
+    for f in field {
         if !names.insert(f.name.as_str()) {
             return Err(format!("field {} defined twice", f.name));
         }

@@ -1,6 +1,6 @@
 //! The three readings of a checked description: SV localparams, a Rust module, Markdown tables.
 
-use super::desc::{camel, screaming, Checked, Expr, Field, Resolved};
+use super::desc::{camel, screaming, stored_mask, Access, Checked, Expr, Field, Resolved};
 use std::fmt::Write;
 
 /// Lines are wrapped at this column (STYLE.md, rustfmt's default).
@@ -100,11 +100,12 @@ pub fn sv(b: &Checked, indent: &str) -> String {
                 r.name, r.offset
             );
             let fields: Vec<String> = fs.iter().map(field_text).collect();
-            push_trailing(
-                &mut out,
-                decl,
-                &format!("{}: {}", r.access.as_str(), fields.join(", ")),
-            );
+            let comment = if fields.is_empty() {
+                r.access.as_str().to_string()
+            } else {
+                format!("{}: {}", r.access.as_str(), fields.join(", "))
+            };
+            push_trailing(&mut out, decl, &comment);
         }
         let resets: Vec<_> = d.register.iter().filter(|r| r.reset.is_some()).collect();
         if !resets.is_empty() {
@@ -152,10 +153,154 @@ pub fn sv(b: &Checked, indent: &str) -> String {
             }
         }
     }
+    if d.block.axil {
+        out.push('\n');
+        sv_axil(&mut out, b, indent);
+    }
     while out.ends_with("\n\n") {
         out.pop();
     }
     out
+}
+
+/// One word offset of an `axil` block: `(access, stored mask, reset)`, `None` where no register is.
+type Slot = Option<(Access, u64, Option<u64>)>;
+
+/// Every word offset of an `axil` block.
+fn axil_slots(b: &Checked) -> Vec<Slot> {
+    let d = &b.desc;
+    let words = d.register.iter().map(|r| r.offset + 1).max().unwrap_or(0);
+    let mut slots = vec![None; words as usize];
+    for (r, fs) in d.register.iter().zip(&b.fields) {
+        slots[r.offset as usize] = Some((r.access, stored_mask(fs, d.block.data_w), r.reset));
+    }
+    slots
+}
+
+/// The offset of register `name` (checked to exist by `desc::check_axil`).
+fn offset_of(b: &Checked, name: &str) -> u64 {
+    b.desc
+        .register
+        .iter()
+        .find(|r| r.name == name)
+        .map_or(0, |r| r.offset)
+}
+
+/// The tables `cube5_axil_regs` takes as parameters.
+fn sv_axil(out: &mut String, b: &Checked, indent: &str) {
+    let slots = axil_slots(b);
+    let n = slots.len();
+    wrap(
+        out,
+        &format!("{indent}/// "),
+        "Tables of the AXI4-Lite register block (rtl/cube5/cube5_axil_regs.sv, docs/accel-regs.md): \
+         one entry per word offset 0 .. AxilWords - 1, bit `[i]` or word `[i*32 +: 32]` for \
+         offset `i`, the highest offset first.",
+    );
+    let _ = writeln!(out, "{indent}localparam int unsigned AxilWords = {n};");
+    let bits = |f: &dyn Fn(Access) -> bool| -> String {
+        slots
+            .iter()
+            .rev()
+            .map(|s| match s {
+                Some((a, _, _)) if f(*a) => '1',
+                _ => '0',
+            })
+            .collect()
+    };
+    let tables: [(&str, String, &str); 5] = [
+        ("AxilMapped", bits(&|_| true), "a register is at the offset"),
+        (
+            "AxilStored",
+            bits(&|a| a != Access::RO),
+            "the block keeps its value (RW, WO, W1C)",
+        ),
+        (
+            "AxilReadable",
+            bits(&|a| a != Access::WO),
+            "a read answers OKAY (RW, RO, W1C)",
+        ),
+        (
+            "AxilRo",
+            bits(&|a| a == Access::RO),
+            "a read returns `ro_i` (RO)",
+        ),
+        (
+            "AxilW1c",
+            bits(&|a| a == Access::W1C),
+            "writing 1 clears a bit, `w1c_set_i` sets it (W1C)",
+        ),
+    ];
+    for (name, v, doc) in tables {
+        let _ = writeln!(out, "{indent}// {doc}");
+        let _ = writeln!(
+            out,
+            "{indent}localparam logic [{}:0] {name} = {n}'b{v};",
+            n - 1
+        );
+    }
+    let has_reset: String = slots
+        .iter()
+        .rev()
+        .map(|s| match s {
+            Some((_, _, Some(_))) => '1',
+            _ => '0',
+        })
+        .collect();
+    let _ = writeln!(
+        out,
+        "{indent}// reset sets the register to its AxilReset word"
+    );
+    let _ = writeln!(
+        out,
+        "{indent}localparam logic [{}:0] AxilHasReset = {n}'b{has_reset};",
+        n - 1
+    );
+    let words = |f: &dyn Fn(&Slot) -> u64| -> String {
+        let w: Vec<String> = slots
+            .iter()
+            .rev()
+            .map(|s| format!("32'h{:08x}", f(s)))
+            .collect();
+        w.join(", ")
+    };
+    for (name, doc, v) in [
+        (
+            "AxilMask",
+            "the bits a register keeps (its fields; all where a field's place depends on parameters)",
+            words(&|s| s.map_or(0, |(_, m, _)| m)),
+        ),
+        (
+            "AxilReset",
+            "reset values",
+            words(&|s| s.and_then(|(_, _, r)| r).unwrap_or(0)),
+        ),
+    ] {
+        let _ = writeln!(out, "{indent}// {doc}");
+        let _ = writeln!(out, "{indent}localparam logic [{}:0] {name} = {{", n * 32 - 1);
+        let mut line = String::new();
+        for (i, w) in v.split(", ").enumerate() {
+            let sep = if i + 1 == n { "" } else { "," };
+            if !line.is_empty() && indent.len() + 4 + line.len() + w.len() + 2 > COLUMNS {
+                let _ = writeln!(out, "{indent}    {}", line.trim_end());
+                line.clear();
+            }
+            let _ = write!(line, "{w}{sep} ");
+        }
+        let _ = writeln!(out, "{indent}    {}", line.trim_end());
+        let _ = writeln!(out, "{indent}}};");
+    }
+    let (has, st, en) = match &b.desc.block.irq {
+        Some(irq) => (1, offset_of(b, &irq.status), offset_of(b, &irq.enable)),
+        None => (0, 0, 0),
+    };
+    let _ = writeln!(
+        out,
+        "{indent}// irq_o = |(word AxilIrqStatus & word AxilIrqEnable) when AxilHasIrq"
+    );
+    let _ = writeln!(out, "{indent}localparam int unsigned AxilHasIrq = {has};");
+    let _ = writeln!(out, "{indent}localparam int unsigned AxilIrqStatus = {st};");
+    let _ = writeln!(out, "{indent}localparam int unsigned AxilIrqEnable = {en};");
 }
 
 /// `decl  // comment`, or the comment on the line above when that would pass [`COLUMNS`].
@@ -322,7 +467,46 @@ pub fn rust(b: &Checked) -> String {
         }
         out.push_str("];\n");
     }
+    if d.block.axil {
+        rust_axil(&mut out, b);
+    }
     out
+}
+
+/// The `axil` block's masks and interrupt, for the host driver and the register file model.
+fn rust_axil(out: &mut String, b: &Checked) {
+    let slots = axil_slots(b);
+    out.push('\n');
+    wrap(
+        out,
+        "/// ",
+        "The bits each word offset keeps (AXI4-Lite register block, docs/accel-regs.md): its \
+         fields, every bit where a field's place depends on parameters, 0 where no register is.",
+    );
+    let _ = writeln!(out, "pub const AXIL_MASK: [u32; {}] = [", slots.len());
+    // Eight to a line, as rustfmt lays them out.
+    let masks: Vec<String> = slots
+        .iter()
+        .map(|s| format!("{:#010x}", s.map_or(0, |(_, m, _)| m)))
+        .collect();
+    for row in masks.chunks(8) {
+        let _ = writeln!(out, "    {},", row.join(", "));
+    }
+    out.push_str("];\n");
+    out.push('\n');
+    out.push_str(
+        "/// The interrupt: `irq_o` is high while (status & enable) != 0, as (status, enable) \
+         offsets.\n",
+    );
+    let v = match &b.desc.block.irq {
+        Some(irq) => format!(
+            "Some(({}, {}))",
+            offset_of(b, &irq.status),
+            offset_of(b, &irq.enable)
+        ),
+        None => "None".into(),
+    };
+    let _ = writeln!(out, "pub const AXIL_IRQ: Option<(u32, u32)> = {v};");
 }
 
 /// `model/src/regs/mod.rs`: the blocks' modules and the types they share.

@@ -1,0 +1,173 @@
+// axil_shim.h: DutCore for a Verilated top V with an AXI4-Lite subordinate port (s_axil_*) and the
+// narrow hardware side of cube5_axil (hw_i, hw_set_i, wsel_i, rsel_i, hw_q_o, hw_wr_stb_o,
+// hw_rd_stb_o, irq_o). An AXI4-Lite manager (tb/axil_mgr.h) runs in the clock loop; the
+// DutCore stream interface carries its transactions in and its responses out (formats in
+// tb/axil_mgr.h and tb-rs/src/axil.rs), so the existing bridge serves it unchanged.
+#pragma once
+
+#include "axil_mgr.h"
+#include "stream_shim.h"
+
+namespace cube5 {
+
+template <class V>
+class AxilShim final : public DutCore {
+ public:
+  AxilShim(uint32_t seed, PortWidths widths) : widths_(widths), seed_(seed) {
+    ctx_ = std::make_unique<VerilatedContext>();
+    ctx_->randReset(2);
+    ctx_->randSeed(static_cast<int>(seed & 0x7fffffff));
+    ctx_->traceEverOn(true);
+    top_ = std::make_unique<V>(ctx_.get(), "top");
+    top_->clk_i = 0;
+    top_->rst_ni = 1;
+    idle_inputs();
+    top_->eval();
+  }
+
+  ~AxilShim() override {
+    if (trace_) trace_->close();
+    Verilated::threadContextp(ctx_.get());  // see StreamShim's destructor
+    top_->final();
+    top_.reset();
+  }
+
+  /// Resets the top and the manager together: transactions in flight are dropped on both sides.
+  /// A subordinate still driving BVALID or RVALID out of reset is a protocol error.
+  void reset(uint32_t cycles) override {
+    top_->rst_ni = 0;
+    idle_inputs();
+    mgr_.reset();
+    for (uint32_t i = 0; i < cycles; ++i) {
+      drive_hw();
+      top_->eval();
+      tick();
+    }
+    top_->rst_ni = 1;
+    drive_hw();
+    top_->eval();
+    if (top_->s_axil_bvalid_o || top_->s_axil_rvalid_o) mgr_.error(cycle_, "BVALID or RVALID high out of reset");
+  }
+
+  /// Items are transactions (AxilMgr::kItemWords words each), outputs are response and interrupt
+  /// records (AxilMgr::kRecordWords words after the two cycle words). `idle` is unused (each
+  /// transaction carries its own delays); `stall[c % len]` holds BREADY low, `stall[(c + 2053) %
+  /// len]` RREADY. `expect_out` counts B and R responses; interrupt records come on top.
+  RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t*, size_t,
+               const uint8_t* stall, size_t stall_len, uint64_t expect_out, uint64_t max_cycles,
+               std::vector<uint32_t>& out, uint32_t out_words) override {
+    RunStats st;
+    if (in_words != AxilMgr::kItemWords || out_words != AxilMgr::kRecordWords) {
+      st.protocol_errors = 1;
+      return st;
+    }
+    mgr_.load(items, n_items);
+    uint64_t responses = 0;
+    while (st.cycles < max_cycles && (!mgr_.all_issued() || responses < expect_out)) {
+      const bool bready = !(stall_len && stall[cycle_ % stall_len]);
+      const bool rready = !(stall_len && stall[(cycle_ + 2053) % stall_len]);
+      const MgrOut m = mgr_.drive(bready, rready);
+      top_->s_axil_awvalid_i = m.awvalid;
+      top_->s_axil_awaddr_i = m.awaddr;
+      top_->s_axil_wvalid_i = m.wvalid;
+      top_->s_axil_wdata_i = m.wdata;
+      top_->s_axil_wstrb_i = m.wstrb;
+      top_->s_axil_bready_i = m.bready;
+      top_->s_axil_arvalid_i = m.arvalid;
+      top_->s_axil_araddr_i = m.araddr;
+      top_->s_axil_rready_i = m.rready;
+      top_->wsel_i = m.wsel;
+      top_->rsel_i = m.rsel;
+      drive_hw();
+      top_->eval();
+      SubOut s;
+      s.awready = top_->s_axil_awready_o;
+      s.wready = top_->s_axil_wready_o;
+      s.bvalid = top_->s_axil_bvalid_o;
+      s.bresp = top_->s_axil_bresp_o;
+      s.arready = top_->s_axil_arready_o;
+      s.rvalid = top_->s_axil_rvalid_o;
+      s.rdata = top_->s_axil_rdata_o;
+      s.rresp = top_->s_axil_rresp_o;
+      s.hw_q = top_->hw_q_o;
+      s.wr_stb = top_->hw_wr_stb_o;
+      s.rd_stb = top_->hw_rd_stb_o;
+      s.irq = top_->irq_o;
+      responses += mgr_.observe(cycle_, s, out);
+      tick();
+      ++st.cycles;
+      if (ctx_->gotFinish()) {
+        st.finished = true;
+        break;
+      }
+    }
+    st.consumed = mgr_.issued();
+    st.produced = responses;
+    st.protocol_errors = mgr_.errors();
+    st.first_protocol_error_cycle = mgr_.first_error_cycle();
+    idle_inputs();
+    drive_hw();
+    top_->eval();
+    return st;
+  }
+
+  bool write_config(uint32_t, const uint32_t*, uint32_t) override { return false; }
+
+  bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) override {
+    if (trace_) trace_->close();
+    trace_ = std::make_unique<VerilatedVcdC>();
+    top_->trace(trace_.get(), 99);
+    trace_->open(path.c_str());
+    trace_from_ = from_cycle;
+    trace_to_ = to_cycle;
+    return trace_->isOpen();
+  }
+
+  uint64_t cycle() const override { return cycle_; }
+  PortWidths widths() const override { return widths_; }
+
+ private:
+  void idle_inputs() {
+    top_->s_axil_awvalid_i = 0;
+    top_->s_axil_wvalid_i = 0;
+    top_->s_axil_bready_i = 0;
+    top_->s_axil_arvalid_i = 0;
+    top_->s_axil_rready_i = 0;
+  }
+
+  // The hardware side's stimulus of this cycle (axil_hw in tb/axil_mgr.h).
+  void drive_hw() {
+    const uint64_t h = axil_hw(seed_, cycle_);
+    top_->hw_i = static_cast<uint32_t>(h);
+    top_->hw_set_i = static_cast<bool>((h >> 32) & 1);  // bit 32: the set flag
+  }
+
+  void dump() {
+    if (trace_ && cycle_ >= trace_from_ && cycle_ <= trace_to_) trace_->dump(ctx_->time());
+  }
+
+  void tick() {
+    top_->clk_i = 0;
+    top_->eval();
+    dump();
+    ctx_->timeInc(1);
+    top_->clk_i = 1;
+    top_->eval();
+    dump();
+    ctx_->timeInc(1);
+    top_->clk_i = 0;
+    top_->eval();
+    ++cycle_;
+  }
+
+  PortWidths widths_;
+  uint32_t seed_;
+  std::unique_ptr<VerilatedContext> ctx_;
+  std::unique_ptr<V> top_;
+  std::unique_ptr<VerilatedVcdC> trace_;
+  uint64_t trace_from_ = 0, trace_to_ = 0;
+  uint64_t cycle_ = 0;
+  AxilMgr mgr_;
+};
+
+}  // namespace cube5
