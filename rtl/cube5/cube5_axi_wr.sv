@@ -154,7 +154,7 @@ module cube5_axi_wr #(
   logic [NbW-1:0]   in_beats;
   assign in_addr = in_data_i[AddrW-1:0];
   assign in_len  = in_data_i[AddrW+LenW-1:AddrW];
-  assign in_beat_addr = {in_addr[AddrW-1:SizeW], SizeW'(0)};
+  assign in_beat_addr = in_addr & ~AddrW'(Bytes - 1);
   if (LaneBits > 0) begin : gen_lane
     assign in_lane = in_addr[SizeW-1:ISizeW];
     if (ISizeW > 0) begin : gen_item_low
@@ -163,8 +163,6 @@ module cube5_axi_wr #(
     end
   end else begin : gen_one_lane
     assign in_lane = 1'b0;
-    logic unused_in_low;
-    assign unused_in_low = ^in_addr[SizeW-1:0];
   end
   // Beats = ceil((lane + items) / Lanes).
   logic [SpanW-1:0] in_span;
