@@ -246,6 +246,7 @@ fn main() {
         "stream_shim.h",
         "axi_mem.h",
         "axi_shim.h",
+        "axi_wr_shim.h",
         "stream_dut.h",
         "stream_dut.cpp",
     ] {
@@ -293,6 +294,8 @@ fn main() {
         .iter()
         .map(|f| fs::read_to_string(tb.join(f)).unwrap())
         .collect();
+    // Tops with an AXI write port run in AxiWrShim, which includes both headers above.
+    let axi_wr_text = axi_text.clone() + &fs::read_to_string(tb.join("axi_wr_shim.h")).unwrap();
 
     // Runtime objects, shared by every variant.
     let runtime = build_runtime(&cache, &vl_include, &verilator_version);
@@ -321,7 +324,13 @@ fn main() {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(v) = selected.get(i) else { break };
-                let axi: &str = if has_axi_port(v) { &axi_text } else { "" };
+                let axi: &str = if has_axi_wr_port(v) {
+                    &axi_wr_text
+                } else if has_axi_port(v) {
+                    &axi_text
+                } else {
+                    ""
+                };
                 let stamp = variant_stamp(
                     v,
                     &repo,
@@ -585,7 +594,9 @@ fn compile_variant(
     for c in &cpps {
         unity.push_str(&format!("#include \"{c}\"\n"));
     }
-    let (header, shim) = if has_axi_port(v) {
+    let (header, shim) = if has_axi_wr_port(v) {
+        ("axi_wr_shim.h", "AxiWrShim")
+    } else if has_axi_port(v) {
         ("axi_shim.h", "AxiShim")
     } else {
         ("stream_shim.h", "StreamShim")
@@ -628,6 +639,16 @@ fn has_axi_port(v: &Variant) -> bool {
     v.files.iter().any(|f| {
         f.file_name().is_some_and(|n| n.to_string_lossy() == own)
             && fs::read_to_string(f).is_ok_and(|t| t.contains("m_axi_arvalid_o"))
+    })
+}
+
+/// Whether the top has an AXI4 write manager port (`m_axi_awvalid_o` in its own file): such tops
+/// run in `AxiWrShim` (tb/axi_wr_shim.h) with the subordinate's write port in the clock loop.
+fn has_axi_wr_port(v: &Variant) -> bool {
+    let own = format!("{}.sv", v.top);
+    v.files.iter().any(|f| {
+        f.file_name().is_some_and(|n| n.to_string_lossy() == own)
+            && fs::read_to_string(f).is_ok_and(|t| t.contains("m_axi_awvalid_o"))
     })
 }
 

@@ -441,5 +441,9 @@ pub fn axi_mem_setup(
         seed,
         slverr_lo: mem.slverr_lo,
         slverr_hi: mem.slverr_hi,
+        aw_gap_permille: 0,
+        w_gap_permille: 0,
+        b_gap_permille: 0,
+        declared_outstanding: 0,
     }
 }
