@@ -154,7 +154,13 @@ module cube5_axi_wr #(
   logic [NbW-1:0]   in_beats;
   assign in_addr = in_data_i[AddrW-1:0];
   assign in_len  = in_data_i[AddrW+LenW-1:AddrW];
-  assign in_beat_addr = in_addr & ~AddrW'(Bytes - 1);
+  // The address rounded down to the bus. (Written as a concatenation: Yosys 0.23 dropped the mask
+  // of `in_addr & ~AddrW'(Bytes - 1)` in the gate-level netlist.)
+  if (SizeW > 0) begin : gen_beat_addr
+    assign in_beat_addr = {in_addr[AddrW-1:SizeW], {SizeW{1'b0}}};
+  end else begin : gen_byte_bus
+    assign in_beat_addr = in_addr;
+  end
   if (LaneBits > 0) begin : gen_lane
     assign in_lane = in_addr[SizeW-1:ISizeW];
     if (ISizeW > 0) begin : gen_item_low
@@ -163,6 +169,10 @@ module cube5_axi_wr #(
     end
   end else begin : gen_one_lane
     assign in_lane = 1'b0;
+    if (SizeW > 0) begin : gen_item_low
+      logic unused_in_low;  // an item fills the beat: the bits below it are ignored
+      assign unused_in_low = ^in_addr[SizeW-1:0];
+    end
   end
   // Beats = ceil((lane + items) / Lanes).
   logic [SpanW-1:0] in_span;

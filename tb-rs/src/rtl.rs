@@ -1,9 +1,9 @@
 //! A Verilated streaming top behind the same `StreamUnit` trait as the golden model.
 
 use crate::error::TbError;
+pub use crate::ffi::bridge::AxiWrCounters;
 use crate::ffi::bridge::{self, RunResult, StreamDut};
 pub use crate::ffi::bridge::{AxiCounters, AxiMemSetup};
-pub use crate::ffi::bridge::AxiWrCounters;
 use crate::variants::{Variant, VARIANTS};
 use cube5_model::bits::words_for;
 use cube5_model::unit::UnitConfig;
@@ -52,6 +52,21 @@ pub struct ArHandshake {
     pub size: u32,
     pub burst: u32,
     pub id: u32,
+}
+
+/// Address-channel handshakes as the bridge packs them: (cycle, addr, len | size << 8 |
+/// burst << 12 | id << 16) each.
+fn handshakes(raw: &[u64]) -> Vec<ArHandshake> {
+    raw.chunks_exact(3)
+        .map(|r| ArHandshake {
+            cycle: r[0],
+            addr: r[1],
+            len: (r[2] & 0xff) as u32,
+            size: ((r[2] >> 8) & 0x7) as u32,
+            burst: ((r[2] >> 12) & 0x3) as u32,
+            id: (r[2] >> 16) as u32,
+        })
+        .collect()
 }
 
 /// One output as it left the RTL: the cycle it was taken and its value.
@@ -188,17 +203,7 @@ impl<C: StreamCodec> RtlStream<C> {
         if !self.dut.pin_mut().axi_take_ar(&mut raw) {
             return Err(self.no_axi());
         }
-        Ok(raw
-            .chunks_exact(3)
-            .map(|r| ArHandshake {
-                cycle: r[0],
-                addr: r[1],
-                len: (r[2] & 0xff) as u32,
-                size: ((r[2] >> 8) & 0x7) as u32,
-                burst: ((r[2] >> 12) & 0x3) as u32,
-                id: (r[2] >> 16) as u32,
-            })
-            .collect())
+        Ok(handshakes(&raw))
     }
 
     /// The subordinate's counters and the top's `err_o`.
@@ -227,17 +232,7 @@ impl<C: StreamCodec> RtlStream<C> {
         if !self.dut.pin_mut().axi_take_aw(&mut raw) {
             return Err(self.no_axi());
         }
-        Ok(raw
-            .chunks_exact(3)
-            .map(|r| ArHandshake {
-                cycle: r[0],
-                addr: r[1],
-                len: (r[2] & 0xff) as u32,
-                size: ((r[2] >> 8) & 0x7) as u32,
-                burst: ((r[2] >> 12) & 0x3) as u32,
-                id: (r[2] >> 16) as u32,
-            })
-            .collect())
+        Ok(handshakes(&raw))
     }
 
     /// The subordinate's memory image as it is now (the bytes from the loaded base).

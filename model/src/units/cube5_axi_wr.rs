@@ -58,9 +58,9 @@ impl AxiWrConfig {
     }
 
     pub fn validate(&self) -> Result<()> {
-        self.bus()
-            .validate()
-            .map_err(|e| ModelError::Config(e.to_string().replace("cube5_axi_rd", "cube5_axi_wr")))?;
+        self.bus().validate().map_err(|e| {
+            ModelError::Config(e.to_string().replace("cube5_axi_rd", "cube5_axi_wr"))
+        })?;
         if self.item_w < 8 || self.item_w > self.data_w || !self.item_w.is_power_of_two() {
             return Err(ModelError::Config(format!(
                 "cube5_axi_wr: ItemW {} is not a power of two in 8..=DataW ({})",
@@ -293,9 +293,18 @@ mod tests {
     #[test]
     fn a_command_covers_the_beats_its_items_touch() {
         // 3 items from byte 4: lanes 1, 0, 1 of beats 0, 1: two beats from 0.
-        assert_eq!(C.beats(&AxiWrCmd { addr: 4, len: 3 }), AxiRdCmd { addr: 0, len: 2 });
-        assert_eq!(C.beats(&AxiWrCmd { addr: 8, len: 2 }), AxiRdCmd { addr: 8, len: 1 });
-        assert_eq!(C.beats(&AxiWrCmd { addr: 12, len: 1 }), AxiRdCmd { addr: 8, len: 1 });
+        assert_eq!(
+            C.beats(&AxiWrCmd { addr: 4, len: 3 }),
+            AxiRdCmd { addr: 0, len: 2 }
+        );
+        assert_eq!(
+            C.beats(&AxiWrCmd { addr: 8, len: 2 }),
+            AxiRdCmd { addr: 8, len: 1 }
+        );
+        assert_eq!(
+            C.beats(&AxiWrCmd { addr: 12, len: 1 }),
+            AxiRdCmd { addr: 8, len: 1 }
+        );
         assert_eq!(C.beats(&AxiWrCmd { addr: 12, len: 0 }).len, 0);
         // 4 KB rule over beats: 33 items from 0xffc cover 17 beats from 0xff8: 1 + 16.
         let b = C.bursts(&AxiWrCmd {
@@ -326,10 +335,19 @@ mod tests {
             slverr_hi: 0x188,
         };
         let cmds = [
-            AxiWrCmd { addr: 0x104, len: 3 },
+            AxiWrCmd {
+                addr: 0x104,
+                len: 3,
+            },
             AxiWrCmd { addr: 0, len: 0 },
-            AxiWrCmd { addr: 0x17c, len: 2 }, // second item in the SLVERR beat
-            AxiWrCmd { addr: 0x1fc, len: 2 }, // second item outside the image
+            AxiWrCmd {
+                addr: 0x17c,
+                len: 2,
+            }, // second item in the SLVERR beat
+            AxiWrCmd {
+                addr: 0x1fc,
+                len: 2,
+            }, // second item outside the image
         ];
         let items: Vec<Vec<u8>> = (1..=7u8).map(|k| vec![k; 4]).collect();
         let e = C.expected(&cmds, &items, &mem, 65535).unwrap();

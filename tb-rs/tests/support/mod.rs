@@ -336,6 +336,32 @@ pub fn compare_ar<C: StreamCodec>(
     context: impl Fn(usize) -> String,
 ) -> Result<usize, cube5_tb::TbError> {
     let ars = dut.axi_take_ar()?;
+    compare_handshakes(&ars, "AR", bursts, size, variant, seed, context)
+}
+
+/// The AW handshakes since the last call against the model's bursts, as `compare_ar` does for AR.
+pub fn compare_aw<C: StreamCodec>(
+    dut: &mut RtlStream<C>,
+    bursts: &[cube5_model::units::cube5_axi_rd::Burst],
+    size: u32,
+    variant: &'static Variant,
+    seed: u64,
+    context: impl Fn(usize) -> String,
+) -> Result<usize, cube5_tb::TbError> {
+    let aws = dut.axi_take_aw()?;
+    compare_handshakes(&aws, "AW", bursts, size, variant, seed, context)
+}
+
+/// Address-channel handshakes (`ch` is "AR" or "AW") against the model's bursts, in order.
+fn compare_handshakes(
+    ars: &[cube5_tb::rtl::ArHandshake],
+    ch: &str,
+    bursts: &[cube5_model::units::cube5_axi_rd::Burst],
+    size: u32,
+    variant: &'static Variant,
+    seed: u64,
+    context: impl Fn(usize) -> String,
+) -> Result<usize, cube5_tb::TbError> {
     for (k, ar) in ars.iter().enumerate() {
         let model = bursts.get(k);
         let got = cube5_model::units::cube5_axi_rd::Burst {
@@ -353,7 +379,9 @@ pub fn compare_ar<C: StreamCodec>(
                 model: model.map_or("(no burst expected)".into(), |b| {
                     format!("{b:?} size {size} burst 1 id 0")
                 }),
-                what: "AR burst differs (address, beats; ARSIZE, ARBURST = INCR, ARID = 0)".into(),
+                what: format!(
+                    "{ch} burst differs (address, beats; {ch}SIZE, {ch}BURST = INCR, {ch}ID = 0)"
+                ),
                 ..Default::default()
             }));
         }
