@@ -447,7 +447,6 @@ fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
 /// configuration, in cases of 2,000 commands each with its own latency, gaps, bandwidth, idle and
 /// back-pressure, the third of them reset in mid-stream.
 #[test]
-#[ignore = "sim-full: a million items per configuration, about a minute on the loaded 2-core machine"]
 fn a_million_random_items_per_config() {
     for (i, (variant, cfg)) in configs::<AxiWrConfig>().into_iter().enumerate() {
         let mut items = 0u64;
