@@ -154,8 +154,8 @@ module cube5_axi_wr #(
   logic [NbW-1:0]   in_beats;
   assign in_addr = in_data_i[AddrW-1:0];
   assign in_len  = in_data_i[AddrW+LenW-1:AddrW];
-  // The address rounded down to the bus. (Written as a concatenation: Yosys 0.23 dropped the mask
-  // of `in_addr & ~AddrW'(Bytes - 1)` in the gate-level netlist.)
+  // The address rounded down to the bus. (A concatenation: Yosys 0.23 reads `~N'(v)` as
+  // `(~N)'(v)`, docs/architecture.md "RTL conventions", and dropped the mask in the netlist.)
   if (SizeW > 0) begin : gen_beat_addr
     assign in_beat_addr = {in_addr[AddrW-1:SizeW], {SizeW{1'b0}}};
   end else begin : gen_byte_bus
