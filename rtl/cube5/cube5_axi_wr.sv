@@ -114,8 +114,9 @@ module cube5_axi_wr #(
   localparam int unsigned CntW       = $clog2(Depth) + 1;
   localparam int unsigned OPtrW      = $clog2(Outstanding);
   localparam int unsigned OCntW      = $clog2(Outstanding) + 1;
-  localparam int unsigned NbW        = LenW + 1;            // a command's beats: <= 2^LenW
-  localparam int unsigned CmpW       = (NbW > 14) ? NbW : 14;
+  localparam int unsigned BurstW     = $clog2(MaxBurst) + 1; // 1 .. MaxBurst
+  // A command's beats (<= 2^LenW), at least one bit wider than a burst length.
+  localparam int unsigned NbW        = (LenW > BurstW) ? LenW + 1 : BurstW + 1;
   localparam int unsigned WordW      = DataW + Bytes;       // {strb, data}
   localparam int unsigned SpanW      = LenW + LaneBits + 1; // lane + items + Lanes - 1
   localparam int unsigned PkW        = LaneW + LenW;        // packer command {items, lane}
@@ -175,16 +176,18 @@ module cube5_axi_wr #(
     end
   end
   // Beats = ceil((lane + items) / Lanes).
-  logic [SpanW-1:0] in_span;
-  assign in_span  = SpanW'(in_lane) + SpanW'(in_len) + SpanW'(Lanes - 1);
-  assign in_beats = NbW'(in_span >> LaneBits);
+  logic [SpanW-1:0] in_span, in_span_beats;
+  assign in_span       = SpanW'(in_lane) + SpanW'(in_len) + (SpanW'(Lanes) - SpanW'(1));
+  assign in_span_beats = in_span >> LaneBits;
+  assign in_beats      = NbW'(in_span_beats);
+  logic unused_span_hi;  // the shift's top bits are zero: a command has at most 2^LenW beats
+  assign unused_span_hi = ^in_span_beats;
 
   // ==============================================================================================
   // Burst splitter, plan register and AW register
   // ==============================================================================================
 
   localparam int unsigned MbW    = $clog2(MaxBurst);
-  localparam int unsigned BurstW = MbW + 1;
 
   logic             active_q, active_d;
   logic [AddrW-1:0] cur_addr_q, cur_addr_d;
@@ -212,10 +215,17 @@ module cube5_axi_wr #(
   end else begin : gen_one_span
     assign last_span = 1'b1;
   end
+  // For clock rate the comparison with the cap is split: the high bits of the remaining count
+  // (zero or not) in parallel with a BurstW-bit compare of its low bits.
+  logic              rem_hi_zero, rem_fits;
+  logic [BurstW-1:0] rem_lo;
+  assign rem_lo      = rem_q[BurstW-1:0];
+  assign rem_hi_zero = ((rem_q >> BurstW) == '0);
   always_comb begin
     cap = BurstW'(MaxBurst);
     if (last_span && span_off != '0) cap = BurstW'(MaxBurst) - BurstW'(span_off);
-    blen = (CmpW'(rem_q) < CmpW'(cap)) ? BurstW'(rem_q) : cap;
+    rem_fits = rem_hi_zero && (rem_lo <= cap);  // this burst ends the command
+    blen = rem_fits ? rem_lo : cap;
   end
 
   logic aw_free, issue, plan_fill, plan_fill_last;
@@ -223,7 +233,7 @@ module cube5_axi_wr #(
   assign issue          = plan_valid_q && aw_free && (avail_q >= CntW'(plan_len_q))
                           && (bursts_q < OCntW'(Outstanding));
   assign plan_fill      = active_q && (!plan_valid_q || issue);
-  assign plan_fill_last = plan_fill && (CmpW'(rem_q) == CmpW'(blen));
+  assign plan_fill_last = plan_fill && rem_fits;
 
   // Packer command FIFO (two entries, flops): room decides whether a command is taken.
   logic [PkW-1:0] pk_mem_q [2];
@@ -256,8 +266,10 @@ module cube5_axi_wr #(
       plan_addr_d  = cur_addr_q;
       plan_len_d   = blen;
       plan_last_d  = plan_fill_last;
-      cur_addr_d   = cur_addr_q + (AddrW'(blen) << SizeW);
-      rem_d        = rem_q - NbW'(blen);
+      // Advanced by the cap, not blen: after a command's last burst both are dead (active_q
+      // drops), and before it blen = cap; so the cap's mux stays off these adders' path.
+      cur_addr_d   = cur_addr_q + (AddrW'(cap) << SizeW);
+      rem_d        = rem_q - NbW'(cap);
       if (plan_fill_last) active_d = 1'b0;
     end
     if (in_fire) begin
