@@ -119,7 +119,7 @@ module cube5_axi_wr #(
   localparam int unsigned NbW        = (LenW > BurstW) ? LenW + 1 : BurstW + 1;
   localparam int unsigned WordW      = DataW + Bytes;       // {strb, data}
   localparam int unsigned SpanW      = LenW + LaneBits + 1; // lane + items + Lanes - 1
-  localparam int unsigned PkW        = LaneW + LenW;        // packer command {items, lane}
+  localparam int unsigned PkW        = 1 + LaneW + LenW;    // packer command {one, items, lane}
 
   if (DataW < 8 || DataW > 1024 || (1 << $clog2(DataW)) != DataW) begin : gen_bad_data_w
     $fatal(1, "cube5_axi_wr: DataW must be a power of two in 8..1024");
@@ -315,18 +315,20 @@ module cube5_axi_wr #(
   logic             pk_busy_q, pk_busy_d;  // lane/left hold the head command's progress
   logic [LaneW-1:0] lane_q, lane_d, cur_lane;
   logic [LenW-1:0]  left_q, left_d, cur_left;
+  logic             one_q, one_d, cur_one;   // one item left (kept as a flag for clock rate)
   logic [DataW-1:0] pk_data_q, pk_data_d, merged;
   logic [Bytes-1:0] pk_strb_q, pk_strb_d, merged_strb;
   logic             beat_done, dat_fire, ram_full;
   logic [CntW-1:0]  count_q, count_d;      // beats in the W buffer
 
   assign cur_lane  = pk_busy_q ? lane_q : pk_mem_q[pk_rd_q][LaneW-1:0];
-  assign cur_left  = pk_busy_q ? left_q : pk_mem_q[pk_rd_q][PkW-1:LaneW];
+  assign cur_left  = pk_busy_q ? left_q : pk_mem_q[pk_rd_q][LaneW+LenW-1:LaneW];
+  assign cur_one   = pk_busy_q ? one_q : pk_mem_q[pk_rd_q][PkW-1];
   assign ram_full  = (count_q == CntW'(Depth));
-  assign beat_done = (cur_lane == LaneW'(Lanes - 1)) || (cur_left == LenW'(1));
+  assign beat_done = (cur_lane == LaneW'(Lanes - 1)) || cur_one;
   assign dat_ready_o = (pk_cnt_q != 2'd0) && !(beat_done && ram_full);
   assign dat_fire  = dat_valid_i && dat_ready_o;
-  assign pk_pop    = dat_fire && (cur_left == LenW'(1));
+  assign pk_pop    = dat_fire && cur_one;
 
   always_comb begin
     merged      = pk_data_q;
@@ -343,12 +345,14 @@ module cube5_axi_wr #(
     pk_busy_d = pk_busy_q;
     lane_d    = lane_q;
     left_d    = left_q;
+    one_d     = one_q;
     pk_data_d = pk_data_q;
     pk_strb_d = pk_strb_q;
     if (dat_fire) begin
       pk_busy_d = !pk_pop;
       lane_d    = (cur_lane == LaneW'(Lanes - 1)) ? '0 : cur_lane + LaneW'(1);
       left_d    = cur_left - LenW'(1);
+      one_d     = (cur_left == LenW'(2));
       pk_data_d = merged;
       pk_strb_d = beat_done ? '0 : merged_strb;
     end
@@ -379,8 +383,9 @@ module cube5_axi_wr #(
   always_ff @(posedge clk_i) begin
     lane_q    <= lane_d;
     left_q    <= left_d;
+    one_q     <= one_d;
     pk_data_q <= pk_data_d;
-    if (pk_push) pk_mem_q[pk_wr_q] <= {in_len, in_lane};
+    if (pk_push) pk_mem_q[pk_wr_q] <= {in_len == LenW'(1), in_len, in_lane};
   end
 
   // ==============================================================================================
@@ -487,10 +492,11 @@ module cube5_axi_wr #(
     out_valid_d = out_valid_q && !out_ready_i;
     out_resp_d  = out_resp_q;
     done_d      = done_q;
-    if (issue) begin
-      info_d[info_wr_q] = plan_last_q;
-      info_wr_d = info_wr_q + OPtrW'(1);
+    // A decoded write (an indexed one became a 32-bit compare chain in synth_ecp5).
+    for (int unsigned i = 0; i < Outstanding; i++) begin
+      if (issue && info_wr_q == OPtrW'(i)) info_d[i] = plan_last_q;
     end
+    if (issue) info_wr_d = info_wr_q + OPtrW'(1);
     if (b_fire) begin
       info_rd_d  = info_rd_q + OPtrW'(1);
       cmd_resp_d = acc_resp;
