@@ -12,25 +12,18 @@
 namespace cube5 {
 
 template <class V>
-class AxiWrShim final : public DutCore, public AxiHost {
+class AxiWrShim final : public AxiTopBase<V> {
+  using B = AxiTopBase<V>;
+  using B::cycle_;
+  using B::has_stalled_;
+  using B::mem_;
+  using B::tick;
+  using B::top_;
+
  public:
-  AxiWrShim(uint32_t seed, PortWidths widths) : widths_(widths) {
-    ctx_ = std::make_unique<VerilatedContext>();
-    ctx_->randReset(2);
-    ctx_->randSeed(static_cast<int>(seed & 0x7fffffff));
-    ctx_->traceEverOn(true);
-    top_ = std::make_unique<V>(ctx_.get(), "top");
-    top_->clk_i = 0;
-    top_->rst_ni = 1;
+  AxiWrShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     idle_inputs();
     top_->eval();
-  }
-
-  ~AxiWrShim() override {
-    if (trace_) trace_->close();
-    Verilated::threadContextp(ctx_.get());  // see StreamShim's destructor
-    top_->final();
-    top_.reset();
   }
 
   /// Resets the top and the subordinate together: bursts outstanding are dropped on both sides,
@@ -45,13 +38,8 @@ class AxiWrShim final : public DutCore, public AxiHost {
     for (uint32_t i = 0; i < cycles; ++i) tick();
     top_->rst_ni = 1;
     top_->eval();
-    if (top_->m_axi_awvalid_o || top_->m_axi_wvalid_o) {
-      AxiStats& st = mem_.stats;
-      if (st.protocol_errors++ == 0) {
-        st.first_error_cycle = cycle_;
-        st.first_error = "AWVALID or WVALID high out of reset";
-      }
-    }
+    if (top_->m_axi_awvalid_o || top_->m_axi_wvalid_o)
+      this->axi_violation("AWVALID or WVALID high out of reset");
     has_stalled_ = false;
   }
 
@@ -112,28 +100,15 @@ class AxiWrShim final : public DutCore, public AxiHost {
                               static_cast<uint32_t>(top_->m_axi_awid_o)},
                          w, top_->m_axi_bready_o);
 
-      if (has_stalled_ && (!top_->out_valid_o || !port_equal(top_->out_data_o, stalled_data_))) {
-        if (st.protocol_errors++ == 0) st.first_protocol_error_cycle = cycle_;
-      }
-      has_stalled_ = top_->out_valid_o && !take;
-      if (has_stalled_) stalled_data_ = top_->out_data_o;
-
       if (offer && top_->in_ready_o) {
         ++next;
         ++st.consumed;
       }
       if (dat_offer && top_->dat_ready_o) ++data_next_;
-      if (top_->out_valid_o && take) {
-        const size_t at = out.size();
-        out.resize(at + 2 + out_words);
-        out[at] = static_cast<uint32_t>(cycle_);
-        out[at + 1] = static_cast<uint32_t>(cycle_ >> 32);
-        read_port(top_->out_data_o, out.data() + at + 2, out_words);
-        ++st.produced;
-      }
+      this->watch_output(st, take, out, out_words);
       tick();
       ++st.cycles;
-      if (ctx_->gotFinish()) {
+      if (this->ctx_->gotFinish()) {
         st.finished = true;
         break;
       }
@@ -145,24 +120,6 @@ class AxiWrShim final : public DutCore, public AxiHost {
     return st;
   }
 
-  bool write_config(uint32_t, const uint32_t*, uint32_t) override { return false; }
-
-  bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) override {
-    if (trace_) trace_->close();
-    trace_ = std::make_unique<VerilatedVcdC>();
-    top_->trace(trace_.get(), 99);
-    trace_->open(path.c_str());
-    trace_from_ = from_cycle;
-    trace_to_ = to_cycle;
-    return trace_->isOpen();
-  }
-
-  uint64_t cycle() const override { return cycle_; }
-  PortWidths widths() const override { return widths_; }
-
-  AxiMem& axi_mem() override { return mem_; }
-  bool axi_err_flag() const override { return top_->err_o; }
-
  private:
   void idle_inputs() {
     top_->in_valid_i = 0;
@@ -173,38 +130,10 @@ class AxiWrShim final : public DutCore, public AxiHost {
     top_->m_axi_bvalid_i = 0;
   }
 
-  void dump() {
-    if (trace_ && cycle_ >= trace_from_ && cycle_ <= trace_to_) trace_->dump(ctx_->time());
-  }
-
-  // Between runs the subordinate is idle; the clock only runs inside run() and reset().
-  void tick() {
-    top_->clk_i = 0;
-    top_->eval();
-    dump();
-    ctx_->timeInc(1);
-    top_->clk_i = 1;
-    top_->eval();
-    dump();
-    ctx_->timeInc(1);
-    top_->clk_i = 0;
-    top_->eval();
-    ++cycle_;
-  }
-
-  PortWidths widths_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> top_;
-  std::unique_ptr<VerilatedVcdC> trace_;
-  uint64_t trace_from_ = 0, trace_to_ = 0;
-  uint64_t cycle_ = 0;
-  bool has_stalled_ = false;
-  std::remove_reference_t<decltype(V::out_data_o)> stalled_data_{};
   std::vector<uint32_t> data_;
   uint32_t data_words_ = 0;
   size_t data_next_ = 0;
   std::vector<uint8_t> data_idle_;
-  AxiMem mem_;
 };
 
 }  // namespace cube5
