@@ -12,8 +12,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi_mem_setup, axi_protocol_clean, compare_ar, compare_axi_outputs, configs, gate_configs,
-    seed, with_waves,
+    axi_mem_setup, axi_protocol_clean, axi_random_image, compare_ar, compare_axi_outputs, configs,
+    gate_configs, seed, with_waves,
 };
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
@@ -59,15 +59,7 @@ fn mem_setup(
 /// A 64 KB image of random bytes: at 0 for a 16-bit address space (it is the whole space, so
 /// commands that wrap read memory), else at 0x10000; an SLVERR window of 64 bytes inside.
 fn random_image(cfg: AxiRdConfig, rng: &mut ChaCha8Rng) -> AxiMemImage {
-    let base = if cfg.addr_w <= 16 { 0 } else { 0x1_0000 };
-    let bytes: Vec<u8> = (0..0x1_0000).map(|_| rng.random()).collect();
-    let lo = base + rng.random_range(0..0x1_0000u64 / 64) * 64;
-    AxiMemImage {
-        base,
-        bytes,
-        slverr_lo: lo,
-        slverr_hi: lo + 64,
-    }
+    axi_random_image(cfg.addr_w, rng)
 }
 
 /// Random commands: mostly inside the image, some just below it (DECERR), lengths mostly up to

@@ -95,22 +95,22 @@ impl AxiWrConfig {
     }
 
     /// Whether a command is well formed: the address aligned to an item, inside the address
-    /// space, and the length fits `LenW` bits.
+    /// space, and the length fits `LenW` bits (the read unit's rule with an item for a beat).
     pub fn check_cmd(&self, cmd: &AxiWrCmd) -> Result<()> {
-        if !cmd.addr.is_multiple_of(u64::from(self.item_bytes())) {
-            return Err(ModelError::Config(format!(
-                "cube5_axi_wr: command address {:#x} not aligned to an item ({} bytes)",
-                cmd.addr,
-                self.item_bytes()
-            )));
-        }
-        if self.wrap(cmd.addr) != cmd.addr || (self.len_w < 32 && cmd.len >> self.len_w != 0) {
-            return Err(ModelError::Config(format!(
-                "cube5_axi_wr: command {cmd} does not fit AddrW {} / LenW {}",
-                self.addr_w, self.len_w
-            )));
-        }
-        Ok(())
+        let items = AxiRdConfig {
+            data_w: self.item_w,
+            ..self.bus()
+        };
+        items
+            .check_cmd(&AxiRdCmd {
+                addr: cmd.addr,
+                len: cmd.len,
+            })
+            .map_err(|e| {
+                let why = e.to_string();
+                let why = why.rsplit("cube5_axi_rd: ").next().unwrap_or_default();
+                ModelError::Config(format!("cube5_axi_wr: command {cmd}: {why}"))
+            })
     }
 
     /// The beats a command covers: from its address rounded down to the bus, `ceil((lane + len)

@@ -475,3 +475,21 @@ pub fn axi_mem_setup(
         declared_outstanding: 0,
     }
 }
+
+/// The AXI tests' memory: a 64 KB image of random bytes at 0 for a 16-bit address space (it is
+/// the whole space, so commands that wrap reach memory), else at 0x10000; an SLVERR window of 64
+/// bytes inside.
+pub fn axi_random_image(
+    addr_w: u32,
+    rng: &mut impl rand::Rng,
+) -> cube5_model::units::cube5_axi_rd::AxiMemImage {
+    let base = if addr_w <= 16 { 0 } else { 0x1_0000 };
+    let bytes: Vec<u8> = (0..0x1_0000).map(|_| rng.random()).collect();
+    let lo = base + rng.random_range(0..0x1_0000u64 / 64) * 64;
+    cube5_model::units::cube5_axi_rd::AxiMemImage {
+        base,
+        bytes,
+        slverr_lo: lo,
+        slverr_hi: lo + 64,
+    }
+}
