@@ -44,7 +44,8 @@ struct AxiMemConfig {
   uint32_t aw_gap_permille = 0;  ///< chance that AWREADY is low in a cycle
   uint32_t w_gap_permille = 0;   ///< chance that WREADY is low in a cycle
   uint32_t b_gap_permille = 0;   ///< chance that a due B response is held back in a cycle
-  uint32_t declared_outstanding = 0;  ///< the manager's declared limit of write bursts (0: none)
+  uint32_t declared_outstanding = 0;  ///< the manager's declared limit of bursts in flight, per
+                                      ///< direction (0: not checked)
 };
 
 /// One accepted AR handshake.
@@ -231,6 +232,10 @@ class AxiReadPort : private AxiPortBase {
     ar_stalled_ = ar.valid && !out_.arready;
     ar_last_ = ar;
     if (ar.valid && out_.arready) {
+      if (cfg_.declared_outstanding && bursts_.size() >= cfg_.declared_outstanding)
+        fail(cycle, "AR accepted with " + std::to_string(bursts_.size()) +
+                        " bursts in flight (the manager declares at most " +
+                        std::to_string(cfg_.declared_outstanding) + ")");
       const uint32_t extra =
           cfg_.latency_random ? static_cast<uint32_t>(next() % (cfg_.latency_random + 1)) : 0;
       bursts_.push_back(Burst{ar.addr, ar.len, 0, ar.id, cycle + cfg_.latency_fixed + extra});

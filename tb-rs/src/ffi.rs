@@ -28,8 +28,8 @@ pub mod bridge {
         seed: u64,
         slverr_lo: u64,
         slverr_hi: u64,
-        /// Write port (AW, W, B): channel gaps in per mille, and the manager's declared limit of
-        /// outstanding write bursts (0: not checked).
+        /// Write port (AW, W, B): channel gaps in per mille; the manager's declared limit of
+        /// bursts in flight per direction, checked on AR and AW (0: not checked).
         aw_gap_permille: u32,
         w_gap_permille: u32,
         b_gap_permille: u32,
