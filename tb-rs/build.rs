@@ -248,6 +248,7 @@ fn main() {
         "axi_shim.h",
         "axil_mgr.h",
         "axil_shim.h",
+        "axi_wr_shim.h",
         "stream_dut.h",
         "stream_dut.cpp",
     ] {
@@ -295,6 +296,8 @@ fn main() {
         .iter()
         .map(|f| fs::read_to_string(tb.join(f)).unwrap())
         .collect();
+    // Tops with an AXI write port run in AxiWrShim, which includes both headers above.
+    let axi_wr_text = axi_text.clone() + &fs::read_to_string(tb.join("axi_wr_shim.h")).unwrap();
 
     // Tops with an AXI4-Lite subordinate port are wrapped in AxilShim (the same arrangement).
     let axil_text: String = ["axil_mgr.h", "axil_shim.h"]
@@ -329,8 +332,15 @@ fn main() {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(v) = selected.get(i) else { break };
-                let axi: &str = if has_axi_port(v) { &axi_text } else { "" };
-                let axi: &str = if has_axil_port(v) { &axil_text } else { axi };
+                let axi: &str = if has_axi_wr_port(v) {
+                    &axi_wr_text
+                } else if has_axi_port(v) {
+                    &axi_text
+                } else if has_axil_port(v) {
+                    &axil_text
+                } else {
+                    ""
+                };
                 let stamp = variant_stamp(
                     v,
                     &repo,
@@ -601,7 +611,9 @@ fn compile_variant(
     for c in &cpps {
         unity.push_str(&format!("#include \"{c}\"\n"));
     }
-    let (header, shim) = if has_axi_port(v) {
+    let (header, shim) = if has_axi_wr_port(v) {
+        ("axi_wr_shim.h", "AxiWrShim")
+    } else if has_axi_port(v) {
         ("axi_shim.h", "AxiShim")
     } else if has_axil_port(v) {
         ("axil_shim.h", "AxilShim")
@@ -662,6 +674,16 @@ fn has_axil_port(v: &Variant) -> bool {
 /// AxilShim's transaction and record widths (tb/axil_mgr.h, `kItemWords`, `kRecordWords`).
 const AXIL_ITEM_BITS: u32 = 128;
 const AXIL_RECORD_BITS: u32 = 128;
+
+/// Whether the top has an AXI4 write manager port (`m_axi_awvalid_o` in its own file): such tops
+/// run in `AxiWrShim` (tb/axi_wr_shim.h) with the subordinate's write port in the clock loop.
+fn has_axi_wr_port(v: &Variant) -> bool {
+    let own = format!("{}.sv", v.top);
+    v.files.iter().any(|f| {
+        f.file_name().is_some_and(|n| n.to_string_lossy() == own)
+            && fs::read_to_string(f).is_ok_and(|t| t.contains("m_axi_awvalid_o"))
+    })
+}
 
 /// The bit width of a port from Verilator's header: `VL_IN*(&name,MSB,LSB...)` declarations.
 fn port_width(header: &str, port: &str) -> Result<u32, String> {

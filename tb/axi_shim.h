@@ -15,10 +15,45 @@ struct HasErrFlag : std::false_type {};
 template <class V>
 struct HasErrFlag<V, std::void_t<decltype(std::declval<V&>().err_o)>> : std::true_type {};
 
+/// What the shims of tops with an AXI port share (AxiShim here, AxiWrShim in tb/axi_wr_shim.h):
+/// the Verilated top in its own context, the clock, the trace window, the subordinate, and the
+/// output stream's stall rule and collection. The derived shim idles its own inputs and evals.
 template <class V>
-class AxiShim final : public DutCore, public AxiHost {
+class AxiTopBase : public DutCore, public AxiHost {
  public:
-  AxiShim(uint32_t seed, PortWidths widths) : widths_(widths) {
+  ~AxiTopBase() override {
+    if (trace_) trace_->close();
+    Verilated::threadContextp(ctx_.get());  // see StreamShim's destructor
+    top_->final();
+    top_.reset();
+  }
+
+  bool write_config(uint32_t, const uint32_t*, uint32_t) override { return false; }
+
+  bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) override {
+    if (trace_) trace_->close();
+    trace_ = std::make_unique<VerilatedVcdC>();
+    top_->trace(trace_.get(), 99);
+    trace_->open(path.c_str());
+    trace_from_ = from_cycle;
+    trace_to_ = to_cycle;
+    return trace_->isOpen();
+  }
+
+  uint64_t cycle() const override { return cycle_; }
+  PortWidths widths() const override { return widths_; }
+
+  AxiMem& axi_mem() override { return mem_; }
+  bool axi_err_flag() const override {
+    if constexpr (HasErrFlag<V>::value) {
+      return top_->err_o;
+    } else {
+      return false;
+    }
+  }
+
+ protected:
+  AxiTopBase(uint32_t seed, PortWidths widths) : widths_(widths) {
     ctx_ = std::make_unique<VerilatedContext>();
     ctx_->randReset(2);
     ctx_->randSeed(static_cast<int>(seed & 0x7fffffff));
@@ -28,16 +63,79 @@ class AxiShim final : public DutCore, public AxiHost {
     top_->rst_ni = 1;
     top_->in_valid_i = 0;
     top_->out_ready_i = 0;
+  }
+
+  /// Records a protocol error of the manager found outside the subordinate's own checks.
+  void axi_violation(const char* what) {
+    AxiStats& st = mem_.stats;
+    if (st.protocol_errors++ == 0) {
+      st.first_error_cycle = cycle_;
+      st.first_error = what;
+    }
+  }
+
+  /// After eval: the output's stall rule, and the output taken this cycle (if `take`) appended to
+  /// `out` as DutCore::run describes.
+  void watch_output(RunStats& st, bool take, std::vector<uint32_t>& out, uint32_t out_words) {
+    if (has_stalled_ && (!top_->out_valid_o || !port_equal(top_->out_data_o, stalled_data_))) {
+      if (st.protocol_errors++ == 0) st.first_protocol_error_cycle = cycle_;
+    }
+    has_stalled_ = top_->out_valid_o && !take;
+    if (has_stalled_) stalled_data_ = top_->out_data_o;
+    if (top_->out_valid_o && take) {
+      const size_t at = out.size();
+      out.resize(at + 2 + out_words);
+      out[at] = static_cast<uint32_t>(cycle_);
+      out[at + 1] = static_cast<uint32_t>(cycle_ >> 32);
+      read_port(top_->out_data_o, out.data() + at + 2, out_words);
+      ++st.produced;
+    }
+  }
+
+  void dump() {
+    if (trace_ && cycle_ >= trace_from_ && cycle_ <= trace_to_) trace_->dump(ctx_->time());
+  }
+
+  // Between runs the subordinate is idle; the clock only runs inside run() and reset().
+  void tick() {
+    top_->clk_i = 0;
+    top_->eval();
+    dump();
+    ctx_->timeInc(1);
+    top_->clk_i = 1;
+    top_->eval();
+    dump();
+    ctx_->timeInc(1);
+    top_->clk_i = 0;
+    top_->eval();
+    ++cycle_;
+  }
+
+  PortWidths widths_;
+  std::unique_ptr<VerilatedContext> ctx_;
+  std::unique_ptr<V> top_;
+  std::unique_ptr<VerilatedVcdC> trace_;
+  uint64_t trace_from_ = 0, trace_to_ = 0;
+  uint64_t cycle_ = 0;
+  bool has_stalled_ = false;
+  std::remove_reference_t<decltype(V::out_data_o)> stalled_data_{};
+  AxiMem mem_;
+};
+
+template <class V>
+class AxiShim final : public AxiTopBase<V> {
+  using B = AxiTopBase<V>;
+  using B::cycle_;
+  using B::has_stalled_;
+  using B::mem_;
+  using B::tick;
+  using B::top_;
+
+ public:
+  AxiShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     top_->m_axi_arready_i = 0;
     top_->m_axi_rvalid_i = 0;
     top_->eval();
-  }
-
-  ~AxiShim() override {
-    if (trace_) trace_->close();
-    Verilated::threadContextp(ctx_.get());  // see StreamShim's destructor
-    top_->final();
-    top_.reset();
   }
 
   /// Resets the top and the subordinate together: bursts in flight are dropped on both sides. A
@@ -52,13 +150,7 @@ class AxiShim final : public DutCore, public AxiHost {
     for (uint32_t i = 0; i < cycles; ++i) tick();
     top_->rst_ni = 1;
     top_->eval();
-    if (top_->m_axi_arvalid_o) {
-      AxiStats& st = mem_.stats;
-      if (st.protocol_errors++ == 0) {
-        st.first_error_cycle = cycle_;
-        st.first_error = "ARVALID high out of reset";
-      }
-    }
+    if (top_->m_axi_arvalid_o) this->axi_violation("ARVALID high out of reset");
     has_stalled_ = false;
   }
 
@@ -98,27 +190,14 @@ class AxiShim final : public DutCore, public AxiHost {
                              static_cast<uint32_t>(top_->m_axi_arid_o)},
                         top_->m_axi_rready_o);
 
-      if (has_stalled_ && (!top_->out_valid_o || !port_equal(top_->out_data_o, stalled_data_))) {
-        if (st.protocol_errors++ == 0) st.first_protocol_error_cycle = cycle_;
-      }
-      has_stalled_ = top_->out_valid_o && !take;
-      if (has_stalled_) stalled_data_ = top_->out_data_o;
-
       if (offer && top_->in_ready_o) {
         ++next;
         ++st.consumed;
       }
-      if (top_->out_valid_o && take) {
-        const size_t at = out.size();
-        out.resize(at + 2 + out_words);
-        out[at] = static_cast<uint32_t>(cycle_);
-        out[at + 1] = static_cast<uint32_t>(cycle_ >> 32);
-        read_port(top_->out_data_o, out.data() + at + 2, out_words);
-        ++st.produced;
-      }
+      this->watch_output(st, take, out, out_words);
       tick();
       ++st.cycles;
-      if (ctx_->gotFinish()) {
+      if (this->ctx_->gotFinish()) {
         st.finished = true;
         break;
       }
@@ -128,60 +207,6 @@ class AxiShim final : public DutCore, public AxiHost {
     top_->eval();
     return st;
   }
-
-  bool write_config(uint32_t, const uint32_t*, uint32_t) override { return false; }
-
-  bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) override {
-    if (trace_) trace_->close();
-    trace_ = std::make_unique<VerilatedVcdC>();
-    top_->trace(trace_.get(), 99);
-    trace_->open(path.c_str());
-    trace_from_ = from_cycle;
-    trace_to_ = to_cycle;
-    return trace_->isOpen();
-  }
-
-  uint64_t cycle() const override { return cycle_; }
-  PortWidths widths() const override { return widths_; }
-
-  AxiMem& axi_mem() override { return mem_; }
-  bool axi_err_flag() const override {
-    if constexpr (HasErrFlag<V>::value) {
-      return top_->err_o;
-    } else {
-      return false;
-    }
-  }
-
- private:
-  void dump() {
-    if (trace_ && cycle_ >= trace_from_ && cycle_ <= trace_to_) trace_->dump(ctx_->time());
-  }
-
-  // Between runs the subordinate is idle; the clock only runs inside run() and reset().
-  void tick() {
-    top_->clk_i = 0;
-    top_->eval();
-    dump();
-    ctx_->timeInc(1);
-    top_->clk_i = 1;
-    top_->eval();
-    dump();
-    ctx_->timeInc(1);
-    top_->clk_i = 0;
-    top_->eval();
-    ++cycle_;
-  }
-
-  PortWidths widths_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> top_;
-  std::unique_ptr<VerilatedVcdC> trace_;
-  uint64_t trace_from_ = 0, trace_to_ = 0;
-  uint64_t cycle_ = 0;
-  bool has_stalled_ = false;
-  std::remove_reference_t<decltype(V::out_data_o)> stalled_data_{};
-  AxiMem mem_;
 };
 
 }  // namespace cube5

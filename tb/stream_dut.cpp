@@ -53,6 +53,10 @@ bool StreamDut::axi_setup(const AxiMemSetup& s) {
   c.seed = s.seed;
   c.slverr_lo = s.slverr_lo;
   c.slverr_hi = s.slverr_hi;
+  c.aw_gap_permille = s.aw_gap_permille;
+  c.w_gap_permille = s.w_gap_permille;
+  c.b_gap_permille = s.b_gap_permille;
+  c.declared_outstanding = s.declared_outstanding;
   h->axi_mem().configure(c);
   return true;
 }
@@ -88,6 +92,43 @@ AxiCounters StreamDut::axi_counters() const {
 rust::String StreamDut::axi_first_error() const {
   AxiHost* h = axi();
   return rust::String(h ? h->axi_mem().stats.first_error : std::string());
+}
+
+bool StreamDut::axi_feed(rust::Slice<const uint32_t> items, uint32_t words,
+                         rust::Slice<const uint8_t> idle) {
+  AxiHost* h = axi();
+  if (!h || words == 0) return false;
+  return h->feed_data(items.data(), items.size() / words, words, idle.data(), idle.size());
+}
+
+bool StreamDut::axi_take_aw(rust::Vec<uint64_t>& out) {
+  AxiHost* h = axi();
+  if (!h) return false;
+  for (const ArRecord& r : h->axi_mem().write.take_records()) {
+    out.push_back(r.cycle);
+    out.push_back(r.addr);
+    out.push_back(uint64_t{r.len} | uint64_t{r.size} << 8 | uint64_t{r.burst} << 12 |
+                  uint64_t{r.id} << 16);
+  }
+  return true;
+}
+
+bool StreamDut::axi_image(rust::Vec<uint8_t>& out) const {
+  AxiHost* h = axi();
+  if (!h) return false;
+  const std::vector<uint8_t>& b = h->axi_mem().image.bytes;
+  out.reserve(out.size() + b.size());
+  for (uint8_t x : b) out.push_back(x);
+  return true;
+}
+
+AxiWrCounters StreamDut::axi_wr_counters() const {
+  AxiHost* h = axi();
+  if (!h) return AxiWrCounters{};
+  const AxiStats& s = h->axi_mem().stats;
+  return AxiWrCounters{s.aw_accepted, s.w_beats,           s.w_bytes,
+                       s.b_responses, s.w_dropped_at_reset, s.bready_low,
+                       h->axi_mem().write.in_flight()};
 }
 
 uint64_t StreamDut::cycle() const { return core_->cycle(); }

@@ -11,6 +11,7 @@ namespace cube5 {
 struct RunResult;
 struct AxiMemSetup;
 struct AxiCounters;
+struct AxiWrCounters;
 class AxiHost;
 
 class StreamDut {
@@ -30,6 +31,10 @@ class StreamDut {
   bool axi_take_ar(rust::Vec<uint64_t>& out);
   AxiCounters axi_counters() const;
   rust::String axi_first_error() const;
+  bool axi_feed(rust::Slice<const uint32_t> items, uint32_t words, rust::Slice<const uint8_t> idle);
+  bool axi_take_aw(rust::Vec<uint64_t>& out);
+  bool axi_image(rust::Vec<uint8_t>& out) const;
+  AxiWrCounters axi_wr_counters() const;
   uint32_t in_bits() const;
   uint32_t out_bits() const;
 

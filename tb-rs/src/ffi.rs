@@ -28,6 +28,24 @@ pub mod bridge {
         seed: u64,
         slverr_lo: u64,
         slverr_hi: u64,
+        /// Write port (AW, W, B): channel gaps in per mille; the manager's declared limit of
+        /// bursts in flight per direction, checked on AR and AW (0: not checked).
+        aw_gap_permille: u32,
+        w_gap_permille: u32,
+        b_gap_permille: u32,
+        declared_outstanding: u32,
+    }
+
+    /// The subordinate's write-port counters (mirrors `AxiStats` in tb/axi_mem.h).
+    #[derive(Debug, Clone, Copy, Default)]
+    struct AxiWrCounters {
+        aw_accepted: u64,
+        w_beats: u64,
+        w_bytes: u64,
+        b_responses: u64,
+        dropped_at_reset: u64,
+        bready_low: u64,
+        in_flight: u64,
     }
 
     /// The subordinate's counters (mirrors `AxiStats` in tb/axi_mem.h) and the top's `err_o`.
@@ -80,6 +98,12 @@ pub mod bridge {
         fn axi_take_ar(self: Pin<&mut StreamDut>, out: &mut Vec<u64>) -> bool;
         fn axi_counters(self: &StreamDut) -> AxiCounters;
         fn axi_first_error(self: &StreamDut) -> String;
+        /// The write port (tb/axi_mem.h, tb/axi_wr_shim.h): items for the data stream, the AW
+        /// handshakes (as `axi_take_ar`), the memory image, the write counters.
+        fn axi_feed(self: Pin<&mut StreamDut>, items: &[u32], words: u32, idle: &[u8]) -> bool;
+        fn axi_take_aw(self: Pin<&mut StreamDut>, out: &mut Vec<u64>) -> bool;
+        fn axi_image(self: &StreamDut, out: &mut Vec<u8>) -> bool;
+        fn axi_wr_counters(self: &StreamDut) -> AxiWrCounters;
         fn in_bits(self: &StreamDut) -> u32;
         fn out_bits(self: &StreamDut) -> u32;
     }

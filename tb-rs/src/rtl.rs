@@ -1,6 +1,7 @@
 //! A Verilated streaming top behind the same `StreamUnit` trait as the golden model.
 
 use crate::error::TbError;
+pub use crate::ffi::bridge::AxiWrCounters;
 use crate::ffi::bridge::{self, RunResult, StreamDut};
 pub use crate::ffi::bridge::{AxiCounters, AxiMemSetup};
 use crate::variants::{Variant, VARIANTS};
@@ -51,6 +52,21 @@ pub struct ArHandshake {
     pub size: u32,
     pub burst: u32,
     pub id: u32,
+}
+
+/// Address-channel handshakes as the bridge packs them: (cycle, addr, len | size << 8 |
+/// burst << 12 | id << 16) each.
+fn handshakes(raw: &[u64]) -> Vec<ArHandshake> {
+    raw.chunks_exact(3)
+        .map(|r| ArHandshake {
+            cycle: r[0],
+            addr: r[1],
+            len: (r[2] & 0xff) as u32,
+            size: ((r[2] >> 8) & 0x7) as u32,
+            burst: ((r[2] >> 12) & 0x3) as u32,
+            id: (r[2] >> 16) as u32,
+        })
+        .collect()
 }
 
 /// One output as it left the RTL: the cycle it was taken and its value.
@@ -187,17 +203,7 @@ impl<C: StreamCodec> RtlStream<C> {
         if !self.dut.pin_mut().axi_take_ar(&mut raw) {
             return Err(self.no_axi());
         }
-        Ok(raw
-            .chunks_exact(3)
-            .map(|r| ArHandshake {
-                cycle: r[0],
-                addr: r[1],
-                len: (r[2] & 0xff) as u32,
-                size: ((r[2] >> 8) & 0x7) as u32,
-                burst: ((r[2] >> 12) & 0x3) as u32,
-                id: (r[2] >> 16) as u32,
-            })
-            .collect())
+        Ok(handshakes(&raw))
     }
 
     /// The subordinate's counters and the top's `err_o`.
@@ -208,6 +214,40 @@ impl<C: StreamCodec> RtlStream<C> {
     /// The subordinate's first protocol violation (empty if none).
     pub fn axi_first_error(&self) -> String {
         self.dut.axi_first_error()
+    }
+
+    /// Queues `items` (packed, `words` words each) for the data stream of a top with an AXI write
+    /// port, offered except where `idle` (a repeating pattern) is nonzero; replaces the last.
+    pub fn axi_feed(&mut self, items: &[u32], words: u32, idle: &[u8]) -> Result<(), TbError> {
+        if self.dut.pin_mut().axi_feed(items, words, idle) {
+            Ok(())
+        } else {
+            Err(self.no_axi())
+        }
+    }
+
+    /// The AW handshakes the subordinate accepted since the last call, in order.
+    pub fn axi_take_aw(&mut self) -> Result<Vec<ArHandshake>, TbError> {
+        let mut raw = Vec::new();
+        if !self.dut.pin_mut().axi_take_aw(&mut raw) {
+            return Err(self.no_axi());
+        }
+        Ok(handshakes(&raw))
+    }
+
+    /// The subordinate's memory image as it is now (the bytes from the loaded base).
+    pub fn axi_image(&self) -> Result<Vec<u8>, TbError> {
+        let mut out = Vec::new();
+        if self.dut.axi_image(&mut out) {
+            Ok(out)
+        } else {
+            Err(self.no_axi())
+        }
+    }
+
+    /// The subordinate's write-port counters.
+    pub fn axi_wr_counters(&self) -> AxiWrCounters {
+        self.dut.axi_wr_counters()
     }
 
     fn no_axi(&self) -> TbError {

@@ -12,8 +12,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi_mem_setup, axi_protocol_clean, compare_ar, compare_axi_outputs, configs, gate_configs,
-    seed, with_waves,
+    axi_mem_setup, axi_protocol_clean, axi_random_image, compare_ar, compare_axi_outputs, configs,
+    gate_configs, seed, with_waves,
 };
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
@@ -44,7 +44,7 @@ impl Report {
 }
 
 /// The subordinate: latency `fixed + U(0..random)`, ARREADY/RVALID gaps, bandwidth `bw` bytes
-/// per cycle as `(num, den)` (`num = 0`: unlimited).
+/// per cycle as `(num, den)` (`num = 0`: unlimited), the unit's Outstanding as its declared limit.
 fn mem_setup(
     cfg: AxiRdConfig,
     mem: &AxiMemImage,
@@ -53,21 +53,16 @@ fn mem_setup(
     bw: (u32, u32),
     seed: u64,
 ) -> AxiMemSetup {
-    axi_mem_setup((cfg.bytes(), cfg.addr_w), mem, lat, gaps, bw, seed)
+    AxiMemSetup {
+        declared_outstanding: cfg.outstanding,
+        ..axi_mem_setup((cfg.bytes(), cfg.addr_w), mem, lat, gaps, bw, seed)
+    }
 }
 
 /// A 64 KB image of random bytes: at 0 for a 16-bit address space (it is the whole space, so
 /// commands that wrap read memory), else at 0x10000; an SLVERR window of 64 bytes inside.
 fn random_image(cfg: AxiRdConfig, rng: &mut ChaCha8Rng) -> AxiMemImage {
-    let base = if cfg.addr_w <= 16 { 0 } else { 0x1_0000 };
-    let bytes: Vec<u8> = (0..0x1_0000).map(|_| rng.random()).collect();
-    let lo = base + rng.random_range(0..0x1_0000u64 / 64) * 64;
-    AxiMemImage {
-        base,
-        bytes,
-        slverr_lo: lo,
-        slverr_hi: lo + 64,
-    }
+    axi_random_image(cfg.addr_w, rng)
 }
 
 /// Random commands: mostly inside the image, some just below it (DECERR), lengths mostly up to
@@ -638,7 +633,8 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
 
 /// The subordinate's protocol checker bites, and its report reaches the test: told the bus is
 /// twice as wide as it is, it refuses the unit's ARSIZE; told the address space is 8 KB, it
-/// refuses a burst above it. Both fail as protocol errors naming the rule and the seed.
+/// refuses a burst above it; told the unit declares one burst fewer than it keeps in flight, it
+/// refuses the AR beyond. Each fails as a protocol error naming the rule and the seed.
 #[test]
 fn the_axi_checker_reports_a_violation() {
     let (variant, cfg) = configs::<AxiRdConfig>()[0];
@@ -647,7 +643,7 @@ fn the_axi_checker_reports_a_violation() {
     let good = mem_setup(cfg, &mem, (10, 0), (200, 0), (0, 1), 1);
     let cmds = vec![AxiRdCmd {
         addr: mem.base + 0x3000,
-        len: 4,
+        len: 4 * cfg.max_burst,
     }];
     for (setup, rule) in [
         (
@@ -663,6 +659,13 @@ fn the_axi_checker_reports_a_violation() {
                 ..good
             },
             "past the address space",
+        ),
+        (
+            AxiMemSetup {
+                declared_outstanding: cfg.outstanding - 1,
+                ..good
+            },
+            "declares at most",
         ),
     ] {
         let case = Case {

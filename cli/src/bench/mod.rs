@@ -6,6 +6,7 @@
 //! (`cube5_tb::variants_of`) and names none. What they share is in [`common`].
 
 mod common;
+mod cube5_axi_wr;
 mod cube5_compos;
 mod cube5_frame;
 mod cube5_gradient;
@@ -104,6 +105,11 @@ const BENCHES: &[Bench] = &[
         top: cube5_warp::TOP,
         alias: "warp",
         run: cube5_warp::run,
+    },
+    Bench {
+        top: cube5_axi_wr::TOP,
+        alias: "axi_wr",
+        run: cube5_axi_wr::run,
     },
 ];
 

@@ -336,6 +336,32 @@ pub fn compare_ar<C: StreamCodec>(
     context: impl Fn(usize) -> String,
 ) -> Result<usize, cube5_tb::TbError> {
     let ars = dut.axi_take_ar()?;
+    compare_handshakes(&ars, "AR", bursts, size, variant, seed, context)
+}
+
+/// The AW handshakes since the last call against the model's bursts, as `compare_ar` does for AR.
+pub fn compare_aw<C: StreamCodec>(
+    dut: &mut RtlStream<C>,
+    bursts: &[cube5_model::units::cube5_axi_rd::Burst],
+    size: u32,
+    variant: &'static Variant,
+    seed: u64,
+    context: impl Fn(usize) -> String,
+) -> Result<usize, cube5_tb::TbError> {
+    let aws = dut.axi_take_aw()?;
+    compare_handshakes(&aws, "AW", bursts, size, variant, seed, context)
+}
+
+/// Address-channel handshakes (`ch` is "AR" or "AW") against the model's bursts, in order.
+fn compare_handshakes(
+    ars: &[cube5_tb::rtl::ArHandshake],
+    ch: &str,
+    bursts: &[cube5_model::units::cube5_axi_rd::Burst],
+    size: u32,
+    variant: &'static Variant,
+    seed: u64,
+    context: impl Fn(usize) -> String,
+) -> Result<usize, cube5_tb::TbError> {
     for (k, ar) in ars.iter().enumerate() {
         let model = bursts.get(k);
         let got = cube5_model::units::cube5_axi_rd::Burst {
@@ -353,7 +379,9 @@ pub fn compare_ar<C: StreamCodec>(
                 model: model.map_or("(no burst expected)".into(), |b| {
                     format!("{b:?} size {size} burst 1 id 0")
                 }),
-                what: "AR burst differs (address, beats; ARSIZE, ARBURST = INCR, ARID = 0)".into(),
+                what: format!(
+                    "{ch} burst differs (address, beats; {ch}SIZE, {ch}BURST = INCR, {ch}ID = 0)"
+                ),
                 ..Default::default()
             }));
         }
@@ -441,5 +469,27 @@ pub fn axi_mem_setup(
         seed,
         slverr_lo: mem.slverr_lo,
         slverr_hi: mem.slverr_hi,
+        aw_gap_permille: 0,
+        w_gap_permille: 0,
+        b_gap_permille: 0,
+        declared_outstanding: 0,
+    }
+}
+
+/// The AXI tests' memory: a 64 KB image of random bytes at 0 for a 16-bit address space (it is
+/// the whole space, so commands that wrap reach memory), else at 0x10000; an SLVERR window of 64
+/// bytes inside.
+pub fn axi_random_image(
+    addr_w: u32,
+    rng: &mut impl rand::Rng,
+) -> cube5_model::units::cube5_axi_rd::AxiMemImage {
+    let base = if addr_w <= 16 { 0 } else { 0x1_0000 };
+    let bytes: Vec<u8> = (0..0x1_0000).map(|_| rng.random()).collect();
+    let lo = base + rng.random_range(0..0x1_0000u64 / 64) * 64;
+    cube5_model::units::cube5_axi_rd::AxiMemImage {
+        base,
+        bytes,
+        slverr_lo: lo,
+        slverr_hi: lo + 64,
     }
 }

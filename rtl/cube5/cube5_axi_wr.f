@@ -1,0 +1,1 @@
+rtl/cube5/cube5_axi_wr.sv

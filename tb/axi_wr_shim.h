@@ -1,0 +1,139 @@
+// axi_wr_shim.h: DutCore for a Verilated top V with an AXI4 write manager port (m_axi_aw*,
+// m_axi_w*, m_axi_b*) and a second input stream for its data (dat_valid_i, dat_ready_o,
+// dat_data_i), answered cycle by cycle by the write port of an AxiMem (tb/axi_mem.h). The command
+// and output streams behave exactly as StreamShim's (tb/stream_shim.h); the data stream takes the
+// items queued by feed_data, with its own idle pattern.
+#pragma once
+
+#include "axi_mem.h"
+#include "axi_shim.h"
+#include "stream_shim.h"
+
+namespace cube5 {
+
+template <class V>
+class AxiWrShim final : public AxiTopBase<V> {
+  using B = AxiTopBase<V>;
+  using B::cycle_;
+  using B::has_stalled_;
+  using B::mem_;
+  using B::tick;
+  using B::top_;
+
+ public:
+  AxiWrShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
+    idle_inputs();
+    top_->eval();
+  }
+
+  /// Resets the top and the subordinate together: bursts outstanding are dropped on both sides,
+  /// and so are the queued data items. A manager still driving AWVALID or WVALID out of reset is
+  /// a protocol error.
+  void reset(uint32_t cycles) override {
+    top_->rst_ni = 0;
+    idle_inputs();
+    mem_.reset();
+    data_.clear();
+    data_next_ = 0;
+    for (uint32_t i = 0; i < cycles; ++i) tick();
+    top_->rst_ni = 1;
+    top_->eval();
+    if (top_->m_axi_awvalid_o || top_->m_axi_wvalid_o)
+      this->axi_violation("AWVALID or WVALID high out of reset");
+    has_stalled_ = false;
+  }
+
+  bool feed_data(const uint32_t* items, size_t n, uint32_t words, const uint8_t* idle,
+                 size_t idle_len) override {
+    data_.assign(items, items + n * words);
+    data_words_ = words;
+    data_next_ = 0;
+    data_idle_.assign(idle, idle + idle_len);
+    return true;
+  }
+
+  RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t* idle,
+               size_t idle_len, const uint8_t* stall, size_t stall_len, uint64_t expect_out,
+               uint64_t max_cycles, std::vector<uint32_t>& out, uint32_t out_words) override {
+    RunStats st;
+    size_t next = 0;
+    const size_t n_data = data_words_ ? data_.size() / data_words_ : 0;
+    const uint32_t nb = static_cast<uint32_t>(mem_.cfg.data_bytes);
+    std::vector<uint32_t> wwords((nb + 3) / 4 + 1), swords(nb / 32 + 2);
+    WIn w;
+    while (st.cycles < max_cycles && (next < n_items || st.produced < expect_out)) {
+      const bool offer = next < n_items && !(idle_len && idle[cycle_ % idle_len]);
+      const bool take = !(stall_len && stall[cycle_ % stall_len]);
+      const bool dat_offer = data_next_ < n_data &&
+                             !(!data_idle_.empty() && data_idle_[cycle_ % data_idle_.size()]);
+      top_->in_valid_i = offer;
+      if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
+      top_->dat_valid_i = dat_offer;
+      if (dat_offer)
+        write_port(top_->dat_data_i, data_.data() + data_next_ * data_words_, data_words_);
+      top_->out_ready_i = take;
+
+      const WriteOut& o = mem_.write.drive(cycle_);
+      top_->m_axi_awready_i = o.awready;
+      top_->m_axi_wready_i = o.wready;
+      top_->m_axi_bvalid_i = o.bvalid;
+      top_->m_axi_bresp_i = o.bresp;
+      top_->m_axi_bid_i = o.bid;
+      top_->eval();
+
+      w.valid = top_->m_axi_wvalid_o;
+      w.last = top_->m_axi_wlast_o;
+      read_port(top_->m_axi_wdata_o, wwords.data(), static_cast<uint32_t>(wwords.size()));
+      read_port(top_->m_axi_wstrb_o, swords.data(), static_cast<uint32_t>(swords.size()));
+      w.data.resize(nb);
+      w.strb.resize(nb);
+      for (uint32_t i = 0; i < nb; ++i) {
+        w.data[i] = static_cast<uint8_t>(wwords[i / 4] >> (8 * (i % 4)));
+        w.strb[i] = static_cast<uint8_t>((swords[i / 32] >> (i % 32)) & 1);
+      }
+      mem_.write.observe(cycle_,
+                         ArIn{static_cast<bool>(top_->m_axi_awvalid_o),
+                              static_cast<uint64_t>(top_->m_axi_awaddr_o),
+                              static_cast<uint32_t>(top_->m_axi_awlen_o),
+                              static_cast<uint32_t>(top_->m_axi_awsize_o),
+                              static_cast<uint32_t>(top_->m_axi_awburst_o),
+                              static_cast<uint32_t>(top_->m_axi_awid_o)},
+                         w, top_->m_axi_bready_o);
+
+      if (offer && top_->in_ready_o) {
+        ++next;
+        ++st.consumed;
+      }
+      if (dat_offer && top_->dat_ready_o) ++data_next_;
+      this->watch_output(st, take, out, out_words);
+      tick();
+      ++st.cycles;
+      if (this->ctx_->gotFinish()) {
+        st.finished = true;
+        break;
+      }
+    }
+    top_->in_valid_i = 0;
+    top_->dat_valid_i = 0;
+    top_->out_ready_i = 0;
+    top_->eval();
+    return st;
+  }
+
+ private:
+  void idle_inputs() {
+    top_->in_valid_i = 0;
+    top_->dat_valid_i = 0;
+    top_->out_ready_i = 0;
+    top_->m_axi_awready_i = 0;
+    top_->m_axi_wready_i = 0;
+    top_->m_axi_bvalid_i = 0;
+  }
+
+  std::vector<uint32_t> data_;
+  uint32_t data_words_ = 0;
+  size_t data_next_ = 0;
+  std::vector<uint8_t> data_idle_;
+};
+
+}  // namespace cube5
