@@ -297,14 +297,13 @@ impl ErSetup {
         &self.frame.params
     }
 
-    /// `G`: the ray spacing at a region's rear, `U(.16)`.
-    fn g(&self) -> i64 {
-        ONE >> self.scheme.rate_log2()
-    }
-
     /// Region of slice `s` and the ray spacing `H(s)` (contract, integers only).
     pub fn slice_spacing(&self, s: usize) -> (u32, i64) {
-        let d = self.e + s as i64 * ONE;
+        self.spacing_at(self.e + s as i64 * ONE)
+    }
+
+    /// Region and ray spacing (`U(1.16)`) at distance `d` (`U(.16)`, `d >= E`) from the eye.
+    pub fn spacing_at(&self, d: i64) -> (u32, i64) {
         let mut r = 0u32;
         while (self.e << (r + 1)) <= d {
             r += 1;
@@ -312,6 +311,11 @@ impl ErSetup {
         let big = i128::from(self.e) << (r + 1);
         let h = (2 * i128::from(self.g()) * i128::from(d) + big) / (2 * big);
         (r, h as i64)
+    }
+
+    /// `G`: the ray spacing at a region's rear, `U(.16)`.
+    pub fn g(&self) -> i64 {
+        ONE >> self.scheme.rate_log2()
     }
 
     /// The fixed-point layout: regions, rays per slice, buffers.
@@ -613,24 +617,7 @@ impl ErJob {
             units.compos.step(cox, &smp)
         };
         let merge_kind = setup.scheme.merge;
-        let merge = |nb: &[[Coxel; 3]; 3]| -> Coxel {
-            let mut out = empty;
-            match merge_kind {
-                ErMerge::Centre => out.rgba = nb[1][1].rgba,
-                ErMerge::Bartlett => {
-                    for ch in 0..4 {
-                        let mut sum = 0u64;
-                        for (v, row) in nb.iter().enumerate() {
-                            for (u, c) in row.iter().enumerate() {
-                                sum += TENT[u] * TENT[v] * c.rgba[ch];
-                            }
-                        }
-                        out.rgba[ch] = (sum + 8) >> 4;
-                    }
-                }
-            }
-            out
-        };
+        let merge = |nb: &[[Coxel; 3]; 3]| merge_coxels(nb, merge_kind, &empty);
         let coxels = sweep(&layout, empty, merge, sample);
         let extent = layout.extent[0];
         let rgb: Vec<[f64; 3]> = {
@@ -653,6 +640,29 @@ impl ErJob {
 }
 
 const TENT: [u64; 3] = [1, 2, 1];
+
+/// The merge of 3 x 3 coxels of the farther region (`nb[v][u]` at `(2m' + u - 1, 2n' + v - 1)`)
+/// into ray `(m', n')` of the nearer one (contract: *Merge at a region boundary*): each of `R, G,
+/// B, A` the tent-weighted sum `+ 8 >> 4` (Bartlett) or the centre's (the what-if); the other fields
+/// those of `empty`.
+pub fn merge_coxels(nb: &[[Coxel; 3]; 3], merge: ErMerge, empty: &Coxel) -> Coxel {
+    let mut out = *empty;
+    match merge {
+        ErMerge::Centre => out.rgba = nb[1][1].rgba,
+        ErMerge::Bartlett => {
+            for ch in 0..4 {
+                let mut sum = 0u64;
+                for (v, row) in nb.iter().enumerate() {
+                    for (u, c) in row.iter().enumerate() {
+                        sum += TENT[u] * TENT[v] * c.rgba[ch];
+                    }
+                }
+                out.rgba[ch] = (sum + 8) >> 4;
+            }
+        }
+    }
+    out
+}
 
 /// The bilinear sample of slice `t` (processing order; 0 outside `0..nk`) at anchor `(a, b)` (0
 /// outside the face) with weights `(wx, wy)`: the frame's rules with a ray's own weights.
