@@ -318,6 +318,12 @@ impl ErSetup {
         ONE >> self.scheme.rate_log2()
     }
 
+    /// The counts of this set-up's frame that do not depend on the volume's values (regions,
+    /// samples, samples per slice against the bound), for `plan:`.
+    pub fn counts(&self) -> ErStats {
+        ErStats::new(self, &self.layout(), 0)
+    }
+
     /// The fixed-point layout: regions, rays per slice, buffers.
     pub fn layout(&self) -> Layout {
         let p = self.params();
@@ -433,10 +439,11 @@ impl ErStats {
         self.samples_per_slice.iter().copied().max().unwrap_or(0)
     }
 
-    /// One phrase for `plan:`: regions, samples, per slice against the bound.
+    /// One phrase for `plan:`: regions, samples, per slice against the bound (and the samples
+    /// shaded, once a frame has run).
     pub fn describe(&self) -> String {
         format!(
-            "eye {:.1} slices in front, {} region{} (starting at slices {:?}), base plane {}x{}, {} samples ({} shaded), per slice {}..{} against the bound N^2 = {} .. 4N^2 = {}",
+            "eye {:.1} slices in front of the first slice, {} region{} (first slices {:?}), base plane {}x{}, {} samples{}, per slice {}..{} against the bound N^2 = {} .. 4N^2 = {}",
             self.eye_distance,
             self.regions,
             if self.regions == 1 { "" } else { "s" },
@@ -444,7 +451,11 @@ impl ErStats {
             self.base.0,
             self.base.1,
             self.samples,
-            self.shaded,
+            if self.shaded > 0 {
+                format!(" ({} shaded)", self.shaded)
+            } else {
+                String::new()
+            },
             self.min_per_slice(),
             self.max_per_slice(),
             self.n2,
