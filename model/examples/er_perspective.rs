@@ -7,6 +7,8 @@
 //! [--fovs 20,40,60,90] [--rates 1,2] [--mode composite|mip] [--png DIR]`; defaults: the scene's
 //! 96^3 and 256^2.
 
+mod support;
+
 use cube5_model::er_perspective::{render_er, render_er_f64, ErMerge, ErScheme};
 use cube5_model::render::render_reference;
 use cube5_model::scene::Scene;
@@ -25,22 +27,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let value = args.next().ok_or(format!("{a}: needs a value"))?;
+        if support::scene_option(&mut scene, &a, &value)? {
+            continue;
+        }
         match a.as_str() {
-            "--size" => scene.volume.size = value.parse()?,
-            "--image" => {
-                scene.image.width = value.parse()?;
-                scene.image.height = scene.image.width;
-            }
             "--png" => png = Some(value.into()),
             "--fovs" => fovs = list(&value)?,
             "--rates" => rates = list(&value)?,
-            "--mode" => {
-                scene.render.mode = match value.as_str() {
-                    "mip" => cube5_model::render::CompositeMode::Mip,
-                    "composite" => cube5_model::render::CompositeMode::Composite,
-                    _ => return Err(format!("--mode {value}: composite or mip").into()),
-                }
-            }
             _ => return Err(format!("unknown option {a}").into()),
         }
     }

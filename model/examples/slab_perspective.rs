@@ -5,6 +5,8 @@
 //! `cargo run --release -p cube5-model --example slab_perspective -- [--size N] [--image PX]
 //! [--counts 1,2,4,8,16,32] [--png DIR] [--mode composite|mip]`; defaults: the scene's 96^3 and 256^2.
 
+mod support;
+
 use cube5_model::render::render_reference;
 use cube5_model::scene::Scene;
 use cube5_model::slab_perspective::{render_slabs, SlabSpacing, Slabs};
@@ -18,20 +20,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let value = args.next().ok_or(format!("{a}: needs a value"))?;
+        if support::scene_option(&mut scene, &a, &value)? {
+            continue;
+        }
         match a.as_str() {
-            "--size" => scene.volume.size = value.parse()?,
-            "--image" => {
-                scene.image.width = value.parse()?;
-                scene.image.height = scene.image.width;
-            }
             "--png" => png = Some(value.into()),
-            "--mode" => {
-                scene.render.mode = match value.as_str() {
-                    "mip" => cube5_model::render::CompositeMode::Mip,
-                    "composite" => cube5_model::render::CompositeMode::Composite,
-                    _ => return Err(format!("--mode {value}: composite or mip").into()),
-                }
-            }
             "--counts" => counts = value.split(',').map(str::parse).collect::<Result<_, _>>()?,
             _ => return Err(format!("unknown option {a}").into()),
         }

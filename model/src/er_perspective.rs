@@ -18,7 +18,7 @@ use crate::scene_render::{at_voxel_width, params_phong};
 use crate::transfer::TransferFunction;
 use crate::units::cube5_compos::{corrected_alpha, ComposMode, Coxel, OpacityLut};
 use crate::units::cube5_frame::{
-    shade_n6, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, STEP_W,
+    shade_n6, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, N6_OFFSETS, STEP_W,
 };
 use crate::units::cube5_shader::{Phong, ShaderIn, ShaderMode};
 use crate::units::cube5_trilin::Trilin;
@@ -613,15 +613,10 @@ impl ErJob {
                 }
             } else {
                 shaded.fetch_add(1, Ordering::Relaxed);
-                let nb = [
-                    c,
-                    at(s_i, -1, 0),
-                    at(s_i, 1, 0),
-                    at(s_i, 0, -1),
-                    at(s_i, 0, 1),
-                    at(s_i - 1, 0, 0),
-                    at(s_i + 1, 0, 0),
-                ];
+                let nb = N6_OFFSETS.map(|(di, dj, dk)| match (di, dj, dk) {
+                    (0, 0, 0) => c,
+                    _ => at(s_i + i64::from(dk), i64::from(di), i64::from(dj)),
+                });
                 shade_n6(&units.gradient, &units.shader, &nb, smode, s as u32)
             };
             smp.mode = cmode;

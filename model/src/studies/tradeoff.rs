@@ -11,16 +11,16 @@
 //! The data come out as [`Table`]s and [`Figure`]s; the command line writes them as Markdown, CSV
 //! and PNG.
 
+use crate::er_perspective::{render_er, render_er_f64, ErMerge, ErScheme};
 use crate::error::{ModelError, Result};
 use crate::phantom::{sphere_phantom, SphereGeometry};
 use crate::render::{
     render_pipeline, render_reference, CompositeMode, GradientScheme, ImageF64, Interpolation,
     Projection, Quality, RenderParams, SliceSetup, View, STEP_W,
 };
-use crate::er_perspective::{render_er, render_er_f64, ErMerge, ErScheme};
 use crate::slab_perspective::{render_slabs, SlabSpacing, Slabs};
-use crate::units::cube5_frame::FrameConfig;
 use crate::transfer::TransferFunction;
+use crate::units::cube5_frame::FrameConfig;
 use crate::units::cube5_gradient::{block_index, Gradient, GradientConfig, GradientIn};
 use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use crate::volume::Volume;
