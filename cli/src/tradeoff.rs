@@ -604,8 +604,9 @@ fn document(
          that keeps the continuing ray and drops its neighbours. `PSNR vs its f64` is the fixed \
          point's error alone (the f64 reference of the same algorithm); samples per slice stay \
          within N^2 .. 4N^2 (patent [195]). The eye sits where the bounding sphere fills the field \
-         of view, so narrow views have one region (no merge) and the merge acts from about 60 \
-         degrees. No RTL yet.",
+         of view (as the reference renderer puts it), at least about 0.2 N in front of the volume: \
+         narrow views have one region (no merge); two regions at 90 and 120 degrees here. Times \
+         are the model's on a shared two-core machine. No RTL yet.",
     );
     w(&mut s, "");
     s.push_str(&table("tradeoff-er").to_markdown());

@@ -272,7 +272,7 @@ impl ErSetup {
         };
         if !(e.is_finite() && e >= 1.0) {
             return Err(ModelError::View(format!(
-                "view: the eye is {e:.2} slices in front of the volume's first slice; ER-perspective needs it at least one slice in front (a narrower field of view or a smaller zoom moves it out)"
+                "the eye is {e:.2} slices in front of the volume's first slice; ER-perspective needs it at least one slice in front (a narrower view.fov moves the eye out)"
             )));
         }
         let (e_i, e_j) = (v[p.axis_i], v[p.axis_j]);
