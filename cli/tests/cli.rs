@@ -368,6 +368,11 @@ fn er_perspective_renders_and_names_its_counts() {
             "[view]\nprojection = \"perspective\"\n[run]\nrenderer = \"er\"\ntarget = \"rtl\"\n",
             "run.renderer",
         ),
+        (
+            "er-eye-too-close",
+            "[view]\nprojection = \"perspective\"\nfov = 169.0\ndirection = [1, 1, 1]\n[run]\nrenderer = \"er\"\n",
+            "view.fov",
+        ),
     ] {
         let (out, _) = render_view(name, text, &[]);
         assert_refused(&out, field);

@@ -319,3 +319,60 @@ fn bartlett_beats_dropping_rays() {
         "bartlett {b:?}, centre {c:?}"
     );
 }
+
+/// The rays of a slice are exactly those whose anchor lies on the face (`0 <= X >> 16 < ni`, the
+/// same for `j`): the first and last of each range are inside, their neighbours outside; and the
+/// f64 layout puts every slice in the same region as the fixed-point one for eyes away from a
+/// boundary.
+#[test]
+fn the_rays_of_a_slice_are_those_whose_anchor_is_on_the_face() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(141);
+    for case in 0..200 {
+        let dims = [
+            rng.random_range(2..30usize),
+            rng.random_range(2..30usize),
+            rng.random_range(2..30usize),
+        ];
+        let dir = DVec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        if dir.length() < 0.1 {
+            continue;
+        }
+        let e = rng.random_range(1.0..40.0);
+        let lateral = [rng.random_range(-30.0..50.0), rng.random_range(-30.0..50.0)];
+        let s = placed(dims, dir, e, lateral, [1, 2, 4][case % 3]);
+        let p = *s.params();
+        let layout = s.layout();
+        let (f64_layout, _) = s.layout_f64();
+        for (k, rays) in layout.rays.iter().enumerate() {
+            let h = s.slice_spacing(k).1;
+            let anchor = |e0: i64, m: i64| (e0 + m * h) >> 16;
+            let on = |a: i64, n: usize| a >= 0 && a < n as i64;
+            for (e0, lo, hi, n) in [
+                (s.ei, rays.m0, rays.m1, p.ni),
+                (s.ej, rays.n0, rays.n1, p.nj),
+            ] {
+                assert!(
+                    on(anchor(e0, lo), n) && on(anchor(e0, hi), n),
+                    "case {case} slice {k}"
+                );
+                assert!(
+                    !on(anchor(e0, lo - 1), n) && !on(anchor(e0, hi + 1), n),
+                    "case {case} slice {k}"
+                );
+            }
+            let d = s.eye[2] + k as f64;
+            let near_boundary =
+                (0..12).any(|r| (d / (s.eye[2] * f64::from(1u32 << r)) - 1.0).abs() < 1e-3);
+            if !near_boundary {
+                assert_eq!(
+                    layout.region[k], f64_layout.region[k],
+                    "case {case} slice {k}"
+                );
+            }
+        }
+    }
+}
