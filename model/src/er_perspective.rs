@@ -567,6 +567,19 @@ impl ErJob {
         })
     }
 
+    /// The job with another set-up of the same volume axes (an eye placed by
+    /// [`ErSetup::with_eye`]); the units' tables stay those of the scene's view.
+    pub fn with_setup(mut self, mut setup: ErSetup) -> Result<Self> {
+        if setup.frame.params != self.setup.frame.params {
+            return Err(ModelError::View(
+                "the placed eye's frame set-up differs from the job's view".into(),
+            ));
+        }
+        setup.size = self.setup.size;
+        self.setup = setup;
+        Ok(self)
+    }
+
     /// The model's frame (contract: every step in integers up to the base plane).
     pub fn render(&self) -> ErRun {
         let setup = &self.setup;
@@ -741,10 +754,21 @@ pub fn render_er_f64(
     params: &RenderParams,
     scheme: ErScheme,
 ) -> Result<(ImageF64, ErStats)> {
+    let setup = ErSetup::new(vol.dims, vol.spacing, params, scheme)?;
+    render_er_f64_with(&setup, vol, tf, params)
+}
+
+/// [`render_er_f64`] on a set-up made beforehand (an eye placed by [`ErSetup::with_eye`]; its
+/// `size` is the image's).
+pub fn render_er_f64_with(
+    setup: &ErSetup,
+    vol: &Volume,
+    tf: &TransferFunction,
+    params: &RenderParams,
+) -> Result<(ImageF64, ErStats)> {
     tf.validate()?;
     let mode = frame_mode(params.mode)?;
-    let mut setup = ErSetup::new(vol.dims, vol.spacing, params, scheme)?;
-    setup.size = (params.width, params.height);
+    let scheme = setup.scheme;
     let p = *setup.params();
     let phong: Phong = params_phong(params, &p);
     let ratio = setup
@@ -826,12 +850,12 @@ pub fn render_er_f64(
     let rgb: Vec<[f64; 3]> = base.iter().map(|c| [c[0], c[1], c[2]]).collect();
     let ext = layout.extent[0];
     let image = warp(
-        &setup,
+        setup,
         params,
         &rgb,
         &ext,
         setup.eye[2],
         1.0 / f64::from(scheme.rays_per_voxel),
     );
-    Ok((image, ErStats::new(&setup, &layout, shaded.into_inner())))
+    Ok((image, ErStats::new(setup, &layout, shaded.into_inner())))
 }

@@ -3,7 +3,7 @@
 //! model against its f64 reference and the exact perspective.
 
 use cube5_model::er_perspective::{
-    merge_coxels, render_er, render_er_f64, ErMerge, ErScheme, ErSetup,
+    merge_coxels, render_er, render_er_f64, render_er_f64_with, ErJob, ErMerge, ErScheme, ErSetup,
 };
 use cube5_model::phantom::head_phantom;
 use cube5_model::render::{render_reference, CompositeMode, Projection, RenderParams};
@@ -374,5 +374,57 @@ fn the_rays_of_a_slice_are_those_whose_anchor_is_on_the_face() {
                 );
             }
         }
+    }
+}
+
+/// An eye inside the volume's bounding sphere (2 slices in front of the first slice, over the
+/// face's centre; the scene's camera never puts it there): five regions, four merges, the bound
+/// on every slice, and the model within the fixed point of its f64 reference, composite and MIP.
+#[test]
+fn an_eye_inside_the_bounding_sphere_renders_with_many_regions() {
+    let vol = head_phantom(32, 12).unwrap();
+    let tf = cube5_model::transfer::TransferFunction::head_default();
+    for mode in [CompositeMode::Composite, CompositeMode::Mip] {
+        let params = RenderParams {
+            mode,
+            up: Some([0.0, 1.0, 0.0]),
+            ..persp([0.0, 0.0, 1.0], 90.0, 48)
+        };
+        let job = ErJob::new(&vol, &tf, &params, &FrameConfig::DEFAULT, scheme(1)).unwrap();
+        let s = &job.setup;
+        let eye = DVec3::new(15.5, 15.5, -2.0);
+        assert!(
+            (eye - DVec3::splat(15.5)).length() < 16.0 * 3f64.sqrt(),
+            "inside the sphere"
+        );
+        let placed = ErSetup::with_eye(
+            s.frame,
+            s.scheme,
+            eye,
+            s.dir,
+            (s.right, s.up),
+            s.tan_half,
+            s.spacing,
+        )
+        .unwrap();
+        let job = job.with_setup(placed).unwrap();
+        let run = job.render();
+        let st = &run.stats;
+        assert_eq!(
+            (st.regions, st.region_starts.clone()),
+            (5, vec![0, 2, 6, 14, 30])
+        );
+        assert!(
+            st.min_per_slice() >= st.n2 && st.max_per_slice() <= 4 * st.n2,
+            "{st:?}"
+        );
+        assert!(
+            run.image.rgb.iter().any(|c| c[0] > 0.1),
+            "{}: a black image",
+            mode.name()
+        );
+        let (ideal, _) = render_er_f64_with(&job.setup, &vol, &tf, &params).unwrap();
+        let own = image_error(&run.image, &ideal).psnr_db;
+        assert!(own >= 45.0, "{}: {own:.1} dB against its f64", mode.name());
     }
 }
