@@ -11,32 +11,20 @@ mod support;
 
 use cube5_model::er_perspective::{render_er, render_er_f64, ErMerge, ErScheme};
 use cube5_model::render::render_reference;
-use cube5_model::scene::Scene;
 use cube5_model::scene_render::frame_config;
 use cube5_model::studies::tradeoff::image_error;
 use std::time::Instant;
 
-fn list<T: std::str::FromStr>(v: &str) -> Result<Vec<T>, T::Err> {
-    v.split(',').map(str::parse).collect()
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut scene = Scene::load(&cube5_model::repo_root().join("scenes/head-perspective.toml"))?;
     let (mut fovs, mut rates) = (vec![20.0, 40.0, 60.0, 90.0], vec![1u32, 2]);
-    let mut png: Option<std::path::PathBuf> = None;
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        let value = args.next().ok_or(format!("{a}: needs a value"))?;
-        if support::scene_option(&mut scene, &a, &value)? {
-            continue;
+    let (scene, png) = support::perspective_scene(|flag, value| {
+        match flag {
+            "--fovs" => fovs = support::list(value)?,
+            "--rates" => rates = support::list(value)?,
+            _ => return Ok(false),
         }
-        match a.as_str() {
-            "--png" => png = Some(value.into()),
-            "--fovs" => fovs = list(&value)?,
-            "--rates" => rates = list(&value)?,
-            _ => return Err(format!("unknown option {a}").into()),
-        }
-    }
+        Ok(true)
+    })?;
     let vol = scene.build_volume()?;
     let tf = scene.transfer_function();
     let cfg = frame_config(&scene)?;

@@ -57,6 +57,28 @@ fn placed(dims: [usize; 3], dir: DVec3, e: f64, lateral: [f64; 2], rho: u32) -> 
     .unwrap()
 }
 
+/// A random set-up: dimensions in `edges`, a direction, an eye `1..max_e` slices in front at a
+/// random lateral place (inside or outside the face), base rate 1, 2 or 4 by `case`; `None` for a
+/// direction too short to name a view.
+#[allow(clippy::type_complexity)]
+fn random_setup(
+    rng: &mut rand::rngs::StdRng,
+    case: usize,
+    edges: std::ops::Range<usize>,
+    max_e: f64,
+) -> Option<(ErSetup, ([usize; 3], DVec3, f64, u32))> {
+    let dims = [(); 3].map(|_| rng.random_range(edges.clone()));
+    let dir = DVec3::new(
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+        rng.random_range(-1.0..1.0),
+    );
+    let rho = [1, 2, 4][case % 3];
+    let e = rng.random_range(1.0..max_e);
+    let lateral = [rng.random_range(-30.0..60.0), rng.random_range(-30.0..60.0)];
+    (dir.length() >= 0.1).then(|| (placed(dims, dir, e, lateral, rho), (dims, dir, e, rho)))
+}
+
 /// Regions start at 0, never decrease, grow by at most one per slice, and match the contract's
 /// bounds `E 2^r <= d < E 2^(r+1)`; the ray spacing stays in `[G/2, G]`, is `G/2` exactly at
 /// every region's front boundary and grows within a region.
@@ -114,23 +136,9 @@ fn regions_are_exponential_and_the_spacing_stays_in_bounds() {
 fn samples_per_slice_stay_between_n2_and_4n2() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(14);
     for case in 0..300 {
-        let dims = [
-            rng.random_range(4..40usize),
-            rng.random_range(4..40usize),
-            rng.random_range(4..40usize),
-        ];
-        let dir = DVec3::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
-        if dir.length() < 0.1 {
+        let Some((s, (dims, dir, e, rho))) = random_setup(&mut rng, case, 4..40, 60.0) else {
             continue;
-        }
-        let rho = [1, 2, 4][case % 3];
-        let e = rng.random_range(1.0..60.0);
-        let lateral = [rng.random_range(-20.0..60.0), rng.random_range(-20.0..60.0)];
-        let s = placed(dims, dir, e, lateral, rho);
+        };
         let p = *s.params();
         let layout = s.layout();
         let n2 = (p.ni * p.nj) as u64 * u64::from(rho * rho);
@@ -328,22 +336,9 @@ fn bartlett_beats_dropping_rays() {
 fn the_rays_of_a_slice_are_those_whose_anchor_is_on_the_face() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(141);
     for case in 0..200 {
-        let dims = [
-            rng.random_range(2..30usize),
-            rng.random_range(2..30usize),
-            rng.random_range(2..30usize),
-        ];
-        let dir = DVec3::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
-        if dir.length() < 0.1 {
+        let Some((s, _)) = random_setup(&mut rng, case, 2..30, 40.0) else {
             continue;
-        }
-        let e = rng.random_range(1.0..40.0);
-        let lateral = [rng.random_range(-30.0..50.0), rng.random_range(-30.0..50.0)];
-        let s = placed(dims, dir, e, lateral, [1, 2, 4][case % 3]);
+        };
         let p = *s.params();
         let layout = s.layout();
         let (f64_layout, _) = s.layout_f64();
