@@ -17,6 +17,7 @@ mod tradeoff;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
+use cube5_model::er_perspective::render_er;
 use cube5_model::phantom::{phantom_by_name, PHANTOMS};
 use cube5_model::render::{render_pipeline, render_reference, ImageF64, Projection};
 use cube5_model::scene::{Plan, Renderer, Scene, Target};
@@ -99,6 +100,10 @@ struct RenderArgs {
     /// slab model, run.renderer = "slabs").
     #[arg(long)]
     slabs: Option<u32>,
+    /// Perspective scenes: render with ER-perspective on the frame's unit models (exponential
+    /// regions, Bartlett ray merging; run.renderer = "er").
+    #[arg(long)]
+    er: bool,
     /// Also render the f64 reference and print the pipeline's error against it.
     #[arg(long)]
     compare: bool,
@@ -235,6 +240,12 @@ fn render(args: RenderArgs) -> Result<()> {
     if args.reference && args.slabs.is_some() {
         bail!("--reference and --slabs name two renderers; give one");
     }
+    if args.er && (args.reference || args.slabs.is_some()) {
+        bail!("--er and --reference or --slabs name two renderers; give one");
+    }
+    if args.er {
+        scene.run.renderer = Renderer::Er;
+    }
     if args.reference {
         scene.run.renderer = Renderer::Reference;
     }
@@ -297,6 +308,15 @@ fn render(args: RenderArgs) -> Result<()> {
                     params.step
                 );
                 (img, what, 0)
+            }
+            Renderer::Er => {
+                let run = render_er(&vol, &tf, &params, &frame_config(&scene)?, scene.er())?;
+                let what = format!(
+                    "ER-perspective model on the frame's unit models, {}: {}",
+                    scene.er().describe(),
+                    run.stats.describe()
+                );
+                (run.image, what, run.stats.samples)
             }
             Renderer::Pipeline if let Some(job) = &job => {
                 // The one golden model: the frame the RTL computes, then the warp.
@@ -409,6 +429,9 @@ fn render_gi(scene: &Scene, vol: &cube5_model::volume::Volume, args: &RenderArgs
             Renderer::Pipeline => job.run()?,
             // Refused by the scene's validation; kept here so no renderer falls through.
             Renderer::Slabs => bail!("run.renderer = \"slabs\": a [gi] scene has no slab model"),
+            Renderer::Er => {
+                bail!("run.renderer = \"er\": a [gi] scene has no ER-perspective model")
+            }
             Renderer::Reference => {
                 let image = job
                     .reference()?
@@ -460,7 +483,7 @@ fn render_gi(scene: &Scene, vol: &cube5_model::volume::Volume, args: &RenderArgs
         scene.image.height,
         best,
         match scene.run.renderer {
-            Renderer::Pipeline | Renderer::Slabs => "GI-Cube processor model",
+            Renderer::Pipeline | Renderer::Slabs | Renderer::Er => "GI-Cube processor model",
             Renderer::Reference => "f64 reference of the GI-Cube processor model",
         }
     );

@@ -318,6 +318,69 @@ fn perspective_scenes_name_their_scheme() {
     assert_refused(&out, "--reference and --slabs");
 }
 
+/// ER-perspective (`--er` or `run.renderer = "er"`): `plan:` names the scheme with its counts
+/// (samples per slice against the N^2 .. 4N^2 bound), `--compare` its error against the exact
+/// perspective; the scene and the flag render the same image; what it cannot take is refused by
+/// the field's name.
+#[test]
+fn er_perspective_renders_and_names_its_counts() {
+    let persp = "[view]\nprojection = \"perspective\"\nfov = 90\n[run]\nrenderer = \"reference\"\n";
+    let (out, flag) = render_view("er-flag", persp, &["--er", "--compare"]);
+    let stdout = ok(&out);
+    assert!(
+        stdout.contains("plan: ER-perspective model")
+            && stdout.contains("against the bound N^2 = ")
+            && stdout.contains("perspective (ER-perspective: rays from the eye")
+            && stdout.contains("early termination (ER-perspective composites back to front)")
+            && stdout.contains("error against the f64 reference: PSNR"),
+        "{stdout}"
+    );
+    let er = "[view]\nprojection = \"perspective\"\nfov = 90\n[run]\nrenderer = \"er\"\n";
+    let (out, scene_er) = render_view("er-scene", er, &[]);
+    ok(&out);
+    assert_eq!(flag, scene_er);
+    let (out, centre) = render_view(
+        "er-centre",
+        "[view]\nprojection = \"perspective\"\nfov = 90\ner_merge = \"centre\"\n[run]\nrenderer = \"er\"\n",
+        &[],
+    );
+    ok(&out);
+    assert_ne!(flag, centre, "two regions: the merge shows");
+    for (name, text, field) in [
+        ("er-parallel", "[run]\nrenderer = \"er\"\n", "run.renderer"),
+        (
+            "er-rate",
+            "[view]\nprojection = \"perspective\"\ner_rays_per_voxel = 3\n[run]\nrenderer = \"er\"\n",
+            "view.er_rays_per_voxel",
+        ),
+        (
+            "er-xray",
+            "[view]\nprojection = \"perspective\"\n[render]\nmode = \"xray\"\n[run]\nrenderer = \"er\"\n",
+            "render.mode",
+        ),
+        (
+            "er-sheared",
+            "[view]\nprojection = \"perspective\"\n[quality]\ninterpolation = \"sheared\"\n[run]\nrenderer = \"er\"\n",
+            "quality.interpolation",
+        ),
+        (
+            "er-rtl",
+            "[view]\nprojection = \"perspective\"\n[run]\nrenderer = \"er\"\ntarget = \"rtl\"\n",
+            "run.renderer",
+        ),
+        (
+            "er-eye-too-close",
+            "[view]\nprojection = \"perspective\"\nfov = 169.0\ndirection = [1, 1, 1]\n[run]\nrenderer = \"er\"\n",
+            "view.fov",
+        ),
+    ] {
+        let (out, _) = render_view(name, text, &[]);
+        assert_refused(&out, field);
+    }
+    let (out, _) = render_view("er-and-ref", persp, &["--er", "--reference"]);
+    assert_refused(&out, "--er and --reference");
+}
+
 /// `cube5 transfer NAME` prints the preset's points (the peer benchmark's only copy of the
 /// transfer function it hands VTK); an unknown name is refused.
 #[test]

@@ -389,6 +389,8 @@ fn tradeoff_tiny_sweep_end_to_end() {
         "tradeoff-gradient.png",
         "tradeoff-slabs.csv",
         "tradeoff-slabs.png",
+        "tradeoff-er.csv",
+        "tradeoff-er.png",
     ] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }

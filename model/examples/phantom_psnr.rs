@@ -119,6 +119,17 @@ fn render_scene(file: &str, png: Option<&std::path::Path>) {
         cube5_model::scene::Renderer::Slabs => {
             cube5_model::slab_perspective::render_slabs(&vol, &tf, &params, scene.slabs()).unwrap()
         }
+        cube5_model::scene::Renderer::Er => {
+            cube5_model::er_perspective::render_er(
+                &vol,
+                &tf,
+                &params,
+                &cube5_model::scene_render::frame_config(&scene).unwrap(),
+                scene.er(),
+            )
+            .unwrap()
+            .image
+        }
         cube5_model::scene::Renderer::Pipeline => {
             render_pipeline(&vol, &tf, &params, &scene.quality())
                 .unwrap()

@@ -5,37 +5,22 @@
 //! `cargo run --release -p cube5-model --example slab_perspective -- [--size N] [--image PX]
 //! [--counts 1,2,4,8,16,32] [--png DIR] [--mode composite|mip]`; defaults: the scene's 96^3 and 256^2.
 
+mod support;
+
 use cube5_model::render::render_reference;
-use cube5_model::scene::Scene;
 use cube5_model::slab_perspective::{render_slabs, SlabSpacing, Slabs};
 use cube5_model::studies::tradeoff::image_error;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut scene = Scene::load(&cube5_model::repo_root().join("scenes/head-perspective.toml"))?;
     let mut counts = vec![1u32, 2, 4, 8, 16, 32];
-    let mut png: Option<std::path::PathBuf> = None;
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        let value = args.next().ok_or(format!("{a}: needs a value"))?;
-        match a.as_str() {
-            "--size" => scene.volume.size = value.parse()?,
-            "--image" => {
-                scene.image.width = value.parse()?;
-                scene.image.height = scene.image.width;
-            }
-            "--png" => png = Some(value.into()),
-            "--mode" => {
-                scene.render.mode = match value.as_str() {
-                    "mip" => cube5_model::render::CompositeMode::Mip,
-                    "composite" => cube5_model::render::CompositeMode::Composite,
-                    _ => return Err(format!("--mode {value}: composite or mip").into()),
-                }
-            }
-            "--counts" => counts = value.split(',').map(str::parse).collect::<Result<_, _>>()?,
-            _ => return Err(format!("unknown option {a}").into()),
+    let (scene, png) = support::perspective_scene(|flag, value| {
+        if flag != "--counts" {
+            return Ok(false);
         }
-    }
+        counts = support::list(value)?;
+        Ok(true)
+    })?;
     let vol = scene.build_volume()?;
     let tf = scene.transfer_function();
     let params = scene.render_params();

@@ -9,12 +9,14 @@
 //! `phantom`, `volume_io`, `scene`, `render` (scenes, files and renderers that use the units);
 //! `scene_render` (what `cube5 render` runs: a scene on the frame model, or a named what-if);
 //! `slab_perspective` (a what-if: perspective approximated by parallel slabs);
+//! `er_perspective` (ER-perspective: exponential regions, Bartlett ray merging, on the frame's units);
 //! `scene_gi` (a scene with `[gi]`: the GI-Cube processor model, lighting and rendering passes);
 //! `studies` (the tradeoff sweeps, not part of the golden model).
 
 pub mod accel_host;
 pub mod bits;
 pub mod camera;
+pub mod er_perspective;
 pub mod error;
 pub mod phantom;
 pub mod regmap;

@@ -8,6 +8,7 @@
 //! at a step of exactly one voxel, ...) and why the others are left out.
 
 use crate::camera;
+use crate::er_perspective::{ErMerge, ErScheme};
 use crate::error::{ModelError, Result};
 use crate::phantom::{phantom_by_name, PHANTOMS};
 use crate::render::{
@@ -129,6 +130,11 @@ pub struct ViewSpec {
     pub slabs: u32,
     /// `run.renderer = "slabs"`: how the slabs' thicknesses grow along the view.
     pub slab_spacing: SlabSpacing,
+    /// `run.renderer = "er"`: rays per voxel at each exponential region's rear (1, 2, 4).
+    pub er_rays_per_voxel: u32,
+    /// `run.renderer = "er"`: how rays merge at a region boundary (`bartlett`, or the what-if
+    /// `centre`).
+    pub er_merge: ErMerge,
     /// Perspective: full field of view across the shorter image side, degrees.
     pub fov: f64,
     pub zoom: f64,
@@ -182,8 +188,9 @@ pub enum Target {
     Both,
 }
 
-/// Which model renders: the slice-order pipeline at the quality knobs, the f64 reference, or
-/// perspective approximated by parallel slabs (a what-if, `slab_perspective`).
+/// Which model renders: the slice-order pipeline at the quality knobs, the f64 reference,
+/// perspective approximated by parallel slabs (a what-if, `slab_perspective`), or ER-perspective
+/// on the frame's units (`er_perspective`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum Renderer {
@@ -191,6 +198,7 @@ pub enum Renderer {
     Pipeline,
     Reference,
     Slabs,
+    Er,
 }
 
 impl Renderer {
@@ -199,6 +207,7 @@ impl Renderer {
             Self::Pipeline => "pipeline",
             Self::Reference => "reference",
             Self::Slabs => "slabs",
+            Self::Er => "er",
         }
     }
 }
@@ -232,6 +241,8 @@ impl Default for ViewSpec {
             projection: p.projection,
             slabs: 8,
             slab_spacing: SlabSpacing::Equal,
+            er_rays_per_voxel: 1,
+            er_merge: ErMerge::Bartlett,
             fov: p.fov,
             zoom: p.zoom,
         }
@@ -607,7 +618,7 @@ impl Scene {
         {
             return bad(
                 "view.projection",
-                "perspective is rendered by the reference renderer (the slice-order pipeline model is parallel); set `run.renderer = \"reference\"` (exact) or `\"slabs\"` (parallel slabs, a what-if)".into(),
+                "perspective is rendered by the reference renderer (the slice-order pipeline model is parallel); set `run.renderer = \"reference\"` (exact), `\"er\"` (ER-perspective on the frame's units) or `\"slabs\"` (parallel slabs, a what-if)".into(),
             );
         }
         if self.run.renderer == Renderer::Slabs {
@@ -619,6 +630,11 @@ impl Scene {
             }
             if let Err(e) = self.slabs().validate() {
                 return bad("view.slabs", inner(&e));
+            }
+        }
+        if self.run.renderer == Renderer::Er && self.gi.is_none() {
+            if let Err((field, m)) = self.er_refusal() {
+                return bad(&field, m);
             }
         }
         if self.run.target.uses_rtl() && self.run.renderer != Renderer::Pipeline {
@@ -789,6 +805,61 @@ impl Scene {
 
     pub fn quality(&self) -> Quality {
         self.quality
+    }
+
+    /// The ER-perspective scheme of `run.renderer = "er"` (`view.er_rays_per_voxel`,
+    /// `view.er_merge`).
+    pub fn er(&self) -> ErScheme {
+        ErScheme {
+            rays_per_voxel: self.view.er_rays_per_voxel,
+            merge: self.view.er_merge,
+        }
+    }
+
+    /// What `run.renderer = "er"` cannot take, as (field, message): a parallel view, a mode other
+    /// than composite and MIP, a base rate other than 1, 2, 4, quality knobs other than the
+    /// frame's sampling, widths the frame refuses.
+    fn er_refusal(&self) -> std::result::Result<(), (String, String)> {
+        let no = |f: &str, m: &str| Err((f.to_string(), m.to_string()));
+        if self.view.projection != Projection::Perspective {
+            return no(
+                "run.renderer",
+                "`er` renders a perspective view; set `view.projection = \"perspective\"`",
+            );
+        }
+        if let Err(e) = self.er().validate() {
+            return no("view.er_rays_per_voxel", &inner(&e));
+        }
+        if !matches!(
+            self.render.mode,
+            CompositeMode::Composite | CompositeMode::Mip
+        ) {
+            return no(
+                "render.mode",
+                &format!(
+                    "\"{}\": ER-perspective composites back to front (composite) or takes maxima (mip)",
+                    self.render.mode.name()
+                ),
+            );
+        }
+        let q = self.quality();
+        let frame = Quality::default();
+        for (field, differs) in [
+            ("interpolation", q.interpolation != frame.interpolation),
+            ("samples_per_slice", q.samples_per_slice != 1),
+            ("gradient", q.gradient != frame.gradient),
+        ] {
+            if differs {
+                return no(
+                    &format!("quality.{field}"),
+                    "ER-perspective samples as the frame does (bilinear on the slices, one sample per slice, the 6-neighbourhood gradient)",
+                );
+            }
+        }
+        if let Err(e) = crate::scene_render::frame_config(self) {
+            return no("quality", &inner(&e));
+        }
+        Ok(())
     }
 
     /// The slab scheme of `run.renderer = "slabs"` (`view.slabs`, `view.slab_spacing`).
@@ -1002,6 +1073,10 @@ impl Plan {
             if params.projection == Projection::Perspective {
                 match scene.run.renderer {
                     Renderer::Slabs => format!("approximated by {}", scene.slabs().describe()),
+                    Renderer::Er => format!(
+                        "ER-perspective: rays from the eye, exponential regions, {}",
+                        scene.er().describe()
+                    ),
                     _ => "exact rays from the eye (reference renderer)".into(),
                 }
             } else {
@@ -1015,6 +1090,33 @@ impl Plan {
                 "what-if slab perspective (not the hardware: {}, each an f64 parallel ray cast along the view, textured onto its middle plane through the perspective, blended front to back; docs/numerics/slab_perspective.md)",
                 scene.slabs().describe()
             ),
+            Renderer::Er => {
+                // Back to front: no ray terminates; the model takes every sample of every slice.
+                for e in entries.iter_mut() {
+                    match e.unit {
+                        Unit::EarlyTermination => {
+                            e.needed = false;
+                            e.detail = "ER-perspective composites back to front".into();
+                        }
+                        Unit::EmptySpaceSkip => {
+                            e.needed = false;
+                            e.detail = "ER-perspective samples every slice".into();
+                        }
+                        _ => {}
+                    }
+                }
+                let setup = crate::er_perspective::ErSetup::new(
+                    vol.dims,
+                    vol.spacing,
+                    &params,
+                    scene.er(),
+                )?;
+                format!(
+                    "ER-perspective model (the frame's unit models: cube5_trilin, cube5_gradient, cube5_shader, cube5_compos back to front; {}; base plane warped in f64; no RTL yet; docs/numerics/er_perspective.md) [counts: {}]",
+                    scene.er().describe(),
+                    setup.counts().describe()
+                )
+            }
             Renderer::Pipeline if what_if.is_empty() => {
                 frame_entries(&mut entries, scene, vol);
                 "frame (cube5_frame's bits, then the warp)".to_string()

@@ -189,10 +189,10 @@ pub fn validate(scene: &Scene, gi: &GiSpec) -> std::result::Result<(), (String, 
             "the GI-Cube processor's widths and sampling are fixed (docs/numerics/gicube_processor.md); gi.block_size, gi.queue_length and render.step are its knobs".into(),
         );
     }
-    if scene.run.renderer == Renderer::Slabs {
+    if matches!(scene.run.renderer, Renderer::Slabs | Renderer::Er) {
         return bad(
             "run.renderer",
-            "\"slabs\" approximates a perspective frame; a [gi] scene renders on the GI-Cube processor model (\"pipeline\") or its f64 reference".into(),
+            format!("\"{}\" renders a perspective frame; a [gi] scene renders on the GI-Cube processor model (\"pipeline\") or its f64 reference", scene.run.renderer.name()),
         );
     }
     if scene.run.renderer == Renderer::Reference && gi.albedo > 0.0 && gi.passes == 2 {
@@ -545,8 +545,8 @@ pub fn plan(scene: &Scene, vol: &Volume) -> Result<Plan> {
         Renderer::Reference => format!(
             "f64 reference of the GI-Cube processor model (not the hardware; {passes})"
         ),
-        // Slabs are refused by validate (above).
-        Renderer::Pipeline | Renderer::Slabs => format!(
+        // Slabs and ER are refused by validate (above).
+        Renderer::Pipeline | Renderer::Slabs | Renderer::Er => format!(
             "GI-Cube processor model (units::gicube_processor: {}^3 blocks, {}-ray queues, the queue sorter; {passes})",
             gi.block_size, gi.queue_length
         ),

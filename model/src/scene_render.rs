@@ -11,7 +11,9 @@
 
 use crate::camera::Camera;
 use crate::error::{ModelError, Result};
-use crate::render::{CompositeMode, GradientScheme, ImageF64, Interpolation, Projection};
+use crate::render::{
+    CompositeMode, GradientScheme, ImageF64, Interpolation, Projection, RenderParams,
+};
 use crate::scene::Scene;
 use crate::transfer::TransferFunction;
 use crate::unit::UnitConfig;
@@ -140,7 +142,13 @@ pub fn at_voxel_width(vol: &Volume, w: u32) -> Result<Volume> {
 
 /// The scene's lights and material in the frame's axes (the reflectance map's input).
 pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
-    let lights: Vec<DistantLight> = scene
+    params_phong(&scene.render_params(), params)
+}
+
+/// The lights, material and shading switch of `render` in the frame's axes (what
+/// [`scene_phong`] reads from a scene; ER-perspective's studies call it with render parameters).
+pub fn params_phong(render: &RenderParams, params: &FrameParams) -> Phong {
+    let lights: Vec<DistantLight> = render
         .lights
         .iter()
         .map(|l| DistantLight {
@@ -150,8 +158,8 @@ pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
         })
         .collect();
     let base = cube5_frame::frame_phong(params, &lights);
-    if scene.render.shading {
-        let m = scene.shading;
+    if render.shading {
+        let m = render.material;
         Phong {
             ambient: m.ambient,
             diffuse: m.diffuse,

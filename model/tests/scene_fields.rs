@@ -32,6 +32,8 @@ enum Shows {
     Reference { because: &'static str },
     /// The what-if slab-perspective model's image (`renderer = "slabs"`), likewise.
     Slabs { because: &'static str },
+    /// The ER-perspective model's image (`renderer = "er"`), likewise.
+    Er { because: &'static str },
     /// A `[gi]` scene's run on the GI-Cube processor model: its configuration, the counts of its
     /// passes or its image change.
     Processor,
@@ -86,6 +88,8 @@ fn cases() -> Vec<Case> {
         c("view.roll", "", "[view]\nroll = 30.0\n", Frame),
         c("view.slabs", SLABS, "[view]\nprojection = \"perspective\"\nslabs = 3\n", Slabs { because: "view.projection" }),
         c("view.slab_spacing", SLABS, "[view]\nprojection = \"perspective\"\nslab_spacing = \"geometric\"\n", Slabs { because: "view.projection" }),
+        c("view.er_rays_per_voxel", ER, "[view]\ner_rays_per_voxel = 2\n", Er { because: "view.projection" }),
+        c("view.er_merge", ER, "[view]\ner_merge = \"centre\"\n", Er { because: "view.projection" }),
         // [image]: the warp's output.
         c("image.width", "", "[image]\nwidth = 40\n", Frame),
         c("image.height", "", "[image]\nheight = 40\n", Frame),
@@ -174,6 +178,10 @@ const PERSPECTIVE: &str = "[view]\nprojection = \"perspective\"\n[run]\nrenderer
 /// A perspective scene on the what-if slab model.
 const SLABS: &str = "[view]\nprojection = \"perspective\"\n[run]\nrenderer = \"slabs\"\n";
 
+/// A wide perspective scene on the ER-perspective model (fov 120: the eye close enough for two
+/// regions, so the merge acts).
+const ER: &str = "[view]\nprojection = \"perspective\"\nfov = 120.0\n[run]\nrenderer = \"er\"\n";
+
 /// The context of the `volume.*` file cases.
 const RAW_FILE: &str = "[volume]\nfile = \"fields.raw\"\ndims = [20, 18, 16]\ntype = \"u16\"\n";
 
@@ -261,6 +269,7 @@ fn gi_outcome(scene: &Scene) -> Result<Outcome, String> {
             job.reference().map_err(e)?.ok_or("no f64 reference")?,
         ),
         Renderer::Slabs => return Err("run.renderer = \"slabs\" in a [gi] scene".into()),
+        Renderer::Er => return Err("run.renderer = \"er\" in a [gi] scene".into()),
     };
     Ok(Outcome {
         frame: format!("{:?} {counts}", processor_config(scene).map_err(e)?),
@@ -292,14 +301,17 @@ fn frame_outcome(scene: &Scene) -> Result<Outcome, String> {
     })
 }
 
-/// The image of a what-if model: the f64 reference or the slab perspective.
-fn what_if_image(scene: &Scene, slabs: bool) -> Result<ImageF64, String> {
+/// The image of a what-if model: the f64 reference, the slab perspective or ER-perspective.
+fn what_if_image(scene: &Scene, shows: Shows) -> Result<ImageF64, String> {
     let vol = scene.build_volume().map_err(|e| e.to_string())?;
     let (tf, params) = (scene.transfer_function(), scene.render_params());
-    if slabs {
-        render_slabs(&vol, &tf, &params, scene.slabs())
-    } else {
-        render_reference(&vol, &tf, &params)
+    match shows {
+        Shows::Slabs { .. } => render_slabs(&vol, &tf, &params, scene.slabs()),
+        Shows::Er { .. } => cube5_model::scene_render::frame_config(scene).and_then(|cfg| {
+            cube5_model::er_perspective::render_er(&vol, &tf, &params, &cfg, scene.er())
+                .map(|run| run.image)
+        }),
+        _ => render_reference(&vol, &tf, &params),
     }
     .map_err(|e| e.to_string())
 }
@@ -409,12 +421,11 @@ fn every_scene_field_changes_the_run_or_is_refused_by_name() {
                     (_, Err(m)) => Err(format!("refused without naming it: {m}")),
                 }
             }
-            Shows::Reference { because } | Shows::Slabs { because } => {
-                let slabs = matches!(case.shows, Shows::Slabs { .. });
+            Shows::Reference { because } | Shows::Slabs { because } | Shows::Er { because } => {
                 let after = after.unwrap_or_else(|e| panic!("{}: {e}", case.field));
                 let refused_by = frame_outcome(&after).err().unwrap_or_default();
-                let a = what_if_image(&after, slabs);
-                let b = what_if_image(&before, slabs);
+                let a = what_if_image(&after, case.shows);
+                let b = what_if_image(&before, case.shows);
                 match (a, b) {
                     (Ok(a), Ok(b)) if a.to_rgb8() == b.to_rgb8() => {
                         Err("the what-if model renders the same image".into())

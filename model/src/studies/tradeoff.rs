@@ -11,6 +11,7 @@
 //! The data come out as [`Table`]s and [`Figure`]s; the command line writes them as Markdown, CSV
 //! and PNG.
 
+use crate::er_perspective::{render_er, render_er_f64, ErMerge, ErScheme};
 use crate::error::{ModelError, Result};
 use crate::phantom::{sphere_phantom, SphereGeometry};
 use crate::render::{
@@ -19,6 +20,7 @@ use crate::render::{
 };
 use crate::slab_perspective::{render_slabs, SlabSpacing, Slabs};
 use crate::transfer::TransferFunction;
+use crate::units::cube5_frame::FrameConfig;
 use crate::units::cube5_gradient::{block_index, Gradient, GradientConfig, GradientIn};
 use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use crate::volume::Volume;
@@ -429,6 +431,9 @@ pub struct Setup {
     pub sphere_size: usize,
     /// Slab perspective: the slab counts (the perspective view of `params`, fov 40 degrees).
     pub slab_counts: Vec<u32>,
+    /// ER-perspective: the fields of view (degrees) and base rates (rays per voxel) swept.
+    pub er_fovs: Vec<f64>,
+    pub er_rates: Vec<u32>,
     pub synth: Option<Synth>,
 }
 
@@ -456,6 +461,8 @@ impl Setup {
             paper_step: 0.5,
             sphere_size: 64,
             slab_counts: vec![1, 2, 4, 8, 16, 32, 64],
+            er_fovs: vec![20.0, 40.0, 60.0, 90.0, 120.0],
+            er_rates: vec![1, 2],
             synth: None,
         }
     }
@@ -472,6 +479,8 @@ impl Setup {
             angles: vec![0.0, 30.0, 45.0],
             sphere_size: 24,
             slab_counts: vec![2, 4],
+            er_fovs: vec![40.0, 90.0],
+            er_rates: vec![1],
             ..Self::new(vol, tf, params, quality)
         }
     }
@@ -494,6 +503,103 @@ pub struct Report {
     pub paper_62: [[f64; 3]; 3],
     /// Whether the synthesis table was found.
     pub synth_found: bool,
+}
+
+/// ER-perspective (`er_perspective::render_er`, the frame's units at their default widths) over
+/// the fields of view and base rates of `setup`, Bartlett and the dropped-ray what-if: error
+/// against the f64 perspective reference and against its own f64 reference, samples per slice
+/// against the `N^2 .. 4N^2` bound, time per frame.
+fn er_sweep(
+    setup: &Setup,
+    persp: &RenderParams,
+    progress: &dyn Progress,
+) -> Result<(Table, Figure)> {
+    let (vol, tf) = (&setup.volume, &setup.tf);
+    let mut table = Table::new(
+        "tradeoff-er",
+        "ER-perspective: error against the f64 perspective reference, samples per slice, time",
+        &[
+            "fov (deg)",
+            "rays/voxel",
+            "merge",
+            ERR_COLUMNS[0],
+            ERR_COLUMNS[1],
+            ERR_COLUMNS[2],
+            "PSNR vs its f64 (dB)",
+            "regions",
+            "samples/slice min..max",
+            "N^2",
+            "time/frame (ms)",
+        ],
+    );
+    let merges = [ErMerge::Bartlett, ErMerge::Centre];
+    progress.start(
+        "ER-perspective",
+        (setup.er_fovs.len() * setup.er_rates.len() * merges.len()) as u64,
+    );
+    let mut series: Vec<Series> = Vec::new();
+    for &fov in &setup.er_fovs {
+        let params = RenderParams {
+            fov,
+            ..persp.clone()
+        };
+        let reference = render_reference(vol, tf, &params)?;
+        for &rays_per_voxel in &setup.er_rates {
+            for merge in merges {
+                let scheme = ErScheme {
+                    rays_per_voxel,
+                    merge,
+                };
+                let t = std::time::Instant::now();
+                let run = render_er(vol, tf, &params, &FrameConfig::DEFAULT, scheme)?;
+                let ms = t.elapsed().as_secs_f64() * 1e3;
+                let (ideal, _) = render_er_f64(vol, tf, &params, scheme)?;
+                let e = image_error(&run.image, &reference);
+                let own = image_error(&run.image, &ideal);
+                let [a, m, r] = fmt_err(&e);
+                let st = &run.stats;
+                table.rows.push(vec![
+                    format!("{fov}"),
+                    rays_per_voxel.to_string(),
+                    merge.name().into(),
+                    a,
+                    m,
+                    r,
+                    fmt_err(&own)[0].clone(),
+                    st.regions.to_string(),
+                    format!("{}..{}", st.min_per_slice(), st.max_per_slice()),
+                    st.n2.to_string(),
+                    format!("{ms:.0}"),
+                ]);
+                let name = format!("{rays_per_voxel} ray/voxel, {}", merge.name());
+                let idx = match series.iter().position(|s| s.name == name) {
+                    Some(i) => i,
+                    None => {
+                        series.push(Series {
+                            name,
+                            points: Vec::new(),
+                        });
+                        series.len() - 1
+                    }
+                };
+                if e.psnr_db.is_finite() {
+                    series[idx].points.push((fov, e.psnr_db));
+                }
+                progress.tick();
+            }
+        }
+    }
+    progress.finish();
+    let figure = Figure {
+        name: "tradeoff-er".into(),
+        title: "ER-perspective: PSNR against the f64 perspective".into(),
+        x_label: "field of view (degrees)".into(),
+        y_label: "PSNR (dB)".into(),
+        series,
+        marks: Vec::new(),
+        log_x: false,
+    };
+    Ok((table, figure))
 }
 
 fn fmt_err(e: &ImageError) -> [String; 3] {
@@ -1000,6 +1106,11 @@ pub fn run(setup: &Setup, progress: &dyn Progress) -> Result<Report> {
         marks: Vec::new(),
         log_x: true,
     });
+
+    // ---- ER-perspective -----------------------------------------------------------------------
+    let (er_table, er_figure) = er_sweep(setup, &persp, progress)?;
+    tables.push(er_table);
+    figures.push(er_figure);
     let _ = vb0;
     Ok(Report {
         tables,
@@ -1245,8 +1356,14 @@ mod tests {
         );
         setup.sphere_size = 16;
         let report = run(&setup, &Quiet).unwrap();
-        assert_eq!(report.tables.len(), 7);
-        assert_eq!(report.figures.len(), 5);
+        assert_eq!(report.tables.len(), 8);
+        assert_eq!(report.figures.len(), 6);
+        let er = report
+            .tables
+            .iter()
+            .find(|t| t.name == "tradeoff-er")
+            .unwrap();
+        assert_eq!(er.rows.len(), 4, "2 fields of view x 2 merges");
         let slabs = report
             .tables
             .iter()
