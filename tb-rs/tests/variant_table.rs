@@ -16,6 +16,7 @@ use cube5_model::units::{
     gicube_packet_loop::PacketLoopConfig, gicube_scatter::ScatterConfig,
     gicube_sorter::SorterConfig,
 };
+use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_tb::variants::{Netlist, Variant, VARIANTS};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -63,6 +64,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == AxiRdConfig::TOP => agree::<AxiRdConfig>(v),
         t if t == VolFetchConfig::TOP => agree::<VolFetchConfig>(v),
         t if t == WarpConfig::TOP => agree::<WarpConfig>(v),
+        t if t == RayQueuesConfig::TOP => agree::<RayQueuesConfig>(v),
         other => Err(format!(
             "top {other} has no model configuration (UnitConfig)"
         )),
