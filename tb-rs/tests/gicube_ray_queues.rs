@@ -5,6 +5,12 @@
 
 mod support;
 
+use cube5_model::camera::Camera;
+use cube5_model::phantom::head_phantom;
+use cube5_model::transfer::TransferFunction;
+use cube5_model::unit::StreamUnit;
+use cube5_model::units::gicube_packet_loop::PACKET_BITS;
+use cube5_model::units::gicube_processor::{Processor, ProcessorConfig, Projection, QueueOp};
 use cube5_model::units::gicube_ray_queues::{
     directed_items, QueueTraffic, QueuesIn, Ray, RayQueuesConfig, RayQueuesUnit,
 };
@@ -137,4 +143,69 @@ fn forced_overflow_loses_no_ray() {
             &check,
         );
     }
+}
+
+/// The processor model's own queue traffic replayed on the RTL: the head phantom at 32^3 (blocks
+/// of 8: 64 queues) rendered by `gicube_processor` with queues of the RTL's `QueueLen`, every pop
+/// and push its frame loop made (`render_traced`) sent as one item each, with the packets as the
+/// 256-bit rays, under idle and back-pressure. The RTL must match the model item for item, and the
+/// replay must reproduce the frame's counts: one pop per busy cycle, the rays it overflowed.
+#[test]
+fn processor_frame_queue_traffic_replays_on_the_rtl() {
+    let vol = head_phantom(32, 12).unwrap();
+    let (a, e) = (65f64.to_radians(), 20f64.to_radians());
+    let dir = [-e.cos() * a.cos(), -e.cos() * a.sin(), -e.sin()];
+    let cam = Camera::new(dir.into(), vol.dims, vol.spacing, 96, 96);
+    let tf = TransferFunction::head_default();
+    let fit = configs::<RayQueuesConfig>()
+        .into_iter()
+        .filter(|(_, c)| c.data_w == PACKET_BITS && c.queues() >= 64);
+    let mut ran = 0;
+    for (variant, cfg) in fit {
+        let pcfg = ProcessorConfig {
+            block_log2: 3,
+            queue_len: cfg.queue_len,
+            ..ProcessorConfig::DEFAULT
+        };
+        let proc = Processor::new(pcfg, &vol, &tf).unwrap();
+        let (frame, ops) = proc.render_traced(&cam, Projection::Parallel).unwrap();
+        let items: Vec<QueuesIn> = ops
+            .iter()
+            .map(|op| match *op {
+                QueueOp::Pop(q) => QueuesIn {
+                    pop: true,
+                    pop_q: q,
+                    ..Default::default()
+                },
+                QueueOp::Push(q, ray) => QueuesIn {
+                    push: true,
+                    push_q: q,
+                    data: ray.to_bits().unwrap(),
+                    ..Default::default()
+                },
+            })
+            .collect();
+        let outs = RayQueuesUnit::new(cfg).unwrap().run(&items);
+        let c = &frame.counts;
+        let pops = outs.iter().filter(|o| o.popped).count() as u64;
+        let ovf = outs.iter().filter(|o| o.overflow).count() as u64;
+        assert_eq!(pops, c.samples + c.leaps, "{variant}: one ray per busy cycle");
+        assert_eq!(ovf, c.rays_overflowed, "{variant}: the frame's overflows");
+        assert!(ovf > 0, "{variant}: the frame overflowed some queue");
+        assert_eq!(outs.last().map(|o| o.total), Some(0), "{variant}: drained");
+        let check = StreamCheck::new(seed(670), items.len()).with_traffic(0.2, 0.3);
+        let r = must_match_items(
+            variant,
+            cfg,
+            &mut RayQueuesUnit::new(cfg).unwrap(),
+            items,
+            &check,
+        );
+        eprintln!(
+            "{variant}: processor frame ({} rays, {} overflowed, {} cycles): {} queue items replayed",
+            c.rays_made, c.rays_overflowed, c.cycles, r.compared
+        );
+        ran += 1;
+    }
+    assert!(ran > 0, "a configuration that holds the packet and 64 queues");
 }

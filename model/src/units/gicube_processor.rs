@@ -26,6 +26,7 @@ use crate::units::cube5_shader::{
 use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, DIR_FRAC_W, POS_FRAC_W};
+use crate::units::gicube_ray_queues::RayQueues;
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
 use crate::volume::Volume;
@@ -416,6 +417,39 @@ impl BlockCache {
     }
 }
 
+/// One step the frame loop made on its ray queues (`RayQueues`): a pop of the active queue, or a
+/// push of a ray into a queue (re-queued, moved or from the host).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum QueueOp {
+    Pop(u32),
+    Push(u32, RayPacket),
+}
+
+/// `queues.pop(q)`, logged.
+fn pop_logged(
+    queues: &mut RayQueues<RayPacket>,
+    log: &mut Option<&mut Vec<QueueOp>>,
+    q: u32,
+) -> Option<RayPacket> {
+    if let Some(l) = log.as_deref_mut() {
+        l.push(QueueOp::Pop(q));
+    }
+    queues.pop(q)
+}
+
+/// `queues.push(q, ray)`, logged.
+fn push_logged(
+    queues: &mut RayQueues<RayPacket>,
+    log: &mut Option<&mut Vec<QueueOp>>,
+    q: u32,
+    ray: RayPacket,
+) -> std::result::Result<(), RayPacket> {
+    if let Some(l) = log.as_deref_mut() {
+        l.push(QueueOp::Push(q, ray));
+    }
+    queues.push(q, ray)
+}
+
 /// What one pipeline cycle did to a ray.
 enum Outcome {
     /// Still in the same block: back to the tail of the same queue.
@@ -770,7 +804,21 @@ impl Processor {
     pub fn render(&self, cam: &Camera, proj: Projection) -> Result<ProcessorFrame> {
         let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
         let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
-        self.run(packets, cam.width, cam.height, None)
+        self.run(packets, cam.width, cam.height, None, None)
+    }
+
+    /// `render`, and every step the frame loop made on its ray queues, in order: the frame's queue
+    /// traffic, which the RTL queues (`gicube_ray_queues`) replay in the co-simulation.
+    pub fn render_traced(
+        &self,
+        cam: &Camera,
+        proj: Projection,
+    ) -> Result<(ProcessorFrame, Vec<QueueOp>)> {
+        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
+        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let mut log = Vec::new();
+        let f = self.run(packets, cam.width, cam.height, None, Some(&mut log))?;
+        Ok((f, log))
     }
 
     /// The lighting pass of volumetric GI ([358]-[363], low albedo, single scattering): lighting
@@ -795,7 +843,7 @@ impl Processor {
         };
         let mut field = vec![0u16; self.vol.len()];
         self.irradiance = None;
-        let f = self.run(packets, light.grid, light.grid, Some(&mut field));
+        let f = self.run(packets, light.grid, light.grid, Some(&mut field), None);
         self.photon_albedo = None;
         self.irradiance = Some(field);
         f
@@ -826,6 +874,7 @@ impl Processor {
         w: u32,
         h: u32,
         mut irr: Option<&mut Vec<u16>>,
+        mut log: Option<&mut Vec<QueueOp>>,
     ) -> Result<ProcessorFrame> {
         let rays = packets.len();
         let packets_lives = packets
@@ -844,15 +893,14 @@ impl Processor {
             self.cfg.queue_len,
         )?;
         let mut sorter = Sorter::new(scfg)?;
-        let mut queues: Vec<VecDeque<RayPacket>> = vec![VecDeque::new(); nq as usize];
-        let cap = self.cfg.queue_len as usize;
+        // The ray queues: the one description of them (`gicube_ray_queues`, the RTL's model).
+        let mut queues: RayQueues<RayPacket> = RayQueues::new(nq, self.cfg.queue_len);
         let mut counts = ProcessorCounts {
             rays_made: rays as u64,
             ..Default::default()
         };
         let mut rgb = vec![[0u16; 3]; (w * h) as usize];
         let mut done = vec![false; (w * h) as usize];
-        let mut held = 0u64;
         let mut scan_active: Option<u32> = None;
         let mut cache = BlockCache::new(self.cfg.block_log2);
         let mut last_active: Option<u32> = None;
@@ -864,7 +912,8 @@ impl Processor {
             2 * u64::from(self.side) * 256 / u64::from(self.cfg.step) + u64::from(nq) + 64;
         let bound = 64 + 8 * rays as u64 * lives * per_path;
 
-        while !feed.is_empty() || held > 0 {
+        while !feed.is_empty() || queues.total() > 0 {
+            let held = u64::from(queues.total());
             counts.cycles += 1;
             if counts.cycles > bound {
                 return Err(ModelError::Config(format!(
@@ -877,11 +926,11 @@ impl Processor {
             let active = match self.cfg.order {
                 QueueOrder::Sorter => sorter.active().map(|e| e.queue),
                 QueueOrder::Scan => {
-                    if scan_active.is_none_or(|q| queues[q as usize].is_empty()) && held > 0 {
+                    if scan_active.is_none_or(|q| queues.is_empty(q)) && held > 0 {
                         let from = scan_active.map_or(0, |q| q + 1);
                         scan_active = (0..nq)
                             .map(|i| (from + i) % nq)
-                            .find(|&q| !queues[q as usize].is_empty());
+                            .find(|&q| !queues.is_empty(q));
                     }
                     scan_active
                 }
@@ -890,7 +939,7 @@ impl Processor {
                 counts.activations += 1;
             }
             last_active = active;
-            match active.and_then(|q| queues[q as usize].pop_front().map(|r| (q, r))) {
+            match active.and_then(|q| pop_logged(&mut queues, &mut log, q).map(|r| (q, r))) {
                 Some((q, ray)) => match self.advance(
                     ray,
                     q,
@@ -898,22 +947,27 @@ impl Processor {
                     &mut cache,
                     irr.as_deref_mut().map(|v| v.as_mut_slice()),
                 ) {
-                    Outcome::Stay(ray) => queues[q as usize].push_back(ray),
-                    Outcome::Move(mut ray, q2) => {
+                    Outcome::Stay(ray) => {
+                        // Its own queue has the slot the pop freed.
+                        if push_logged(&mut queues, &mut log, q, ray).is_err() {
+                            return Err(ModelError::Config(format!(
+                                "gicube processor: queue {q} full after its own pop"
+                            )));
+                        }
+                    }
+                    Outcome::Move(ray, q2) => {
                         updates.push(SorterIn::add(q, -1));
-                        if queues[q2 as usize].len() < cap {
-                            queues[q2 as usize].push_back(ray);
-                            updates.push(SorterIn::add(q2, 1));
-                        } else {
-                            held -= 1;
-                            counts.rays_overflowed += 1;
-                            ray.flags |= flag::OVERFLOW;
-                            feed.push_back(ray);
+                        match push_logged(&mut queues, &mut log, q2, ray) {
+                            Ok(()) => updates.push(SorterIn::add(q2, 1)),
+                            Err(mut ray) => {
+                                counts.rays_overflowed += 1;
+                                ray.flags |= flag::OVERFLOW;
+                                feed.push_back(ray);
+                            }
                         }
                     }
                     Outcome::Done(ray) => {
                         updates.push(SorterIn::add(q, -1));
-                        held -= 1;
                         counts.rays_finished += 1;
                         let i = (u32::from(ray.v) * w + u32::from(ray.u)) as usize;
                         if done[i] {
@@ -943,13 +997,16 @@ impl Processor {
                             ray.u, ray.v
                         ))
                     })?;
-                    if queues[qh as usize].len() < cap {
+                    if !queues.is_full(qh) {
                         let mut ray = ray;
                         feed.pop_front();
                         ray.flags &= !flag::OVERFLOW;
                         counts.rays_in += 1;
-                        queues[qh as usize].push_back(ray);
-                        held += 1;
+                        if push_logged(&mut queues, &mut log, qh, ray).is_err() {
+                            return Err(ModelError::Config(format!(
+                                "gicube processor: queue {qh} refused a ray it had room for"
+                            )));
+                        }
                         updates.push(SorterIn::add(qh, 1));
                     } else {
                         counts.host_stalls += 1;
@@ -957,7 +1014,7 @@ impl Processor {
                 }
             }
             for u in &updates {
-                counts.max_queue = counts.max_queue.max(queues[u.queue as usize].len() as u32);
+                counts.max_queue = counts.max_queue.max(queues.len(u.queue));
             }
             if self.cfg.order == QueueOrder::Sorter {
                 for s in 0..SORTER_SLOTS {
@@ -965,8 +1022,8 @@ impl Processor {
                 }
                 // The sorter's counters are the queue lengths (criterion 1 of [373]).
                 for u in &updates {
-                    let len = queues[u.queue as usize].len();
-                    if sorter.importance(u.queue) as usize != len {
+                    let len = queues.len(u.queue);
+                    if sorter.importance(u.queue) != len {
                         return Err(ModelError::Config(format!(
                             "gicube processor: sorter counter {} of queue {} holds {len} rays",
                             sorter.importance(u.queue),
