@@ -99,7 +99,11 @@ fn forced_overflow_loses_no_ray() {
         let out = dut
             .drive(&items, &Traffic::random(&mut rng, 0.2, 0.3), n, 20 * n)
             .unwrap();
-        assert_eq!(out.outputs.len(), items.len(), "{variant}: one output per item");
+        assert_eq!(
+            out.outputs.len(),
+            items.len(),
+            "{variant}: one output per item"
+        );
         let mut seen = vec![0u32; rays as usize];
         let (mut dequeued, mut overflowed) = (0u64, 0u64);
         for o in &out.outputs {
@@ -189,7 +193,11 @@ fn processor_frame_queue_traffic_replays_on_the_rtl() {
         let c = &frame.counts;
         let pops = outs.iter().filter(|o| o.popped).count() as u64;
         let ovf = outs.iter().filter(|o| o.overflow).count() as u64;
-        assert_eq!(pops, c.samples + c.leaps, "{variant}: one ray per busy cycle");
+        assert_eq!(
+            pops,
+            c.samples + c.leaps,
+            "{variant}: one ray per busy cycle"
+        );
         assert_eq!(ovf, c.rays_overflowed, "{variant}: the frame's overflows");
         assert!(ovf > 0, "{variant}: the frame overflowed some queue");
         assert_eq!(outs.last().map(|o| o.total), Some(0), "{variant}: drained");
@@ -207,5 +215,8 @@ fn processor_frame_queue_traffic_replays_on_the_rtl() {
         );
         ran += 1;
     }
-    assert!(ran > 0, "a configuration that holds the packet and 64 queues");
+    assert!(
+        ran > 0,
+        "a configuration that holds the packet and 64 queues"
+    );
 }

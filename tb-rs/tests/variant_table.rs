@@ -8,6 +8,7 @@
 //! Needs no RTL build: the table carries the parameters Verilator elaborated.
 
 use cube5_model::unit::UnitConfig;
+use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_model::units::{
     cube5_axi_rd::AxiRdConfig, cube5_compos::ComposConfig, cube5_frame::FrameConfig,
     cube5_gradient::GradientConfig, cube5_rblock::RBlockConfig, cube5_sepconv::SepconvConfig,
@@ -16,7 +17,6 @@ use cube5_model::units::{
     gicube_packet_loop::PacketLoopConfig, gicube_scatter::ScatterConfig,
     gicube_sorter::SorterConfig,
 };
-use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_tb::variants::{Netlist, Variant, VARIANTS};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -480,7 +480,11 @@ pub fn directed_items(cfg: RayQueuesConfig) -> Vec<QueuesIn> {
     let last = nq - 1;
     let ones = cfg.mask([u32::MAX; DATA_WORDS]);
     let alt = cfg.mask([0xaaaa_5555; DATA_WORDS]);
-    let tag = |k: u32| cfg.mask(std::array::from_fn(|i| k.rotate_left(7 * i as u32) ^ 0x5a5a_0f0f));
+    let tag = |k: u32| {
+        cfg.mask(std::array::from_fn(|i| {
+            k.rotate_left(7 * i as u32) ^ 0x5a5a_0f0f
+        }))
+    };
     let push = |q: u32, data: Ray| QueuesIn {
         push: true,
         push_q: q,
@@ -603,7 +607,11 @@ mod tests {
             }
             assert!(ovf > 1000, "the traffic forces overflow ({ovf})");
             let held = u64::from(unit.queues().total());
-            assert_eq!(offered, popped + ovf + held, "rays in = out + overflowed + held");
+            assert_eq!(
+                offered,
+                popped + ovf + held,
+                "rays in = out + overflowed + held"
+            );
         }
     }
 
