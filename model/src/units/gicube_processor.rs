@@ -25,10 +25,11 @@ use crate::units::cube5_shader::{
 };
 use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
-use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, DIR_FRAC_W, POS_FRAC_W};
+use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_ray_queues::RayQueues;
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
+use crate::units::gicube_step::{StepConfig, Stepper};
 use crate::volume::Volume;
 
 /// Largest value of a `U(0.12)` packet channel.
@@ -370,12 +371,6 @@ pub fn interaction_draw(bits: u32) -> u16 {
     (jenkins_hash(bits ^ INTERACTION_KEY) >> 16).min(65520) as u16
 }
 
-/// `rnd` of a signed product: `(x + 2^(s-1)) >> s`, arithmetic (round half up, toward +inf).
-#[inline]
-fn rnd_signed(x: i64, s: u32) -> i64 {
-    (x + (1 << (s - 1))) >> s
-}
-
 /// The volume cache as counted here ([351]): it holds the `(n + 1)^3` voxels a block's samples
 /// read; a voxel read is a miss the first time after the block's queue became the cache's block,
 /// a hit after that; sampling a ray of another block empties it. (Counts only: no timing.)
@@ -482,6 +477,8 @@ pub struct Processor {
     scatter: Scatter,
     /// During a high-albedo lighting pass: the albedo, `U(0.16)` raw.
     photon_albedo: Option<u32>,
+    /// Step, leap, advance and re-bucketing (`gicube_step`).
+    stepper: Stepper,
 }
 
 impl Processor {
@@ -532,6 +529,11 @@ impl Processor {
             irradiance: None,
             scatter: Scatter::new(ScatterConfig::DEFAULT)?,
             photon_albedo: None,
+            stepper: Stepper::new(StepConfig {
+                block_log2: cfg.block_log2,
+                vol_blocks: blocks,
+                step: cfg.step,
+            })?,
         };
         p.empty = (0..blocks * blocks * blocks)
             .map(|q| p.block_is_empty(q))
@@ -608,10 +610,9 @@ impl Processor {
         (!b.outside).then_some(b.queue)
     }
 
-    /// The per-ray step `delta = rnd(dir * step, 14)`, `S(.8)` voxels per axis.
+    /// The per-ray step `delta = rnd(dir * step, 14)`, `S(.8)` voxels per axis (`gicube_step`).
     pub fn delta(&self, ray: &RayPacket) -> [i64; 3] {
-        ray.dir
-            .map(|d| rnd_signed(i64::from(d) * i64::from(self.cfg.step), DIR_FRAC_W))
+        self.stepper.delta(ray.dir)
     }
 
     /// The classified, composited sample at the ray's position (the pipeline's datapath). A
@@ -713,24 +714,6 @@ impl Processor {
         }
     }
 
-    /// Steps to leave the block `[lo, lo + n)` (raw positions) from `pos` with `delta`: the
-    /// smallest `k >= 1` with `pos + k delta` outside on some axis.
-    fn steps_to_exit(&self, pos: [u32; 3], delta: [i64; 3], block: [u32; 3]) -> i64 {
-        let n = (1i64 << self.cfg.block_log2) << POS_FRAC_W;
-        let mut k = i64::MAX;
-        for a in 0..3 {
-            let p = i64::from(pos[a]);
-            let lo = i64::from(block[a]) * n;
-            let d = delta[a];
-            if d > 0 {
-                k = k.min((lo + n - p + d - 1) / d);
-            } else if d < 0 {
-                k = k.min((p - lo - d) / -d);
-            }
-        }
-        k.max(1)
-    }
-
     /// One pipeline cycle on a ray of queue `q`: a sample (or a leap), then the advance.
     fn advance(
         &self,
@@ -740,10 +723,10 @@ impl Processor {
         cache: &mut BlockCache,
         irr: Option<&mut [u16]>,
     ) -> Outcome {
-        let leap = ray.ray_type == RayType::Rendering && self.cfg.space_leap;
-        let k = if leap && self.empty[q as usize] {
+        let leap =
+            ray.ray_type == RayType::Rendering && self.cfg.space_leap && self.empty[q as usize];
+        if leap {
             counts.leaps += 1;
-            self.steps_to_exit(ray.start, self.delta(&ray), self.bucket.block_of(0, q))
         } else {
             counts.samples += 1;
             let n = 1u32 << self.cfg.block_log2;
@@ -782,19 +765,17 @@ impl Processor {
                 counts.rays_terminated += 1;
                 return Outcome::Done(ray);
             }
-            1
-        };
-        let delta = self.delta(&ray);
-        let limit = i64::from(self.side) << POS_FRAC_W;
-        let next: [i64; 3] = std::array::from_fn(|a| i64::from(ray.start[a]) + k * delta[a]);
-        if next.iter().any(|&c| c < 0 || c >= limit) {
+        }
+        // Leap (k steps) or one step, exit test and re-bucketing: the step unit (gicube_step).
+        let s = self.stepper.step(ray.start, ray.dir, q, leap);
+        if s.exit {
             return Outcome::Done(ray);
         }
-        ray.start = next.map(|c| c as u32);
-        match self.queue_of(ray.start) {
-            Some(q2) if q2 == q => Outcome::Stay(ray),
-            Some(q2) => Outcome::Move(ray, q2),
-            None => Outcome::Done(ray),
+        ray.start = s.next;
+        if s.queue == q {
+            Outcome::Stay(ray)
+        } else {
+            Outcome::Move(ray, s.queue)
         }
     }
 

@@ -23,3 +23,4 @@ pub mod gicube_processor;
 pub mod gicube_ray_queues;
 pub mod gicube_scatter;
 pub mod gicube_sorter;
+pub mod gicube_step;
