@@ -109,4 +109,29 @@ package gicube_pkg;
     sorter_out_w = 4 + imp_w + queue_w + 2 * ranks * sorter_entry_w(queue_w, imp_w);
   endfunction
 
+  // ---------------------------------------------------------------------------
+  // Ray queues (docs/numerics/gicube_ray_queues.md)
+  // ---------------------------------------------------------------------------
+
+  /// LenW = bitlen(QueueLen): one queue's count, 0..QueueLen.
+  function automatic int unsigned rq_len_w(int unsigned queue_len);
+    rq_len_w = $clog2(queue_len + 1);
+  endfunction
+
+  /// TotW = bitlen(2^QueueW QueueLen): the rays in all queues.
+  function automatic int unsigned rq_tot_w(int unsigned queue_w, int unsigned queue_len);
+    rq_tot_w = $clog2((queue_len << queue_w) + 1);
+  endfunction
+
+  /// Bits of one input item: pop, pop_q, push, push_q, data.
+  function automatic int unsigned rq_in_w(int unsigned queue_w, int unsigned data_w);
+    rq_in_w = 2 + 2 * queue_w + data_w;
+  endfunction
+
+  /// Bits of one output item: four flags, pop_len, push_len, total, pop_data, ovf_data.
+  function automatic int unsigned rq_out_w(int unsigned queue_w, int unsigned queue_len,
+                                           int unsigned data_w);
+    rq_out_w = 4 + 2 * rq_len_w(queue_len) + rq_tot_w(queue_w, queue_len) + 2 * data_w;
+  endfunction
+
 endpackage

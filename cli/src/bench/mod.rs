@@ -18,6 +18,7 @@ mod cube5_trilin;
 mod cube5_warp;
 mod gicube_bucket;
 mod gicube_packet_loop;
+mod gicube_ray_queues;
 mod gicube_scatter;
 mod gicube_sorter;
 
@@ -85,6 +86,11 @@ const BENCHES: &[Bench] = &[
         top: gicube_scatter::TOP,
         alias: "scatter",
         run: gicube_scatter::run,
+    },
+    Bench {
+        top: gicube_ray_queues::TOP,
+        alias: "queues",
+        run: gicube_ray_queues::run,
     },
     Bench {
         top: cube5_skewmem::TOP,

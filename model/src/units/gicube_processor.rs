@@ -25,9 +25,11 @@ use crate::units::cube5_shader::{
 };
 use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
-use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, DIR_FRAC_W, POS_FRAC_W};
+use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
+use crate::units::gicube_ray_queues::RayQueues;
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
+use crate::units::gicube_step::{StepConfig, Stepper};
 use crate::volume::Volume;
 
 /// Largest value of a `U(0.12)` packet channel.
@@ -369,12 +371,6 @@ pub fn interaction_draw(bits: u32) -> u16 {
     (jenkins_hash(bits ^ INTERACTION_KEY) >> 16).min(65520) as u16
 }
 
-/// `rnd` of a signed product: `(x + 2^(s-1)) >> s`, arithmetic (round half up, toward +inf).
-#[inline]
-fn rnd_signed(x: i64, s: u32) -> i64 {
-    (x + (1 << (s - 1))) >> s
-}
-
 /// The volume cache as counted here ([351]): it holds the `(n + 1)^3` voxels a block's samples
 /// read; a voxel read is a miss the first time after the block's queue became the cache's block,
 /// a hit after that; sampling a ray of another block empties it. (Counts only: no timing.)
@@ -416,6 +412,39 @@ impl BlockCache {
     }
 }
 
+/// One step the frame loop made on its ray queues (`RayQueues`): a pop of the active queue, or a
+/// push of a ray into a queue (re-queued, moved or from the host).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum QueueOp {
+    Pop(u32),
+    Push(u32, RayPacket),
+}
+
+/// `queues.pop(q)`, logged.
+fn pop_logged(
+    queues: &mut RayQueues<RayPacket>,
+    log: &mut Option<&mut Vec<QueueOp>>,
+    q: u32,
+) -> Option<RayPacket> {
+    if let Some(l) = log.as_deref_mut() {
+        l.push(QueueOp::Pop(q));
+    }
+    queues.pop(q)
+}
+
+/// `queues.push(q, ray)`, logged.
+fn push_logged(
+    queues: &mut RayQueues<RayPacket>,
+    log: &mut Option<&mut Vec<QueueOp>>,
+    q: u32,
+    ray: RayPacket,
+) -> std::result::Result<(), RayPacket> {
+    if let Some(l) = log.as_deref_mut() {
+        l.push(QueueOp::Push(q, ray));
+    }
+    queues.push(q, ray)
+}
+
 /// What one pipeline cycle did to a ray.
 enum Outcome {
     /// Still in the same block: back to the tail of the same queue.
@@ -448,6 +477,8 @@ pub struct Processor {
     scatter: Scatter,
     /// During a high-albedo lighting pass: the albedo, `U(0.16)` raw.
     photon_albedo: Option<u32>,
+    /// Step, leap, advance and re-bucketing (`gicube_step`).
+    stepper: Stepper,
 }
 
 impl Processor {
@@ -498,6 +529,11 @@ impl Processor {
             irradiance: None,
             scatter: Scatter::new(ScatterConfig::DEFAULT)?,
             photon_albedo: None,
+            stepper: Stepper::new(StepConfig {
+                block_log2: cfg.block_log2,
+                vol_blocks: blocks,
+                step: cfg.step,
+            })?,
         };
         p.empty = (0..blocks * blocks * blocks)
             .map(|q| p.block_is_empty(q))
@@ -574,10 +610,9 @@ impl Processor {
         (!b.outside).then_some(b.queue)
     }
 
-    /// The per-ray step `delta = rnd(dir * step, 14)`, `S(.8)` voxels per axis.
+    /// The per-ray step `delta = rnd(dir * step, 14)`, `S(.8)` voxels per axis (`gicube_step`).
     pub fn delta(&self, ray: &RayPacket) -> [i64; 3] {
-        ray.dir
-            .map(|d| rnd_signed(i64::from(d) * i64::from(self.cfg.step), DIR_FRAC_W))
+        self.stepper.delta(ray.dir)
     }
 
     /// The classified, composited sample at the ray's position (the pipeline's datapath). A
@@ -679,24 +714,6 @@ impl Processor {
         }
     }
 
-    /// Steps to leave the block `[lo, lo + n)` (raw positions) from `pos` with `delta`: the
-    /// smallest `k >= 1` with `pos + k delta` outside on some axis.
-    fn steps_to_exit(&self, pos: [u32; 3], delta: [i64; 3], block: [u32; 3]) -> i64 {
-        let n = (1i64 << self.cfg.block_log2) << POS_FRAC_W;
-        let mut k = i64::MAX;
-        for a in 0..3 {
-            let p = i64::from(pos[a]);
-            let lo = i64::from(block[a]) * n;
-            let d = delta[a];
-            if d > 0 {
-                k = k.min((lo + n - p + d - 1) / d);
-            } else if d < 0 {
-                k = k.min((p - lo - d) / -d);
-            }
-        }
-        k.max(1)
-    }
-
     /// One pipeline cycle on a ray of queue `q`: a sample (or a leap), then the advance.
     fn advance(
         &self,
@@ -706,10 +723,10 @@ impl Processor {
         cache: &mut BlockCache,
         irr: Option<&mut [u16]>,
     ) -> Outcome {
-        let leap = ray.ray_type == RayType::Rendering && self.cfg.space_leap;
-        let k = if leap && self.empty[q as usize] {
+        let leap =
+            ray.ray_type == RayType::Rendering && self.cfg.space_leap && self.empty[q as usize];
+        if leap {
             counts.leaps += 1;
-            self.steps_to_exit(ray.start, self.delta(&ray), self.bucket.block_of(0, q))
         } else {
             counts.samples += 1;
             let n = 1u32 << self.cfg.block_log2;
@@ -748,19 +765,17 @@ impl Processor {
                 counts.rays_terminated += 1;
                 return Outcome::Done(ray);
             }
-            1
-        };
-        let delta = self.delta(&ray);
-        let limit = i64::from(self.side) << POS_FRAC_W;
-        let next: [i64; 3] = std::array::from_fn(|a| i64::from(ray.start[a]) + k * delta[a]);
-        if next.iter().any(|&c| c < 0 || c >= limit) {
+        }
+        // Leap (k steps) or one step, exit test and re-bucketing: the step unit (gicube_step).
+        let s = self.stepper.step(ray.start, ray.dir, q, leap);
+        if s.exit {
             return Outcome::Done(ray);
         }
-        ray.start = next.map(|c| c as u32);
-        match self.queue_of(ray.start) {
-            Some(q2) if q2 == q => Outcome::Stay(ray),
-            Some(q2) => Outcome::Move(ray, q2),
-            None => Outcome::Done(ray),
+        ray.start = s.next;
+        if s.queue == q {
+            Outcome::Stay(ray)
+        } else {
+            Outcome::Move(ray, s.queue)
         }
     }
 
@@ -770,7 +785,21 @@ impl Processor {
     pub fn render(&self, cam: &Camera, proj: Projection) -> Result<ProcessorFrame> {
         let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
         let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
-        self.run(packets, cam.width, cam.height, None)
+        self.run(packets, cam.width, cam.height, None, None)
+    }
+
+    /// `render`, and every step the frame loop made on its ray queues, in order: the frame's queue
+    /// traffic, which the RTL queues (`gicube_ray_queues`) replay in the co-simulation.
+    pub fn render_traced(
+        &self,
+        cam: &Camera,
+        proj: Projection,
+    ) -> Result<(ProcessorFrame, Vec<QueueOp>)> {
+        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
+        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let mut log = Vec::new();
+        let f = self.run(packets, cam.width, cam.height, None, Some(&mut log))?;
+        Ok((f, log))
     }
 
     /// The lighting pass of volumetric GI ([358]-[363], low albedo, single scattering): lighting
@@ -795,7 +824,7 @@ impl Processor {
         };
         let mut field = vec![0u16; self.vol.len()];
         self.irradiance = None;
-        let f = self.run(packets, light.grid, light.grid, Some(&mut field));
+        let f = self.run(packets, light.grid, light.grid, Some(&mut field), None);
         self.photon_albedo = None;
         self.irradiance = Some(field);
         f
@@ -826,6 +855,7 @@ impl Processor {
         w: u32,
         h: u32,
         mut irr: Option<&mut Vec<u16>>,
+        mut log: Option<&mut Vec<QueueOp>>,
     ) -> Result<ProcessorFrame> {
         let rays = packets.len();
         let packets_lives = packets
@@ -844,15 +874,14 @@ impl Processor {
             self.cfg.queue_len,
         )?;
         let mut sorter = Sorter::new(scfg)?;
-        let mut queues: Vec<VecDeque<RayPacket>> = vec![VecDeque::new(); nq as usize];
-        let cap = self.cfg.queue_len as usize;
+        // The ray queues: the one description of them (`gicube_ray_queues`, the RTL's model).
+        let mut queues: RayQueues<RayPacket> = RayQueues::new(nq, self.cfg.queue_len);
         let mut counts = ProcessorCounts {
             rays_made: rays as u64,
             ..Default::default()
         };
         let mut rgb = vec![[0u16; 3]; (w * h) as usize];
         let mut done = vec![false; (w * h) as usize];
-        let mut held = 0u64;
         let mut scan_active: Option<u32> = None;
         let mut cache = BlockCache::new(self.cfg.block_log2);
         let mut last_active: Option<u32> = None;
@@ -864,7 +893,8 @@ impl Processor {
             2 * u64::from(self.side) * 256 / u64::from(self.cfg.step) + u64::from(nq) + 64;
         let bound = 64 + 8 * rays as u64 * lives * per_path;
 
-        while !feed.is_empty() || held > 0 {
+        while !feed.is_empty() || queues.total() > 0 {
+            let held = u64::from(queues.total());
             counts.cycles += 1;
             if counts.cycles > bound {
                 return Err(ModelError::Config(format!(
@@ -877,11 +907,11 @@ impl Processor {
             let active = match self.cfg.order {
                 QueueOrder::Sorter => sorter.active().map(|e| e.queue),
                 QueueOrder::Scan => {
-                    if scan_active.is_none_or(|q| queues[q as usize].is_empty()) && held > 0 {
+                    if scan_active.is_none_or(|q| queues.is_empty(q)) && held > 0 {
                         let from = scan_active.map_or(0, |q| q + 1);
                         scan_active = (0..nq)
                             .map(|i| (from + i) % nq)
-                            .find(|&q| !queues[q as usize].is_empty());
+                            .find(|&q| !queues.is_empty(q));
                     }
                     scan_active
                 }
@@ -890,7 +920,7 @@ impl Processor {
                 counts.activations += 1;
             }
             last_active = active;
-            match active.and_then(|q| queues[q as usize].pop_front().map(|r| (q, r))) {
+            match active.and_then(|q| pop_logged(&mut queues, &mut log, q).map(|r| (q, r))) {
                 Some((q, ray)) => match self.advance(
                     ray,
                     q,
@@ -898,22 +928,27 @@ impl Processor {
                     &mut cache,
                     irr.as_deref_mut().map(|v| v.as_mut_slice()),
                 ) {
-                    Outcome::Stay(ray) => queues[q as usize].push_back(ray),
-                    Outcome::Move(mut ray, q2) => {
+                    Outcome::Stay(ray) => {
+                        // Its own queue has the slot the pop freed.
+                        if push_logged(&mut queues, &mut log, q, ray).is_err() {
+                            return Err(ModelError::Config(format!(
+                                "gicube processor: queue {q} full after its own pop"
+                            )));
+                        }
+                    }
+                    Outcome::Move(ray, q2) => {
                         updates.push(SorterIn::add(q, -1));
-                        if queues[q2 as usize].len() < cap {
-                            queues[q2 as usize].push_back(ray);
-                            updates.push(SorterIn::add(q2, 1));
-                        } else {
-                            held -= 1;
-                            counts.rays_overflowed += 1;
-                            ray.flags |= flag::OVERFLOW;
-                            feed.push_back(ray);
+                        match push_logged(&mut queues, &mut log, q2, ray) {
+                            Ok(()) => updates.push(SorterIn::add(q2, 1)),
+                            Err(mut ray) => {
+                                counts.rays_overflowed += 1;
+                                ray.flags |= flag::OVERFLOW;
+                                feed.push_back(ray);
+                            }
                         }
                     }
                     Outcome::Done(ray) => {
                         updates.push(SorterIn::add(q, -1));
-                        held -= 1;
                         counts.rays_finished += 1;
                         let i = (u32::from(ray.v) * w + u32::from(ray.u)) as usize;
                         if done[i] {
@@ -943,13 +978,16 @@ impl Processor {
                             ray.u, ray.v
                         ))
                     })?;
-                    if queues[qh as usize].len() < cap {
+                    if !queues.is_full(qh) {
                         let mut ray = ray;
                         feed.pop_front();
                         ray.flags &= !flag::OVERFLOW;
                         counts.rays_in += 1;
-                        queues[qh as usize].push_back(ray);
-                        held += 1;
+                        if push_logged(&mut queues, &mut log, qh, ray).is_err() {
+                            return Err(ModelError::Config(format!(
+                                "gicube processor: queue {qh} refused a ray it had room for"
+                            )));
+                        }
                         updates.push(SorterIn::add(qh, 1));
                     } else {
                         counts.host_stalls += 1;
@@ -957,7 +995,7 @@ impl Processor {
                 }
             }
             for u in &updates {
-                counts.max_queue = counts.max_queue.max(queues[u.queue as usize].len() as u32);
+                counts.max_queue = counts.max_queue.max(queues.len(u.queue));
             }
             if self.cfg.order == QueueOrder::Sorter {
                 for s in 0..SORTER_SLOTS {
@@ -965,8 +1003,8 @@ impl Processor {
                 }
                 // The sorter's counters are the queue lengths (criterion 1 of [373]).
                 for u in &updates {
-                    let len = queues[u.queue as usize].len();
-                    if sorter.importance(u.queue) as usize != len {
+                    let len = queues.len(u.queue);
+                    if sorter.importance(u.queue) != len {
                         return Err(ModelError::Config(format!(
                             "gicube processor: sorter counter {} of queue {} holds {len} rays",
                             sorter.importance(u.queue),

@@ -1,0 +1,3 @@
+rtl/gicube/gicube_pkg.sv
+rtl/cube5/cube5_shader_ram.sv
+rtl/gicube/gicube_ray_queues.sv
