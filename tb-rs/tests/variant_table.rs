@@ -8,8 +8,8 @@
 //! Needs no RTL build: the table carries the parameters Verilator elaborated.
 
 use cube5_model::unit::UnitConfig;
-use cube5_model::units::cube5_axil::AxilConfig;
 use cube5_model::units::cube5_axi_wr::AxiWrConfig;
+use cube5_model::units::cube5_axil::AxilConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_model::units::{
     cube5_axi_rd::AxiRdConfig, cube5_compos::ComposConfig, cube5_frame::FrameConfig,

@@ -7,8 +7,8 @@
 //! [346]-[392]).
 
 pub mod cube5_axi_rd;
-pub mod cube5_axil;
 pub mod cube5_axi_wr;
+pub mod cube5_axil;
 pub mod cube5_compos;
 pub mod cube5_frame;
 pub mod cube5_gradient;
