@@ -8,6 +8,7 @@
 //! Needs no RTL build: the table carries the parameters Verilator elaborated.
 
 use cube5_model::unit::UnitConfig;
+use cube5_model::units::cube5_section_buf::SectionBufConfig;
 use cube5_model::units::{
     cube5_axi_rd::AxiRdConfig, cube5_compos::ComposConfig, cube5_frame::FrameConfig,
     cube5_gradient::GradientConfig, cube5_rblock::RBlockConfig, cube5_sepconv::SepconvConfig,
@@ -63,6 +64,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == AxiRdConfig::TOP => agree::<AxiRdConfig>(v),
         t if t == VolFetchConfig::TOP => agree::<VolFetchConfig>(v),
         t if t == WarpConfig::TOP => agree::<WarpConfig>(v),
+        t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
         other => Err(format!(
             "top {other} has no model configuration (UnitConfig)"
         )),

@@ -59,9 +59,9 @@ impl SectionBufConfig {
             ));
         }
         let s = self.section;
-        if !s.is_power_of_two() || s < b || s > self.max_dim {
+        if !s.is_power_of_two() || s < b || s >= self.max_dim {
             return bad(format!(
-                "Section {s} is not a power of two in BlockDim ..= MaxDim"
+                "Section {s} is not a power of two with BlockDim <= S < MaxDim"
             ));
         }
         Ok(())
