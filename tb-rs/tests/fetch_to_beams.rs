@@ -84,103 +84,99 @@ fn one_case(
     scfg: SectionBufConfig,
     s: u64,
 ) {
-    {
-        {
-            let mut rng = ChaCha8Rng::seed_from_u64(s);
-            let edge = fcfg.max_dim.min(scfg.max_dim).min(48) as usize;
-            let (vol, lut) = random_volume(
-                scfg.p as usize,
-                scfg.block_dim as usize,
-                scfg.voxel_w,
-                edge,
-                &mut rng,
-            );
-            let bbus = u64::from(fcfg.data_w / 8);
-            let base = rng.random_range(0..4096 / bbus) * bbus;
-            let img = dram_image(&vol, &lut, base).unwrap();
-            // Every section of the face, for a few random views.
-            let mut cmds = Vec::new();
-            for _ in 0..4 {
-                let axis_k = rng.random_range(0..3u32);
-                let (ai, aj) = frame_axes(axis_k);
-                let d = vol.dims;
-                let fd = [d[ai], d[aj], d[axis_k as usize]].map(|n| n as u32);
-                let reversed = rng.random_bool(0.5);
-                for a0 in (0..fd[0]).step_by(scfg.section as usize) {
-                    cmds.push(SectionCmd {
-                        axis_k,
-                        reversed,
-                        dims: fd,
-                        a0,
-                    });
-                }
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let edge = fcfg.max_dim.min(scfg.max_dim).min(48) as usize;
+    let (vol, lut) = random_volume(
+        scfg.p as usize,
+        scfg.block_dim as usize,
+        scfg.voxel_w,
+        edge,
+        &mut rng,
+    );
+    let bbus = u64::from(fcfg.data_w / 8);
+    let base = rng.random_range(0..4096 / bbus) * bbus;
+    let img = dram_image(&vol, &lut, base).unwrap();
+    // Every section of the face, for a few random views.
+    let mut cmds = Vec::new();
+    for _ in 0..4 {
+        let axis_k = rng.random_range(0..3u32);
+        let (ai, aj) = frame_axes(axis_k);
+        let d = vol.dims;
+        let fd = [d[ai], d[aj], d[axis_k as usize]].map(|n| n as u32);
+        let reversed = rng.random_bool(0.5);
+        for a0 in (0..fd[0]).step_by(scfg.section as usize) {
+            cmds.push(SectionCmd {
+                axis_k,
+                reversed,
+                dims: fd,
+                a0,
+            });
+        }
+    }
+    // The fetch: LUT, then one sweep per section, on the RTL with the AXI memory.
+    let mut fetch_in = fcfg.lut_writes(&lut).unwrap();
+    fetch_in.extend(cmds.iter().map(|c| FetchCmd::Sweep(scfg.sweep(c, base))));
+    let want_items = VolFetch::new(fcfg)
+        .unwrap()
+        .run(&fetch_in, &img)
+        .unwrap()
+        .items;
+    let mut fetch = RtlStream::new(fv, fcfg, s as u32).unwrap();
+    let setup = axi_mem_setup(
+        (fcfg.data_w / 8, fcfg.addr_w),
+        &img,
+        (10, 190),
+        (100, 100),
+        (0, 1),
+        rng.random(),
+    );
+    fetch.axi_setup(&setup).unwrap();
+    fetch.axi_load(img.base, &img.bytes).unwrap();
+    let traffic = Traffic::random(&mut rng, 0.2, 0.3);
+    let n = want_items.len() as u64;
+    let d = fetch
+        .drive(&fetch_in, &traffic, n, 100_000 + 400 * n)
+        .unwrap();
+    axi_protocol_clean(&fetch, &d.stats, fv, s).unwrap_or_else(|e| panic!("{e}"));
+    let items: Vec<FetchItem> = d.outputs.into_iter().map(|t| t.value).collect();
+    assert_eq!(items.len(), want_items.len(), "{fv}: every item delivered");
+    assert!(
+        items == want_items,
+        "{fv}: the fetch's items equal its model's"
+    );
+    // The buffer: each section command, then the items of its sweep (up to `last`).
+    let mut input = Vec::new();
+    let mut want: Vec<Beam> = Vec::new();
+    let mut it = items.into_iter();
+    for c in &cmds {
+        input.push(SbufIn::Section(*c));
+        for item in it.by_ref() {
+            let last = item.last;
+            input.push(SbufIn::Item(item));
+            if last {
+                break;
             }
-            // The fetch: LUT, then one sweep per section, on the RTL with the AXI memory.
-            let mut fetch_in = fcfg.lut_writes(&lut).unwrap();
-            fetch_in.extend(cmds.iter().map(|c| FetchCmd::Sweep(scfg.sweep(c, base))));
-            let want_items = VolFetch::new(fcfg)
-                .unwrap()
-                .run(&fetch_in, &img)
-                .unwrap()
-                .items;
-            let mut fetch = RtlStream::new(fv, fcfg, s as u32).unwrap();
-            let setup = axi_mem_setup(
-                (fcfg.data_w / 8, fcfg.addr_w),
-                &img,
-                (10, 190),
-                (100, 100),
-                (0, 1),
-                rng.random(),
-            );
-            fetch.axi_setup(&setup).unwrap();
-            fetch.axi_load(img.base, &img.bytes).unwrap();
-            let traffic = Traffic::random(&mut rng, 0.2, 0.3);
-            let n = want_items.len() as u64;
-            let d = fetch
-                .drive(&fetch_in, &traffic, n, 100_000 + 400 * n)
-                .unwrap();
-            axi_protocol_clean(&fetch, &d.stats, fv, s).unwrap_or_else(|e| panic!("{e}"));
-            let items: Vec<FetchItem> = d.outputs.into_iter().map(|t| t.value).collect();
-            assert_eq!(items.len(), want_items.len(), "{fv}: every item delivered");
-            assert!(
-                items == want_items,
-                "{fv}: the fetch's items equal its model's"
-            );
-            // The buffer: each section command, then the items of its sweep (up to `last`).
-            let mut input = Vec::new();
-            let mut want: Vec<Beam> = Vec::new();
-            let mut it = items.into_iter();
-            for c in &cmds {
-                input.push(SbufIn::Section(*c));
-                for item in it.by_ref() {
-                    let last = item.last;
-                    input.push(SbufIn::Item(item));
-                    if last {
-                        break;
-                    }
-                }
-                want.extend(section_beams(&scfg, &vol, &lut, c).unwrap());
-            }
-            let mut sbuf = RtlStream::new(sv, scfg, s as u32).unwrap();
-            let traffic = Traffic::random(&mut rng, 0.2, 0.3);
-            let m = want.len() as u64;
-            let d = sbuf
-                .drive(&input, &traffic, m, 100_000 + 20 * (m + input.len() as u64))
-                .unwrap();
-            assert_eq!(d.outputs.len(), want.len(), "{sv}: every beam out");
-            for (k, t) in d.outputs.iter().enumerate() {
-                assert_eq!(
-                    t.value, want[k],
-                    "{fv} -> {sv}: beam {k} (seed {s}) differs from the volume's"
-                );
-            }
-            eprintln!(
+        }
+        want.extend(section_beams(&scfg, &vol, &lut, c).unwrap());
+    }
+    let mut sbuf = RtlStream::new(sv, scfg, s as u32).unwrap();
+    let traffic = Traffic::random(&mut rng, 0.2, 0.3);
+    let m = want.len() as u64;
+    let d = sbuf
+        .drive(&input, &traffic, m, 100_000 + 20 * (m + input.len() as u64))
+        .unwrap();
+    assert_eq!(d.outputs.len(), want.len(), "{sv}: every beam out");
+    for (k, t) in d.outputs.iter().enumerate() {
+        assert_eq!(
+            t.value, want[k],
+            "{fv} -> {sv}: beam {k} (seed {s}) differs from the volume's"
+        );
+    }
+    eprintln!(
                 "{fv} -> {sv}: volume {:?}, {} sections, {} items, {} beams: every beam equals the volume's",
                 vol.dims,
                 cmds.len(),
                 input.len() - cmds.len(),
                 want.len()
             );
-        }
-    }
 }
