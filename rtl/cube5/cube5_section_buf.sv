@@ -47,9 +47,9 @@ module cube5_section_buf #(
 
   localparam int unsigned M         = $clog2(MaxDim);
   localparam int unsigned DimW      = M + 1;
-  localparam int unsigned NbW       = cube5_section_buf_pkg::nb_w(MaxDim, BlockDim);
+  localparam int unsigned NbW       = cube5_vol_fetch_pkg::nb_w(MaxDim, BlockDim);
   localparam int unsigned NbCW      = NbW + 1;
-  localparam int unsigned WordW     = cube5_section_buf_pkg::word_w(P, BlockDim);
+  localparam int unsigned WordW     = cube5_vol_fetch_pkg::word_w(P, BlockDim);
   localparam int unsigned InW       = cube5_section_buf_pkg::in_w(P, VoxelW, MaxDim, BlockDim);
   localparam int unsigned OutW      = cube5_section_buf_pkg::out_w(P, VoxelW);
   localparam int unsigned BW        = $clog2(BlockDim);
@@ -65,9 +65,7 @@ module cube5_section_buf #(
   localparam int unsigned EAW       = $clog2(EdgeDepth);
   localparam int unsigned NBR       = MaxDim / BlockDim;         // block rows of a slab
   localparam int unsigned CB        = Section / BlockDim + 2;    // block columns of a slab
-  localparam int unsigned CBW       = $clog2(CB);                // their stride, a power of two
-  localparam int unsigned PresN     = 2 * NBR * (1 << CBW);
-  localparam int unsigned PresW     = $clog2(PresN);
+  localparam int unsigned PresW     = 1 + NbW;                   // a present-flag row
   // Every size is a power of two: products and quotients below are shifts (log2 of each).
   localparam int unsigned LP        = $clog2(P);
   localparam int unsigned LBPP      = $clog2(BPP);
@@ -144,12 +142,12 @@ module cube5_section_buf #(
   logic [M-1:0]    a0_q, a0_d;
   logic [NbCW-1:0] nbj_q, nbj_d, nbk_q, nbk_d, sechi_q, sechi_d, t_q, t_d;
   logic            wh_q, wh_d;                // the half being filled
-  logic            started_q, started_d;      // the slab has had an item
 
   logic [1:0] full_q, full_d;                 // half h holds a slab (or an error) to read
+  logic [1:0] held_q, held_d;                 // half h is closed (full, or its last write in flight)
 
   logic in_fire, cmd_fire, item_fire;
-  assign in_ready_o = !full_q[wh_q];
+  assign in_ready_o = !held_q[wh_q];
   assign in_fire    = in_valid_i && in_ready_o;
   assign cmd_fire   = in_fire && op && !act_q;
   assign item_fire  = in_fire && !op && act_q && !it_error;
@@ -220,7 +218,6 @@ module cube5_section_buf #(
     sechi_d   = sechi_q;
     t_d       = t_q;
     wh_d      = wh_q;
-    started_d = started_q;
     if (cmd_fire) begin
       act_d     = !cm_refused;
       axis_d    = cm_axis;
@@ -234,11 +231,9 @@ module cube5_section_buf #(
       nbk_d     = NbCW'((cm_nk + DimW'(BlockDim - 1)) >> BW);
       sechi_d   = (cm_sechi_cap < cm_nbi) ? cm_sechi_cap : cm_nbi;
       t_d       = '0;
-      started_d = 1'b0;
       if (cm_refused) wh_d = !wh_q;            // the error takes a half
     end
     if (item_fire) begin
-      started_d = !item_close;
       if (item_close) begin
         wh_d = !wh_q;
         t_d  = t_q + NbCW'(1);
@@ -251,12 +246,10 @@ module cube5_section_buf #(
     if (!rst_ni) begin
       act_q     <= 1'b0;
       wh_q      <= 1'b0;
-      started_q <= 1'b0;
       t_q       <= '0;
     end else begin
       act_q     <= act_d;
       wh_q      <= wh_d;
-      started_q <= started_d;
       t_q       <= t_d;
     end
   end
@@ -301,28 +294,53 @@ module cube5_section_buf #(
   end
 
   // ==============================================================================================
-  // Present flags: one per block (row, column) of each half, cleared when a slab begins
+  // Present flags: a word of CB flags per block row of each half (LUT RAM). The items of a block
+  // row arrive together (block columns in order), so the row's flags gather in a register and
+  // are written once, with the row's closing item; every row of a slab is rewritten.
   // ==============================================================================================
 
-  logic [PresN-1:0] pres_q, pres_d;
-  logic [NbCW-1:0]  pcol;   // bi - (a0 / B - 1)
-  logic [PresW-1:0] pidx;
-  assign pcol = NbCW'(bi0) + NbCW'(1) - NbCW'(a0_q >> BW);
+  logic [NbCW-1:0]  pcol;                     // bi - (a0 / B - 1)
+  logic [CB-1:0]    pacc_q, pacc_d, pacc_next;
+  logic             popen_q, popen_d;         // a block row has begun
+  logic             row_close, pres_we_q;
+  logic [PresW-1:0] pres_waddr_q;
+  logic [CB-1:0]    pres_wdata_q;
+  assign pcol      = NbCW'(bi0) + NbCW'(1) - NbCW'(a0_q >> BW);
+  assign row_close = (NbCW'(bi0) + NbCW'(1) == sechi_q)
+                  && (it_skip || it_word == WordW'(Groups - 1));
 
   always_comb begin
-    pres_d = pres_q;
-    // Constant indices only: a clear or set at a computed index would elaborate a demultiplexer
-    // per bit.
-    pidx = PresW'((((32'(wh_q) << NbW) | 32'(bj0)) << CBW) | 32'(pcol));
-    for (int unsigned n = 0; n < PresN; n++) begin
-      if (item_fire) begin
-        if (!started_q && (n >> (NbW + CBW)) == 32'(wh_q)) pres_d[n] = 1'b0;
-        if (!it_skip && pcol < NbCW'(CB) && pidx == PresW'(n)) pres_d[n] = 1'b1;
-      end
+    pacc_next = popen_q ? pacc_q : '0;
+    for (int unsigned c = 0; c < CB; c++) begin
+      if (!it_skip && pcol == NbCW'(c)) pacc_next[c] = 1'b1;
+    end
+    pacc_d  = pacc_q;
+    popen_d = popen_q;
+    if (item_fire) begin
+      pacc_d  = pacc_next;
+      popen_d = !row_close;
+    end
+    if (cmd_fire) popen_d = 1'b0;
+  end
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      popen_q   <= 1'b0;
+      pres_we_q <= 1'b0;
+    end else begin
+      popen_q   <= popen_d;
+      pres_we_q <= item_fire && row_close;
     end
   end
   always_ff @(posedge clk_i) begin
-    pres_q <= pres_d;
+    pacc_q       <= pacc_d;
+    pres_waddr_q <= {wh_q, bj0};
+    pres_wdata_q <= pacc_next;
+  end
+
+  // Written in the cycle after the row's closing item (before its half is handed to the reader).
+  logic [CB-1:0] pres_mem [2 * NBR];
+  always_ff @(posedge clk_i) begin
+    if (pres_we_q) pres_mem[pres_waddr_q] <= pres_wdata_q;
   end
 
   // ==============================================================================================
@@ -392,14 +410,20 @@ module cube5_section_buf #(
   logic [3*P*EAW-1:0]    e2addr_q, e2addr_d;
   logic [3*P*VoxelW-1:0] e2data_q, e2data_d;
   logic                  w2close_q, w2half_q;
-  int unsigned           src;
 
   always_comb begin
+    // Bank b takes lane (b - rot) mod P (loops over constant indices: no index arithmetic).
+    w2we_d   = '0;
+    w2addr_d = '0;
+    w2data_d = '0;
     for (int unsigned b = 0; b < P; b++) begin
-      src       = (b + P - 32'(w1rot)) & (P - 1);
-      w2we_d[b] = w1_q && l_main[src];
-      w2addr_d[b * BAW +: BAW]       = l_maddr[src * BAW +: BAW];
-      w2data_d[b * VoxelW +: VoxelW] = w1lanes_q[src * VoxelW +: VoxelW];
+      for (int unsigned l = 0; l < P; l++) begin
+        if (((l + 32'(w1rot)) & (P - 1)) == b) begin
+          w2we_d[b] = w1_q && l_main[l];
+          w2addr_d[b * BAW +: BAW]       = l_maddr[l * BAW +: BAW];
+          w2data_d[b * VoxelW +: VoxelW] = w1lanes_q[l * VoxelW +: VoxelW];
+        end
+      end
     end
     for (int unsigned c = 0; c < 3; c++) begin
       for (int unsigned e = 0; e < P; e++) begin
@@ -492,10 +516,16 @@ module cube5_section_buf #(
   end
 
   // A half becomes full when the write of its slab's last item lands (w2), free at its last issue.
+  // The writer moves on when it closes a half (held); the reader sees it two cycles later (full).
   always_comb begin
     full_d = full_q;
-    if (issue && slab_done) full_d[rh_q] = 1'b0;
+    held_d = held_q;
+    if (issue && slab_done) begin
+      full_d[rh_q] = 1'b0;
+      held_d[rh_q] = 1'b0;
+    end
     if (w2close_q) full_d[w2half_q] = 1'b1;
+    if (desc_we) held_d[wh_q] = 1'b1;
   end
 
   always_ff @(posedge clk_i) begin
@@ -505,12 +535,14 @@ module cube5_section_buf #(
       rj_q   <= '0;
       rm_q   <= '0;
       full_q <= '0;
+      held_q <= '0;
     end else begin
       rh_q   <= rh_d;
       rn_q   <= rn_d;
       rj_q   <= rj_d;
       rm_q   <= rm_d;
       full_q <= full_d;
+      held_q <= held_d;
     end
   end
 
@@ -519,21 +551,18 @@ module cube5_section_buf #(
   logic [EAW-1:0] r_eaddr;
   logic [PW-1:0]  r_rot, r_ebank;
   logic           r_lane_ok, r_lo_ok, r_hi0_ok, r_hi1_ok;
-  int unsigned    row, pbase;
+  logic [CB-1:0]  r_pres;
   always_comb begin
     r_addr  = BAW'((((((32'(rh_q) << BW) | 32'(r_lk)) << M) | 32'(rj_q)) << LSP)
                    | (32'(rm_q) & (SP - 1)));
     r_eaddr = EAW'((((32'(rh_q) << M) | 32'(rj_q)) << LBPP) | (32'(r_lk) >> LP));
     r_rot   = PW'((32'(rj_q) + 32'(r_lk)) & (P - 1));
     r_ebank = PW'(32'(r_lk) & (P - 1));
-    row     = 32'(rj_q) >> BW;
-    pbase   = ((32'(rh_q) << NbW) | row) << CBW;
-    r_lane_ok = !r_err && pres_q[PresW'(pbase + ((32'(rm_q) << LP) >> BW) + 1)];
-    r_lo_ok   = !r_err && (rm_q == '0) && !de_lo0_q[rh_q] && pres_q[PresW'(pbase)];
-    r_hi0_ok  = !r_err && m_last && !de_hi00_q[rh_q]
-             && pres_q[PresW'(pbase + (32'(r_ns) >> BW) + 1)];
-    r_hi1_ok  = !r_err && m_last && !de_hi10_q[rh_q]
-             && pres_q[PresW'(pbase + ((32'(r_ns) + 1) >> BW) + 1)];
+    r_pres  = pres_mem[{rh_q, rj_q[M-1:BW]}];
+    r_lane_ok = !r_err && r_pres[((32'(rm_q) << LP) >> BW) + 1];
+    r_lo_ok   = !r_err && (rm_q == '0) && !de_lo0_q[rh_q] && r_pres[0];
+    r_hi0_ok  = !r_err && m_last && !de_hi00_q[rh_q] && r_pres[(32'(r_ns) >> BW) + 1];
+    r_hi1_ok  = !r_err && m_last && !de_hi10_q[rh_q] && r_pres[((32'(r_ns) + 1) >> BW) + 1];
   end
 
   // ==============================================================================================
@@ -544,7 +573,8 @@ module cube5_section_buf #(
   logic [3*P*VoxelW-1:0] edge_rd;
 
   for (genvar b = 0; b < P; b++) begin : gen_bank
-    cube5_section_buf_ram #(
+    cube5_shader_ram #(
+      .Depth(BankDepth),
       .Width(VoxelW),
       .AddrW(BAW)
     ) u_bank (
@@ -559,7 +589,8 @@ module cube5_section_buf #(
   end
 
   for (genvar e = 0; e < 3 * P; e++) begin : gen_edge
-    cube5_section_buf_ram #(
+    cube5_shader_ram #(
+      .Depth(EdgeDepth),
       .Width(VoxelW),
       .AddrW(EAW)
     ) u_edge (
@@ -608,16 +639,22 @@ module cube5_section_buf #(
 
   logic [OutW-1:0] beam;
   always_comb begin
+    // Lane l from bank (l + rot) mod P; edges from bank lk mod P (constant-index loops).
+    beam = '0;
     for (int unsigned l = 0; l < P; l++) begin
-      beam[l * VoxelW +: VoxelW] =
-          dlane_q ? bank_rd[((l + 32'(drot_q)) & (P - 1)) * VoxelW +: VoxelW] : '0;
+      for (int unsigned b = 0; b < P; b++) begin
+        if (dlane_q && ((l + 32'(drot_q)) & (P - 1)) == b) begin
+          beam[l * VoxelW +: VoxelW] = bank_rd[b * VoxelW +: VoxelW];
+        end
+      end
     end
-    beam[P * VoxelW +: VoxelW] =
-        dlo_q ? edge_rd[(0 * P + 32'(debank_q)) * VoxelW +: VoxelW] : '0;
-    beam[(P + 1) * VoxelW +: VoxelW] =
-        dhi0_q ? edge_rd[(1 * P + 32'(debank_q)) * VoxelW +: VoxelW] : '0;
-    beam[(P + 2) * VoxelW +: VoxelW] =
-        dhi1_q ? edge_rd[(2 * P + 32'(debank_q)) * VoxelW +: VoxelW] : '0;
+    for (int unsigned e = 0; e < P; e++) begin
+      if (32'(debank_q) == e) begin
+        if (dlo_q)  beam[P * VoxelW +: VoxelW]       = edge_rd[e * VoxelW +: VoxelW];
+        if (dhi0_q) beam[(P + 1) * VoxelW +: VoxelW] = edge_rd[(P + e) * VoxelW +: VoxelW];
+        if (dhi1_q) beam[(P + 2) * VoxelW +: VoxelW] = edge_rd[(2 * P + e) * VoxelW +: VoxelW];
+      end
+    end
     beam[(P + 3) * VoxelW +: 5]      = dflags_q;
   end
 

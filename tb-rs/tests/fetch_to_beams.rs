@@ -10,51 +10,15 @@
 mod support;
 
 use cube5_model::units::cube5_section_buf::{
-    section_beams, Beam, SbufIn, SectionBufConfig, SectionCmd,
+    frame_dims, section_beams, Beam, SbufIn, SectionBufConfig, SectionCmd,
 };
-use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::units::cube5_vol_fetch::{
-    dram_image, frame_axes, FetchCmd, FetchItem, VolFetch, VolFetchConfig,
+    dram_image, FetchCmd, FetchItem, VolFetch, VolFetchConfig,
 };
-use cube5_model::volume::Volume;
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{axi_mem_setup, axi_protocol_clean, configs, seed};
-
-fn random_volume(
-    p: usize,
-    b: usize,
-    voxel_w: u32,
-    edge: usize,
-    rng: &mut ChaCha8Rng,
-) -> (Volume, BlockLut) {
-    let dims = [0; 3].map(|_: usize| rng.random_range(1..=edge / p) * p);
-    let nb = dims.map(|n| n.div_ceil(b));
-    let zero: Vec<bool> = (0..nb.iter().product::<usize>())
-        .map(|_| rng.random_bool(0.3))
-        .collect();
-    let max = (1u32 << voxel_w) - 1;
-    let mut data = Vec::new();
-    for z in 0..dims[2] {
-        for y in 0..dims[1] {
-            for x in 0..dims[0] {
-                let blk = x / b + nb[0] * (y / b + nb[1] * (z / b));
-                data.push(if zero[blk] {
-                    0
-                } else {
-                    rng.random_range(1..=max) as u16
-                });
-            }
-        }
-    }
-    let vol = Volume::new(dims, [1.0; 3], voxel_w, data).unwrap();
-    let mut lut = BlockLut::from_volume(&vol, b, 0).unwrap();
-    for e in &mut lut.entries {
-        e.masked = rng.random_bool(0.1);
-    }
-    (vol, lut)
-}
+use support::{axi_mem_setup, axi_protocol_clean, configs, random_blocked_volume, seed};
 
 #[test]
 fn dram_to_beams_through_both_rtl_units() {
@@ -86,13 +50,9 @@ fn one_case(
 ) {
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let edge = fcfg.max_dim.min(scfg.max_dim).min(48) as usize;
-    let (vol, lut) = random_volume(
-        scfg.p as usize,
-        scfg.block_dim as usize,
-        scfg.voxel_w,
-        edge,
-        &mut rng,
-    );
+    let p = scfg.p as usize;
+    let dims = [0; 3].map(|_: usize| rng.random_range(1..=edge / p) * p);
+    let (vol, lut) = random_blocked_volume(dims, scfg.block_dim, scfg.voxel_w, &mut rng);
     let bbus = u64::from(fcfg.data_w / 8);
     let base = rng.random_range(0..4096 / bbus) * bbus;
     let img = dram_image(&vol, &lut, base).unwrap();
@@ -100,9 +60,7 @@ fn one_case(
     let mut cmds = Vec::new();
     for _ in 0..4 {
         let axis_k = rng.random_range(0..3u32);
-        let (ai, aj) = frame_axes(axis_k);
-        let d = vol.dims;
-        let fd = [d[ai], d[aj], d[axis_k as usize]].map(|n| n as u32);
+        let fd = frame_dims(vol.dims, axis_k);
         let reversed = rng.random_bool(0.5);
         for a0 in (0..fd[0]).step_by(scfg.section as usize) {
             cmds.push(SectionCmd {

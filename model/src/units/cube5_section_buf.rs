@@ -10,7 +10,9 @@ use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
 use crate::unit::StreamCodec;
 use crate::units::cube5_skewmem::BlockLut;
-use crate::units::cube5_vol_fetch::{frame_axes, FetchItem, Sweep};
+use crate::units::cube5_vol_fetch::{
+    dram_image, frame_axes, FetchCmd, FetchItem, Sweep, VolFetch, VolFetchConfig,
+};
 use crate::volume::Volume;
 
 /// The RTL parameters of one `cube5_section_buf` configuration.
@@ -38,33 +40,51 @@ impl SectionBufConfig {
         section: 16,
     };
 
+    /// P, VoxelW, MaxDim and BlockDim have the ranges of `cube5_vol_fetch`, whose items the unit
+    /// takes (checked by its configuration); Section is the unit's own.
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("cube5_section_buf: {what}")));
-        if ![1, 2, 4, 8].contains(&self.p) {
-            return bad(format!("P {} is not 1, 2, 4 or 8", self.p));
+        if let Err(e) = self.fetch().validate() {
+            return bad(e.to_string());
         }
-        if !(4..=16).contains(&self.voxel_w) {
-            return bad(format!("VoxelW {} outside 4..=16", self.voxel_w));
-        }
-        if !self.max_dim.is_power_of_two() || !(8..=1024).contains(&self.max_dim) {
-            return bad(format!(
-                "MaxDim {} is not a power of two in 8..=1024",
-                self.max_dim
-            ));
-        }
-        let b = self.block_dim;
-        if !b.is_power_of_two() || b < self.p.max(2) || b > 16 || b >= self.max_dim {
-            return bad(format!(
-                "BlockDim {b} is not a power of two with max(2, P) <= B <= 16 and B < MaxDim"
-            ));
-        }
-        let s = self.section;
+        let (b, s) = (self.block_dim, self.section);
         if !s.is_power_of_two() || s < b || s >= self.max_dim {
             return bad(format!(
                 "Section {s} is not a power of two with BlockDim <= S < MaxDim"
             ));
         }
         Ok(())
+    }
+
+    /// A `cube5_vol_fetch` whose items feed this unit: the same P, voxel width, largest edge and
+    /// block edge, a bus of `2P` bytes (the sweep's demand) and the fetch's other defaults.
+    pub fn fetch(&self) -> VolFetchConfig {
+        VolFetchConfig {
+            p: self.p,
+            voxel_w: self.voxel_w,
+            max_dim: self.max_dim,
+            block_dim: self.block_dim,
+            data_w: 16 * self.p,
+            ..VolFetchConfig::DEFAULT
+        }
+    }
+
+    /// The inputs of section `cmd` of `vol` (LUT `lut`): the command, then the items the fetch
+    /// model delivers for `sweep(cmd)` from the volume's memory image.
+    pub fn section_inputs(
+        &self,
+        vol: &Volume,
+        lut: &BlockLut,
+        cmd: &SectionCmd,
+    ) -> Result<Vec<SbufIn>> {
+        let f = self.fetch();
+        let img = dram_image(vol, lut, 0)?;
+        let mut cmds = f.lut_writes(lut)?;
+        cmds.push(FetchCmd::Sweep(self.sweep(cmd, 0)));
+        let items = VolFetch::new(f)?.run(&cmds, &img)?.items;
+        let mut input = vec![SbufIn::Section(*cmd)];
+        input.extend(items.into_iter().map(SbufIn::Item));
+        Ok(input)
     }
 
     /// `m = log2 MaxDim`.
@@ -126,6 +146,12 @@ impl SectionBufConfig {
         }
         .with_anchor_section(b, cmd.a0, self.section)
     }
+}
+
+/// The sizes `(ni, nj, nk)` in frame axes of a volume of `dims` swept along `axis_k` (0..=2).
+pub fn frame_dims(dims: [usize; 3], axis_k: u32) -> [u32; 3] {
+    let (ai, aj) = frame_axes(axis_k);
+    [dims[ai], dims[aj], dims[axis_k as usize]].map(|n| n as u32)
 }
 
 /// A section command: frame axes (`axis_k`, direction), sizes `(ni, nj, nk)` in frame axes, and
@@ -530,34 +556,6 @@ crate::unit_config!(SectionBufConfig, "cube5_section_buf", DEFAULT, {
 mod tests {
     use super::*;
     use crate::phantom::head_phantom;
-    use crate::units::cube5_vol_fetch::{dram_image, FetchCmd, VolFetch, VolFetchConfig};
-
-    /// The fetch model's items for `cmd` over `vol` (LUT from the volume at `threshold`).
-    fn fetched(
-        c: &SectionBufConfig,
-        vol: &Volume,
-        lut: &BlockLut,
-        cmd: &SectionCmd,
-    ) -> Vec<FetchItem> {
-        let f = VolFetchConfig {
-            p: c.p,
-            voxel_w: c.voxel_w,
-            max_dim: c.max_dim,
-            block_dim: c.block_dim,
-            data_w: 16 * c.p,
-            ..VolFetchConfig::DEFAULT
-        };
-        let img = dram_image(vol, lut, 0).unwrap();
-        let mut unit = VolFetch::new(f).unwrap();
-        let mut cmds = f.lut_writes(lut).unwrap();
-        cmds.push(FetchCmd::Sweep(c.sweep(cmd, 0)));
-        unit.run(&cmds, &img).unwrap().items
-    }
-
-    fn frame_dims(dims: [usize; 3], axis_k: u32) -> [u32; 3] {
-        let (ai, aj) = frame_axes(axis_k);
-        [dims[ai], dims[aj], dims[axis_k as usize]].map(|n| n as u32)
-    }
 
     /// DRAM -> fetch model -> section buffer model equals the beams read from the volume, for
     /// every axis both ways, every section of the face, P = 1 .. 8, with empty blocks.
@@ -604,9 +602,7 @@ mod tests {
                             dims,
                             a0,
                         };
-                        let mut input = vec![SbufIn::Section(cmd)];
-                        input.extend(fetched(&c, &vol, &lut, &cmd).into_iter().map(SbufIn::Item));
-                        let got = unit.run(&input);
+                        let got = unit.run(&c.section_inputs(&vol, &lut, &cmd).unwrap());
                         let want = section_beams(&c, &vol, &lut, &cmd).unwrap();
                         assert_eq!(got.len(), want.len());
                         for (k, (g, w)) in got.iter().zip(&want).enumerate() {
