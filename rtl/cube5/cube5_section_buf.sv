@@ -9,7 +9,7 @@
 //   in ─► accept: decode (i, j, k) of lane 0 ─► w1 ─► per bank: rotate by (ci + j + lk) mod P ─► w2
 //         present flags (per half, block)                     ▼ write            (edges: 3 x P banks)
 //                                                   P banks x 2 halves ──► read (slice, row, beat)
-//   out ◄── FIFO (4) ◄── rotate back by (j + lk) mod P, zero blocks not present ◄── d ◄── issue
+//   out ◄── FIFO (8) ◄── rotate back by (j + lk) mod P, zero blocks not present ◄── d2 ◄── d ◄── issue
 module cube5_section_buf #(
   /// Voxels per item and per beam.
   parameter int unsigned P = 4,
@@ -72,7 +72,8 @@ module cube5_section_buf #(
   localparam int unsigned LSP       = $clog2(SP);
   localparam int unsigned CiW       = M + 3;                     // signed column, -MaxDim..2 MaxDim
   localparam int unsigned KW        = BW + 1;                    // slices of a slab, 0..B
-  localparam int unsigned FifoDepth = 4;
+  localparam int unsigned FifoDepth = 8;
+  localparam int unsigned FifoW     = $clog2(FifoDepth);
 
   if (P != 1 && P != 2 && P != 4 && P != 8) begin : gen_bad_p
     $fatal(1, "cube5_section_buf: P must be 1, 2, 4 or 8");
@@ -469,8 +470,8 @@ module cube5_section_buf #(
   logic [M-1:0]  rj_q, rj_d;
   logic [MW-1:0] rm_q, rm_d;
 
-  logic [2:0] fcnt_q;
-  logic       dv_q;
+  logic [FifoW:0] fcnt_q;
+  logic           dv_q, dv2_q;
   logic       issue, r_err, r_last_slab, r_rev, m_last, j_last, n_last, slab_done;
   logic [KW-1:0]   r_nkl;
   logic [DimW-1:0] r_ns, r_nj;
@@ -487,7 +488,7 @@ module cube5_section_buf #(
     j_last      = (DimW'(rj_q) + DimW'(1) == r_nj);
     n_last      = (rn_q + KW'(1) == r_nkl);
     slab_done   = r_err || (m_last && j_last && n_last);
-    issue       = full_q[rh_q] && (32'(fcnt_q) + 32'(dv_q) < FifoDepth);
+    issue       = full_q[rh_q] && (32'(fcnt_q) + 32'(dv_q) + 32'(dv2_q) < FifoDepth);
   end
 
   always_comb begin
@@ -608,15 +609,21 @@ module cube5_section_buf #(
   // Data stage: rotate back, zero what is not present, into the output FIFO
   // ==============================================================================================
 
-  logic [PW-1:0] drot_q, debank_q;
-  logic          dlane_q, dlo_q, dhi0_q, dhi1_q;
-  logic [4:0]    dflags_q;                          // row_first, row_last, slice_last, last, error
+  // Stage d: the banks' (unregistered) outputs; stage d2: them registered (the block RAMs'
+  // clock-to-output and the routing from them is a cycle of its own), then rotation and masks.
+  logic [PW-1:0] drot_q, debank_q, drot_q2, debank_q2;
+  logic          dlane_q, dlo_q, dhi0_q, dhi1_q, dlane_q2, dlo_q2, dhi0_q2, dhi1_q2;
+  logic [4:0]    dflags_q, dflags_q2;               // row_first, row_last, slice_last, last, error
+  logic [P*VoxelW-1:0]   bank_q2;
+  logic [3*P*VoxelW-1:0] edge_q2;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
-      dv_q <= 1'b0;
+      dv_q  <= 1'b0;
+      dv2_q <= 1'b0;
     end else begin
-      dv_q <= issue;
+      dv_q  <= issue;
+      dv2_q <= dv_q;
     end
   end
   always_ff @(posedge clk_i) begin
@@ -626,6 +633,15 @@ module cube5_section_buf #(
     dlo_q    <= r_lo_ok;
     dhi0_q   <= r_hi0_ok;
     dhi1_q   <= r_hi1_ok;
+    drot_q2   <= drot_q;
+    debank_q2 <= debank_q;
+    dlane_q2  <= dlane_q;
+    dlo_q2    <= dlo_q;
+    dhi0_q2   <= dhi0_q;
+    dhi1_q2   <= dhi1_q;
+    dflags_q2 <= dflags_q;
+    bank_q2   <= bank_rd;
+    edge_q2   <= edge_rd;
     dflags_q <= {r_err,
                  r_err || (slab_done && r_last_slab),
                  !r_err && m_last && j_last,
@@ -635,7 +651,7 @@ module cube5_section_buf #(
 
   // At P = 1 the rotation is the identity.
   logic unused_rot;
-  assign unused_rot = ^drot_q;
+  assign unused_rot = ^drot_q2;
 
   logic [OutW-1:0] beam;
   always_comb begin
@@ -643,31 +659,31 @@ module cube5_section_buf #(
     beam = '0;
     for (int unsigned l = 0; l < P; l++) begin
       for (int unsigned b = 0; b < P; b++) begin
-        if (dlane_q && ((l + 32'(drot_q)) & (P - 1)) == b) begin
-          beam[l * VoxelW +: VoxelW] = bank_rd[b * VoxelW +: VoxelW];
+        if (dlane_q2 && ((l + 32'(drot_q2)) & (P - 1)) == b) begin
+          beam[l * VoxelW +: VoxelW] = bank_q2[b * VoxelW +: VoxelW];
         end
       end
     end
     for (int unsigned e = 0; e < P; e++) begin
-      if (32'(debank_q) == e) begin
-        if (dlo_q)  beam[P * VoxelW +: VoxelW]       = edge_rd[e * VoxelW +: VoxelW];
-        if (dhi0_q) beam[(P + 1) * VoxelW +: VoxelW] = edge_rd[(P + e) * VoxelW +: VoxelW];
-        if (dhi1_q) beam[(P + 2) * VoxelW +: VoxelW] = edge_rd[(2 * P + e) * VoxelW +: VoxelW];
+      if (32'(debank_q2) == e) begin
+        if (dlo_q2)  beam[P * VoxelW +: VoxelW]       = edge_q2[e * VoxelW +: VoxelW];
+        if (dhi0_q2) beam[(P + 1) * VoxelW +: VoxelW] = edge_q2[(P + e) * VoxelW +: VoxelW];
+        if (dhi1_q2) beam[(P + 2) * VoxelW +: VoxelW] = edge_q2[(2 * P + e) * VoxelW +: VoxelW];
       end
     end
-    beam[(P + 3) * VoxelW +: 5]      = dflags_q;
+    beam[(P + 3) * VoxelW +: 5]      = dflags_q2;
   end
 
   // Output FIFO (FifoDepth entries); the issue credit keeps room for every beam in flight.
   logic [OutW-1:0] fifo_q [FifoDepth];
-  logic [1:0]      fwr_q, frd_q;
+  logic [FifoW-1:0] fwr_q, frd_q;
   logic            pop;
   assign out_valid_o = (fcnt_q != '0);
   assign out_data_o  = fifo_q[frd_q];
   assign pop         = out_valid_o && out_ready_i;
 
   always_ff @(posedge clk_i) begin
-    if (dv_q) fifo_q[fwr_q] <= beam;
+    if (dv2_q) fifo_q[fwr_q] <= beam;
   end
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -675,9 +691,9 @@ module cube5_section_buf #(
       fwr_q  <= '0;
       frd_q  <= '0;
     end else begin
-      fcnt_q <= fcnt_q + 3'(dv_q) - 3'(pop);
-      fwr_q  <= fwr_q + 2'(dv_q);
-      frd_q  <= frd_q + 2'(pop);
+      fcnt_q <= fcnt_q + (FifoW + 1)'(dv2_q) - (FifoW + 1)'(pop);
+      fwr_q  <= fwr_q + FifoW'(dv2_q);
+      frd_q  <= frd_q + FifoW'(pop);
     end
   end
 
@@ -689,7 +705,7 @@ module cube5_section_buf #(
       (|w2we_q || |e2we_q) |-> !full_q[w2half_q])
     else $error("cube5_section_buf: a write into a half that is being read");
   a_fifo_room: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      dv_q |-> (fcnt_q < 3'(FifoDepth)) || pop)
+      dv2_q |-> (fcnt_q < (FifoW + 1)'(FifoDepth)) || pop)
     else $error("cube5_section_buf: output FIFO overflow");
 `endif
 

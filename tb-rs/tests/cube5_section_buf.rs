@@ -610,7 +610,7 @@ fn gate_level_smoke() {
 /// The acceptance figure (docs/adding-a-unit.md): over 1,000,000 inputs per configuration, every
 /// third case reset in mid-stream.
 #[test]
-#[ignore = "sim-full: a million inputs per configuration, minutes of simulation"]
+#[ignore = "sim-full: a million inputs per configuration, about 30 s of simulation (CI keeps a unit to a few seconds)"]
 fn a_million_random_inputs_per_config() {
     for (i, (variant, cfg)) in configs::<SectionBufConfig>().into_iter().enumerate() {
         let mut inputs = 0u64;
