@@ -6,10 +6,11 @@
 // while slab t is read. P banks with voxel (ci, j, lk) in bank (ci + j + lk) mod P: an item
 // writes every bank at most once, a beam reads every bank once (conflict-free, [37]).
 //
-//   in ─► accept: decode (i, j, k) of lane 0 ─► w1 ─► per bank: rotate by (ci + j + lk) mod P ─► w2
-//         present flags (per half, block)                     ▼ write            (edges: 3 x P banks)
-//                                                   P banks x 2 halves ──► read (slice, row, beat)
-//   out ◄── FIFO (8) ◄── rotate back by (j + lk) mod P, zero blocks not present ◄── d2 ◄── d ◄── issue
+//   in ─► accept: (i, j, k) of lane 0 ─► w1 ─► per lane: column, address ─► wb
+//         present flags (a word per block row)      ─► per bank: rotate by (ci + j + lk) mod P ─► w2
+//                                                              ▼ write     (edges: 3 x P banks)
+//                                            P banks x 2 halves ──► read (slice, row, beat)
+//   out ◄── FIFO (8) ◄── rotate back by (j + lk) mod P, zero absent blocks ◄── d2 ◄── d ◄── issue
 module cube5_section_buf #(
   /// Voxels per item and per beam.
   parameter int unsigned P = 4,
@@ -401,6 +402,40 @@ module cube5_section_buf #(
   end
 
   // ==============================================================================================
+  // Write stage b: the lanes' decisions and addresses registered (the column compares and the
+  // address adders are one cycle, the rotation into the banks the next)
+  // ==============================================================================================
+
+  logic                wb_q, wbclose_q, wbhalf_q;
+  logic [P-1:0]        wbmain_q;
+  logic [3*P-1:0]      wbedge_q;
+  logic [P*BAW-1:0]    wbmaddr_q;
+  logic [P*EAW-1:0]    wbeaddr_q;
+  logic [P*PW-1:0]     wbebank_q;
+  logic [PW-1:0]       wbrot_q;
+  logic [P*VoxelW-1:0] wblanes_q;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      wb_q      <= 1'b0;
+      wbclose_q <= 1'b0;
+    end else begin
+      wb_q      <= w1_q;
+      wbclose_q <= w1close_q;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    wbhalf_q  <= w1half_q;
+    wbmain_q  <= l_main;
+    wbedge_q  <= l_edge;
+    wbmaddr_q <= l_maddr;
+    wbeaddr_q <= l_eaddr;
+    wbebank_q <= l_ebank;
+    wbrot_q   <= w1rot;
+    wblanes_q <= w1lanes_q;
+  end
+
+  // ==============================================================================================
   // Write stage 2: per bank, the lane it takes (registered in front of the RAMs)
   // ==============================================================================================
 
@@ -419,23 +454,23 @@ module cube5_section_buf #(
     w2data_d = '0;
     for (int unsigned b = 0; b < P; b++) begin
       for (int unsigned l = 0; l < P; l++) begin
-        if (((l + 32'(w1rot)) & (P - 1)) == b) begin
-          w2we_d[b] = w1_q && l_main[l];
-          w2addr_d[b * BAW +: BAW]       = l_maddr[l * BAW +: BAW];
-          w2data_d[b * VoxelW +: VoxelW] = w1lanes_q[l * VoxelW +: VoxelW];
+        if (((l + 32'(wbrot_q)) & (P - 1)) == b) begin
+          w2we_d[b] = wb_q && wbmain_q[l];
+          w2addr_d[b * BAW +: BAW]       = wbmaddr_q[l * BAW +: BAW];
+          w2data_d[b * VoxelW +: VoxelW] = wblanes_q[l * VoxelW +: VoxelW];
         end
       end
     end
     for (int unsigned c = 0; c < 3; c++) begin
       for (int unsigned e = 0; e < P; e++) begin
         e2we_d[c * P + e] = 1'b0;
-        e2addr_d[(c * P + e) * EAW +: EAW]       = l_eaddr[0 +: EAW];
-        e2data_d[(c * P + e) * VoxelW +: VoxelW] = w1lanes_q[0 +: VoxelW];
+        e2addr_d[(c * P + e) * EAW +: EAW]       = wbeaddr_q[0 +: EAW];
+        e2data_d[(c * P + e) * VoxelW +: VoxelW] = wblanes_q[0 +: VoxelW];
         for (int unsigned l = 0; l < P; l++) begin
-          if (w1_q && l_edge[l * 3 + c] && l_ebank[l * PW +: PW] == PW'(e)) begin
+          if (wb_q && wbedge_q[l * 3 + c] && wbebank_q[l * PW +: PW] == PW'(e)) begin
             e2we_d[c * P + e] = 1'b1;
-            e2addr_d[(c * P + e) * EAW +: EAW]       = l_eaddr[l * EAW +: EAW];
-            e2data_d[(c * P + e) * VoxelW +: VoxelW] = w1lanes_q[l * VoxelW +: VoxelW];
+            e2addr_d[(c * P + e) * EAW +: EAW]       = wbeaddr_q[l * EAW +: EAW];
+            e2data_d[(c * P + e) * VoxelW +: VoxelW] = wblanes_q[l * VoxelW +: VoxelW];
           end
         end
       end
@@ -450,7 +485,7 @@ module cube5_section_buf #(
     end else begin
       w2we_q    <= w2we_d;
       e2we_q    <= e2we_d;
-      w2close_q <= w1close_q;
+      w2close_q <= wbclose_q;
     end
   end
   always_ff @(posedge clk_i) begin
@@ -458,7 +493,7 @@ module cube5_section_buf #(
     w2data_q <= w2data_d;
     e2addr_q <= e2addr_d;
     e2data_q <= e2data_d;
-    w2half_q <= w1half_q;
+    w2half_q <= wbhalf_q;
   end
 
   // ==============================================================================================
@@ -471,7 +506,8 @@ module cube5_section_buf #(
   logic [MW-1:0] rm_q, rm_d;
 
   logic [FifoW:0] fcnt_q;
-  logic           dv_q, dv2_q;
+  logic [FifoW:0] cred_q;                         // beams issued and not yet taken
+  logic           dv_q, dv2_q, pop;
   logic       issue, r_err, r_last_slab, r_rev, m_last, j_last, n_last, slab_done;
   logic [KW-1:0]   r_nkl;
   logic [DimW-1:0] r_ns, r_nj;
@@ -488,7 +524,7 @@ module cube5_section_buf #(
     j_last      = (DimW'(rj_q) + DimW'(1) == r_nj);
     n_last      = (rn_q + KW'(1) == r_nkl);
     slab_done   = r_err || (m_last && j_last && n_last);
-    issue       = full_q[rh_q] && (32'(fcnt_q) + 32'(dv_q) + 32'(dv2_q) < FifoDepth);
+    issue       = full_q[rh_q] && !cred_q[FifoW];   // fewer than FifoDepth in flight or stored
   end
 
   always_comb begin
@@ -517,7 +553,7 @@ module cube5_section_buf #(
   end
 
   // A half becomes full when the write of its slab's last item lands (w2), free at its last issue.
-  // The writer moves on when it closes a half (held); the reader sees it two cycles later (full).
+  // The writer moves on when it closes a half (held); the reader sees it three cycles later (full).
   always_comb begin
     full_d = full_q;
     held_d = held_q;
@@ -677,7 +713,6 @@ module cube5_section_buf #(
   // Output FIFO (FifoDepth entries); the issue credit keeps room for every beam in flight.
   logic [OutW-1:0] fifo_q [FifoDepth];
   logic [FifoW-1:0] fwr_q, frd_q;
-  logic            pop;
   assign out_valid_o = (fcnt_q != '0);
   assign out_data_o  = fifo_q[frd_q];
   assign pop         = out_valid_o && out_ready_i;
@@ -688,10 +723,12 @@ module cube5_section_buf #(
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
       fcnt_q <= '0;
+      cred_q <= '0;
       fwr_q  <= '0;
       frd_q  <= '0;
     end else begin
       fcnt_q <= fcnt_q + (FifoW + 1)'(dv2_q) - (FifoW + 1)'(pop);
+      cred_q <= cred_q + (FifoW + 1)'(issue) - (FifoW + 1)'(pop);
       fwr_q  <= fwr_q + FifoW'(dv2_q);
       frd_q  <= frd_q + FifoW'(pop);
     end
