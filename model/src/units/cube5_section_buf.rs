@@ -327,14 +327,14 @@ impl SectionBuf {
         if cmd
             .dims
             .iter()
-            .any(|&n| n < c.p || n > c.max_dim || n % c.p != 0)
+            .any(|&n| n < c.p || n > c.max_dim || !n.is_multiple_of(c.p))
         {
             return Some(format!(
                 "sizes {:?} not multiples of P = {} in P..={}",
                 cmd.dims, c.p, c.max_dim
             ));
         }
-        if cmd.a0 % c.section != 0 || cmd.a0 >= cmd.dims[0] {
+        if !cmd.a0.is_multiple_of(c.section) || cmd.a0 >= cmd.dims[0] {
             return Some(format!(
                 "first anchor {} is not a multiple of S = {} below ni = {}",
                 cmd.a0, c.section, cmd.dims[0]
