@@ -152,6 +152,21 @@ struct Report {
     inputs: u64,
     beams: u64,
     cycles: u64,
+    /// What the run did, for the log.
+    line: String,
+}
+
+impl Report {
+    fn described(mut self, variant: &'static Variant, seed: u64, what: &str) -> Self {
+        self.line = format!(
+            "{variant}: seed {seed}: {} inputs, {} beams in {} cycles ({:.3} beams/clock){what}",
+            self.inputs,
+            self.beams,
+            self.cycles,
+            self.beams as f64 / self.cycles.max(1) as f64,
+        );
+        self
+    }
 }
 
 /// Drives `input` into a fresh RTL instance and the model under `traffic`; with `reset_at`, resets
@@ -196,7 +211,7 @@ fn run(
             true,
             &mut report,
         )?;
-        return Ok(report);
+        return Ok(report.described(variant, seed, ""));
     };
     let taken = drive(
         variant,
@@ -224,7 +239,7 @@ fn run(
         true,
         &mut report,
     )?;
-    Ok(report)
+    Ok(report.described(variant, seed, ", reset once"))
 }
 
 /// Drives `input` for at most `limit` cycles and compares the beams that came out with `want`;
@@ -296,29 +311,11 @@ fn check_protocol(
     Ok(())
 }
 
-fn must(
-    variant: &'static Variant,
-    cfg: SectionBufConfig,
-    seed: u64,
-    input: &[SbufIn],
-    reference: Option<&[Beam]>,
-    traffic: &Traffic,
-    reset_at: Option<u64>,
-) -> Report {
-    match run(variant, cfg, seed, input, reference, traffic, reset_at) {
+/// A run's report, printed; a failure panics with the full mismatch report.
+fn must(run: Result<Report, TbError>) -> Report {
+    match run {
         Ok(r) => {
-            eprintln!(
-                "{variant}: seed {seed}: {} inputs, {} beams in {} cycles ({:.3} beams/clock){}",
-                r.inputs,
-                r.beams,
-                r.cycles,
-                r.beams as f64 / r.cycles.max(1) as f64,
-                if reset_at.is_some() {
-                    ", reset once"
-                } else {
-                    ""
-                }
-            );
+            eprintln!("{}", r.line);
             r
         }
         Err(e) => panic!("{e}"),
@@ -337,7 +334,7 @@ fn random_sections_under_idle_and_backpressure() {
             let (input, want) = random_inputs(cfg, 12, CI_EDGE, &mut rng);
             let stall = rng.random_range(0.0..0.6);
             let traffic = Traffic::random(&mut rng, 0.3, stall);
-            let r = must(variant, cfg, s, &input, Some(&want), &traffic, None);
+            let r = must(run(variant, cfg, s, &input, Some(&want), &traffic, None));
             assert!(
                 r.beams > 50,
                 "{variant}: the case delivers enough (seed {s})"
@@ -357,7 +354,7 @@ fn a_reset_in_mid_section_leaves_the_next_sections_exact() {
             let (input, _) = random_inputs(cfg, 6, CI_EDGE, &mut rng);
             let traffic = Traffic::random(&mut rng, 0.2, 0.3);
             let cut = rng.random_range(50..(input.len() as u64).max(100));
-            let r = must(variant, cfg, s, &input, None, &traffic, Some(cut));
+            let r = must(run(variant, cfg, s, &input, None, &traffic, Some(cut)));
             assert!(r.beams > 0, "{variant}: beams after the reset (seed {s})");
         }
     }
@@ -489,7 +486,7 @@ fn directed_extremes() {
         input.extend(bi);
         want.extend(bw);
         let traffic = Traffic::random(&mut rng, 0.3, 0.3);
-        must(variant, cfg, s, &input, Some(&want), &traffic, None);
+        must(run(variant, cfg, s, &input, Some(&want), &traffic, None));
     }
 }
 
@@ -594,23 +591,16 @@ fn gate_level_smoke() {
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let (input, want) = random_inputs(cfg, 8, CI_EDGE, &mut rng);
         let traffic = Traffic::random(&mut rng, 0.2, 0.2);
-        must(variant, cfg, s, &input, Some(&want), &traffic, None);
-        must(
-            variant,
-            cfg,
-            s,
-            &input,
-            None,
-            &traffic,
-            Some(input.len() as u64 / 2),
-        );
+        must(run(variant, cfg, s, &input, Some(&want), &traffic, None));
+        let half = Some(input.len() as u64 / 2);
+        must(run(variant, cfg, s, &input, None, &traffic, half));
     }
 }
 
 /// The acceptance figure (docs/adding-a-unit.md): over 1,000,000 inputs per configuration, every
 /// third case reset in mid-stream.
 #[test]
-#[ignore = "sim-full: a million inputs per configuration, about 30 s of simulation (CI keeps a unit to a few seconds)"]
+#[ignore = "sim-full: a million inputs per configuration, 10-40 s of simulation on the shared machine"]
 fn a_million_random_inputs_per_config() {
     for (i, (variant, cfg)) in configs::<SectionBufConfig>().into_iter().enumerate() {
         let mut inputs = 0u64;
@@ -622,9 +612,9 @@ fn a_million_random_inputs_per_config() {
             let traffic = Traffic::random(&mut rng, 0.2, 0.3);
             let r = if k % 3 == 2 {
                 let cut = rng.random_range(100..(input.len() as u64).max(200));
-                must(variant, cfg, s, &input, None, &traffic, Some(cut))
+                must(run(variant, cfg, s, &input, None, &traffic, Some(cut)))
             } else {
-                must(variant, cfg, s, &input, Some(&want), &traffic, None)
+                must(run(variant, cfg, s, &input, Some(&want), &traffic, None))
             };
             inputs += r.inputs;
             k += 1;
