@@ -325,39 +325,44 @@ fn must(run: Result<Report, TbError>) -> Report {
 /// The largest volume edge the CI runs use (the simulation time grows with the volume).
 const CI_EDGE: usize = 40;
 
-#[test]
-fn random_sections_under_idle_and_backpressure() {
+/// Three cases per configuration: `case(variant, cfg, seed, rng)` with seeds from `base`.
+fn three_cases(
+    base: u64,
+    mut case: impl FnMut(&'static Variant, SectionBufConfig, u64, &mut ChaCha8Rng),
+) {
     for (i, (variant, cfg)) in configs::<SectionBufConfig>().into_iter().enumerate() {
         for k in 0..3 {
-            let s = seed(100 + 10 * i as u64 + k);
-            let mut rng = ChaCha8Rng::seed_from_u64(s);
-            let (input, want) = random_inputs(cfg, 12, CI_EDGE, &mut rng);
-            let stall = rng.random_range(0.0..0.6);
-            let traffic = Traffic::random(&mut rng, 0.3, stall);
-            let r = must(run(variant, cfg, s, &input, Some(&want), &traffic, None));
-            assert!(
-                r.beams > 50,
-                "{variant}: the case delivers enough (seed {s})"
-            );
+            let s = seed(base + 10 * i as u64 + k);
+            case(variant, cfg, s, &mut ChaCha8Rng::seed_from_u64(s));
         }
     }
+}
+
+#[test]
+fn random_sections_under_idle_and_backpressure() {
+    three_cases(100, |variant, cfg, s, rng| {
+        let (input, want) = random_inputs(cfg, 12, CI_EDGE, rng);
+        let stall = rng.random_range(0.0..0.6);
+        let traffic = Traffic::random(rng, 0.3, stall);
+        let r = must(run(variant, cfg, s, &input, Some(&want), &traffic, None));
+        assert!(
+            r.beams > 50,
+            "{variant}: the case delivers enough (seed {s})"
+        );
+    });
 }
 
 /// A reset in the middle of a section: the beams before it are a prefix of the model's, the
 /// rest of the interrupted section's items are dropped, and the next sections are exact.
 #[test]
 fn a_reset_in_mid_section_leaves_the_next_sections_exact() {
-    for (i, (variant, cfg)) in configs::<SectionBufConfig>().into_iter().enumerate() {
-        for k in 0..3 {
-            let s = seed(200 + 10 * i as u64 + k);
-            let mut rng = ChaCha8Rng::seed_from_u64(s);
-            let (input, _) = random_inputs(cfg, 6, CI_EDGE, &mut rng);
-            let traffic = Traffic::random(&mut rng, 0.2, 0.3);
-            let cut = rng.random_range(50..(input.len() as u64).max(100));
-            let r = must(run(variant, cfg, s, &input, None, &traffic, Some(cut)));
-            assert!(r.beams > 0, "{variant}: beams after the reset (seed {s})");
-        }
-    }
+    three_cases(200, |variant, cfg, s, rng| {
+        let (input, _) = random_inputs(cfg, 6, CI_EDGE, rng);
+        let traffic = Traffic::random(rng, 0.2, 0.3);
+        let cut = rng.random_range(50..(input.len() as u64).max(100));
+        let r = must(run(variant, cfg, s, &input, None, &traffic, Some(cut)));
+        assert!(r.beams > 0, "{variant}: beams after the reset (seed {s})");
+    });
 }
 
 /// Every axis both ways, every section of the face (the first without a left column, the last
