@@ -142,7 +142,9 @@ module cube5_section_buf #(
   logic            rev_q, rev_d;
   logic [DimW-1:0] ni_q, ni_d, nj_q, nj_d, nk_q, nk_d, ns_q, ns_d;
   logic [M-1:0]    a0_q, a0_d;
-  logic [NbCW-1:0] nbj_q, nbj_d, nbk_q, nbk_d, sechi_q, sechi_d, t_q, t_d;
+  // Block counts minus one and the present-column offset a0 / B - 1, so the per-item compares
+  // on the acceptance path need no adder.
+  logic [NbCW-1:0] nbj1_q, nbj1_d, nbk1_q, nbk1_d, sechi1_q, sechi1_d, pofs_q, pofs_d, t_q, t_d;
   logic            wh_q, wh_d;                // the half being filled
 
   logic [1:0] full_q, full_d;                 // half h holds a slab (or an error) to read
@@ -193,7 +195,7 @@ module cube5_section_buf #(
   assign unused_k = ^k0[M-1:BW];
 
   logic item_close;                           // the item closes its slab
-  assign item_close = (NbCW'(bj0) + NbCW'(1) == nbj_q) && (NbCW'(bi0) + NbCW'(1) == sechi_q)
+  assign item_close = (NbCW'(bj0) == nbj1_q) && (NbCW'(bi0) == sechi1_q)
                    && (it_skip || it_word == WordW'(Groups - 1));
 
   // Slab t's slices: bk = reversed ? nbk - 1 - t : t, nkl = min(B, nk - B bk).
@@ -201,7 +203,7 @@ module cube5_section_buf #(
   logic [DimW-1:0] rest_k;
   logic [KW-1:0]   nkl_w;
   always_comb begin
-    bk_w   = rev_q ? nbk_q - NbCW'(1) - t_q : t_q;
+    bk_w   = rev_q ? nbk1_q - t_q : t_q;
     rest_k = nk_q - DimW'(32'(bk_w) << BW);
     nkl_w  = (rest_k > DimW'(BlockDim)) ? KW'(BlockDim) : KW'(rest_k);
   end
@@ -215,9 +217,10 @@ module cube5_section_buf #(
     nk_d      = nk_q;
     ns_d      = ns_q;
     a0_d      = a0_q;
-    nbj_d     = nbj_q;
-    nbk_d     = nbk_q;
-    sechi_d   = sechi_q;
+    nbj1_d    = nbj1_q;
+    nbk1_d    = nbk1_q;
+    sechi1_d  = sechi1_q;
+    pofs_d    = pofs_q;
     t_d       = t_q;
     wh_d      = wh_q;
     if (cmd_fire) begin
@@ -229,9 +232,10 @@ module cube5_section_buf #(
       nk_d      = cm_nk;
       ns_d      = cm_ns;
       a0_d      = cm_a0;
-      nbj_d     = NbCW'((cm_nj + DimW'(BlockDim - 1)) >> BW);
-      nbk_d     = NbCW'((cm_nk + DimW'(BlockDim - 1)) >> BW);
-      sechi_d   = (cm_sechi_cap < cm_nbi) ? cm_sechi_cap : cm_nbi;
+      nbj1_d    = NbCW'((cm_nj + DimW'(BlockDim - 1)) >> BW) - NbCW'(1);
+      nbk1_d    = NbCW'((cm_nk + DimW'(BlockDim - 1)) >> BW) - NbCW'(1);
+      sechi1_d  = ((cm_sechi_cap < cm_nbi) ? cm_sechi_cap : cm_nbi) - NbCW'(1);
+      pofs_d    = NbCW'(cm_a0 >> BW) - NbCW'(1);
       t_d       = '0;
       if (cm_refused) wh_d = !wh_q;            // the error takes a half
     end
@@ -239,7 +243,7 @@ module cube5_section_buf #(
       if (item_close) begin
         wh_d = !wh_q;
         t_d  = t_q + NbCW'(1);
-        if (t_q + NbCW'(1) == nbk_q) act_d = 1'b0;
+        if (t_q == nbk1_q) act_d = 1'b0;
       end
     end
   end
@@ -264,9 +268,10 @@ module cube5_section_buf #(
     nk_q    <= nk_d;
     ns_q    <= ns_d;
     a0_q    <= a0_d;
-    nbj_q   <= nbj_d;
-    nbk_q   <= nbk_d;
-    sechi_q <= sechi_d;
+    nbj1_q   <= nbj1_d;
+    nbk1_q   <= nbk1_d;
+    sechi1_q <= sechi1_d;
+    pofs_q   <= pofs_d;
   end
 
   // ==============================================================================================
@@ -284,7 +289,7 @@ module cube5_section_buf #(
   always_ff @(posedge clk_i) begin
     if (desc_we) begin
       de_err_q[wh_q]  <= desc_err;
-      de_last_q[wh_q] <= (t_q + NbCW'(1) == nbk_q);
+      de_last_q[wh_q] <= (t_q == nbk1_q);
       de_rev_q[wh_q]  <= rev_q;
       de_lo0_q[wh_q]  <= (a0_q == '0);
       de_hi00_q[wh_q] <= (DimW'(a0_q) + ns_q >= ni_q);
@@ -307,8 +312,8 @@ module cube5_section_buf #(
   logic             row_close, pres_we_q;
   logic [PresW-1:0] pres_waddr_q;
   logic [CB-1:0]    pres_wdata_q;
-  assign pcol      = NbCW'(bi0) + NbCW'(1) - NbCW'(a0_q >> BW);
-  assign row_close = (NbCW'(bi0) + NbCW'(1) == sechi_q)
+  assign pcol      = NbCW'(bi0) - pofs_q;
+  assign row_close = (NbCW'(bi0) == sechi1_q)
                   && (it_skip || it_word == WordW'(Groups - 1));
 
   always_comb begin
