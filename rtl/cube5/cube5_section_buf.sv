@@ -1,0 +1,754 @@
+// cube5_section_buf: the accelerator's section buffer (issue 12; docs/numerics/section_buf.md,
+// design in docs/accel.md; patent [37], [43], [54]-[57]). Takes cube5_vol_fetch's items of one
+// section (slab by slab: B slices, block rows, block columns) and gives beams of P voxels along
+// the frame's i axis in the frame's order (slice, row, beat), with the edge voxels A0 - 1,
+// A0 + ns, A0 + ns + 1 beside each row's first and last beam. Two halves: slab t + 1 is written
+// while slab t is read. P banks with voxel (ci, j, lk) in bank (ci + j + lk) mod P: an item
+// writes every bank at most once, a beam reads every bank once (conflict-free, [37]).
+//
+//   in ─► accept: (i, j, k) of lane 0 ─► w1 ─► per lane: column, address ─► wb
+//         present flags (a word per block row)      ─► per bank: rotate by (ci + j + lk) mod P ─► w2
+//                                                              ▼ write     (edges: 3 x P banks)
+//                                            P banks x 2 halves ──► read (slice, row, beat)
+//   out ◄── FIFO (8) ◄── rotate back by (j + lk) mod P, zero absent blocks ◄── d2 ◄── d ◄── issue
+module cube5_section_buf #(
+  /// Voxels per item and per beam.
+  parameter int unsigned P = 4,
+  /// Voxel bits.
+  parameter int unsigned VoxelW = 12,
+  /// Largest volume edge (a power of two, 8..1024).
+  parameter int unsigned MaxDim = 64,
+  /// Block edge B: a power of two, max(2, P) <= B <= 16, B < MaxDim.
+  parameter int unsigned BlockDim = 8,
+  /// Section width S in anchors: a power of two, BlockDim <= S < MaxDim.
+  parameter int unsigned Section = 16
+) (
+  input  logic clk_i,
+  input  logic rst_ni,
+
+  /// Input valid.
+  input  logic in_valid_i,
+  /// The unit takes the input (low while the half being written is still full).
+  output logic in_ready_o,
+  /// op (1), then a fetch item {lanes, blk_x, blk_y, blk_z, word, skip, last, error, resp_err}
+  /// or a section command {axis_k, reversed, ni, nj, nk, a0}, LSB first.
+  input  logic [cube5_section_buf_pkg::in_w(P, VoxelW, MaxDim, BlockDim)-1:0] in_data_i,
+
+  /// Beam valid.
+  output logic out_valid_o,
+  /// Consumer takes the beam.
+  input  logic out_ready_i,
+  /// lanes (P x VoxelW), lo, hi0, hi1 (VoxelW each), row_first, row_last, slice_last, last,
+  /// error, LSB first.
+  output logic [cube5_section_buf_pkg::out_w(P, VoxelW)-1:0] out_data_o
+);
+  // ==============================================================================================
+  // Derived sizes
+  // ==============================================================================================
+
+  localparam int unsigned M         = $clog2(MaxDim);
+  localparam int unsigned DimW      = M + 1;
+  localparam int unsigned NbW       = cube5_vol_fetch_pkg::nb_w(MaxDim, BlockDim);
+  localparam int unsigned NbCW      = NbW + 1;
+  localparam int unsigned WordW     = cube5_vol_fetch_pkg::word_w(P, BlockDim);
+  localparam int unsigned InW       = cube5_section_buf_pkg::in_w(P, VoxelW, MaxDim, BlockDim);
+  localparam int unsigned OutW      = cube5_section_buf_pkg::out_w(P, VoxelW);
+  localparam int unsigned BW        = $clog2(BlockDim);
+  localparam int unsigned PW        = (P > 1) ? $clog2(P) : 1;   // a lane or bank number
+  localparam int unsigned SW        = $clog2(Section);
+  localparam int unsigned Groups    = BlockDim * BlockDim * BlockDim / P;
+  localparam int unsigned BPP       = BlockDim / P;              // P-groups per block row
+  localparam int unsigned SP        = Section / P;               // beats per full row
+  localparam int unsigned MW        = (SP > 1) ? $clog2(SP) : 1;
+  localparam int unsigned BankDepth = 2 * BlockDim * MaxDim * SP;
+  localparam int unsigned BAW       = $clog2(BankDepth);
+  localparam int unsigned EdgeDepth = 2 * MaxDim * BPP;
+  localparam int unsigned EAW       = $clog2(EdgeDepth);
+  localparam int unsigned NBR       = MaxDim / BlockDim;         // block rows of a slab
+  localparam int unsigned CB        = Section / BlockDim + 2;    // block columns of a slab
+  localparam int unsigned PresW     = 1 + NbW;                   // a present-flag row
+  // Every size is a power of two: products and quotients below are shifts (log2 of each).
+  localparam int unsigned LP        = $clog2(P);
+  localparam int unsigned LBPP      = $clog2(BPP);
+  localparam int unsigned LSP       = $clog2(SP);
+  localparam int unsigned CiW       = M + 3;                     // signed column, -MaxDim..2 MaxDim
+  localparam int unsigned KW        = BW + 1;                    // slices of a slab, 0..B
+  localparam int unsigned FifoDepth = 8;
+  localparam int unsigned FifoW     = $clog2(FifoDepth);
+
+  if (P != 1 && P != 2 && P != 4 && P != 8) begin : gen_bad_p
+    $fatal(1, "cube5_section_buf: P must be 1, 2, 4 or 8");
+  end
+  if (VoxelW < 4 || VoxelW > 16) begin : gen_bad_voxel_w
+    $fatal(1, "cube5_section_buf: VoxelW must be in 4..16");
+  end
+  if (MaxDim < 8 || MaxDim > 1024 || (1 << M) != MaxDim) begin : gen_bad_max_dim
+    $fatal(1, "cube5_section_buf: MaxDim must be a power of two in 8..1024");
+  end
+  if ((1 << BW) != BlockDim || BlockDim < 2 || BlockDim < P || BlockDim > 16
+      || BlockDim >= MaxDim) begin : gen_bad_block
+    $fatal(1, "cube5_section_buf: BlockDim must be a power of two, max(2, P) <= B <= 16, B < MaxDim");
+  end
+  if ((1 << SW) != Section || Section < BlockDim || Section >= MaxDim) begin : gen_bad_section
+    $fatal(1, "cube5_section_buf: Section must be a power of two, BlockDim <= Section < MaxDim");
+  end
+
+  // ==============================================================================================
+  // Input fields
+  // ==============================================================================================
+
+  localparam int unsigned ItBlk  = 1 + P * VoxelW;
+  localparam int unsigned ItWord = ItBlk + 3 * NbW;
+  localparam int unsigned ItSkip = ItWord + WordW;
+  localparam int unsigned CmdNi  = 4;
+  localparam int unsigned CmdA0  = CmdNi + 3 * DimW;
+
+  logic                op;
+  logic [P*VoxelW-1:0] it_lanes;
+  logic [NbW-1:0]      it_bx, it_by, it_bz;
+  logic [WordW-1:0]    it_word;
+  logic                it_skip, it_error;
+  logic [1:0]          cm_axis;
+  logic                cm_rev;
+  logic [DimW-1:0]     cm_ni, cm_nj, cm_nk;
+  logic [M-1:0]        cm_a0;
+  assign op       = in_data_i[0];
+  assign it_lanes = in_data_i[1 +: P * VoxelW];
+  assign it_bx    = in_data_i[ItBlk +: NbW];
+  assign it_by    = in_data_i[ItBlk + NbW +: NbW];
+  assign it_bz    = in_data_i[ItBlk + 2 * NbW +: NbW];
+  assign it_word  = in_data_i[ItWord +: WordW];
+  assign it_skip  = in_data_i[ItSkip];
+  assign it_error = in_data_i[ItSkip + 2];
+  assign cm_axis  = in_data_i[1 +: 2];
+  assign cm_rev   = in_data_i[3];
+  assign cm_ni    = in_data_i[CmdNi +: DimW];
+  assign cm_nj    = in_data_i[CmdNi + DimW +: DimW];
+  assign cm_nk    = in_data_i[CmdNi + 2 * DimW +: DimW];
+  assign cm_a0    = in_data_i[CmdA0 +: M];
+
+  // `last` and `resp_err` of an item are not used (docs/numerics/section_buf.md, "Protocol"); the
+  // bits above the longer payload are padding.
+  logic unused_in;
+  assign unused_in = ^{in_data_i[ItSkip + 1], in_data_i[ItSkip + 3 +: InW - ItSkip - 3],
+                       in_data_i[CmdA0 + M +: InW - CmdA0 - M]};
+
+  // ==============================================================================================
+  // Writer: the section being written, its slab counter and the half it fills
+  // ==============================================================================================
+
+  logic            act_q, act_d;             // a section is being written
+  logic [1:0]      axis_q, axis_d;
+  logic            rev_q, rev_d;
+  logic [DimW-1:0] ni_q, ni_d, nj_q, nj_d, nk_q, nk_d, ns_q, ns_d;
+  logic [M-1:0]    a0_q, a0_d;
+  // Block counts minus one and the present-column offset a0 / B - 1, so the per-item compares
+  // on the acceptance path need no adder.
+  logic [NbCW-1:0] nbj1_q, nbj1_d, nbk1_q, nbk1_d, sechi1_q, sechi1_d, pofs_q, pofs_d, t_q, t_d;
+  logic            wh_q, wh_d;                // the half being filled
+
+  logic [1:0] full_q, full_d;                 // half h holds a slab (or an error) to read
+  logic [1:0] held_q, held_d;                 // half h is closed (full, or its last write in flight)
+
+  logic in_fire, cmd_fire, item_fire;
+  assign in_ready_o = !held_q[wh_q];
+  assign in_fire    = in_valid_i && in_ready_o;
+  assign cmd_fire   = in_fire && op && !act_q;
+  assign item_fire  = in_fire && !op && act_q && !it_error;
+
+  // The command's checks and derived sizes.
+  logic            cm_refused;
+  logic [DimW-1:0] cm_ns, cm_rest, cm_n;
+  logic [NbCW-1:0] cm_nbi, cm_sechi_cap;
+  always_comb begin
+    cm_refused = (cm_axis == 2'd3) || (cm_a0[SW-1:0] != '0) || (DimW'(cm_a0) >= cm_ni);
+    for (int unsigned d = 0; d < 3; d++) begin
+      cm_n = (d == 0) ? cm_ni : ((d == 1) ? cm_nj : cm_nk);
+      if (cm_n == '0 || cm_n > DimW'(MaxDim) || (cm_n & DimW'(P - 1)) != '0) cm_refused = 1'b1;
+    end
+    cm_rest      = cm_ni - DimW'(cm_a0);
+    cm_ns        = (cm_rest > DimW'(Section)) ? DimW'(Section) : cm_rest;
+    cm_nbi       = NbCW'((cm_ni + DimW'(BlockDim - 1)) >> BW);
+    cm_sechi_cap = NbCW'(((DimW'(cm_a0) + DimW'(Section)) >> BW) + DimW'(1));
+  end
+
+  // Lane 0 of an item in volume and frame coordinates.
+  logic [M-1:0]    x0, y0, z0, i0, j0, k0;
+  logic [NbW-1:0]  bi0, bj0;
+  logic            axx0;                       // slice axis x: the lanes run along k
+  logic [31:0]     w;
+  always_comb begin
+    w  = 32'(it_word);
+    x0 = M'((32'(it_bx) << BW) | ((w & (BPP - 1)) << LP));
+    y0 = M'((32'(it_by) << BW) | ((w >> LBPP) & (BlockDim - 1)));
+    z0 = M'((32'(it_bz) << BW) | (w >> (LBPP + BW)));
+    unique case (axis_q)
+      2'd0:    begin i0 = y0; j0 = z0; k0 = x0; bi0 = it_by; bj0 = it_bz; end
+      2'd1:    begin i0 = x0; j0 = z0; k0 = y0; bi0 = it_bx; bj0 = it_bz; end
+      default: begin i0 = x0; j0 = y0; k0 = z0; bi0 = it_bx; bj0 = it_by; end
+    endcase
+    axx0 = (axis_q == 2'd0);
+  end
+
+  // Only the slice inside the slab (k mod B) is stored; the slab is the writer's counter.
+  logic unused_k;
+  assign unused_k = ^k0[M-1:BW];
+
+  logic item_close;                           // the item closes its slab
+  assign item_close = (NbCW'(bj0) == nbj1_q) && (NbCW'(bi0) == sechi1_q)
+                   && (it_skip || it_word == WordW'(Groups - 1));
+
+  // Slab t's slices: bk = reversed ? nbk - 1 - t : t, nkl = min(B, nk - B bk).
+  logic [NbCW-1:0] bk_w;
+  logic [DimW-1:0] rest_k;
+  logic [KW-1:0]   nkl_w;
+  always_comb begin
+    bk_w   = rev_q ? nbk1_q - t_q : t_q;
+    rest_k = nk_q - DimW'(32'(bk_w) << BW);
+    nkl_w  = (rest_k > DimW'(BlockDim)) ? KW'(BlockDim) : KW'(rest_k);
+  end
+
+  always_comb begin
+    act_d     = act_q;
+    axis_d    = axis_q;
+    rev_d     = rev_q;
+    ni_d      = ni_q;
+    nj_d      = nj_q;
+    nk_d      = nk_q;
+    ns_d      = ns_q;
+    a0_d      = a0_q;
+    nbj1_d    = nbj1_q;
+    nbk1_d    = nbk1_q;
+    sechi1_d  = sechi1_q;
+    pofs_d    = pofs_q;
+    t_d       = t_q;
+    wh_d      = wh_q;
+    if (cmd_fire) begin
+      act_d     = !cm_refused;
+      axis_d    = cm_axis;
+      rev_d     = cm_rev;
+      ni_d      = cm_ni;
+      nj_d      = cm_nj;
+      nk_d      = cm_nk;
+      ns_d      = cm_ns;
+      a0_d      = cm_a0;
+      nbj1_d    = NbCW'((cm_nj + DimW'(BlockDim - 1)) >> BW) - NbCW'(1);
+      nbk1_d    = NbCW'((cm_nk + DimW'(BlockDim - 1)) >> BW) - NbCW'(1);
+      sechi1_d  = ((cm_sechi_cap < cm_nbi) ? cm_sechi_cap : cm_nbi) - NbCW'(1);
+      pofs_d    = NbCW'(cm_a0 >> BW) - NbCW'(1);
+      t_d       = '0;
+      if (cm_refused) wh_d = !wh_q;            // the error takes a half
+    end
+    if (item_fire) begin
+      if (item_close) begin
+        wh_d = !wh_q;
+        t_d  = t_q + NbCW'(1);
+        if (t_q == nbk1_q) act_d = 1'b0;
+      end
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      act_q     <= 1'b0;
+      wh_q      <= 1'b0;
+      t_q       <= '0;
+    end else begin
+      act_q     <= act_d;
+      wh_q      <= wh_d;
+      t_q       <= t_d;
+    end
+  end
+  // Section registers: qualified by act_q.
+  always_ff @(posedge clk_i) begin
+    axis_q  <= axis_d;
+    rev_q   <= rev_d;
+    ni_q    <= ni_d;
+    nj_q    <= nj_d;
+    nk_q    <= nk_d;
+    ns_q    <= ns_d;
+    a0_q    <= a0_d;
+    nbj1_q   <= nbj1_d;
+    nbk1_q   <= nbk1_d;
+    sechi1_q <= sechi1_d;
+    pofs_q   <= pofs_d;
+  end
+
+  // ==============================================================================================
+  // Per-half descriptors (written with the slab's closing input, read while the half is full)
+  // ==============================================================================================
+
+  logic [1:0]      de_err_q, de_last_q, de_rev_q, de_lo0_q, de_hi00_q, de_hi10_q;
+  logic [KW-1:0]   de_nkl_q [2];
+  logic [DimW-1:0] de_ns_q [2], de_nj_q [2];
+
+  logic desc_we, desc_err;
+  assign desc_we  = (cmd_fire && cm_refused) || (item_fire && item_close);
+  assign desc_err = cmd_fire;
+
+  always_ff @(posedge clk_i) begin
+    if (desc_we) begin
+      de_err_q[wh_q]  <= desc_err;
+      de_last_q[wh_q] <= (t_q == nbk1_q);
+      de_rev_q[wh_q]  <= rev_q;
+      de_lo0_q[wh_q]  <= (a0_q == '0);
+      de_hi00_q[wh_q] <= (DimW'(a0_q) + ns_q >= ni_q);
+      de_hi10_q[wh_q] <= (DimW'(a0_q) + ns_q + DimW'(1) >= ni_q);
+      de_nkl_q[wh_q]  <= nkl_w;
+      de_ns_q[wh_q]   <= ns_q;
+      de_nj_q[wh_q]   <= nj_q;
+    end
+  end
+
+  // ==============================================================================================
+  // Present flags: a word of CB flags per block row of each half (LUT RAM). The items of a block
+  // row arrive together (block columns in order), so the row's flags gather in a register and
+  // are written once, with the row's closing item; every row of a slab is rewritten.
+  // ==============================================================================================
+
+  logic [NbCW-1:0]  pcol;                     // bi - (a0 / B - 1)
+  logic [CB-1:0]    pacc_q, pacc_d, pacc_next;
+  logic             popen_q, popen_d;         // a block row has begun
+  logic             row_close, pres_we_q;
+  logic [PresW-1:0] pres_waddr_q;
+  logic [CB-1:0]    pres_wdata_q;
+  assign pcol      = NbCW'(bi0) - pofs_q;
+  assign row_close = (NbCW'(bi0) == sechi1_q)
+                  && (it_skip || it_word == WordW'(Groups - 1));
+
+  always_comb begin
+    pacc_next = popen_q ? pacc_q : '0;
+    for (int unsigned c = 0; c < CB; c++) begin
+      if (!it_skip && pcol == NbCW'(c)) pacc_next[c] = 1'b1;
+    end
+    pacc_d  = pacc_q;
+    popen_d = popen_q;
+    if (item_fire) begin
+      pacc_d  = pacc_next;
+      popen_d = !row_close;
+    end
+    if (cmd_fire) popen_d = 1'b0;
+  end
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      popen_q   <= 1'b0;
+      pres_we_q <= 1'b0;
+    end else begin
+      popen_q   <= popen_d;
+      pres_we_q <= item_fire && row_close;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    pacc_q       <= pacc_d;
+    pres_waddr_q <= {wh_q, bj0};
+    pres_wdata_q <= pacc_next;
+  end
+
+  // Written in the cycle after the row's closing item (before its half is handed to the reader).
+  logic [CB-1:0] pres_mem [2 * NBR];
+  always_ff @(posedge clk_i) begin
+    if (pres_we_q) pres_mem[pres_waddr_q] <= pres_wdata_q;
+  end
+
+  // ==============================================================================================
+  // Write stage 1: the item's column, row and slice
+  // ==============================================================================================
+
+  logic                 w1_q, w1close_q, w1half_q, w1axx_q;
+  logic signed [CiW-1:0] w1ci_q;
+  logic [M-1:0]         w1j_q;
+  logic [BW-1:0]        w1lk_q;
+  logic [DimW-1:0]      w1ns_q;
+  logic [P*VoxelW-1:0]  w1lanes_q;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      w1_q      <= 1'b0;
+      w1close_q <= 1'b0;
+    end else begin
+      w1_q      <= item_fire && !it_skip;
+      w1close_q <= desc_we;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    w1half_q  <= wh_q;
+    w1axx_q   <= axx0;
+    w1ci_q    <= $signed(CiW'(i0)) - $signed(CiW'(a0_q));
+    w1j_q     <= j0;
+    w1lk_q    <= BW'(k0);
+    w1ns_q    <= ns_q;
+    w1lanes_q <= it_lanes;
+  end
+
+  // Per lane: column, slice, which store it goes to, its address there.
+  logic signed [CiW-1:0] ci_l, ns_s;
+  logic [BW-1:0]         lk_l;
+  logic [P-1:0]          l_main;
+  logic [3*P-1:0]        l_edge;                   // lane l, edge column c at l 3 + c
+  logic [P*BAW-1:0]      l_maddr;
+  logic [P*EAW-1:0]      l_eaddr;
+  logic [P*PW-1:0]       l_ebank;
+  logic [PW-1:0]         w1rot;
+  always_comb begin
+    ns_s = $signed(CiW'(w1ns_q));
+    for (int unsigned l = 0; l < P; l++) begin
+      ci_l = w1axx_q ? w1ci_q : w1ci_q + $signed(CiW'(l));
+      lk_l = w1axx_q ? w1lk_q + BW'(l) : w1lk_q;
+      l_main[l]           = (ci_l >= 0) && (ci_l < ns_s);
+      l_edge[l * 3 +: 3]  = {ci_l == ns_s + $signed(CiW'(1)), ci_l == ns_s,
+                             ci_l == -$signed(CiW'(1))};
+      l_maddr[l * BAW +: BAW] = BAW'((((((32'(w1half_q) << BW) | 32'(lk_l)) << M)
+                                      | 32'(w1j_q)) << LSP) | (32'(ci_l[CiW-2:0]) >> LP));
+      l_eaddr[l * EAW +: EAW] = EAW'((((32'(w1half_q) << M) | 32'(w1j_q)) << LBPP)
+                                     | (32'(lk_l) >> LP));
+      l_ebank[l * PW +: PW]   = PW'(32'(lk_l) & (P - 1));
+    end
+    w1rot = PW'((32'(w1ci_q[CiW-2:0]) + 32'(w1j_q) + 32'(w1lk_q)) & (P - 1));
+  end
+
+  // ==============================================================================================
+  // Write stage b: the lanes' decisions and addresses registered (the column compares and the
+  // address adders are one cycle, the rotation into the banks the next)
+  // ==============================================================================================
+
+  logic                wb_q, wbclose_q, wbhalf_q;
+  logic [P-1:0]        wbmain_q;
+  logic [3*P-1:0]      wbedge_q;
+  logic [P*BAW-1:0]    wbmaddr_q;
+  logic [P*EAW-1:0]    wbeaddr_q;
+  logic [P*PW-1:0]     wbebank_q;
+  logic [PW-1:0]       wbrot_q;
+  logic [P*VoxelW-1:0] wblanes_q;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      wb_q      <= 1'b0;
+      wbclose_q <= 1'b0;
+    end else begin
+      wb_q      <= w1_q;
+      wbclose_q <= w1close_q;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    wbhalf_q  <= w1half_q;
+    wbmain_q  <= l_main;
+    wbedge_q  <= l_edge;
+    wbmaddr_q <= l_maddr;
+    wbeaddr_q <= l_eaddr;
+    wbebank_q <= l_ebank;
+    wbrot_q   <= w1rot;
+    wblanes_q <= w1lanes_q;
+  end
+
+  // ==============================================================================================
+  // Write stage 2: per bank, the lane it takes (registered in front of the RAMs)
+  // ==============================================================================================
+
+  logic [P-1:0]          w2we_q, w2we_d;
+  logic [P*BAW-1:0]      w2addr_q, w2addr_d;
+  logic [P*VoxelW-1:0]   w2data_q, w2data_d;
+  logic [3*P-1:0]        e2we_q, e2we_d;          // edge column c, bank e at c P + e
+  logic [3*P*EAW-1:0]    e2addr_q, e2addr_d;
+  logic [3*P*VoxelW-1:0] e2data_q, e2data_d;
+  logic                  w2close_q, w2half_q;
+
+  always_comb begin
+    // Bank b takes lane (b - rot) mod P (loops over constant indices: no index arithmetic).
+    w2we_d   = '0;
+    w2addr_d = '0;
+    w2data_d = '0;
+    for (int unsigned b = 0; b < P; b++) begin
+      for (int unsigned l = 0; l < P; l++) begin
+        if (((l + 32'(wbrot_q)) & (P - 1)) == b) begin
+          w2we_d[b] = wb_q && wbmain_q[l];
+          w2addr_d[b * BAW +: BAW]       = wbmaddr_q[l * BAW +: BAW];
+          w2data_d[b * VoxelW +: VoxelW] = wblanes_q[l * VoxelW +: VoxelW];
+        end
+      end
+    end
+    for (int unsigned c = 0; c < 3; c++) begin
+      for (int unsigned e = 0; e < P; e++) begin
+        e2we_d[c * P + e] = 1'b0;
+        e2addr_d[(c * P + e) * EAW +: EAW]       = wbeaddr_q[0 +: EAW];
+        e2data_d[(c * P + e) * VoxelW +: VoxelW] = wblanes_q[0 +: VoxelW];
+        for (int unsigned l = 0; l < P; l++) begin
+          if (wb_q && wbedge_q[l * 3 + c] && wbebank_q[l * PW +: PW] == PW'(e)) begin
+            e2we_d[c * P + e] = 1'b1;
+            e2addr_d[(c * P + e) * EAW +: EAW]       = wbeaddr_q[l * EAW +: EAW];
+            e2data_d[(c * P + e) * VoxelW +: VoxelW] = wblanes_q[l * VoxelW +: VoxelW];
+          end
+        end
+      end
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      w2we_q    <= '0;
+      e2we_q    <= '0;
+      w2close_q <= 1'b0;
+    end else begin
+      w2we_q    <= w2we_d;
+      e2we_q    <= e2we_d;
+      w2close_q <= wbclose_q;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    w2addr_q <= w2addr_d;
+    w2data_q <= w2data_d;
+    e2addr_q <= e2addr_d;
+    e2data_q <= e2data_d;
+    w2half_q <= wbhalf_q;
+  end
+
+  // ==============================================================================================
+  // Reader: slices in sweep order, rows, beats; one beam read per clock
+  // ==============================================================================================
+
+  logic          rh_q, rh_d;
+  logic [KW-1:0] rn_q, rn_d;                      // slice of the slab, in sweep order
+  logic [M-1:0]  rj_q, rj_d;
+  logic [MW-1:0] rm_q, rm_d;
+
+  logic [FifoW:0] fcnt_q;
+  logic [FifoW:0] cred_q;                         // beams issued and not yet taken
+  logic           dv_q, dv2_q, pop;
+  logic       issue, r_err, r_last_slab, r_rev, m_last, j_last, n_last, slab_done;
+  logic [KW-1:0]   r_nkl;
+  logic [DimW-1:0] r_ns, r_nj;
+  logic [BW-1:0]   r_lk;
+  always_comb begin
+    r_err       = de_err_q[rh_q];
+    r_last_slab = de_last_q[rh_q];
+    r_rev       = de_rev_q[rh_q];
+    r_nkl       = de_nkl_q[rh_q];
+    r_ns        = de_ns_q[rh_q];
+    r_nj        = de_nj_q[rh_q];
+    r_lk        = r_rev ? BW'(r_nkl - KW'(1) - rn_q) : BW'(rn_q);
+    m_last      = (DimW'(rm_q) + DimW'(1) == (r_ns >> $clog2(P)));
+    j_last      = (DimW'(rj_q) + DimW'(1) == r_nj);
+    n_last      = (rn_q + KW'(1) == r_nkl);
+    slab_done   = r_err || (m_last && j_last && n_last);
+    issue       = full_q[rh_q] && !cred_q[FifoW];   // fewer than FifoDepth in flight or stored
+  end
+
+  always_comb begin
+    rh_d = rh_q;
+    rn_d = rn_q;
+    rj_d = rj_q;
+    rm_d = rm_q;
+    if (issue) begin
+      if (slab_done) begin
+        rh_d = !rh_q;
+        rn_d = '0;
+        rj_d = '0;
+        rm_d = '0;
+      end else if (m_last) begin
+        rm_d = '0;
+        if (j_last) begin
+          rj_d = '0;
+          rn_d = rn_q + KW'(1);
+        end else begin
+          rj_d = rj_q + M'(1);
+        end
+      end else begin
+        rm_d = rm_q + MW'(1);
+      end
+    end
+  end
+
+  // A half becomes full when the write of its slab's last item lands (w2), free at its last issue.
+  // The writer moves on when it closes a half (held); the reader sees it three cycles later (full).
+  always_comb begin
+    full_d = full_q;
+    held_d = held_q;
+    if (issue && slab_done) begin
+      full_d[rh_q] = 1'b0;
+      held_d[rh_q] = 1'b0;
+    end
+    if (w2close_q) full_d[w2half_q] = 1'b1;
+    if (desc_we) held_d[wh_q] = 1'b1;
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      rh_q   <= 1'b0;
+      rn_q   <= '0;
+      rj_q   <= '0;
+      rm_q   <= '0;
+      full_q <= '0;
+      held_q <= '0;
+    end else begin
+      rh_q   <= rh_d;
+      rn_q   <= rn_d;
+      rj_q   <= rj_d;
+      rm_q   <= rm_d;
+      full_q <= full_d;
+      held_q <= held_d;
+    end
+  end
+
+  // Read addresses, the rotation back, and the present flags of the beam and the row's edges.
+  logic [BAW-1:0] r_addr;
+  logic [EAW-1:0] r_eaddr;
+  logic [PW-1:0]  r_rot, r_ebank;
+  logic           r_lane_ok, r_lo_ok, r_hi0_ok, r_hi1_ok;
+  logic [CB-1:0]  r_pres;
+  always_comb begin
+    r_addr  = BAW'((((((32'(rh_q) << BW) | 32'(r_lk)) << M) | 32'(rj_q)) << LSP)
+                   | (32'(rm_q) & (SP - 1)));
+    r_eaddr = EAW'((((32'(rh_q) << M) | 32'(rj_q)) << LBPP) | (32'(r_lk) >> LP));
+    r_rot   = PW'((32'(rj_q) + 32'(r_lk)) & (P - 1));
+    r_ebank = PW'(32'(r_lk) & (P - 1));
+    r_pres  = pres_mem[{rh_q, rj_q[M-1:BW]}];
+    r_lane_ok = !r_err && r_pres[((32'(rm_q) << LP) >> BW) + 1];
+    r_lo_ok   = !r_err && (rm_q == '0) && !de_lo0_q[rh_q] && r_pres[0];
+    r_hi0_ok  = !r_err && m_last && !de_hi00_q[rh_q] && r_pres[(32'(r_ns) >> BW) + 1];
+    r_hi1_ok  = !r_err && m_last && !de_hi10_q[rh_q] && r_pres[((32'(r_ns) + 1) >> BW) + 1];
+  end
+
+  // ==============================================================================================
+  // The banks
+  // ==============================================================================================
+
+  logic [P*VoxelW-1:0]   bank_rd;
+  logic [3*P*VoxelW-1:0] edge_rd;
+
+  for (genvar b = 0; b < P; b++) begin : gen_bank
+    cube5_shader_ram #(
+      .Depth(BankDepth),
+      .Width(VoxelW),
+      .AddrW(BAW)
+    ) u_bank (
+      .clk_i  (clk_i),
+      .we_i   (w2we_q[b]),
+      .waddr_i(w2addr_q[b * BAW +: BAW]),
+      .wdata_i(w2data_q[b * VoxelW +: VoxelW]),
+      .re_i   (issue),
+      .raddr_i(r_addr),
+      .rdata_o(bank_rd[b * VoxelW +: VoxelW])
+    );
+  end
+
+  for (genvar e = 0; e < 3 * P; e++) begin : gen_edge
+    cube5_shader_ram #(
+      .Depth(EdgeDepth),
+      .Width(VoxelW),
+      .AddrW(EAW)
+    ) u_edge (
+      .clk_i  (clk_i),
+      .we_i   (e2we_q[e]),
+      .waddr_i(e2addr_q[e * EAW +: EAW]),
+      .wdata_i(e2data_q[e * VoxelW +: VoxelW]),
+      .re_i   (issue),
+      .raddr_i(r_eaddr),
+      .rdata_o(edge_rd[e * VoxelW +: VoxelW])
+    );
+  end
+
+  // ==============================================================================================
+  // Data stage: rotate back, zero what is not present, into the output FIFO
+  // ==============================================================================================
+
+  // Stage d: the banks' (unregistered) outputs; stage d2: them registered (the block RAMs'
+  // clock-to-output and the routing from them is a cycle of its own), then rotation and masks.
+  logic [PW-1:0] drot_q, debank_q, drot_q2, debank_q2;
+  logic          dlane_q, dlo_q, dhi0_q, dhi1_q, dlane_q2, dlo_q2, dhi0_q2, dhi1_q2;
+  logic [4:0]    dflags_q, dflags_q2;               // row_first, row_last, slice_last, last, error
+  logic [P*VoxelW-1:0]   bank_q2;
+  logic [3*P*VoxelW-1:0] edge_q2;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      dv_q  <= 1'b0;
+      dv2_q <= 1'b0;
+    end else begin
+      dv_q  <= issue;
+      dv2_q <= dv_q;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    drot_q   <= r_rot;
+    debank_q <= r_ebank;
+    dlane_q  <= r_lane_ok;
+    dlo_q    <= r_lo_ok;
+    dhi0_q   <= r_hi0_ok;
+    dhi1_q   <= r_hi1_ok;
+    drot_q2   <= drot_q;
+    debank_q2 <= debank_q;
+    dlane_q2  <= dlane_q;
+    dlo_q2    <= dlo_q;
+    dhi0_q2   <= dhi0_q;
+    dhi1_q2   <= dhi1_q;
+    dflags_q2 <= dflags_q;
+    bank_q2   <= bank_rd;
+    edge_q2   <= edge_rd;
+    dflags_q <= {r_err,
+                 r_err || (slab_done && r_last_slab),
+                 !r_err && m_last && j_last,
+                 !r_err && m_last,
+                 !r_err && (rm_q == '0)};
+  end
+
+  // At P = 1 the rotation is the identity.
+  logic unused_rot;
+  assign unused_rot = ^drot_q2;
+
+  logic [OutW-1:0] beam;
+  always_comb begin
+    // Lane l from bank (l + rot) mod P; edges from bank lk mod P (constant-index loops).
+    beam = '0;
+    for (int unsigned l = 0; l < P; l++) begin
+      for (int unsigned b = 0; b < P; b++) begin
+        if (dlane_q2 && ((l + 32'(drot_q2)) & (P - 1)) == b) begin
+          beam[l * VoxelW +: VoxelW] = bank_q2[b * VoxelW +: VoxelW];
+        end
+      end
+    end
+    for (int unsigned e = 0; e < P; e++) begin
+      if (32'(debank_q2) == e) begin
+        if (dlo_q2)  beam[P * VoxelW +: VoxelW]       = edge_q2[e * VoxelW +: VoxelW];
+        if (dhi0_q2) beam[(P + 1) * VoxelW +: VoxelW] = edge_q2[(P + e) * VoxelW +: VoxelW];
+        if (dhi1_q2) beam[(P + 2) * VoxelW +: VoxelW] = edge_q2[(2 * P + e) * VoxelW +: VoxelW];
+      end
+    end
+    beam[(P + 3) * VoxelW +: 5]      = dflags_q2;
+  end
+
+  // Output FIFO (FifoDepth entries); the issue credit keeps room for every beam in flight.
+  logic [OutW-1:0] fifo_q [FifoDepth];
+  logic [FifoW-1:0] fwr_q, frd_q;
+  assign out_valid_o = (fcnt_q != '0);
+  assign out_data_o  = fifo_q[frd_q];
+  assign pop         = out_valid_o && out_ready_i;
+
+  always_ff @(posedge clk_i) begin
+    if (dv2_q) fifo_q[fwr_q] <= beam;
+  end
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      fcnt_q <= '0;
+      cred_q <= '0;
+      fwr_q  <= '0;
+      frd_q  <= '0;
+    end else begin
+      fcnt_q <= fcnt_q + (FifoW + 1)'(dv2_q) - (FifoW + 1)'(pop);
+      cred_q <= cred_q + (FifoW + 1)'(issue) - (FifoW + 1)'(pop);
+      fwr_q  <= fwr_q + FifoW'(dv2_q);
+      frd_q  <= frd_q + FifoW'(pop);
+    end
+  end
+
+`ifndef SYNTHESIS
+  a_out_stable: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
+    else $error("cube5_section_buf: a stalled beam changed or vanished");
+  a_no_write_into_full: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      (|w2we_q || |e2we_q) |-> !full_q[w2half_q])
+    else $error("cube5_section_buf: a write into a half that is being read");
+  a_fifo_room: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      dv2_q |-> (fcnt_q < (FifoW + 1)'(FifoDepth)) || pop)
+    else $error("cube5_section_buf: output FIFO overflow");
+`endif
+
+endmodule
