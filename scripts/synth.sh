@@ -48,6 +48,10 @@ synth_one() {
   echo "synth: $top $name ($*)" >&2
   local t0=$SECONDS generic="-" fmax="n/a"
   local ecp5 ice40
+  # `bram`: memories too large for the generic flow (flip-flops) and the iCE40 parts: ECP5 alone.
+  if [[ ",$flags," == *,bram,* ]]; then
+    flow() { [[ "$1" == ecp5 && "$flows" == *,ecp5,* ]]; }
+  fi
   if flow generic; then
     yosys -q -e "$fatal" -l "$base.generic.log" -p "$prelude synth -flatten -top $top; stat" >/dev/null
     generic=$(awk '/Number of cells:/ {n = $4} END {print n}' "$base.generic.log")

@@ -22,7 +22,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 /// The flags a `.variants` line may carry.
-pub const FLAGS: &[&str] = &["gate", "mutant", "fmax", "fmax85", "sim"];
+pub const FLAGS: &[&str] = &["gate", "mutant", "fmax", "fmax85", "sim", "bram"];
 
 /// Words allowed as the leading token of a variant name (schemes that no single parameter
 /// initial says): the ray-bucketing schemes of `gicube_bucket`.
