@@ -465,8 +465,11 @@ impl SliceWork<'_> {
                         // `Compos::step`, spelled out so that it inlines here.
                         *cox = units.compos.step_coded(cox, &units.compos.code(&sample));
                     } else if let Some(flat) = self.flat {
+                        // The table's mode is `cmode`; a constant here, so that `step_coded`'s
+                        // other modes fold away.
                         let coded = CodedSample {
                             depth: self.depth,
+                            mode: cmode,
                             ..flat[idx]
                         };
                         *cox = units.compos.step_coded(cox, &coded);
