@@ -11,19 +11,9 @@ use cube5_model::units::cube5_warp;
 use std::path::Path;
 use std::time::Instant;
 
-/// CPU seconds of this process so far (all threads; Linux, 10 ms ticks): on a shared machine the
-/// CPU time of many frames says more than the wall time of the best.
-fn cpu_secs() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit(')').next().unwrap_or("");
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .map(|x| x.parse().unwrap_or(0.0))
-        .collect();
-    f.get(11)
-        .zip(f.get(12))
-        .map_or(0.0, |(u, s)| (u + s) / 100.0)
-}
+#[path = "support/cpu.rs"]
+mod cpu;
+use cpu::cpu_secs;
 
 /// Best wall ms and mean CPU ms of `n` runs of `f` (after one more), and its last output.
 fn best_ms<T>(n: usize, mut f: impl FnMut() -> T) -> ((f64, f64), T) {

@@ -820,7 +820,14 @@ impl Shader {
     pub fn shade_lit_by_float_division(&self, sample: u32, grad: [i32; 3]) -> Rgba {
         let c = &self.cfg;
         let e = self.tables.class.entries[(sample >> (c.sample_w() - c.class_idx_w)) as usize];
-        let t = self.intensity_by_float_division(grad);
+        self.lit(e, self.intensity_by_float_division(grad))
+    }
+
+    /// The classified entry `e` lit by the intensities `t`: `c d + sp` per channel, rounded and
+    /// saturated (contract § Illumination); alpha unchanged.
+    #[inline(always)]
+    fn lit(&self, e: Rgba, t: Texel) -> Rgba {
+        let c = &self.cfg;
         let (cw, dw, sw) = (c.color_w, c.diff_w, c.spec_w);
         let lit = |ch: u32| -> u32 {
             let sum = ((u64::from(ch) * u64::from(t.d)) << sw) + (u64::from(t.sp) << (cw + dw - 1));
@@ -838,23 +845,11 @@ impl Shader {
     /// the classification's 2-D branch and the unlit return fold away.
     #[inline(always)]
     pub fn shade(&self, item: &ShaderIn) -> Rgba {
-        let c = &self.cfg;
         let e = self.classify(item);
         if item.mode.unlit {
             return e;
         }
-        let t = self.intensity(item.grad);
-        let (cw, dw, sw) = (c.color_w, c.diff_w, c.spec_w);
-        let lit = |ch: u32| -> u32 {
-            let sum = ((u64::from(ch) * u64::from(t.d)) << sw) + (u64::from(t.sp) << (cw + dw - 1));
-            rnd(sum, dw - 1 + sw).min(u64::from(c.color_max())) as u32
-        };
-        Rgba {
-            r: lit(e.r),
-            g: lit(e.g),
-            b: lit(e.b),
-            a: e.a,
-        }
+        self.lit(e, self.intensity(item.grad))
     }
 
     /// The colour `c * d + sp` of one channel in output LSBs, saturated, from real intensities.

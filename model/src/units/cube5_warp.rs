@@ -772,24 +772,27 @@ mod tests {
         }
     }
 
+    /// The default, wide colour with narrow weights, and narrow colour with wide weights.
+    const FILTER_CONFIGS: [WarpConfig; 3] = [
+        WarpConfig::DEFAULT,
+        WarpConfig {
+            color_w: 12,
+            weight_w: 4,
+            ..WarpConfig::DEFAULT
+        },
+        WarpConfig {
+            color_w: 5,
+            weight_w: 12,
+            ..WarpConfig::DEFAULT
+        },
+    ];
+
     /// `warp_image` is `pixel_at` of every pixel (the per-pixel form the stream model uses),
     /// with affine maps that reach far outside the base plane on every side.
     #[test]
     fn the_image_is_pixel_at_of_every_pixel() {
         let mut rng = ChaCha8Rng::seed_from_u64(4);
-        for cfg in [
-            WarpConfig::DEFAULT,
-            WarpConfig {
-                color_w: 12,
-                weight_w: 4,
-                ..WarpConfig::DEFAULT
-            },
-            WarpConfig {
-                color_w: 4,
-                weight_w: 12,
-                ..WarpConfig::DEFAULT
-            },
-        ] {
+        for cfg in FILTER_CONFIGS {
             for _ in 0..40 {
                 let (w, h) = (rng.random_range(1..=24), rng.random_range(1..=24));
                 let out = rng.random_range(1..=64);
@@ -814,19 +817,7 @@ mod tests {
     fn within_the_bound_of_the_reference() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let mut worst: f64 = 0.0;
-        for cfg in [
-            WarpConfig::DEFAULT,
-            WarpConfig {
-                color_w: 12,
-                weight_w: 4,
-                ..WarpConfig::DEFAULT
-            },
-            WarpConfig {
-                color_w: 5,
-                weight_w: 12,
-                ..WarpConfig::DEFAULT
-            },
-        ] {
+        for cfg in FILTER_CONFIGS {
             for _ in 0..30 {
                 let (w, h) = (rng.random_range(1..=40), rng.random_range(1..=40));
                 let out = rng.random_range(1..=96);

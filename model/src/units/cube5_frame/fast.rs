@@ -8,15 +8,17 @@
 //! the largest corrected alpha any sample of the block can have (the class entries of the range's
 //! class indices); a block whose samples leave every coxel they meet unchanged (alpha 0 where a
 //! transparent sample is the identity, or every coxel of its rays terminated or already above it
-//! under `Max`) is not interpolated at all. Otherwise, rows of anchors in bands, in parallel, each
-//! against its own rows of coxels (anchor row `b` feeds base-plane row `b - sy(s) + max(sy)`, a
-//! different row for every `b`, so no two threads share a coxel and each ray still sees its
-//! samples in slice order). Per anchor, before any gradient: a coxel of a terminated ray, or a
-//! sample that the compositing unit would leave without effect (`Compos::leaves_unchanged` on the
-//! classified alpha), costs nothing more; otherwise, when the shaded colour depends on the
-//! gradient, the in-plane neighbours come from the band's plane rows, `B = S'(s-1)` and
-//! `A = S'(s+1)` are interpolated on demand with slice `s`'s weights, and the sample goes through
-//! [`shade_n6`] and `Compos::step`, the unit models' own functions; when it does not (MIP, or a
+//! under `Max`) is not interpolated at all. The base plane is split into bands of rows, in
+//! parallel, and each band takes every slice in order from the anchor rows that feed it (anchor
+//! row `b` feeds base-plane row `b - sy(s) + max(sy)`, a different row for every `b`, so no two
+//! threads share a coxel and each ray still sees its samples in slice order). Per anchor, before
+//! any gradient: a coxel of a terminated ray, or a sample that the compositing unit would leave
+//! without effect (`Compos::leaves_unchanged` on the classified alpha), costs nothing more;
+//! otherwise, when the shaded colour depends on the gradient, the in-plane neighbours come from
+//! the band's plane rows, `B = S'(s-1)` and `A = S'(s+1)` are interpolated on demand with slice
+//! `s`'s weights (a row of the block's anchors at a time), and the sample goes through the `N6`
+//! differences, `Shader::shade_lit_by_float_division` (the bits of [`super::shade_n6`]) and
+//! `Compos::step`, the unit models' own functions; when it does not (MIP, or a
 //! uniform reflectance map), the shaded entry of its class index is the shader's own output for
 //! that index. Leading and trailing slices whose voxels are all 0 are left out when a zero sample
 //! is the identity of every coxel (the contract's rule for skipping empty slices).
