@@ -12,19 +12,9 @@ use cube5_model::units::cube5_frame::{
 use glam::DVec3;
 use std::time::Instant;
 
-/// CPU seconds of this process so far (all threads; Linux), to measure on a shared machine.
-fn cpu_secs() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit(')').next().unwrap_or("");
-    // Fields 14 and 15 of the file (utime, stime, in 1/100 s) are 11 and 12 after the name.
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .map(|x| x.parse().unwrap_or(0.0))
-        .collect();
-    f.get(11)
-        .zip(f.get(12))
-        .map_or(0.0, |(u, s)| (u + s) / 100.0)
-}
+#[path = "support/cpu.rs"]
+mod cpu;
+use cpu::cpu_secs;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();

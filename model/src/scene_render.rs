@@ -202,6 +202,10 @@ pub struct FrameJob {
     /// `seen` in the sweep's axis order with its blocks' voxel ranges, made once with the job
     /// (the model's copy; it depends on the slice axis only).
     pub sweep: SweepVolume,
+    /// The hardware's counts that depend on the view and the block LUT only, made once with the
+    /// job: the empty slices the sweep skips before and after, and the samples of the swept
+    /// slices in blocks the LUT skips.
+    pub lut_counts: ((usize, usize), u64),
 }
 
 /// What one frame of the model computed.
@@ -264,6 +268,7 @@ impl FrameJob {
                 seen.dims
             ))
         })?;
+        let lut_counts = lut_counts(&setup.params, &lut);
         Ok(Self {
             cfg,
             seen,
@@ -273,6 +278,7 @@ impl FrameJob {
             look,
             units,
             sweep,
+            lut_counts,
         })
     }
 
@@ -280,31 +286,15 @@ impl FrameJob {
     pub fn render(&self) -> FrameRun {
         let params = &self.setup.params;
         let (base, model) = cube5_frame::render_sweep(params, &self.sweep, &self.units);
-        let skipped_slices = cube5_frame::empty_slices(params, &self.lut);
+        let (skipped_slices, in_skipped) = self.lut_counts;
         let swept = params.nk - skipped_slices.0 - skipped_slices.1;
-        let b = self.lut.block as usize;
-        let mut in_skipped = 0u64;
-        for s in skipped_slices.0..params.nk - skipped_slices.1 {
-            let k = params.slice(s).k;
-            for bj in 0..params.nj.div_ceil(b) {
-                for bi in 0..params.ni.div_ceil(b) {
-                    let mut blk = [0u32; 3];
-                    blk[params.axis_i] = bi as u32;
-                    blk[params.axis_j] = bj as u32;
-                    blk[params.axis_k] = (k / b) as u32;
-                    if self.lut.entry(blk).is_none_or(|e| e.empty || e.masked) {
-                        let w = b.min(params.ni - bi * b) * b.min(params.nj - bj * b);
-                        in_skipped += w as u64;
-                    }
-                }
-            }
-        }
         FrameRun {
             samples: (swept * params.ni * params.nj) as u64,
             samples_in_skipped_blocks: in_skipped,
             skipped_slices,
             slices: params.nk,
-            terminated_rays: base.coxels.iter().filter(|c| c.terminated).count(),
+            // The sweep counted them (its coxels are the base plane).
+            terminated_rays: model.rays_terminated as usize,
             model,
             base,
         }
@@ -373,6 +363,31 @@ impl FrameJob {
             (regs.out_w, regs.out_h),
         ))
     }
+}
+
+/// The empty slices the sweep of `params` skips before and after (`cube5_frame::empty_slices`),
+/// and the samples of the swept slices whose voxels lie in blocks `lut` skips (their memory reads
+/// are not made).
+fn lut_counts(params: &FrameParams, lut: &BlockLut) -> ((usize, usize), u64) {
+    let skipped_slices = cube5_frame::empty_slices(params, lut);
+    let b = lut.block as usize;
+    let mut in_skipped = 0u64;
+    for s in skipped_slices.0..params.nk - skipped_slices.1 {
+        let k = params.slice(s).k;
+        for bj in 0..params.nj.div_ceil(b) {
+            for bi in 0..params.ni.div_ceil(b) {
+                let mut blk = [0u32; 3];
+                blk[params.axis_i] = bi as u32;
+                blk[params.axis_j] = bj as u32;
+                blk[params.axis_k] = (k / b) as u32;
+                if lut.entry(blk).is_none_or(|e| e.empty || e.masked) {
+                    let w = b.min(params.ni - bi * b) * b.min(params.nj - bj * b);
+                    in_skipped += w as u64;
+                }
+            }
+        }
+    }
+    (skipped_slices, in_skipped)
 }
 
 /// What the memory returns: `vol` with the voxels of blocks the LUT skips (empty or masked) read

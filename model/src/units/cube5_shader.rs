@@ -754,16 +754,80 @@ impl Shader {
         }
     }
 
-    /// One shaded sample. Always inlined: at a call site with a constant mode (the frame's sweep)
-    /// the classification's 2-D branch and the unlit return fold away.
+    /// [`Shader::intensity`], the same bits, with each face coordinate's quotient
+    /// `floor(n / d)` (`n = num 2^(p+1) + m`, `d = 2m`) taken as the floor of the f64 quotient,
+    /// which costs a fraction of a u64 division (the frame's sweep divides twice per shaded
+    /// sample). Exact: `n <= 2^(GradW + RmLog2 + RmFracW + 1) <= 2^42` and `d` are exact in f64;
+    /// the division is correctly rounded, so an integer quotient comes out exact, and an inexact
+    /// one lies at least `1/d >= 2^-GradW` below the next integer while its rounding error is at
+    /// most `(n/d) 2^-53 <= 2^(RmLog2 + RmFracW - 53)`: the floor never moves up.
     #[inline(always)]
-    pub fn shade(&self, item: &ShaderIn) -> Rgba {
+    pub fn intensity_by_float_division(&self, grad: [i32; 3]) -> Texel {
         let c = &self.cfg;
-        let e = self.classify(item);
-        if item.mode.unlit {
-            return e;
+        let g = grad.map(i64::from);
+        let Some((axis, negative, u, v)) = major_axis(g) else {
+            return self.tables.rmap.zero;
+        };
+        let m = g[axis].unsigned_abs();
+        let p = c.rm_log2 + c.rm_frac_w - 1;
+        let top = 1u64 << (c.rm_log2 + c.rm_frac_w);
+        // Through i64: the conversions between i64 and f64 are single instructions, those of u64
+        // are not (below 2^53 all are exact).
+        let d = (2 * m) as i64 as f64;
+        let cell_weight = |minor: usize| {
+            let num = (g[minor] + m as i64) as u64; // in [0, 2m]
+            let n = (num << (p + 1)) + m;
+            debug_assert!(n < 1 << 53);
+            // Truncation is the floor: the quotient is >= 0.
+            let q = (n as i64 as f64 / d) as i64 as u64;
+            if q == top {
+                ((1usize << c.rm_log2) - 1, 1u64 << c.rm_frac_w)
+            } else {
+                ((q >> c.rm_frac_w) as usize, q & ((1 << c.rm_frac_w) - 1))
+            }
+        };
+        let ((i0, eu), (j0, ev)) = (cell_weight(u), cell_weight(v));
+        let face = 2 * axis + usize::from(negative);
+        let f = c.rm_frac_w;
+        let one = 1u64 << f;
+        let rm = &self.tables.rmap;
+        let t = [
+            rm.texel(face, i0, j0),
+            rm.texel(face, i0 + 1, j0),
+            rm.texel(face, i0, j0 + 1),
+            rm.texel(face, i0 + 1, j0 + 1),
+        ];
+        let w = [
+            (one - eu) * (one - ev),
+            eu * (one - ev),
+            (one - eu) * ev,
+            eu * ev,
+        ];
+        let (mut dsum, mut spsum) = (0u64, 0u64);
+        for (t, w) in t.iter().zip(w) {
+            dsum += u64::from(t.d) * w;
+            spsum += u64::from(t.sp) * w;
         }
-        let t = self.intensity(item.grad);
+        Texel {
+            d: rnd(dsum, 2 * f) as u32,
+            sp: rnd(spsum, 2 * f) as u32,
+        }
+    }
+
+    /// [`Shader::shade`] of a lit item without 2-D classification, its intensity by
+    /// [`Shader::intensity_by_float_division`] (the same bits).
+    #[inline(always)]
+    pub fn shade_lit_by_float_division(&self, sample: u32, grad: [i32; 3]) -> Rgba {
+        let c = &self.cfg;
+        let e = self.tables.class.entries[(sample >> (c.sample_w() - c.class_idx_w)) as usize];
+        self.lit(e, self.intensity_by_float_division(grad))
+    }
+
+    /// The classified entry `e` lit by the intensities `t`: `c d + sp` per channel, rounded and
+    /// saturated (contract § Illumination); alpha unchanged.
+    #[inline(always)]
+    fn lit(&self, e: Rgba, t: Texel) -> Rgba {
+        let c = &self.cfg;
         let (cw, dw, sw) = (c.color_w, c.diff_w, c.spec_w);
         let lit = |ch: u32| -> u32 {
             let sum = ((u64::from(ch) * u64::from(t.d)) << sw) + (u64::from(t.sp) << (cw + dw - 1));
@@ -775,6 +839,17 @@ impl Shader {
             b: lit(e.b),
             a: e.a,
         }
+    }
+
+    /// One shaded sample. Always inlined: at a call site with a constant mode (the frame's sweep)
+    /// the classification's 2-D branch and the unlit return fold away.
+    #[inline(always)]
+    pub fn shade(&self, item: &ShaderIn) -> Rgba {
+        let e = self.classify(item);
+        if item.mode.unlit {
+            return e;
+        }
+        self.lit(e, self.intensity(item.grad))
     }
 
     /// The colour `c * d + sp` of one channel in output LSBs, saturated, from real intensities.
@@ -1014,6 +1089,74 @@ mod tests {
         assert_eq!(s.class_index(&item(0xabcd, (3 << 10) + 1023, true)), 0xab3);
         assert_eq!(s.class_index(&item(0xabcd, 16 << 10, true)), 0xabf);
         assert_eq!(s.class_index(&item(0xabcd, cfg.mag_max(), true)), 0xabf);
+    }
+
+    /// `shade_lit_by_float_division` (the frame's sweep) is `shade` of a lit item bit for bit:
+    /// random tables, gradients over the full range, small ones, near-ties and the extremes, at
+    /// the narrow, default and widest widths (`VoxelW` 16, `FracW` 8, `RmLog2` 7, `RmFracW` 8:
+    /// the largest dividends).
+    #[test]
+    fn shading_by_float_division_is_shade() {
+        let widest = ShaderConfig {
+            voxel_w: 16,
+            frac_w: 8,
+            class_idx_w: 12,
+            rm_log2: 7,
+            rm_frac_w: 8,
+            ..ShaderConfig::DEFAULT
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(21);
+        for cfg in [ShaderConfig::NARROW, ShaderConfig::DEFAULT, widest] {
+            let s = Shader::new(cfg, ShaderTables::random(&cfg, &mut rng).unwrap()).unwrap();
+            let lit = ShaderMode {
+                tf2d: false,
+                unlit: false,
+            };
+            let (gmin, gmax) = (-cfg.grad_max() - 1, cfg.grad_max());
+            let edges = [gmin, gmin + 1, -1, 0, 1, gmax - 1, gmax];
+            let mut grads: Vec<[i32; 3]> = Vec::new();
+            for &x in &edges {
+                for &y in &edges {
+                    for &z in &edges {
+                        grads.push([x, y, z]);
+                    }
+                }
+            }
+            for _ in 0..200_000 {
+                let lim = match rng.random_range(0..3) {
+                    0 => gmax,
+                    1 => rng.random_range(1..=64),
+                    _ => 1 << rng.random_range(0..cfg.grad_w() - 1),
+                };
+                let mut g: [i32; 3] = std::array::from_fn(|_| rng.random_range(-lim - 1..=lim));
+                if rng.random_bool(0.2) {
+                    // A near-tie between the major axis and a minor one.
+                    g[1] = g[0]
+                        .saturating_add(rng.random_range(-1..=1))
+                        .clamp(gmin, gmax);
+                }
+                grads.push(g);
+            }
+            for g in grads {
+                let sample = rng.random_range(0..=cfg.sample_max());
+                let item = ShaderIn {
+                    sample,
+                    grad: g,
+                    mag: 0,
+                    mode: lit,
+                };
+                assert_eq!(
+                    s.intensity_by_float_division(g),
+                    s.intensity(g),
+                    "{cfg:?} {g:?}"
+                );
+                assert_eq!(
+                    s.shade_lit_by_float_division(sample, g),
+                    s.shade(&item),
+                    "{cfg:?} {g:?}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -8,22 +8,22 @@
 //! the largest corrected alpha any sample of the block can have (the class entries of the range's
 //! class indices); a block whose samples leave every coxel they meet unchanged (alpha 0 where a
 //! transparent sample is the identity, or every coxel of its rays terminated or already above it
-//! under `Max`) is not interpolated at all. Otherwise, rows of anchors in bands, in parallel, each
-//! against its own rows of coxels (anchor row `b` feeds base-plane row `b - sy(s) + max(sy)`, a
-//! different row for every `b`, so no two threads share a coxel and each ray still sees its
-//! samples in slice order). Per anchor, before any gradient: a coxel of a terminated ray, or a
-//! sample that the compositing unit would leave without effect (`Compos::leaves_unchanged` on the
-//! classified alpha), costs nothing more; otherwise, when the shaded colour depends on the
-//! gradient, the in-plane neighbours come from the band's plane rows, `B = S'(s-1)` and
-//! `A = S'(s+1)` are interpolated on demand with slice `s`'s weights, and the sample goes through
-//! [`shade_n6`] and `Compos::step`, the unit models' own functions; when it does not (MIP, or a
+//! under `Max`) is not interpolated at all. The base plane is split into bands of rows, in
+//! parallel, and each band takes every slice in order from the anchor rows that feed it (anchor
+//! row `b` feeds base-plane row `b - sy(s) + max(sy)`, a different row for every `b`, so no two
+//! threads share a coxel and each ray still sees its samples in slice order). Per anchor, before
+//! any gradient: a coxel of a terminated ray, or a sample that the compositing unit would leave
+//! without effect (`Compos::leaves_unchanged` on the classified alpha), costs nothing more;
+//! otherwise, when the shaded colour depends on the gradient, the in-plane neighbours come from
+//! the band's plane rows, `B = S'(s-1)` and `A = S'(s+1)` are interpolated on demand with slice
+//! `s`'s weights (a row of the block's anchors at a time), and the sample goes through the `N6`
+//! differences, `Shader::shade_lit_by_float_division` (the bits of [`super::shade_n6`]) and
+//! `Compos::step`, the unit models' own functions; when it does not (MIP, or a
 //! uniform reflectance map), the shaded entry of its class index is the shader's own output for
 //! that index. Leading and trailing slices whose voxels are all 0 are left out when a zero sample
 //! is the identity of every coxel (the contract's rule for skipping empty slices).
 
-use super::{
-    render_base_plane_reference, shade_n6, BasePlane, FrameMode, FrameParams, FrameUnits, STEP_W,
-};
+use super::{render_base_plane_reference, BasePlane, FrameMode, FrameParams, FrameUnits, STEP_W};
 use crate::units::cube5_compos::{CodedSample, Compos, ComposMode, Coxel, Sample};
 use crate::units::cube5_shader::{Shader, ShaderIn, ShaderMode};
 use crate::volume::Volume;
@@ -321,8 +321,9 @@ struct SliceWork<'a> {
     amax: &'a [u64],
     /// Samples of corrected alpha 0 are the identity of every coxel.
     zero_ok: bool,
-    /// Base-plane column of anchor 0.
+    /// Base-plane column of anchor 0 and row of anchor row 0.
     r0: usize,
+    q0: usize,
     depth: u32,
     k: usize,
     wx: u32,
@@ -355,23 +356,17 @@ impl SliceWork<'_> {
             .row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, out);
     }
 
-    /// `S'(t)` at anchor `(a, b)`: slice `k(t)`'s voxels, slice `s`'s weights (0 outside).
+    /// `S'(t)` at anchors `a0 .. a0 + out.len()` of row `b`: slice `k(t)`'s voxels, slice `s`'s
+    /// weights (0 outside).
     #[inline]
-    fn other(&self, k: Option<usize>, a: usize, b: usize) -> u32 {
+    fn other_row(&self, k: Option<usize>, a0: usize, b: usize, out: &mut [u32]) {
         match k {
-            None => 0,
+            None => out.fill(0),
             Some(k) => {
                 let (top, bot) = (self.sv.row(k, b), self.sv.row(k, b + 1));
-                self.units.trilin.sample_in_slice(
-                    [
-                        u32::from(top[a]),
-                        u32::from(top[a + 1]),
-                        u32::from(bot[a]),
-                        u32::from(bot[a + 1]),
-                    ],
-                    self.wx,
-                    self.wy,
-                )
+                self.units
+                    .trilin
+                    .row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, out);
             }
         }
     }
@@ -419,6 +414,8 @@ impl SliceWork<'_> {
                 self.ensure(band, b as isize, c);
                 let r = (b as isize - band.b0 + 1) as usize;
                 let mut neighbours = false;
+                let cox_len = cox.len();
+                let (mut before, mut after) = ([0u32; BLOCK], [0u32; BLOCK]);
                 for (n, cox) in cox.iter_mut().enumerate() {
                     let a = c * BLOCK + n;
                     if cox.terminated {
@@ -446,24 +443,35 @@ impl SliceWork<'_> {
                             }
                             self.ensure(band, b as isize - 1, c);
                             self.ensure(band, b as isize + 1, c);
+                            // `B = S'(s-1)` and `A = S'(s+1)` of the block's row, in lanes.
+                            let len = cox_len;
+                            self.other_row(self.k_before, c * BLOCK, b, &mut before[..len]);
+                            self.other_row(self.k_after, c * BLOCK, b, &mut after[..len]);
                         }
-                        let at = |rr: usize, aa: usize| band.rows[rr * ni + aa];
-                        let nb = [
-                            centre,
-                            if a > 0 { at(r, a - 1) } else { 0 },
-                            if a + 1 < ni { at(r, a + 1) } else { 0 },
-                            if b > 0 { at(r - 1, a) } else { 0 },
-                            if b + 1 < nj { at(r + 1, a) } else { 0 },
-                            self.other(self.k_before, a, b),
-                            self.other(self.k_after, a, b),
-                        ];
-                        let sample =
-                            shade_n6(&units.gradient, &units.shader, &nb, smode, self.depth);
+                        let at = |rr: usize, aa: usize| band.rows[rr * ni + aa] as i32;
+                        let xm = if a > 0 { at(r, a - 1) } else { 0 };
+                        let xp = if a + 1 < ni { at(r, a + 1) } else { 0 };
+                        let ym = if b > 0 { at(r - 1, a) } else { 0 };
+                        let yp = if b + 1 < nj { at(r + 1, a) } else { 0 };
+                        // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
+                        // (`n6_components`, `shader_in`): the differences themselves. The
+                        // magnitude is not computed: the frame never classifies in 2-D.
+                        let grad = [xp - xm, yp - ym, after[n] as i32 - before[n] as i32];
+                        let e = units.shader.shade_lit_by_float_division(centre, grad);
+                        let sample = Sample {
+                            rgb: [e.r, e.g, e.b],
+                            alpha: e.a,
+                            depth: self.depth,
+                            mode: cmode,
+                        };
                         // `Compos::step`, spelled out so that it inlines here.
                         *cox = units.compos.step_coded(cox, &units.compos.code(&sample));
                     } else if let Some(flat) = self.flat {
+                        // The table's mode is `cmode`; a constant here, so that `step_coded`'s
+                        // other modes fold away.
                         let coded = CodedSample {
                             depth: self.depth,
+                            mode: cmode,
                             ..flat[idx]
                         };
                         *cox = units.compos.step_coded(cox, &coded);
@@ -483,6 +491,41 @@ impl SliceWork<'_> {
         }
         st
     }
+}
+
+/// Base-plane rows `q ..` (`rows`, `w` coxels each) through every swept slice in order: the
+/// anchor rows of each slice that feed them, as one band.
+#[inline(always)]
+fn sweep_band(
+    slices: &[SliceWork],
+    q: usize,
+    rows: &mut [Coxel],
+    w: usize,
+    band: &mut BandRows,
+    mode: FrameMode,
+    lit: bool,
+) -> SweepStats {
+    let mut st = SweepStats::default();
+    let n_rows = rows.len() / w;
+    for work in slices {
+        let nj = work.sv.nj;
+        // Anchor rows `b` with `q <= b + q0 < q + n_rows`, within `0 .. nj`.
+        let b0 = q.saturating_sub(work.q0);
+        let b1 = (q + n_rows).saturating_sub(work.q0).min(nj);
+        if b0 >= b1 {
+            continue;
+        }
+        let at = b0 + work.q0 - q;
+        st = st.add(work.band(
+            b0,
+            &mut rows[at * w..(at + b1 - b0) * w],
+            w,
+            band,
+            mode,
+            lit,
+        ));
+    }
+    st
 }
 
 /// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md): the
@@ -529,7 +572,7 @@ pub fn render_sweep(
         "render_sweep: {sv:?} is not in the sweep order of {params:?}"
     );
     let anchors = params.samples() as u64;
-    let (ni, nj, nk) = (params.ni, params.nj, params.nk);
+    let (ni, nk) = (params.ni, params.nk);
     let (w, h) = params.base_plane_size();
     let ((_, max_sx), (_, max_sy)) = params.shift_range();
     let init = Coxel::empty(&units.compos.config());
@@ -597,57 +640,65 @@ pub fn render_sweep(
         slices_skipped: (front_zero, back_zero),
         ..SweepStats::default()
     };
+    let swept = front_zero..nk - back_zero;
+    // Per swept slice, per block: the largest corrected alpha its samples can have.
     let nb = sv.nbi * sv.nbj;
-    let mut amax = vec![0u64; nb];
-    // The plane rows of every band, made once per frame.
-    let mut bands: Vec<BandRows> = (0..nj.div_ceil(BAND)).map(|_| BandRows::new(ni)).collect();
-    for s in front_zero..nk - back_zero {
-        let c = params.slice(s);
-        let depth = s as u32;
-        let r0 = (max_sx - c.shift_x) as usize;
-        let q0 = (max_sy - c.shift_y) as usize;
-        let rows = &mut coxels[q0 * w..(q0 + nj) * w];
-        let (wx, wy) = (weight(c.frac_x), weight(c.frac_y));
-        for (m, (&lo, &hi)) in amax.iter_mut().zip(
-            sv.lo[c.k * nb..(c.k + 1) * nb]
-                .iter()
-                .zip(&sv.hi[c.k * nb..(c.k + 1) * nb]),
-        ) {
+    let mut amax = vec![0u64; swept.len() * nb];
+    amax.par_chunks_mut(nb).enumerate().for_each(|(n, amax)| {
+        let k = params.slice(front_zero + n).k;
+        let (lo, hi) = (&sv.lo[k * nb..(k + 1) * nb], &sv.hi[k * nb..(k + 1) * nb]);
+        for (m, (&lo, &hi)) in amax.iter_mut().zip(lo.iter().zip(hi)) {
             *m = range_max.max(idx_of(lo), idx_of(hi));
         }
-        let work = SliceWork {
-            units,
-            sv,
-            corrected: &corrected,
-            flat: flat.as_deref(),
-            amax: &amax,
-            zero_ok,
-            r0,
-            depth,
-            k: c.k,
-            wx,
-            wy,
-            k_before: (s > 0).then(|| params.slice(s - 1).k),
-            k_after: (s + 1 < nk).then(|| params.slice(s + 1).k),
-        };
-        // Bands of anchor rows in parallel; one copy of the band loop per mode and lighting, so
-        // that the units' mode branches fold away.
-        let part = rows
-            .par_chunks_mut(BAND * w)
-            .zip(bands.par_iter_mut())
-            .enumerate()
-            .map(|(n, (rows, band))| match (units.mode, lit) {
-                (FrameMode::Mip, _) => work.band(n * BAND, rows, w, band, FrameMode::Mip, false),
+    });
+    let slices: Vec<SliceWork> = swept
+        .clone()
+        .zip(amax.chunks_exact(nb))
+        .map(|(s, amax)| {
+            let c = params.slice(s);
+            SliceWork {
+                units,
+                sv,
+                corrected: &corrected,
+                flat: flat.as_deref(),
+                amax,
+                zero_ok,
+                r0: (max_sx - c.shift_x) as usize,
+                q0: (max_sy - c.shift_y) as usize,
+                depth: s as u32,
+                k: c.k,
+                wx: weight(c.frac_x),
+                wy: weight(c.frac_y),
+                k_before: (s > 0).then(|| params.slice(s - 1).k),
+                k_after: (s + 1 < nk).then(|| params.slice(s + 1).k),
+            }
+        })
+        .collect();
+    // Bands of base-plane rows in parallel, each through every slice in order (a ray's samples
+    // arrive in slice order; anchor row `b` of slice `s` feeds row `b + q0(s)` only, so no two
+    // bands share a coxel): one parallel split per frame, and a band's coxels stay in the
+    // thread's cache across the slices. One copy of the band loop per mode and lighting, so that
+    // the units' mode branches fold away.
+    let part = coxels
+        .par_chunks_mut(BAND * w)
+        .enumerate()
+        .map(|(n, rows)| {
+            let mut band = BandRows::new(ni);
+            let q = n * BAND;
+            match (units.mode, lit) {
+                (FrameMode::Mip, _) => {
+                    sweep_band(&slices, q, rows, w, &mut band, FrameMode::Mip, false)
+                }
                 (FrameMode::Composite, false) => {
-                    work.band(n * BAND, rows, w, band, FrameMode::Composite, false)
+                    sweep_band(&slices, q, rows, w, &mut band, FrameMode::Composite, false)
                 }
                 (FrameMode::Composite, true) => {
-                    work.band(n * BAND, rows, w, band, FrameMode::Composite, true)
+                    sweep_band(&slices, q, rows, w, &mut band, FrameMode::Composite, true)
                 }
-            })
-            .reduce(SweepStats::default, SweepStats::add);
-        stats = stats.add(part);
-    }
+            }
+        })
+        .reduce(SweepStats::default, SweepStats::add);
+    stats = stats.add(part);
     stats.rays_terminated = coxels.iter().filter(|c| c.terminated).count() as u64;
     (
         BasePlane {
