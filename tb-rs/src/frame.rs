@@ -114,9 +114,9 @@ impl FrameRtl {
 /// description as `cube5_frame_pkg`. Only the cycle budget and the smallest-volume rule (compos)
 /// depend on the latencies.
 pub use cube5_model::regs::cube5_frame::{
-    CLASS_LATENCY, COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK, REGION_COMPOS, REGION_FRAME,
-    REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE, REG_SKIP, REG_VIEW,
-    TRILIN_LATENCY,
+    CLASS_LATENCY, COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK, REGION_COMPOS,
+    REGION_FRAME, REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE, REG_SKIP,
+    REG_VIEW, TRILIN_LATENCY,
 };
 
 /// The frame's two renderings (docs/numerics/frame.md, "The pipeline of one sample").

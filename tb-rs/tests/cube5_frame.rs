@@ -584,7 +584,10 @@ fn frames_without_gradient_and_shader_mip_bit_exact_composite_refused() {
     assert!(!bare.is_empty(), "a cube5_frame variant with Shade = 0");
     for rtl in bare {
         let vols = if rtl.max_dim() >= 32 {
-            vec![head_phantom(32, 12).unwrap(), blob_volume([16, 8, 24], 12, s)]
+            vec![
+                head_phantom(32, 12).unwrap(),
+                blob_volume([16, 8, 24], 12, s),
+            ]
         } else {
             let w = rtl.trilin.voxel_w;
             vec![head_phantom(8, w).unwrap(), blob_volume([8, 4, 8], w, s)]

@@ -1205,28 +1205,30 @@ mod tests {
                 let params = setup.params;
                 let phong = frame_phong(&params, &[]);
                 let units = |cfg: &FrameConfig| {
-                    FrameUnits::with_config(cfg, FrameMode::Mip, &setup, &tf, &phong, None)
-                        .unwrap()
+                    FrameUnits::with_config(cfg, FrameMode::Mip, &setup, &tf, &phong, None).unwrap()
                 };
                 let (uf, ub) = (units(&full), units(&bare));
                 let want = render_base_plane_reference(&params, &vol, &uf);
-                assert_eq!(render_base_plane_reference(&params, &vol, &ub), want, "{v:?}");
+                assert_eq!(
+                    render_base_plane_reference(&params, &vol, &ub),
+                    want,
+                    "{v:?}"
+                );
                 assert_eq!(render_base_plane(&params, &vol, &ub), want, "{v:?}");
-                assert!(want.coxels.iter().any(|c| c.rgba[3] > 0), "{v:?}: an empty image");
-                let e = FrameUnits::with_config(
-                    &bare,
-                    FrameMode::Composite,
-                    &setup,
-                    &tf,
-                    &phong,
-                    None,
-                )
-                .unwrap_err()
-                .to_string();
+                assert!(
+                    want.coxels.iter().any(|c| c.rgba[3] > 0),
+                    "{v:?}: an empty image"
+                );
+                let e =
+                    FrameUnits::with_config(&bare, FrameMode::Composite, &setup, &tf, &phong, None)
+                        .unwrap_err()
+                        .to_string();
                 assert!(e.contains("Shade = 0"), "{e}");
             }
         }
-        let e = FrameConfig::from_params(&[("Shade", 2)]).unwrap_err().to_string();
+        let e = FrameConfig::from_params(&[("Shade", 2)])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("Shade = 2"), "{e}");
     }
 }
