@@ -92,7 +92,7 @@ fn built(e: &Elaboration) -> String {
             r.variant
         ),
         None => format!(
-            "not built: a generated configuration (`make cosim SCENE=...` or CUBE5_TOPS={spec} builds cube5_frame_{})",
+            "not built: a generated configuration, {} (`make cosim SCENE=...` or CUBE5_TOPS={spec} builds it)",
             e.name()
         ),
     }

@@ -206,3 +206,172 @@ pub fn elaborate(scene: &Scene, dims: [usize; 3], pipelines: Option<usize>) -> R
         left_out,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(text: &str) -> Scene {
+        Scene::parse(text, "test.toml").unwrap()
+    }
+
+    fn elab(s: &Scene) -> Result<Elaboration> {
+        let vol = s.build_volume()?;
+        elaborate(s, vol.dims, None)
+    }
+
+    /// Every example scene (scenes/*.toml) elaborates to the configuration it needs: the MIP scene
+    /// without gradient and shader, the composite ones with them, at their widths, pipelines and
+    /// memory; the rest are refused with the fields the frame cannot express. A new example scene
+    /// must be added here.
+    #[test]
+    fn every_example_scene_elaborates_to_what_it_needs() {
+        // (scene, P, MaxDim, shade, params of the .variants line) or the refused fields.
+        let built: &[(&str, usize, usize, bool, &str)] = &[
+            ("head-mip", 4, 128, false, "P=4 MaxDim=128 Shade=0"),
+            ("head", 4, 128, true, "P=4 MaxDim=128"),
+            ("head-nifti", 4, 64, true, "P=4 MaxDim=64"),
+            (
+                "head-narrow",
+                2,
+                128,
+                true,
+                "P=2 MaxDim=128 VoxelW=8 WeightW=4 ColorW=5 AlphaW=8 AccW=12",
+            ),
+        ];
+        let refused: &[(&str, &[&str])] = &[
+            ("bubbles-minip", &["render.mode = \"minip\""]),
+            (
+                "head-xray",
+                &["render.mode = \"xray\"", "quality.samples_per_slice"],
+            ),
+            (
+                "head-bone-lights",
+                &["render.mode = \"first-opaque\"", "light[0].colour"],
+            ),
+            ("cube3-6.1", &["quality.interpolation", "quality.gradient"]),
+            (
+                "sphere-sheared",
+                &["quality.interpolation", "quality.supersampling"],
+            ),
+            ("head-nrrd", &["quality.interpolation"]),
+            ("head-perspective", &["view.projection"]),
+            ("head-perspective-slabs", &["view.projection"]),
+            ("gi-shadow", &["[gi]"]),
+        ];
+        let dir = crate::repo_root().join("scenes");
+        let mut seen = Vec::new();
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let path = e.unwrap().path();
+            if path.extension().is_none_or(|x| x != "toml") {
+                continue;
+            }
+            let name = path.file_stem().unwrap().to_string_lossy().to_string();
+            let s = Scene::load(&path).unwrap();
+            if let Some(&(_, p, max_dim, shade, line)) = built.iter().find(|b| b.0 == name) {
+                let e = elab(&s).unwrap_or_else(|e| panic!("{name}: {e}"));
+                assert_eq!(e.config.p, p, "{name}");
+                assert_eq!(e.config.max_dim(), max_dim, "{name}");
+                assert_eq!(e.config.shade, shade, "{name}");
+                assert!(
+                    e.variants_line().ends_with(&format!("sim  {line}")),
+                    "{name}: {}",
+                    e.variants_line()
+                );
+                assert_eq!(
+                    e.spec(),
+                    format!("cube5_frame@{}", line.replace(' ', ":")),
+                    "{name}"
+                );
+                let units: Vec<&str> = e.left_out.iter().map(|l| l.unit).collect();
+                if shade {
+                    assert!(units.is_empty(), "{name}: {units:?}");
+                    assert!(e.full().is_none(), "{name}");
+                } else {
+                    assert_eq!(units, ["cube5_gradient", "cube5_shader"], "{name}");
+                    assert!(e
+                        .left_out
+                        .iter()
+                        .all(|l| l.why.contains("render.mode = \"mip\"")));
+                    assert!(e.full().unwrap().config.shade, "{name}");
+                }
+            } else if let Some((_, fields)) = refused.iter().find(|r| r.0 == name) {
+                let why = elab(&s).unwrap_err().to_string();
+                for f in *fields {
+                    assert!(why.contains(f), "{name}: `{why}` does not name {f}");
+                }
+            } else {
+                panic!("{name}: an example scene this test does not list");
+            }
+            seen.push(name);
+        }
+        assert_eq!(seen.len(), built.len() + refused.len(), "{seen:?}");
+    }
+
+    /// The name follows the naming rule, and the choices name the scene fields behind them.
+    #[test]
+    fn names_and_reasons() {
+        let e = elab(&scene(
+            "[volume]\nsize = 16\n[render]\nmode = \"mip\"\n[run]\npipelines = 1\n",
+        ))
+        .unwrap();
+        assert_eq!(e.name(), "p1m16s0");
+        assert_eq!(e.variants_line(), "p1m16s0  sim  P=1 MaxDim=16 Shade=0");
+        let why: Vec<String> = e
+            .choices
+            .iter()
+            .map(|c| format!("{}: {}", c.0, c.1))
+            .collect();
+        assert!(
+            why.iter()
+                .any(|w| w.starts_with("P = 1: run.pipelines = 1")),
+            "{why:?}"
+        );
+        assert!(
+            why.iter()
+                .any(|w| w.starts_with("MaxDim = 16:") && w.contains("16")),
+            "{why:?}"
+        );
+        // The smallest memory is 8 and 2 P.
+        let e = elab(&scene("[volume]\nsize = 8\n[run]\npipelines = 8\n")).unwrap();
+        assert_eq!(e.config.max_dim(), 16);
+        // --pipelines overrides run.pipelines.
+        let s = scene("[volume]\nsize = 16\n[run]\npipelines = 1\n");
+        let e = elaborate(&s, [16; 3], Some(8)).unwrap();
+        assert_eq!(e.config.p, 8);
+        assert!(e.choices[0].1.contains("--pipelines 8"));
+    }
+
+    /// Refusals name the field: pipelines that do not divide the volume or do not exist, a volume
+    /// above the RTL's memory, widths the frame cannot take, a mode it cannot render.
+    #[test]
+    fn refusals_name_their_field() {
+        let why = |text: &str, p: Option<usize>| {
+            let s = scene(text);
+            let vol = s.build_volume().unwrap();
+            elaborate(&s, vol.dims, p).unwrap_err().to_string()
+        };
+        let w = why("[volume]\nsize = 18\n", None);
+        assert!(
+            w.contains("run.pipelines unset (P = 4)") && w.contains("18"),
+            "{w}"
+        );
+        let w = why("[volume]\nsize = 12\n[run]\npipelines = 8\n", None);
+        assert!(w.contains("run.pipelines") && w.contains("P = 8"), "{w}");
+        let w = why("[volume]\nsize = 16\n", Some(3));
+        assert!(w.contains("--pipelines") && w.contains("P = 3"), "{w}");
+        let w = why("[volume]\nsize = 136\n", None);
+        assert!(
+            w.contains("volume:") && w.contains("128 voxels per edge"),
+            "{w}"
+        );
+        let w = why("[volume]\nsize = 16\n[quality]\nalpha_bits = 3\n", None);
+        assert!(w.contains("quality.alpha_bits"), "{w}");
+        let w = why("[volume]\nsize = 16\n[render]\nmode = \"minip\"\n", None);
+        assert!(w.contains("render.mode"), "{w}");
+        let e = Scene::parse("[volume]\nsize = 16\n[run]\npipelines = 3\n", "p3.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("run.pipelines") && e.contains("3"), "{e}");
+    }
+}
