@@ -3,7 +3,7 @@
 //! mismatch (pixel, channel, both values, the model's sample trail of that ray), the cycles per
 //! frame and samples per clock per pipeline, and writes both base planes and both warped images.
 
-use crate::{load_scene, write_png_atomically};
+use crate::write_png_atomically;
 use anyhow::{anyhow, bail, Context, Result};
 use cube5_model::render::ImageF64;
 use cube5_model::scene::Scene;
@@ -37,12 +37,7 @@ pub struct CosimResult {
 }
 
 pub fn run(args: CosimArgs) -> Result<()> {
-    let scene = load_scene(args.scene.as_deref())?;
-    let origin = args
-        .scene
-        .as_ref()
-        .map_or("the default scene".to_string(), |p| p.display().to_string());
-    scene.validate(&origin)?;
+    let (scene, origin) = crate::elaborate::load_valid(args.scene.as_deref())?;
     if scene.gi.is_some() {
         bail!("{origin}: [gi]: the scene renders on the GI-Cube processor model, and there is no GI-Cube RTL yet to co-simulate (`cube5 render` renders it)");
     }

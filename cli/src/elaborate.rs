@@ -34,13 +34,16 @@ pub fn derive(scene: &Scene, origin: &str, pipelines: Option<usize>) -> Result<E
     elaborate(scene, vol.dims, pipelines).map_err(|e| anyhow!("{origin}: {e}"))
 }
 
-pub fn run(args: ElaborateArgs) -> Result<()> {
-    let scene = load_scene(args.scene.as_deref())?;
-    let origin = args
-        .scene
-        .as_ref()
-        .map_or("the default scene".to_string(), |p| p.display().to_string());
+/// The scene at `path` (the embedded default scene when none), validated, and how to name it.
+pub fn load_valid(path: Option<&std::path::Path>) -> Result<(Scene, String)> {
+    let scene = load_scene(path)?;
+    let origin = path.map_or("the default scene".to_string(), |p| p.display().to_string());
     scene.validate(&origin)?;
+    Ok((scene, origin))
+}
+
+pub fn run(args: ElaborateArgs) -> Result<()> {
+    let (scene, origin) = load_valid(args.scene.as_deref())?;
     let e = derive(&scene, &origin, args.pipelines)?;
     if args.spec {
         println!("{}", e.spec());

@@ -62,12 +62,17 @@ impl Elaboration {
     /// The `CUBE5_TOPS` entry that builds exactly this configuration (tb-rs/build.rs:
     /// `top@Param=value:...`, the top's defaults for every other parameter).
     pub fn spec(&self) -> String {
+        format!("{}@{}", FrameConfig::TOP, self.assignments(":"))
+    }
+
+    /// `Param=value` for each of [`Elaboration::params`], joined by `sep`.
+    pub fn assignments(&self, sep: &str) -> String {
         let kv: Vec<String> = self
             .params()
             .iter()
             .map(|(k, v)| format!("{k}={v}"))
             .collect();
-        format!("{}@{}", FrameConfig::TOP, kv.join(":"))
+        kv.join(sep)
     }
 
     /// The configuration's name by the naming rule (docs/adding-a-unit.md, "Naming a variant"):
@@ -81,12 +86,7 @@ impl Elaboration {
 
     /// The configuration as a `.variants` line (generated in the build, flag `sim`).
     pub fn variants_line(&self) -> String {
-        let kv: Vec<String> = self
-            .params()
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect();
-        format!("{}  sim  {}", self.name(), kv.join(" "))
+        format!("{}  sim  {}", self.name(), self.assignments(" "))
     }
 }
 
