@@ -3,6 +3,7 @@ CARGO ?= cargo
 DEMO_DIR ?= out
 
 .PHONY: setup demo test sim sim-full lint synth bench bench-peer tradeoff regs fmt clippy clean clean-cache
+.PHONY: cosim
 
 # The build cache of verilated and compiled RTL variants (shared by every clone on the machine).
 CUBE5_CACHE ?= $(if $(XDG_CACHE_HOME),$(XDG_CACHE_HOME),$(HOME)/.cache)/cube5
@@ -35,6 +36,21 @@ endif
 ## Everything in `sim` plus the runs too long for CI (tests marked #[ignore = "sim-full: ..."]).
 sim-full: setup
 	CUBE5_FULL=1 $(CARGO) test --release -p cube5-tb -p cube5-cli -- --include-ignored
+
+## Scene-driven elaboration (docs/scenes.md, "What a scene builds"): `make cosim SCENE=scenes/head-mip.toml`
+## prints the cube5_frame configuration the scene needs and why (`cube5 elaborate`), its area from
+## Yosys synth_ecp5 against the full frame (cached; AREA=0 leaves it out), builds exactly that
+## configuration (CUBE5_TOPS=cube5_frame@...: a generated variant where no .variants line has it,
+## cached like any other) and co-simulates the scene on it. The elaboration runs from a cube5
+## without the RTL (target/elab), so working it out builds no variant.
+ELAB_CUBE5 = CARGO_TARGET_DIR=target/elab $(CARGO) run -q --release -p cube5-cli --no-default-features --
+AREA ?= 1
+cosim: setup
+	@test -n "$(SCENE)" || { echo "usage: make cosim SCENE=scenes/head-mip.toml [AREA=0] [COSIM_OUT=dir]"; exit 2; }
+	@spec=$$($(ELAB_CUBE5) elaborate --spec $(SCENE)) && \
+	  $(ELAB_CUBE5) elaborate $(if $(filter 1,$(AREA)),--area) $(SCENE) && \
+	  echo "make cosim: CUBE5_TOPS=$$spec" && \
+	  CUBE5_TOPS=$$spec $(CARGO) run -q --release -p cube5-cli -- cosim $(SCENE) -o $(or $(COSIM_OUT),$(DEMO_DIR)/cosim-elab)
 
 lint:
 	@scripts/lint.sh

@@ -12,6 +12,11 @@
 # A finished row is cached (beside the RTL build cache, make clean-cache) under a hash of its
 # inputs: the RTL files, parameters, flows, this script and the tool versions. A cached row says
 # so in its cost column. SYNTH_NOCACHE=1 runs everything again.
+#   SYNTH_SPEC=top@Param=value:...   one configuration given by its parameters (the top's
+#                          defaults for the rest; what `cube5 elaborate` prints), whether or not a
+#                          .variants line has it: scene-driven elaboration. Its row is named by the
+#                          naming rule (`p4m128s0`) and cached like any other.
+#   SYNTH_CACHED=1         print cached rows only, synthesize nothing (a row not cached is left out).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=target/synth
@@ -36,13 +41,25 @@ synth_one() {
   shift 4
   local base="$out/${top}_$name" prelude
   # read_verilog and chparam: written once, in scripts/cube5-gen (tb-rs/build.rs uses the same).
-  prelude=$("$gen" yosys "$top" "$name")
+  if [ -n "${SYNTH_SPEC:-}" ]; then
+    # The files of the top's filelist (any line's prelude up to the first `;`), the spec's values.
+    local first chp="" kv
+    first=$("$gen" yosys "$top" "$spec_line")
+    for kv in "$@"; do chp="$chp -set ${kv%%=*} ${kv#*=}"; done
+    prelude="${first%%;*};"
+    [ -n "$chp" ] && prelude="$prelude chparam$chp $top;"
+  else
+    prelude=$("$gen" yosys "$top" "$name")
+  fi
   local key f
   key=$( { echo "$flows $tools ${SYNTH_FMAX:-1} $flags $*"; cat "$0"; for f in $files; do cat "$f"; done; } | sha256sum | cut -c1-32)
   local cached="$cache/${top}_$name.$key.row"
   if [ "${SYNTH_NOCACHE:-0}" = 0 ] && [ -f "$cached" ]; then
     echo "synth: $top $name (cached)" >&2
     sed -E 's/\| ([0-9]+) \|$/| \1 (cached) |/' "$cached" > "$base.row"
+    return
+  fi
+  if [ "${SYNTH_CACHED:-0}" = 1 ]; then
     return
   fi
   echo "synth: $top $name ($*)" >&2
@@ -98,7 +115,25 @@ done
 
 jobs=${SYNTH_JOBS:-$(nproc)}
 selected=()
-while read -r top name flags files params; do
+if [ -n "${SYNTH_SPEC:-}" ]; then
+  spec_top=${SYNTH_SPEC%%@*}
+  spec_params=${SYNTH_SPEC#*@}
+  if [ "$spec_top" = "$SYNTH_SPEC" ]; then
+    echo "synth: SYNTH_SPEC=$SYNTH_SPEC is not top@Param=value:..." >&2; exit 2
+  fi
+  read -r _ spec_line _ spec_files _ < <(scripts/variants.sh | awk -v t="$spec_top" '$1 == t && !n {print; n = 1}') || true
+  if [ -z "${spec_line:-}" ]; then
+    echo "synth: SYNTH_SPEC=$SYNTH_SPEC: no top $spec_top in rtl/**/*.variants" >&2; exit 2
+  fi
+  spec_name=""
+  for kv in ${spec_params//:/ }; do
+    k=${kv%%=*}
+    spec_name="$spec_name$(echo "${k:0:1}" | tr 'A-Z' 'a-z')${kv#*=}"
+  done
+  selected+=("$spec_top $spec_name - $spec_files ${spec_params//:/ }")
+  rm -f "$out/${spec_top}_$spec_name.row"
+fi
+[ -n "${SYNTH_SPEC:-}" ] || while read -r top name flags files params; do
   if [ -n "${SYNTH_ONLY:-}" ] && ! echo ",$SYNTH_ONLY," | grep -q ",$top,"; then continue; fi
   # `sim`: a simulation-only configuration (memories too large for Yosys's generic flow).
   if [[ ",$flags," == *,sim,* ]]; then continue; fi
@@ -123,7 +158,7 @@ for line in "${selected[@]}"; do
   read -r top name _ <<< "$line"
   if [ -f "$out/${top}_$name.row" ]; then
     cat "$out/${top}_$name.row" >> "$table"
-  else
+  elif [ "${SYNTH_CACHED:-0}" != 1 ]; then
     echo "synth: FAILED $top $name (logs: $out/${top}_$name.*.log)" >&2
     failed=1
   fi

@@ -261,11 +261,33 @@ fn main() {
     let yosys_version = tool_output("yosys", &["-V"]);
     let vl_include = PathBuf::from(verilator_root.trim()).join("include");
 
-    let (tops, variants) = discover_variants(&repo);
+    let (tops, mut variants) = discover_variants(&repo);
     let only: Option<Vec<String>> = env::var("CUBE5_TOPS")
         .ok()
         .filter(|s| !s.trim().is_empty())
         .map(|s| s.split(',').map(|t| t.trim().to_string()).collect());
+    let cache = Cache::open(&out);
+    // Every line's resolved top-level parameters, as Verilator elaborates them (defaults
+    // included): the variant table carries them so a test can hold the model to every one.
+    let mut resolved = resolve_all_params(&cache, &repo, &tops, &verilator_version);
+    // `top@Param=value:...` entries: exactly that configuration, a checked-in line or a
+    // generated one (scene-driven elaboration, `cube5 elaborate`).
+    let only: Option<Vec<String>> = only.map(|entries| {
+        entries
+            .iter()
+            .map(|e| {
+                exact_entry(
+                    e,
+                    &tops,
+                    &mut variants,
+                    &mut resolved,
+                    &cache,
+                    &repo,
+                    &verilator_version,
+                )
+            })
+            .collect()
+    });
     let selected: Vec<Variant> = variants
         .iter()
         .filter(|v| {
@@ -275,10 +297,6 @@ fn main() {
         .cloned()
         .collect();
 
-    let cache = Cache::open(&out);
-    // Every line's resolved top-level parameters, as Verilator elaborates them (defaults
-    // included): the variant table carries them so a test can hold the model to every one.
-    let resolved = resolve_all_params(&cache, &repo, &tops, &verilator_version);
     let built_names: Vec<String> = selected.iter().map(|v| v.full_name.clone()).collect();
     write_if_changed(
         &out.join("variant_table.rs"),
@@ -798,6 +816,81 @@ fn selects(entry: &str, v: &Variant) -> bool {
                 .iter()
                 .any(|(pk, pv)| pk == k && pv.to_string() == *val)
         })
+}
+
+/// A `CUBE5_TOPS` entry `top@Param=value:...` (what `cube5 elaborate` prints): exactly that
+/// configuration, the top's defaults for every other parameter. The checked-in `.variants` line
+/// that Verilator elaborates to the same parameters when there is one; otherwise a line generated
+/// here (flag `sim`, named by the naming rule from the given parameters: `p4m32s0`), added to this
+/// build's variants and cached like any other, never written to the `.variants` files. Other
+/// entries are returned as they are.
+fn exact_entry(
+    entry: &str,
+    tops: &[cube5_gen::variants::Top],
+    variants: &mut Vec<Variant>,
+    resolved: &mut Resolved,
+    cache: &Cache,
+    repo: &Path,
+    verilator_version: &str,
+) -> String {
+    let Some((top, spec)) = entry.split_once('@') else {
+        return entry.to_string();
+    };
+    let bad = |why: String| -> ! { panic!("CUBE5_TOPS entry `{entry}`: {why}") };
+    let Some(t) = tops.iter().find(|t| t.name == top) else {
+        bad(format!("no top `{top}` has a .variants file"))
+    };
+    let mut params = Vec::new();
+    for kv in spec.split(':').filter(|kv| !kv.is_empty()) {
+        let Some((k, v)) = kv.split_once('=') else {
+            bad(format!("`{kv}` is not Param=value"))
+        };
+        let Ok(v) = v.parse::<i64>() else {
+            bad(format!("`{kv}`: the value is not an integer"))
+        };
+        params.push((k.to_string(), v));
+    }
+    let name: String = params
+        .iter()
+        .map(|(k, v)| format!("{}{v}", k[..1].to_ascii_lowercase()))
+        .collect();
+    let line = cube5_gen::variants::VariantLine {
+        top: top.to_string(),
+        config: name.clone(),
+        params: params.clone(),
+        flags: vec!["sim".to_string()],
+        origin: format!("CUBE5_TOPS entry `{entry}`"),
+    };
+    cube5_gen::variants::check_name(&line).unwrap_or_else(|e| bad(e));
+    let want = resolve_params(cache, repo, t, &line, verilator_version)
+        .unwrap_or_else(|e| bad(e.to_string()));
+    if let Some(l) = t
+        .variants
+        .iter()
+        .find(|l| resolved.get(&(top.to_string(), l.config.clone())) == Some(&want))
+    {
+        return l.full_name();
+    }
+    if t.variants.iter().any(|l| l.config == name) {
+        bad(format!(
+            "the generated name `{name}` is a line of {} with other parameters",
+            t.variants_file.display()
+        ));
+    }
+    if !variants.iter().any(|v| v.full_name == line.full_name()) {
+        variants.push(Variant {
+            top: top.to_string(),
+            config: name.clone(),
+            full_name: line.full_name(),
+            params,
+            flags: line.flags.clone(),
+            files: t.files.iter().map(|f| repo.join(f)).collect(),
+            gate: false,
+            mutant: false,
+        });
+        resolved.insert((top.to_string(), name), want);
+    }
+    line.full_name()
 }
 
 /// `(top, config) -> [(Param, value)]` for every `.variants` line, read back from Verilator's

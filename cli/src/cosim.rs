@@ -3,7 +3,7 @@
 //! mismatch (pixel, channel, both values, the model's sample trail of that ray), the cycles per
 //! frame and samples per clock per pipeline, and writes both base planes and both warped images.
 
-use crate::{load_scene, write_png_atomically};
+use crate::write_png_atomically;
 use anyhow::{anyhow, bail, Context, Result};
 use cube5_model::render::ImageF64;
 use cube5_model::scene::Scene;
@@ -20,9 +20,9 @@ use std::time::Instant;
 pub struct CosimArgs {
     /// Scene file (TOML); omit for the embedded default scene.
     scene: Option<PathBuf>,
-    /// Pipelines: a P that rtl/cube5/cube5_frame.variants has (1, 4 or 8 today).
-    #[arg(short, long, default_value_t = 4)]
-    pipelines: usize,
+    /// Pipelines, overriding the scene's run.pipelines (default 4): a P this build has.
+    #[arg(short, long)]
+    pipelines: Option<usize>,
     /// Directory for the images (created if missing).
     #[arg(short, long, default_value = "cube5-cosim")]
     out_dir: PathBuf,
@@ -37,26 +37,23 @@ pub struct CosimResult {
 }
 
 pub fn run(args: CosimArgs) -> Result<()> {
-    let scene = load_scene(args.scene.as_deref())?;
-    let origin = args
-        .scene
-        .as_ref()
-        .map_or("the default scene".to_string(), |p| p.display().to_string());
-    scene.validate(&origin)?;
+    let (scene, origin) = crate::elaborate::load_valid(args.scene.as_deref())?;
     if scene.gi.is_some() {
         bail!("{origin}: [gi]: the scene renders on the GI-Cube processor model, and there is no GI-Cube RTL yet to co-simulate (`cube5 render` renders it)");
     }
-    let rtl = FrameRtl::with_pipelines(args.pipelines).ok_or_else(|| {
-        anyhow!(
-            "--pipelines {}: cube5_frame is built for P = {} (rtl/cube5/cube5_frame.variants)",
-            args.pipelines,
-            FrameRtl::pipeline_counts()
-                .iter()
-                .map(|p| p.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    })?;
+    if let Some(p) = args.pipelines {
+        if !FrameRtl::all().iter().any(|r| r.p == p && r.variant.built) {
+            bail!(
+                "--pipelines {p}: cube5_frame is built for P = {} (rtl/cube5/cube5_frame.variants)",
+                FrameRtl::pipeline_counts()
+                    .iter()
+                    .map(|p| p.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+    }
+    let rtl = variant_for(&scene, &origin, args.pipelines)?;
     let result = cosim_scene(&scene, &origin, rtl, &args.out_dir, args.seed)?;
     if !result.matched {
         bail!("the RTL frame differs from the model (report above)");
@@ -64,18 +61,49 @@ pub fn run(args: CosimArgs) -> Result<()> {
     Ok(())
 }
 
-/// The cube5_frame variant a scene co-simulates on: its widths, four pipelines where built, the
-/// largest memory.
-pub fn variant_for(scene: &Scene) -> Result<FrameRtl> {
-    let want = frame_config(scene)?;
-    let widths = |c: &FrameConfig| (c.trilin, c.gradient, c.shader, c.compos);
-    FrameRtl::all()
+/// The cube5_frame variant a scene co-simulates on: the configuration the scene elaborates to
+/// (`cube5 elaborate`: P, widths, units, MaxDim), built in this cube5; where only a larger memory
+/// of the same configuration is built, that one (it holds the volume, and the image does not
+/// depend on MaxDim), said so. Prints what was elaborated and why, and the area where a synthesis
+/// of it is cached. Refused, naming the `make cosim` that builds it, when neither is built.
+pub fn variant_for(scene: &Scene, origin: &str, pipelines: Option<usize>) -> Result<FrameRtl> {
+    let e = crate::elaborate::derive(scene, origin, pipelines)?;
+    for line in crate::elaborate::report(&e, origin) {
+        say!("{line}");
+    }
+    match crate::elaborate::area_lines(&e, false) {
+        Ok(lines) => lines.iter().for_each(|l| say!("{l}")),
+        Err(why) => say!("area: {why}"),
+    }
+    let same = |r: &FrameRtl| {
+        r.variant.built
+            && r.max_dim_log2 >= e.config.max_dim_log2
+            && r.cfg
+                == FrameConfig {
+                    max_dim_log2: r.max_dim_log2,
+                    ..e.config
+                }
+    };
+    let rtl = FrameRtl::all()
         .into_iter()
-        .filter(|r| widths(r) == widths(&want))
-        .max_by_key(|r| (r.p == 4, r.max_dim_log2))
+        .filter(same)
+        .min_by_key(|r| r.max_dim_log2)
         .ok_or_else(|| {
-            anyhow!("no cube5_frame variant in rtl/cube5/cube5_frame.variants has the scene's widths ([quality]): the model renders it, the RTL cannot be co-simulated")
-        })
+            anyhow!(
+                "{origin}: cube5_frame {} is not built in this cube5: `make cosim SCENE={origin}` builds it (CUBE5_TOPS={})",
+                e.name(),
+                e.spec()
+            )
+        })?;
+    if rtl.cfg != e.config {
+        say!(
+            "runs on {}: the same configuration with a larger memory (MaxDim {} >= {}); `make cosim SCENE={origin}` builds the exact one",
+            rtl.variant,
+            rtl.max_dim(),
+            e.config.max_dim()
+        );
+    }
+    Ok(rtl)
 }
 
 /// One frame of `scene` on `rtl` and on the model (`FrameJob`, what `cube5 render` computes);

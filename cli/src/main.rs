@@ -13,6 +13,7 @@ macro_rules! say {
 mod bench;
 #[cfg(feature = "rtl")]
 mod cosim;
+mod elaborate;
 mod tradeoff;
 
 use anyhow::{bail, Context, Result};
@@ -57,6 +58,9 @@ enum Command {
     /// Print speed figures: simulated RTL cycles per second and model samples per second.
     #[cfg(feature = "rtl")]
     Bench(bench::BenchArgs),
+    /// Print the cube5_frame configuration a scene needs (P, widths, MaxDim, the units it leaves
+    /// out and why), its .variants line and CUBE5_TOPS entry, whether it is built, its area.
+    Elaborate(elaborate::ElaborateArgs),
 }
 
 #[derive(Debug, clap::Args)]
@@ -168,6 +172,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => bench::run(args),
         #[cfg(feature = "rtl")]
         Command::Cosim(args) => cosim::run(args),
+        Command::Elaborate(args) => elaborate::run(args),
     }
 }
 
@@ -495,25 +500,22 @@ fn render_gi(scene: &Scene, vol: &cube5_model::volume::Volume, args: &RenderArgs
 /// output. True when the scene asks for the RTL only (nothing more to render).
 #[cfg(feature = "rtl")]
 fn cosim_for_render(scene: &Scene, args: &RenderArgs) -> Result<bool> {
-    // The RTL frame (P = 4) against the model, images beside the output. It is the only RTL
-    // variant a scene needs: `CUBE5_TOPS=cube5_frame:P=4:MaxDim=128` builds just it.
-    let rtl = cosim::variant_for(scene)?;
+    // The RTL frame the scene elaborates to (`cube5 elaborate`) against the model, images beside
+    // the output.
+    let origin = args
+        .scene
+        .as_ref()
+        .map_or("the default scene".to_string(), |p| p.display().to_string());
+    let rtl = cosim::variant_for(scene, &origin, None)?;
     say!(
-        "rtl: {} (the only RTL variant this scene needs; CUBE5_TOPS={}:P={}:MaxDim={} builds just it)",
-        rtl.variant,
-        rtl.variant.top,
-        rtl.p,
-        rtl.max_dim()
+        "rtl: {} (the only RTL variant this scene needs; `make cosim SCENE=...` builds just it)",
+        rtl.variant
     );
     let stem = args
         .output
         .file_stem()
         .map_or("cube5".into(), |s| s.to_string_lossy().into_owned());
     let dir = args.output.with_file_name(format!("{stem}-cosim"));
-    let origin = args
-        .scene
-        .as_ref()
-        .map_or("the default scene".to_string(), |p| p.display().to_string());
     let r = cosim::cosim_scene(scene, &origin, rtl, &dir, 1)?;
     if !r.matched {
         bail!(

@@ -23,6 +23,7 @@ pub mod regmap;
 pub mod regs;
 pub mod render;
 pub mod scene;
+pub mod scene_elab;
 pub mod scene_gi;
 pub mod scene_render;
 pub mod slab_perspective;

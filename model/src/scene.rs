@@ -176,6 +176,9 @@ pub type QualitySpec = Quality;
 pub struct RunSpec {
     pub target: Target,
     pub renderer: Renderer,
+    /// Pipelines of the RTL frame the scene elaborates (`cube5 elaborate`, `cube5 cosim`,
+    /// `run.target = "rtl"`): 1, 2, 4 or 8; unset: 4 (`scene_elab`).
+    pub pipelines: Option<u32>,
 }
 
 /// Where the scene runs: the golden model, the RTL (co-simulated), or both compared.
@@ -646,6 +649,14 @@ impl Scene {
                     self.run.renderer.name()
                 ),
             );
+        }
+        if let Some(p) = self.run.pipelines {
+            if ![1, 2, 4, 8].contains(&p) {
+                return bad(
+                    "run.pipelines",
+                    format!("{p}: the RTL frame has 1, 2, 4 or 8 pipelines"),
+                );
+            }
         }
         if self.run.target.uses_rtl() && v.file.is_none() && v.size > RTL_MAX_EDGE {
             return bad(

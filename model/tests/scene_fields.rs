@@ -131,6 +131,8 @@ fn cases() -> Vec<Case> {
         // [run]: what runs.
         c("run.target", "", "[run]\ntarget = \"rtl\"\n", Run),
         c("run.renderer", "", "[run]\nrenderer = \"reference\"\n", Run),
+        // run.pipelines sets the RTL configuration's P (scene_elab's tests); here its refusal.
+        c("run.pipelines", "", "[run]\npipelines = 3\n", Refused),
         // [gi]: the GI-Cube processor model's lighting and rendering passes.
         c("gi.light", GI, "[gi]\nlight = [-0.55, 0.25, -0.8]\n", Processor),
         c("gi.light", GI, "[gi]\nlight = [0.0, 0.0, 0.0]\n", Refused),

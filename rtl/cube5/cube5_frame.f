@@ -13,5 +13,6 @@ rtl/cube5/cube5_frame_vwin.sv
 rtl/cube5/cube5_frame_interp.sv
 rtl/cube5/cube5_frame_swin.sv
 rtl/cube5/cube5_frame_shade.sv
+rtl/cube5/cube5_frame_class.sv
 rtl/cube5/cube5_frame_cbuf.sv
 rtl/cube5/cube5_frame.sv

@@ -38,7 +38,11 @@ module cube5_frame #(
   /// Compositing (cube5_compos).
   parameter int unsigned ExtraW     = 4,
   parameter int unsigned AccW       = 20,
-  parameter int unsigned ZW         = 12
+  parameter int unsigned ZW         = 12,
+  /// Units of the pipelines: 1 gradient and shader (every mode); 0 neither, for MIP only: each
+  /// pipeline classifies its sample with the shader's 1-D table alone (cube5_frame_class;
+  /// docs/numerics/frame.md, "A frame without gradient and shader").
+  parameter int unsigned Shade      = 1
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -119,6 +123,9 @@ module cube5_frame #(
   end
   if (VoxelW + FracW < ClassIdxW) begin : gen_bad_class
     $fatal(1, "cube5_frame: ClassIdxW must not exceed the sample width");
+  end
+  if (Shade > 1) begin : gen_bad_shade
+    $fatal(1, "cube5_frame: Shade must be 0 (no gradient, no shader: MIP only) or 1");
   end
   if (OffW + cube5_frame_pkg::CfgRegionW > 32) begin : gen_bad_cfg
     $fatal(1, "cube5_frame: the configuration address must fit 32 bits");
@@ -202,6 +209,8 @@ module cube5_frame #(
     view_ok_d = (axis_k_q != 2'd3)
                 && (render_q == cube5_frame_pkg::RenderMip
                     || render_q == cube5_frame_pkg::RenderComposite)
+                // Without gradient and shader: MIP with the 1-D classification only.
+                && (Shade != 0 || (render_q == cube5_frame_pkg::RenderMip && !tf2d_q))
                 && (dx_q <= one_step) && (dx_q >= -one_step)
                 && (dy_q <= one_step) && (dy_q >= -one_step);
   end
@@ -559,35 +568,58 @@ module cube5_frame #(
   logic               is_mip;
   assign is_mip = (render_q == cube5_frame_pkg::RenderMip);
 
-  cube5_frame_shade #(
-    .P          (P),
-    .VoxelW     (VoxelW),
-    .FracW      (FracW),
-    .WeightW    (WeightW),
-    .ClassIdxW  (ClassIdxW),
-    .MagIdxW    (MagIdxW),
-    .MagShift   (MagShift),
-    .ColorW     (ColorW),
-    .AlphaW     (AlphaW),
-    .RmLog2     (RmLog2),
-    .RmFracW    (RmFracW),
-    .DiffW      (DiffW),
-    .SpecW      (SpecW),
-    .ShCfgAddrW (ShAddrW),
-    .ShCfgDataW (ShDataW)
-  ) u_shade (
-    .clk_i         (clk_i),
-    .rst_ni        (rst_ni),
-    .start_i       (start),
-    .shader_mode_i ({is_mip, tf2d_q}),
-    .nb_valid_i    (nb_valid),
-    .nb_i          (nb),
-    .cfg_valid_i   (cfg_shader),
-    .cfg_addr_i    (cfg_off[ShAddrW-1:0]),
-    .cfg_data_i    (cfg_data_i[ShDataW-1:0]),
-    .rgba_valid_o  (rgba_valid),
-    .rgba_o        (rgba)
-  );
+  if (Shade != 0) begin : gen_shade
+    cube5_frame_shade #(
+      .P          (P),
+      .VoxelW     (VoxelW),
+      .FracW      (FracW),
+      .WeightW    (WeightW),
+      .ClassIdxW  (ClassIdxW),
+      .MagIdxW    (MagIdxW),
+      .MagShift   (MagShift),
+      .ColorW     (ColorW),
+      .AlphaW     (AlphaW),
+      .RmLog2     (RmLog2),
+      .RmFracW    (RmFracW),
+      .DiffW      (DiffW),
+      .SpecW      (SpecW),
+      .ShCfgAddrW (ShAddrW),
+      .ShCfgDataW (ShDataW)
+    ) u_shade (
+      .clk_i         (clk_i),
+      .rst_ni        (rst_ni),
+      .start_i       (start),
+      .shader_mode_i ({is_mip, tf2d_q}),
+      .nb_valid_i    (nb_valid),
+      .nb_i          (nb),
+      .cfg_valid_i   (cfg_shader),
+      .cfg_addr_i    (cfg_off[ShAddrW-1:0]),
+      .cfg_data_i    (cfg_data_i[ShDataW-1:0]),
+      .rgba_valid_o  (rgba_valid),
+      .rgba_o        (rgba)
+    );
+  end else begin : gen_class
+    cube5_frame_class #(
+      .P          (P),
+      .VoxelW     (VoxelW),
+      .FracW      (FracW),
+      .ClassIdxW  (ClassIdxW),
+      .ColorW     (ColorW),
+      .AlphaW     (AlphaW),
+      .ShCfgAddrW (ShAddrW),
+      .ShCfgDataW (ShDataW)
+    ) u_class (
+      .clk_i        (clk_i),
+      .rst_ni       (rst_ni),
+      .nb_valid_i   (nb_valid),
+      .nb_i         (nb),
+      .cfg_valid_i  (cfg_shader),
+      .cfg_addr_i   (cfg_off[ShAddrW-1:0]),
+      .cfg_data_i   (cfg_data_i[ShDataW-1:0]),
+      .rgba_valid_o (rgba_valid),
+      .rgba_o       (rgba)
+    );
+  end
 
   // ---------------------------------------------------------------------------
   // Compositing buffer and the compositing units (one per bank)

@@ -19,6 +19,11 @@ package cube5_frame_pkg;
   /// "Timing").
   localparam int unsigned GradientLatency = 5;
 
+  /// Latency of cube5_frame_class, the classification that takes the place of gradient and shader
+  /// in a frame with Shade = 0 (the table's registered read; docs/numerics/frame.md, "A frame
+  /// without gradient and shader").
+  localparam int unsigned ClassLatency = 1;
+
   /// Latency of cube5_compos (docs/numerics/compos.md, "Timing"). The compositing buffer's update
   /// loop, and with it the smallest volume the frame accepts, follows from it; cube5_frame asserts
   /// in simulation that the unit keeps it.

@@ -72,11 +72,11 @@ impl FrameRtl {
     }
 
     /// The configuration with `p` pipelines and the largest memory: the default widths that
-    /// `cube5 cosim` and the whole-frame tests run.
+    /// `cube5 cosim` and the whole-frame tests run (with gradient and shader).
     pub fn with_pipelines(p: usize) -> Option<FrameRtl> {
         Self::all()
             .into_iter()
-            .filter(|r| r.p == p && r.default_widths())
+            .filter(|r| r.p == p && r.default_widths() && r.shade)
             .max_by_key(|r| r.max_dim_log2)
     }
 
@@ -85,8 +85,13 @@ impl FrameRtl {
     pub fn smallest(p: usize) -> Option<FrameRtl> {
         Self::all()
             .into_iter()
-            .filter(|r| r.p == p)
+            .filter(|r| r.p == p && r.shade)
             .min_by_key(|r| r.max_dim_log2)
+    }
+
+    /// The configurations without gradient and shader (`Shade = 0`, MIP only).
+    pub fn without_shade() -> Vec<FrameRtl> {
+        Self::all().into_iter().filter(|r| !r.shade).collect()
     }
 
     /// The pipeline counts of the default-width configurations ([`FrameRtl::with_pipelines`]),
@@ -94,7 +99,7 @@ impl FrameRtl {
     pub fn pipeline_counts() -> Vec<usize> {
         let mut ps: Vec<usize> = Self::all()
             .iter()
-            .filter(|r| r.default_widths())
+            .filter(|r| r.default_widths() && r.shade)
             .map(|r| r.p)
             .collect();
         ps.sort_unstable();
@@ -109,9 +114,9 @@ impl FrameRtl {
 /// description as `cube5_frame_pkg`. Only the cycle budget and the smallest-volume rule (compos)
 /// depend on the latencies.
 pub use cube5_model::regs::cube5_frame::{
-    COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK, REGION_COMPOS, REGION_FRAME,
-    REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE, REG_SKIP, REG_VIEW,
-    TRILIN_LATENCY,
+    CLASS_LATENCY, COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK, REGION_COMPOS,
+    REGION_FRAME, REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE, REG_SKIP,
+    REG_VIEW, TRILIN_LATENCY,
 };
 
 /// The frame's two renderings (docs/numerics/frame.md, "The pipeline of one sample").
@@ -279,6 +284,16 @@ impl FrameRtl {
             .into_iter()
             .map(|(a, d)| (self.addr(REGION_COMPOS, a), d))
             .collect()
+    }
+
+    /// Cycles from a sample's neighbourhood to its shaded sample: gradient and shader, or the
+    /// classification table alone without them (`Shade = 0`).
+    pub fn shade_latency(&self) -> u64 {
+        if self.shade {
+            GRADIENT_LATENCY + self.shader.latency()
+        } else {
+            CLASS_LATENCY
+        }
     }
 
     /// The default unit widths, the only ones `cube5_model::units::cube5_frame::FrameUnits` builds.

@@ -495,21 +495,29 @@ fn sweep_and_readout_cycles_follow_the_budget() {
     // Set-up 3 + beats + flush (nbs + 2 nbr + 2) + the pipeline; then one pixel per clock.
     let s = seed(7);
     let vol = head_phantom(32, 12).unwrap();
-    for rtl in [p(1), p(4), p(8)] {
+    // With and without gradient and shader (MIP only: the classification table alone).
+    let bare = FrameRtl::without_shade()
+        .into_iter()
+        .filter(|r| r.max_dim() >= 32);
+    for rtl in [p(1), p(4), p(8)].into_iter().chain(bare) {
         let (mut bench, seen) = loaded(rtl, &vol, s);
-        // Memory L + 2, corner register 1, trilin, window register 1, gradient, shader, buffer
-        // read 1, compos, write-back count 1.
+        // Memory L + 2, corner register 1, trilin, window register 1, gradient and shader (or
+        // the table), buffer read 1, compos, write-back count 1.
         let pipeline = u64::from(rtl.skew().latency())
             + 1
             + TRILIN_LATENCY
             + 1
-            + GRADIENT_LATENCY
-            + rtl.shader.latency()
+            + rtl.shade_latency()
             + 1
             + COMPOS_LATENCY
             + 1;
+        let render = if rtl.shade {
+            Render::Composite
+        } else {
+            Render::Mip
+        };
         for v in [("+z", [0.0, 0.0, 1.0]), OBLIQUE_Z] {
-            let e = expect(&rtl, &seen, v, Render::Composite, false);
+            let e = expect(&rtl, &seen, v, render, false);
             let st = must(bench.check(&e, &Traffic::full_speed(), s));
             let p = &e.params;
             let (nbr, nbs) = (p.ni / rtl.p, p.ni * p.nj / rtl.p);
@@ -562,6 +570,55 @@ fn narrow_configurations_s1_s4() {
                 "{} {:?} {render:?}: {n} views bit-exact",
                 rtl.variant, vol.dims
             );
+        }
+    }
+}
+
+/// The frames without gradient and shader (`Shade = 0`): MIP frames bit-exact at every accepted
+/// view, with idle and back-pressure, on a volume of each configuration's memory; composite and
+/// the 2-D classification are refused with one error item, and nothing of them stays behind.
+#[test]
+fn frames_without_gradient_and_shader_mip_bit_exact_composite_refused() {
+    let s = seed(12);
+    let bare = FrameRtl::without_shade();
+    assert!(!bare.is_empty(), "a cube5_frame variant with Shade = 0");
+    for rtl in bare {
+        let vols = if rtl.max_dim() >= 32 {
+            vec![
+                head_phantom(32, 12).unwrap(),
+                blob_volume([16, 8, 24], 12, s),
+            ]
+        } else {
+            let w = rtl.trilin.voxel_w;
+            vec![head_phantom(8, w).unwrap(), blob_volume([8, 4, 8], w, s)]
+        };
+        for vol in &vols {
+            let (mut bench, seen) = loaded(rtl, vol, s);
+            let mut rng = ChaCha8Rng::seed_from_u64(s);
+            let traffic = [Traffic::full_speed(), Traffic::random(&mut rng, 0.0, 0.3)];
+            let mut rendered = Vec::new();
+            for v in views() {
+                let e = expect(&rtl, &seen, v, Render::Mip, false);
+                if !accepted(&e.params, rtl.p) {
+                    continue;
+                }
+                let n = rendered.len();
+                must(bench.check(&e, &traffic[n % 2], s + n as u64));
+                rendered.push(e);
+            }
+            let n = rendered.len();
+            assert!(n >= 4, "{}: {n} views rendered", rtl.variant);
+            eprintln!("{} {:?} Mip: {n} views bit-exact", rtl.variant, vol.dims);
+            // The last view the frame accepts: refused in the other modes, then rendered again.
+            let good = rendered.pop().unwrap();
+            for (what, mode) in [("composite", 1), ("MIP with the 2-D classification", 4)] {
+                must(bench.load(&good));
+                must(bench.write(&[rtl.reg(REG_MODE, mode)]));
+                let out = must(bench.refused(OP_RENDER));
+                assert!(out.error, "{}: {what} is refused", rtl.variant);
+            }
+            must(bench.load(&good));
+            must(bench.render_and_compare(&good, &Traffic::full_speed(), s + 1));
         }
     }
 }

@@ -18,6 +18,11 @@ pub const TRILIN_LATENCY: u64 = 3;
 /// Latency of cube5_gradient in cycles: five register stages (docs/numerics/gradient.md, "Timing").
 pub const GRADIENT_LATENCY: u64 = 5;
 
+/// Latency of cube5_frame_class, the classification that takes the place of gradient and shader in
+/// a frame with Shade = 0 (the table's registered read; docs/numerics/frame.md, "A frame without
+/// gradient and shader").
+pub const CLASS_LATENCY: u64 = 1;
+
 /// Latency of cube5_compos (docs/numerics/compos.md, "Timing"). The compositing buffer's update
 /// loop, and with it the smallest volume the frame accepts, follows from it; cube5_frame asserts in
 /// simulation that the unit keeps it.

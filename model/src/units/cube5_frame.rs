@@ -50,6 +50,10 @@ pub struct FrameConfig {
     pub gradient: GradientConfig,
     pub shader: ShaderConfig,
     pub compos: ComposConfig,
+    /// Gradient and shader in every pipeline (`Shade = 1`), or neither (`Shade = 0`): the frame
+    /// then renders MIP only, each sample classified by the shader's 1-D table alone
+    /// (docs/numerics/frame.md, "A frame without gradient and shader").
+    pub shade: bool,
 }
 
 impl FrameConfig {
@@ -63,6 +67,7 @@ impl FrameConfig {
         gradient: GradientConfig::DEFAULT,
         shader: ShaderConfig::DEFAULT,
         compos: ComposConfig::DEFAULT,
+        shade: true,
     };
 
     /// The largest volume edge (`MaxDim`).
@@ -81,6 +86,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         let mut max_dim = 1u32 << d.max_dim_log2;
         let (mut block, mut mem_latency) = (d.block, d.mem_latency);
         let (mut t, mut g, mut s, mut c) = (d.trilin, d.gradient, d.shader, d.compos);
+        let mut shade = u32::from(d.shade);
         crate::unit::set_params(
             Self::TOP,
             params,
@@ -104,8 +110,14 @@ impl crate::unit::UnitConfig for FrameConfig {
                 ("ExtraW", &mut c.extra_w),
                 ("AccW", &mut c.acc_w),
                 ("ZW", &mut c.z_w),
+                ("Shade", &mut shade),
             ],
         )?;
+        if shade > 1 {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: Shade = {shade} must be 0 (no gradient, no shader: MIP only) or 1"
+            )));
+        }
         if !max_dim.is_power_of_two() {
             return Err(ModelError::Config(format!(
                 "cube5_frame: MaxDim = {max_dim} is not a power of two"
@@ -127,6 +139,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             gradient: g,
             shader: s,
             compos: c,
+            shade: shade == 1,
         })
     }
 
@@ -153,6 +166,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             ("ExtraW", i(c.extra_w)),
             ("AccW", i(c.acc_w)),
             ("ZW", i(c.z_w)),
+            ("Shade", i64::from(self.shade)),
         ]
     }
 }
@@ -621,6 +635,9 @@ pub struct FrameUnits {
     pub shader: Shader,
     pub compos: Compos,
     pub mode: FrameMode,
+    /// The frame has gradient and shader ([`FrameConfig::shade`]); without them a sample is
+    /// classified by the shader's 1-D table alone ([`classify_only`]).
+    pub shade: bool,
 }
 
 /// The base-plane image: the final coxel of every ray, row-major.
@@ -725,6 +742,11 @@ impl FrameUnits {
         phong: &Phong,
         early_termination: Option<f64>,
     ) -> Result<Self> {
+        if !cfg.shade && mode != FrameMode::Mip {
+            return Err(ModelError::Config(
+                "cube5_frame: Shade = 0 (no gradient, no shader) renders MIP only; a composite frame needs Shade = 1".into(),
+            ));
+        }
         let rmap = ReflectanceMap::from_lights(&cfg.shader, phong)?;
         let (class, ratio) = match mode {
             FrameMode::Mip => (density_ramp(&cfg.shader)?, 1.0),
@@ -745,6 +767,7 @@ impl FrameUnits {
                 compos_regs(&cfg.compos, mode, early_termination),
             )?,
             mode,
+            shade: cfg.shade,
         })
     }
 
@@ -757,6 +780,10 @@ impl FrameUnits {
         a: usize,
         b: usize,
     ) -> Sample {
+        if !self.shade {
+            let centre = sample_at(params, vol, c, c.s as i64, a as i64, b as i64, &self.trilin);
+            return classify_only(&self.shader, centre, c.s as u32);
+        }
         let n = neighbourhood(params, vol, c, a, b, &self.trilin);
         let mode = ShaderMode {
             tf2d: false,
@@ -827,6 +854,22 @@ pub fn shade_n6(
         } else {
             ComposMode::FrontToBack
         },
+    }
+}
+
+/// A sample's way through a frame without gradient and shader (`Shade = 0`, MIP only;
+/// docs/numerics/frame.md, "A frame without gradient and shader"): the entry of the 1-D
+/// classification table at the sample's top `ClassIdxW` bits, as it is, composited by `Max` at
+/// slice `depth`. The shader's reflectance map is not read.
+pub fn classify_only(shader: &Shader, sample: u32, depth: u32) -> Sample {
+    let cfg = shader.config();
+    let idx = (sample >> (cfg.sample_w() - cfg.class_idx_w)) as usize;
+    let e = shader.tables().class.entries()[idx];
+    Sample {
+        rgb: [e.r, e.g, e.b],
+        alpha: e.a,
+        depth,
+        mode: ComposMode::Max,
     }
 }
 
@@ -1128,5 +1171,64 @@ mod tests {
                 "consecutive slices: {t:?}"
             );
         }
+    }
+
+    /// `Shade = 0`: the frame without gradient and shader. Its MIP image (the 1-D table read at
+    /// every sample, `classify_only`) is the full frame's MIP image, through the reference and
+    /// the fast path, at the default and the narrow widths; it refuses composite frames and the
+    /// parameter takes only 0 and 1, each refusal naming `Shade`.
+    #[test]
+    fn a_frame_without_gradient_and_shader_renders_the_same_mip() {
+        use crate::unit::UnitConfig;
+        let vol = crate::phantom::head_phantom(24, 12).unwrap();
+        let tf = TransferFunction::head_default();
+        let narrow = [
+            ("VoxelW", 8),
+            ("WeightW", 6),
+            ("FracW", 2),
+            ("ClassIdxW", 8),
+            ("ColorW", 8),
+            ("AlphaW", 8),
+            ("ExtraW", 0),
+            ("AccW", 8),
+        ];
+        for base in [&[][..], &narrow[..]] {
+            let mut with = base.to_vec();
+            let full = FrameConfig::from_params(&with).unwrap();
+            with.push(("Shade", 0));
+            let bare = FrameConfig::from_params(&with).unwrap();
+            assert!(full.shade && !bare.shade);
+            assert!(bare.to_params().contains(&("Shade", 0)));
+            let vol = crate::scene_render::at_voxel_width(&vol, full.trilin.voxel_w).unwrap();
+            for v in [[0.0, 0.0, 1.0], [0.3, -0.7, 1.0], [-1.0, 0.4, 0.2]] {
+                let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), 4).unwrap();
+                let params = setup.params;
+                let phong = frame_phong(&params, &[]);
+                let units = |cfg: &FrameConfig| {
+                    FrameUnits::with_config(cfg, FrameMode::Mip, &setup, &tf, &phong, None).unwrap()
+                };
+                let (uf, ub) = (units(&full), units(&bare));
+                let want = render_base_plane_reference(&params, &vol, &uf);
+                assert_eq!(
+                    render_base_plane_reference(&params, &vol, &ub),
+                    want,
+                    "{v:?}"
+                );
+                assert_eq!(render_base_plane(&params, &vol, &ub), want, "{v:?}");
+                assert!(
+                    want.coxels.iter().any(|c| c.rgba[3] > 0),
+                    "{v:?}: an empty image"
+                );
+                let e =
+                    FrameUnits::with_config(&bare, FrameMode::Composite, &setup, &tf, &phong, None)
+                        .unwrap_err()
+                        .to_string();
+                assert!(e.contains("Shade = 0"), "{e}");
+            }
+        }
+        let e = FrameConfig::from_params(&[("Shade", 2)])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("Shade = 2"), "{e}");
     }
 }
