@@ -16,8 +16,8 @@ setup:
 ## RTL configuration (cube5_frame with P = 4, 128^3) is built for it.
 demo: setup
 	@mkdir -p $(DEMO_DIR)
-	CUBE5_TOPS=cube5_frame:P=4:MaxDim=128 $(CARGO) run --release -q -p cube5-cli -- render -o $(DEMO_DIR)/cube5-demo.png
-	CUBE5_TOPS=cube5_frame:P=4:MaxDim=128 $(CARGO) run --release -q -p cube5-cli -- cosim -o $(DEMO_DIR)/cosim
+	CUBE5_TOPS=cube5_frame@P=4:MaxDim=128 $(CARGO) run --release -q -p cube5-cli -- render -o $(DEMO_DIR)/cube5-demo.png
+	CUBE5_TOPS=cube5_frame@P=4:MaxDim=128 $(CARGO) run --release -q -p cube5-cli -- cosim -o $(DEMO_DIR)/cosim
 
 ## Every test: golden model, co-simulation (RTL and gate-level netlists), command line.
 test: setup
