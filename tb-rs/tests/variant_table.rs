@@ -10,8 +10,8 @@
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_axi_wr::AxiWrConfig;
 use cube5_model::units::cube5_axil::AxilConfig;
-use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
+use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_model::units::{
     cube5_axi_rd::AxiRdConfig, cube5_compos::ComposConfig, cube5_frame::FrameConfig,
     cube5_gradient::GradientConfig, cube5_rblock::RBlockConfig, cube5_sepconv::SepconvConfig,
