@@ -257,6 +257,7 @@ mod tests {
             ("head-nrrd", &["quality.interpolation"]),
             ("head-perspective", &["view.projection"]),
             ("head-perspective-slabs", &["view.projection"]),
+            ("head-perspective-er", &["view.projection"]),
             ("gi-shadow", &["[gi]"]),
         ];
         let dir = crate::repo_root().join("scenes");
