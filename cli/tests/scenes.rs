@@ -223,7 +223,7 @@ fn rtl_target_cosimulates_the_frame() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(
-        stdout.contains("gradient (computed, unused: MIP is unlit)"),
+        stdout.contains("gradient (MIP is unlit; its frame has Shade = 0, no gradient unit)"),
         "{stdout}"
     );
     assert!(stdout.contains("MATCH"), "{stdout}");

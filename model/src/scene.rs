@@ -1172,16 +1172,17 @@ impl fmt::Display for Plan {
     }
 }
 
-/// The plan's entries as the frame computes them: all four units run for every sample (MIP takes
-/// the density ramp, unlit), the gradient is the 6-neighbourhood at orthogonal positions, and the
+/// The plan's entries as the frame computes them: every unit runs for every sample, except that a
+/// MIP frame (`Shade = 0`) has no gradient and classifies by the table alone (the density ramp,
+/// unlit); the gradient is the 6-neighbourhood at orthogonal positions, and the
 /// sweep skips whole empty slices at its ends (blocks of zeros), not transparent blocks.
 fn frame_entries(entries: &mut [PlanEntry], scene: &Scene, vol: &Volume) {
     let mip = scene.render.mode == CompositeMode::Mip;
     for e in entries.iter_mut() {
         match e.unit {
             Unit::Gradient if mip => {
-                e.needed = true;
-                e.detail = "computed, unused: MIP is unlit".into();
+                e.needed = false;
+                e.detail = "MIP is unlit; its frame has Shade = 0, no gradient unit".into();
             }
             Unit::Gradient => {
                 e.detail = "6-neighbourhood at orthogonal positions".into();
@@ -1189,7 +1190,7 @@ fn frame_entries(entries: &mut [PlanEntry], scene: &Scene, vol: &Volume) {
             }
             Unit::Shader if mip => {
                 e.needed = true;
-                e.detail = "density ramp, unlit".into();
+                e.detail = "classification table only (the density ramp), unlit".into();
             }
             Unit::Shader if !scene.render.shading => {
                 e.detail = "classification, reflectance map 1 (shading off)".into();
@@ -1294,12 +1295,12 @@ mod tests {
         let vol = crate::phantom::head_phantom(32, 12).unwrap();
         let scene = Scene::parse("[render]\nmode = \"mip\"\n", "s").unwrap();
         let plan = Plan::new(&scene, &vol).unwrap();
-        // The frame runs every unit for every sample; MIP leaves the gradient unused.
+        // A MIP frame has no gradient (Shade = 0) and classifies by the table alone.
         assert!(plan.model.starts_with("frame"), "{}", plan.model);
-        assert!(plan.needs(Unit::Gradient) && plan.needs(Unit::Shader));
+        assert!(!plan.needs(Unit::Gradient) && plan.needs(Unit::Shader));
         let text = plan.to_string();
         assert!(
-            text.contains("gradient (computed, unused: MIP is unlit)"),
+            text.contains("gradient (MIP is unlit; its frame has Shade = 0, no gradient unit)"),
             "{text}"
         );
         // The what-if pipeline leaves them out.
