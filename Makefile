@@ -55,8 +55,11 @@ cosim: setup
 lint:
 	@scripts/lint.sh
 
+## synth-docs.sh: SYNTH_WRITE_DOCS=1 rewrites, SYNTH_CHECK_DOCS=1 checks the generated ECP5 table
+## in docs/measurements.md (issue 17).
 synth:
 	@scripts/synth.sh
+	@scripts/synth-docs.sh
 
 ## Simulation-speed figures come from RTL variants compiled at C++ -O2 (tests use -O1, which
 ## builds twice as fast; docs/ci.md). The -O2 objects are cached beside the -O1 ones.
