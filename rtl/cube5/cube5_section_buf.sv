@@ -140,12 +140,15 @@ module cube5_section_buf #(
   logic            act_q, act_d;             // a section is being written
   logic [1:0]      axis_q, axis_d;
   logic            rev_q, rev_d;
-  logic [DimW-1:0] ni_q, ni_d, nj_q, nj_d, nk_q, nk_d, ns_q, ns_d;
+  logic [DimW-1:0] nj_q, nj_d, ns_q, ns_d;
   logic [M-1:0]    a0_q, a0_d;
   // Block counts minus one and the present-column offset a0 / B - 1, so the per-item compares
   // on the acceptance path need no adder.
   logic [NbCW-1:0] nbj1_q, nbj1_d, nbk1_q, nbk1_d, sechi1_q, sechi1_d, pofs_q, pofs_d, t_q, t_d;
   logic            wh_q, wh_d;                // the half being filled
+  // The row's high edge columns a0 + ns and a0 + ns + 1 lie past the volume (a0 + ns = min(a0 + S,
+  // ni), so a0 + ns >= ni is ni - a0 <= S): kept per section.
+  logic            hi00_q, hi00_d, hi10_q, hi10_d;
 
   logic [1:0] full_q, full_d;                 // half h holds a slab (or an error) to read
   logic [1:0] held_q, held_d;                 // half h is closed (full, or its last write in flight)
@@ -198,23 +201,26 @@ module cube5_section_buf #(
   assign item_close = (NbCW'(bj0) == nbj1_q) && (NbCW'(bi0) == sechi1_q)
                    && (it_skip || it_word == WordW'(Groups - 1));
 
-  // Slab t's slices: bk = reversed ? nbk - 1 - t : t, nkl = min(B, nk - B bk).
-  logic [NbCW-1:0] bk_w;
-  logic [DimW-1:0] rest_k;
-  logic [KW-1:0]   nkl_w;
+  // Slab t's slices: bk = reversed ? nbk - 1 - t : t, nkl = min(B, nk - B bk): B but for the
+  // slab bk = nbk - 1 (t = 0 reversed, t = nbk - 1 forward), which holds ktail = (nk - 1) mod B + 1
+  // slices (kept per section, so no adder on the slab-closing path).
+  logic [KW-1:0] ktail_q, ktail_d;
+  logic          tlast, kend;
+  logic [KW-1:0] nkl_w;
   always_comb begin
-    bk_w   = rev_q ? nbk1_q - t_q : t_q;
-    rest_k = nk_q - DimW'(32'(bk_w) << BW);
-    nkl_w  = (rest_k > DimW'(BlockDim)) ? KW'(BlockDim) : KW'(rest_k);
+    tlast = (t_q == nbk1_q);
+    kend  = rev_q ? (t_q == '0) : tlast;
+    nkl_w = kend ? ktail_q : KW'(BlockDim);
   end
 
   always_comb begin
     act_d     = act_q;
     axis_d    = axis_q;
     rev_d     = rev_q;
-    ni_d      = ni_q;
+    hi00_d    = hi00_q;
+    hi10_d    = hi10_q;
     nj_d      = nj_q;
-    nk_d      = nk_q;
+    ktail_d   = ktail_q;
     ns_d      = ns_q;
     a0_d      = a0_q;
     nbj1_d    = nbj1_q;
@@ -227,9 +233,10 @@ module cube5_section_buf #(
       act_d     = !cm_refused;
       axis_d    = cm_axis;
       rev_d     = cm_rev;
-      ni_d      = cm_ni;
+      hi00_d    = (cm_rest <= DimW'(Section));
+      hi10_d    = (cm_rest <= DimW'(Section + 1));
       nj_d      = cm_nj;
-      nk_d      = cm_nk;
+      ktail_d   = KW'(32'(BW'(cm_nk - DimW'(1)))) + KW'(1);
       ns_d      = cm_ns;
       a0_d      = cm_a0;
       nbj1_d    = NbCW'((cm_nj + DimW'(BlockDim - 1)) >> BW) - NbCW'(1);
@@ -263,9 +270,10 @@ module cube5_section_buf #(
   always_ff @(posedge clk_i) begin
     axis_q  <= axis_d;
     rev_q   <= rev_d;
-    ni_q    <= ni_d;
+    hi00_q  <= hi00_d;
+    hi10_q  <= hi10_d;
     nj_q    <= nj_d;
-    nk_q    <= nk_d;
+    ktail_q <= ktail_d;
     ns_q    <= ns_d;
     a0_q    <= a0_d;
     nbj1_q   <= nbj1_d;
@@ -279,8 +287,13 @@ module cube5_section_buf #(
   // ==============================================================================================
 
   logic [1:0]      de_err_q, de_last_q, de_rev_q, de_lo0_q, de_hi00_q, de_hi10_q;
-  logic [KW-1:0]   de_nkl_q [2];
-  logic [DimW-1:0] de_ns_q [2], de_nj_q [2];
+  // The reader's last beat, row and slice, minus one (its compares need no adder).
+  logic [MW-1:0]   de_m1_q [2];
+  logic [M-1:0]    de_nj1_q [2];
+  logic [KW-1:0]   de_nkl1_q [2];
+  // The present-flag columns of the high edge voxels a0 + ns and a0 + ns + 1.
+  localparam int unsigned CBW = $clog2(CB);
+  logic [CBW-1:0]  de_c0_q [2], de_c1_q [2];
 
   logic desc_we, desc_err;
   assign desc_we  = (cmd_fire && cm_refused) || (item_fire && item_close);
@@ -289,14 +302,16 @@ module cube5_section_buf #(
   always_ff @(posedge clk_i) begin
     if (desc_we) begin
       de_err_q[wh_q]  <= desc_err;
-      de_last_q[wh_q] <= (t_q == nbk1_q);
+      de_last_q[wh_q] <= tlast;
       de_rev_q[wh_q]  <= rev_q;
       de_lo0_q[wh_q]  <= (a0_q == '0);
-      de_hi00_q[wh_q] <= (DimW'(a0_q) + ns_q >= ni_q);
-      de_hi10_q[wh_q] <= (DimW'(a0_q) + ns_q + DimW'(1) >= ni_q);
-      de_nkl_q[wh_q]  <= nkl_w;
-      de_ns_q[wh_q]   <= ns_q;
-      de_nj_q[wh_q]   <= nj_q;
+      de_hi00_q[wh_q] <= hi00_q;
+      de_hi10_q[wh_q] <= hi10_q;
+      de_m1_q[wh_q]   <= MW'((ns_q >> LP) - DimW'(1));
+      de_nj1_q[wh_q]  <= M'(nj_q - DimW'(1));
+      de_nkl1_q[wh_q] <= nkl_w - KW'(1);
+      de_c0_q[wh_q]   <= CBW'((32'(ns_q) >> BW) + 1);
+      de_c1_q[wh_q]   <= CBW'(((32'(ns_q) + 1) >> BW) + 1);
     end
   end
 
@@ -358,7 +373,7 @@ module cube5_section_buf #(
   logic signed [CiW-1:0] w1ci_q;
   logic [M-1:0]         w1j_q;
   logic [BW-1:0]        w1lk_q;
-  logic [DimW-1:0]      w1ns_q;
+  logic [DimW-1:0]      w1ns_q, w1ns1_q;            // ns and ns + 1
   logic [P*VoxelW-1:0]  w1lanes_q;
 
   always_ff @(posedge clk_i) begin
@@ -377,11 +392,19 @@ module cube5_section_buf #(
     w1j_q     <= j0;
     w1lk_q    <= BW'(k0);
     w1ns_q    <= ns_q;
+    w1ns1_q   <= ns_q + DimW'(1);
     w1lanes_q <= it_lanes;
   end
 
-  // Per lane: column, slice, which store it goes to, its address there.
-  logic signed [CiW-1:0] ci_l, ns_s;
+  // Per lane: column, slice, which store it goes to, its address there. An item whose lanes run
+  // along i (slice axis y or z) starts at a column ci0 that is a multiple of P, and ns is a
+  // multiple of P (a0 a multiple of S, ni of P), so its lanes are all in 0..ns - 1 or all out,
+  // their main-bank word is ci0 / P, and edge column c goes to lane c mod P when
+  // ci0 = c - (c mod P). An item of slice axis x has one column for all lanes. So every compare
+  // is one of ci0 (no per-lane adder in front of the compares).
+  localparam int unsigned Lane1 = 1 % P;          // the lane of column ns + 1 (along i)
+  logic signed [CiW-1:0] ns_s, ns1_s, ns2_s;
+  logic                  c_main, c_m1, c_mp, c_ns, c_ns1, c_ns2;
   logic [BW-1:0]         lk_l;
   logic [P-1:0]          l_main;
   logic [3*P-1:0]        l_edge;                   // lane l, edge column c at l 3 + c
@@ -390,15 +413,25 @@ module cube5_section_buf #(
   logic [P*PW-1:0]       l_ebank;
   logic [PW-1:0]         w1rot;
   always_comb begin
-    ns_s = $signed(CiW'(w1ns_q));
+    ns_s   = $signed(CiW'(w1ns_q));
+    ns1_s  = $signed(CiW'(w1ns1_q));
+    ns2_s  = (P == 1) ? ns1_s : ns_s;             // ns + 1 - (1 mod P)
+    c_main = !w1ci_q[CiW-1] && (w1ci_q < ns_s);
+    c_m1   = (w1ci_q == -$signed(CiW'(1)));
+    c_mp   = (w1ci_q == -$signed(CiW'(P)));
+    c_ns   = (w1ci_q == ns_s);
+    c_ns1  = (w1ci_q == ns1_s);
+    c_ns2  = (w1ci_q == ns2_s);
     for (int unsigned l = 0; l < P; l++) begin
-      ci_l = w1axx_q ? w1ci_q : w1ci_q + $signed(CiW'(l));
       lk_l = w1axx_q ? w1lk_q + BW'(l) : w1lk_q;
-      l_main[l]           = (ci_l >= 0) && (ci_l < ns_s);
-      l_edge[l * 3 +: 3]  = {ci_l == ns_s + $signed(CiW'(1)), ci_l == ns_s,
-                             ci_l == -$signed(CiW'(1))};
+      l_main[l] = c_main;
+      if (w1axx_q) begin
+        l_edge[l * 3 +: 3] = {c_ns1, c_ns, c_m1};
+      end else begin
+        l_edge[l * 3 +: 3] = {(l == Lane1) && c_ns2, (l == 0) && c_ns, (l == P - 1) && c_mp};
+      end
       l_maddr[l * BAW +: BAW] = BAW'((((((32'(w1half_q) << BW) | 32'(lk_l)) << M)
-                                      | 32'(w1j_q)) << LSP) | (32'(ci_l[CiW-2:0]) >> LP));
+                                      | 32'(w1j_q)) << LSP) | (32'(w1ci_q[CiW-2:0]) >> LP));
       l_eaddr[l * EAW +: EAW] = EAW'((((32'(w1half_q) << M) | 32'(w1j_q)) << LBPP)
                                      | (32'(lk_l) >> LP));
       l_ebank[l * PW +: PW]   = PW'(32'(lk_l) & (P - 1));
@@ -514,20 +547,21 @@ module cube5_section_buf #(
   logic [FifoW:0] cred_q;                         // beams issued and not yet taken
   logic           dv_q, dv2_q, pop;
   logic       issue, r_err, r_last_slab, r_rev, m_last, j_last, n_last, slab_done;
-  logic [KW-1:0]   r_nkl;
-  logic [DimW-1:0] r_ns, r_nj;
+  logic [MW-1:0]   r_m1;
+  logic [M-1:0]    r_nj1;
+  logic [KW-1:0]   r_nkl1;
   logic [BW-1:0]   r_lk;
   always_comb begin
     r_err       = de_err_q[rh_q];
     r_last_slab = de_last_q[rh_q];
     r_rev       = de_rev_q[rh_q];
-    r_nkl       = de_nkl_q[rh_q];
-    r_ns        = de_ns_q[rh_q];
-    r_nj        = de_nj_q[rh_q];
-    r_lk        = r_rev ? BW'(r_nkl - KW'(1) - rn_q) : BW'(rn_q);
-    m_last      = (DimW'(rm_q) + DimW'(1) == (r_ns >> $clog2(P)));
-    j_last      = (DimW'(rj_q) + DimW'(1) == r_nj);
-    n_last      = (rn_q + KW'(1) == r_nkl);
+    r_m1        = de_m1_q[rh_q];
+    r_nj1       = de_nj1_q[rh_q];
+    r_nkl1      = de_nkl1_q[rh_q];
+    r_lk        = r_rev ? BW'(r_nkl1 - rn_q) : BW'(rn_q);
+    m_last      = (rm_q == r_m1);
+    j_last      = (rj_q == r_nj1);
+    n_last      = (rn_q == r_nkl1);
     slab_done   = r_err || (m_last && j_last && n_last);
     issue       = full_q[rh_q] && !cred_q[FifoW];   // fewer than FifoDepth in flight or stored
   end
@@ -603,8 +637,8 @@ module cube5_section_buf #(
     r_pres  = pres_mem[{rh_q, rj_q[M-1:BW]}];
     r_lane_ok = !r_err && r_pres[((32'(rm_q) << LP) >> BW) + 1];
     r_lo_ok   = !r_err && (rm_q == '0) && !de_lo0_q[rh_q] && r_pres[0];
-    r_hi0_ok  = !r_err && m_last && !de_hi00_q[rh_q] && r_pres[(32'(r_ns) >> BW) + 1];
-    r_hi1_ok  = !r_err && m_last && !de_hi10_q[rh_q] && r_pres[((32'(r_ns) + 1) >> BW) + 1];
+    r_hi0_ok  = !r_err && m_last && !de_hi00_q[rh_q] && r_pres[de_c0_q[rh_q]];
+    r_hi1_ok  = !r_err && m_last && !de_hi10_q[rh_q] && r_pres[de_c1_q[rh_q]];
   end
 
   // ==============================================================================================
