@@ -308,19 +308,16 @@ fn main() {
         .map(|f| fs::read_to_string(tb.join(f)).unwrap())
         .collect();
     let vlt_text = fs::read_to_string(&vlt).unwrap();
-    // Tops with an AXI port are wrapped in AxiShim: its headers enter their stamps only, so the
-    // other tops' cached objects stay valid.
-    let axi_text: String = ["axi_mem.h", "axi_shim.h"]
+    // A shim's own headers enter the stamps of its tops only, so the other tops' cached objects
+    // stay valid when they change.
+    let shim_headers: Vec<String> = Shim::ALL
         .iter()
-        .map(|f| fs::read_to_string(tb.join(f)).unwrap())
-        .collect();
-    // Tops with an AXI write port run in AxiWrShim, which includes both headers above.
-    let axi_wr_text = axi_text.clone() + &fs::read_to_string(tb.join("axi_wr_shim.h")).unwrap();
-
-    // Tops with an AXI4-Lite subordinate port are wrapped in AxilShim (the same arrangement).
-    let axil_text: String = ["axil_mgr.h", "axil_shim.h"]
-        .iter()
-        .map(|f| fs::read_to_string(tb.join(f)).unwrap())
+        .map(|sh| {
+            sh.stamp_headers()
+                .iter()
+                .map(|f| fs::read_to_string(tb.join(f)).unwrap())
+                .collect()
+        })
         .collect();
 
     // Runtime objects, shared by every variant.
@@ -350,15 +347,7 @@ fn main() {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
                 let Some(v) = selected.get(i) else { break };
-                let axi: &str = if has_axi_wr_port(v) {
-                    &axi_wr_text
-                } else if has_axi_port(v) {
-                    &axi_text
-                } else if has_axil_port(v) {
-                    &axil_text
-                } else {
-                    ""
-                };
+                let own_headers = &shim_headers[Shim::of(v) as usize];
                 let stamp = variant_stamp(
                     v,
                     &repo,
@@ -367,7 +356,7 @@ fn main() {
                         &yosys_version,
                         &shim_text,
                         &vlt_text,
-                        axi,
+                        own_headers,
                     ],
                 );
                 match build_variant(v, &cache, &tb, &vl_include, &vlt, &stamp) {
@@ -609,7 +598,8 @@ fn compile_variant(
 
     let header = fs::read_to_string(mdir.join(format!("{prefix}.h"))).map_err(|e| e.to_string())?;
     // An AXI4-Lite top has no stream ports: its items are AxilShim's transactions and records.
-    let (in_bits, out_bits) = if has_axil_port(v) {
+    let shim = Shim::of(v);
+    let (in_bits, out_bits) = if shim == Shim::Axil {
         (AXIL_ITEM_BITS, AXIL_RECORD_BITS)
     } else {
         (
@@ -629,15 +619,7 @@ fn compile_variant(
     for c in &cpps {
         unity.push_str(&format!("#include \"{c}\"\n"));
     }
-    let (header, shim) = if has_axi_wr_port(v) {
-        ("axi_wr_shim.h", "AxiWrShim")
-    } else if has_axi_port(v) {
-        ("axi_shim.h", "AxiShim")
-    } else if has_axil_port(v) {
-        ("axil_shim.h", "AxilShim")
-    } else {
-        ("stream_shim.h", "StreamShim")
-    };
+    let (header, shim) = (shim.header(), shim.class());
     unity.push_str(&format!(
         "#include \"{header}\"\nnamespace cube5 {{\nDutCore* make_{name}(uint32_t seed) {{\n  \
          return new {shim}<{prefix}>(seed, PortWidths{{{in_bits}, {out_bits}}});\n}}\n}}\n",
@@ -669,39 +651,74 @@ fn compile_variant(
     Ok(())
 }
 
-/// Whether the top has an AXI4 read manager port (`m_axi_arvalid_o` in its own file): such tops
-/// run in `AxiShim` (tb/axi_shim.h) with the AXI memory subordinate in the clock loop.
-fn has_axi_port(v: &Variant) -> bool {
-    let own = format!("{}.sv", v.top);
-    v.files.iter().any(|f| {
-        f.file_name().is_some_and(|n| n.to_string_lossy() == own)
-            && fs::read_to_string(f).is_ok_and(|t| t.contains("m_axi_arvalid_o"))
-    })
+/// The C++ shim a top runs in (tb/*_shim.h), chosen by the ports its own file declares: an AXI4
+/// write manager port (`m_axi_awvalid_o`, with the subordinate's write port in the clock loop),
+/// an AXI4 read manager port (`m_axi_arvalid_o`, the AXI memory subordinate), an AXI4-Lite
+/// subordinate port (`s_axil_awvalid_i`, an AXI4-Lite manager), or the plain streams.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Shim {
+    Stream,
+    Axi,
+    AxiWr,
+    Axil,
 }
 
-/// Whether the top has an AXI4-Lite subordinate port (`s_axil_awvalid_i` in its own file): such
-/// tops run in `AxilShim` (tb/axil_shim.h) with an AXI4-Lite manager in the clock loop.
-fn has_axil_port(v: &Variant) -> bool {
-    let own = format!("{}.sv", v.top);
-    v.files.iter().any(|f| {
-        f.file_name().is_some_and(|n| n.to_string_lossy() == own)
-            && fs::read_to_string(f).is_ok_and(|t| t.contains("s_axil_awvalid_i"))
-    })
+impl Shim {
+    /// In `Shim as usize` order.
+    const ALL: [Shim; 4] = [Shim::Stream, Shim::Axi, Shim::AxiWr, Shim::Axil];
+
+    fn of(v: &Variant) -> Shim {
+        let own = format!("{}.sv", v.top);
+        let text = v
+            .files
+            .iter()
+            .find(|f| f.file_name().is_some_and(|n| n.to_string_lossy() == own))
+            .and_then(|f| fs::read_to_string(f).ok())
+            .unwrap_or_default();
+        if text.contains("m_axi_awvalid_o") {
+            Shim::AxiWr
+        } else if text.contains("m_axi_arvalid_o") {
+            Shim::Axi
+        } else if text.contains("s_axil_awvalid_i") {
+            Shim::Axil
+        } else {
+            Shim::Stream
+        }
+    }
+
+    fn header(self) -> &'static str {
+        match self {
+            Shim::Stream => "stream_shim.h",
+            Shim::Axi => "axi_shim.h",
+            Shim::AxiWr => "axi_wr_shim.h",
+            Shim::Axil => "axil_shim.h",
+        }
+    }
+
+    fn class(self) -> &'static str {
+        match self {
+            Shim::Stream => "StreamShim",
+            Shim::Axi => "AxiShim",
+            Shim::AxiWr => "AxiWrShim",
+            Shim::Axil => "AxilShim",
+        }
+    }
+
+    /// The headers beyond dut_core.h and stream_shim.h (in every stamp) that enter this shim's
+    /// stamps, in the order they always have (so unchanged variants keep their stamps).
+    fn stamp_headers(self) -> &'static [&'static str] {
+        match self {
+            Shim::Stream => &[],
+            Shim::Axi => &["axi_mem.h", "axi_shim.h"],
+            Shim::AxiWr => &["axi_mem.h", "axi_shim.h", "axi_wr_shim.h"],
+            Shim::Axil => &["axil_mgr.h", "axil_shim.h"],
+        }
+    }
 }
 
 /// AxilShim's transaction and record widths (tb/axil_mgr.h, `kItemWords`, `kRecordWords`).
 const AXIL_ITEM_BITS: u32 = 128;
 const AXIL_RECORD_BITS: u32 = 128;
-
-/// Whether the top has an AXI4 write manager port (`m_axi_awvalid_o` in its own file): such tops
-/// run in `AxiWrShim` (tb/axi_wr_shim.h) with the subordinate's write port in the clock loop.
-fn has_axi_wr_port(v: &Variant) -> bool {
-    let own = format!("{}.sv", v.top);
-    v.files.iter().any(|f| {
-        f.file_name().is_some_and(|n| n.to_string_lossy() == own)
-            && fs::read_to_string(f).is_ok_and(|t| t.contains("m_axi_awvalid_o"))
-    })
-}
 
 /// The bit width of a port from Verilator's header: `VL_IN*(&name,MSB,LSB...)` declarations.
 fn port_width(header: &str, port: &str) -> Result<u32, String> {
