@@ -21,6 +21,17 @@ use glam::DVec3;
 /// it names no image up, and a small change of either would turn the image by much more.
 pub const MIN_UP_DEGREES: f64 = 0.1;
 
+/// The six principal view directions (+z, -z, +x, -x, +y, -y): the axis-aligned views, each a
+/// face of the volume, that every test of a view-dependent unit includes.
+pub const FACE_DIRECTIONS: [[f64; 3]; 6] = [
+    [0.0, 0.0, 1.0],
+    [0.0, 0.0, -1.0],
+    [1.0, 0.0, 0.0],
+    [-1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, -1.0, 0.0],
+];
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
     /// Unit vector from the eye into the scene (physical coordinates).

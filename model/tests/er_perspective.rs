@@ -250,15 +250,10 @@ fn what_the_scheme_cannot_do_is_refused() {
 fn views_down_each_axis_and_oblique_are_near_both_references() {
     let vol = head_phantom(32, 12).unwrap();
     let tf = cube5_model::transfer::TransferFunction::head_default();
-    let axes: [[f64; 3]; 6] = [
-        [1.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, -1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, -1.0],
-    ];
-    let mut views: Vec<([f64; 3], f64)> = axes.iter().map(|&d| (d, 60.0)).collect();
+    let mut views: Vec<([f64; 3], f64)> = cube5_model::camera::FACE_DIRECTIONS
+        .iter()
+        .map(|&d| (d, 60.0))
+        .collect();
     views.extend([
         ([0.7, 0.5, -0.3], 20.0),
         ([-0.2, 0.9, 0.4], 90.0),

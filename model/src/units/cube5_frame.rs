@@ -987,17 +987,12 @@ mod tests {
     #[test]
     fn every_beam_of_a_frame_is_conflict_free_at_each_p() {
         let dims = [16, 24, 32];
-        let views = [
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
+        let views = crate::camera::FACE_DIRECTIONS.into_iter().chain([
             [1.0, 0.0, 1.0],
             [1.0 + 1e-3, 0.0, 1.0],
             [-1.0, -1.0, 1.0],
-        ];
+        ]);
+        let views: Vec<[f64; 3]> = views.collect();
         for p in [1u32, 2, 4, 8] {
             let cfg = SkewConfig {
                 p,
@@ -1007,7 +1002,7 @@ mod tests {
                 read_latency: 1,
                 cnt_w: 16,
             };
-            for v in views {
+            for &v in &views {
                 let lut = BlockLut::identity(dims, 8).unwrap();
                 let sd = SkewDims::new(&cfg, dims.map(|d| d as u32)).unwrap();
                 let mut mem = SkewMem::new(cfg, sd, lut).unwrap();

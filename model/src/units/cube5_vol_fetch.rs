@@ -676,16 +676,12 @@ mod tests {
             .params
     }
 
-    const VIEWS: [[f64; 3]; 8] = [
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, -1.0],
-        [1.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, -1.0, 0.0],
-        [1.0, 0.0, 1.0],
-        [-0.4, 0.8, -1.0],
-    ];
+    /// The six faces, exactly 45 degrees, and an oblique view.
+    fn views() -> impl Iterator<Item = [f64; 3]> {
+        crate::camera::FACE_DIRECTIONS
+            .into_iter()
+            .chain([[1.0, 0.0, 1.0], [-0.4, 0.8, -1.0]])
+    }
 
     /// The whole data path against the frame: the delivered stream, put into a buffer that keeps
     /// one slab (the blocks delivered since the slab began; skip items read as zeros), serves every
@@ -724,7 +720,7 @@ mod tests {
                     }
                 }
             }
-            for view in VIEWS {
+            for view in views() {
                 let params = frame_params(dims, view, p);
                 // The whole face, then a section of anchors [8, 16) (its blocks and overlap).
                 for section in [None, Some((8u32, 8u32))] {

@@ -746,18 +746,13 @@ mod tests {
 
     /// Six faces, exact 45 degrees (the tie rule), reversed sweeps and seeded obliques.
     fn views(n_random: usize, rng: &mut rand_chacha::ChaCha8Rng) -> Vec<[f64; 3]> {
-        let mut v = vec![
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
+        let mut v = crate::camera::FACE_DIRECTIONS.to_vec();
+        v.extend([
             [1.0, 0.0, 1.0],
             [-1.0, 1.0, 0.0],
             [1.0, -1.0, -1.0],
             [-0.37, 0.81, -1.0],
-        ];
+        ]);
         for _ in 0..n_random {
             v.push(std::array::from_fn(|_| rng.random_range(-1.0..1.0)));
         }
