@@ -6,7 +6,7 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use support::{assert_refused, cube5, scratch};
+use support::{assert_refused, cube5, render_scene, scratch};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -158,20 +158,7 @@ fn bad_gi_fields_are_refused_in_one_line() {
             "gi.block_size",
         ),
     ] {
-        let scene = scratch("gi-bad.toml");
-        std::fs::write(&scene, text).unwrap();
-        let png = scratch("gi-bad.png");
-        let _ = std::fs::remove_file(&png);
-        let out = cube5(&[
-            "render",
-            s(&scene),
-            "-o",
-            s(&png),
-            "--width",
-            "16",
-            "--height",
-            "16",
-        ]);
+        let (out, png) = render_scene("gi-bad", text);
         assert_refused(&out, &["gi-bad.toml", field]);
         assert!(!png.exists(), "{text}");
     }

@@ -5,31 +5,10 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use std::process::Output;
-use support::{assert_refused, cube5, scratch};
+use support::{assert_refused, cube5, render_scene, scratch};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-/// Writes `scene` as NAME.toml in the scratch directory and renders it; returns the output and
-/// the PNG path (removed first).
-fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
-    let toml = scratch(&format!("{name}.toml"));
-    std::fs::write(&toml, scene).unwrap();
-    let png = scratch(&format!("{name}.png"));
-    let _ = std::fs::remove_file(&png);
-    let out = cube5(&[
-        "render",
-        s(&toml),
-        "-o",
-        s(&png),
-        "--width",
-        "16",
-        "--height",
-        "16",
-    ]);
-    (out, png)
 }
 
 #[test]

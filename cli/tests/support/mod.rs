@@ -34,3 +34,23 @@ pub fn assert_refused(out: &Output, needles: &[&str]) {
         assert!(err.contains(n), "error should mention `{n}`: {err}");
     }
 }
+
+/// Writes `scene` as NAME.toml in the scratch directory and renders it; returns the output and
+/// the PNG path (removed first).
+pub fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
+    let toml = scratch(&format!("{name}.toml"));
+    std::fs::write(&toml, scene).unwrap();
+    let png = scratch(&format!("{name}.png"));
+    let _ = std::fs::remove_file(&png);
+    let out = cube5(&[
+        "render",
+        toml.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ]);
+    (out, png)
+}
