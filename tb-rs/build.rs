@@ -244,6 +244,7 @@ fn main() {
     for f in [
         "dut_core.h",
         "stream_shim.h",
+        "clocked_top.h",
         "axi_mem.h",
         "axi_shim.h",
         "axil_mgr.h",
@@ -709,9 +710,9 @@ impl Shim {
     fn stamp_headers(self) -> &'static [&'static str] {
         match self {
             Shim::Stream => &[],
-            Shim::Axi => &["axi_mem.h", "axi_shim.h"],
-            Shim::AxiWr => &["axi_mem.h", "axi_shim.h", "axi_wr_shim.h"],
-            Shim::Axil => &["axil_mgr.h", "axil_shim.h"],
+            Shim::Axi => &["clocked_top.h", "axi_mem.h", "axi_shim.h"],
+            Shim::AxiWr => &["clocked_top.h", "axi_mem.h", "axi_shim.h", "axi_wr_shim.h"],
+            Shim::Axil => &["clocked_top.h", "axil_mgr.h", "axil_shim.h"],
         }
     }
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "axi_mem.h"
+#include "clocked_top.h"
 #include "stream_shim.h"
 
 namespace cube5 {
@@ -15,34 +16,14 @@ struct HasErrFlag : std::false_type {};
 template <class V>
 struct HasErrFlag<V, std::void_t<decltype(std::declval<V&>().err_o)>> : std::true_type {};
 
-/// What the shims of tops with an AXI port share (AxiShim here, AxiWrShim in tb/axi_wr_shim.h):
-/// the Verilated top in its own context, the clock, the trace window, the subordinate, and the
-/// output stream's stall rule and collection. The derived shim idles its own inputs and evals.
+/// What the shims of tops with an AXI port share (AxiShim here, AxiWrShim in tb/axi_wr_shim.h)
+/// beyond ClockedTop: the subordinate, and the output stream's stall rule and collection. The
+/// derived shim idles its own inputs and evals.
 template <class V>
-class AxiTopBase : public DutCore, public AxiHost {
+class AxiTopBase : public ClockedTop<V>, public AxiHost {
+  using C = ClockedTop<V>;
+
  public:
-  ~AxiTopBase() override {
-    if (trace_) trace_->close();
-    Verilated::threadContextp(ctx_.get());  // see StreamShim's destructor
-    top_->final();
-    top_.reset();
-  }
-
-  bool write_config(uint32_t, const uint32_t*, uint32_t) override { return false; }
-
-  bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) override {
-    if (trace_) trace_->close();
-    trace_ = std::make_unique<VerilatedVcdC>();
-    top_->trace(trace_.get(), 99);
-    trace_->open(path.c_str());
-    trace_from_ = from_cycle;
-    trace_to_ = to_cycle;
-    return trace_->isOpen();
-  }
-
-  uint64_t cycle() const override { return cycle_; }
-  PortWidths widths() const override { return widths_; }
-
   AxiMem& axi_mem() override { return mem_; }
   bool axi_err_flag() const override {
     if constexpr (HasErrFlag<V>::value) {
@@ -53,14 +34,10 @@ class AxiTopBase : public DutCore, public AxiHost {
   }
 
  protected:
-  AxiTopBase(uint32_t seed, PortWidths widths) : widths_(widths) {
-    ctx_ = std::make_unique<VerilatedContext>();
-    ctx_->randReset(2);
-    ctx_->randSeed(static_cast<int>(seed & 0x7fffffff));
-    ctx_->traceEverOn(true);
-    top_ = std::make_unique<V>(ctx_.get(), "top");
-    top_->clk_i = 0;
-    top_->rst_ni = 1;
+  using C::cycle_;
+  using C::top_;
+
+  AxiTopBase(uint32_t seed, PortWidths widths) : C(seed, widths) {
     top_->in_valid_i = 0;
     top_->out_ready_i = 0;
   }
@@ -92,31 +69,6 @@ class AxiTopBase : public DutCore, public AxiHost {
     }
   }
 
-  void dump() {
-    if (trace_ && cycle_ >= trace_from_ && cycle_ <= trace_to_) trace_->dump(ctx_->time());
-  }
-
-  // Between runs the subordinate is idle; the clock only runs inside run() and reset().
-  void tick() {
-    top_->clk_i = 0;
-    top_->eval();
-    dump();
-    ctx_->timeInc(1);
-    top_->clk_i = 1;
-    top_->eval();
-    dump();
-    ctx_->timeInc(1);
-    top_->clk_i = 0;
-    top_->eval();
-    ++cycle_;
-  }
-
-  PortWidths widths_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> top_;
-  std::unique_ptr<VerilatedVcdC> trace_;
-  uint64_t trace_from_ = 0, trace_to_ = 0;
-  uint64_t cycle_ = 0;
   bool has_stalled_ = false;
   std::remove_reference_t<decltype(V::out_data_o)> stalled_data_{};
   AxiMem mem_;

@@ -6,30 +6,23 @@
 #pragma once
 
 #include "axil_mgr.h"
+#include "clocked_top.h"
 #include "stream_shim.h"
 
 namespace cube5 {
 
 template <class V>
-class AxilShim final : public DutCore {
+class AxilShim final : public ClockedTop<V> {
+  using C = ClockedTop<V>;
+  using C::ctx_;
+  using C::cycle_;
+  using C::tick;
+  using C::top_;
+
  public:
-  AxilShim(uint32_t seed, PortWidths widths) : widths_(widths), seed_(seed) {
-    ctx_ = std::make_unique<VerilatedContext>();
-    ctx_->randReset(2);
-    ctx_->randSeed(static_cast<int>(seed & 0x7fffffff));
-    ctx_->traceEverOn(true);
-    top_ = std::make_unique<V>(ctx_.get(), "top");
-    top_->clk_i = 0;
-    top_->rst_ni = 1;
+  AxilShim(uint32_t seed, PortWidths widths) : C(seed, widths), seed_(seed) {
     idle_inputs();
     top_->eval();
-  }
-
-  ~AxilShim() override {
-    if (trace_) trace_->close();
-    Verilated::threadContextp(ctx_.get());  // see StreamShim's destructor
-    top_->final();
-    top_.reset();
   }
 
   /// Resets the top and the manager together: transactions in flight are dropped on both sides.
@@ -111,21 +104,6 @@ class AxilShim final : public DutCore {
     return st;
   }
 
-  bool write_config(uint32_t, const uint32_t*, uint32_t) override { return false; }
-
-  bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) override {
-    if (trace_) trace_->close();
-    trace_ = std::make_unique<VerilatedVcdC>();
-    top_->trace(trace_.get(), 99);
-    trace_->open(path.c_str());
-    trace_from_ = from_cycle;
-    trace_to_ = to_cycle;
-    return trace_->isOpen();
-  }
-
-  uint64_t cycle() const override { return cycle_; }
-  PortWidths widths() const override { return widths_; }
-
  private:
   void idle_inputs() {
     top_->s_axil_awvalid_i = 0;
@@ -142,31 +120,7 @@ class AxilShim final : public DutCore {
     top_->hw_set_i = static_cast<bool>((h >> 32) & 1);  // bit 32: the set flag
   }
 
-  void dump() {
-    if (trace_ && cycle_ >= trace_from_ && cycle_ <= trace_to_) trace_->dump(ctx_->time());
-  }
-
-  void tick() {
-    top_->clk_i = 0;
-    top_->eval();
-    dump();
-    ctx_->timeInc(1);
-    top_->clk_i = 1;
-    top_->eval();
-    dump();
-    ctx_->timeInc(1);
-    top_->clk_i = 0;
-    top_->eval();
-    ++cycle_;
-  }
-
-  PortWidths widths_;
   uint32_t seed_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> top_;
-  std::unique_ptr<VerilatedVcdC> trace_;
-  uint64_t trace_from_ = 0, trace_to_ = 0;
-  uint64_t cycle_ = 0;
   AxilMgr mgr_;
 };
 
