@@ -8,7 +8,7 @@
 // consumer never stalls the bus. The FIFO is one write port and one registered read port with no
 // reset on the array, so synth_ecp5 maps it to block RAM (DP16KD).
 //
-//   command ─► splitter (cur_addr, remaining) ─► plan register ─► AR register ─► AR channel
+//   command ─► cube5_axi_split (splitter ─► plan register ─► AR register) ─► AR channel
 //                                     last-of-command flag per burst ─► info FIFO (Outstanding) ─┐
 //   R channel (RREADY = 1) ─► {resp, last, data} ─► return FIFO (RAM) ─► read register ─► out
 module cube5_axi_rd #(
@@ -88,8 +88,6 @@ module cube5_axi_rd #(
   localparam int unsigned CntW       = $clog2(Depth) + 1;
   localparam int unsigned OPtrW      = $clog2(Outstanding);
   localparam int unsigned OCntW      = $clog2(Outstanding) + 1;
-  // Width for comparing a command's remaining beats with the burst cap.
-  localparam int unsigned CmpW       = (LenW > 14) ? LenW : 14;
   localparam int unsigned WordW      = DataW + 3;
 
   if (DataW < 8 || DataW > 1024 || (1 << $clog2(DataW)) != DataW) begin : gen_bad_data_w
@@ -110,15 +108,14 @@ module cube5_axi_rd #(
   end
 
   // ==============================================================================================
-  // Command splitter, burst plan register and AR register
+  // Command splitter, burst plan register and AR register (cube5_axi_split)
   // ==============================================================================================
   //
   // Two stages, so the burst-length arithmetic and the credit check are not one path: the
   // splitter plans the next burst of the current command into the plan register; the plan is
   // issued (loaded into the AR register) when its beats fit the credits.
 
-  localparam int unsigned MbW    = $clog2(MaxBurst);  // low address bits inside a MaxBurst span
-  localparam int unsigned BurstW = MbW + 1;           // 1 .. MaxBurst
+  localparam int unsigned BurstW = $clog2(MaxBurst) + 1;  // 1 .. MaxBurst
 
   logic             in_fire;
   logic [AddrW-1:0] in_addr;
@@ -126,114 +123,44 @@ module cube5_axi_rd #(
   assign in_addr = in_data_i[AddrW-1:0];
   assign in_len  = in_data_i[AddrW+LenW-1:AddrW];
 
-  logic             active_q, active_d;
-  logic [AddrW-1:0] cur_addr_q, cur_addr_d;
-  logic [LenW-1:0]  rem_q, rem_d;
-
-  logic              plan_valid_q, plan_valid_d;
-  logic [AddrW-1:0]  plan_addr_q, plan_addr_d;
-  logic [BurstW-1:0] plan_len_q, plan_len_d;
-  logic              plan_last_q, plan_last_d;
-
-  logic [AddrW-1:0] araddr_q, araddr_d;
-  logic [7:0]       arlen_q, arlen_d;
-  logic             arvalid_q, arvalid_d;
-
   logic [CntW-1:0]  credit_q, credit_d;  // return-FIFO slots not reserved by a burst
   logic [OCntW-1:0] bursts_q, bursts_d;  // bursts issued whose RLAST has not arrived
 
-  // This burst's cap: MaxBurst, or the beats to the 4 KB boundary when that is nearer, i.e. when
-  // the address lies in the last MaxBurst-beat span below the boundary but not at its start.
-  // blen = min(remaining, cap).
-  logic [BurstW-1:0] cap, blen;
-  logic [MbW-1:0]    span_off;   // beat offset inside the MaxBurst span
-  logic              last_span;  // the span ends at the 4 KB boundary
-  logic              rem_small;
-  assign span_off = cur_addr_q[SizeW+MbW-1:SizeW];
-  if (SizeW + MbW < 12) begin : gen_last_span
-    assign last_span = (cur_addr_q[11:SizeW+MbW] == '1);
-  end else begin : gen_one_span
-    assign last_span = 1'b1;  // MaxBurst beats are 4 KB: every span ends at a boundary
-  end
-  always_comb begin
-    cap = BurstW'(MaxBurst);
-    if (last_span && span_off != '0) cap = BurstW'(MaxBurst) - BurstW'(span_off);
-    rem_small = (CmpW'(rem_q) < CmpW'(cap));
-    blen      = rem_small ? BurstW'(rem_q) : cap;
-  end
-
-  logic ar_free, issue, plan_fill, plan_fill_last;
-  assign ar_free        = !arvalid_q || m_axi_arready_i;
-  assign issue          = plan_valid_q && ar_free && (credit_q >= CntW'(plan_len_q))
-                          && (bursts_q < OCntW'(Outstanding));
-  assign plan_fill      = active_q && (!plan_valid_q || issue);
-  assign plan_fill_last = plan_fill && (CmpW'(rem_q) == CmpW'(blen));
+  logic              in_any, split_take, may_issue, issue, plan_last;
+  logic [BurstW-1:0] plan_len;
+  assign in_any    = (in_len != '0);
+  assign may_issue = (credit_q >= CntW'(plan_len)) && (bursts_q < OCntW'(Outstanding));
 
   // A new command is taken when the splitter is idle or plans its last burst this cycle.
-  assign in_ready_o = !active_q || plan_fill_last;
+  assign in_ready_o = split_take;
   assign in_fire    = in_valid_i && in_ready_o;
 
-  always_comb begin
-    active_d     = active_q;
-    cur_addr_d   = cur_addr_q;
-    rem_d        = rem_q;
-    plan_valid_d = plan_valid_q && !issue;
-    plan_addr_d  = plan_addr_q;
-    plan_len_d   = plan_len_q;
-    plan_last_d  = plan_last_q;
-    araddr_d     = araddr_q;
-    arlen_d      = arlen_q;
-    arvalid_d    = arvalid_q && !m_axi_arready_i;
-    if (issue) begin
-      araddr_d  = plan_addr_q;
-      arlen_d   = 8'(plan_len_q) - 8'd1;  // MaxBurst = 256 wraps to 255 as it should
-      arvalid_d = 1'b1;
-    end
-    if (plan_fill) begin
-      plan_valid_d = 1'b1;
-      plan_addr_d  = cur_addr_q;
-      plan_len_d   = blen;
-      plan_last_d  = plan_fill_last;
-      cur_addr_d   = cur_addr_q + (AddrW'(blen) << SizeW);
-      rem_d        = rem_q - LenW'(blen);
-      if (plan_fill_last) active_d = 1'b0;
-    end
-    if (in_fire) begin
-      active_d   = (in_len != '0);
-      cur_addr_d = in_addr;
-      rem_d      = in_len;
-    end
-  end
+  cube5_axi_split #(
+    .AddrW   (AddrW),
+    .SizeW   (SizeW),
+    .BeatsW  (LenW),
+    .MaxBurst(MaxBurst)
+  ) u_split (
+    .clk_i      (clk_i),
+    .rst_ni     (rst_ni),
+    .take_o     (split_take),
+    .cmd_fire_i (in_fire),
+    .cmd_addr_i (in_addr),
+    .cmd_beats_i(in_len),
+    .cmd_any_i  (in_any),
+    .may_issue_i(may_issue),
+    .issue_o    (issue),
+    .plan_len_o (plan_len),
+    .plan_last_o(plan_last),
+    .a_addr_o   (m_axi_araddr_o),
+    .a_len_o    (m_axi_arlen_o),
+    .a_valid_o  (m_axi_arvalid_o),
+    .a_ready_i  (m_axi_arready_i)
+  );
 
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      active_q     <= 1'b0;
-      plan_valid_q <= 1'b0;
-      arvalid_q    <= 1'b0;
-    end else begin
-      active_q     <= active_d;
-      plan_valid_q <= plan_valid_d;
-      arvalid_q    <= arvalid_d;
-    end
-  end
-
-  // Datapath: no reset (qualified by active_q / plan_valid_q / arvalid_q).
-  always_ff @(posedge clk_i) begin
-    cur_addr_q  <= cur_addr_d;
-    rem_q       <= rem_d;
-    plan_addr_q <= plan_addr_d;
-    plan_len_q  <= plan_len_d;
-    plan_last_q <= plan_last_d;
-    araddr_q    <= araddr_d;
-    arlen_q     <= arlen_d;
-  end
-
-  assign m_axi_araddr_o  = araddr_q;
-  assign m_axi_arlen_o   = arlen_q;
   assign m_axi_arsize_o  = 3'(SizeW);
   assign m_axi_arburst_o = 2'b01;
   assign m_axi_arid_o    = '0;
-  assign m_axi_arvalid_o = arvalid_q;
 
   // ==============================================================================================
   // Burst info FIFO: whether each burst in flight ends its command
@@ -252,7 +179,7 @@ module cube5_axi_rd #(
     info_wr_d = info_wr_q;
     info_rd_d = info_rd_q;
     if (issue) begin
-      info_d[info_wr_q] = plan_last_q;
+      info_d[info_wr_q] = plan_last;
       info_wr_d = info_wr_q + OPtrW'(1);
     end
     if (r_end) info_rd_d = info_rd_q + OPtrW'(1);
@@ -292,7 +219,7 @@ module cube5_axi_rd #(
     rd_ptr_d    = ren ? rd_ptr_q + PtrW'(1) : rd_ptr_q;
     count_d     = count_q + CntW'(r_fire) - CntW'(ren);
     out_valid_d = ren || (out_valid_q && !out_ready_i);
-    credit_d    = credit_q + CntW'(ren) - (issue ? CntW'(plan_len_q) : CntW'(0));
+    credit_d    = credit_q + CntW'(ren) - (issue ? CntW'(plan_len) : CntW'(0));
     bursts_d    = bursts_q + OCntW'(issue) - OCntW'(r_end);
     err_d       = err_q || (r_fire && m_axi_rresp_i != 2'b00);
   end

@@ -1,1 +1,2 @@
+rtl/cube5/cube5_axi_split.sv
 rtl/cube5/cube5_axi_wr.sv

@@ -10,7 +10,7 @@
 // the W channel never waits for the item stream inside a burst. The W buffer is one write port
 // and one registered read port with no reset on the array (block RAM or LUT RAM).
 //
-//   command ─► splitter (cur_addr, beats left) ─► plan register ─► AW register ─► AW channel
+//   command ─► cube5_axi_split (splitter ─► plan register ─► AW register) ─► AW channel
 //          └─► packer command FIFO (lane, items) ─┐      │ burst lengths ─► WLAST count
 //   items ─► packer (lane, strobes) ─► W buffer (RAM) ─► read register ─► W channel
 //   B channel ─► {last-of-command per burst} ─► completion register ─► out {count, resp}
@@ -184,56 +184,43 @@ module cube5_axi_wr #(
   assign unused_span_hi = ^in_span_beats;
 
   // ==============================================================================================
-  // Burst splitter, plan register and AW register
+  // Burst splitter, plan register and AW register (cube5_axi_split)
   // ==============================================================================================
-
-  localparam int unsigned MbW    = $clog2(MaxBurst);
-
-  logic             active_q, active_d;
-  logic [AddrW-1:0] cur_addr_q, cur_addr_d;
-  logic [NbW-1:0]   rem_q, rem_d;
-
-  logic              plan_valid_q, plan_valid_d;
-  logic [AddrW-1:0]  plan_addr_q, plan_addr_d;
-  logic [BurstW-1:0] plan_len_q, plan_len_d;
-  logic              plan_last_q, plan_last_d;
-
-  logic [AddrW-1:0] awaddr_q, awaddr_d;
-  logic [7:0]       awlen_q, awlen_d;
-  logic             awvalid_q, awvalid_d;
 
   logic [CntW-1:0]  avail_q, avail_d;    // W-buffer beats not yet claimed by an issued burst
   logic [OCntW-1:0] bursts_q, bursts_d;  // bursts issued whose B has not been taken
 
-  // The burst cap: MaxBurst, or the beats to the 4 KB boundary when that is nearer.
-  logic [BurstW-1:0] cap, blen;
-  logic [MbW-1:0]    span_off;
-  logic              last_span;
-  assign span_off = cur_addr_q[SizeW+MbW-1:SizeW];
-  if (SizeW + MbW < 12) begin : gen_last_span
-    assign last_span = (cur_addr_q[11:SizeW+MbW] == '1);
-  end else begin : gen_one_span
-    assign last_span = 1'b1;
-  end
-  // For clock rate the comparison with the cap is split: the high bits of the remaining count
-  // (zero or not) in parallel with a BurstW-bit compare of its low bits.
-  logic              rem_hi_zero, rem_fits;
-  logic [BurstW-1:0] rem_lo;
-  assign rem_lo      = rem_q[BurstW-1:0];
-  assign rem_hi_zero = ((rem_q >> BurstW) == '0);
-  always_comb begin
-    cap = BurstW'(MaxBurst);
-    if (last_span && span_off != '0) cap = BurstW'(MaxBurst) - BurstW'(span_off);
-    rem_fits = rem_hi_zero && (rem_lo <= cap);  // this burst ends the command
-    blen = rem_fits ? rem_lo : cap;
-  end
+  logic              in_any, split_take, may_issue, issue, plan_last;
+  logic [BurstW-1:0] plan_len;
+  assign in_any    = (in_len != '0);
+  assign may_issue = (avail_q >= CntW'(plan_len)) && (bursts_q < OCntW'(Outstanding));
 
-  logic aw_free, issue, plan_fill, plan_fill_last;
-  assign aw_free        = !awvalid_q || m_axi_awready_i;
-  assign issue          = plan_valid_q && aw_free && (avail_q >= CntW'(plan_len_q))
-                          && (bursts_q < OCntW'(Outstanding));
-  assign plan_fill      = active_q && (!plan_valid_q || issue);
-  assign plan_fill_last = plan_fill && rem_fits;
+  cube5_axi_split #(
+    .AddrW   (AddrW),
+    .SizeW   (SizeW),
+    .BeatsW  (NbW),
+    .MaxBurst(MaxBurst)
+  ) u_split (
+    .clk_i      (clk_i),
+    .rst_ni     (rst_ni),
+    .take_o     (split_take),
+    .cmd_fire_i (in_fire),
+    .cmd_addr_i (in_beat_addr),
+    .cmd_beats_i(in_beats),
+    .cmd_any_i  (in_any),
+    .may_issue_i(may_issue),
+    .issue_o    (issue),
+    .plan_len_o (plan_len),
+    .plan_last_o(plan_last),
+    .a_addr_o   (m_axi_awaddr_o),
+    .a_len_o    (m_axi_awlen_o),
+    .a_valid_o  (m_axi_awvalid_o),
+    .a_ready_i  (m_axi_awready_i)
+  );
+
+  assign m_axi_awsize_o  = 3'(SizeW);
+  assign m_axi_awburst_o = 2'b01;
+  assign m_axi_awid_o    = '0;
 
   // Packer command FIFO (two entries, flops): room decides whether a command is taken.
   logic [PkW-1:0] pk_mem_q [2];
@@ -241,72 +228,9 @@ module cube5_axi_wr #(
   logic           pk_wr_q, pk_wr_d, pk_rd_q, pk_rd_d;
   logic           pk_push, pk_pop;
 
-  assign in_ready_o = (!active_q || plan_fill_last) && (pk_cnt_q != 2'd2);
+  assign in_ready_o = split_take && (pk_cnt_q != 2'd2);
   assign in_fire    = in_valid_i && in_ready_o;
-  assign pk_push    = in_fire && (in_len != '0);
-
-  always_comb begin
-    active_d     = active_q;
-    cur_addr_d   = cur_addr_q;
-    rem_d        = rem_q;
-    plan_valid_d = plan_valid_q && !issue;
-    plan_addr_d  = plan_addr_q;
-    plan_len_d   = plan_len_q;
-    plan_last_d  = plan_last_q;
-    awaddr_d     = awaddr_q;
-    awlen_d      = awlen_q;
-    awvalid_d    = awvalid_q && !m_axi_awready_i;
-    if (issue) begin
-      awaddr_d  = plan_addr_q;
-      awlen_d   = 8'(plan_len_q) - 8'd1;  // MaxBurst = 256 wraps to 255 as it should
-      awvalid_d = 1'b1;
-    end
-    if (plan_fill) begin
-      plan_valid_d = 1'b1;
-      plan_addr_d  = cur_addr_q;
-      plan_len_d   = blen;
-      plan_last_d  = plan_fill_last;
-      // Advanced by the cap, not blen: after a command's last burst both are dead (active_q
-      // drops), and before it blen = cap; so the cap's mux stays off these adders' path.
-      cur_addr_d   = cur_addr_q + (AddrW'(cap) << SizeW);
-      rem_d        = rem_q - NbW'(cap);
-      if (plan_fill_last) active_d = 1'b0;
-    end
-    if (in_fire) begin
-      active_d   = (in_len != '0);
-      cur_addr_d = in_beat_addr;
-      rem_d      = in_beats;
-    end
-  end
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      active_q     <= 1'b0;
-      plan_valid_q <= 1'b0;
-      awvalid_q    <= 1'b0;
-    end else begin
-      active_q     <= active_d;
-      plan_valid_q <= plan_valid_d;
-      awvalid_q    <= awvalid_d;
-    end
-  end
-
-  always_ff @(posedge clk_i) begin
-    cur_addr_q  <= cur_addr_d;
-    rem_q       <= rem_d;
-    plan_addr_q <= plan_addr_d;
-    plan_len_q  <= plan_len_d;
-    plan_last_q <= plan_last_d;
-    awaddr_q    <= awaddr_d;
-    awlen_q     <= awlen_d;
-  end
-
-  assign m_axi_awaddr_o  = awaddr_q;
-  assign m_axi_awlen_o   = awlen_q;
-  assign m_axi_awsize_o  = 3'(SizeW);
-  assign m_axi_awburst_o = 2'b01;
-  assign m_axi_awid_o    = '0;
-  assign m_axi_awvalid_o = awvalid_q;
+  assign pk_push    = in_fire && in_any;
 
   // ==============================================================================================
   // Packer: items to beats at their lanes, into the W buffer
@@ -411,8 +335,8 @@ module cube5_axi_wr #(
     wr_d      = ram_we ? wr_q + PtrW'(1) : wr_q;
     rd_ptr_d  = ren ? rd_ptr_q + PtrW'(1) : rd_ptr_q;
     count_d   = count_q + CntW'(ram_we) - CntW'(ren);
-    avail_d   = avail_q + CntW'(ram_we) - (issue ? CntW'(plan_len_q) : CntW'(0));
-    claimed_d = claimed_q - CntW'(ren) + (issue ? CntW'(plan_len_q) : CntW'(0));
+    avail_d   = avail_q + CntW'(ram_we) - (issue ? CntW'(plan_len) : CntW'(0));
+    claimed_d = claimed_q - CntW'(ren) + (issue ? CntW'(plan_len) : CntW'(0));
     wvalid_d  = ren || (wvalid_q && !m_axi_wready_i);
     wlast_d   = ren ? rd_last : wlast_q;
     wbeat_d   = wbeat_q;
@@ -450,7 +374,7 @@ module cube5_axi_wr #(
 
   always_ff @(posedge clk_i) begin
     wlast_q <= wlast_d;
-    if (issue) blq_q[blq_wr_q] <= plan_len_q;
+    if (issue) blq_q[blq_wr_q] <= plan_len;
   end
 
   // The RAM: one write port, one registered read port with enable, no reset.
@@ -494,7 +418,7 @@ module cube5_axi_wr #(
     done_d      = done_q;
     // A decoded write (an indexed one became a 32-bit compare chain in synth_ecp5).
     for (int unsigned i = 0; i < Outstanding; i++) begin
-      if (issue && info_wr_q == OPtrW'(i)) info_d[i] = plan_last_q;
+      if (issue && info_wr_q == OPtrW'(i)) info_d[i] = plan_last;
     end
     if (issue) info_wr_d = info_wr_q + OPtrW'(1);
     if (b_fire) begin
