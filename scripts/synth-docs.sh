@@ -5,10 +5,13 @@
 #   SYNTH_WRITE_DOCS=1   rewrite the block between the markers from this run's rows, in
 #                        rtl/**/*.variants order. Rows of configurations this run did not synthesize
 #                        (SYNTH_ONLY, SYNTH_CACHED) stay as they are; rows of configurations no
-#                        longer in a .variants file (or flagged `sim`) are dropped.
+#                        longer in a .variants file (or flagged `sim`) are dropped. The Fmax
+#                        column is this run's place and route (configurations flagged fmax or
+#                        fmax85, SYNTH_FMAX not 0); a run that placed nothing keeps the last one.
 #   SYNTH_CHECK_DOCS=1   compare this run's ECP5 counts with the block: one line per differing
 #                        configuration (top, config, column, docs value, synthesized value), a line
-#                        per block row that is no synthesized configuration; exit 1 if any. CI runs it.
+#                        per block row that is no synthesized configuration; exit 1 if any. CI runs it
+#                        (SYNTH_FMAX=0: counts only); with place and route, Fmax is compared too.
 # Neither set: does nothing. Both need the ecp5 flow, and refuse SYNTH_SPEC (not a .variants line).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -52,17 +55,27 @@ awk -v mode="$mode" -v begin="$begin" -v end="$end" -v docs="$docs" -v out="$tmp
     return f[2] != "top"
   }
   FNR == 1 { file++ }
-  file == 1 { if (("," $3 ",") !~ /,sim,/) { order[++n] = $1 " " $2; known[$1 " " $2] = 1 } next }
+  file == 1 {
+    if (("," $3 ",") !~ /,sim,/) { order[++n] = $1 " " $2; known[$1 " " $2] = 1 }
+    if (("," $3 ",") ~ /,fmax(85)?,/) placed[$1 " " $2] = 1
+    next
+  }
   file == 2 {
     # | top | config | generic | LUT4 | FF | CCU2C | MULT18 | DP16KD | iCE40 x3 | Fmax | cost |
-    if (row($0) && f[5] != "-") run[f[2] " " f[3]] = f[5] "|" f[6] "|" f[7] "|" f[8] "|" f[9]
+    if (row($0) && f[5] != "-") {
+      run[f[2] " " f[3]] = f[5] "|" f[6] "|" f[7] "|" f[8] "|" f[9]
+      if (f[13] ~ /^[0-9.]+$/) runf[f[2] " " f[3]] = f[13]
+    }
     next
   }
   {
     lines[++nl] = $0
     if ($0 == begin) inblock = 1
     else if ($0 == end) inblock = 0
-    else if (inblock && row($0)) doc[f[2] " " f[3]] = f[4] "|" f[5] "|" f[6] "|" f[7] "|" f[8]
+    else if (inblock && row($0)) {
+      doc[f[2] " " f[3]] = f[4] "|" f[5] "|" f[6] "|" f[7] "|" f[8]
+      if (f[9] ~ /^[0-9.]+$/) docf[f[2] " " f[3]] = f[9]
+    }
   }
   END {
     split("LUT4|FF|CCU2C|MULT18|DP16KD", col, "|")
@@ -75,6 +88,9 @@ awk -v mode="$mode" -v begin="$begin" -v end="$end" -v docs="$docs" -v out="$tmp
         split(run[k], r, "|"); split(doc[k], d, "|"); msg = ""
         for (c = 1; c <= 5; c++)
           if (r[c] != d[c]) msg = msg sprintf("%s%s docs %s synthesized %s", msg == "" ? "" : "; ", col[c], d[c], r[c])
+        # Fmax only where this run placed the configuration (CI runs SYNTH_FMAX=0).
+        if ((k in runf) && runf[k] != docf[k])
+          msg = msg sprintf("%sFmax docs %s placed %s", msg == "" ? "" : "; ", (k in docf) ? docf[k] : "-", runf[k])
         if (msg != "") { print "synth-docs: " k ": " msg; bad++ }
       }
       for (k in doc) if (!(k in known)) { print "synth-docs: " k ": in " docs " but not a synthesized configuration of rtl/**/*.variants"; bad++ }
@@ -84,13 +100,16 @@ awk -v mode="$mode" -v begin="$begin" -v end="$end" -v docs="$docs" -v out="$tmp
     }
     for (i = 1; i <= nl; i++) {
       if (lines[i] == end) {
-        print "| top | config | ECP5 LUT4 | ECP5 FF | ECP5 CCU2C | ECP5 MULT18 | ECP5 DP16KD |" > out
-        print "|-----|--------|----------:|--------:|-----------:|------------:|------------:|" > out
+        print "| top | config | ECP5 LUT4 | ECP5 FF | ECP5 CCU2C | ECP5 MULT18 | ECP5 DP16KD | ECP5 Fmax (MHz) |" > out
+        print "|-----|--------|----------:|--------:|-----------:|------------:|------------:|----------------:|" > out
         for (j = 1; j <= n; j++) {
           k = order[j]; v = (k in run) ? run[k] : (k in doc) ? doc[k] : ""
           if (v == "") continue
+          # Fmax: this run's place and route, else the last one written (kept while SYNTH_FMAX=0
+          # runs, which place nothing); "-" for a configuration not flagged fmax/fmax85.
+          fm = !(k in placed) ? "-" : (k in runf) ? runf[k] : (k in docf) ? docf[k] : "not placed yet"
           split(k, t, " "); gsub(/\|/, " | ", v)
-          print "| " t[1] " | " t[2] " | " v " |" > out
+          print "| " t[1] " | " t[2] " | " v " | " fm " |" > out
         }
         skip = 0
       }

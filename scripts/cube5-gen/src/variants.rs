@@ -5,8 +5,10 @@
 //! A `.variants` line is `name [flag ...] Param=value ...` (`#` starts a comment). Flags:
 //! `gate` (also build Yosys's gate-level netlist for the smoke co-simulation), `mutant` (also a
 //! gate-level netlist with one injected fault, which the tests must catch), `fmax` / `fmax85`
-//! (`make synth` places and routes it on the ECP5 25k / 85k part), `sim` (simulation only: left
-//! out of `make synth`).
+//! (`make synth` places and routes it on the ECP5 25k / 85k part), `ooc` (with `fmax`/`fmax85`:
+//! placed out of context, without I/O pads, for a unit whose ports outnumber the package's pins;
+//! inside a design they are internal nets), `sim` (simulation only: left out of `make synth`),
+//! `bram` (synthesized by the ECP5 flow alone).
 //!
 //! A filelist holds one path per line, relative to the repository, `//` comments, and `-f
 //! other.f` lines that include another top's filelist (a file named twice is kept once, at its
@@ -22,7 +24,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 /// The flags a `.variants` line may carry.
-pub const FLAGS: &[&str] = &["gate", "mutant", "fmax", "fmax85", "sim", "bram"];
+pub const FLAGS: &[&str] = &["gate", "mutant", "fmax", "fmax85", "ooc", "sim", "bram"];
 
 /// Words allowed as the leading token of a variant name (schemes that no single parameter
 /// initial says): the ray-bucketing schemes of `gicube_bucket`.
