@@ -660,11 +660,10 @@ module cube5_section_buf #(
   logic [3*P*VoxelW-1:0] edge_rd;
 
   for (genvar b = 0; b < P; b++) begin : gen_bank
-    cube5_shader_ram #(
-      .Depth    (BankDepth),
-      .Width    (VoxelW),
-      .AddrW    (BAW),
-      .NoRwCheck(1'b1)                          // reads and writes are in different halves
+    cube5_section_buf_ram #(                    // reads and writes are in different halves
+      .Depth(BankDepth),
+      .Width(VoxelW),
+      .AddrW(BAW)
     ) u_bank (
       .clk_i  (clk_i),
       .we_i   (w2we_q[b]),
@@ -677,11 +676,10 @@ module cube5_section_buf #(
   end
 
   for (genvar e = 0; e < 3 * P; e++) begin : gen_edge
-    cube5_shader_ram #(
-      .Depth    (EdgeDepth),
-      .Width    (VoxelW),
-      .AddrW    (EAW),
-      .NoRwCheck(1'b1)                          // reads and writes are in different halves
+    cube5_section_buf_ram #(                    // reads and writes are in different halves
+      .Depth(EdgeDepth),
+      .Width(VoxelW),
+      .AddrW(EAW)
     ) u_edge (
       .clk_i  (clk_i),
       .we_i   (e2we_q[e]),
