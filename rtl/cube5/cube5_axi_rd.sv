@@ -178,10 +178,12 @@ module cube5_axi_rd #(
     info_d    = info_q;
     info_wr_d = info_wr_q;
     info_rd_d = info_rd_q;
-    if (issue) begin
-      info_d[info_wr_q] = plan_last;
-      info_wr_d = info_wr_q + OPtrW'(1);
+    // Constant indices (as cube5_axi_wr's): Yosys makes a bit-select write with a variable index
+    // a 32-bit offset adder in front of a decoder, the critical path here.
+    for (int unsigned i = 0; i < Outstanding; i++) begin
+      if (issue && info_wr_q == OPtrW'(i)) info_d[i] = plan_last;
     end
+    if (issue) info_wr_d = info_wr_q + OPtrW'(1);
     if (r_end) info_rd_d = info_rd_q + OPtrW'(1);
   end
 
@@ -209,17 +211,24 @@ module cube5_axi_rd #(
   logic [CntW-1:0]  count_q, count_d;  // words in the RAM
   logic             out_valid_q, out_valid_d;
   logic             ren;
+  logic             count_nz_q, count_nz_d;  // count_q != 0, kept as a flag for ren
+  logic [CntW-1:0]  credit_base;             // the credits after this cycle's issue, if any
   logic             err_q, err_d;
 
   assign wr_word  = {m_axi_rresp_i, m_axi_rlast_i && info_q[info_rd_q], m_axi_rdata_i};
-  assign ren      = (count_q != '0) && (!out_valid_q || out_ready_i);
+  assign ren      = count_nz_q && (!out_valid_q || out_ready_i);
 
   always_comb begin
     wr_d        = r_fire ? wr_q + PtrW'(1) : wr_q;
     rd_ptr_d    = ren ? rd_ptr_q + PtrW'(1) : rd_ptr_q;
     count_d     = count_q + CntW'(r_fire) - CntW'(ren);
+    // ren implies count_q >= 1: the count is nonzero after a beat arrives, and after a read
+    // unless it was 1.
+    count_nz_d  = r_fire || (ren ? (count_q != CntW'(1)) : count_nz_q);
     out_valid_d = ren || (out_valid_q && !out_ready_i);
-    credit_d    = credit_q + CntW'(ren) - (issue ? CntW'(plan_len) : CntW'(0));
+    // ren (behind the consumer's ready) selects last: the increment does not wait for it.
+    credit_base = issue ? credit_q - CntW'(plan_len) : credit_q;
+    credit_d    = ren ? credit_base + CntW'(1) : credit_base;
     bursts_d    = bursts_q + OCntW'(issue) - OCntW'(r_end);
     err_d       = err_q || (r_fire && m_axi_rresp_i != 2'b00);
   end
@@ -229,6 +238,7 @@ module cube5_axi_rd #(
       wr_q        <= '0;
       rd_ptr_q    <= '0;
       count_q     <= '0;
+      count_nz_q  <= 1'b0;
       out_valid_q <= 1'b0;
       credit_q    <= CntW'(Depth);
       bursts_q    <= '0;
@@ -237,6 +247,7 @@ module cube5_axi_rd #(
       wr_q        <= wr_d;
       rd_ptr_q    <= rd_ptr_d;
       count_q     <= count_d;
+      count_nz_q  <= count_nz_d;
       out_valid_q <= out_valid_d;
       credit_q    <= credit_d;
       bursts_q    <= bursts_d;
@@ -269,6 +280,10 @@ module cube5_axi_rd #(
       m_axi_arvalid_o && !m_axi_arready_i |=> m_axi_arvalid_o
       && $stable(m_axi_araddr_o) && $stable(m_axi_arlen_o))
     else $error("cube5_axi_rd: AR changed while stalled");
+  // The read enable's flag is the count's.
+  CountFlagIsCount: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      count_nz_q == (count_q != '0))
+    else $error("cube5_axi_rd: count_nz_q disagrees with count_q");
   // The credit rule keeps the return FIFO from overflowing, so RREADY may stay high.
   ReturnFifoNeverOverflows: assert property (@(posedge clk_i) disable iff (!rst_ni)
       r_fire |-> count_q < CntW'(Depth))

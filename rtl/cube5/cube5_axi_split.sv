@@ -89,11 +89,36 @@ module cube5_axi_split #(
   logic [BurstW-1:0] rem_lo;
   assign rem_lo      = rem_q[BurstW-1:0];
   assign rem_hi_zero = ((rem_q >> BurstW) == '0);
+  // Every quantity below is computed for both caps (MaxBurst, and the beats to the boundary) from
+  // registers, and `capped` selects: no adder or compare waits for the cap's multiplexer.
+  logic              capped;     // the burst stops at the 4 KB boundary short of MaxBurst
+  logic [BurstW-1:0] cap_b;      // the beats to the boundary, MaxBurst - span_off
+  logic              fits_m, fits_b;
   always_comb begin
-    cap = BurstW'(MaxBurst);
-    if (last_span && span_off != '0) cap = BurstW'(MaxBurst) - BurstW'(span_off);
-    rem_fits = rem_hi_zero && (rem_lo <= cap);  // this burst ends the command
-    blen = rem_fits ? rem_lo : cap;
+    capped   = last_span && span_off != '0;
+    cap_b    = BurstW'(MaxBurst) - BurstW'(span_off);
+    fits_m   = (rem_lo <= BurstW'(MaxBurst));
+    fits_b   = ((BurstW + 1)'(rem_lo) + (BurstW + 1)'(span_off)
+                <= (BurstW + 1)'(MaxBurst));          // rem_lo <= cap_b, with no subtraction
+    cap      = capped ? cap_b : BurstW'(MaxBurst);
+    rem_fits = rem_hi_zero && (capped ? fits_b : fits_m);  // this burst ends the command
+    blen     = rem_fits ? rem_lo : cap;
+  end
+  // The next burst's address is the current one advanced by the cap: its span number plus one,
+  // with the beat offset inside the span kept, or cleared when the cap is the boundary's (the
+  // address lands on the boundary). The bytes below a beat are kept either way.
+  logic [AddrW-1:0] next_addr;
+  // The beats left after the burst: rem - MaxBurst (the count of spans less one, the offset
+  // kept), or rem - (MaxBurst - span_off) = rem - MaxBurst + span_off, whose low bits are a small
+  // sum and whose high bits are rem's or rem - MaxBurst's, as that sum carries.
+  logic [RemW-1:0]  rem_m, rem_b;
+  logic [MbW:0]     lo_sum;
+  always_comb begin
+    next_addr = cur_addr_q + (AddrW'(1) << (SizeW + MbW));
+    if (capped) next_addr[SizeW+MbW-1:SizeW] = '0;
+    rem_m  = rem_q - RemW'(MaxBurst);
+    lo_sum = {1'b0, rem_q[MbW-1:0]} + {1'b0, span_off};
+    rem_b  = {lo_sum[MbW] ? rem_q[RemW-1:MbW] : rem_m[RemW-1:MbW], lo_sum[MbW-1:0]};
   end
 
   logic a_free, issue, plan_fill, plan_fill_last;
@@ -127,8 +152,8 @@ module cube5_axi_split #(
       plan_last_d  = plan_fill_last;
       // Advanced by the cap, not blen: after a command's last burst both are dead (active_q
       // drops), and before it blen = cap; so the cap's mux stays off these adders' path.
-      cur_addr_d   = cur_addr_q + (AddrW'(cap) << SizeW);
-      rem_d        = rem_q - RemW'(cap);
+      cur_addr_d   = next_addr;
+      rem_d        = capped ? rem_b : rem_m;
       if (plan_fill_last) active_d = 1'b0;
     end
     if (cmd_fire_i) begin

@@ -188,6 +188,7 @@ module cube5_axi_wr #(
   // ==============================================================================================
 
   logic [CntW-1:0]  avail_q, avail_d;    // W-buffer beats not yet claimed by an issued burst
+  logic [CntW-1:0]  claimed_add;         // the burst issued this cycle's beats, or 0
   logic [OCntW-1:0] bursts_q, bursts_d;  // bursts issued whose B has not been taken
 
   logic              in_any, split_take, may_issue, issue, plan_last;
@@ -321,6 +322,7 @@ module cube5_axi_wr #(
   logic [PtrW-1:0]   wr_q, wr_d, rd_ptr_q, rd_ptr_d;
   logic              ram_we, ren;
   logic [CntW-1:0]   claimed_q, claimed_d;  // W-buffer beats of issued bursts, not yet read
+  logic              claimed_nz_q, claimed_nz_d;  // claimed_q != 0, kept as a flag for ren
   logic              wvalid_q, wvalid_d, wlast_q, wlast_d;
   logic [BurstW-1:0] blq_q [Outstanding];   // beats of each issued burst, for WLAST
   logic [OPtrW-1:0]  blq_wr_q, blq_wr_d, blq_rd_q, blq_rd_d;
@@ -328,15 +330,21 @@ module cube5_axi_wr #(
   logic              rd_last;
 
   assign ram_we  = dat_fire && beat_done;
-  assign ren     = (claimed_q != '0) && (!wvalid_q || m_axi_wready_i);
+  assign ren     = claimed_nz_q && (!wvalid_q || m_axi_wready_i);
   assign rd_last = (wbeat_q + BurstW'(1) == blq_q[blq_rd_q]);
 
   always_comb begin
+    claimed_add = issue ? CntW'(plan_len) : CntW'(0);
     wr_d      = ram_we ? wr_q + PtrW'(1) : wr_q;
     rd_ptr_d  = ren ? rd_ptr_q + PtrW'(1) : rd_ptr_q;
     count_d   = count_q + CntW'(ram_we) - CntW'(ren);
-    avail_d   = avail_q + CntW'(ram_we) - (issue ? CntW'(plan_len) : CntW'(0));
-    claimed_d = claimed_q - CntW'(ren) + (issue ? CntW'(plan_len) : CntW'(0));
+    // ram_we (behind the packer's lane decode) selects last, between sums that do not wait for it.
+    avail_d   = avail_q - claimed_add;
+    if (ram_we) avail_d = avail_q - claimed_add + CntW'(1);
+    // ren selects last, between sums that do not wait for it; plan_len >= 1 and ren implies
+    // claimed_q >= 1, so the count is nonzero after an issue, and after a read unless it was 1.
+    claimed_d    = ren ? claimed_q + claimed_add - CntW'(1) : claimed_q + claimed_add;
+    claimed_nz_d = issue || (ren ? (claimed_q != CntW'(1)) : claimed_nz_q);
     wvalid_d  = ren || (wvalid_q && !m_axi_wready_i);
     wlast_d   = ren ? rd_last : wlast_q;
     wbeat_d   = wbeat_q;
@@ -355,6 +363,7 @@ module cube5_axi_wr #(
       count_q   <= '0;
       avail_q   <= '0;
       claimed_q <= '0;
+      claimed_nz_q <= 1'b0;
       wvalid_q  <= 1'b0;
       wbeat_q   <= '0;
       blq_wr_q  <= '0;
@@ -365,6 +374,7 @@ module cube5_axi_wr #(
       count_q   <= count_d;
       avail_q   <= avail_d;
       claimed_q <= claimed_d;
+      claimed_nz_q <= claimed_nz_d;
       wvalid_q  <= wvalid_d;
       wbeat_q   <= wbeat_d;
       blq_wr_q  <= blq_wr_d;
@@ -485,6 +495,10 @@ module cube5_axi_wr #(
   WBufferNeverOverflows: assert property (@(posedge clk_i) disable iff (!rst_ni)
       ram_we |-> count_q < CntW'(Depth))
     else $error("cube5_axi_wr: a beat written into a full W buffer");
+  // The read enable's flag is the count's.
+  ClaimedFlagIsCount: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      claimed_nz_q == (claimed_q != '0))
+    else $error("cube5_axi_wr: claimed_nz_q disagrees with claimed_q");
   // Every B belongs to a burst in flight.
   NoResponseWithoutBurst: assert property (@(posedge clk_i) disable iff (!rst_ni)
       b_fire |-> bursts_q != '0)

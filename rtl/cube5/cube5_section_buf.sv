@@ -138,13 +138,16 @@ module cube5_section_buf #(
   // ==============================================================================================
 
   logic            act_q, act_d;             // a section is being written
-  logic [1:0]      axis_q, axis_d;
+  logic            axx_q, axx_d, axz_q, axz_d;  // axis_k = 0 (slice axis x), axis_k = 2 (z)
   logic            rev_q, rev_d;
   logic [DimW-1:0] nj_q, nj_d, ns_q, ns_d;
   logic [M-1:0]    a0_q, a0_d;
   // Block counts minus one and the present-column offset a0 / B - 1, so the per-item compares
   // on the acceptance path need no adder.
-  logic [NbCW-1:0] nbj1_q, nbj1_d, nbk1_q, nbk1_d, sechi1_q, sechi1_d, pofs_q, pofs_d, t_q, t_d;
+  logic [NbCW-1:0] nbj1_q, nbj1_d, nbk1_q, nbk1_d, sechi1_q, sechi1_d, t_q, t_d;
+  // The present-flag column c's block column a0 / B - 1 + c (CB of them): the item's column
+  // test is an equality, no subtraction.
+  logic [CB*NbCW-1:0] pofs_q, pofs_d;
   logic            wh_q, wh_d;                // the half being filled
   // The row's high edge columns a0 + ns and a0 + ns + 1 lie past the volume (a0 + ns = min(a0 + S,
   // ni), so a0 + ns >= ni is ni - a0 <= S): kept per section.
@@ -185,12 +188,14 @@ module cube5_section_buf #(
     x0 = M'((32'(it_bx) << BW) | ((w & (BPP - 1)) << LP));
     y0 = M'((32'(it_by) << BW) | ((w >> LBPP) & (BlockDim - 1)));
     z0 = M'((32'(it_bz) << BW) | (w >> (LBPP + BW)));
-    unique case (axis_q)
-      2'd0:    begin i0 = y0; j0 = z0; k0 = x0; bi0 = it_by; bj0 = it_bz; end
-      2'd1:    begin i0 = x0; j0 = z0; k0 = y0; bi0 = it_bx; bj0 = it_bz; end
-      default: begin i0 = x0; j0 = y0; k0 = z0; bi0 = it_bx; bj0 = it_by; end
-    endcase
-    axx0 = (axis_q == 2'd0);
+    // axis_k 0: (i, j, k) = (y, z, x); 1: (x, z, y); 2: (x, y, z). Two flags, so every field is
+    // one 2:1 multiplexer (k: two).
+    i0   = axx_q ? y0 : x0;
+    j0   = axz_q ? y0 : z0;
+    k0   = axx_q ? x0 : (axz_q ? z0 : y0);
+    bi0  = axx_q ? it_by : it_bx;
+    bj0  = axz_q ? it_by : it_bz;
+    axx0 = axx_q;
   end
 
   // Only the slice inside the slab (k mod B) is stored; the slab is the writer's counter.
@@ -215,7 +220,8 @@ module cube5_section_buf #(
 
   always_comb begin
     act_d     = act_q;
-    axis_d    = axis_q;
+    axx_d     = axx_q;
+    axz_d     = axz_q;
     rev_d     = rev_q;
     hi00_d    = hi00_q;
     hi10_d    = hi10_q;
@@ -231,7 +237,8 @@ module cube5_section_buf #(
     wh_d      = wh_q;
     if (cmd_fire) begin
       act_d     = !cm_refused;
-      axis_d    = cm_axis;
+      axx_d     = (cm_axis == 2'd0);
+      axz_d     = (cm_axis == 2'd2);
       rev_d     = cm_rev;
       hi00_d    = (cm_rest <= DimW'(Section));
       hi10_d    = (cm_rest <= DimW'(Section + 1));
@@ -242,7 +249,9 @@ module cube5_section_buf #(
       nbj1_d    = NbCW'((cm_nj + DimW'(BlockDim - 1)) >> BW) - NbCW'(1);
       nbk1_d    = NbCW'((cm_nk + DimW'(BlockDim - 1)) >> BW) - NbCW'(1);
       sechi1_d  = ((cm_sechi_cap < cm_nbi) ? cm_sechi_cap : cm_nbi) - NbCW'(1);
-      pofs_d    = NbCW'(cm_a0 >> BW) - NbCW'(1);
+      for (int unsigned c = 0; c < CB; c++) begin
+        pofs_d[c * NbCW +: NbCW] = NbCW'(cm_a0 >> BW) + NbCW'(c) - NbCW'(1);
+      end
       t_d       = '0;
       if (cm_refused) wh_d = !wh_q;            // the error takes a half
     end
@@ -268,7 +277,8 @@ module cube5_section_buf #(
   end
   // Section registers: qualified by act_q.
   always_ff @(posedge clk_i) begin
-    axis_q  <= axis_d;
+    axx_q   <= axx_d;
+    axz_q   <= axz_d;
     rev_q   <= rev_d;
     hi00_q  <= hi00_d;
     hi10_q  <= hi10_d;
@@ -299,19 +309,23 @@ module cube5_section_buf #(
   assign desc_we  = (cmd_fire && cm_refused) || (item_fire && item_close);
   assign desc_err = cmd_fire;
 
+  // Constant indices (a loop over the halves): Yosys makes a bit-select write with a variable
+  // index a 32-bit offset adder in front of a decoder.
   always_ff @(posedge clk_i) begin
-    if (desc_we) begin
-      de_err_q[wh_q]  <= desc_err;
-      de_last_q[wh_q] <= tlast;
-      de_rev_q[wh_q]  <= rev_q;
-      de_lo0_q[wh_q]  <= (a0_q == '0);
-      de_hi00_q[wh_q] <= hi00_q;
-      de_hi10_q[wh_q] <= hi10_q;
-      de_m1_q[wh_q]   <= MW'((ns_q >> LP) - DimW'(1));
-      de_nj1_q[wh_q]  <= M'(nj_q - DimW'(1));
-      de_nkl1_q[wh_q] <= nkl_w - KW'(1);
-      de_c0_q[wh_q]   <= CBW'((32'(ns_q) >> BW) + 1);
-      de_c1_q[wh_q]   <= CBW'(((32'(ns_q) + 1) >> BW) + 1);
+    for (int unsigned h = 0; h < 2; h++) begin
+      if (desc_we && wh_q == 1'(h)) begin
+        de_err_q[h]  <= desc_err;
+        de_last_q[h] <= tlast;
+        de_rev_q[h]  <= rev_q;
+        de_lo0_q[h]  <= (a0_q == '0);
+        de_hi00_q[h] <= hi00_q;
+        de_hi10_q[h] <= hi10_q;
+        de_m1_q[h]   <= MW'((ns_q >> LP) - DimW'(1));
+        de_nj1_q[h]  <= M'(nj_q - DimW'(1));
+        de_nkl1_q[h] <= nkl_w - KW'(1);
+        de_c0_q[h]   <= CBW'((32'(ns_q) >> BW) + 1);
+        de_c1_q[h]   <= CBW'(((32'(ns_q) + 1) >> BW) + 1);
+      end
     end
   end
 
@@ -321,20 +335,18 @@ module cube5_section_buf #(
   // are written once, with the row's closing item; every row of a slab is rewritten.
   // ==============================================================================================
 
-  logic [NbCW-1:0]  pcol;                     // bi - (a0 / B - 1)
   logic [CB-1:0]    pacc_q, pacc_d, pacc_next;
   logic             popen_q, popen_d;         // a block row has begun
   logic             row_close, pres_we_q;
   logic [PresW-1:0] pres_waddr_q;
   logic [CB-1:0]    pres_wdata_q;
-  assign pcol      = NbCW'(bi0) - pofs_q;
   assign row_close = (NbCW'(bi0) == sechi1_q)
                   && (it_skip || it_word == WordW'(Groups - 1));
 
   always_comb begin
     pacc_next = popen_q ? pacc_q : '0;
     for (int unsigned c = 0; c < CB; c++) begin
-      if (!it_skip && pcol == NbCW'(c)) pacc_next[c] = 1'b1;
+      if (!it_skip && NbCW'(bi0) == pofs_q[c * NbCW +: NbCW]) pacc_next[c] = 1'b1;
     end
     pacc_d  = pacc_q;
     popen_d = popen_q;
@@ -596,12 +608,14 @@ module cube5_section_buf #(
   always_comb begin
     full_d = full_q;
     held_d = held_q;
-    if (issue && slab_done) begin
-      full_d[rh_q] = 1'b0;
-      held_d[rh_q] = 1'b0;
+    for (int unsigned h = 0; h < 2; h++) begin    // constant indices, as the descriptors
+      if (issue && slab_done && rh_q == 1'(h)) begin
+        full_d[h] = 1'b0;
+        held_d[h] = 1'b0;
+      end
+      if (w2close_q && w2half_q == 1'(h)) full_d[h] = 1'b1;
+      if (desc_we && wh_q == 1'(h)) held_d[h] = 1'b1;
     end
-    if (w2close_q) full_d[w2half_q] = 1'b1;
-    if (desc_we) held_d[wh_q] = 1'b1;
   end
 
   always_ff @(posedge clk_i) begin
@@ -626,8 +640,8 @@ module cube5_section_buf #(
   logic [BAW-1:0] r_addr;
   logic [EAW-1:0] r_eaddr;
   logic [PW-1:0]  r_rot, r_ebank;
-  logic           r_lane_ok, r_lo_ok, r_hi0_ok, r_hi1_ok;
   logic [CB-1:0]  r_pres;
+  logic [CBW-1:0] r_col;
   always_comb begin
     r_addr  = BAW'((((((32'(rh_q) << BW) | 32'(r_lk)) << M) | 32'(rj_q)) << LSP)
                    | (32'(rm_q) & (SP - 1)));
@@ -635,10 +649,7 @@ module cube5_section_buf #(
     r_rot   = PW'((32'(rj_q) + 32'(r_lk)) & (P - 1));
     r_ebank = PW'(32'(r_lk) & (P - 1));
     r_pres  = pres_mem[{rh_q, rj_q[M-1:BW]}];
-    r_lane_ok = !r_err && r_pres[((32'(rm_q) << LP) >> BW) + 1];
-    r_lo_ok   = !r_err && (rm_q == '0) && !de_lo0_q[rh_q] && r_pres[0];
-    r_hi0_ok  = !r_err && m_last && !de_hi00_q[rh_q] && r_pres[de_c0_q[rh_q]];
-    r_hi1_ok  = !r_err && m_last && !de_hi10_q[rh_q] && r_pres[de_c1_q[rh_q]];
+    r_col   = CBW'(((32'(rm_q) << LP) >> BW) + 1);
   end
 
   // ==============================================================================================
@@ -649,7 +660,7 @@ module cube5_section_buf #(
   logic [3*P*VoxelW-1:0] edge_rd;
 
   for (genvar b = 0; b < P; b++) begin : gen_bank
-    cube5_shader_ram #(
+    cube5_section_buf_ram #(                    // reads and writes are in different halves
       .Depth(BankDepth),
       .Width(VoxelW),
       .AddrW(BAW)
@@ -665,7 +676,7 @@ module cube5_section_buf #(
   end
 
   for (genvar e = 0; e < 3 * P; e++) begin : gen_edge
-    cube5_shader_ram #(
+    cube5_section_buf_ram #(                    // reads and writes are in different halves
       .Depth(EdgeDepth),
       .Width(VoxelW),
       .AddrW(EAW)
@@ -687,7 +698,19 @@ module cube5_section_buf #(
   // Stage d: the banks' (unregistered) outputs; stage d2: them registered (the block RAMs'
   // clock-to-output and the routing from them is a cycle of its own), then rotation and masks.
   logic [PW-1:0] drot_q, debank_q, drot_q2, debank_q2;
-  logic          dlane_q, dlo_q, dhi0_q, dhi1_q, dlane_q2, dlo_q2, dhi0_q2, dhi1_q2;
+  logic          dlane_q2, dlo_q2, dhi0_q2, dhi1_q2;
+  // Stage d also holds the beam's present-flag word and which of its flags each voxel reads:
+  // the flag selection is stage d's logic (not the issue cycle's, behind the LUT-RAM read).
+  logic [CB-1:0]  dpres_q;
+  logic [CBW-1:0] dcol_q, dc0_q, dc1_q;
+  logic           dlane_ok_q, dlo_ok_q, dhi0_ok_q, dhi1_ok_q;
+  logic           d_lane_ok, d_lo_ok, d_hi0_ok, d_hi1_ok;
+  always_comb begin
+    d_lane_ok = dlane_ok_q && dpres_q[dcol_q];
+    d_lo_ok   = dlo_ok_q && dpres_q[0];
+    d_hi0_ok  = dhi0_ok_q && dpres_q[dc0_q];
+    d_hi1_ok  = dhi1_ok_q && dpres_q[dc1_q];
+  end
   logic [4:0]    dflags_q, dflags_q2;               // row_first, row_last, slice_last, last, error
   logic [P*VoxelW-1:0]   bank_q2;
   logic [3*P*VoxelW-1:0] edge_q2;
@@ -704,16 +727,20 @@ module cube5_section_buf #(
   always_ff @(posedge clk_i) begin
     drot_q   <= r_rot;
     debank_q <= r_ebank;
-    dlane_q  <= r_lane_ok;
-    dlo_q    <= r_lo_ok;
-    dhi0_q   <= r_hi0_ok;
-    dhi1_q   <= r_hi1_ok;
+    dpres_q    <= r_pres;
+    dcol_q     <= r_col;
+    dc0_q      <= de_c0_q[rh_q];
+    dc1_q      <= de_c1_q[rh_q];
+    dlane_ok_q <= !r_err;
+    dlo_ok_q   <= !r_err && (rm_q == '0) && !de_lo0_q[rh_q];
+    dhi0_ok_q  <= !r_err && m_last && !de_hi00_q[rh_q];
+    dhi1_ok_q  <= !r_err && m_last && !de_hi10_q[rh_q];
     drot_q2   <= drot_q;
     debank_q2 <= debank_q;
-    dlane_q2  <= dlane_q;
-    dlo_q2    <= dlo_q;
-    dhi0_q2   <= dhi0_q;
-    dhi1_q2   <= dhi1_q;
+    dlane_q2  <= d_lane_ok;
+    dlo_q2    <= d_lo_ok;
+    dhi0_q2   <= d_hi0_ok;
+    dhi1_q2   <= d_hi1_ok;
     dflags_q2 <= dflags_q;
     bank_q2   <= bank_rd;
     edge_q2   <= edge_rd;

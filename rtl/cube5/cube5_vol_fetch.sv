@@ -179,32 +179,36 @@ module cube5_vol_fetch #(
   logic             walk_q, walk_d;      // a sweep is being walked
   logic             refused_q, refused_d;
   logic [AddrW-1:0] base_q, base_d;
-  logic [NbCW-1:0]  nbi_q, nbi_d, nbj_q, nbj_d, nbk_q, nbk_d, hi_q, hi_d;
+  // The walk's ends minus one (its compares need no adder), the slab's block bk counted itself
+  // (no subtraction from t when reversed), the axis as two flags (every coordinate one 2:1
+  // multiplexer, y two).
+  logic [NbCW-1:0]  nbi_q, nbi_d, nbj1_q, nbj1_d, nbk1_q, nbk1_d, hi1_q, hi1_d;
   logic [NbW-1:0]   lo_q, lo_d;
-  logic [1:0]       axis_q, axis_d;
+  logic             ax0_q, ax0_d, ax2_q, ax2_d;
   logic             rev_q, rev_d;
-  logic [NbW-1:0]   t_q, t_d, bj_q, bj_d, bi_q, bi_d;
+  logic [NbW-1:0]   t_q, t_d, bj_q, bj_d, bi_q, bi_d, bk_q, bk_d;
 
-  logic             s2_ready, s1_fire;
+  logic             s1_ready, s1_fire, s12;
+  logic             v1_q, v1_d;        // the LUT's (registered) read port holds a block's entry
+  logic             s2_ready;
   logic             v2_q, v2_d;        // stage 2 holds a block
   logic [NbW-1:0]   bk, bx, by, bz;
   logic             row_end, slab_end, walk_end;
 
   // Stage 2 must be empty too: its read command is formed from this sweep's base register.
-  assign in_ready_o = !walk_q && !v2_q;
+  assign in_ready_o = !walk_q && !v1_q && !v2_q;
   assign in_fire    = in_valid_i && in_ready_o;
-  assign s1_fire    = walk_q && s2_ready;
+  assign s1_fire    = walk_q && s1_ready;
 
   always_comb begin
-    bk = rev_q ? NbW'(nbk_q - NbCW'(1)) - t_q : t_q;
-    unique case (axis_q)
-      2'd0:    begin bx = bk; by = bi_q; bz = bj_q; end
-      2'd1:    begin bx = bi_q; by = bk; bz = bj_q; end
-      default: begin bx = bi_q; by = bj_q; bz = bk; end
-    endcase
-    row_end  = (NbCW'(bi_q) + NbCW'(1) == hi_q);
-    slab_end = row_end && (NbCW'(bj_q) + NbCW'(1) == nbj_q);
-    walk_end = refused_q || (slab_end && (NbCW'(t_q) + NbCW'(1) == nbk_q));
+    // axis 0: (bx, by, bz) = (bk, bi, bj); 1: (bi, bk, bj); 2: (bi, bj, bk).
+    bk = bk_q;
+    bx = ax0_q ? bk : bi_q;
+    by = ax0_q ? bi_q : (ax2_q ? bj_q : bk);
+    bz = ax2_q ? bk : bj_q;
+    row_end  = (NbCW'(bi_q) == hi1_q);
+    slab_end = row_end && (NbCW'(bj_q) == nbj1_q);
+    walk_end = refused_q || (slab_end && (NbCW'(t_q) == nbk1_q));
   end
 
   always_comb begin
@@ -212,13 +216,15 @@ module cube5_vol_fetch #(
     refused_d = refused_q;
     base_d    = base_q;
     nbi_d     = nbi_q;
-    nbj_d     = nbj_q;
-    nbk_d     = nbk_q;
-    hi_d      = hi_q;
+    nbj1_d    = nbj1_q;
+    nbk1_d    = nbk1_q;
+    hi1_d     = hi1_q;
     lo_d      = lo_q;
-    axis_d    = axis_q;
+    ax0_d     = ax0_q;
+    ax2_d     = ax2_q;
     rev_d     = rev_q;
     t_d       = t_q;
+    bk_d      = bk_q;
     bj_d      = bj_q;
     bi_d      = bi_q;
     if (s1_fire) begin
@@ -228,6 +234,7 @@ module cube5_vol_fetch #(
         bi_d = lo_q;
         bj_d = '0;
         t_d  = t_q + NbW'(1);
+        bk_d = rev_q ? bk_q - NbW'(1) : bk_q + NbW'(1);
       end else if (row_end) begin
         bi_d = lo_q;
         bj_d = bj_q + NbW'(1);
@@ -240,13 +247,15 @@ module cube5_vol_fetch #(
       refused_d = sw_refused;
       base_d    = sw_base;
       nbi_d     = sw_nbi;
-      nbj_d     = sw_nbj;
-      nbk_d     = sw_nbk;
-      hi_d      = sw_hi;
+      nbj1_d    = sw_nbj - NbCW'(1);
+      nbk1_d    = sw_nbk - NbCW'(1);
+      hi1_d     = sw_hi - NbCW'(1);
       lo_d      = sw_lo;
-      axis_d    = sw_axis;
+      ax0_d     = (sw_axis == 2'd0);
+      ax2_d     = (sw_axis == 2'd2);
       rev_d     = sw_rev;
       t_d       = '0;
+      bk_d      = sw_rev ? NbW'(sw_nbk - NbCW'(1)) : '0;
       bj_d      = '0;
       bi_d      = sw_lo;
     end
@@ -265,18 +274,23 @@ module cube5_vol_fetch #(
     refused_q <= refused_d;
     base_q    <= base_d;
     nbi_q     <= nbi_d;
-    nbj_q     <= nbj_d;
-    nbk_q     <= nbk_d;
-    hi_q      <= hi_d;
+    nbj1_q    <= nbj1_d;
+    nbk1_q    <= nbk1_d;
+    hi1_q     <= hi1_d;
     lo_q      <= lo_d;
-    axis_q    <= axis_d;
+    ax0_q     <= ax0_d;
+    ax2_q     <= ax2_d;
     rev_q     <= rev_d;
     t_q       <= t_d;
+    bk_q      <= bk_d;
     bj_q      <= bj_d;
     bi_q      <= bi_d;
   end
 
   // The block LUT: one write port (commands), one registered read port (the walker). No reset.
+  // Commands are taken only while the walker and its stages are empty, so no read meets a write
+  // (no_rw_check: the ECP5 flow needs no collision logic around the block RAM).
+  (* no_rw_check *)
   logic [LutW-1:0] lut_mem [NB * NB * NB];
   logic [LutW-1:0] lut_rd_q;
   logic            lut_we;
@@ -293,49 +307,109 @@ module cube5_vol_fetch #(
   // Stage 2: skip, or a read command; a tag per block into the tag FIFO
   // ==============================================================================================
 
-  logic [BlkW-1:0] blk2_q, blk2_d;   // {bz, by, bx}
-  logic            last2_q, last2_d, err2_q, err2_d;
+  // Stage 1 (the block beside its LUT entry in the read port) and stage 2 (both registered: the
+  // block RAM's output goes straight into a register, the skip decision reads that register).
+  logic [BlkW-1:0] blk1_q, blk1_d, blk2_q, blk2_d;   // {bz, by, bx}
+  logic            last1_q, last1_d, err1_q, err1_d, last2_q, last2_d, err2_q, err2_d;
+  logic [LutW-1:0] lut2_q, lut2_d;
 
   logic [BlkW-1:0] ptr2;
   logic            skip2, tag_space, s2_fire, rd_in_valid, rd_in_ready;
-  assign ptr2  = lut_rd_q[BlkW-1:0];
-  assign skip2 = !err2_q && (lut_rd_q[BlkW] || lut_rd_q[BlkW+1]);
+  assign ptr2  = lut2_q[BlkW-1:0];
+  assign skip2 = !err2_q && (lut2_q[BlkW] || lut2_q[BlkW+1]);
 
   logic [TagCntW-1:0] tag_count_q, tag_count_d;
   assign tag_space   = (tag_count_q != TagCntW'(TagDepth));
-  assign rd_in_valid = v2_q && !skip2 && !err2_q && tag_space;
-  assign s2_fire     = v2_q && tag_space && (skip2 || err2_q || rd_in_ready);
+  // A block to read hands its command to the command FIFO (cmd3, two entries) while it has room:
+  // a registered condition, so the reader's acceptance (its splitter's last-burst compare) does
+  // not reach back through stage 2 to the walker in the same cycle.
+  logic [1:0] cmd3_cnt_q, cmd3_cnt_d;
+  logic       cmd3_free, cmd3_pop, s2_read;
+  assign cmd3_free   = (cmd3_cnt_q != 2'd2);
+  assign s2_fire     = v2_q && tag_space && (skip2 || err2_q || cmd3_free);
+  assign s2_read     = s2_fire && !skip2 && !err2_q;
   assign s2_ready    = !v2_q || s2_fire;
+  assign s12         = v1_q && s2_ready;
+  assign s1_ready    = !v1_q || s12;
 
   always_comb begin
+    v1_d    = v1_q && !s12;
+    blk1_d  = blk1_q;
+    last1_d = last1_q;
+    err1_d  = err1_q;
+    if (s1_fire) begin
+      v1_d    = 1'b1;
+      blk1_d  = refused_q ? '0 : {bz, by, bx};
+      last1_d = walk_end;
+      err1_d  = refused_q;
+    end
     v2_d    = v2_q && !s2_fire;
     blk2_d  = blk2_q;
     last2_d = last2_q;
     err2_d  = err2_q;
-    if (s1_fire) begin
+    lut2_d  = lut2_q;
+    if (s12) begin
       v2_d    = 1'b1;
-      blk2_d  = refused_q ? '0 : {bz, by, bx};
-      last2_d = walk_end;
-      err2_d  = refused_q;
+      blk2_d  = blk1_q;
+      last2_d = last1_q;
+      err2_d  = err1_q;
+      lut2_d  = lut_rd_q;
     end
   end
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
+      v1_q <= 1'b0;
       v2_q <= 1'b0;
     end else begin
+      v1_q <= v1_d;
       v2_q <= v2_d;
     end
   end
   always_ff @(posedge clk_i) begin
+    blk1_q  <= blk1_d;
+    last1_q <= last1_d;
+    err1_q  <= err1_d;
     blk2_q  <= blk2_d;
     last2_q <= last2_d;
     err2_q  <= err2_d;
+    lut2_q  <= lut2_d;
   end
 
-  // The block's read command: base + ptr * 2 B^3, BeatsPerBlock beats.
+  // The block's read command: base + ptr * 2 B^3, BeatsPerBlock beats, into the command FIFO
+  // (head cmd3_addr_q, then cmd3_next_q), so the address adder is not one path with the reader's
+  // splitter.
+  logic [AddrW-1:0]      cmd3_addr_q, cmd3_addr_d, cmd3_next_q, cmd3_next_d, s2_addr;
   logic [AddrW+LenW-1:0] rd_cmd;
-  assign rd_cmd = {LenW'(BeatsPerBlock), base_q + (AddrW'(ptr2) << BlkShift)};
+  assign cmd3_pop = rd_in_valid && rd_in_ready;
+  always_comb begin
+    s2_addr     = base_q + (AddrW'(ptr2) << BlkShift);
+    cmd3_cnt_d  = cmd3_cnt_q + 2'(s2_read) - 2'(cmd3_pop);
+    cmd3_addr_d = cmd3_addr_q;
+    cmd3_next_d = cmd3_next_q;
+    if (cmd3_pop) cmd3_addr_d = cmd3_next_q;
+    if (s2_read) begin
+      // The new command is the head when the FIFO is empty after this cycle's pop.
+      if (cmd3_cnt_q == 2'd0 || (cmd3_cnt_q == 2'd1 && cmd3_pop)) begin
+        cmd3_addr_d = s2_addr;
+      end else begin
+        cmd3_next_d = s2_addr;
+      end
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      cmd3_cnt_q <= '0;
+    end else begin
+      cmd3_cnt_q <= cmd3_cnt_d;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    cmd3_addr_q <= cmd3_addr_d;
+    cmd3_next_q <= cmd3_next_d;
+  end
+  assign rd_in_valid = (cmd3_cnt_q != 2'd0);
+  assign rd_cmd      = {LenW'(BeatsPerBlock), cmd3_addr_q};
 
   // ==============================================================================================
   // The reader
