@@ -7,6 +7,7 @@
 //! [346]-[392]).
 
 pub mod cube5_axi_rd;
+pub mod cube5_accel_ctrl;
 pub mod cube5_axi_wr;
 pub mod cube5_axil;
 pub mod cube5_compos;
