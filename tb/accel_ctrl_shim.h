@@ -80,16 +80,7 @@ class AccelCtrlShim final : public ClockedTop<V> {
     uint64_t responses = 0;
     auto stalled = [&](uint64_t off) { return stall_len && stall[(cycle_ + off) % stall_len]; };
     while (st.cycles < max_cycles && (n_items == 0 || !mgr_.all_issued() || responses < expect_out)) {
-      const MgrOut m = mgr_.drive(!stalled(0), !stalled(2053));
-      top_->s_axil_awvalid_i = m.awvalid;
-      top_->s_axil_awaddr_i = m.awaddr;
-      top_->s_axil_wvalid_i = m.wvalid;
-      top_->s_axil_wdata_i = m.wdata;
-      top_->s_axil_wstrb_i = m.wstrb;
-      top_->s_axil_bready_i = m.bready;
-      top_->s_axil_arvalid_i = m.arvalid;
-      top_->s_axil_araddr_i = m.araddr;
-      top_->s_axil_rready_i = m.rready;
+      axil_drive(*top_, mgr_.drive(!stalled(0), !stalled(2053)));
       top_->fetch_cmd_ready_i = !stalled(17);
       top_->sbuf_cmd_ready_i = !stalled(101);
       top_->frame_cmd_ready_i = !stalled(409);
@@ -102,16 +93,7 @@ class AccelCtrlShim final : public ClockedTop<V> {
       top_->wr_cpl_valid_i = cpl;
       top_->wr_cpl_resp_i = cpl ? cpl_.front().resp : 0;
       top_->eval();
-      SubOut s;
-      s.awready = top_->s_axil_awready_o;
-      s.wready = top_->s_axil_wready_o;
-      s.bvalid = top_->s_axil_bvalid_o;
-      s.bresp = top_->s_axil_bresp_o;
-      s.arready = top_->s_axil_arready_o;
-      s.rvalid = top_->s_axil_rvalid_o;
-      s.rdata = top_->s_axil_rdata_o;
-      s.rresp = top_->s_axil_rresp_o;
-      s.irq = top_->irq_o;
+      const SubOut s = axil_sub(*top_);
       tmp_.clear();
       responses += mgr_.observe(cycle_, s, tmp_);
       for (size_t i = 0; i + 2 + AxilMgr::kRecordWords <= tmp_.size(); i += 2 + AxilMgr::kRecordWords) {
@@ -230,11 +212,7 @@ class AccelCtrlShim final : public ClockedTop<V> {
   uint64_t rand(uint64_t salt) const { return axil_hw(seed_ ^ static_cast<uint32_t>(salt * 0x9e3779b9u), cycle_); }
 
   void idle_inputs() {
-    top_->s_axil_awvalid_i = 0;
-    top_->s_axil_wvalid_i = 0;
-    top_->s_axil_bready_i = 0;
-    top_->s_axil_arvalid_i = 0;
-    top_->s_axil_rready_i = 0;
+    axil_idle(*top_);
     top_->fetch_cmd_ready_i = 0;
     top_->sbuf_cmd_ready_i = 0;
     top_->frame_cmd_ready_i = 0;

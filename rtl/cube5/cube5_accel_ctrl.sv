@@ -188,7 +188,7 @@ module cube5_accel_ctrl #(
     word = v[i*32 +: 32];
   endfunction
 
-  typedef enum logic [1:0] {StIdle, StCheck, StRun} state_e;
+  typedef enum logic [1:0] {StIdle, StSetup, StCheck, StRun} state_e;
   state_e state_q, state_d;
 
   logic start_stb, abort_stb;
@@ -263,6 +263,8 @@ module cube5_accel_ctrl #(
     abs_shift = (s < 0) ? -s : s;
   endfunction
 
+  // Stage 1 (the Setup cycle, t0 + 1): frame axes, products, the checks of the registers alone.
+  logic [3:0] code_a;
   always_comb begin
     unique case (axis_q)
       2'd0:    begin ni = ny_q; nj = nz_q; nk = nx_q; end
@@ -273,13 +275,10 @@ module cube5_accel_ctrl #(
     ty = $signed({1'b0, nk - M1'(1)}) * $signed(dy_q);
     sx = tx[M+19:StepW];
     sy = ty[M+19:StepW];
-    wpix = ni + M1'(abs_shift(sx));
-    hpix = nj + M1'(abs_shift(sy));
     ninj = (2*M+2)'(ni) * (2*M+2)'(nj);
     nj_m1 = nj - M1'(1);
     ni_nj1 = (2*M+2)'(ni) * (2*M+2)'(nj_m1);
     swept = nk - front_q - back_q;
-    samples = (3*M+3)'(ninj) * (3*M+3)'(swept);
     nsec = (ni + M1'(Section - 1)) >> LogS;
     nbx = blocks(nx_q);
     nby = blocks(ny_q);
@@ -290,21 +289,36 @@ module cube5_accel_ctrl #(
     endcase
     dx_neg = dx_q[17];
     // Refusals, the first that applies (docs/numerics/accel_ctrl.md, "Refused frames").
-    if (axis_q == 2'd3) code = cube5_accel_regs_pkg::CodeAxisK;
-    else if (bad_dim(nx_q) || bad_dim(ny_q) || bad_dim(nz_q)) code = cube5_accel_regs_pkg::CodeDims;
-    else if (mode_q[1:0] >= 2'd2) code = cube5_accel_regs_pkg::CodeRender;
-    else if (bad_step(dx_q) || bad_step(dy_q)) code = cube5_accel_regs_pkg::CodeStep;
-    else if ({1'b0, front_q} + {1'b0, back_q} >= {1'b0, nk}) code = cube5_accel_regs_pkg::CodeSkip;
-    else if (ni < M1'(2 * P) || (ni_nj1 >> LogP) < (2*M+2)'(9)) code = cube5_accel_regs_pkg::CodeSmall;
+    if (axis_q == 2'd3) code_a = cube5_accel_regs_pkg::CodeAxisK;
+    else if (bad_dim(nx_q) || bad_dim(ny_q) || bad_dim(nz_q)) code_a = cube5_accel_regs_pkg::CodeDims;
+    else if (mode_q[1:0] >= 2'd2) code_a = cube5_accel_regs_pkg::CodeRender;
+    else if (bad_step(dx_q) || bad_step(dy_q)) code_a = cube5_accel_regs_pkg::CodeStep;
+    else code_a = cube5_accel_regs_pkg::CodeNone;
+  end
+
+  // Stage 1's results (datapath registers, loaded in the Setup cycle).
+  logic [M:0]         ni_q, nj_q, nk_q, nsec_q, swept_q;
+  logic [NbW:0]       nbx_q, nby_q, nbz_q, nbi_q;
+  logic               neg_q;
+  logic signed [M+3:0] sx_q, sy_q;
+  logic [2*M+1:0]     ninj_q, ni_nj1_q;
+  logic [3:0]         code_a_q;
+
+  // Stage 2 (the Check cycle, t0 + 2): the rules that need the products, the base plane, samples.
+  always_comb begin
+    wpix = ni_q + M1'(abs_shift(sx_q));
+    hpix = nj_q + M1'(abs_shift(sy_q));
+    samples = (3*M+3)'(ninj_q) * (3*M+3)'(swept_q);
+    if (code_a_q != cube5_accel_regs_pkg::CodeNone) code = code_a_q;
+    else if ({1'b0, front_q} + {1'b0, back_q} >= {1'b0, nk_q}) code = cube5_accel_regs_pkg::CodeSkip;
+    else if (ni_q < M1'(2 * P) || (ni_nj1_q >> LogP) < (2*M+2)'(9)) code = cube5_accel_regs_pkg::CodeSmall;
     else if ((vbase_q & AddrW'(VolMask)) != '0) code = cube5_accel_regs_pkg::CodeVolAlign;
     else if ((ibase_q & AddrW'(ImgMask)) != '0) code = cube5_accel_regs_pkg::CodeImgAlign;
     else code = cube5_accel_regs_pkg::CodeNone;
   end
 
-  // Set-up results, registered in the Check cycle.
-  logic [M:0]       ni_q, nj_q, nk_q, w_q, h_q, nsec_q;
-  logic [NbW:0]     nbx_q, nby_q, nbz_q, nbi_q;
-  logic             neg_q;
+  // Stage 2's results.
+  logic [M:0]       w_q, h_q;
   logic [AddrW-1:0] row_step_q;
 
   // ---------------------------------------------------------------------------------------------
@@ -378,7 +392,7 @@ module cube5_accel_ctrl #(
     unique case (state_q)
       StIdle: begin
         if (start_stb) begin
-          state_d = StCheck;
+          state_d = StSetup;
           cyc_d   = 64'd0;
           samp_d  = 64'd0;
           done_d  = 1'b0;
@@ -386,6 +400,7 @@ module cube5_accel_ctrl #(
           code_d  = cube5_accel_regs_pkg::CodeNone;
         end
       end
+      StSetup: state_d = StCheck;
       StCheck: begin
         fidx_d  = '0;
         sidx_d  = '0;
@@ -480,18 +495,26 @@ module cube5_accel_ctrl #(
 
   // Datapath registers (no reset): the set-up results and the row address.
   always_ff @(posedge clk_i) begin
+    if (state_q == StSetup) begin
+      ni_q     <= ni;
+      nj_q     <= nj;
+      nk_q     <= nk;
+      nsec_q   <= nsec;
+      swept_q  <= swept;
+      nbx_q    <= nbx;
+      nby_q    <= nby;
+      nbz_q    <= nbz;
+      nbi_q    <= nbi;
+      neg_q    <= dx_neg;
+      sx_q     <= sx;
+      sy_q     <= sy;
+      ninj_q   <= ninj;
+      ni_nj1_q <= ni_nj1;
+      code_a_q <= code_a;
+    end
     if (state_q == StCheck) begin
-      ni_q       <= ni;
-      nj_q       <= nj;
-      nk_q       <= nk;
       w_q        <= wpix;
       h_q        <= hpix;
-      nsec_q     <= nsec;
-      nbx_q      <= nbx;
-      nby_q      <= nby;
-      nbz_q      <= nbz;
-      nbi_q      <= nbi;
-      neg_q      <= dx_neg;
       row_step_q <= AddrW'(wpix) << LogPix;
     end
     waddr_q <= waddr_d;

@@ -15,9 +15,9 @@ use cube5_model::regs::cube5_accel::{
     CODE_ABORTED, CODE_AXIS_K, CODE_DIMS, CODE_FRAME, CODE_IMG_ALIGN, CODE_NONE, CODE_RENDER,
     CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_CTRL, REG_CYCLE_HI,
     REG_CYCLE_LO, REG_DIMS, REG_DX, REG_DY, REG_IMG_BASE_HI, REG_IMG_BASE_LO, REG_IRQ_ENABLE,
-    REG_IRQ_STATUS, REG_MODE, REG_SAMPLE_HI, REG_SAMPLE_LO, REG_SKIP, REG_STATUS,
-    REG_STATUS_BUSY, REG_STATUS_CODE, REG_STATUS_DONE, REG_STATUS_ERROR, REG_TABLE_ADDR,
-    REG_TABLE_DATA, REG_TABLE_POS, REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO, TABLE_CLASS,
+    REG_IRQ_STATUS, REG_MODE, REG_SAMPLE_HI, REG_SAMPLE_LO, REG_SKIP, REG_STATUS, REG_STATUS_BUSY,
+    REG_STATUS_CODE, REG_STATUS_DONE, REG_STATUS_ERROR, REG_TABLE_ADDR, REG_TABLE_DATA,
+    REG_TABLE_POS, REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO, TABLE_CLASS,
 };
 use cube5_model::units::cube5_accel_ctrl::{
     AccelCtrlCodec, AccelCtrlConfig, CtrlRecord, CtrlRegs, Port, PORTS,
@@ -162,9 +162,7 @@ impl Bench {
         let resp: Vec<_> = d
             .outputs
             .iter()
-            .filter(|t| {
-                matches!(&t.value, CtrlRecord::Axil(r) if r.kind != AxilRecordKind::Irq)
-            })
+            .filter(|t| matches!(&t.value, CtrlRecord::Axil(r) if r.kind != AxilRecordKind::Irq))
             .cloned()
             .collect();
         self.recs.extend(d.outputs);
@@ -255,7 +253,15 @@ fn frame(b: &mut Bench, regs: &CtrlRegs, env: &Env) -> Result<u32, TbError> {
     let (_, s_lo) = b.read(REG_SAMPLE_LO)?;
     let (_, s_hi) = b.read(REG_SAMPLE_HI)?;
     let got = b.take_streams();
-    let ctx = |what: String| format!("{what}\n  registers {regs:x?}\n  env {:?}", Env { stall: Vec::new(), ..env.clone() });
+    let ctx = |what: String| {
+        format!(
+            "{what}\n  registers {regs:x?}\n  env {:?}",
+            Env {
+                stall: Vec::new(),
+                ..env.clone()
+            }
+        )
+    };
     // Streams, command for command.
     let (want_streams, mut want_code, samples) = match &plan {
         Ok(p) => (cfg.streams(p), CODE_NONE, p.samples),
@@ -264,7 +270,11 @@ fn frame(b: &mut Bench, regs: &CtrlRegs, env: &Env) -> Result<u32, TbError> {
     for port in PORTS {
         let (g, w) = (&got[port as usize], &want_streams[port as usize]);
         if g != w {
-            let at = g.iter().zip(w).position(|(a, b)| a != b).unwrap_or(g.len().min(w.len()));
+            let at = g
+                .iter()
+                .zip(w)
+                .position(|(a, b)| a != b)
+                .unwrap_or(g.len().min(w.len()));
             return Err(b.fail(ctx(format!(
                 "{port:?} stream: {} commands, model {}; first difference at {at}: RTL {:x?}, model {:x?}",
                 g.len(),
@@ -274,8 +284,9 @@ fn frame(b: &mut Bench, regs: &CtrlRegs, env: &Env) -> Result<u32, TbError> {
             ))));
         }
     }
-    // The end cycle te: one after the last handshake or event (the check cycle when refused).
-    let mut last = t0;
+    // The end cycle te: one after the last handshake or event (the check cycle t0 + 2 when
+    // refused; accepted frames issue from t0 + 3).
+    let mut last = t0 + 1;
     let mut rows = 0u32;
     for t in &b.recs {
         match &t.value {
@@ -346,7 +357,14 @@ fn pack_dims(cfg: &AccelCtrlConfig, d: [u32; 3]) -> u32 {
 }
 
 /// A legal frame of `dims` (volume axes) seen along `axis_k` (reversed or not) with steps dx, dy.
-fn regs_of(cfg: &AccelCtrlConfig, dims: [u32; 3], axis_k: u32, rev: bool, dx: i32, dy: i32) -> CtrlRegs {
+fn regs_of(
+    cfg: &AccelCtrlConfig,
+    dims: [u32; 3],
+    axis_k: u32,
+    rev: bool,
+    dx: i32,
+    dy: i32,
+) -> CtrlRegs {
     CtrlRegs {
         dims: pack_dims(cfg, dims),
         view: axis_k | u32::from(rev) << 2,
@@ -382,7 +400,11 @@ fn random_regs(rng: &mut ChaCha8Rng, cfg: &AccelCtrlConfig) -> CtrlRegs {
         }
     };
     let m1 = cfg.m() + 1;
-    let axis = if rng.random_bool(0.03) { 3 } else { rng.random_range(0..3) };
+    let axis = if rng.random_bool(0.03) {
+        3
+    } else {
+        rng.random_range(0..3)
+    };
     let skip = if rng.random_bool(0.2) {
         rng.random_range(0..12) | rng.random_range(0..12) << m1
     } else {
@@ -402,7 +424,12 @@ fn random_regs(rng: &mut ChaCha8Rng, cfg: &AccelCtrlConfig) -> CtrlRegs {
         }
     };
     CtrlRegs {
-        dims: pack_dims(cfg, dims) | if rng.random_bool(0.1) { rng.random::<u32>() & !((1 << (3 * m1)) - 1) } else { 0 },
+        dims: pack_dims(cfg, dims)
+            | if rng.random_bool(0.1) {
+                rng.random::<u32>() & !((1 << (3 * m1)) - 1)
+            } else {
+                0
+            },
         view: axis | rng.random_range(0..2) << 2,
         dx: step(rng) as u32 & 0x3_ffff,
         dy: step(rng) as u32 & 0x3_ffff,
@@ -426,7 +453,10 @@ fn random_register_programs_match_the_model_stream_by_stream() {
             let env = Env::random(&mut rng);
             codes[must(frame(&mut b, &regs, &env)) as usize] += 1;
         }
-        assert!(codes[CODE_NONE as usize] > n / 3, "{v}: too few accepted frames: {codes:?}");
+        assert!(
+            codes[CODE_NONE as usize] > n / 3,
+            "{v}: too few accepted frames: {codes:?}"
+        );
         eprintln!("{v}: {n} frames, codes {codes:?}");
     }
 }
@@ -450,7 +480,10 @@ fn directed_extremes_faces_directions_and_section_counts() {
                         let regs = regs_of(&cfg, dims, axis, rev, dx, -dx / 2);
                         let env = Env::random(&mut rng);
                         let code = must(frame(&mut b, &regs, &env));
-                        assert!(code == CODE_NONE || code == CODE_FRAME || code == CODE_WRITE, "{v}: {regs:x?} refused {code}");
+                        assert!(
+                            code == CODE_NONE || code == CODE_FRAME || code == CODE_WRITE,
+                            "{v}: {regs:x?} refused {code}"
+                        );
                     }
                 }
             }
@@ -459,26 +492,80 @@ fn directed_extremes_faces_directions_and_section_counts() {
         let ok = regs_of(&cfg, [16, 16, 16], 2, false, 0, 0);
         let mut cases: Vec<(CtrlRegs, u32)> = Vec::new();
         cases.push((CtrlRegs { view: 3, ..ok }, CODE_AXIS_K));
-        cases.push((CtrlRegs { dims: pack_dims(&cfg, [16, 16 + p / 2, 16]), ..ok }, CODE_DIMS));
-        cases.push((CtrlRegs { dims: pack_dims(&cfg, [16, 0, 16]), ..ok }, CODE_DIMS));
-        cases.push((CtrlRegs { dims: pack_dims(&cfg, [16, 2 * md, 16]), ..ok }, CODE_DIMS));
+        cases.push((
+            CtrlRegs {
+                dims: pack_dims(&cfg, [16, 16 + p / 2, 16]),
+                ..ok
+            },
+            CODE_DIMS,
+        ));
+        cases.push((
+            CtrlRegs {
+                dims: pack_dims(&cfg, [16, 0, 16]),
+                ..ok
+            },
+            CODE_DIMS,
+        ));
+        cases.push((
+            CtrlRegs {
+                dims: pack_dims(&cfg, [16, 2 * md, 16]),
+                ..ok
+            },
+            CODE_DIMS,
+        ));
         cases.push((CtrlRegs { mode: 2, ..ok }, CODE_RENDER));
-        cases.push((CtrlRegs { dx: (1 << 16) + 1, ..ok }, CODE_STEP));
+        cases.push((
+            CtrlRegs {
+                dx: (1 << 16) + 1,
+                ..ok
+            },
+            CODE_STEP,
+        ));
         cases.push((CtrlRegs { dy: 1 << 17, ..ok }, CODE_STEP));
-        cases.push((CtrlRegs { skip: 8 | 8 << (cfg.m() + 1), ..ok }, CODE_SKIP));
-        cases.push((CtrlRegs { dims: pack_dims(&cfg, [p, 16, 16]), ..ok }, CODE_SMALL));
-        cases.push((CtrlRegs { vol_base: ok.vol_base + 2, ..ok }, CODE_VOL_ALIGN));
+        cases.push((
+            CtrlRegs {
+                skip: 8 | 8 << (cfg.m() + 1),
+                ..ok
+            },
+            CODE_SKIP,
+        ));
+        cases.push((
+            CtrlRegs {
+                dims: pack_dims(&cfg, [p, 16, 16]),
+                ..ok
+            },
+            CODE_SMALL,
+        ));
+        cases.push((
+            CtrlRegs {
+                vol_base: ok.vol_base + 2,
+                ..ok
+            },
+            CODE_VOL_ALIGN,
+        ));
         if cfg.pixel_bytes > 1 {
-            cases.push((CtrlRegs { img_base: ok.img_base + 1, ..ok }, CODE_IMG_ALIGN));
+            cases.push((
+                CtrlRegs {
+                    img_base: ok.img_base + 1,
+                    ..ok
+                },
+                CODE_IMG_ALIGN,
+            ));
         }
         for (regs, want) in cases {
             let code = must(frame(&mut b, &regs, &Env::quiet()));
             assert_eq!(code, want, "{v}: {regs:x?}");
         }
         // Injected errors: the frame's, a row's.
-        let e = Env { frame_err: true, ..Env::quiet() };
+        let e = Env {
+            frame_err: true,
+            ..Env::quiet()
+        };
         assert_eq!(must(frame(&mut b, &ok, &e)), CODE_FRAME);
-        let e = Env { err_row: 3, ..Env::quiet() };
+        let e = Env {
+            err_row: 3,
+            ..Env::quiet()
+        };
         assert_eq!(must(frame(&mut b, &ok, &e)), CODE_WRITE);
         assert_eq!(must(frame(&mut b, &ok, &Env::quiet())), CODE_NONE);
     }
@@ -490,7 +577,12 @@ fn assert_prefixes(b: &mut Bench, regs: &CtrlRegs, v: &Variant) {
     let want = b.cfg.streams(&b.cfg.plan(regs).expect("accepted"));
     for port in PORTS {
         let (g, w) = (&got[port as usize], &want[port as usize]);
-        assert!(g.len() <= w.len() && g[..] == w[..g.len()], "{v}: {port:?} not a prefix: {} of {}", g.len(), w.len());
+        assert!(
+            g.len() <= w.len() && g[..] == w[..g.len()],
+            "{v}: {port:?} not a prefix: {} of {}",
+            g.len(),
+            w.len()
+        );
     }
 }
 
@@ -500,9 +592,20 @@ fn reset_mid_frame_then_the_next_frame_is_exact() {
     for (v, cfg) in configs::<AccelCtrlConfig>() {
         let mut b = Bench::open(v, cfg, s);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
-        for k in 0..12 {
-            let regs = regs_of(&cfg, [cfg.max_dim.min(64), 16, 16], 2, k % 2 == 0, if k % 3 == 0 { -300 } else { 300 }, 0);
-            let env = Env { stall: (0..4111).map(|_| u8::from(rng.random_bool(0.6))).collect(), cpl_delay: 30, ..Env::quiet() };
+        for k in 0..12u32 {
+            let regs = regs_of(
+                &cfg,
+                [cfg.max_dim.min(64), 16, 16],
+                2,
+                k.is_multiple_of(2),
+                if k.is_multiple_of(3) { -300 } else { 300 },
+                0,
+            );
+            let env = Env {
+                stall: (0..4111).map(|_| u8::from(rng.random_bool(0.6))).collect(),
+                cpl_delay: 30,
+                ..Env::quiet()
+            };
             b.env(&env);
             must(b.write_regs(&regs));
             b.recs.clear();
@@ -530,7 +633,11 @@ fn soft_reset_abandons_the_frame_after_the_commands_in_flight() {
         let mut aborted = 0;
         for _ in 0..10 {
             let regs = regs_of(&cfg, [cfg.max_dim.min(64), 32, 16], 1, false, 1000, 0);
-            let env = Env { stall: (0..4111).map(|_| u8::from(rng.random_bool(0.7))).collect(), cpl_delay: 20, ..Env::quiet() };
+            let env = Env {
+                stall: (0..4111).map(|_| u8::from(rng.random_bool(0.7))).collect(),
+                cpl_delay: 20,
+                ..Env::quiet()
+            };
             b.env(&env);
             must(b.write_regs(&regs));
             b.recs.clear();
@@ -544,14 +651,37 @@ fn soft_reset_abandons_the_frame_after_the_commands_in_flight() {
                     break;
                 }
             }
-            assert_eq!(REG_STATUS_BUSY.get(u64::from(st)), 0, "{v}: still busy after the soft reset");
+            assert_eq!(
+                REG_STATUS_BUSY.get(u64::from(st)),
+                0,
+                "{v}: still busy after the soft reset"
+            );
             let code = REG_STATUS_CODE.get(u64::from(st)) as u32;
-            assert!(code == CODE_ABORTED || code == CODE_NONE, "{v}: code {code}");
+            assert!(
+                code == CODE_ABORTED || code == CODE_NONE,
+                "{v}: code {code}"
+            );
             if code == CODE_ABORTED {
                 aborted += 1;
                 // Every row issued was completed before the core idled.
-                let issued = b.recs.iter().filter(|t| matches!(&t.value, CtrlRecord::Cmd { port: Port::Write, .. })).count();
-                let done = b.recs.iter().filter(|t| matches!(&t.value, CtrlRecord::Completion { .. })).count();
+                let issued = b
+                    .recs
+                    .iter()
+                    .filter(|t| {
+                        matches!(
+                            &t.value,
+                            CtrlRecord::Cmd {
+                                port: Port::Write,
+                                ..
+                            }
+                        )
+                    })
+                    .count();
+                let done = b
+                    .recs
+                    .iter()
+                    .filter(|t| matches!(&t.value, CtrlRecord::Completion { .. }))
+                    .count();
                 assert_eq!(issued, done, "{v}: rows issued and completed");
                 let irq = b.recs.iter().any(|t| matches!(&t.value, CtrlRecord::Axil(r) if r.kind == AxilRecordKind::Irq && r.irq));
                 assert!(irq, "{v}: no interrupt after the abort (start {t0})");
@@ -575,7 +705,11 @@ fn table_writes_step_the_index() {
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         for _ in 0..4 {
             let table = rng.random_range(0..16u32);
-            let first = if rng.random_bool(0.5) { 0xfffc } else { rng.random_range(0..1000u32) };
+            let first = if rng.random_bool(0.5) {
+                0xfffc
+            } else {
+                rng.random_range(0..1000u32)
+            };
             b.host_delay = rng.random_range(0..3);
             must(b.write(REG_TABLE_ADDR, first | table << 16));
             b.recs.clear();
@@ -619,13 +753,25 @@ fn the_host_driver_renders_a_frame_on_the_rtl() {
     let s = seed(0xacc6);
     let (v, cfg) = configs::<AccelCtrlConfig>()[0];
     let mut b = Bench::open(v, cfg, s);
-    b.env(&Env { cpl_delay: 5, done_delay: 10, ..Env::quiet() });
+    b.env(&Env {
+        cpl_delay: 5,
+        done_delay: 10,
+        ..Env::quiet()
+    });
     let regs = regs_of(&cfg, [32, 16, 24], 0, true, -5000, 7000);
     let mut host = AccelHost::new(b, 0);
-    let f = FrameRegs { dims: regs.dims, view: regs.view, dx: regs.dx, dy: regs.dy, mode: regs.mode, skip: regs.skip };
+    let f = FrameRegs {
+        dims: regs.dims,
+        view: regs.view,
+        dx: regs.dx,
+        dy: regs.dy,
+        mode: regs.mode,
+        skip: regs.skip,
+    };
     host.write_frame(&f).unwrap();
     host.set_bases(regs.vol_base, regs.img_base).unwrap();
     host.load_table(TABLE_CLASS, 5, &[1, 2, 3]).unwrap();
+    assert_eq!(host.table_pos().unwrap(), (TABLE_CLASS, 8));
     host.enable_irq(true, true).unwrap();
     host.start().unwrap();
     let st = host.wait_done(10_000).unwrap();
@@ -640,8 +786,7 @@ fn the_host_driver_renders_a_frame_on_the_rtl() {
     host.write(REG_VIEW, 3).unwrap();
     host.start().unwrap();
     assert!(host.wait_done(1000).is_err());
-    let st = host.read(REG_STATUS).unwrap();
-    assert_eq!(REG_STATUS_CODE.get(u64::from(st)) as u32, CODE_AXIS_K);
+    assert_eq!(host.status_code().unwrap(), CODE_AXIS_K);
 }
 
 #[test]

@@ -19,7 +19,8 @@ use crate::regs::cube5_accel::{
 use crate::unit::StreamCodec;
 use crate::units::cube5_axil::{AxilCodec, AxilRecord, AxilTxn};
 use crate::units::cube5_frame::FrameParams;
-use crate::units::cube5_vol_fetch::{frame_axes, Sweep};
+use crate::units::cube5_section_buf::SectionBufConfig;
+use crate::units::cube5_vol_fetch::{frame_axes, Sweep, VolFetchConfig};
 
 /// `StepW` of the frame's `S(2.StepW)` ray steps.
 const STEP_W: u32 = 16;
@@ -58,39 +59,29 @@ impl AccelCtrlConfig {
         len_w: 16,
     };
 
+    /// P, MaxDim, BlockDim, AddrW and DataW have the fetch's ranges, Section the section
+    /// buffer's (the core's commands go to them); PixelBytes and LenW are the core's own.
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("cube5_accel_ctrl: {what}")));
-        if ![1, 2, 4, 8].contains(&self.p) {
-            return bad(format!("P {} is not 1, 2, 4 or 8", self.p));
-        }
-        if !self.max_dim.is_power_of_two() || !(8..=1024).contains(&self.max_dim) {
-            return bad(format!(
-                "MaxDim {} is not a power of two in 8..=1024",
-                self.max_dim
-            ));
-        }
-        let (b, s) = (self.block_dim, self.section);
-        if !b.is_power_of_two() || b < self.p.max(2) || b > 16 || b >= self.max_dim {
-            return bad(format!(
-                "BlockDim {b} is not a power of two with max(2, P) <= B <= 16 and B < MaxDim"
-            ));
-        }
-        if !s.is_power_of_two() || s < b || s >= self.max_dim {
-            return bad(format!(
-                "Section {s} is not a power of two with BlockDim <= S < MaxDim"
-            ));
-        }
-        if !(13..=64).contains(&self.addr_w) {
-            return bad(format!("AddrW {} outside 13..=64", self.addr_w));
-        }
-        if !self.data_w.is_power_of_two()
-            || self.data_w < 16 * self.p
-            || self.data_w > 16 * b * b * b
-        {
-            return bad(format!(
-                "DataW {} is not a power of two in 16 P ..= 16 B^3",
-                self.data_w
-            ));
+        let fetch = VolFetchConfig {
+            addr_w: self.addr_w,
+            data_w: self.data_w,
+            p: self.p,
+            max_dim: self.max_dim,
+            block_dim: self.block_dim,
+            // The shortest burst: the fetch's burst rule then allows every DataW it allows.
+            max_burst: 2,
+            ..VolFetchConfig::DEFAULT
+        };
+        let sbuf = SectionBufConfig {
+            p: self.p,
+            max_dim: self.max_dim,
+            block_dim: self.block_dim,
+            section: self.section,
+            ..SectionBufConfig::DEFAULT
+        };
+        if let Err(e) = fetch.validate().and_then(|_| sbuf.validate()) {
+            return bad(e.to_string());
         }
         if !self.pixel_bytes.is_power_of_two() || self.pixel_bytes > 128 {
             return bad(format!(
@@ -166,7 +157,7 @@ impl AccelCtrlConfig {
         let p = self.p;
         if dims
             .iter()
-            .any(|&n| n < p || n > self.max_dim || n % p != 0)
+            .any(|&n| n < p || n > self.max_dim || !n.is_multiple_of(p))
         {
             return Err(CODE_DIMS);
         }
@@ -186,10 +177,10 @@ impl AccelCtrlConfig {
         }
         let vol_base = regs.vol_base & self.addr_mask();
         let img_base = regs.img_base & self.addr_mask();
-        if vol_base % u64::from(self.data_w / 8) != 0 {
+        if !vol_base.is_multiple_of(u64::from(self.data_w / 8)) {
             return Err(CODE_VOL_ALIGN);
         }
-        if img_base % u64::from(self.pixel_bytes) != 0 {
+        if !img_base.is_multiple_of(u64::from(self.pixel_bytes)) {
             return Err(CODE_IMG_ALIGN);
         }
         let params = FrameParams {
@@ -296,7 +287,8 @@ impl AccelCtrlConfig {
     /// The writer's row command (docs/numerics/axi_wr.md: `addr`, `len`).
     pub fn pack_row(&self, row: &RowCmd) -> Vec<u32> {
         let mut b = BitWriter::new();
-        b.put(row.addr, self.addr_w).put(u64::from(row.len), self.len_w);
+        b.put(row.addr, self.addr_w)
+            .put(u64::from(row.len), self.len_w);
         b.finish(self.write_w())
     }
 
@@ -456,7 +448,7 @@ impl AccelCtrlConfig {
         };
         let mut v: Vec<u32> = bits.iter().copied().take(words_for(w)).collect();
         v.resize(words_for(w), 0);
-        if w % 32 != 0 {
+        if !w.is_multiple_of(32) {
             if let Some(last) = v.last_mut() {
                 *last &= (1u32 << (w % 32)) - 1;
             }
