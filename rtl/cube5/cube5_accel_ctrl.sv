@@ -2,7 +2,7 @@
 // block cube5_axil_regs (the map of cube5_accel.regs.toml, instantiated here) it sequences one
 // frame as sections of `Section` anchors. Contract: docs/numerics/accel_ctrl.md.
 //
-// On a write of Ctrl.start (idle): latch the frame registers and the bases; one cycle of checks
+// On a write of Ctrl.start (idle): latch the frame registers and the bases; three cycles of checks
 // (refused: IrqStatus.error, Status.code); then, per section in order (left to right when DX >= 0,
 // right to left when DX < 0), one command on each of the fetch, section-buffer and frame ports
 // (each port independent, its own back-pressure); once the frame port has its last section, one
@@ -188,7 +188,7 @@ module cube5_accel_ctrl #(
     word = v[i*32 +: 32];
   endfunction
 
-  typedef enum logic [1:0] {StIdle, StSetup, StCheck, StRun} state_e;
+  typedef enum logic [2:0] {StIdle, StAxes, StSetup, StCheck, StRun} state_e;
   state_e state_q, state_d;
 
   logic start_stb, abort_stb;
@@ -263,21 +263,16 @@ module cube5_accel_ctrl #(
     abs_shift = (s < 0) ? -s : s;
   endfunction
 
-  // Stage 1 (the Setup cycle, t0 + 1): frame axes, products, the checks of the registers alone.
+  // Stage 1 (the Axes cycle, t0 + 1): the frame axes and the checks of the registers alone.
   logic [3:0] code_a;
+  logic [M:0] nk_m1_q, nj_m1_q;
   always_comb begin
     unique case (axis_q)
       2'd0:    begin ni = ny_q; nj = nz_q; nk = nx_q; end
       2'd1:    begin ni = nx_q; nj = nz_q; nk = ny_q; end
       default: begin ni = nx_q; nj = ny_q; nk = nz_q; end
     endcase
-    tx = $signed({1'b0, nk - M1'(1)}) * $signed(dx_q);
-    ty = $signed({1'b0, nk - M1'(1)}) * $signed(dy_q);
-    sx = tx[M+19:StepW];
-    sy = ty[M+19:StepW];
-    ninj = (2*M+2)'(ni) * (2*M+2)'(nj);
     nj_m1 = nj - M1'(1);
-    ni_nj1 = (2*M+2)'(ni) * (2*M+2)'(nj_m1);
     swept = nk - front_q - back_q;
     nsec = (ni + M1'(Section - 1)) >> LogS;
     nbx = blocks(nx_q);
@@ -296,7 +291,17 @@ module cube5_accel_ctrl #(
     else code_a = cube5_accel_regs_pkg::CodeNone;
   end
 
-  // Stage 1's results (datapath registers, loaded in the Setup cycle).
+  // Stage 1.5 (the Setup cycle, t0 + 2): the products, from stage 1's registers.
+  always_comb begin
+    tx = $signed({1'b0, nk_m1_q}) * $signed(dx_q);
+    ty = $signed({1'b0, nk_m1_q}) * $signed(dy_q);
+    sx = tx[M+19:StepW];
+    sy = ty[M+19:StepW];
+    ninj = (2*M+2)'(ni_q) * (2*M+2)'(nj_q);
+    ni_nj1 = (2*M+2)'(ni_q) * (2*M+2)'(nj_m1_q);
+  end
+
+  // Stage 1's and 1.5's results (datapath registers).
   logic [M:0]         ni_q, nj_q, nk_q, nsec_q, swept_q;
   logic [NbW:0]       nbx_q, nby_q, nbz_q, nbi_q;
   logic               neg_q;
@@ -304,7 +309,7 @@ module cube5_accel_ctrl #(
   logic [2*M+1:0]     ninj_q, ni_nj1_q;
   logic [3:0]         code_a_q;
 
-  // Stage 2 (the Check cycle, t0 + 2): the rules that need the products, the base plane, samples.
+  // Stage 2 (the Check cycle, t0 + 3): the rules that need the products, the base plane, samples.
   always_comb begin
     wpix = ni_q + M1'(abs_shift(sx_q));
     hpix = nj_q + M1'(abs_shift(sy_q));
@@ -392,7 +397,7 @@ module cube5_accel_ctrl #(
     unique case (state_q)
       StIdle: begin
         if (start_stb) begin
-          state_d = StSetup;
+          state_d = StAxes;
           cyc_d   = 64'd0;
           samp_d  = 64'd0;
           done_d  = 1'b0;
@@ -400,6 +405,7 @@ module cube5_accel_ctrl #(
           code_d  = cube5_accel_regs_pkg::CodeNone;
         end
       end
+      StAxes:  state_d = StSetup;
       StSetup: state_d = StCheck;
       StCheck: begin
         fidx_d  = '0;
@@ -495,10 +501,12 @@ module cube5_accel_ctrl #(
 
   // Datapath registers (no reset): the set-up results and the row address.
   always_ff @(posedge clk_i) begin
-    if (state_q == StSetup) begin
+    if (state_q == StAxes) begin
       ni_q     <= ni;
       nj_q     <= nj;
       nk_q     <= nk;
+      nk_m1_q  <= nk - M1'(1);
+      nj_m1_q  <= nj_m1;
       nsec_q   <= nsec;
       swept_q  <= swept;
       nbx_q    <= nbx;
@@ -506,11 +514,13 @@ module cube5_accel_ctrl #(
       nbz_q    <= nbz;
       nbi_q    <= nbi;
       neg_q    <= dx_neg;
+      code_a_q <= code_a;
+    end
+    if (state_q == StSetup) begin
       sx_q     <= sx;
       sy_q     <= sy;
       ninj_q   <= ninj;
       ni_nj1_q <= ni_nj1;
-      code_a_q <= code_a;
     end
     if (state_q == StCheck) begin
       w_q        <= wpix;

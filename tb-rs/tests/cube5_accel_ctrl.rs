@@ -284,9 +284,9 @@ fn frame(b: &mut Bench, regs: &CtrlRegs, env: &Env) -> Result<u32, TbError> {
             ))));
         }
     }
-    // The end cycle te: one after the last handshake or event (the check cycle t0 + 2 when
-    // refused; accepted frames issue from t0 + 3).
-    let mut last = t0 + 1;
+    // The end cycle te: one after the last handshake or event (the check cycle t0 + 3 when
+    // refused; accepted frames issue from t0 + 4).
+    let mut last = t0 + 2;
     let mut rows = 0u32;
     for t in &b.recs {
         match &t.value {
