@@ -263,7 +263,7 @@ module cube5_accel_ctrl #(
     abs_shift = (s < 0) ? -s : s;
   endfunction
 
-  // Stage 1 (the Axes cycle, t0 + 1): the frame axes and the checks of the registers alone.
+  // Stage 1 (the Axes cycle, t0 + 1): the frame axes and the checks that need no product.
   logic [3:0] code_a;
   logic [M:0] nk_m1_q, nj_m1_q;
   always_comb begin
@@ -288,6 +288,7 @@ module cube5_accel_ctrl #(
     else if (bad_dim(nx_q) || bad_dim(ny_q) || bad_dim(nz_q)) code_a = cube5_accel_regs_pkg::CodeDims;
     else if (mode_q[1:0] >= 2'd2) code_a = cube5_accel_regs_pkg::CodeRender;
     else if (bad_step(dx_q) || bad_step(dy_q)) code_a = cube5_accel_regs_pkg::CodeStep;
+    else if ({1'b0, front_q} + {1'b0, back_q} >= {1'b0, nk}) code_a = cube5_accel_regs_pkg::CodeSkip;
     else code_a = cube5_accel_regs_pkg::CodeNone;
   end
 
@@ -315,7 +316,6 @@ module cube5_accel_ctrl #(
     hpix = nj_q + M1'(abs_shift(sy_q));
     samples = (3*M+3)'(ninj_q) * (3*M+3)'(swept_q);
     if (code_a_q != cube5_accel_regs_pkg::CodeNone) code = code_a_q;
-    else if ({1'b0, front_q} + {1'b0, back_q} >= {1'b0, nk_q}) code = cube5_accel_regs_pkg::CodeSkip;
     else if (ni_q < M1'(2 * P) || (ni_nj1_q >> LogP) < (2*M+2)'(9)) code = cube5_accel_regs_pkg::CodeSmall;
     else if ((vbase_q & AddrW'(VolMask)) != '0) code = cube5_accel_regs_pkg::CodeVolAlign;
     else if ((ibase_q & AddrW'(ImgMask)) != '0) code = cube5_accel_regs_pkg::CodeImgAlign;

@@ -490,59 +490,40 @@ fn directed_extremes_faces_directions_and_section_counts() {
         }
         // Each refusal.
         let ok = regs_of(&cfg, [16, 16, 16], 2, false, 0, 0);
-        let mut cases: Vec<(CtrlRegs, u32)> = Vec::new();
-        cases.push((CtrlRegs { view: 3, ..ok }, CODE_AXIS_K));
-        cases.push((
-            CtrlRegs {
-                dims: pack_dims(&cfg, [16, 16 + p / 2, 16]),
-                ..ok
-            },
-            CODE_DIMS,
-        ));
-        cases.push((
-            CtrlRegs {
-                dims: pack_dims(&cfg, [16, 0, 16]),
-                ..ok
-            },
-            CODE_DIMS,
-        ));
-        cases.push((
-            CtrlRegs {
-                dims: pack_dims(&cfg, [16, 2 * md, 16]),
-                ..ok
-            },
-            CODE_DIMS,
-        ));
-        cases.push((CtrlRegs { mode: 2, ..ok }, CODE_RENDER));
-        cases.push((
-            CtrlRegs {
-                dx: (1 << 16) + 1,
-                ..ok
-            },
-            CODE_STEP,
-        ));
-        cases.push((CtrlRegs { dy: 1 << 17, ..ok }, CODE_STEP));
-        cases.push((
-            CtrlRegs {
-                skip: 8 | 8 << (cfg.m() + 1),
-                ..ok
-            },
-            CODE_SKIP,
-        ));
-        cases.push((
-            CtrlRegs {
-                dims: pack_dims(&cfg, [p, 16, 16]),
-                ..ok
-            },
-            CODE_SMALL,
-        ));
-        cases.push((
-            CtrlRegs {
-                vol_base: ok.vol_base + 2,
-                ..ok
-            },
-            CODE_VOL_ALIGN,
-        ));
+        let dims = |d: [u32; 3]| CtrlRegs {
+            dims: pack_dims(&cfg, d),
+            ..ok
+        };
+        let mut cases: Vec<(CtrlRegs, u32)> = vec![
+            (CtrlRegs { view: 3, ..ok }, CODE_AXIS_K),
+            (dims([16, 16 + p / 2, 16]), CODE_DIMS),
+            (dims([16, 0, 16]), CODE_DIMS),
+            (dims([16, 2 * md, 16]), CODE_DIMS),
+            (CtrlRegs { mode: 2, ..ok }, CODE_RENDER),
+            (
+                CtrlRegs {
+                    dx: (1 << 16) + 1,
+                    ..ok
+                },
+                CODE_STEP,
+            ),
+            (CtrlRegs { dy: 1 << 17, ..ok }, CODE_STEP),
+            (
+                CtrlRegs {
+                    skip: 8 | 8 << (cfg.m() + 1),
+                    ..ok
+                },
+                CODE_SKIP,
+            ),
+            (dims([p, 16, 16]), CODE_SMALL),
+            (
+                CtrlRegs {
+                    vol_base: ok.vol_base + 2,
+                    ..ok
+                },
+                CODE_VOL_ALIGN,
+            ),
+        ];
         if cfg.pixel_bytes > 1 {
             cases.push((
                 CtrlRegs {
