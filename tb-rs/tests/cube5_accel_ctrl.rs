@@ -16,11 +16,11 @@ use cube5_model::regs::cube5_accel::{
     CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_CTRL, REG_CYCLE_HI,
     REG_CYCLE_LO, REG_DIMS, REG_DX, REG_DY, REG_IMG_BASE_HI, REG_IMG_BASE_LO, REG_IRQ_ENABLE,
     REG_IRQ_STATUS, REG_MODE, REG_SAMPLE_HI, REG_SAMPLE_LO, REG_SKIP, REG_STATUS, REG_STATUS_BUSY,
-    REG_STATUS_CODE, REG_STATUS_DONE, REG_STATUS_ERROR, REG_TABLE_ADDR, REG_TABLE_DATA,
-    REG_TABLE_POS, REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO, TABLE_CLASS,
+    REG_STATUS_CODE, REG_TABLE_ADDR, REG_TABLE_DATA, REG_TABLE_POS, REG_VIEW, REG_VOL_BASE_HI,
+    REG_VOL_BASE_LO, TABLE_CLASS,
 };
 use cube5_model::units::cube5_accel_ctrl::{
-    AccelCtrlCodec, AccelCtrlConfig, CtrlRecord, CtrlRegs, Port, PORTS,
+    AccelCtrlCodec, AccelCtrlConfig, CtrlRecord, CtrlRegs, Outcome, Port, PORTS,
 };
 use cube5_model::units::cube5_axil::{AxilRecordKind, AxilTxn, RESP_OKAY};
 use cube5_tb::rtl::{RtlStream, Taken, Traffic};
@@ -263,7 +263,7 @@ fn frame(b: &mut Bench, regs: &CtrlRegs, env: &Env) -> Result<u32, TbError> {
         )
     };
     // Streams, command for command.
-    let (want_streams, mut want_code, samples) = match &plan {
+    let (want_streams, refused, samples) = match &plan {
         Ok(p) => (cfg.streams(p), CODE_NONE, p.samples),
         Err(code) => (Default::default(), *code, 0),
     };
@@ -299,15 +299,16 @@ fn frame(b: &mut Bench, regs: &CtrlRegs, env: &Env) -> Result<u32, TbError> {
         }
     }
     let te = last + 1;
-    if let Ok(p) = &plan {
-        if env.frame_err {
-            want_code = CODE_FRAME;
-        } else if env.err_row >= 1 && env.err_row <= p.rows.len() as u32 {
-            want_code = CODE_WRITE;
-        }
-        if rows != p.rows.len() as u32 {
-            return Err(b.fail(ctx(format!("{rows} completions for {} rows", p.rows.len()))));
-        }
+    let rows_n = plan.as_ref().map_or(0, |p| p.rows.len() as u32);
+    let outcome = Outcome {
+        refused,
+        frame_error: plan.is_ok() && env.frame_err,
+        write_error: env.err_row >= 1 && env.err_row <= rows_n,
+        aborted: false,
+    };
+    let want_code = outcome.code();
+    if rows != rows_n {
+        return Err(b.fail(ctx(format!("{rows} completions for {rows_n} rows"))));
     }
     // Status in every poll: busy from t0 + 1 to te, then the outcome.
     for &(c, s) in &polls {
@@ -317,10 +318,7 @@ fn frame(b: &mut Bench, regs: &CtrlRegs, env: &Env) -> Result<u32, TbError> {
         } else if c <= te {
             f(REG_STATUS_BUSY) == 1 && s >> 1 == 0
         } else {
-            f(REG_STATUS_BUSY) == 0
-                && f(REG_STATUS_CODE) == want_code
-                && f(REG_STATUS_DONE) == u32::from(want_code == CODE_NONE)
-                && f(REG_STATUS_ERROR) == u32::from(want_code != CODE_NONE)
+            s == outcome.status()
         };
         if !ok {
             return Err(b.fail(ctx(format!(

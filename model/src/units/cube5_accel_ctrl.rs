@@ -13,8 +13,9 @@
 use crate::bits::{words_for, BitReader, BitWriter};
 use crate::error::{ModelError, Result};
 use crate::regs::cube5_accel::{
-    CODE_AXIS_K, CODE_DIMS, CODE_IMG_ALIGN, CODE_RENDER, CODE_SKIP, CODE_SMALL, CODE_STEP,
-    CODE_VOL_ALIGN, REG_DX_DX, REG_MODE_RENDER, REG_VIEW_AXIS_K, REG_VIEW_K_REVERSED,
+    CODE_ABORTED, CODE_AXIS_K, CODE_DIMS, CODE_FRAME, CODE_IMG_ALIGN, CODE_NONE, CODE_RENDER,
+    CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_DX_DX, REG_MODE_RENDER,
+    REG_STATUS_CODE, REG_STATUS_DONE, REG_STATUS_ERROR, REG_VIEW_AXIS_K, REG_VIEW_K_REVERSED,
 };
 use crate::unit::StreamCodec;
 use crate::units::cube5_axil::{AxilCodec, AxilRecord, AxilTxn};
@@ -309,6 +310,50 @@ impl AccelCtrlConfig {
     }
 }
 
+/// How a frame ended, as the core reports it (docs/numerics/accel_ctrl.md, "Events, end of frame,
+/// status").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Outcome {
+    /// The refusal code, or 0 for an accepted frame.
+    pub refused: u32,
+    /// The frame's done carried an error.
+    pub frame_error: bool,
+    /// A row's completion answered other than OKAY.
+    pub write_error: bool,
+    /// `Ctrl.soft_reset` ended the frame.
+    pub aborted: bool,
+}
+
+impl Outcome {
+    /// `Status.code` after the frame: the refusal, else Aborted, Frame, Write, in this order.
+    pub fn code(&self) -> u32 {
+        if self.refused != CODE_NONE {
+            self.refused
+        } else if self.aborted {
+            CODE_ABORTED
+        } else if self.frame_error {
+            CODE_FRAME
+        } else if self.write_error {
+            CODE_WRITE
+        } else {
+            CODE_NONE
+        }
+    }
+
+    /// `Status` after the frame (busy 0): `done` [1], `error` [2], `code` [7:4]; `IrqStatus` gets
+    /// `done` [0] or `error` [1].
+    pub fn status(&self) -> u32 {
+        let code = self.code();
+        let w = REG_STATUS_CODE.set(0, u64::from(code));
+        let w = if code == CODE_NONE {
+            REG_STATUS_DONE.set(w, 1)
+        } else {
+            REG_STATUS_ERROR.set(w, 1)
+        };
+        w as u32
+    }
+}
+
 crate::unit_config!(AccelCtrlConfig, "cube5_accel_ctrl", DEFAULT, {
     "P" => p,
     "MaxDim" => max_dim,
@@ -472,7 +517,24 @@ impl AccelCtrlConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::regs::cube5_accel::CODE_NONE;
+
+    #[test]
+    fn outcome_codes_in_order() {
+        let o = Outcome {
+            frame_error: true,
+            write_error: true,
+            ..Outcome::default()
+        };
+        assert_eq!(o.code(), CODE_FRAME);
+        assert_eq!(o.status(), 0x94);
+        assert_eq!(Outcome::default().status(), 0x2);
+        let o = Outcome {
+            refused: CODE_STEP,
+            aborted: true,
+            ..o
+        };
+        assert_eq!(o.code(), CODE_STEP);
+    }
 
     fn regs(dims: [u32; 3], view: u32, dx: i32) -> CtrlRegs {
         let m1 = AccelCtrlConfig::DEFAULT.m() + 1;
