@@ -250,6 +250,7 @@ fn main() {
         "axil_mgr.h",
         "axil_shim.h",
         "axi_wr_shim.h",
+        "accel_ctrl_shim.h",
         "stream_dut.h",
         "stream_dut.cpp",
     ] {
@@ -602,6 +603,8 @@ fn compile_variant(
     let shim = Shim::of(v);
     let (in_bits, out_bits) = if shim == Shim::Axil {
         (AXIL_ITEM_BITS, AXIL_RECORD_BITS)
+    } else if shim == Shim::AccelCtrl {
+        (AXIL_ITEM_BITS, ACCEL_CTRL_RECORD_BITS)
     } else {
         (
             port_width(&header, "in_data_i")?,
@@ -662,11 +665,18 @@ enum Shim {
     Axi,
     AxiWr,
     Axil,
+    AccelCtrl,
 }
 
 impl Shim {
     /// In `Shim as usize` order.
-    const ALL: [Shim; 4] = [Shim::Stream, Shim::Axi, Shim::AxiWr, Shim::Axil];
+    const ALL: [Shim; 5] = [
+        Shim::Stream,
+        Shim::Axi,
+        Shim::AxiWr,
+        Shim::Axil,
+        Shim::AccelCtrl,
+    ];
 
     fn of(v: &Variant) -> Shim {
         let own = format!("{}.sv", v.top);
@@ -680,6 +690,8 @@ impl Shim {
             Shim::AxiWr
         } else if text.contains("m_axi_arvalid_o") {
             Shim::Axi
+        } else if text.contains("s_axil_awvalid_i") && text.contains("fetch_cmd_valid_o") {
+            Shim::AccelCtrl
         } else if text.contains("s_axil_awvalid_i") {
             Shim::Axil
         } else {
@@ -693,6 +705,7 @@ impl Shim {
             Shim::Axi => "axi_shim.h",
             Shim::AxiWr => "axi_wr_shim.h",
             Shim::Axil => "axil_shim.h",
+            Shim::AccelCtrl => "accel_ctrl_shim.h",
         }
     }
 
@@ -702,6 +715,7 @@ impl Shim {
             Shim::Axi => "AxiShim",
             Shim::AxiWr => "AxiWrShim",
             Shim::Axil => "AxilShim",
+            Shim::AccelCtrl => "AccelCtrlShim",
         }
     }
 
@@ -713,6 +727,7 @@ impl Shim {
             Shim::Axi => &["clocked_top.h", "axi_mem.h", "axi_shim.h"],
             Shim::AxiWr => &["clocked_top.h", "axi_mem.h", "axi_shim.h", "axi_wr_shim.h"],
             Shim::Axil => &["clocked_top.h", "axil_mgr.h", "axil_shim.h"],
+            Shim::AccelCtrl => &["clocked_top.h", "axil_mgr.h", "accel_ctrl_shim.h"],
         }
     }
 }
@@ -720,6 +735,9 @@ impl Shim {
 /// AxilShim's transaction and record widths (tb/axil_mgr.h, `kItemWords`, `kRecordWords`).
 const AXIL_ITEM_BITS: u32 = 128;
 const AXIL_RECORD_BITS: u32 = 128;
+
+/// AccelCtrlShim's record width (tb/accel_ctrl_shim.h, `kRecordWords`).
+const ACCEL_CTRL_RECORD_BITS: u32 = 192;
 
 /// The bit width of a port from Verilator's header: `VL_IN*(&name,MSB,LSB...)` declarations.
 fn port_width(header: &str, port: &str) -> Result<u32, String> {

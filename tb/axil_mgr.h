@@ -46,6 +46,47 @@ struct SubOut {
   bool wr_stb = false, rd_stb = false, irq = false;
 };
 
+/// Drives the manager's outputs of this cycle onto a top's AXI4-Lite subordinate port (s_axil_*).
+template <class V>
+void axil_drive(V& top, const MgrOut& m) {
+  top.s_axil_awvalid_i = m.awvalid;
+  top.s_axil_awaddr_i = m.awaddr;
+  top.s_axil_wvalid_i = m.wvalid;
+  top.s_axil_wdata_i = m.wdata;
+  top.s_axil_wstrb_i = m.wstrb;
+  top.s_axil_bready_i = m.bready;
+  top.s_axil_arvalid_i = m.arvalid;
+  top.s_axil_araddr_i = m.araddr;
+  top.s_axil_rready_i = m.rready;
+}
+
+/// The manager's side of the port idle (no VALID, no READY).
+template <class V>
+void axil_idle(V& top) {
+  top.s_axil_awvalid_i = 0;
+  top.s_axil_wvalid_i = 0;
+  top.s_axil_bready_i = 0;
+  top.s_axil_arvalid_i = 0;
+  top.s_axil_rready_i = 0;
+}
+
+/// What a top's AXI4-Lite subordinate port drives in this cycle (the hardware-side fields 0) and
+/// its interrupt.
+template <class V>
+SubOut axil_sub(const V& top) {
+  SubOut s;
+  s.awready = top.s_axil_awready_o;
+  s.wready = top.s_axil_wready_o;
+  s.bvalid = top.s_axil_bvalid_o;
+  s.bresp = top.s_axil_bresp_o;
+  s.arready = top.s_axil_arready_o;
+  s.rvalid = top.s_axil_rvalid_o;
+  s.rdata = top.s_axil_rdata_o;
+  s.rresp = top.s_axil_rresp_o;
+  s.irq = top.irq_o;
+  return s;
+}
+
 class AxilMgr {
  public:
   static constexpr uint32_t kItemWords = 4;

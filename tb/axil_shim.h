@@ -60,32 +60,15 @@ class AxilShim final : public ClockedTop<V> {
       const bool bready = !(stall_len && stall[cycle_ % stall_len]);
       const bool rready = !(stall_len && stall[(cycle_ + 2053) % stall_len]);
       const MgrOut m = mgr_.drive(bready, rready);
-      top_->s_axil_awvalid_i = m.awvalid;
-      top_->s_axil_awaddr_i = m.awaddr;
-      top_->s_axil_wvalid_i = m.wvalid;
-      top_->s_axil_wdata_i = m.wdata;
-      top_->s_axil_wstrb_i = m.wstrb;
-      top_->s_axil_bready_i = m.bready;
-      top_->s_axil_arvalid_i = m.arvalid;
-      top_->s_axil_araddr_i = m.araddr;
-      top_->s_axil_rready_i = m.rready;
+      axil_drive(*top_, m);
       top_->wsel_i = m.wsel;
       top_->rsel_i = m.rsel;
       drive_hw();
       top_->eval();
-      SubOut s;
-      s.awready = top_->s_axil_awready_o;
-      s.wready = top_->s_axil_wready_o;
-      s.bvalid = top_->s_axil_bvalid_o;
-      s.bresp = top_->s_axil_bresp_o;
-      s.arready = top_->s_axil_arready_o;
-      s.rvalid = top_->s_axil_rvalid_o;
-      s.rdata = top_->s_axil_rdata_o;
-      s.rresp = top_->s_axil_rresp_o;
+      SubOut s = axil_sub(*top_);
       s.hw_q = top_->hw_q_o;
       s.wr_stb = top_->hw_wr_stb_o;
       s.rd_stb = top_->hw_rd_stb_o;
-      s.irq = top_->irq_o;
       responses += mgr_.observe(cycle_, s, out);
       tick();
       ++st.cycles;
@@ -105,13 +88,7 @@ class AxilShim final : public ClockedTop<V> {
   }
 
  private:
-  void idle_inputs() {
-    top_->s_axil_awvalid_i = 0;
-    top_->s_axil_wvalid_i = 0;
-    top_->s_axil_bready_i = 0;
-    top_->s_axil_arvalid_i = 0;
-    top_->s_axil_rready_i = 0;
-  }
+  void idle_inputs() { axil_idle(*top_); }
 
   // The hardware side's stimulus of this cycle (axil_hw in tb/axil_mgr.h).
   void drive_hw() {

@@ -267,6 +267,27 @@ impl<B: RegBus> AccelHost<B> {
     }
 }
 
+/// Additions for the control core `cube5_accel_ctrl` (docs/numerics/accel_ctrl.md): the reason a
+/// frame was refused or stopped, and the table window's position.
+impl<B: RegBus> AccelHost<B> {
+    /// `Status.code`: a `Code` encoding (`crate::regs::cube5_accel::CODE_*`), 0 while busy and
+    /// after a frame without error.
+    pub fn status_code(&mut self) -> Result<u32, HostError<B::Error>> {
+        let s = self.read(crate::regs::cube5_accel::REG_STATUS)?;
+        Ok(crate::regs::cube5_accel::REG_STATUS_CODE.get(u64::from(s)) as u32)
+    }
+
+    /// `TablePos`: the (table, index) the next TableData write goes to, as the core holds them.
+    pub fn table_pos(&mut self) -> Result<(u32, u32), HostError<B::Error>> {
+        use crate::regs::cube5_accel::{REG_TABLE_POS, REG_TABLE_POS_INDEX, REG_TABLE_POS_TABLE};
+        let w = u64::from(self.read(REG_TABLE_POS)?);
+        Ok((
+            REG_TABLE_POS_TABLE.get(w) as u32,
+            REG_TABLE_POS_INDEX.get(w) as u32,
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,6 +8,7 @@
 //! Needs no RTL build: the table carries the parameters Verilator elaborated.
 
 use cube5_model::unit::UnitConfig;
+use cube5_model::units::cube5_accel_ctrl::AccelCtrlConfig;
 use cube5_model::units::cube5_axi_wr::AxiWrConfig;
 use cube5_model::units::cube5_axil::AxilConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
@@ -69,6 +70,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == WarpConfig::TOP => agree::<WarpConfig>(v),
         t if t == AxilConfig::TOP => agree::<AxilConfig>(v),
         t if t == AxiWrConfig::TOP => agree::<AxiWrConfig>(v),
+        t if t == AccelCtrlConfig::TOP => agree::<AccelCtrlConfig>(v),
         t if t == RayQueuesConfig::TOP => agree::<RayQueuesConfig>(v),
         t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
         other => Err(format!(

@@ -6,6 +6,33 @@
 
 use super::{Access, Field, Register};
 
+// The `code` field of Status: why the control core refused or stopped the last frame
+// (docs/numerics/accel_ctrl.md, "Refused frames"); the first that applies, in this order.
+/// no error
+pub const CODE_NONE: u32 = 0;
+/// `axis_k` = 3
+pub const CODE_AXIS_K: u32 = 1;
+/// a dimension outside `P ..= MaxDim` or not a multiple of `P`
+pub const CODE_DIMS: u32 = 2;
+/// `render` >= 2
+pub const CODE_RENDER: u32 = 3;
+/// `|DX|` or `|DY|` above `2^16`
+pub const CODE_STEP: u32 = 4;
+/// `front + back >= nk`: no slice left
+pub const CODE_SKIP: u32 = 5;
+/// `ni < 2P` or `ni (nj - 1) / P - 1 < 8` (the frame's smallest volumes)
+pub const CODE_SMALL: u32 = 6;
+/// the volume base is not a multiple of the read bus's bytes
+pub const CODE_VOL_ALIGN: u32 = 7;
+/// the image base is not a multiple of the pixel's bytes
+pub const CODE_IMG_ALIGN: u32 = 8;
+/// the frame reported an error
+pub const CODE_FRAME: u32 = 9;
+/// an image row's write completed with an AXI4 error response
+pub const CODE_WRITE: u32 = 10;
+/// `Ctrl.soft_reset` abandoned the frame
+pub const CODE_ABORTED: u32 = 11;
+
 // The `table` field of TableAddr: which on-chip table the table-load window writes.
 /// block LUT of the volume (one bit per block: non-empty)
 pub const TABLE_BLOCK: u32 = 0;
@@ -25,7 +52,7 @@ pub const REG_CTRL_START: Field = Field::new(0, 1);
 /// Field `soft_reset` of `Ctrl`: abandon the frame: the core waits for its AXI4 transactions to
 /// finish, then idles.
 pub const REG_CTRL_SOFT_RESET: Field = Field::new(1, 1);
-/// `Status` (RO): the core's state, read live. Fields: busy [0], done [1], error [2].
+/// `Status` (RO): the core's state, read live. Fields: busy [0], done [1], error [2], code [7:4].
 pub const REG_STATUS: u32 = 1;
 /// Field `busy` of `Status`: a frame is being rendered.
 pub const REG_STATUS_BUSY: Field = Field::new(0, 1);
@@ -34,6 +61,9 @@ pub const REG_STATUS_DONE: Field = Field::new(1, 1);
 /// Field `error` of `Status`: the last frame stopped on an error (an AXI4 error response or refused
 /// registers).
 pub const REG_STATUS_ERROR: Field = Field::new(2, 1);
+/// Field `code` of `Status`: why the last frame stopped on an error: a `Code` encoding (0 while
+/// busy and after a frame without error).
+pub const REG_STATUS_CODE: Field = Field::new(4, 4);
 /// `IrqStatus` (W1C): interrupt status: the core sets a bit, the host clears it by writing 1;
 /// `irq_o` is high while a set bit is enabled. Fields: done [0], error [1].
 pub const REG_IRQ_STATUS: u32 = 2;
@@ -105,9 +135,18 @@ pub const REG_TABLE_ADDR_TABLE: Field = Field::new(16, 4);
 /// `TableData` (WO): table-load window: a write puts the word into entry TableAddr.index of table
 /// TableAddr.table (the core acts on the write strobe). Fields: .
 pub const REG_TABLE_DATA: u32 = 21;
+/// `TablePos` (RO): table-load window: the table and entry the next TableData write goes to, as the
+/// core holds them (TableAddr reads back what the host wrote; the core loads this from it on each
+/// TableAddr write and adds 1 to `index` after each TableData write). Fields: index [15:0], table
+/// [19:16].
+pub const REG_TABLE_POS: u32 = 22;
+/// Field `index` of `TablePos`: entry.
+pub const REG_TABLE_POS_INDEX: Field = Field::new(0, 16);
+/// Field `table` of `TablePos`: a `Table` encoding.
+pub const REG_TABLE_POS_TABLE: Field = Field::new(16, 4);
 
 /// Every register, by offset.
-pub const REGISTERS: [Register; 20] = [
+pub const REGISTERS: [Register; 21] = [
     Register::new("Ctrl", 0, Access::Wo, Some(0x0)),
     Register::new("Status", 1, Access::Ro, None),
     Register::new("IrqStatus", 2, Access::W1c, Some(0x0)),
@@ -128,14 +167,15 @@ pub const REGISTERS: [Register; 20] = [
     Register::new("SampleHi", 19, Access::Ro, None),
     Register::new("TableAddr", 20, Access::Rw, Some(0x0)),
     Register::new("TableData", 21, Access::Wo, Some(0x0)),
+    Register::new("TablePos", 22, Access::Ro, None),
 ];
 
 /// The bits each word offset keeps (AXI4-Lite register block, docs/accel-regs.md): its fields,
 /// every bit where a field's place depends on parameters, 0 where no register is.
-pub const AXIL_MASK: [u32; 22] = [
-    0x00000003, 0x00000007, 0x00000003, 0x00000003, 0xffffffff, 0x00000007, 0x0003ffff, 0x0003ffff,
+pub const AXIL_MASK: [u32; 23] = [
+    0x00000003, 0x000000f7, 0x00000003, 0x00000003, 0xffffffff, 0x00000007, 0x0003ffff, 0x0003ffff,
     0x00000007, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x00000000, 0x00000000,
-    0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x000fffff, 0xffffffff,
+    0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x000fffff, 0xffffffff, 0x000fffff,
 ];
 
 /// The interrupt: `irq_o` is high while (status & enable) != 0, as (status, enable) offsets.

@@ -1,0 +1,3 @@
+rtl/cube5/cube5_accel_regs_pkg.sv
+rtl/cube5/cube5_axil_regs.sv
+rtl/cube5/cube5_accel_ctrl.sv
