@@ -490,7 +490,7 @@ pub fn line_samples(
         u = (u + 1) & mask;
         let sum = phase + i64::from(regs.slope);
         if sum >= ONE_K {
-            v = if regs.neg { v.wrapping_sub(1) } else { v + 1 } & mask;
+            v = (if regs.neg { v.wrapping_sub(1) } else { v + 1 }) & mask;
         }
         phase = sum & (ONE_K - 1);
     }
