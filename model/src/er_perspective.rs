@@ -559,7 +559,11 @@ pub struct ErRun {
     pub coxels: Vec<Coxel>,
     pub extent: Extent,
     pub stats: ErStats,
+    /// The final image through `cube5_pwarp`'s bit-exact perspective warp (8-bit samples).
     pub image: ImageF64,
+    /// The same base plane through the f64 projective warp (`cube5_warp::bilinear_f64` at each
+    /// pixel's exact position): the frame's fixed point without the warp's error.
+    pub image_f64_warp: ImageF64,
 }
 
 /// The volume-dependent part of a frame: the volume at the frame's voxel width and the units.
@@ -685,16 +689,18 @@ impl ErJob {
         };
         let e = setup.e as f64 / ONE as f64;
         let g = setup.g() as f64 / ONE as f64;
+        let image_f64_warp = warp(setup, &self.params, &rgb, &extent, e, g);
         let image = match warp_pwarp(setup, &self.params, &cfg, &coxels, &extent, e, g) {
             Ok(image) => image,
             // Images beyond cube5_pwarp's 2048 pixels a side (supersampled): the f64 warp.
-            Err(_) => warp(setup, &self.params, &rgb, &extent, e, g),
+            Err(_) => image_f64_warp.clone(),
         };
         ErRun {
             stats: ErStats::new(setup, &layout, shaded.into_inner()),
             coxels,
             extent,
             image,
+            image_f64_warp,
         }
     }
 }
