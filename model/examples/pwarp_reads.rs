@@ -42,7 +42,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("| image | views | scanlines | pixels | naive reads (4 taps) | scanline reads, 1-line buffer | 2-line buffer | distinct texels | naive / 2-line | PSNR vs f64 at pixel centres (dB) | max abs (codes) | max abs at sample points (codes) |");
     println!("|------:|------:|----------:|-------:|--------------------:|----------:|----------:|---------:|------:|------:|------:|------:|");
     for size in [64u32, 128, 256, 512] {
-        let (mut lines, mut c) = (0usize, cube5_model::units::cube5_pwarp::ReadCounts::default());
+        let (mut lines, mut c) = (
+            0usize,
+            cube5_model::units::cube5_pwarp::ReadCounts::default(),
+        );
         let (mut mse, mut maxabs, mut maxsample) = (0.0f64, 0.0f64, 0.0f64);
         for _ in 0..views {
             let map = Projective::tilted(
@@ -58,7 +61,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 (f64::from(bw) / 2.0, f64::from(bh) / 2.0),
             );
             let setup = PwarpSetup::new(&map, (bw, bh), (size, size))?;
-            let r = read_counts(&cfg, &setup);
+            let r = read_counts(&setup);
             lines += setup.lines.len();
             c.pixels += r.pixels;
             c.naive += r.naive;
@@ -73,8 +76,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let got = warp_samples(&cfg, &setup, &base);
             let want = reference_at_samples(&map, &setup, &base, cfg.color_w);
             for (g, w) in got.iter().zip(&want) {
-                for ch in 0..3 {
-                    maxsample = maxsample.max((f64::from(g.rgb[ch]) - 255.0 * w[ch]).abs());
+                for (c, i) in g.rgb.iter().zip(w) {
+                    maxsample = maxsample.max((f64::from(*c) - 255.0 * i).abs());
                 }
             }
         }

@@ -391,7 +391,14 @@ impl ErSetup {
     /// The projective map from the pixels of an `ss`-times supersampled `width x height` image
     /// (centres at integers, the sub-pixels `image_of` takes) to the base plane's texels
     /// (`x - m_lo(0)`, `y - n_lo(0)`): what `cube5_pwarp`'s set-up takes.
-    pub fn projective(&self, (width, height): (u32, u32), ss: u32, ext: &Extent, e: f64, g: f64) -> Projective {
+    pub fn projective(
+        &self,
+        (width, height): (u32, u32),
+        ss: u32,
+        ext: &Extent,
+        e: f64,
+        g: f64,
+    ) -> Projective {
         let (w, h) = (f64::from(width * ss), f64::from(height * ss));
         let at = |px: f64, py: f64| {
             let ndc = ((px + 0.5) / w * 2.0 - 1.0, 1.0 - (py + 0.5) / h * 2.0);
@@ -804,7 +811,9 @@ fn warp_pwarp(
         height: bh,
         codes: coxels
             .iter()
-            .map(|c| std::array::from_fn(|i| ((c.rgba[i] * max + half) >> cfg.acc_w).min(max) as u32))
+            .map(|c| {
+                std::array::from_fn(|i| ((c.rgba[i] * max + half) >> cfg.acc_w).min(max) as u32)
+            })
             .collect(),
     };
     let (ow, oh) = (params.width * ss, params.height * ss);

@@ -74,7 +74,13 @@ fn random_base(rng: &mut ChaCha8Rng, w: usize, h: usize, color_w: u32) -> BaseCo
 /// image of `out_lo..=out_hi` pixels a side: field of view 20-80 degrees, tilts up to 75 degrees
 /// about both axes (past the horizon at the image's edge for the steepest), any roll, zoom 1/3 to
 /// 4 planes across the view, the view's centre near the plane.
-fn random_frame(rng: &mut ChaCha8Rng, cfg: &PwarpConfig, base_hi: usize, out_lo: u32, out_hi: u32) -> Frame {
+fn random_frame(
+    rng: &mut ChaCha8Rng,
+    cfg: &PwarpConfig,
+    base_hi: usize,
+    out_lo: u32,
+    out_hi: u32,
+) -> Frame {
     let mb = base_hi.min(cfg.max_base as usize);
     let (w, h) = (rng.random_range(1..=mb), rng.random_range(1..=mb));
     let hi = out_hi.min(cfg.max_out);
@@ -165,7 +171,14 @@ fn check_frames(
 }
 
 /// The first differing sample, named by frame, line, sample, its registers and coordinates.
-fn compare(variant: &Variant, seed: u64, frames: &[Frame], got: &[PwarpOut], want: &[PwarpOut], cfg: &PwarpConfig) {
+fn compare(
+    variant: &Variant,
+    seed: u64,
+    frames: &[Frame],
+    got: &[PwarpOut],
+    want: &[PwarpOut],
+    cfg: &PwarpConfig,
+) {
     let Some(k) = (0..got.len().min(want.len())).find(|&k| got[k] != want[k]) else {
         return;
     };
@@ -223,8 +236,16 @@ fn random_views(n: usize, lo: u32, hi: u32, base_hi: usize, seed_no: u64) {
             .map(|_| random_frame(&mut rng, &cfg, base_hi, lo, hi))
             .collect();
         for f in &frames {
-            let img = to_raster(f.setup.out_w, f.setup.out_h, &Pwarp::new(cfg).unwrap().run(&f.items(&cfg)));
-            assert!(img.is_some(), "{variant}: {}: the samples do not cover the image once", f.what);
+            let img = to_raster(
+                f.setup.out_w,
+                f.setup.out_h,
+                &Pwarp::new(cfg).unwrap().run(&f.items(&cfg)),
+            );
+            assert!(
+                img.is_some(),
+                "{variant}: {}: the samples do not cover the image once",
+                f.what
+            );
         }
         let t = traffic(&mut rng, 0.2, 0.3);
         let cycles = check_frames(variant, cfg, &frames, &t, s, None);
@@ -302,7 +323,10 @@ fn directed_frames(cfg: &PwarpConfig, rng: &mut ChaCha8Rng) -> Vec<Frame> {
     );
     for (t, what) in [
         ([40.0, 0.0, 0.0], "tilt about x: rows (slope 0)"),
-        ([0.0, 40.0, 0.0], "tilt about y: columns (transposed, slope 0)"),
+        (
+            [0.0, 40.0, 0.0],
+            "tilt about y: columns (transposed, slope 0)",
+        ),
         ([30.0, 0.0, 45.0], "rolled 45 degrees: slope 2^20"),
         ([30.0, 0.0, -45.0], "rolled -45 degrees: slope -2^20"),
         ([30.0, 20.0, 20.0], "slope > 0"),
@@ -423,15 +447,26 @@ fn one_sample_per_clock_over_a_frame() {
                 .flat_map(|l| PwarpSetup::line_items(&cfg, l))
                 .collect();
             let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-            let loaded = dut.drive(&load, &Traffic::full_speed(), 0, 1 << 24).unwrap();
+            let loaded = dut
+                .drive(&load, &Traffic::full_speed(), 0, 1 << 24)
+                .unwrap();
             assert_eq!(loaded.stats.consumed, load.len() as u64);
             let n = s.samples();
-            let driven = dut.drive(&lines, &Traffic::full_speed(), n, 10 * n + 1000).unwrap();
+            let driven = dut
+                .drive(&lines, &Traffic::full_speed(), n, 10 * n + 1000)
+                .unwrap();
             let want = Pwarp::new(cfg).unwrap().run(&frame.items(&cfg));
             let got: Vec<PwarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-            assert!(got == want, "{variant}: {what}: the full-speed frame differs from the model");
+            assert!(
+                got == want,
+                "{variant}: {what}: the full-speed frame differs from the model"
+            );
             // Bubbles a line of n < 6 samples leaves: its six items take six clocks.
-            let short: u64 = s.lines.iter().map(|l| 6u64.saturating_sub(u64::from(l.n))).sum();
+            let short: u64 = s
+                .lines
+                .iter()
+                .map(|l| 6u64.saturating_sub(u64::from(l.n)))
+                .sum();
             let rate = n as f64 / driven.stats.cycles as f64;
             eprintln!(
                 "{variant}: {what}: {n} samples on {} scanlines in {} cycles ({rate:.4} samples/clock; short-line bubbles {short})",
@@ -445,7 +480,11 @@ fn one_sample_per_clock_over_a_frame() {
             if short == 0 {
                 let first = driven.outputs.first().unwrap().cycle;
                 let last = driven.outputs.last().unwrap().cycle;
-                assert_eq!(last - first + 1, n, "{variant}: {what}: samples leave back to back");
+                assert_eq!(
+                    last - first + 1,
+                    n,
+                    "{variant}: {what}: samples leave back to back"
+                );
             }
         }
     }
@@ -482,7 +521,12 @@ fn a_model_with_the_wrong_weight_width_is_caught() {
     let want = Pwarp::new(wrong).unwrap().run(&items);
     let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
     let n = want.len() as u64;
-    let driven = dut.drive(&items, &Traffic::full_speed(), n, 1 << 24).unwrap();
+    let driven = dut
+        .drive(&items, &Traffic::full_speed(), n, 1 << 24)
+        .unwrap();
     let got: Vec<PwarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-    assert!(got != want, "{variant}: a one-bit-narrower weight went unnoticed");
+    assert!(
+        got != want,
+        "{variant}: a one-bit-narrower weight went unnoticed"
+    );
 }

@@ -150,7 +150,9 @@ impl Projective {
         let ry = [[cy, 0.0, sy], [0.0, 1.0, 0.0], [-sy, 0.0, cy]];
         let rz = [[cr, -sr, 0.0], [sr, cr, 0.0], [0.0, 0.0, 1.0]];
         let mul = |a: [[f64; 3]; 3], b: [[f64; 3]; 3]| -> [[f64; 3]; 3] {
-            std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+            std::array::from_fn(|i| {
+                std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum())
+            })
         };
         let rows = mul(rz, mul(ry, mul(rx, m)));
         let s = f64::from(base_w.max(base_h)) / zoom / (2.0 * t);
@@ -218,7 +220,11 @@ impl PwarpSetup {
     /// The host's set-up of `map` onto an `out_w x out_h` image of a `base_w x base_h` base plane
     /// (contract: *Set-up*). Refused (an error, no warp): a non-finite coefficient, an empty or
     /// larger-than-2048 image.
-    pub fn new(map: &Projective, (base_w, base_h): (u32, u32), (out_w, out_h): (u32, u32)) -> Result<Self> {
+    pub fn new(
+        map: &Projective,
+        (base_w, base_h): (u32, u32),
+        (out_w, out_h): (u32, u32),
+    ) -> Result<Self> {
         let all = map.nx.iter().chain(&map.ny).chain(&map.w);
         if all.clone().any(|c| !c.is_finite()) || map.w.iter().all(|&c| c == 0.0) {
             return Err(ModelError::View(format!(
@@ -265,7 +271,10 @@ impl PwarpSetup {
             let Some(ulo) = (0..i64::from(nu)).find(|&u| inside(u)) else {
                 continue;
             };
-            let uhi = (ulo..i64::from(nu)).take_while(|&u| inside(u)).last().unwrap_or(ulo);
+            let uhi = (ulo..i64::from(nu))
+                .take_while(|&u| inside(u))
+                .last()
+                .unwrap_or(ulo);
             // The sample points on the line v = b + kq u, and their projections.
             let point = |u: i64| {
                 let (px, py) = out(u as f64, b as f64 + kq * u as f64);
@@ -509,7 +518,13 @@ pub fn warp_samples(cfg: &PwarpConfig, setup: &PwarpSetup, base: &BaseCodes) -> 
     let mut out = Vec::with_capacity(setup.samples() as usize);
     for l in &setup.lines {
         (regs.x, regs.y, regs.xs, regs.ys, regs.phase) = (l.x, l.y, l.xs, l.ys, l.phase);
-        line_samples(cfg, &regs, (l.u0, l.v0, l.n), |x, y| base.texel(x, y), &mut out);
+        line_samples(
+            cfg,
+            &regs,
+            (l.u0, l.v0, l.n),
+            |x, y| base.texel(x, y),
+            &mut out,
+        );
     }
     out
 }
@@ -542,16 +557,31 @@ pub fn warp_image(cfg: &PwarpConfig, setup: &PwarpSetup, base: &BaseCodes) -> Re
 fn ideal(map: &Projective, base: &BaseCodes, color_w: u32, px: f64, py: f64) -> [f64; 3] {
     let max = f64::from((1u32 << color_w) - 1);
     match map.at(px, py) {
-        Some((x, y)) => bilinear_f64(x, y, |tx, ty| base.texel(tx, ty).map(|c| f64::from(c) / max)),
+        Some((x, y)) => bilinear_f64(x, y, |tx, ty| {
+            base.texel(tx, ty).map(|c| f64::from(c) / max)
+        }),
         None => [0.0; 3],
     }
 }
 
 /// The ideal: the f64 bilinear projective warp of `base` (codes on the unit interval) at the pixel
 /// centres, zero outside the base plane and behind the eye, in 0..1.
-pub fn reference(map: &Projective, base: &BaseCodes, color_w: u32, (out_w, out_h): (u32, u32)) -> ImageF64 {
+pub fn reference(
+    map: &Projective,
+    base: &BaseCodes,
+    color_w: u32,
+    (out_w, out_h): (u32, u32),
+) -> ImageF64 {
     let rgb = (0..out_w * out_h)
-        .map(|i| ideal(map, base, color_w, f64::from(i % out_w), f64::from(i / out_w)))
+        .map(|i| {
+            ideal(
+                map,
+                base,
+                color_w,
+                f64::from(i % out_w),
+                f64::from(i / out_w),
+            )
+        })
         .collect();
     ImageF64 {
         width: out_w,
@@ -561,7 +591,12 @@ pub fn reference(map: &Projective, base: &BaseCodes, color_w: u32, (out_w, out_h
 }
 
 /// The ideal at each sample's own point on its scanline, in the order the unit emits them.
-pub fn reference_at_samples(map: &Projective, setup: &PwarpSetup, base: &BaseCodes, color_w: u32) -> Vec<[f64; 3]> {
+pub fn reference_at_samples(
+    map: &Projective,
+    setup: &PwarpSetup,
+    base: &BaseCodes,
+    color_w: u32,
+) -> Vec<[f64; 3]> {
     let mut out = Vec::with_capacity(setup.samples() as usize);
     for l in &setup.lines {
         for i in 0..l.n {
@@ -597,13 +632,13 @@ pub struct ReadCounts {
 
 /// The source reads of `setup`'s scanlines on a `base_w x base_h` plane (taps outside it are not
 /// reads).
-pub fn read_counts(cfg: &PwarpConfig, setup: &PwarpSetup) -> ReadCounts {
+pub fn read_counts(setup: &PwarpSetup) -> ReadCounts {
     let (bw, bh) = (i64::from(setup.base_w), i64::from(setup.base_h));
     let frac = |c: i64| c >> COORD_FRAC_W;
-    let _ = cfg;
     let mut counts = ReadCounts::default();
-    let mut all = HashSet::new();
-    let (mut prev1, mut prev2): (HashSet<(i64, i64)>, HashSet<(i64, i64)>) = Default::default();
+    let mut all: HashSet<(i64, i64)> = HashSet::new();
+    type Texels = HashSet<(i64, i64)>;
+    let (mut prev1, mut prev2) = (Texels::new(), Texels::new());
     for l in &setup.lines {
         let mut cur = HashSet::new();
         let (mut x, mut y) = (l.x, l.y);
@@ -730,7 +765,13 @@ impl StreamUnit for Pwarp {
                 OP_LINE => {
                     let f = |lsb: u32, w: u32| ((it.payload >> lsb) & ((1u64 << w) - 1)) as u32;
                     let line = (f(0, o), f(o, o), f(2 * o, o + 1));
-                    line_samples(&self.cfg, &self.regs, line, |x, y| self.stored(x, y), &mut out);
+                    line_samples(
+                        &self.cfg,
+                        &self.regs,
+                        line,
+                        |x, y| self.stored(x, y),
+                        &mut out,
+                    );
                     self.pos = (0, 0);
                 }
                 _ => {}
@@ -869,8 +910,8 @@ mod tests {
             for l in &setup.lines {
                 for i in 0..l.n {
                     let bound = error_bound(&cfg, i);
-                    for ch in 0..3 {
-                        let e = (f64::from(got[k].rgb[ch]) - 255.0 * want[k][ch]).abs();
+                    for (g, w) in got[k].rgb.iter().zip(want[k]) {
+                        let e = (f64::from(*g) - 255.0 * w).abs();
                         worst = worst.max(e);
                         assert!(e <= bound, "{map:?}: line {l:?} sample {i}: {e} > {bound}");
                     }
@@ -900,7 +941,7 @@ mod tests {
             let out = (64, 64);
             let map = random_map(&mut rng, out, (64, 64));
             let setup = PwarpSetup::new(&map, (64, 64), out).unwrap();
-            let c = read_counts(&PwarpConfig::DEFAULT, &setup);
+            let c = read_counts(&setup);
             assert!(c.distinct <= c.buffered2 && c.buffered2 <= c.buffered1);
             assert!(c.buffered1 <= c.naive && c.naive <= 4 * c.pixels);
         }
@@ -917,6 +958,11 @@ mod tests {
         assert!(PwarpSetup::new(&zero, (4, 4), (4, 4)).is_err());
         assert!(PwarpSetup::new(&ok, (4, 4), (0, 4)).is_err());
         assert!(PwarpSetup::new(&ok, (4, 4), (4, 4096)).is_err());
-        assert!(PwarpConfig { max_out: 4096, ..PwarpConfig::DEFAULT }.validate().is_err());
+        assert!(PwarpConfig {
+            max_out: 4096,
+            ..PwarpConfig::DEFAULT
+        }
+        .validate()
+        .is_err());
     }
 }
