@@ -418,20 +418,8 @@ impl ErSetup {
     /// `None` when the ray does not go forward along the sweep. `e` and `g` are the model's or
     /// the reference's.
     fn base_coords(&self, ndc: (f64, f64), e: f64, g: f64) -> Option<(f64, f64)> {
-        let aspect = f64::from(self.size.0) / f64::from(self.size.1);
-        let u = ndc.0 * self.tan_half * aspect.max(1.0);
-        let v = ndc.1 * self.tan_half / aspect.min(1.0);
-        let rd = (self.dir + self.right * u + self.up * v) / DVec3::from_array(self.spacing);
-        let p = self.params();
-        let qk = if p.k_reversed {
-            -rd[p.axis_k]
-        } else {
-            rd[p.axis_k]
-        };
-        (qk > 0.0).then(|| {
-            let f = 2.0 * e / g / qk;
-            (rd[p.axis_i] * f, rd[p.axis_j] * f)
-        })
+        let [x, y, q] = self.base_homogeneous(ndc, e, g);
+        (q > 0.0).then(|| (x / q, y / q))
     }
 }
 
@@ -789,7 +777,7 @@ fn warp(
 }
 
 /// The final image by `cube5_pwarp`'s bit-exact perspective warp (docs/numerics/pwarp.md): the
-/// coxels as `ColorW` codes (`cube5_warp::base_codes`' rule), the set-up of the projective map of
+/// coxels as `ColorW` codes (`cube5_warp::base_codes`), the set-up of the projective map of
 /// [`ErSetup::projective`], 8-bit samples on the `ss`-times supersampled grid, averaged per pixel
 /// as `image_of` averages its sub-pixels. Refused beyond 2048 sub-pixels a side.
 fn warp_pwarp(
@@ -804,18 +792,12 @@ fn warp_pwarp(
     use crate::units::cube5_pwarp::{warp_image, PwarpConfig, PwarpSetup};
     let ss = params.supersampling;
     let (bw, bh) = (ext.width(), ext.height());
-    let max = (1u64 << cfg.color_w) - 1;
-    let half = 1u64 << (cfg.acc_w - 1);
-    let base = crate::units::cube5_warp::BaseCodes {
+    let plane = crate::units::cube5_frame::BasePlane {
         width: bw,
         height: bh,
-        codes: coxels
-            .iter()
-            .map(|c| {
-                std::array::from_fn(|i| ((c.rgba[i] * max + half) >> cfg.acc_w).min(max) as u32)
-            })
-            .collect(),
+        coxels: coxels.to_vec(),
     };
+    let base = crate::units::cube5_warp::base_codes(&plane, cfg);
     let (ow, oh) = (params.width * ss, params.height * ss);
     let map = setup.projective((params.width, params.height), ss, ext, e, g);
     let pw = PwarpSetup::new(&map, (bw as u32, bh as u32), (ow, oh))?;

@@ -16,7 +16,7 @@ use crate::regs::cube5_pwarp::{
 use crate::regs::cube5_warp::{COORD_FRAC_W, COORD_LIMIT, COORD_W, OUT_CODE_W, REG_ADDR_W};
 use crate::render::ImageF64;
 use crate::unit::{StreamCodec, StreamUnit};
-use crate::units::cube5_warp::{bilinear_f64, pixel_at, BaseCodes, WarpConfig};
+use crate::units::cube5_warp::{bilinear_f64, pixel_at, BaseCodes, TexelMem, WarpConfig};
 use std::collections::HashSet;
 
 /// One configuration of the `cube5_pwarp` RTL (the parameters of the same names).
@@ -674,8 +674,7 @@ pub fn read_counts(setup: &PwarpSetup) -> ReadCounts {
 pub struct Pwarp {
     cfg: PwarpConfig,
     regs: PwarpRegs,
-    mem: Vec<[u32; 3]>,
-    pos: (u32, u32),
+    tex: TexelMem,
 }
 
 impl Pwarp {
@@ -684,8 +683,7 @@ impl Pwarp {
         Ok(Self {
             cfg,
             regs: PwarpRegs::default(),
-            mem: vec![[0; 3]; (cfg.max_base * cfg.max_base) as usize],
-            pos: (0, 0),
+            tex: TexelMem::new(cfg.max_base),
         })
     }
 
@@ -694,18 +692,7 @@ impl Pwarp {
     }
 
     fn stored(&self, x: i64, y: i64) -> [u32; 3] {
-        let (mb, r) = (i64::from(self.cfg.max_base), &self.regs);
-        let inside = x >= 0
-            && y >= 0
-            && x < i64::from(r.base_w)
-            && y < i64::from(r.base_h)
-            && x < mb
-            && y < mb;
-        if inside {
-            self.mem[(y * mb + x) as usize]
-        } else {
-            [0; 3]
-        }
+        self.tex.stored(x, y, (self.regs.base_w, self.regs.base_h))
     }
 
     fn write(&mut self, addr: u32, data: u64) {
@@ -729,22 +716,6 @@ impl Pwarp {
             _ => {}
         }
     }
-
-    fn store(&mut self, payload: u64) {
-        let c = self.cfg.color_w;
-        let rgb: [u32; 3] =
-            std::array::from_fn(|i| ((payload >> (i as u32 * c)) & ((1 << c) - 1)) as u32);
-        let (x, y) = self.pos;
-        let mb = self.cfg.max_base;
-        if x < mb && y < mb {
-            self.mem[(y * mb + x) as usize] = rgb;
-        }
-        self.pos = if x + 1 >= self.regs.base_w {
-            (0, (y + 1).min(mb))
-        } else {
-            (x + 1, y)
-        };
-    }
 }
 
 impl StreamUnit for Pwarp {
@@ -759,9 +730,11 @@ impl StreamUnit for Pwarp {
             match it.op & 3 {
                 OP_WRITE => {
                     self.write(it.addr & ((1 << REG_ADDR_W) - 1), it.payload);
-                    self.pos = (0, 0);
+                    self.tex.restart();
                 }
-                OP_TEXEL => self.store(it.payload),
+                OP_TEXEL => self
+                    .tex
+                    .store(it.payload, self.cfg.color_w, self.regs.base_w),
                 OP_LINE => {
                     let f = |lsb: u32, w: u32| ((it.payload >> lsb) & ((1u64 << w) - 1)) as u32;
                     let line = (f(0, o), f(o, o), f(2 * o, o + 1));
@@ -772,7 +745,7 @@ impl StreamUnit for Pwarp {
                         |x, y| self.stored(x, y),
                         &mut out,
                     );
-                    self.pos = (0, 0);
+                    self.tex.restart();
                 }
                 _ => {}
             }
@@ -783,7 +756,7 @@ impl StreamUnit for Pwarp {
     /// Registers and texel position to 0; the block RAM keeps its contents (not reset).
     fn reset(&mut self) {
         self.regs = PwarpRegs::default();
-        self.pos = (0, 0);
+        self.tex.restart();
     }
 }
 
