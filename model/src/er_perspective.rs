@@ -20,6 +20,7 @@ use crate::units::cube5_compos::{corrected_alpha, ComposMode, Coxel, OpacityLut}
 use crate::units::cube5_frame::{
     shade_n6, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, N6_OFFSETS, STEP_W,
 };
+use crate::units::cube5_pwarp::Projective;
 use crate::units::cube5_shader::{Phong, ShaderIn, ShaderMode};
 use crate::units::cube5_trilin::Trilin;
 use crate::volume::Volume;
@@ -370,10 +371,10 @@ impl ErSetup {
         (Layout::new(region, rays), hs)
     }
 
-    /// The f64 mapping of a screen ray to base-plane coordinates (before the extent's offset):
-    /// `None` when the ray does not go forward along the sweep. `e` and `g` are the model's or
-    /// the reference's.
-    fn base_coords(&self, ndc: (f64, f64), e: f64, g: f64) -> Option<(f64, f64)> {
+    /// The base-plane position of a screen ray in homogeneous form `(x w, y w, w)` (before the
+    /// extent's offset), `w = q_k`: linear in `ndc`, so the screen-to-base-plane map is
+    /// projective (contract: *The base-plane image and the final image*).
+    fn base_homogeneous(&self, ndc: (f64, f64), e: f64, g: f64) -> [f64; 3] {
         let aspect = f64::from(self.size.0) / f64::from(self.size.1);
         let u = ndc.0 * self.tan_half * aspect.max(1.0);
         let v = ndc.1 * self.tan_half / aspect.min(1.0);
@@ -384,10 +385,41 @@ impl ErSetup {
         } else {
             rd[p.axis_k]
         };
-        (qk > 0.0).then(|| {
-            let f = 2.0 * e / g / qk;
-            (rd[p.axis_i] * f, rd[p.axis_j] * f)
-        })
+        [rd[p.axis_i] * 2.0 * e / g, rd[p.axis_j] * 2.0 * e / g, qk]
+    }
+
+    /// The projective map from the pixels of an `ss`-times supersampled `width x height` image
+    /// (centres at integers, the sub-pixels `image_of` takes) to the base plane's texels
+    /// (`x - m_lo(0)`, `y - n_lo(0)`): what `cube5_pwarp`'s set-up takes.
+    pub fn projective(
+        &self,
+        (width, height): (u32, u32),
+        ss: u32,
+        ext: &Extent,
+        e: f64,
+        g: f64,
+    ) -> Projective {
+        let (w, h) = (f64::from(width * ss), f64::from(height * ss));
+        let at = |px: f64, py: f64| {
+            let ndc = ((px + 0.5) / w * 2.0 - 1.0, 1.0 - (py + 0.5) / h * 2.0);
+            let [x, y, q] = self.base_homogeneous(ndc, e, g);
+            [x - ext.m0 as f64 * q, y - ext.n0 as f64 * q, q]
+        };
+        let (o, dx, dy) = (at(0.0, 0.0), at(1.0, 0.0), at(0.0, 1.0));
+        let row = |i: usize| [dx[i] - o[i], dy[i] - o[i], o[i]];
+        Projective {
+            nx: row(0),
+            ny: row(1),
+            w: row(2),
+        }
+    }
+
+    /// The f64 mapping of a screen ray to base-plane coordinates (before the extent's offset):
+    /// `None` when the ray does not go forward along the sweep. `e` and `g` are the model's or
+    /// the reference's.
+    fn base_coords(&self, ndc: (f64, f64), e: f64, g: f64) -> Option<(f64, f64)> {
+        let [x, y, q] = self.base_homogeneous(ndc, e, g);
+        (q > 0.0).then(|| (x / q, y / q))
     }
 }
 
@@ -522,7 +554,11 @@ pub struct ErRun {
     pub coxels: Vec<Coxel>,
     pub extent: Extent,
     pub stats: ErStats,
+    /// The final image through `cube5_pwarp`'s bit-exact perspective warp (8-bit samples).
     pub image: ImageF64,
+    /// The same base plane through the f64 projective warp (`cube5_warp::bilinear_f64` at each
+    /// pixel's exact position): the frame's fixed point without the warp's error.
+    pub image_f64_warp: ImageF64,
 }
 
 /// The volume-dependent part of a frame: the volume at the frame's voxel width and the units.
@@ -648,12 +684,18 @@ impl ErJob {
         };
         let e = setup.e as f64 / ONE as f64;
         let g = setup.g() as f64 / ONE as f64;
-        let image = warp(setup, &self.params, &rgb, &extent, e, g);
+        let image_f64_warp = warp(setup, &self.params, &rgb, &extent, e, g);
+        let image = match warp_pwarp(setup, &self.params, &cfg, &coxels, &extent, e, g) {
+            Ok(image) => image,
+            // Images beyond cube5_pwarp's 2048 pixels a side (supersampled): the f64 warp.
+            Err(_) => image_f64_warp.clone(),
+        };
         ErRun {
             stats: ErStats::new(setup, &layout, shaded.into_inner()),
             coxels,
             extent,
             image,
+            image_f64_warp,
         }
     }
 }
@@ -731,6 +773,61 @@ fn warp(
             }
             None => [0.0; 3],
         }
+    })
+}
+
+/// The final image by `cube5_pwarp`'s bit-exact perspective warp (docs/numerics/pwarp.md): the
+/// coxels as `ColorW` codes (`cube5_warp::base_codes`), the set-up of the projective map of
+/// [`ErSetup::projective`], 8-bit samples on the `ss`-times supersampled grid, averaged per pixel
+/// as `image_of` averages its sub-pixels. Refused beyond 2048 sub-pixels a side.
+fn warp_pwarp(
+    setup: &ErSetup,
+    params: &RenderParams,
+    cfg: &crate::units::cube5_compos::ComposConfig,
+    coxels: &[Coxel],
+    ext: &Extent,
+    e: f64,
+    g: f64,
+) -> Result<ImageF64> {
+    use crate::units::cube5_pwarp::{warp_image, PwarpConfig, PwarpSetup};
+    let ss = params.supersampling;
+    let (bw, bh) = (ext.width(), ext.height());
+    let plane = crate::units::cube5_frame::BasePlane {
+        width: bw,
+        height: bh,
+        coxels: coxels.to_vec(),
+    };
+    let base = crate::units::cube5_warp::base_codes(&plane, cfg);
+    let (ow, oh) = (params.width * ss, params.height * ss);
+    let map = setup.projective((params.width, params.height), ss, ext, e, g);
+    let pw = PwarpSetup::new(&map, (bw as u32, bh as u32), (ow, oh))?;
+    let pcfg = PwarpConfig {
+        color_w: cfg.color_w,
+        weight_w: 8,
+        max_base: (bw.max(bh) as u32).next_power_of_two().clamp(4, 1024),
+        max_out: ow.max(oh).next_power_of_two().clamp(4, 2048),
+    };
+    let px = warp_image(&pcfg, &pw, &base)?;
+    let n = f64::from(ss * ss) * 255.0;
+    let rgb = (0..params.width * params.height)
+        .map(|i| {
+            let (x, y) = (i % params.width, i / params.width);
+            let mut acc = [0.0; 3];
+            for sy in 0..ss {
+                for sx in 0..ss {
+                    let p = px[((y * ss + sy) * ow + x * ss + sx) as usize];
+                    for ch in 0..3 {
+                        acc[ch] += f64::from(p[ch]);
+                    }
+                }
+            }
+            acc.map(|v| v / n)
+        })
+        .collect();
+    Ok(ImageF64 {
+        width: params.width,
+        height: params.height,
+        rgb,
     })
 }
 

@@ -11,6 +11,7 @@ use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_accel_ctrl::AccelCtrlConfig;
 use cube5_model::units::cube5_axi_wr::AxiWrConfig;
 use cube5_model::units::cube5_axil::AxilConfig;
+use cube5_model::units::cube5_pwarp::PwarpConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_model::units::{
@@ -68,6 +69,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == AxiRdConfig::TOP => agree::<AxiRdConfig>(v),
         t if t == VolFetchConfig::TOP => agree::<VolFetchConfig>(v),
         t if t == WarpConfig::TOP => agree::<WarpConfig>(v),
+        t if t == PwarpConfig::TOP => agree::<PwarpConfig>(v),
         t if t == AxilConfig::TOP => agree::<AxilConfig>(v),
         t if t == AxiWrConfig::TOP => agree::<AxiWrConfig>(v),
         t if t == AccelCtrlConfig::TOP => agree::<AccelCtrlConfig>(v),

@@ -501,14 +501,68 @@ pub fn frame_items(cfg: &WarpConfig, regs: &WarpRegs, base: &BaseCodes) -> Vec<W
     items
 }
 
+/// The base plane's block RAM and texel position as both warps keep them (`docs/numerics/warp.md`,
+/// "Interface": a `Texel` item stores at the position, then advances it in raster order over
+/// `BaseW`; taps outside `BaseW x BaseH` or `MaxBase` read 0). Not reset.
+#[derive(Debug, Clone)]
+pub struct TexelMem {
+    max_base: u32,
+    mem: Vec<[u32; 3]>,
+    pos: (u32, u32),
+}
+
+impl TexelMem {
+    pub fn new(max_base: u32) -> Self {
+        Self {
+            max_base,
+            mem: vec![[0; 3]; (max_base * max_base) as usize],
+            pos: (0, 0),
+        }
+    }
+
+    /// Texel `(x, y)` of a `base_w x base_h` plane, 0 outside it or beyond `MaxBase`.
+    pub fn stored(&self, x: i64, y: i64, (base_w, base_h): (u32, u32)) -> [u32; 3] {
+        let mb = i64::from(self.max_base);
+        let inside =
+            x >= 0 && y >= 0 && x < i64::from(base_w) && y < i64::from(base_h) && x < mb && y < mb;
+        if inside {
+            self.mem[(y * mb + x) as usize]
+        } else {
+            [0; 3]
+        }
+    }
+
+    /// A `Texel` item's payload (`R, G, B` codes, `color_w` bits each) stored at the position
+    /// (dropped beyond `MaxBase`), then the position advanced over a `base_w`-wide plane.
+    pub fn store(&mut self, payload: u64, color_w: u32, base_w: u32) {
+        let c = color_w;
+        let rgb: [u32; 3] =
+            std::array::from_fn(|i| ((payload >> (i as u32 * c)) & ((1 << c) - 1)) as u32);
+        let (x, y) = self.pos;
+        let mb = self.max_base;
+        if x < mb && y < mb {
+            self.mem[(y * mb + x) as usize] = rgb;
+        }
+        self.pos = if x + 1 >= base_w {
+            (0, (y + 1).min(mb))
+        } else {
+            (x + 1, y)
+        };
+    }
+
+    /// The position back to `(0, 0)` (reset, `Write`, `Go`, `Line`).
+    pub fn restart(&mut self) {
+        self.pos = (0, 0);
+    }
+}
+
 /// The golden model of `cube5_warp` as a stream unit: registers, the block RAM's base plane and
 /// the texel position, driven by input items; a `Go` emits its image.
 #[derive(Debug, Clone)]
 pub struct Warp {
     cfg: WarpConfig,
     regs: WarpRegs,
-    mem: Vec<[u32; 3]>,
-    pos: (u32, u32),
+    tex: TexelMem,
 }
 
 impl Warp {
@@ -517,8 +571,7 @@ impl Warp {
         Ok(Self {
             cfg,
             regs: WarpRegs::default(),
-            mem: vec![[0; 3]; (cfg.max_base * cfg.max_base) as usize],
-            pos: (0, 0),
+            tex: TexelMem::new(cfg.max_base),
         })
     }
 
@@ -531,18 +584,7 @@ impl Warp {
     }
 
     fn stored(&self, x: i64, y: i64) -> [u32; 3] {
-        let (mb, r) = (i64::from(self.cfg.max_base), &self.regs);
-        let inside = x >= 0
-            && y >= 0
-            && x < i64::from(r.base_w)
-            && y < i64::from(r.base_h)
-            && x < mb
-            && y < mb;
-        if inside {
-            self.mem[(y * mb + x) as usize]
-        } else {
-            [0; 3]
-        }
+        self.tex.stored(x, y, (self.regs.base_w, self.regs.base_h))
     }
 
     fn write(&mut self, addr: u32, data: u64) {
@@ -566,22 +608,6 @@ impl Warp {
             REG_YPY => r.ypy = coord(data),
             _ => {}
         }
-    }
-
-    fn store(&mut self, payload: u64) {
-        let c = self.cfg.color_w;
-        let rgb: [u32; 3] =
-            std::array::from_fn(|i| ((payload >> (i as u32 * c)) & ((1 << c) - 1)) as u32);
-        let (x, y) = self.pos;
-        let mb = self.cfg.max_base;
-        if x < mb && y < mb {
-            self.mem[(y * mb + x) as usize] = rgb;
-        }
-        self.pos = if x + 1 >= self.regs.base_w {
-            (0, (y + 1).min(mb))
-        } else {
-            (x + 1, y)
-        };
     }
 
     /// The image of a `Go`: exact steps from `X0, Y0`, raster order.
@@ -616,12 +642,14 @@ impl StreamUnit for Warp {
             match it.op & 3 {
                 OP_WRITE => {
                     self.write(it.addr & ((1 << REG_ADDR_W) - 1), it.payload);
-                    self.pos = (0, 0);
+                    self.tex.restart();
                 }
-                OP_TEXEL => self.store(it.payload),
+                OP_TEXEL => self
+                    .tex
+                    .store(it.payload, self.cfg.color_w, self.regs.base_w),
                 OP_GO => {
                     self.emit(&mut out);
-                    self.pos = (0, 0);
+                    self.tex.restart();
                 }
                 _ => {}
             }
@@ -632,7 +660,7 @@ impl StreamUnit for Warp {
     /// Registers and texel position to 0; the block RAM keeps its contents (not reset).
     fn reset(&mut self) {
         self.regs = WarpRegs::default();
-        self.pos = (0, 0);
+        self.tex.restart();
     }
 }
 

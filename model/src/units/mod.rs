@@ -13,6 +13,7 @@ pub mod cube5_axil;
 pub mod cube5_compos;
 pub mod cube5_frame;
 pub mod cube5_gradient;
+pub mod cube5_pwarp;
 pub mod cube5_rblock;
 pub mod cube5_section_buf;
 pub mod cube5_sepconv;
