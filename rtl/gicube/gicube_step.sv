@@ -108,17 +108,20 @@ module gicube_step #(
 
   logic [3*ProdW-1:0]            prod_d, prod_q;
   logic [3*PosW+QueueW+1-1:0]    side1_d, side1_q;  // start, queue, leap
-  logic signed [DirW-1:0]        dir_s [3];
-  logic signed [StepW:0]         step_s;
-  logic signed [ProdW-1:0]       prod_s [3];
+
+  for (genvar a = 0; a < 3; a++) begin : gen_mul
+    logic signed [DirW-1:0]  dir_s;
+    logic signed [StepW:0]   step_s;
+    logic signed [ProdW-1:0] prod_s;
+    always_comb begin
+      dir_s  = $signed(in_data_i[3*PosW + a*DirW +: DirW]);
+      step_s = $signed({1'b0, StepC});
+      prod_s = dir_s * step_s;
+      prod_d[a*ProdW +: ProdW] = prod_s;
+    end
+  end
 
   always_comb begin
-    step_s = $signed({1'b0, StepC});
-    for (int unsigned a = 0; a < 3; a++) begin
-      dir_s[a]  = $signed(in_data_i[3*PosW + a*DirW +: DirW]);
-      prod_s[a] = dir_s[a] * step_s;
-      prod_d[a*ProdW +: ProdW] = prod_s[a];
-    end
     side1_d = {in_data_i[InW-1 -: QueueW+1], in_data_i[0 +: 3*PosW]};
   end
 
