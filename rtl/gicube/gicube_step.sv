@@ -7,7 +7,7 @@
 //
 // The leap's count without dividers or the product k delta (contract, "The RTL"): b + 8 quotient
 // stages (gicube_step_div) find K = k - 1 on the three axes at once, and k |delta_i| comes out as
-// num_i - r_i + |delta_i|. Latency b + 13, one ray per clock, leaping or not.
+// num_i - r_i + |delta_i|. Latency b + 14, one ray per clock, leaping or not.
 module gicube_step #(
   /// Block side n = 2^BlockLog2 voxels, 2..8.
   parameter int unsigned BlockLog2 = 5,
@@ -54,7 +54,7 @@ module gicube_step #(
   localparam int unsigned BlkW     = PosIntW - BlockLog2;      // a block coordinate
   localparam int unsigned InW      = 3 * PosW + 3 * DirW + QueueW + 1;
   localparam int unsigned OutW     = KW + 1 + 3 * PosW + QueueW;
-  localparam int unsigned Stages   = KBits + 5;
+  localparam int unsigned Stages   = KBits + 6;
   localparam int unsigned DivFirst = 3;                        // ready index of the first quotient stage
   localparam int unsigned Limit    = (VolBlocks << BlockLog2) << PosFracW;  // N 256
   localparam int unsigned SideW    = 3 * PosW + QueueW + 1 + 3;  // start, queue, leap, neg
@@ -251,42 +251,63 @@ module gicube_step #(
   assign side_f = side_s[KBits*SideW +: SideW];
 
   // ---------------------------------------------------------------------------
-  // Stage KBits + 4: k and next_i = start_i +- k |delta_i|
+  // Stage KBits + 4: k and the offsets k |delta_i|
   // ---------------------------------------------------------------------------
   logic                       leap_f;
   logic [2:0]                 neg_f;
-  logic [3*OffW-1:0]          off;
-  logic [3*NextW-1:0]         next_d, next_q;
-  logic [KW-1:0]              kk_d, kk_q;
-  logic [3*PosW+QueueW-1:0]   side4_d, side4_q;  // start, queue
+  logic [3*OffW-1:0]          off_d, off_q;
+  logic [KW-1:0]              kk_d, kk_q, kk_q2;
+  logic [3*PosW+QueueW+3-1:0] side4_d, side4_q;  // start, queue, neg
 
   always_comb begin
     leap_f = side_f[3*PosW + QueueW];
     neg_f  = side_f[SideW-1 -: 3];
     for (int unsigned a = 0; a < 3; a++) begin
       // k |delta_i| = num_i - r_i + |delta_i| on a leap (0 on an axis that does not move).
-      off[a*OffW +: OffW] = leap_f
+      off_d[a*OffW +: OffW] = leap_f
           ? OffW'(numerator(side_f[a*PosW +: BlkRawW], neg_f[a])) - OffW'(rem_f[a*RemW +: RemW])
             + OffW'(mag_f[a*MagW +: MagW])
           : OffW'(mag_f[a*MagW +: MagW]);
-      next_d[a*NextW +: NextW] = neg_f[a]
-          ? NextW'(side_f[a*PosW +: PosW]) - NextW'(off[a*OffW +: OffW])
-          : NextW'(side_f[a*PosW +: PosW]) + NextW'(off[a*OffW +: OffW]);
     end
     kk_d    = (leap_f && (move_f != '0)) ? KW'(k_f) + KW'(1) : KW'(1);
-    side4_d = side_f[0 +: 3*PosW+QueueW];
+    side4_d = {neg_f, side_f[0 +: 3*PosW+QueueW]};
   end
 
   always_ff @(posedge clk_i) begin
     if (ready[DivFirst + KBits]) begin
-      next_q  <= next_d;
+      off_q   <= off_d;
       kk_q    <= kk_d;
       side4_q <= side4_d;
     end
   end
 
   // ---------------------------------------------------------------------------
-  // Stage KBits + 5: exit test and re-bucketing (slab, one processor)
+  // Stage KBits + 5: next_i = start_i +- k |delta_i|
+  // ---------------------------------------------------------------------------
+  logic [3*NextW-1:0]         next_d, next_q;
+  logic [3*PosW+QueueW-1:0]   side5_d, side5_q;  // start, queue
+  logic [2:0]                 neg5;
+
+  always_comb begin
+    neg5 = side4_q[3*PosW+QueueW +: 3];
+    for (int unsigned a = 0; a < 3; a++) begin
+      next_d[a*NextW +: NextW] = neg5[a]
+          ? NextW'(side4_q[a*PosW +: PosW]) - NextW'(off_q[a*OffW +: OffW])
+          : NextW'(side4_q[a*PosW +: PosW]) + NextW'(off_q[a*OffW +: OffW]);
+    end
+    side5_d = side4_q[0 +: 3*PosW+QueueW];
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (ready[DivFirst + KBits + 1]) begin
+      next_q  <= next_d;
+      kk_q2   <= kk_q;
+      side5_q <= side5_d;
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stage KBits + 6: exit test and re-bucketing (slab, one processor)
   // ---------------------------------------------------------------------------
   logic                 exit;
   logic [3*BlkW-1:0]    blk;
@@ -304,13 +325,13 @@ module gicube_step #(
     end
     queue_new = QueueW'(times_b(times_b(QW2'(blk[0 +: BlkW])) + QW2'(blk[BlkW +: BlkW]))
                         + QW2'(blk[2*BlkW +: BlkW]));
-    out_d[0 +: KW] = kk_q;
+    out_d[0 +: KW] = kk_q2;
     out_d[KW]      = exit;
     for (int unsigned a = 0; a < 3; a++) begin
-      out_d[KW + 1 + a*PosW +: PosW] = exit ? side4_q[a*PosW +: PosW]
+      out_d[KW + 1 + a*PosW +: PosW] = exit ? side5_q[a*PosW +: PosW]
                                             : next_q[a*NextW +: PosW];
     end
-    out_d[KW + 1 + 3*PosW +: QueueW] = exit ? side4_q[3*PosW +: QueueW] : queue_new;
+    out_d[KW + 1 + 3*PosW +: QueueW] = exit ? side5_q[3*PosW +: QueueW] : queue_new;
   end
 
   always_ff @(posedge clk_i) begin

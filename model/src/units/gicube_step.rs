@@ -67,9 +67,9 @@ impl StepConfig {
     }
 
     /// Clocks from input to output: the products, `delta`, the numerators, `b + 8` quotient
-    /// stages, `next`, the exit test and re-bucketing (docs/numerics/gicube_step.md).
+    /// stages, `k delta`, `next`, the exit test and re-bucketing (docs/numerics/gicube_step.md).
     pub fn latency(&self) -> u64 {
-        u64::from(self.block_log2) + 13
+        u64::from(self.block_log2) + 14
     }
 
     fn bucket_config(&self) -> BucketConfig {
@@ -445,7 +445,7 @@ mod tests {
             step: 1000,
         };
         assert_eq!((c.in_width(), c.out_width(), c.queue_w(), c.k_w()), (121, 90, 12, 17));
-        assert_eq!(c.latency(), 21);
+        assert_eq!(c.latency(), 22);
         let it = StepIn {
             start: [0xfffff, 1, 0x80000],
             dir: [-1, i16::MIN, i16::MAX],
