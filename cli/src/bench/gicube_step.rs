@@ -26,7 +26,9 @@ pub fn run(n_items: usize) -> Result<()> {
     )?;
 
     println!("Against the f64 reference (real divisions and ceil for the leap's count, real");
-    println!("positions for the exit test and the queue): {n_items} random rays per configuration;");
+    println!(
+        "positions for the exit test and the queue): {n_items} random rays per configuration;"
+    );
     println!("the mean and largest k of the leaps (grid steps one leap replaces).\n");
     println!("| config | disagreements with f64 | leaps | mean k of a leap | largest k | exits |");
     println!("|--------|-----------------------:|------:|-----------------:|----------:|------:|");

@@ -22,9 +22,9 @@ use crate::units::cube5_shader::ClassLut;
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_ray_queues::RayQueues;
+use crate::units::gicube_sample::{SampleConfig, SampleIn, Sampler};
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
-use crate::units::gicube_sample::{SampleConfig, SampleIn, Sampler};
 use crate::units::gicube_step::{StepConfig, Stepper};
 use crate::volume::Volume;
 

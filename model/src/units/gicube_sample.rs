@@ -116,10 +116,7 @@ impl Sampler {
         let rmap = ReflectanceMap::from_fn(&scfg, |_, _, _| Texel::default(), Texel::default())?;
         let shader = Shader::new(scfg, ShaderTables { class, rmap })?;
         let ccfg = compos_config();
-        let lut = OpacityLut::new(
-            f64::from(cfg.step) / f64::from(1u32 << POS_FRAC_W),
-            &ccfg,
-        )?;
+        let lut = OpacityLut::new(f64::from(cfg.step) / f64::from(1u32 << POS_FRAC_W), &ccfg)?;
         let regs = match cfg.et_threshold {
             Some(t) => ComposRegs {
                 et_threshold: u64::from(t),

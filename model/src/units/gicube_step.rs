@@ -444,7 +444,10 @@ mod tests {
             vol_blocks: 16,
             step: 1000,
         };
-        assert_eq!((c.in_width(), c.out_width(), c.queue_w(), c.k_w()), (121, 90, 12, 17));
+        assert_eq!(
+            (c.in_width(), c.out_width(), c.queue_w(), c.k_w()),
+            (121, 90, 12, 17)
+        );
         assert_eq!(c.latency(), 22);
         let it = StepIn {
             start: [0xfffff, 1, 0x80000],
