@@ -14,6 +14,7 @@ use cube5_model::units::cube5_axil::AxilConfig;
 use cube5_model::units::cube5_pwarp::PwarpConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
+use cube5_model::units::gicube_step::StepConfig;
 use cube5_model::units::{
     cube5_axi_rd::AxiRdConfig, cube5_compos::ComposConfig, cube5_frame::FrameConfig,
     cube5_gradient::GradientConfig, cube5_rblock::RBlockConfig, cube5_sepconv::SepconvConfig,
@@ -75,6 +76,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == AccelCtrlConfig::TOP => agree::<AccelCtrlConfig>(v),
         t if t == RayQueuesConfig::TOP => agree::<RayQueuesConfig>(v),
         t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
+        t if t == StepConfig::TOP => agree::<StepConfig>(v),
         other => Err(format!(
             "top {other} has no model configuration (UnitConfig)"
         )),

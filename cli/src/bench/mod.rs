@@ -21,6 +21,7 @@ mod gicube_packet_loop;
 mod gicube_ray_queues;
 mod gicube_scatter;
 mod gicube_sorter;
+mod gicube_step;
 
 use anyhow::{anyhow, Result};
 
@@ -91,6 +92,11 @@ const BENCHES: &[Bench] = &[
         top: gicube_ray_queues::TOP,
         alias: "queues",
         run: gicube_ray_queues::run,
+    },
+    Bench {
+        top: gicube_step::TOP,
+        alias: "step",
+        run: gicube_step::run,
     },
     Bench {
         top: cube5_skewmem::TOP,

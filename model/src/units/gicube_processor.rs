@@ -17,27 +17,22 @@ use glam::DVec3;
 use crate::camera::Camera;
 use crate::error::{ModelError, Result};
 use crate::transfer::TransferFunction;
-use crate::units::cube5_compos::{
-    corrected_alpha, rnd, Compos, ComposConfig, ComposMode, ComposRegs, Coxel, OpacityLut, Sample,
-};
-use crate::units::cube5_shader::{
-    ClassLut, ReflectanceMap, Shader, ShaderConfig, ShaderIn, ShaderMode, ShaderTables, Texel,
-};
-use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use crate::units::cube5_compos::{corrected_alpha, rnd};
+use crate::units::cube5_shader::ClassLut;
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_ray_queues::RayQueues;
+use crate::units::gicube_sample::{SampleConfig, SampleIn, Sampler};
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
 use crate::units::gicube_step::{StepConfig, Stepper};
 use crate::volume::Volume;
 
-/// Largest value of a `U(0.12)` packet channel.
-pub const CHAN_MAX: u32 = 4095;
-/// Fraction bits of the tri-linear sample (`cube5_trilin` `FracW`).
-pub const SAMPLE_FRAC_W: u32 = 4;
-/// Fraction bits of the irradiance, `U(2.14)`.
-pub const IRR_FRAC_W: u32 = 14;
+// The packet channel's maximum, the sample's and the irradiance's fraction bits and the unit
+// configurations of the sample datapath are `gicube_sample`'s (the one description of a sample).
+pub use crate::units::gicube_sample::{
+    compos_config, shader_config, CHAN_MAX, IRR_FRAC_W, SAMPLE_FRAC_W,
+};
 /// `E (12) + T (12) + dr (8) + w_c (24) - IRR_FRAC_W`: the splat's rounding shift.
 pub const DEPOSIT_SHIFT: u32 = 12 + 12 + POS_FRAC_W + 3 * POS_FRAC_W - IRR_FRAC_W;
 /// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
@@ -460,17 +455,14 @@ enum Outcome {
 pub struct Processor {
     cfg: ProcessorConfig,
     vol: Volume,
-    trilin: Trilin,
-    shader: Shader,
-    compos: Compos,
+    /// Resampling, classification, lighting by the irradiance and compositing (`gicube_sample`).
+    sampler: Sampler,
     bucket: BucketUnit,
     /// Blocks a side, domain side in voxels.
     blocks: u32,
     side: u32,
     /// Empty flag of each queue's block.
     empty: Vec<bool>,
-    /// Tri-linear interpolation of the irradiance, `U(16.0)` corners, `WeightW = 8`, `FracW = 0`.
-    irr_trilin: Trilin,
     /// The irradiance field of the last lighting pass, `U(2.14)` per voxel.
     irradiance: Option<Vec<u16>>,
     /// The scattering unit (isotropic scattering of high-albedo photons).
@@ -493,21 +485,15 @@ impl Processor {
             )));
         }
         let (blocks, side) = domain(vol, cfg.block_log2)?;
-        let trilin = Trilin::new(TrilinConfig::new(vol.bits, POS_FRAC_W, SAMPLE_FRAC_W)?)?;
-        let scfg = shader_config(vol.bits);
-        let class = ClassLut::from_transfer(&scfg, tf)?;
-        let rmap = ReflectanceMap::from_fn(&scfg, |_, _, _| Texel::default(), Texel::default())?;
-        let shader = Shader::new(scfg, ShaderTables { class, rmap })?;
-        let ccfg = compos_config();
-        let lut = OpacityLut::new(cfg.step_voxels(), &ccfg)?;
-        let regs = match cfg.et_threshold {
-            Some(t) => ComposRegs {
-                et_threshold: u64::from(t),
-                ..ComposRegs::defaults(&ccfg)
+        let class = ClassLut::from_transfer(&shader_config(vol.bits), tf)?;
+        let sampler = Sampler::new(
+            SampleConfig {
+                voxel_w: vol.bits,
+                step: cfg.step,
+                et_threshold: cfg.et_threshold,
             },
-            None => ComposRegs::without_termination(&ccfg),
-        };
-        let compos = Compos::new(ccfg, lut, regs)?;
+            class,
+        )?;
         let bucket = BucketUnit::new(BucketConfig {
             block_log2: cfg.block_log2,
             vol_blocks: blocks,
@@ -518,14 +504,11 @@ impl Processor {
         let mut p = Self {
             cfg,
             vol: vol.clone(),
-            trilin,
-            shader,
-            compos,
+            sampler,
             bucket,
             blocks,
             side,
             empty: Vec::new(),
-            irr_trilin: Trilin::new(TrilinConfig::new(16, POS_FRAC_W, 0)?)?,
             irradiance: None,
             scatter: Scatter::new(ScatterConfig::DEFAULT)?,
             photon_albedo: None,
@@ -574,15 +557,8 @@ impl Processor {
                 }
             }
         }
-        let idx = |v: u32| {
-            self.shader.class_index(&ShaderIn {
-                sample: v << SAMPLE_FRAC_W,
-                grad: [0; 3],
-                mag: 0,
-                mode: unlit(),
-            })
-        };
-        self.shader.tables().class.entries()[idx(lo)..=idx(hi)]
+        let idx = |v: u32| self.sampler.class_index_of_voxel(v);
+        self.sampler.shader().tables().class.entries()[idx(lo)..=idx(hi)]
             .iter()
             .all(|e| e.a == 0)
     }
@@ -626,17 +602,6 @@ impl Processor {
             *v = self.vol.get(x, y, z);
         }
         let mask = (1u32 << POS_FRAC_W) - 1;
-        let s = self.trilin.sample(&TrilinIn {
-            voxels,
-            weights: p.map(|c| c & mask),
-            mode: TrilinMode::Lerp,
-        });
-        let e = self.shader.classify(&ShaderIn {
-            sample: s,
-            grad: [0; 3],
-            mag: 0,
-            mode: unlit(),
-        });
         let weights = p.map(|c| c & mask);
         let lighting = ray.ray_type == RayType::Lighting;
         if lighting {
@@ -644,47 +609,27 @@ impl Processor {
                 self.deposit(ray, base, weights, irr);
             }
         }
-        let rgb = if lighting {
-            [0; 3]
-        } else if let Some(field) = &self.irradiance {
-            let mut corners = [0u32; 8];
-            for (c, v) in corners.iter_mut().enumerate() {
-                *v = voxel_index(self.vol.dims, corner(base, c)).map_or(0, |i| u32::from(field[i]));
+        let lit = match (&self.irradiance, lighting) {
+            (Some(field), false) => {
+                let mut corners = [0u32; 8];
+                for (c, v) in corners.iter_mut().enumerate() {
+                    *v = voxel_index(self.vol.dims, corner(base, c))
+                        .map_or(0, |i| u32::from(field[i]));
+                }
+                Some(corners)
             }
-            let irr_s = u64::from(self.irr_trilin.sample(&TrilinIn {
-                voxels: corners,
-                weights,
-                mode: TrilinMode::Lerp,
-            }));
-            [e.r, e.g, e.b].map(|c| (rnd(u64::from(c) * irr_s, IRR_FRAC_W) as u32).min(255))
-        } else {
-            [e.r, e.g, e.b]
+            _ => None,
         };
-        let coxel = Coxel {
-            rgba: [
-                u64::from(ray.color[0]),
-                u64::from(ray.color[1]),
-                u64::from(ray.color[2]),
-                u64::from(ray.opacity),
-            ],
-            z: 1,
-            geo: [0; 3],
-            terminated: false,
-        };
-        let out = self.compos.step(
-            &coxel,
-            &Sample {
-                rgb,
-                alpha: e.a,
-                depth: 0,
-                mode: ComposMode::FrontToBack,
-            },
-        );
-        let sat = |x: u64| x.min(u64::from(CHAN_MAX)) as u16;
-        if !lighting {
-            ray.color = [sat(out.rgba[0]), sat(out.rgba[1]), sat(out.rgba[2])];
-        }
-        ray.opacity = sat(out.rgba[3]);
+        let out = self.sampler.sample(&SampleIn {
+            voxels,
+            weights,
+            irr: lit,
+            color: ray.color,
+            opacity: ray.opacity,
+            lighting,
+        });
+        ray.color = out.color;
+        ray.opacity = out.opacity;
         out.terminated
     }
 
@@ -1070,37 +1015,6 @@ impl Processor {
             img[(r.py * cam.width + r.px) as usize] = c;
         }
         Ok(img)
-    }
-}
-
-fn unlit() -> ShaderMode {
-    ShaderMode {
-        tf2d: false,
-        unlit: true,
-    }
-}
-
-/// The classification the processor uses: `cube5_shader` on the `U(VoxelW.4)` sample, 1-D,
-/// `min(12, VoxelW + 4)` index bits, 8-bit colour, 12-bit alpha.
-pub fn shader_config(voxel_w: u32) -> ShaderConfig {
-    ShaderConfig {
-        voxel_w,
-        frac_w: SAMPLE_FRAC_W,
-        class_idx_w: 12.min(voxel_w + SAMPLE_FRAC_W),
-        mag_shift: 10.min(voxel_w + 1 + SAMPLE_FRAC_W),
-        ..ShaderConfig::DEFAULT
-    }
-}
-
-/// The compositing the processor uses: `cube5_compos` with the packet's widths, coxel `U(1.12)`,
-/// corrected alpha `U(1.12)`, 8-bit sample colour, no depth.
-pub fn compos_config() -> ComposConfig {
-    ComposConfig {
-        color_w: 8,
-        alpha_w: 12,
-        extra_w: 0,
-        acc_w: 12,
-        z_w: 1,
     }
 }
 

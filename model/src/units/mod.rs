@@ -26,6 +26,7 @@ pub mod gicube_bucket;
 pub mod gicube_packet_loop;
 pub mod gicube_processor;
 pub mod gicube_ray_queues;
+pub mod gicube_sample;
 pub mod gicube_scatter;
 pub mod gicube_sorter;
 pub mod gicube_step;
