@@ -348,7 +348,8 @@ struct SliceWork<'a> {
     flat: Option<&'a [[u32; 3]]>,
     /// The compositing unit's rules of this slice, on lanes.
     rules: LaneRules,
-    cmode: ComposMode,
+    /// `Compos::code` of each colour code (a channel's code on the coxel's scale).
+    colour_code: &'a [u32],
     /// `SampleW - ClassIdxW`: a sample's class index is `sample >> shift`.
     shift: u32,
     /// Per block of this slice: the largest corrected alpha its samples can have.
@@ -358,7 +359,6 @@ struct SliceWork<'a> {
     /// Base-plane column of anchor 0 and row of anchor row 0.
     r0: usize,
     q0: usize,
-    depth: u32,
     k: usize,
     wx: u32,
     wy: u32,
@@ -521,14 +521,9 @@ impl SliceWork<'_> {
                     // is not computed: the frame never classifies in 2-D.
                     let grad = [xp - xm, yp - ym, after[n] as i32 - before[n] as i32];
                     let e = units.shader.shade_lit_by_float_division(centre[n], grad);
-                    let coded = lanes::colours(&units.compos.code(&Sample {
-                        rgb: [e.r, e.g, e.b],
-                        alpha: e.a,
-                        depth: self.depth,
-                        mode: self.cmode,
-                    }));
-                    for ch in 0..3 {
-                        sc[ch][n] = coded[ch];
+                    // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
+                    for (ch, v) in [e.r, e.g, e.b].into_iter().enumerate() {
+                        sc[ch][n] = self.colour_code[v as usize];
                     }
                 }
             }
@@ -685,6 +680,20 @@ pub fn render_sweep(
             })
             .collect()
     });
+    // The compositing unit's code of each colour code, from `Compos::code` (it codes each
+    // channel alone).
+    let colours = units.compos.config().color_max().max(scfg.color_max());
+    let colour_code: Vec<u32> = (0..=colours)
+        .map(|c| {
+            let coded = units.compos.code(&Sample {
+                rgb: [c; 3],
+                alpha: 0,
+                depth: 0,
+                mode: cmode,
+            });
+            lanes::colours(&coded)[0]
+        })
+        .collect();
     // The corrected alphas in lanes (`<= 2^Q`).
     let corrected32: Vec<u32> = corrected.iter().map(|&a| a as u32).collect();
     let zero_ok = zero_alpha_is_identity(&units.compos, &init, cmode);
@@ -740,13 +749,12 @@ pub fn render_sweep(
                 corrected: &corrected32,
                 flat: flat.as_deref(),
                 rules: LaneRules::new(&units.compos, cmode, s as u32)?,
-                cmode,
+                colour_code: &colour_code,
                 shift,
                 amax,
                 zero_ok,
                 r0: (max_sx - c.shift_x) as usize,
                 q0: (max_sy - c.shift_y) as usize,
-                depth: s as u32,
                 k: c.k,
                 wx: weight(c.frac_x),
                 wy: weight(c.frac_y),
@@ -847,12 +855,29 @@ mod tests {
         cfg: &FrameConfig,
         tf: &TransferFunction,
         et: Option<f64>,
+        view: ([f64; 3], usize, FrameMode),
+    ) -> SweepStats {
+        check_one_lit(what, vol, cfg, tf, et, view, true)
+    }
+
+    /// [`check_one`] lit by the headlight (`lit`) or unlit (a reflectance map of 1 everywhere,
+    /// as a scene with `shading = false` makes it).
+    fn check_one_lit(
+        what: &str,
+        vol: &Volume,
+        cfg: &FrameConfig,
+        tf: &TransferFunction,
+        et: Option<f64>,
         (v, p, mode): ([f64; 3], usize, FrameMode),
+        lit: bool,
     ) -> SweepStats {
         let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), p).unwrap();
         let params = setup.params;
-        let units =
-            FrameUnits::with_config(cfg, mode, &setup, tf, &frame_phong(&params, &[]), et).unwrap();
+        let mut phong = frame_phong(&params, &[]);
+        if !lit {
+            (phong.ambient, phong.diffuse, phong.specular) = (1.0, 0.0, 0.0);
+        }
+        let units = FrameUnits::with_config(cfg, mode, &setup, tf, &phong, et).unwrap();
         let want = render_base_plane_reference(&params, vol, &units);
         let (got, st) = render_base_plane_stats(&params, vol, &units);
         assert_eq!((got.width, got.height), (want.width, want.height));
@@ -1168,6 +1193,55 @@ mod tests {
             assert_eq!(st.rays_terminated, reached);
             assert_eq!(st.shaded + st.without_effect, reached, "{v:?} {st:?}");
         }
+    }
+
+    /// An MRI-like volume (the head phantom with a smooth bias field and seeded noise, so that
+    /// no voxel is 0 and most blocks are neither empty nor opaque), rows not a whole number of
+    /// blocks (20 x 28 x 36: the last block of a row goes lane by lane), random views, MIP and
+    /// composite lit and unlit (the shaded and the flat path), with and without early
+    /// termination: the fast path equals the reference.
+    #[test]
+    fn fast_path_equals_the_reference_on_an_mri_like_volume() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 4);
+        let head = head_phantom(32, 12).unwrap();
+        let dims = [20, 28, 36];
+        let mut data = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    let v = head.get(x as i64 + 6, y as i64 + 2, z as i64 - 2) as f64;
+                    let bias = 1.0 + 0.2 * ((x + 2 * y) as f64 / 20.0).sin();
+                    let noise = rng.random_range(0.0..300.0);
+                    data.push((v * bias + noise).clamp(1.0, 4095.0) as u16);
+                }
+            }
+        }
+        let mri = Volume::new(dims, [1.0, 1.0, 1.3], 12, data).unwrap();
+        let vs = views(6, &mut rng);
+        let tf = TransferFunction::head_default();
+        let cfg = FrameConfig::DEFAULT;
+        let mut total = SweepStats::default();
+        for (n, v) in vs.iter().enumerate() {
+            let p = [1, 4][n % 2];
+            for et in [None, Some(ET_DEFAULT)] {
+                let view = (*v, p, FrameMode::Composite);
+                for lit in [true, false] {
+                    total = total.add(check_one_lit("MRI-like", &mri, &cfg, &tf, et, view, lit));
+                }
+            }
+            total = total.add(check_one(
+                "MRI-like",
+                &mri,
+                &cfg,
+                &tf,
+                None,
+                (*v, p, FrameMode::Mip),
+            ));
+        }
+        assert!(
+            total.shaded > 0 && total.without_effect > 0 && total.in_skipped_blocks > 0,
+            "{total:?}"
+        );
     }
 
     /// A volume that does not match the parameters goes to the reference, which reads it as
