@@ -2,7 +2,8 @@
 //! benchmark's scenes): the sweep (`render_sweep`), the rest of `FrameJob::render` (the hardware's
 //! counts), and the image (codes, warp, 8-bit to f64). Best of N frames per stage, one thread
 //! unless `RAYON_NUM_THREADS` says otherwise.
-//! `cargo run --release -p cube5-model --example peer_profile -- SCENE.toml [N]`
+//! `cargo run --release -p cube5-model --example peer_profile -- SCENE.toml [N] [sweep]`; with
+//! `sweep`, only the sweep, N times (for `perf record`).
 
 use cube5_model::scene::Scene;
 use cube5_model::scene_render::{frame_config, FrameJob};
@@ -37,6 +38,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let vol = scene.build_volume()?;
     let job = FrameJob::new(&scene, &vol, frame_config(&scene)?, 1)?;
     let params = &job.setup.params;
+    if args.get(2).map(String::as_str) == Some("sweep") {
+        let ((wall, cpu), (_, stats)) = best_ms(n, || render_sweep(params, &job.sweep, &job.units));
+        println!("sweep {wall:.2} ms (CPU {cpu:.1}); {stats:?}");
+        return Ok(());
+    }
     let (sweep, (base, stats)) = best_ms(n, || render_sweep(params, &job.sweep, &job.units));
     let (render, _) = best_ms(n, || job.render());
     let (_, regs) = job.warp_setup(&scene, &base)?;

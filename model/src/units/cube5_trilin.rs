@@ -162,6 +162,7 @@ impl Trilin {
     /// `top[n + 1]`, `bot[n]`, `bot[n + 1]` (`top` and `bot` at least one longer than `out`). The
     /// same three rounded lerps with the weights hoisted, in 32-bit lanes when no intermediate
     /// can pass 2^32 (`VoxelW + FracW + WeightW <= 31`), so that the compiler vectorizes the row.
+    #[inline(always)]
     pub fn row_in_slice(&self, top: &[u16], bot: &[u16], wx: u32, wy: u32, out: &mut [u32]) {
         let n = out.len();
         let (top, bot) = (&top[..n + 1], &bot[..n + 1]);

@@ -24,10 +24,13 @@
 //! is the identity of every coxel (the contract's rule for skipping empty slices).
 
 use super::{render_base_plane_reference, BasePlane, FrameMode, FrameParams, FrameUnits, STEP_W};
-use crate::units::cube5_compos::{CodedSample, Compos, ComposMode, Coxel, Sample};
+use crate::units::cube5_compos::{Compos, ComposMode, Coxel, Sample};
 use crate::units::cube5_shader::{Shader, ShaderIn, ShaderMode};
 use crate::volume::Volume;
 use rayon::prelude::*;
+
+mod lanes;
+use lanes::{LaneRules, RayLanes};
 
 /// What a frame's sweep computed and what it left out (the CLI's `plan:` line). These are the
 /// model's own counts: the hardware's (samples, beams of empty blocks, terminated rays) are the
@@ -80,8 +83,10 @@ pub struct SweepVolume {
     ni: usize,
     nj: usize,
     nk: usize,
-    /// Voxel `(i, j, k)` (`k` the volume index along `axes[2]`) at `(k (nj + 1) + j) (ni + 1) + i`;
+    /// Voxel `(i, j, k)` (`k` the volume index along `axes[2]`) at `(j nk + k) (ni + 1) + i`;
     /// column `ni` and row `nj` of every plane are 0 (the frame's zeros past the far faces).
+    /// Row `j` of consecutive planes is contiguous: a band of the sweep reads the same few rows
+    /// of plane after plane, so it streams through memory rather than jumping a plane a slice.
     data: Vec<u16>,
     /// Blocks per plane along `i` and `j`.
     nbi: usize,
@@ -119,10 +124,11 @@ impl SweepVolume {
         let (si, sj, sk) = (strides[axes[0]], strides[axes[1]], strides[axes[2]]);
         let (pi, pj) = (ni + 1, nj + 1);
         let mut data = vec![0u16; pi * pj * nk];
-        data.par_chunks_mut(pi * pj)
+        data.par_chunks_mut(pi * nk)
+            .take(nj)
             .enumerate()
-            .for_each(|(k, plane)| {
-                for (j, row) in plane.chunks_mut(pi).take(nj).enumerate() {
+            .for_each(|(j, rows)| {
+                for (k, row) in rows.chunks_mut(pi).enumerate() {
                     let base = j * sj + k * sk;
                     if si == 1 {
                         row[..ni].copy_from_slice(&vol.data[base..base + ni]);
@@ -140,12 +146,11 @@ impl SweepVolume {
             .zip(hi.par_chunks_mut(nbi * nbj))
             .enumerate()
             .for_each(|(k, (lo, hi))| {
-                let plane = &data[k * pi * pj..(k + 1) * pi * pj];
                 // Per row (the zero row included), per block column: the range of its columns.
                 let mut row_lo = vec![0u16; pj * nbi];
                 let mut row_hi = vec![0u16; pj * nbi];
                 for j in 0..pj {
-                    let row = &plane[j * pi..(j + 1) * pi];
+                    let row = &data[(j * nk + k) * pi..(j * nk + k + 1) * pi];
                     for bi in 0..nbi {
                         let cols = &row[bi * BLOCK..=(bi * BLOCK + BLOCK).min(ni)];
                         row_lo[j * nbi + bi] = cols.iter().copied().min().unwrap_or(0);
@@ -187,8 +192,32 @@ impl SweepVolume {
     #[inline(always)]
     fn row(&self, k: usize, j: usize) -> &[u16] {
         let pi = self.ni + 1;
-        let at = (k * (self.nj + 1) + j) * pi;
+        let at = (j * self.nk + k) * pi;
         &self.data[at..at + pi]
+    }
+
+    /// The voxels back in the volume's order (for the reference; spacing and width are not
+    /// kept, and the frame reads neither).
+    fn volume(&self) -> Volume {
+        let [nx, ny, nz] = self.dims;
+        let strides = [1, nx, nx * ny];
+        let mut data = vec![0u16; nx * ny * nz];
+        for k in 0..self.nk {
+            for j in 0..self.nj {
+                for (i, &v) in self.row(k, j)[..self.ni].iter().enumerate() {
+                    let at = i * strides[self.axes[0]]
+                        + j * strides[self.axes[1]]
+                        + k * strides[self.axes[2]];
+                    data[at] = v;
+                }
+            }
+        }
+        Volume {
+            dims: self.dims,
+            spacing: [1.0; 3],
+            bits: 16,
+            data,
+        }
     }
 
     /// Whether every voxel of plane `k` is 0.
@@ -313,10 +342,16 @@ struct SliceWork<'a> {
     sv: &'a SweepVolume,
     /// The corrected alpha of each class index (the compositing unit's `corrected` of the class
     /// entry's alpha): a sample's effect is known before its gradient.
-    corrected: &'a [u64],
-    /// The shaded sample of each class index, coded for the compositing unit (depth 0), when
-    /// the gradient does not matter.
-    flat: Option<&'a [CodedSample]>,
+    corrected: &'a [u32],
+    /// The colours of the shaded sample of each class index, coded for the compositing unit,
+    /// when the gradient does not matter.
+    flat: Option<&'a [[u32; 3]]>,
+    /// The compositing unit's rules of this slice, on lanes.
+    rules: LaneRules,
+    /// `Compos::code` of each colour code (a channel's code on the coxel's scale).
+    colour_code: &'a [u32],
+    /// `SampleW - ClassIdxW`: a sample's class index is `sample >> shift`.
+    shift: u32,
     /// Per block of this slice: the largest corrected alpha its samples can have.
     amax: &'a [u64],
     /// Samples of corrected alpha 0 are the identity of every coxel.
@@ -324,7 +359,6 @@ struct SliceWork<'a> {
     /// Base-plane column of anchor 0 and row of anchor row 0.
     r0: usize,
     q0: usize,
-    depth: u32,
     k: usize,
     wx: u32,
     wy: u32,
@@ -336,7 +370,7 @@ struct SliceWork<'a> {
 impl SliceWork<'_> {
     /// Makes sure block column `c` of anchor row `b` is in the band's plane rows (`b` within
     /// `b0 - 1 ..= b0 + BAND`; rows outside the face are left alone: they read as 0).
-    #[inline]
+    #[inline(always)]
     fn ensure(&self, band: &mut BandRows, b: isize, c: usize) {
         if b < 0 || b >= self.sv.nj as isize {
             return;
@@ -351,14 +385,20 @@ impl SliceWork<'_> {
         let top = self.sv.row(self.k, b as usize);
         let bot = self.sv.row(self.k, b as usize + 1);
         let out = &mut band.rows[r * ni + a0..r * ni + a1];
-        self.units
-            .trilin
-            .row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, out);
+        let trilin = &self.units.trilin;
+        if a1 - a0 == BLOCK {
+            // A whole block: a row of constant length, which the compiler unrolls into lanes.
+            let mut o = [0u32; BLOCK];
+            trilin.row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, &mut o);
+            out.copy_from_slice(&o);
+        } else {
+            trilin.row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, out);
+        }
     }
 
     /// `S'(t)` at anchors `a0 .. a0 + out.len()` of row `b`: slice `k(t)`'s voxels, slice `s`'s
     /// weights (0 outside).
-    #[inline]
+    #[inline(always)]
     fn other_row(&self, k: Option<usize>, a0: usize, b: usize, out: &mut [u32]) {
         match k {
             None => out.fill(0),
@@ -371,124 +411,127 @@ impl SliceWork<'_> {
         }
     }
 
-    /// Anchor rows `b0 ..` against their rows of coxels (`rows`, one base-plane row each, `w`
-    /// coxels long). Inlined at a constant `mode` and `lit` so that the unit functions' mode
-    /// branches fold.
+    /// Anchor rows `b0 ..` against their rows of coxels: lanes `at + db w ..` of `rays` for
+    /// anchor row `b0 + db` (`n_rows` rows, `w` coxels each). `LIT`: the shaded colour depends
+    /// on the gradient.
     #[inline(always)]
-    fn band(
+    fn band<const LIT: bool>(
         &self,
         b0: usize,
-        rows: &mut [Coxel],
-        w: usize,
+        rays: &mut RayLanes,
+        at: usize,
+        (n_rows, w): (usize, usize),
         band: &mut BandRows,
-        mode: FrameMode,
-        lit: bool,
     ) -> SweepStats {
-        let (smode, cmode) = modes(mode);
-        let units = self.units;
-        let (ni, nj, nbi) = (self.sv.ni, self.sv.nj, self.sv.nbi);
+        let (ni, nbi) = (self.sv.ni, self.sv.nbi);
         let mut st = SweepStats::default();
         band.b0 = b0 as isize;
         band.done.fill(0);
-        let shift = units.shader.config().sample_w() - units.shader.config().class_idx_w;
-        for (db, row) in rows.chunks_mut(w).enumerate() {
+        for db in 0..n_rows {
             let b = b0 + db;
             st.samples += ni as u64;
             let amax = &self.amax[(b / BLOCK) * nbi..(b / BLOCK + 1) * nbi];
-            let row = &mut row[self.r0..self.r0 + ni];
-            for (c, (&am, cox)) in amax.iter().zip(row.chunks_mut(BLOCK)).enumerate() {
-                // A block whose samples cannot change a coxel it meets: `leaves_unchanged` holds
-                // for its largest alpha, so for every smaller one (rules 1-4 do not read the
-                // alpha; rule 5 keeps alpha 0 under `FrontToBack`, anything up to the coxel's
-                // under `Max`).
-                if (am == 0 && self.zero_ok)
-                    || cox.iter().all(|x| {
-                        units
-                            .compos
-                            .leaves_unchanged_corrected(x, am, self.depth, cmode)
-                    })
-                {
-                    st.in_skipped_blocks += cox.len() as u64;
-                    continue;
+            let row_at = at + db * w + self.r0;
+            for (c, &am) in amax.iter().enumerate() {
+                let a0 = c * BLOCK;
+                let len = BLOCK.min(ni - a0);
+                let lane = row_at + a0;
+                let k = if len == BLOCK {
+                    self.block::<BLOCK, LIT>(band, rays, (b, c), a0, lane, am)
+                } else {
+                    // The last block of a row narrower than a block: lane by lane.
+                    let mut k = SweepStats::default();
+                    for n in 0..len {
+                        k = k.add(self.block::<1, LIT>(band, rays, (b, c), a0 + n, lane + n, am));
+                    }
+                    k
+                };
+                st = st.add(k);
+            }
+        }
+        st
+    }
+
+    /// Anchors `a0 .. a0 + N` of anchor row `b` (in block column `c`) against lanes `lane ..` of
+    /// `rays`, whose samples have corrected alphas of at most `am`: skipped when they cannot change
+    /// a coxel, else interpolated, classified, shaded where the colour depends on the gradient
+    /// (`LIT`) and they change their coxel, and composited.
+    #[inline(always)]
+    fn block<const N: usize, const LIT: bool>(
+        &self,
+        band: &mut BandRows,
+        rays: &mut RayLanes,
+        (b, c): (usize, usize),
+        a0: usize,
+        lane: usize,
+        am: u64,
+    ) -> SweepStats {
+        let units = self.units;
+        let rules = &self.rules;
+        let (ni, nj) = (self.sv.ni, self.sv.nj);
+        let mut st = SweepStats::default();
+        // Samples that cannot change a coxel they meet: `leaves_unchanged` holds for their
+        // largest alpha, so for every smaller one (rules 1-4 do not read the alpha; rule 5 keeps
+        // alpha 0 under `FrontToBack`, anything up to the coxel's under `Max`).
+        if (am == 0 && self.zero_ok) || rules.all_unchanged::<N>(rays, lane, am) {
+            st.in_skipped_blocks += N as u64;
+            return st;
+        }
+        self.ensure(band, b as isize, c);
+        let r = (b as isize - band.b0 + 1) as usize;
+        let centre: [u32; N] = band.rows[r * ni + a0..r * ni + a0 + N]
+            .try_into()
+            .expect("N anchors");
+        let shift = self.shift;
+        let idx: [usize; N] = std::array::from_fn(|n| (centre[n] >> shift) as usize);
+        let sa: [u32; N] = std::array::from_fn(|n| self.corrected[idx[n]]);
+        let mut sc = [[0u32; N]; 3];
+        if let Some(flat) = self.flat {
+            for n in 0..N {
+                let e = flat[idx[n]];
+                for ch in 0..3 {
+                    sc[ch][n] = e[ch];
                 }
-                self.ensure(band, b as isize, c);
-                let r = (b as isize - band.b0 + 1) as usize;
-                let mut neighbours = false;
-                let cox_len = cox.len();
-                let (mut before, mut after) = ([0u32; BLOCK], [0u32; BLOCK]);
-                for (n, cox) in cox.iter_mut().enumerate() {
-                    let a = c * BLOCK + n;
-                    if cox.terminated {
-                        st.after_termination += 1;
-                        continue;
+            }
+        } else if LIT {
+            // The samples that change their coxel go through gradient and shader.
+            let changes = rules.changes::<N>(rays, lane, &sa);
+            if changes.iter().any(|&x| x) {
+                if c > 0 {
+                    self.ensure(band, b as isize, c - 1);
+                }
+                if (c + 1) * BLOCK < ni {
+                    self.ensure(band, b as isize, c + 1);
+                }
+                self.ensure(band, b as isize - 1, c);
+                self.ensure(band, b as isize + 1, c);
+                // `B = S'(s-1)` and `A = S'(s+1)` of the anchors, in lanes.
+                let (mut before, mut after) = ([0u32; N], [0u32; N]);
+                self.other_row(self.k_before, a0, b, &mut before);
+                self.other_row(self.k_after, a0, b, &mut after);
+                let at = |rr: usize, aa: usize| band.rows[rr * ni + aa] as i32;
+                for n in (0..N).filter(|&n| changes[n]) {
+                    let a = a0 + n;
+                    let xm = if a > 0 { at(r, a - 1) } else { 0 };
+                    let xp = if a + 1 < ni { at(r, a + 1) } else { 0 };
+                    let ym = if b > 0 { at(r - 1, a) } else { 0 };
+                    let yp = if b + 1 < nj { at(r + 1, a) } else { 0 };
+                    // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
+                    // (`n6_components`, `shader_in`): the differences themselves. The magnitude
+                    // is not computed: the frame never classifies in 2-D.
+                    let grad = [xp - xm, yp - ym, after[n] as i32 - before[n] as i32];
+                    let e = units.shader.shade_lit_by_float_division(centre[n], grad);
+                    // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
+                    for (ch, v) in [e.r, e.g, e.b].into_iter().enumerate() {
+                        sc[ch][n] = self.colour_code[v as usize];
                     }
-                    let centre = band.rows[r * ni + a];
-                    let idx = (centre >> shift) as usize;
-                    let corrected = self.corrected[idx];
-                    if units
-                        .compos
-                        .leaves_unchanged_corrected(cox, corrected, self.depth, cmode)
-                    {
-                        st.without_effect += 1;
-                        continue;
-                    }
-                    if lit {
-                        if !neighbours {
-                            neighbours = true;
-                            if c > 0 {
-                                self.ensure(band, b as isize, c - 1);
-                            }
-                            if (c + 1) * BLOCK < ni {
-                                self.ensure(band, b as isize, c + 1);
-                            }
-                            self.ensure(band, b as isize - 1, c);
-                            self.ensure(band, b as isize + 1, c);
-                            // `B = S'(s-1)` and `A = S'(s+1)` of the block's row, in lanes.
-                            let len = cox_len;
-                            self.other_row(self.k_before, c * BLOCK, b, &mut before[..len]);
-                            self.other_row(self.k_after, c * BLOCK, b, &mut after[..len]);
-                        }
-                        let at = |rr: usize, aa: usize| band.rows[rr * ni + aa] as i32;
-                        let xm = if a > 0 { at(r, a - 1) } else { 0 };
-                        let xp = if a + 1 < ni { at(r, a + 1) } else { 0 };
-                        let ym = if b > 0 { at(r - 1, a) } else { 0 };
-                        let yp = if b + 1 < nj { at(r + 1, a) } else { 0 };
-                        // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
-                        // (`n6_components`, `shader_in`): the differences themselves. The
-                        // magnitude is not computed: the frame never classifies in 2-D.
-                        let grad = [xp - xm, yp - ym, after[n] as i32 - before[n] as i32];
-                        let e = units.shader.shade_lit_by_float_division(centre, grad);
-                        let sample = Sample {
-                            rgb: [e.r, e.g, e.b],
-                            alpha: e.a,
-                            depth: self.depth,
-                            mode: cmode,
-                        };
-                        // `Compos::step`, spelled out so that it inlines here.
-                        *cox = units.compos.step_coded(cox, &units.compos.code(&sample));
-                    } else if let Some(flat) = self.flat {
-                        // The table's mode is `cmode`; a constant here, so that `step_coded`'s
-                        // other modes fold away.
-                        let coded = CodedSample {
-                            depth: self.depth,
-                            mode: cmode,
-                            ..flat[idx]
-                        };
-                        *cox = units.compos.step_coded(cox, &coded);
-                    } else {
-                        let e = units.shader.shade(&class_in(centre, smode));
-                        let sample = Sample {
-                            rgb: [e.r, e.g, e.b],
-                            alpha: e.a,
-                            depth: self.depth,
-                            mode: cmode,
-                        };
-                        *cox = units.compos.step(cox, &sample);
-                    }
-                    st.shaded += 1;
                 }
             }
         }
+        let k = rules.step::<N>(rays, lane, &sa, &sc);
+        st.shaded += k.shaded;
+        st.without_effect += k.without_effect;
+        st.after_termination += k.after_termination;
         st
     }
 }
@@ -496,17 +539,17 @@ impl SliceWork<'_> {
 /// Base-plane rows `q ..` (`rows`, `w` coxels each) through every swept slice in order: the
 /// anchor rows of each slice that feed them, as one band.
 #[inline(always)]
-fn sweep_band(
+fn sweep_band<const LIT: bool>(
     slices: &[SliceWork],
     q: usize,
     rows: &mut [Coxel],
     w: usize,
     band: &mut BandRows,
-    mode: FrameMode,
-    lit: bool,
 ) -> SweepStats {
     let mut st = SweepStats::default();
     let n_rows = rows.len() / w;
+    let init = rows[0];
+    let mut rays = RayLanes::new(rows.len());
     for work in slices {
         let nj = work.sv.nj;
         // Anchor rows `b` with `q <= b + q0 < q + n_rows`, within `0 .. nj`.
@@ -516,16 +559,44 @@ fn sweep_band(
             continue;
         }
         let at = b0 + work.q0 - q;
-        st = st.add(work.band(
-            b0,
-            &mut rows[at * w..(at + b1 - b0) * w],
-            w,
-            band,
-            mode,
-            lit,
-        ));
+        st = st.add(work.band::<LIT>(b0, &mut rays, at * w, (b1 - b0, w), band));
     }
+    rays.write(&init, rows);
     st
+}
+
+/// [`sweep_band`] compiled for AVX2: the same code, so the same bits, in wider vector
+/// instructions (the 32-bit lane products of the interpolation and the compositing have no
+/// SSE2 instruction).
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sweep_band_avx2<const LIT: bool>(
+    slices: &[SliceWork],
+    q: usize,
+    rows: &mut [Coxel],
+    w: usize,
+    band: &mut BandRows,
+) -> SweepStats {
+    sweep_band::<LIT>(slices, q, rows, w, band)
+}
+
+/// [`sweep_band`], in AVX2 where the CPU has it.
+fn sweep_band_dispatch<const LIT: bool>(
+    slices: &[SliceWork],
+    q: usize,
+    rows: &mut [Coxel],
+    w: usize,
+    band: &mut BandRows,
+) -> SweepStats {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (detected just above), `sweep_band_avx2`'s one requirement.
+        return unsafe { sweep_band_avx2::<LIT>(slices, q, rows, w, band) };
+    }
+    sweep_band::<LIT>(slices, q, rows, w, band)
 }
 
 /// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md): the
@@ -596,19 +667,35 @@ pub fn render_sweep(
     let lit = gradient_matters(&units.shader, smode);
     // Without the gradient, a sample's way through the shader and the compositing unit's coding
     // is a function of its class index: the units' own outputs, once per index.
-    let flat: Option<Vec<CodedSample>> = (!lit).then(|| {
+    let flat: Option<Vec<[u32; 3]>> = (!lit).then(|| {
         (0..corrected.len())
             .map(|idx| {
                 let e = units.shader.shade(&class_in((idx as u32) << shift, smode));
-                units.compos.code(&Sample {
+                lanes::colours(&units.compos.code(&Sample {
                     rgb: [e.r, e.g, e.b],
                     alpha: e.a,
                     depth: 0,
                     mode: cmode,
-                })
+                }))
             })
             .collect()
     });
+    // The compositing unit's code of each colour code, from `Compos::code` (it codes each
+    // channel alone).
+    let colours = units.compos.config().color_max().max(scfg.color_max());
+    let colour_code: Vec<u32> = (0..=colours)
+        .map(|c| {
+            let coded = units.compos.code(&Sample {
+                rgb: [c; 3],
+                alpha: 0,
+                depth: 0,
+                mode: cmode,
+            });
+            lanes::colours(&coded)[0]
+        })
+        .collect();
+    // The corrected alphas in lanes (`<= 2^Q`).
+    let corrected32: Vec<u32> = corrected.iter().map(|&a| a as u32).collect();
     let zero_ok = zero_alpha_is_identity(&units.compos, &init, cmode);
     // A voxel range's class indices (samples lie between their corners' smallest and largest).
     let frac = units.trilin.config().frac_w;
@@ -651,29 +738,36 @@ pub fn render_sweep(
             *m = range_max.max(idx_of(lo), idx_of(hi));
         }
     });
-    let slices: Vec<SliceWork> = swept
+    let slices: Option<Vec<SliceWork>> = swept
         .clone()
         .zip(amax.chunks_exact(nb))
         .map(|(s, amax)| {
             let c = params.slice(s);
-            SliceWork {
+            Some(SliceWork {
                 units,
                 sv,
-                corrected: &corrected,
+                corrected: &corrected32,
                 flat: flat.as_deref(),
+                rules: LaneRules::new(&units.compos, cmode, s as u32)?,
+                colour_code: &colour_code,
+                shift,
                 amax,
                 zero_ok,
                 r0: (max_sx - c.shift_x) as usize,
                 q0: (max_sy - c.shift_y) as usize,
-                depth: s as u32,
                 k: c.k,
                 wx: weight(c.frac_x),
                 wy: weight(c.frac_y),
                 k_before: (s > 0).then(|| params.slice(s - 1).k),
                 k_after: (s + 1 < nk).then(|| params.slice(s + 1).k),
-            }
+            })
         })
         .collect();
+    let Some(slices) = slices else {
+        // Not a mode the lanes take (the frame's modes always are): the reference.
+        let bp = render_base_plane_reference(params, &sv.volume(), units);
+        return (bp, stats);
+    };
     // Bands of base-plane rows in parallel, each through every slice in order (a ray's samples
     // arrive in slice order; anchor row `b` of slice `s` feeds row `b + q0(s)` only, so no two
     // bands share a coxel): one parallel split per frame, and a band's coxels stay in the
@@ -685,16 +779,10 @@ pub fn render_sweep(
         .map(|(n, rows)| {
             let mut band = BandRows::new(ni);
             let q = n * BAND;
-            match (units.mode, lit) {
-                (FrameMode::Mip, _) => {
-                    sweep_band(&slices, q, rows, w, &mut band, FrameMode::Mip, false)
-                }
-                (FrameMode::Composite, false) => {
-                    sweep_band(&slices, q, rows, w, &mut band, FrameMode::Composite, false)
-                }
-                (FrameMode::Composite, true) => {
-                    sweep_band(&slices, q, rows, w, &mut band, FrameMode::Composite, true)
-                }
+            if lit {
+                sweep_band_dispatch::<true>(&slices, q, rows, w, &mut band)
+            } else {
+                sweep_band_dispatch::<false>(&slices, q, rows, w, &mut band)
             }
         })
         .reduce(SweepStats::default, SweepStats::add);
@@ -767,12 +855,29 @@ mod tests {
         cfg: &FrameConfig,
         tf: &TransferFunction,
         et: Option<f64>,
+        view: ([f64; 3], usize, FrameMode),
+    ) -> SweepStats {
+        check_one_lit(what, vol, cfg, tf, et, view, true)
+    }
+
+    /// [`check_one`] lit by the headlight (`lit`) or unlit (a reflectance map of 1 everywhere,
+    /// as a scene with `shading = false` makes it).
+    fn check_one_lit(
+        what: &str,
+        vol: &Volume,
+        cfg: &FrameConfig,
+        tf: &TransferFunction,
+        et: Option<f64>,
         (v, p, mode): ([f64; 3], usize, FrameMode),
+        lit: bool,
     ) -> SweepStats {
         let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), p).unwrap();
         let params = setup.params;
-        let units =
-            FrameUnits::with_config(cfg, mode, &setup, tf, &frame_phong(&params, &[]), et).unwrap();
+        let mut phong = frame_phong(&params, &[]);
+        if !lit {
+            (phong.ambient, phong.diffuse, phong.specular) = (1.0, 0.0, 0.0);
+        }
+        let units = FrameUnits::with_config(cfg, mode, &setup, tf, &phong, et).unwrap();
         let want = render_base_plane_reference(&params, vol, &units);
         let (got, st) = render_base_plane_stats(&params, vol, &units);
         assert_eq!((got.width, got.height), (want.width, want.height));
@@ -1088,6 +1193,55 @@ mod tests {
             assert_eq!(st.rays_terminated, reached);
             assert_eq!(st.shaded + st.without_effect, reached, "{v:?} {st:?}");
         }
+    }
+
+    /// An MRI-like volume (the head phantom with a smooth bias field and seeded noise, so that
+    /// no voxel is 0 and most blocks are neither empty nor opaque), rows not a whole number of
+    /// blocks (20 x 28 x 36: the last block of a row goes lane by lane), random views, MIP and
+    /// composite lit and unlit (the shaded and the flat path), with and without early
+    /// termination: the fast path equals the reference.
+    #[test]
+    fn fast_path_equals_the_reference_on_an_mri_like_volume() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 4);
+        let head = head_phantom(32, 12).unwrap();
+        let dims = [20, 28, 36];
+        let mut data = Vec::with_capacity(dims[0] * dims[1] * dims[2]);
+        for z in 0..dims[2] {
+            for y in 0..dims[1] {
+                for x in 0..dims[0] {
+                    let v = head.get(x as i64 + 6, y as i64 + 2, z as i64 - 2) as f64;
+                    let bias = 1.0 + 0.2 * ((x + 2 * y) as f64 / 20.0).sin();
+                    let noise = rng.random_range(0.0..300.0);
+                    data.push((v * bias + noise).clamp(1.0, 4095.0) as u16);
+                }
+            }
+        }
+        let mri = Volume::new(dims, [1.0, 1.0, 1.3], 12, data).unwrap();
+        let vs = views(6, &mut rng);
+        let tf = TransferFunction::head_default();
+        let cfg = FrameConfig::DEFAULT;
+        let mut total = SweepStats::default();
+        for (n, v) in vs.iter().enumerate() {
+            let p = [1, 4][n % 2];
+            for et in [None, Some(ET_DEFAULT)] {
+                let view = (*v, p, FrameMode::Composite);
+                for lit in [true, false] {
+                    total = total.add(check_one_lit("MRI-like", &mri, &cfg, &tf, et, view, lit));
+                }
+            }
+            total = total.add(check_one(
+                "MRI-like",
+                &mri,
+                &cfg,
+                &tf,
+                None,
+                (*v, p, FrameMode::Mip),
+            ));
+        }
+        assert!(
+            total.shaded > 0 && total.without_effect > 0 && total.in_skipped_blocks > 0,
+            "{total:?}"
+        );
     }
 
     /// A volume that does not match the parameters goes to the reference, which reads it as

@@ -1,0 +1,378 @@
+//! The frame's compositing in lanes: the rays of a band as a structure of arrays of 32-bit lanes
+//! ([`RayLanes`]), and `Compos::step_coded` of the frame's two modes (`FrontToBack`, `Max`) on a
+//! row of them as straight-line code ([`LaneRules`]), so that a row of samples costs no
+//! data-dependent branch (`docs/numerics/frame.md`, "The model's fast path").
+//!
+//! Why the lanes hold a frame's coxels exactly: every frame coxel starts as `Coxel::empty` (no
+//! geometry: `z = Znone`, geometry colour 0) and the compositing unit never writes `z` or the
+//! geometry colour outside `Flush`, which the frame never sends; so a frame coxel is its `R, G, B,
+//! A` and its terminated flag. `R, G, B` are saturated to `chan_max < 2^29` at every write
+//! (`AccW <= 28`), and `A` stays at most `one = 2^AccW` (rule 5 adds at most `1 - A`; `Max` writes
+//! a corrected alpha `<= 2^Q` on the `2^AccW` scale). The products (`t a`, `w c`) are taken in 64
+//! bits, as `Compos::step_coded` takes them.
+
+use crate::units::cube5_compos::{rnd, CodedSample, Compos, ComposMode, Coxel};
+
+/// The coxels of a band: lane `n` is coxel `n` (row-major, the band's rows).
+pub(super) struct RayLanes {
+    pub c: [Vec<u32>; 3],
+    pub a: Vec<u32>,
+    /// 1: the ray is terminated.
+    pub term: Vec<u32>,
+}
+
+impl RayLanes {
+    /// `len` empty coxels.
+    pub fn new(len: usize) -> Self {
+        Self {
+            c: std::array::from_fn(|_| vec![0; len]),
+            a: vec![0; len],
+            term: vec![0; len],
+        }
+    }
+
+    /// The coxels, each `init` (the frame's `Coxel::empty`) with the lanes' `R, G, B, A` and flag.
+    pub fn write(&self, init: &Coxel, out: &mut [Coxel]) {
+        for (n, x) in out.iter_mut().enumerate() {
+            *x = Coxel {
+                rgba: [
+                    u64::from(self.c[0][n]),
+                    u64::from(self.c[1][n]),
+                    u64::from(self.c[2][n]),
+                    u64::from(self.a[n]),
+                ],
+                terminated: self.term[n] != 0,
+                ..*init
+            };
+        }
+    }
+}
+
+/// What a row of samples did (the sweep's counts, `SweepStats`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(super) struct RowCounts {
+    pub shaded: u64,
+    pub without_effect: u64,
+    pub after_termination: u64,
+}
+
+/// The compositing unit's constants of one slice of a frame, for its two modes on lanes.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LaneRules {
+    mode: ComposMode,
+    /// `AccW` (the coxel's scale `2^f`) and `Q` (the corrected alpha's).
+    f: u32,
+    q: u32,
+    one: u32,
+    chan_max: u32,
+    et: u32,
+    /// The slice's depth fails the depth test (`depth >= Znone`, every frame coxel's `z`):
+    /// rule 4 leaves every coxel unchanged.
+    past: bool,
+}
+
+impl LaneRules {
+    /// The rules of `compos` in `mode` (`FrontToBack` or `Max`: `None` otherwise) for samples of
+    /// depth `depth` against frame coxels (`z = Znone`).
+    pub fn new(compos: &Compos, mode: ComposMode, depth: u32) -> Option<Self> {
+        let cfg = compos.config();
+        if !matches!(mode, ComposMode::FrontToBack | ComposMode::Max) || cfg.acc_w > 29 {
+            return None;
+        }
+        Some(Self {
+            mode,
+            f: cfg.acc_w,
+            q: cfg.q(),
+            one: cfg.one() as u32,
+            chan_max: cfg.chan_max() as u32,
+            et: compos.regs().et_threshold.min(u64::from(u32::MAX)) as u32,
+            past: depth >= cfg.z_none(),
+        })
+    }
+
+    /// Whether `Compos::leaves_unchanged_corrected` holds at corrected alpha `am` for every coxel
+    /// of lanes `at .. at + N` (so for every smaller alpha: it is monotone in the alpha).
+    #[inline(always)]
+    pub fn all_unchanged<const N: usize>(&self, st: &RayLanes, at: usize, am: u64) -> bool {
+        let a: &[u32; N] = st.a[at..at + N].try_into().expect("N lanes");
+        let term: &[u32; N] = st.term[at..at + N].try_into().expect("N lanes");
+        let mut keep = 0u32;
+        match self.mode {
+            ComposMode::FrontToBack => {
+                let zero = self.past || am == 0;
+                for i in 0..N {
+                    keep += u32::from(term[i] != 0) | (u32::from(a[i] < self.et) & u32::from(zero));
+                }
+            }
+            _ => {
+                if self.past {
+                    return true;
+                }
+                // `am <= 2^Q`, so on the coxel's scale it is at most `2^AccW`.
+                let aw = (am << (self.f - self.q)) as u32;
+                for i in 0..N {
+                    keep += u32::from(term[i] != 0) | u32::from(aw <= a[i]);
+                }
+            }
+        }
+        keep == N as u32
+    }
+
+    /// Which lanes `at .. at + N` a sample of corrected alpha `sa[n]` would change (rule 5
+    /// writes the coxel, or rule 3 terminates it): `!Compos::leaves_unchanged_corrected`, and the
+    /// ray not terminated. These are the samples the sweep shades.
+    #[inline(always)]
+    pub fn changes<const N: usize>(&self, st: &RayLanes, at: usize, sa: &[u32; N]) -> [bool; N] {
+        let a: &[u32; N] = st.a[at..at + N].try_into().expect("N lanes");
+        let term: &[u32; N] = st.term[at..at + N].try_into().expect("N lanes");
+        std::array::from_fn(|i| match self.mode {
+            ComposMode::FrontToBack => {
+                term[i] == 0 && !(a[i] < self.et && (self.past || sa[i] == 0))
+            }
+            _ => term[i] == 0 && !self.past && (sa[i] << (self.f - self.q)) > a[i],
+        })
+    }
+
+    /// `Compos::step_coded` of the samples `sa[n]` (corrected alpha) and `sc[ch][n]` (colour
+    /// codes on the coxel's scale) onto lanes `at .. at + N`, in this slice's mode; the colours
+    /// of a sample that changes nothing are not read. Returns the sweep's counts of the row.
+    #[inline(always)]
+    pub fn step<const N: usize>(
+        &self,
+        st: &mut RayLanes,
+        at: usize,
+        sa: &[u32; N],
+        sc: &[[u32; N]; 3],
+    ) -> RowCounts {
+        let [c0, c1, c2] = &mut st.c;
+        let lanes = |v: &mut Vec<u32>| -> [u32; N] { v[at..at + N].try_into().expect("N lanes") };
+        let (mut c, mut a, mut term) = (
+            [lanes(c0), lanes(c1), lanes(c2)],
+            lanes(&mut st.a),
+            lanes(&mut st.term),
+        );
+        let (mut shaded, mut none_n, mut after) = (0u32, 0u32, 0u32);
+        match self.mode {
+            ComposMode::FrontToBack => {
+                let (f, q) = (self.f, self.q);
+                let (et, one, chan_max) = (self.et, self.one, u64::from(self.chan_max));
+                // Rule 4 (past the depth) gives every lane the weight 0.
+                let open = u64::from(!self.past);
+                for i in 0..N {
+                    let (a_in, t) = (a[i], term[i]);
+                    // Rule 1 (terminated) and rule 3 (at the threshold): no weight. Rule 5
+                    // otherwise; a zero alpha gives a zero weight, which adds 0 to channels
+                    // already saturated.
+                    let live = t == 0 && a_in < et;
+                    let wt = u64::from(live) * open * u64::from(one - a_in.min(one));
+                    let w = rnd(wt * u64::from(sa[i]), q);
+                    for ch in 0..3 {
+                        c[ch][i] = (u64::from(c[ch][i]) + rnd(w * u64::from(sc[ch][i]), f))
+                            .min(chan_max) as u32;
+                    }
+                    let a_out = a_in + w as u32;
+                    a[i] = a_out;
+                    term[i] = t | u32::from(a_out >= et);
+                    let none = live && (self.past || sa[i] == 0);
+                    after += u32::from(t != 0);
+                    none_n += u32::from(none);
+                    shaded += u32::from(t == 0 && !none);
+                }
+            }
+            _ => {
+                let sh = self.f - self.q;
+                for i in 0..N {
+                    let t = term[i];
+                    let aw = sa[i] << sh;
+                    let wins = t == 0 && !self.past && aw > a[i];
+                    for ch in 0..3 {
+                        c[ch][i] = if wins { sc[ch][i] } else { c[ch][i] };
+                    }
+                    a[i] = if wins { aw } else { a[i] };
+                    after += u32::from(t != 0);
+                    none_n += u32::from(t == 0 && !wins);
+                    shaded += u32::from(wins);
+                }
+            }
+        }
+        c0[at..at + N].copy_from_slice(&c[0]);
+        c1[at..at + N].copy_from_slice(&c[1]);
+        c2[at..at + N].copy_from_slice(&c[2]);
+        st.a[at..at + N].copy_from_slice(&a);
+        st.term[at..at + N].copy_from_slice(&term);
+        RowCounts {
+            shaded: u64::from(shaded),
+            without_effect: u64::from(none_n),
+            after_termination: u64::from(after),
+        }
+    }
+}
+
+/// The coded sample's colours as lanes (`c_w` on the coxel's scale, `<= 2^AccW`).
+#[inline(always)]
+pub(super) fn colours(s: &CodedSample) -> [u32; 3] {
+    s.c_w.map(|c| c as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::units::cube5_compos::{ComposConfig, ComposRegs, OpacityLut, Sample};
+    use rand::{Rng, SeedableRng};
+
+    fn seed() -> u64 {
+        std::env::var("CUBE5_SEED")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1313)
+    }
+
+    /// The lanes' rules equal `Compos::step_coded` and `Compos::leaves_unchanged_corrected` on
+    /// frame coxels (any reachable `R, G, B, A` and flag, `z = Znone`, no geometry): random
+    /// coxels and samples, both modes, depths before and past `Znone`, the narrow, default and
+    /// wide widths, thresholds 0, the default and disabled.
+    #[test]
+    fn lanes_equal_the_compositing_unit() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 7);
+        for cfg in [
+            ComposConfig::NARROW,
+            ComposConfig::DEFAULT,
+            ComposConfig::WIDE,
+            ComposConfig::new(12, 12, 6, 28, 16).unwrap(),
+        ] {
+            let one = cfg.one();
+            for regs in [
+                ComposRegs::defaults(&cfg),
+                ComposRegs::without_termination(&cfg),
+                ComposRegs {
+                    et_threshold: 0,
+                    ..ComposRegs::defaults(&cfg)
+                },
+            ] {
+                let ratio = rng.random_range(0.3..3.0);
+                let c = Compos::new(cfg, OpacityLut::new(ratio, &cfg).unwrap(), regs).unwrap();
+                let init = Coxel::empty(&cfg);
+                for mode in [ComposMode::FrontToBack, ComposMode::Max] {
+                    for _ in 0..400 {
+                        let depth = match rng.random_range(0..4) {
+                            0 => cfg.z_none(),
+                            _ => rng.random_range(0..cfg.z_none()),
+                        };
+                        let rules = LaneRules::new(&c, mode, depth).unwrap();
+                        const N: usize = 8;
+                        let n = N;
+                        let coxels: Vec<Coxel> = (0..n)
+                            .map(|_| {
+                                let a = match rng.random_range(0..4) {
+                                    0 => 0,
+                                    1 => one,
+                                    2 => regs.et_threshold.min(one),
+                                    _ => rng.random_range(0..=one),
+                                };
+                                Coxel {
+                                    rgba: [0, 1, 2]
+                                        .map(|_| match rng.random_range(0..3) {
+                                            0 => cfg.chan_max(),
+                                            _ => rng.random_range(0..=cfg.chan_max()),
+                                        })
+                                        .into_iter()
+                                        .chain([a])
+                                        .collect::<Vec<_>>()
+                                        .try_into()
+                                        .unwrap(),
+                                    terminated: rng.random_bool(0.2),
+                                    ..init
+                                }
+                            })
+                            .collect();
+                        let samples: Vec<CodedSample> = (0..n)
+                            .map(|_| {
+                                let alpha = match rng.random_range(0..3) {
+                                    0 => 0,
+                                    _ => rng.random_range(0..=cfg.alpha_max()),
+                                };
+                                c.code(&Sample {
+                                    rgb: std::array::from_fn(|_| {
+                                        rng.random_range(0..=cfg.color_max())
+                                    }),
+                                    alpha,
+                                    depth,
+                                    mode,
+                                })
+                            })
+                            .collect();
+                        let mut st = RayLanes::new(n);
+                        for (i, x) in coxels.iter().enumerate() {
+                            for ch in 0..3 {
+                                st.c[ch][i] = x.rgba[ch] as u32;
+                            }
+                            st.a[i] = x.rgba[3] as u32;
+                            st.term[i] = u32::from(x.terminated);
+                        }
+                        let sa: [u32; N] = std::array::from_fn(|i| samples[i].a as u32);
+                        let sc: [[u32; N]; 3] = std::array::from_fn(|ch| {
+                            std::array::from_fn(|i| colours(&samples[i])[ch])
+                        });
+                        // The block test at the largest alpha of the row.
+                        let am = samples.iter().map(|s| s.a).max().unwrap();
+                        let want_all = coxels
+                            .iter()
+                            .all(|x| c.leaves_unchanged_corrected(x, am, depth, mode));
+                        assert_eq!(rules.all_unchanged::<N>(&st, 0, am), want_all, "{mode:?}");
+                        // And lane by lane.
+                        for (i, x) in coxels.iter().enumerate() {
+                            let want = c.leaves_unchanged_corrected(x, am, depth, mode);
+                            assert_eq!(rules.all_unchanged::<1>(&st, i, am), want, "{mode:?}");
+                        }
+                        let ch = rules.changes::<N>(&st, 0, &sa);
+                        let mut want = RowCounts::default();
+                        for (i, (x, s)) in coxels.iter().zip(&samples).enumerate() {
+                            let unchanged = c.leaves_unchanged_corrected(x, s.a, depth, mode);
+                            if x.terminated {
+                                want.after_termination += 1;
+                            } else if unchanged {
+                                want.without_effect += 1;
+                            } else {
+                                want.shaded += 1;
+                            }
+                            assert_eq!(ch[i], !x.terminated && !unchanged, "{mode:?} {x:?} {s:?}");
+                        }
+                        // Eight lanes at once, and one at a time.
+                        let mut one_by_one = RayLanes::new(n);
+                        for (d, s) in one_by_one.c.iter_mut().zip(&st.c) {
+                            d.copy_from_slice(s);
+                        }
+                        one_by_one.a.copy_from_slice(&st.a);
+                        one_by_one.term.copy_from_slice(&st.term);
+                        let got = rules.step::<N>(&mut st, 0, &sa, &sc);
+                        assert_eq!(got, want, "{mode:?}");
+                        let mut sum = RowCounts::default();
+                        for i in 0..n {
+                            let k = rules.step::<1>(
+                                &mut one_by_one,
+                                i,
+                                &[sa[i]],
+                                &[[sc[0][i]], [sc[1][i]], [sc[2][i]]],
+                            );
+                            sum.shaded += k.shaded;
+                            sum.without_effect += k.without_effect;
+                            sum.after_termination += k.after_termination;
+                        }
+                        assert_eq!(sum, want, "{mode:?}");
+                        for lanes in [&st, &one_by_one] {
+                            let mut out = vec![init; n];
+                            lanes.write(&init, &mut out);
+                            for (i, (x, s)) in coxels.iter().zip(&samples).enumerate() {
+                                assert_eq!(
+                                    out[i],
+                                    c.step_coded(x, s),
+                                    "{cfg:?} {regs:?} {mode:?} depth {depth}: {x:?} {s:?}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
