@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 mod fast;
 pub use fast::{render_base_plane, render_base_plane_stats, render_sweep, SweepStats, SweepVolume};
+pub mod sections;
 
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;
@@ -54,6 +55,9 @@ pub struct FrameConfig {
     /// then renders MIP only, each sample classified by the shader's 1-D table alone
     /// (docs/numerics/frame.md, "A frame without gradient and shader").
     pub shade: bool,
+    /// Where the beams come from (`Source`): the skewed memory inside (false), or a beat stream a
+    /// section at a time (true; docs/numerics/frame.md, "Sections").
+    pub stream: bool,
 }
 
 impl FrameConfig {
@@ -68,6 +72,7 @@ impl FrameConfig {
         shader: ShaderConfig::DEFAULT,
         compos: ComposConfig::DEFAULT,
         shade: true,
+        stream: false,
     };
 
     /// The largest volume edge (`MaxDim`).
@@ -87,6 +92,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         let (mut block, mut mem_latency) = (d.block, d.mem_latency);
         let (mut t, mut g, mut s, mut c) = (d.trilin, d.gradient, d.shader, d.compos);
         let mut shade = u32::from(d.shade);
+        let mut source = u32::from(d.stream);
         crate::unit::set_params(
             Self::TOP,
             params,
@@ -111,8 +117,14 @@ impl crate::unit::UnitConfig for FrameConfig {
                 ("AccW", &mut c.acc_w),
                 ("ZW", &mut c.z_w),
                 ("Shade", &mut shade),
+                ("Source", &mut source),
             ],
         )?;
+        if source > 1 {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: Source = {source} must be 0 (the skewed memory) or 1 (a beat stream)"
+            )));
+        }
         if shade > 1 {
             return Err(ModelError::Config(format!(
                 "cube5_frame: Shade = {shade} must be 0 (no gradient, no shader: MIP only) or 1"
@@ -140,6 +152,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             shader: s,
             compos: c,
             shade: shade == 1,
+            stream: source == 1,
         })
     }
 
@@ -167,6 +180,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             ("AccW", i(c.acc_w)),
             ("ZW", i(c.z_w)),
             ("Shade", i64::from(self.shade)),
+            ("Source", i64::from(self.stream)),
         ]
     }
 }

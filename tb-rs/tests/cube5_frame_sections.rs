@@ -1,0 +1,174 @@
+//! Co-simulation of cube5_frame fed by a beat stream in sections (`Source = 1`; issue 12,
+//! docs/numerics/frame.md, "Sections"): the beats of each section come from the model (the volume
+//! read in the section's order with its edge voxels lo, hi0, hi1, as cube5_section_buf delivers
+//! them) with random idle cycles, the read-out under random back-pressure, and the whole base plane
+//! is compared bit for bit with the frame model's whole-frame image. Driver:
+//! `cube5_tb::frame_stream`.
+
+mod support;
+
+use cube5_model::phantom::head_phantom;
+use cube5_model::units::cube5_frame::sections::section_order;
+use cube5_model::volume::Volume;
+use cube5_tb::frame::{Expected, FrameRtl, Look, Render};
+use cube5_tb::frame_stream::{items_of, StreamBench, StreamIn};
+use cube5_tb::rtl::Traffic;
+use cube5_tb::TbError;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::rc::Rc;
+use support::seed;
+
+fn must<T>(r: Result<T, TbError>) -> T {
+    r.unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The stream configuration with `p` pipelines and the largest memory.
+fn stream(p: usize) -> FrameRtl {
+    FrameRtl::streams()
+        .into_iter()
+        .filter(|r| r.p == p && r.default_widths())
+        .max_by_key(|r| r.max_dim_log2)
+        .unwrap_or_else(|| panic!("no cube5_frame variant with Source = 1 and P = {p}"))
+}
+
+/// Faces (DX = 0), 45 degrees, obliques with DX > 0 and DX < 0 along the beam axis.
+const VIEWS: &[(&str, [f64; 3])] = &[
+    ("+z", [0.0, 0.0, 1.0]),
+    ("-x", [-1.0, 0.0, 0.0]),
+    ("+y", [0.0, 1.0, 0.0]),
+    ("45 xz", [1.0, 0.0, 1.0]),
+    ("45 -x-y", [-1.0, -1.0, 0.0]),
+    ("oblique dx<0", [-0.6, 0.3, 1.0]),
+    ("oblique -z", [0.37, 0.81, -1.0]),
+];
+
+fn expect(rtl: &FrameRtl, vol: &Rc<Volume>, view: (&str, [f64; 3]), render: Render) -> Expected {
+    Expected::new(rtl, vol, view.0, view.1, render, &Look::default()).unwrap()
+}
+
+/// Whole 32^3 frames at P = 4 in sections of 8, 16 and the whole face, MIP and composite, with
+/// 30 % idle beats and 30 % back-pressure: every pixel and the beat count as the model's.
+#[test]
+fn sectioned_frames_bit_exact_p4() {
+    let s = seed(1);
+    let rtl = stream(4);
+    let vol = Rc::new(head_phantom(32, 12).unwrap());
+    let mut bench = must(StreamBench::new(rtl, s as u32));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let traffic = Traffic::random(&mut rng, 0.3, 0.3);
+    for (n, &view) in VIEWS.iter().enumerate() {
+        for render in [Render::Mip, Render::Composite] {
+            let e = expect(&rtl, &vol, view, render);
+            // Every width on two views, one of them per view otherwise (the CI budget).
+            let widths: &[usize] = if n < 2 {
+                &[8, 16, 32]
+            } else {
+                &[[16, 32, 8][n % 3]]
+            };
+            for &w in widths {
+                must(bench.check(&e, w, &traffic, s));
+            }
+        }
+    }
+}
+
+/// P = 1: sections of 16 and the whole face of a 16^3 volume.
+#[test]
+fn sectioned_frames_bit_exact_p1() {
+    let s = seed(2);
+    let rtl = stream(1);
+    let vol = Rc::new(head_phantom(16, 12).unwrap());
+    let mut bench = must(StreamBench::new(rtl, s as u32));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let traffic = Traffic::random(&mut rng, 0.2, 0.3);
+    for &view in &VIEWS[3..] {
+        for (render, w) in [(Render::Composite, 4), (Render::Mip, 16)] {
+            let e = expect(&rtl, &vol, view, render);
+            must(bench.check(&e, w, &traffic, s));
+        }
+    }
+}
+
+/// A reset in the middle of a sectioned frame, then the whole frame exact; a frame left without
+/// its last section, then a new frame (its first section clears the buffer): exact.
+#[test]
+fn reset_mid_frame_and_an_abandoned_frame() {
+    let s = seed(3);
+    let rtl = stream(4);
+    let vol = Rc::new(head_phantom(32, 12).unwrap());
+    let mut bench = must(StreamBench::new(rtl, s as u32));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let traffic = Traffic::random(&mut rng, 0.2, 0.2);
+    let e = expect(&rtl, &vol, VIEWS[6], Render::Composite);
+    must(bench.load(&e));
+    let order = section_order(&e.params, 16, rtl.p).unwrap();
+    let (items, beats) = items_of(&rtl, &e, &order, true);
+    // Halfway through the second section.
+    let d = must(bench.dut.drive(&items, &traffic, u64::MAX, beats * 3 / 4));
+    assert!(d.outputs.is_empty(), "no pixel before the last section");
+    bench.dut.reset();
+    let got = must(bench.drive(&e, &items, &traffic));
+    must(bench.compare(&e, &got, beats, "after a reset mid-frame", s));
+
+    // The first section of a frame alone (no last section), then a whole frame of another view.
+    let (first, _) = items_of(&rtl, &e, &order[..1], false);
+    let d = must(
+        bench
+            .dut
+            .drive(&first, &traffic, 1, 100 * first.len() as u64),
+    );
+    assert!(
+        d.outputs.is_empty(),
+        "a section that is not the last has no output"
+    );
+    let e2 = expect(&rtl, &vol, VIEWS[4], Render::Mip);
+    must(bench.check(&e2, 16, &traffic, s));
+}
+
+/// Sections the frame refuses, one error item each: a first anchor or width not a multiple of
+/// P, a section past the face, rows of one beat; and a good frame after them.
+#[test]
+fn bad_sections_refused() {
+    let s = seed(4);
+    let rtl = stream(4);
+    let vol = Rc::new(head_phantom(32, 12).unwrap());
+    let mut bench = must(StreamBench::new(rtl, s as u32));
+    let e = expect(&rtl, &vol, VIEWS[0], Render::Mip);
+    must(bench.load(&e));
+    for (a0, ns) in [(2, 16), (0, 18), (24, 16), (0, 4), (32, 8)] {
+        let cmd = StreamIn::Cmd(cube5_tb::frame_stream::SecCmd {
+            op: cube5_tb::frame::OP_RENDER,
+            a0,
+            ns,
+            first: true,
+            last: true,
+        });
+        let d = must(bench.dut.drive(&[cmd], &Traffic::full_speed(), 1, 1000));
+        assert!(
+            d.outputs.len() == 1 && d.outputs[0].value.error,
+            "section ({a0}, {ns}) not refused with one error item"
+        );
+    }
+    must(bench.check(&e, 16, &Traffic::full_speed(), s));
+}
+
+/// 64^3 frames in sections of 16, 32 and 64, the views above, MIP and composite.
+#[test]
+#[ignore = "sim-full: 64^3 sectioned frames, several minutes"]
+fn sectioned_frames_64_bit_exact() {
+    let s = seed(5);
+    let rtl = stream(4);
+    let vol = Rc::new(head_phantom(64, 12).unwrap());
+    let mut bench = must(StreamBench::new(rtl, s as u32));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let traffic = Traffic::random(&mut rng, 0.135, 0.2);
+    for &view in VIEWS {
+        for render in [Render::Mip, Render::Composite] {
+            let e = expect(&rtl, &vol, view, render);
+            for w in [16, 32, 64] {
+                must(bench.check(&e, w, &traffic, s));
+            }
+        }
+    }
+}
