@@ -10,7 +10,7 @@ mod support;
 use cube5_model::phantom::head_phantom;
 use cube5_model::units::cube5_frame::sections::section_order;
 use cube5_model::volume::Volume;
-use cube5_tb::frame::{Expected, FrameRtl, Look, Render};
+use cube5_tb::frame::{Expected, FrameRtl, Look, Render, COMPOS_LATENCY, TRILIN_LATENCY};
 use cube5_tb::frame_stream::{items_of, StreamBench, StreamIn};
 use cube5_tb::rtl::Traffic;
 use cube5_tb::TbError;
@@ -169,6 +169,80 @@ fn sectioned_frames_64_bit_exact() {
             for w in [16, 32, 64] {
                 must(bench.check(&e, w, &traffic, s));
             }
+        }
+    }
+}
+
+/// The cycle budget of a sectioned frame (docs/frame-rtl.md, *Cycle budget*, `Source = 1`): per
+/// section set-up 3 + its beats + the flush `nbs + 2 nbr + 2` (its own row and slice lengths) + the
+/// pipeline (the units' latencies, no memory), at full speed exactly; the read-out one pixel per
+/// clock. With 13.5 % of the input cycles idle (0.865 beams per clock, what cube5_section_buf
+/// delivers with every block present) the sweep stretches by the idle beats only.
+fn budget(rtl: &FrameRtl, vol: &Rc<Volume>, view: (&str, [f64; 3]), w: usize, idle: f64, s: u64) -> (u64, u64, u64) {
+    let mut bench = must(StreamBench::new(*rtl, s as u32));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let traffic = Traffic::random(&mut rng, idle, 0.0);
+    let e = expect(rtl, vol, view, Render::Composite);
+    must(bench.load(&e));
+    let order = section_order(&e.params, w, rtl.p).unwrap();
+    let (items, beats) = items_of(rtl, &e, &order, true);
+    let got = must(bench.drive(&e, &items, &traffic));
+    let (_, sweep) = must(bench.compare(&e, &got, beats, &format!("S = {w}, idle {idle}"), s));
+    let pipeline = 1 + TRILIN_LATENCY + 1 + rtl.shade_latency() + 1 + COMPOS_LATENCY + 1;
+    let ideal: u64 = order
+        .iter()
+        .map(|sec| {
+            let (nbr, nbs) = (sec.ns / rtl.p, sec.ns * e.params.nj / rtl.p);
+            3 + (nbs * e.params.nk) as u64 + (nbs + 2 * nbr + 2) as u64 + pipeline
+        })
+        .sum();
+    let n = (e.w * e.h) as u64;
+    assert_eq!(
+        got.taken_at[got.taken_at.len() - 1] - got.taken_at[0] + 1,
+        n,
+        "one pixel per clock"
+    );
+    (u64::from(sweep), ideal, beats)
+}
+
+#[test]
+fn cycle_budget_of_a_sectioned_frame() {
+    let s = seed(6);
+    let vol = Rc::new(head_phantom(32, 12).unwrap());
+    for rtl in [stream(4), stream(1)] {
+        for w in [16, 32] {
+            let (sweep, ideal, beats) = budget(&rtl, &vol, VIEWS[6], w, 0.0, s);
+            assert_eq!(sweep, ideal, "{} S = {w}: sweep cycles at full speed", rtl.variant);
+            let (slow, _, _) = budget(&rtl, &vol, VIEWS[6], w, 0.135, s);
+            let samples = (beats * rtl.p as u64) as f64;
+            eprintln!(
+                "{} 32^3 S = {w}: sweep {sweep} cycles at full speed ({:.3} samples/clock/pipeline), {slow} at 0.865 beams/clock ({:.3})",
+                rtl.variant,
+                samples / rtl.p as f64 / sweep as f64,
+                samples / rtl.p as f64 / slow as f64
+            );
+            // The idle cycles fall on beats only: at most beats / 0.8 more than the ideal.
+            assert!(slow > sweep && slow < ideal + beats / 4, "{} S = {w}: {slow} cycles", rtl.variant);
+        }
+    }
+}
+
+/// The figures of docs/measurements.md (*cube5_frame fed by a beat stream*): 64^3, S = 16, 32, 64.
+#[test]
+#[ignore = "sim-full: the measurement of docs/measurements.md, 64^3 frames"]
+fn measure_sectioned_frames_64() {
+    let s = seed(7);
+    let vol = Rc::new(head_phantom(64, 12).unwrap());
+    let rtl = stream(4);
+    for w in [16, 32, 64] {
+        for idle in [0.0, 0.135] {
+            let (sweep, ideal, beats) = budget(&rtl, &vol, VIEWS[6], w, idle, s);
+            let samples = (beats * rtl.p as u64) as f64;
+            eprintln!(
+                "MEASURE {} 64^3 oblique S = {w} idle {idle}: sweep {sweep} cycles (ideal {ideal}), {:.3} samples/clock/pipeline",
+                rtl.variant,
+                samples / rtl.p as f64 / sweep as f64
+            );
         }
     }
 }
