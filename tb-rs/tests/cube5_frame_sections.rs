@@ -246,3 +246,109 @@ fn measure_sectioned_frames_64() {
         }
     }
 }
+
+/// The buffer's RTL into the frame's RTL (issue 12, the accelerator's data path without DRAM):
+/// the fetch's items (its model, over the volume's blocked DRAM image with the empty blocks
+/// skipped) go into `cube5_section_buf`'s RTL with each section command, and the beams that RTL
+/// delivers, unchanged, go into the frame behind the frame's section commands; random idle and
+/// back-pressure on both. The image is the frame model's, bit for bit. Runs on each build of the
+/// buffer that agrees with a stream frame on P and the voxel width.
+#[test]
+fn section_buffer_rtl_into_the_frame() {
+    use cube5_model::units::cube5_section_buf::{frame_dims, SbufIn, SectionBufConfig, SectionCmd};
+    use cube5_model::units::cube5_skewmem::BlockLut;
+    use cube5_model::units::cube5_vol_fetch::{dram_image, FetchCmd, VolFetch};
+    use cube5_tb::frame_stream::SecCmd;
+    let s = seed(8);
+    let mut pairs = 0;
+    for rtl in FrameRtl::streams().into_iter().filter(|r| r.default_widths()) {
+        for (sv, scfg) in support::configs::<SectionBufConfig>() {
+            let (p, vw) = (rtl.p as u32, rtl.trilin.voxel_w);
+            if (scfg.p, scfg.voxel_w) != (p, vw) || 2 * scfg.section as usize > rtl.max_dim() {
+                continue;
+            }
+            pairs += 1;
+            // Two sections along i (x), a view with DX < 0 (right to left) and one with DX > 0.
+            let n = 2 * scfg.section as usize;
+            let big = head_phantom(n, 12).unwrap();
+            let dims = [n, 32, 32];
+            let data = (0..n * 32 * 32)
+                .map(|q| big.get((q % n) as i64, ((q / n) % 32) as i64, (q / (n * 32)) as i64) as u16)
+                .collect();
+            let vol = Volume::new(dims, [1.0; 3], 12, data).unwrap();
+            let lut = BlockLut::from_volume(&vol, scfg.block_dim as usize, 0).unwrap();
+            let seen = Rc::new(cube5_tb::frame::as_seen(&vol, &lut).unwrap());
+            let fcfg = scfg.fetch();
+            let img = dram_image(&vol, &lut, 0).unwrap();
+            let mut rng = ChaCha8Rng::seed_from_u64(s);
+            let mut bench = must(StreamBench::new(rtl, s as u32));
+            for (view, render) in [
+                (("dx<0", [-0.3, 0.2, 1.0]), Render::Composite),
+                (("dx>0", [0.5, -0.4, -1.0]), Render::Mip),
+            ] {
+                let e = expect(&rtl, &seen, view, render);
+                assert!(e.want.iter().any(|c| c.rgba[3] > 0), "{}: an empty image", view.0);
+                let order = section_order(&e.params, scfg.section as usize, rtl.p).unwrap();
+                let fd = frame_dims(vol.dims, e.params.axis_k as u32);
+                let cmds: Vec<SectionCmd> = order
+                    .iter()
+                    .map(|sec| SectionCmd {
+                        axis_k: e.params.axis_k as u32,
+                        reversed: e.params.k_reversed,
+                        dims: fd,
+                        a0: sec.a0 as u32,
+                    })
+                    .collect();
+                let mut fetch_in = fcfg.lut_writes(&lut).unwrap();
+                fetch_in.extend(cmds.iter().map(|c| FetchCmd::Sweep(scfg.sweep(c, 0))));
+                let items = VolFetch::new(fcfg).unwrap().run(&fetch_in, &img).unwrap().items;
+                let mut input = Vec::new();
+                let mut it = items.into_iter();
+                for c in &cmds {
+                    input.push(SbufIn::Section(*c));
+                    for item in it.by_ref() {
+                        let last = item.last;
+                        input.push(SbufIn::Item(item));
+                        if last {
+                            break;
+                        }
+                    }
+                }
+                let beats: usize = order.iter().map(|sec| e.params.nk * e.params.nj * sec.ns / rtl.p).sum();
+                let mut sbuf = cube5_tb::RtlStream::new(sv, scfg, s as u32).unwrap();
+                let traffic = Traffic::random(&mut rng, 0.1, 0.135);
+                let d = sbuf
+                    .drive(&input, &traffic, beats as u64, 200_000 + 20 * (beats + input.len()) as u64)
+                    .unwrap();
+                assert_eq!(d.outputs.len(), beats, "{sv}: every beam out");
+                // The frame: each section's command, then the buffer's beams of that section.
+                let mut frame_in = Vec::new();
+                let mut out = d.outputs.into_iter().map(|t| t.value);
+                for (k, sec) in order.iter().enumerate() {
+                    frame_in.push(StreamIn::Cmd(SecCmd {
+                        op: cube5_tb::frame::OP_RENDER,
+                        a0: sec.a0 as u32,
+                        ns: sec.ns as u32,
+                        first: k == 0,
+                        last: k + 1 == order.len(),
+                    }));
+                    let nbeats = e.params.nk * e.params.nj * sec.ns / rtl.p;
+                    frame_in.extend(out.by_ref().take(nbeats).map(StreamIn::Beat));
+                }
+                must(bench.load(&e));
+                let traffic = Traffic::random(&mut rng, 0.2, 0.3);
+                let got = must(bench.drive(&e, &frame_in, &traffic));
+                must(bench.compare(&e, &got, beats as u64, &format!("{sv} -> {}", rtl.variant), s));
+                eprintln!(
+                    "{sv} -> {}: {:?} {} in {} sections of {}: every pixel the model's",
+                    rtl.variant,
+                    vol.dims,
+                    view.0,
+                    order.len(),
+                    scfg.section
+                );
+            }
+        }
+    }
+    assert!(pairs > 0, "no build of cube5_section_buf agrees with a stream frame on P and VoxelW");
+}
