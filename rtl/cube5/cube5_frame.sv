@@ -623,6 +623,47 @@ module cube5_frame #(
     assign mem_read   = mem_beat;
     logic unused_marks;
     assign unused_marks = ^{beat_marks, cfg_voxel, cfg_block, k_rev_q};
+`ifndef SYNTHESIS
+    // The beats' marks agree with the frame's own count of the section (same geometry on both
+    // sides of the stream): a counter of the beats taken, checked on every beat.
+    logic [DimW-1:0] in_m, in_b, in_s;
+    logic signed [1:0] in_tx, in_ty;
+    logic in_fb, in_lb, in_fr, in_lr, in_fs, in_ls;
+    cube5_frame_pos #(
+      .DimW (DimW),
+      .TW   (2),
+      .DW   (2)
+    ) u_in_pos (
+      .clk_i         (clk_i),
+      .rst_ni        (rst_ni),
+      .start_i       (start),
+      .step_i        (mem_beat),
+      .nbr_i         (nbr),
+      .nj_i          (nj_q),
+      .s_first_i     ('0),
+      .s_last_i      (nk_q - DimW'(1)),
+      .tx0_i         (2'sd0),
+      .ty0_i         (2'sd0),
+      .dx_i          (2'sd0),
+      .dy_i          (2'sd0),
+      .m_o           (in_m),
+      .b_o           (in_b),
+      .s_o           (in_s),
+      .tx_o          (in_tx),
+      .ty_o          (in_ty),
+      .first_beat_o  (in_fb),
+      .last_beat_o   (in_lb),
+      .first_row_o   (in_fr),
+      .last_row_o    (in_lr),
+      .first_slice_o (in_fs),
+      .last_slice_o  (in_ls)
+    );
+    logic unused_in_pos;
+    assign unused_in_pos = ^{in_m, in_b, in_s, in_tx, in_ty, in_fr, in_fs};
+    BeatMarksAsCounted: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        mem_beat |-> beat_marks[3:0] == {in_lb && in_lr && in_ls, in_lb && in_lr, in_lb, in_fb})
+      else $error("cube5_frame: a beat's marks (row_first, row_last, slice_last, last) disagree with the section's geometry");
+`endif
   end
 
   // After the last memory beat: nbs + 2 nbr + 2 beats of zeros flush the windows.

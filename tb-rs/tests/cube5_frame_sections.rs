@@ -178,7 +178,14 @@ fn sectioned_frames_64_bit_exact() {
 /// pipeline (the units' latencies, no memory), at full speed exactly; the read-out one pixel per
 /// clock. With 13.5 % of the input cycles idle (0.865 beams per clock, what cube5_section_buf
 /// delivers with every block present) the sweep stretches by the idle beats only.
-fn budget(rtl: &FrameRtl, vol: &Rc<Volume>, view: (&str, [f64; 3]), w: usize, idle: f64, s: u64) -> (u64, u64, u64) {
+fn budget(
+    rtl: &FrameRtl,
+    vol: &Rc<Volume>,
+    view: (&str, [f64; 3]),
+    w: usize,
+    idle: f64,
+    s: u64,
+) -> (u64, u64, u64) {
     let mut bench = must(StreamBench::new(*rtl, s as u32));
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let traffic = Traffic::random(&mut rng, idle, 0.0);
@@ -212,7 +219,11 @@ fn cycle_budget_of_a_sectioned_frame() {
     for rtl in [stream(4), stream(1)] {
         for w in [16, 32] {
             let (sweep, ideal, beats) = budget(&rtl, &vol, VIEWS[6], w, 0.0, s);
-            assert_eq!(sweep, ideal, "{} S = {w}: sweep cycles at full speed", rtl.variant);
+            assert_eq!(
+                sweep, ideal,
+                "{} S = {w}: sweep cycles at full speed",
+                rtl.variant
+            );
             let (slow, _, _) = budget(&rtl, &vol, VIEWS[6], w, 0.135, s);
             let samples = (beats * rtl.p as u64) as f64;
             eprintln!(
@@ -222,7 +233,11 @@ fn cycle_budget_of_a_sectioned_frame() {
                 samples / rtl.p as f64 / slow as f64
             );
             // The idle cycles fall on beats only: at most beats / 0.8 more than the ideal.
-            assert!(slow > sweep && slow < ideal + beats / 4, "{} S = {w}: {slow} cycles", rtl.variant);
+            assert!(
+                slow > sweep && slow < ideal + beats / 4,
+                "{} S = {w}: {slow} cycles",
+                rtl.variant
+            );
         }
     }
 }
@@ -255,13 +270,16 @@ fn measure_sectioned_frames_64() {
 /// buffer that agrees with a stream frame on P and the voxel width.
 #[test]
 fn section_buffer_rtl_into_the_frame() {
-    use cube5_model::units::cube5_section_buf::{frame_dims, SbufIn, SectionBufConfig, SectionCmd};
+    use cube5_model::units::cube5_section_buf::{frame_dims, SectionBufConfig, SectionCmd};
     use cube5_model::units::cube5_skewmem::BlockLut;
     use cube5_model::units::cube5_vol_fetch::{dram_image, FetchCmd, VolFetch};
     use cube5_tb::frame_stream::SecCmd;
     let s = seed(8);
     let mut pairs = 0;
-    for rtl in FrameRtl::streams().into_iter().filter(|r| r.default_widths()) {
+    for rtl in FrameRtl::streams()
+        .into_iter()
+        .filter(|r| r.default_widths())
+    {
         for (sv, scfg) in support::configs::<SectionBufConfig>() {
             let (p, vw) = (rtl.p as u32, rtl.trilin.voxel_w);
             if (scfg.p, scfg.voxel_w) != (p, vw) || 2 * scfg.section as usize > rtl.max_dim() {
@@ -273,7 +291,9 @@ fn section_buffer_rtl_into_the_frame() {
             let big = head_phantom(n, 12).unwrap();
             let dims = [n, 32, 32];
             let data = (0..n * 32 * 32)
-                .map(|q| big.get((q % n) as i64, ((q / n) % 32) as i64, (q / (n * 32)) as i64) as u16)
+                .map(|q| {
+                    big.get((q % n) as i64, ((q / n) % 32) as i64, (q / (n * 32)) as i64) as u16
+                })
                 .collect();
             let vol = Volume::new(dims, [1.0; 3], 12, data).unwrap();
             let lut = BlockLut::from_volume(&vol, scfg.block_dim as usize, 0).unwrap();
@@ -287,7 +307,11 @@ fn section_buffer_rtl_into_the_frame() {
                 (("dx>0", [0.5, -0.4, -1.0]), Render::Mip),
             ] {
                 let e = expect(&rtl, &seen, view, render);
-                assert!(e.want.iter().any(|c| c.rgba[3] > 0), "{}: an empty image", view.0);
+                assert!(
+                    e.want.iter().any(|c| c.rgba[3] > 0),
+                    "{}: an empty image",
+                    view.0
+                );
                 let order = section_order(&e.params, scfg.section as usize, rtl.p).unwrap();
                 let fd = frame_dims(vol.dims, e.params.axis_k as u32);
                 let cmds: Vec<SectionCmd> = order
@@ -301,24 +325,25 @@ fn section_buffer_rtl_into_the_frame() {
                     .collect();
                 let mut fetch_in = fcfg.lut_writes(&lut).unwrap();
                 fetch_in.extend(cmds.iter().map(|c| FetchCmd::Sweep(scfg.sweep(c, 0))));
-                let items = VolFetch::new(fcfg).unwrap().run(&fetch_in, &img).unwrap().items;
-                let mut input = Vec::new();
-                let mut it = items.into_iter();
-                for c in &cmds {
-                    input.push(SbufIn::Section(*c));
-                    for item in it.by_ref() {
-                        let last = item.last;
-                        input.push(SbufIn::Item(item));
-                        if last {
-                            break;
-                        }
-                    }
-                }
-                let beats: usize = order.iter().map(|sec| e.params.nk * e.params.nj * sec.ns / rtl.p).sum();
+                let items = VolFetch::new(fcfg)
+                    .unwrap()
+                    .run(&fetch_in, &img)
+                    .unwrap()
+                    .items;
+                let input = support::section_buf_input(&cmds, items);
+                let beats: usize = order
+                    .iter()
+                    .map(|sec| e.params.nk * e.params.nj * sec.ns / rtl.p)
+                    .sum();
                 let mut sbuf = cube5_tb::RtlStream::new(sv, scfg, s as u32).unwrap();
                 let traffic = Traffic::random(&mut rng, 0.1, 0.135);
                 let d = sbuf
-                    .drive(&input, &traffic, beats as u64, 200_000 + 20 * (beats + input.len()) as u64)
+                    .drive(
+                        &input,
+                        &traffic,
+                        beats as u64,
+                        200_000 + 20 * (beats + input.len()) as u64,
+                    )
                     .unwrap();
                 assert_eq!(d.outputs.len(), beats, "{sv}: every beam out");
                 // The frame: each section's command, then the buffer's beams of that section.
@@ -338,7 +363,13 @@ fn section_buffer_rtl_into_the_frame() {
                 must(bench.load(&e));
                 let traffic = Traffic::random(&mut rng, 0.2, 0.3);
                 let got = must(bench.drive(&e, &frame_in, &traffic));
-                must(bench.compare(&e, &got, beats as u64, &format!("{sv} -> {}", rtl.variant), s));
+                must(bench.compare(
+                    &e,
+                    &got,
+                    beats as u64,
+                    &format!("{sv} -> {}", rtl.variant),
+                    s,
+                ));
                 eprintln!(
                     "{sv} -> {}: {:?} {} in {} sections of {}: every pixel the model's",
                     rtl.variant,
@@ -350,5 +381,8 @@ fn section_buffer_rtl_into_the_frame() {
             }
         }
     }
-    assert!(pairs > 0, "no build of cube5_section_buf agrees with a stream frame on P and VoxelW");
+    assert!(
+        pairs > 0,
+        "no build of cube5_section_buf agrees with a stream frame on P and VoxelW"
+    );
 }

@@ -9,12 +9,15 @@
 //! (the order `cube5_section_buf` delivers), and [`render_sections`] renders from those beats
 //! alone, the samples and gradients at a section's edges included.
 
-use super::{shade_n6, BasePlane, FrameParams, FrameUnits, SliceConst, STEP_W};
+use super::{
+    bilinear_input, neighbourhood_from, outside_face, shade_n6, BasePlane, FrameParams, FrameUnits,
+    SliceConst,
+};
 use crate::error::{ModelError, Result};
 use crate::units::cube5_compos::Coxel;
 use crate::units::cube5_section_buf::Beam;
 use crate::units::cube5_shader::ShaderMode;
-use crate::units::cube5_trilin::{Trilin, TrilinIn, TrilinMode};
+use crate::units::cube5_trilin::Trilin;
 use crate::volume::Volume;
 
 /// One section: anchors `a0 .. a0 + ns` along `i`.
@@ -91,7 +94,6 @@ pub fn section_beats(params: &FrameParams, vol: &Volume, sec: Section, p: usize)
 pub struct SectionVoxels {
     pub sec: Section,
     nj: usize,
-    nk: usize,
     /// `(s nj + b) (ns + 3) + (i - a0 + 1)`.
     cols: Vec<u32>,
 }
@@ -129,7 +131,6 @@ impl SectionVoxels {
         Ok(Self {
             sec,
             nj: params.nj,
-            nk: params.nk,
             cols,
         })
     }
@@ -155,23 +156,13 @@ impl SectionVoxels {
         b: i64,
         trilin: &Trilin,
     ) -> u32 {
-        if t < 0
-            || t >= self.nk as i64
-            || a < 0
-            || b < 0
-            || a >= params.ni as i64
-            || b >= params.nj as i64
-        {
+        if outside_face(params, t, a, b) {
             return 0;
         }
         let (t, b) = (t as usize, b as usize);
-        let w = |f: u32| f >> (STEP_W - trilin.config().weight_w);
         let v = |da: i64, db: usize| self.voxel(t, a + da, b + db);
-        trilin.sample(&TrilinIn {
-            voxels: [v(0, 0), v(1, 0), v(0, 1), v(1, 1), 0, 0, 0, 0],
-            weights: [w(c.frac_x), w(c.frac_y), 0],
-            mode: TrilinMode::Lerp,
-        })
+        let corners = [v(0, 0), v(1, 0), v(0, 1), v(1, 1)];
+        trilin.sample(&bilinear_input(c, corners, &trilin.config()))
     }
 
     /// The gradient neighbourhood `[C, x-, x+, y-, y+, B, A]` of anchor `(a, b)` of slice `c`, an
@@ -184,17 +175,7 @@ impl SectionVoxels {
         b: usize,
         trilin: &Trilin,
     ) -> [u32; 7] {
-        let (a, b, s) = (a as i64, b as i64, c.s as i64);
-        let at = |t, da, db| self.sample(params, c, t, a + da, b + db, trilin);
-        [
-            at(s, 0, 0),
-            at(s, -1, 0),
-            at(s, 1, 0),
-            at(s, 0, -1),
-            at(s, 0, 1),
-            at(s - 1, 0, 0),
-            at(s + 1, 0, 0),
-        ]
+        neighbourhood_from(c, a, b, |t, a, b| self.sample(params, c, t, a, b, trilin))
     }
 }
 
