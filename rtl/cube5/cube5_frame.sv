@@ -13,6 +13,14 @@
 // The volume, the frame registers and every table are written through the configuration port
 // (address map: docs/numerics/frame.md, "RTL configuration map"); writes that arrive while a frame
 // is being swept are ignored.
+//
+// Source = 1 (issue 12, the accelerator; docs/numerics/frame.md, "Sections"): no skewed memory and
+// no voxel or block LUT region. The input stream carries commands and beats (a kind bit first): a
+// render command names a section [sec_a0, sec_a0 + sec_ns) of the face's i axis, and the section's
+// beams follow as cube5_section_buf hands them over (slice, row, beat order; lo beside a row's first
+// beat, hi0 and hi1 beside its last). The windows take rows of sec_ns / P beats; the compositing
+// buffer keeps the whole base plane from the first section of a frame (sec_first) to the read-out
+// after its last (sec_last). Beats may come with gaps: every stage advances per beat.
 module cube5_frame #(
   /// Pipelines = memory modules = voxels per beat: 1, 2, 4 or 8.
   parameter int unsigned P          = 4,
@@ -42,7 +50,10 @@ module cube5_frame #(
   /// Units of the pipelines: 1 gradient and shader (every mode); 0 neither, for MIP only: each
   /// pipeline classifies its sample with the shader's 1-D table alone (cube5_frame_class;
   /// docs/numerics/frame.md, "A frame without gradient and shader").
-  parameter int unsigned Shade      = 1
+  parameter int unsigned Shade      = 1,
+  /// Where the beams come from: 0 the skewed memory inside (cube5_skewmem, loaded through the
+  /// configuration port); 1 the input stream, a section at a time (above).
+  parameter int unsigned Source     = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -51,8 +62,10 @@ module cube5_frame #(
   input  logic in_valid_i,
   /// The frame takes a command (idle, buffer cleared).
   output logic in_ready_o,
-  /// op (2): 0 render; 1..3 reserved (answered by one error item).
-  input  logic [1:0] in_data_i,
+  /// Source = 0: op (2): 0 render; 1..3 reserved (answered by one error item). Source = 1: kind
+  /// (1), then a command {op (2), sec_a0 (m), sec_ns (m + 1), sec_first, sec_last} or a beat
+  /// {P lanes, lo, hi0, hi1 (VoxelW each), row_first, row_last, slice_last, last, error}.
+  input  logic [cube5_frame_pkg::in_w(Source, P, VoxelW, $clog2(MaxDim))-1:0] in_data_i,
 
   /// Output item valid.
   output logic out_valid_o,
@@ -107,6 +120,8 @@ module cube5_frame #(
   localparam int unsigned NbsW     = 2 * DimW;              // ni * nj
   /// The coxel update loop: nbs - nbr - 1 >= ReuseMin (docs/frame-rtl.md, "Smallest volumes").
   localparam int unsigned ReuseMin = cube5_frame_pkg::ReuseMin;
+  localparam int unsigned InW      = cube5_frame_pkg::in_w(Source, P, VoxelW, M);
+  localparam int unsigned XBeatW   = (P + 3 * Source) * VoxelW;  // a beat and its edge voxels
 
   // Elaboration checks.
   if (P != 1 && P != 2 && P != 4 && P != 8) begin : gen_bad_p
@@ -126,6 +141,9 @@ module cube5_frame #(
   end
   if (Shade > 1) begin : gen_bad_shade
     $fatal(1, "cube5_frame: Shade must be 0 (no gradient, no shader: MIP only) or 1");
+  end
+  if (Source > 1) begin : gen_bad_source
+    $fatal(1, "cube5_frame: Source must be 0 (the skewed memory) or 1 (a beat stream)");
   end
   if (OffW + cube5_frame_pkg::CfgRegionW > 32) begin : gen_bad_cfg
     $fatal(1, "cube5_frame: the configuration address must fit 32 bits");
@@ -149,8 +167,8 @@ module cube5_frame #(
 
   logic cfg_frame, cfg_voxel, cfg_block, cfg_shader, cfg_compos;
   assign cfg_frame  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionFrame;
-  assign cfg_voxel  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionVoxel;
-  assign cfg_block  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionBlock;
+  assign cfg_voxel  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionVoxel && Source == 0;
+  assign cfg_block  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionBlock && Source == 0;
   assign cfg_shader = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionShader;
   assign cfg_compos = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionCompos;
 
@@ -179,6 +197,41 @@ module cube5_frame #(
     if (we_mode) {tf2d_q, render_q} <= cfg_data_i[2:0];
     if (we_skip) skip_q <= cfg_data_i[0 +: 2*DimW];
   end
+
+  // ---------------------------------------------------------------------------
+  // Input items: commands and (Source = 1) beats; the section of a command
+  // ---------------------------------------------------------------------------
+  logic            in_is_cmd, cmd_first;
+  logic [1:0]      cmd_op;
+  logic [M-1:0]    cmd_a0;
+  logic [DimW-1:0] cmd_ns;
+  logic            cmd_last;
+  logic [InW-1:0]  unused_in;
+
+  if (Source == 0) begin : gen_cmd_op
+    assign in_is_cmd = 1'b1;
+    assign cmd_op    = in_data_i[1:0];
+    assign cmd_a0    = '0;
+    assign cmd_ns    = '0;
+    assign cmd_first = 1'b1;
+    assign cmd_last  = 1'b1;
+  end else begin : gen_cmd_sec
+    assign in_is_cmd = in_data_i[0] == cube5_frame_pkg::InKindCmd;
+    assign cmd_op    = in_data_i[1 +: 2];
+    assign cmd_a0    = in_data_i[3 +: M];
+    assign cmd_ns    = in_data_i[3 + M +: DimW];
+    assign cmd_first = in_data_i[3 + M + DimW];
+    assign cmd_last  = in_data_i[4 + M + DimW];
+  end
+  assign unused_in = in_data_i;
+
+  // The section being swept (Source = 0: the whole face, one section, first and last).
+  logic [M-1:0]    sec_a0_q;
+  logic [DimW-1:0] sec_ns_q;
+  logic            sec_last_q;
+  logic [M-1:0]    sa0;
+  logic [DimW-1:0] sns;
+  logic            slast;
 
   // ---------------------------------------------------------------------------
   // Frame set-up: frame-axis dimensions, counts, base plane, checks (three cycles)
@@ -233,13 +286,16 @@ module cube5_frame #(
   logic [DimW-1:0]      swept_q, swept_d;                          // slices swept
   logic [DimW:0]        skipped;
   logic                 skip_ok_q, skip_ok_d;
+  logic                 sec_ok_q, sec_ok_d;
+  logic [DimW:0]        sec_end, sec_end_q;
 
-  assign skip_front = skip_q[0 +: DimW];
-  assign skip_back  = skip_q[DimW +: DimW];
+  // Source = 1 sweeps every slice of a section (the stream brings them all): Skip is ignored.
+  assign skip_front = (Source == 0) ? skip_q[0 +: DimW] : '0;
+  assign skip_back  = (Source == 0) ? skip_q[DimW +: DimW] : '0;
   assign skipped    = {1'b0, skip_front} + {1'b0, skip_back};
 
   always_comb begin
-    nij_d     = NbsW'(ni_q) * NbsW'(nj_q);
+    nij_d     = NbsW'(sns) * NbsW'(nj_q);
     tx_last_d = TW'($signed({1'b0, nk_q - DimW'(1)})) * TW'(dx_q);
     ty_last_d = TW'($signed({1'b0, nk_q - DimW'(1)})) * TW'(dy_q);
     tx0_d     = TW'($signed({1'b0, skip_front})) * TW'(dx_q);
@@ -249,6 +305,10 @@ module cube5_frame #(
     swept_d   = nk_q - skip_front - skip_back;
     // At least one slice is swept.
     skip_ok_d = skipped < {1'b0, nk_q};
+    // The section: P-aligned, inside the face (Source = 0: the face itself).
+    sec_end   = {1'b0, DimW'(sa0)} + {1'b0, sns};
+    sec_ok_d  = ((sa0 & M'(P - 1)) == '0) && ((sns & DimW'(P - 1)) == '0)
+                && (sec_end <= {1'b0, ni_q});
   end
 
   always_ff @(posedge clk_i) begin
@@ -262,6 +322,8 @@ module cube5_frame #(
       s_last_q  <= s_last_d;
       swept_q   <= swept_d;
       skip_ok_q <= skip_ok_d;
+      sec_ok_q  <= sec_ok_d;
+      sec_end_q <= sec_end;
     end
   end
 
@@ -278,7 +340,7 @@ module cube5_frame #(
   logic                 frame_ok;
 
   always_comb begin
-    nbr      = ni_q >> LogP;
+    nbr      = sns >> LogP;
     nbs      = nij_q >> LogP;
     sx_last  = tx_last_q >>> StepW;
     sy_last  = ty_last_q >>> StepW;
@@ -292,7 +354,7 @@ module cube5_frame #(
     total_d  = TotW'(nbs) * TotW'(swept_q);
     flush_d  = (LagW+1)'(nbs) + (LagW+1)'(2 * nbr) + (LagW+1)'(2);
     // Rows of at least two beats; a coxel's reuse distance nbs - nbr - 1 of at least ReuseMin.
-    frame_ok = dims_ok_q && view_ok_q && skip_ok_q && (nbr >= DimW'(2))
+    frame_ok = dims_ok_q && view_ok_q && skip_ok_q && sec_ok_q && (nbr >= DimW'(2))
                && (nbs >= NbsW'(nbr) + NbsW'(1 + ReuseMin));
   end
 
@@ -318,7 +380,8 @@ module cube5_frame #(
   // ---------------------------------------------------------------------------
   // Control
   // ---------------------------------------------------------------------------
-  logic in_fire, out_fire, cbuf_clear_busy, start, ro_start;
+  logic in_fire, cmd_fire, out_fire, cbuf_clear_busy, start, ro_start, cmd_ready, beat_ready;
+  logic dirty_q, dirty_d, wipe_q, wipe_d;
   logic sweep_done, ro_last;
   logic [TotW-1:0] recvd_q, recvd_d, written_q, written_d;
   logic [LagW:0]   flushed_q, flushed_d;
@@ -326,24 +389,67 @@ module cube5_frame #(
   logic [CntW-1:0] reads_q, reads_d, cycles_q, cycles_d;
   logic            mem_beat, mem_read, flush_beat, upd_done;
 
-  assign in_ready_o = (state_q == StIdle) && !cbuf_clear_busy;
+  // Commands while idle; beats (Source = 1) while the sweep still needs them, or while idle (a
+  // stray beat after a reset: taken and dropped).
+  assign cmd_ready  = (state_q == StIdle) && !cbuf_clear_busy;
+  assign beat_ready = (state_q == StIdle) || (state_q == StSweep && recvd_q != total_q);
+  assign in_ready_o = in_is_cmd ? cmd_ready : beat_ready;
   assign in_fire    = in_valid_i && in_ready_o;
+  assign cmd_fire   = in_fire && in_is_cmd;
   assign out_fire   = out_valid_o && out_ready_i;
   assign start      = (state_q == StSetup3) && frame_ok;
   assign sweep_done = (state_q == StSweep) && (written_q == total_q);
-  assign ro_start   = sweep_done;
+  assign ro_start   = sweep_done && slast;
   assign ro_last    = (state_q == StReadout) && out_fire && (sent_q == pixels_q - PixW'(1));
+
+  // The section's fields (configuration-like: kept until the next command).
+  always_ff @(posedge clk_i) begin
+    if (cmd_fire) begin
+      sec_a0_q   <= cmd_a0;
+      sec_ns_q   <= cmd_ns;
+      sec_last_q <= cmd_last;
+    end
+  end
+  assign sa0   = (Source == 0) ? '0 : sec_a0_q;
+  assign sns   = (Source == 0) ? ni_q : sec_ns_q;
+  assign slast = (Source == 0) ? 1'b1 : sec_last_q;
+
+  // The compositing buffer holds a frame's coxels from its first section's sweep to the end of
+  // its read-out (dirty). A first section that finds it dirty (the last frame was left without
+  // its last section) has it cleared first, through the buffer's clear pass (wipe).
+  always_comb begin
+    dirty_d = dirty_q;
+    wipe_d  = 1'b0;
+    if (start && Source != 0) dirty_d = 1'b1;
+    if (ro_last) dirty_d = 1'b0;
+    if (cmd_fire && Source != 0 && cmd_first && dirty_q
+        && cmd_op == cube5_frame_pkg::OpRender) begin
+      wipe_d  = 1'b1;
+      dirty_d = 1'b0;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      dirty_q <= 1'b0;
+      wipe_q  <= 1'b0;
+    end else begin
+      dirty_q <= dirty_d;
+      wipe_q  <= wipe_d;
+    end
+  end
 
   always_comb begin
     state_d  = state_q;
     unique case (state_q)
-      StIdle: if (in_fire) begin
-        state_d = (in_data_i != cube5_frame_pkg::OpRender) ? StError : StSetup1;
+      StIdle: if (cmd_fire) begin
+        state_d = (cmd_op != cube5_frame_pkg::OpRender) ? StError : StSetup1;
       end
-      StSetup1: state_d = StSetup2;
+      // (Waits while a wipe clears the compositing buffer: Source = 1 only.)
+      StSetup1: if (!wipe_q && !cbuf_clear_busy) state_d = StSetup2;
       StSetup2: state_d = StSetup3;
       StSetup3: state_d = frame_ok ? StSweep : StError;
-      StSweep:   if (sweep_done) state_d = StReadout;
+      StSweep:   if (sweep_done) state_d = slast ? StReadout : StIdle;
       StReadout: if (ro_last) state_d = StIdle;
       StError:   if (out_fire) state_d = StIdle;
       default:   state_d = StIdle;
@@ -358,7 +464,8 @@ module cube5_frame #(
     sent_d    = sent_q;
     reads_d   = reads_q;
     cycles_d  = cycles_q;
-    if (in_fire) begin
+    // A frame's counters run from its first section's command (Source = 0: every command).
+    if (cmd_fire && cmd_first) begin
       reads_d  = '0;
       cycles_d = '0;
     end else if (state_q != StIdle && state_q != StReadout && state_q != StError) begin
@@ -402,99 +509,168 @@ module cube5_frame #(
   end
 
   // ---------------------------------------------------------------------------
-  // Address generation and the skewed memory
+  // Where the beats come from: the skewed memory (Source = 0) or the input stream (Source = 1)
   // ---------------------------------------------------------------------------
-  logic         cmd_valid, sk_in_ready, sk_in_valid;
-  logic [M-1:0] cmd_x, cmd_y, cmd_z;
-  logic [1:0]   cmd_axis;
-  logic [SkInW-1:0] sk_in;
+  logic [XBeatW-1:0] mem_lanes;
 
-  cube5_frame_agen #(
-    .P          (P),
-    .MaxDimLog2 (M)
-  ) u_agen (
-    .clk_i        (clk_i),
-    .rst_ni       (rst_ni),
-    .start_i      (start),
-    .nbr_i        (nbr),
-    .nj_i         (nj_q),
-    .nk_i         (nk_q),
-    .s_first_i    (s_first_q),
-    .s_last_i     (s_last_q),
-    .axis_k_i     (axis_k_q),
-    .k_reversed_i (k_rev_q),
-    .cmd_valid_o  (cmd_valid),
-    .cmd_ready_i  (sk_in_ready && state_q == StSweep),
-    .cmd_x_o      (cmd_x),
-    .cmd_y_o      (cmd_y),
-    .cmd_z_o      (cmd_z),
-    .cmd_axis_o   (cmd_axis)
-  );
+  if (Source == 0) begin : gen_skewmem
+    logic         cmd_valid, sk_in_ready, sk_in_valid;
+    logic [M-1:0] cmd_x, cmd_y, cmd_z;
+    logic [1:0]   cmd_axis;
+    logic [SkInW-1:0] sk_in;
 
-  // A voxel write (configuration region 1) or a beam read; the two never meet (no writes while
-  // sweeping). Command: op, axis, x, y, z, data, probe.
-  always_comb begin
-    if (state_q == StSweep) begin
-      sk_in_valid = cmd_valid;
-      sk_in = {{cube5_skewmem_pkg::mod_w(P){1'b0}}, {VoxelW{1'b0}}, cmd_z, cmd_y, cmd_x, cmd_axis,
-               cube5_skewmem_pkg::OpRead};
-    end else begin
-      sk_in_valid = cfg_voxel;
-      sk_in = {{cube5_skewmem_pkg::mod_w(P){1'b0}}, cfg_data_i[VoxelW-1:0], cfg_off[2*M +: M],
-               cfg_off[M +: M], cfg_off[0 +: M], 2'd0, cube5_skewmem_pkg::OpWrite};
+    cube5_frame_agen #(
+      .P          (P),
+      .MaxDimLog2 (M)
+    ) u_agen (
+      .clk_i        (clk_i),
+      .rst_ni       (rst_ni),
+      .start_i      (start),
+      .nbr_i        (nbr),
+      .nj_i         (nj_q),
+      .nk_i         (nk_q),
+      .s_first_i    (s_first_q),
+      .s_last_i     (s_last_q),
+      .axis_k_i     (axis_k_q),
+      .k_reversed_i (k_rev_q),
+      .cmd_valid_o  (cmd_valid),
+      .cmd_ready_i  (sk_in_ready && state_q == StSweep),
+      .cmd_x_o      (cmd_x),
+      .cmd_y_o      (cmd_y),
+      .cmd_z_o      (cmd_z),
+      .cmd_axis_o   (cmd_axis)
+    );
+
+    // A voxel write (configuration region 1) or a beam read; the two never meet (no writes while
+    // sweeping). Command: op, axis, x, y, z, data, probe.
+    always_comb begin
+      if (state_q == StSweep) begin
+        sk_in_valid = cmd_valid;
+        sk_in = {{cube5_skewmem_pkg::mod_w(P){1'b0}}, {VoxelW{1'b0}}, cmd_z, cmd_y, cmd_x, cmd_axis,
+                 cube5_skewmem_pkg::OpRead};
+      end else begin
+        sk_in_valid = cfg_voxel;
+        sk_in = {{cube5_skewmem_pkg::mod_w(P){1'b0}}, cfg_data_i[VoxelW-1:0], cfg_off[2*M +: M],
+                 cfg_off[M +: M], cfg_off[0 +: M], 2'd0, cube5_skewmem_pkg::OpWrite};
+      end
     end
+
+    // Skewed memory configuration: the dimensions follow the frame register; block LUT entries.
+    logic               sk_cfg_valid;
+    logic [SkAddrW-1:0] sk_cfg_addr;
+    logic [SkDataW-1:0] sk_cfg_data;
+    always_comb begin
+      sk_cfg_valid = we_dims || cfg_block;
+      sk_cfg_addr  = cfg_block ? {1'b1, cfg_off[BlkW-1:0]} : '0;
+      sk_cfg_data  = SkDataW'(cfg_data_i);
+    end
+
+    logic              sk_out_valid;
+    logic [SkOutW-1:0] sk_out;
+
+    cube5_skewmem #(
+      .P           (P),
+      .VoxelW      (VoxelW),
+      .MaxDim      (MaxDim),
+      .BlockDim    (BlockDim),
+      .MemLatency  (MemLatency),
+      .CntW        (SkCntW)
+    ) u_mem (
+      .clk_i       (clk_i),
+      .rst_ni      (rst_ni),
+      .in_valid_i  (sk_in_valid),
+      .in_ready_o  (sk_in_ready),
+      .in_data_i   (sk_in),
+      .out_valid_o (sk_out_valid),
+      .out_ready_i (1'b1),
+      .out_data_o  (sk_out),
+      .cfg_valid_i (sk_cfg_valid),
+      .cfg_addr_i  (sk_cfg_addr),
+      .cfg_data_i  (sk_cfg_data)
+    );
+
+    // Responses: lanes, is_beam, outside, empty, masked, conflict, rd, wr.
+    logic                rsp_beam, rsp_outside, rsp_empty, rsp_masked;
+    assign mem_lanes   = sk_out[0 +: P*VoxelW];
+    assign rsp_beam    = sk_out[P*VoxelW];
+    assign rsp_outside = sk_out[P*VoxelW + 1];
+    assign rsp_empty   = sk_out[P*VoxelW + 2];
+    assign rsp_masked  = sk_out[P*VoxelW + 3];
+    assign mem_beat    = sk_out_valid && rsp_beam && state_q == StSweep;
+    assign mem_read    = mem_beat && !rsp_outside && !rsp_empty && !rsp_masked;
+`ifndef SYNTHESIS
+    // Voxel writes are never lost: the memory takes a command every cycle while idle.
+    VoxelWriteTaken: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        cfg_voxel |-> sk_in_ready)
+      else $error("cube5_frame: the skewed memory refused a voxel write");
+    MemoryBeatsInSweep: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        sk_out_valid && rsp_beam |-> state_q == StSweep)
+      else $error("cube5_frame: a memory beat outside the sweep");
+`endif
+    logic unused_sk;
+    assign unused_sk = ^sk_out;
+  end else begin : gen_stream
+    // A beat: lanes, lo, hi0, hi1, then row_first, row_last, slice_last, last, error. The frame
+    // counts positions itself; the marks are checked against its count in simulation.
+    logic beat_take, beat_err;
+    logic [4:0] beat_marks;
+    assign beat_take  = in_fire && !in_is_cmd && state_q == StSweep;
+    assign beat_err   = in_data_i[1 + XBeatW + 4];
+    assign beat_marks = in_data_i[1 + XBeatW +: 5];
+    assign mem_lanes  = in_data_i[1 +: XBeatW];
+    // A refused section's error beam carries nothing: dropped.
+    assign mem_beat   = beat_take && !beat_err;
+    assign mem_read   = mem_beat;
+    logic unused_marks;
+    assign unused_marks = ^{beat_marks, cfg_voxel, cfg_block, k_rev_q};
+`ifndef SYNTHESIS
+    // The beats' marks agree with the frame's own count of the section (same geometry on both
+    // sides of the stream): a counter of the beats taken, checked on every beat.
+    logic [DimW-1:0] in_m, in_b, in_s;
+    logic signed [1:0] in_tx, in_ty;
+    logic in_fb, in_lb, in_fr, in_lr, in_fs, in_ls;
+    cube5_frame_pos #(
+      .DimW (DimW),
+      .TW   (2),
+      .DW   (2)
+    ) u_in_pos (
+      .clk_i         (clk_i),
+      .rst_ni        (rst_ni),
+      .start_i       (start),
+      .step_i        (mem_beat),
+      .nbr_i         (nbr),
+      .nj_i          (nj_q),
+      .s_first_i     ('0),
+      .s_last_i      (nk_q - DimW'(1)),
+      .tx0_i         (2'sd0),
+      .ty0_i         (2'sd0),
+      .dx_i          (2'sd0),
+      .dy_i          (2'sd0),
+      .m_o           (in_m),
+      .b_o           (in_b),
+      .s_o           (in_s),
+      .tx_o          (in_tx),
+      .ty_o          (in_ty),
+      .first_beat_o  (in_fb),
+      .last_beat_o   (in_lb),
+      .first_row_o   (in_fr),
+      .last_row_o    (in_lr),
+      .first_slice_o (in_fs),
+      .last_slice_o  (in_ls)
+    );
+    logic unused_in_pos;
+    assign unused_in_pos = ^{in_m, in_b, in_s, in_tx, in_ty, in_fr, in_fs};
+    BeatMarksAsCounted: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        mem_beat |-> beat_marks[3:0] == {in_lb && in_lr && in_ls, in_lb && in_lr, in_lb, in_fb})
+      else $error("cube5_frame: a beat's marks (row_first, row_last, slice_last, last) disagree with the section's geometry");
+`endif
   end
-
-  // Skewed memory configuration: the dimensions follow the frame register; block LUT entries.
-  logic               sk_cfg_valid;
-  logic [SkAddrW-1:0] sk_cfg_addr;
-  logic [SkDataW-1:0] sk_cfg_data;
-  always_comb begin
-    sk_cfg_valid = we_dims || cfg_block;
-    sk_cfg_addr  = cfg_block ? {1'b1, cfg_off[BlkW-1:0]} : '0;
-    sk_cfg_data  = SkDataW'(cfg_data_i);
-  end
-
-  logic              sk_out_valid;
-  logic [SkOutW-1:0] sk_out;
-
-  cube5_skewmem #(
-    .P           (P),
-    .VoxelW      (VoxelW),
-    .MaxDim      (MaxDim),
-    .BlockDim    (BlockDim),
-    .MemLatency  (MemLatency),
-    .CntW        (SkCntW)
-  ) u_mem (
-    .clk_i       (clk_i),
-    .rst_ni      (rst_ni),
-    .in_valid_i  (sk_in_valid),
-    .in_ready_o  (sk_in_ready),
-    .in_data_i   (sk_in),
-    .out_valid_o (sk_out_valid),
-    .out_ready_i (1'b1),
-    .out_data_o  (sk_out),
-    .cfg_valid_i (sk_cfg_valid),
-    .cfg_addr_i  (sk_cfg_addr),
-    .cfg_data_i  (sk_cfg_data)
-  );
-
-  // Responses: lanes, is_beam, outside, empty, masked, conflict, rd, wr.
-  logic [P*VoxelW-1:0] mem_lanes;
-  logic                rsp_beam, rsp_outside, rsp_empty, rsp_masked;
-  assign mem_lanes   = sk_out[0 +: P*VoxelW];
-  assign rsp_beam    = sk_out[P*VoxelW];
-  assign rsp_outside = sk_out[P*VoxelW + 1];
-  assign rsp_empty   = sk_out[P*VoxelW + 2];
-  assign rsp_masked  = sk_out[P*VoxelW + 3];
-  assign mem_beat    = sk_out_valid && rsp_beam && state_q == StSweep;
-  assign mem_read    = mem_beat && !rsp_outside && !rsp_empty && !rsp_masked;
 
   // After the last memory beat: nbs + 2 nbr + 2 beats of zeros flush the windows.
   assign flush_beat  = (state_q == StSweep) && (recvd_q == total_q) && (flushed_q != flush_q);
 
   logic                beat_valid;
-  logic [P*VoxelW-1:0] beat;
+  logic [XBeatW-1:0]   beat;
   assign beat_valid = mem_beat || flush_beat;
   assign beat       = mem_beat ? mem_lanes : '0;
 
@@ -502,7 +678,11 @@ module cube5_frame #(
   // The P pipelines
   // ---------------------------------------------------------------------------
   logic                   smp_valid;
-  logic [3*P*SampleW-1:0] smp;
+  logic [(3*P+2*Source)*SampleW-1:0] smp;
+  // The section's edge samples exist unless the section starts or ends at the face's edge.
+  logic                   edge_lo_on, edge_hi_on;
+  assign edge_lo_on = (sa0 != '0);
+  assign edge_hi_on = sec_end_q != {1'b0, ni_q};
   // Delay-line lengths (explicitly sized wires: Yosys ignores a narrowing cast on a port).
   logic [RowLenW-1:0]     row_len;
   logic [SliceLenW-1:0]   slice_len;
@@ -519,7 +699,8 @@ module cube5_frame #(
     .FracW   (FracW),
     .DimW    (DimW),
     .TW      (TW),
-    .DW      (DW)
+    .DW      (DW),
+    .Edges   (Source)
   ) u_interp (
     .clk_i        (clk_i),
     .rst_ni       (rst_ni),
@@ -535,6 +716,8 @@ module cube5_frame #(
     .row_len_i    (row_len),
     .slice_len_i  (slice_len),
     .lag_i        (lag),
+    .edge_lo_on_i (edge_lo_on),
+    .edge_hi_on_i (edge_hi_on),
     .beat_valid_i (beat_valid),
     .beat_i       (beat),
     .smp_valid_o  (smp_valid),
@@ -548,7 +731,8 @@ module cube5_frame #(
     .P       (P),
     .MaxDim  (MaxDim),
     .SampleW (SampleW),
-    .DimW    (DimW)
+    .DimW    (DimW),
+    .Edges   (Source)
   ) u_swin (
     .clk_i       (clk_i),
     .rst_ni      (rst_ni),
@@ -629,6 +813,10 @@ module cube5_frame #(
   logic [P*RgbaW-1:0] upd_pay;
   logic [DimW-1:0]    upd_depth;
   logic [StoreW-1:0]  cb_out_cox;
+  logic [DimW-1:0]    cb_max_sx;   // max sx + A0: the section's anchors land A0 columns right
+  logic               cb_rst_n;    // reset, or a wipe of a frame left without its last section
+  assign cb_max_sx = max_sx_q + DimW'(sa0);
+  assign cb_rst_n  = rst_ni && !wipe_q;
   logic [P-1:0]       co_ready, co_valid;
   logic [P*CoxelW-1:0] co_out;
 
@@ -642,7 +830,7 @@ module cube5_frame #(
     .DW     (DW)
   ) u_cbuf (
     .clk_i        (clk_i),
-    .rst_ni       (rst_ni),
+    .rst_ni       (cb_rst_n),
     .clear_busy_o (cbuf_clear_busy),
     .start_i      (start),
     .nbr_i        (nbr),
@@ -653,7 +841,7 @@ module cube5_frame #(
     .ty0_i        (ty0_q),
     .dx_i         (dx_q),
     .dy_i         (dy_q),
-    .max_sx_i     (max_sx_q),
+    .max_sx_i     (cb_max_sx),
     .max_sy_i     (max_sy_q),
     .in_valid_i   (rgba_valid),
     .in_pay_i     (rgba),
@@ -725,17 +913,13 @@ module cube5_frame #(
                         error_item ? CoxelW'(0) : full_coxel(cb_out_cox)};
 
   logic unused_top;
-  assign unused_top = ^{co_ready, co_valid, co_out, sk_out, cfg_data_i, cfg_off};
+  assign unused_top = ^{co_ready, co_valid, co_out, cfg_data_i, cfg_off, unused_in};
 
 `ifndef SYNTHESIS
   // A stalled output holds its item (STYLE.md rule 3).
   OutputHoldsWhileStalled: assert property (@(posedge clk_i) disable iff (!rst_ni)
       out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
     else $error("cube5_frame: output changed while stalled");
-  // Voxel writes are never lost: the memory takes a command every cycle while idle.
-  VoxelWriteTaken: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      cfg_voxel |-> sk_in_ready)
-    else $error("cube5_frame: the skewed memory refused a voxel write");
   ComposAlwaysReady: assert property (@(posedge clk_i) disable iff (!rst_ni)
       upd_valid |-> &co_ready)
     else $error("cube5_frame: a compositing unit was not ready");
@@ -752,9 +936,6 @@ module cube5_frame #(
       co_valid[0] == co_pipe_q[cube5_frame_pkg::ComposLatency-1])
     else $error("cube5_frame: cube5_compos no longer has latency %0d; update ComposLatency in cube5_frame_pkg and the smallest-volume rule",
                 cube5_frame_pkg::ComposLatency);
-  MemoryBeatsInSweep: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      sk_out_valid && rsp_beam |-> state_q == StSweep)
-    else $error("cube5_frame: a memory beat outside the sweep");
 `endif
 
 endmodule

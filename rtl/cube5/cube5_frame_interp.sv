@@ -7,7 +7,15 @@
 // behind the memory), so each beat that arrives after the first nbs + nbr + 1 of a frame issues one
 // item to the 3P interpolators (through one register of corners). Zero rules of the contract: a corner beyond the far faces (a + 1 =
 // ni, b + 1 = nj) and a slice outside 0 .. nk-1 read as 0. The interpolators never stall (their
-// outputs are always taken); the caller sends exactly as many beats as the frame needs.
+// outputs are always taken); the caller sends exactly as many beats as the frame needs. Beats may
+// come with gaps (beat_valid_i low): every window, counter and register advances per beat.
+//
+// Edges = 1 (a section [A0, A0 + ns) of the face, docs/numerics/frame.md, "Sections"): each beat
+// carries the edge voxels lo, hi0, hi1 (columns A0 - 1, A0 + ns, A0 + ns + 1) beside its lanes, as
+// cube5_section_buf hands them over on a row's first and last beat. The last lane's corner a + 1
+// at the row's last beat is hi0 (not 0), and two more interpolators per beat give S_s at A0 - 1
+// (from lo and lane 0) and at A0 + ns (from hi0 and hi1): the gradient's x- of the first anchor
+// and x+ of the last. They are 0 at the face's own edges (edge_lo_on_i, edge_hi_on_i low).
 module cube5_frame_interp #(
   parameter int unsigned P       = 4,
   parameter int unsigned MaxDim  = 64,
@@ -17,7 +25,9 @@ module cube5_frame_interp #(
   /// Bits of a dimension, T_x and DX (see cube5_frame_pos).
   parameter int unsigned DimW    = 7,
   parameter int unsigned TW      = 25,
-  parameter int unsigned DW      = 18
+  parameter int unsigned DW      = 18,
+  /// 1: beats carry a section's edge voxels (above); 0: whole rows, zeros past the row.
+  parameter int unsigned Edges   = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -38,22 +48,33 @@ module cube5_frame_interp #(
   input  logic [$clog2(MaxDim*MaxDim/P+1)-1:0] slice_len_i,
   input  logic [$clog2(MaxDim*MaxDim/P+1):0] lag_i,
 
-  /// One memory beat (or a flush beat of zeros); lane l at [l*VoxelW +: VoxelW].
+  /// Edges = 1: the section does not start at a = 0 (lo is a voxel of the face), does not end at
+  /// a = ni (hi0 is); otherwise the edge samples are 0. Ignored with Edges = 0.
+  input  logic edge_lo_on_i,
+  input  logic edge_hi_on_i,
+
+  /// One memory beat (or a flush beat of zeros); lane l at [l*VoxelW +: VoxelW], then (Edges = 1)
+  /// lo, hi0, hi1.
   input  logic beat_valid_i,
-  input  logic [P*VoxelW-1:0] beat_i,
+  input  logic [(P+3*Edges)*VoxelW-1:0] beat_i,
 
   /// Samples of one anchor beat: level L (0 = A = S'(s+1), 1 = C = S_s, 2 = B = S'(s-1)), lane l
-  /// at [(L*P + l)*SampleW +: SampleW], U(VoxelW.FracW).
+  /// at [(L*P + l)*SampleW +: SampleW], U(VoxelW.FracW); with Edges = 1 then S_s(A0 - 1) and
+  /// S_s(A0 + ns) of the beat's row (meaningful on the row's first and last beat only).
   output logic smp_valid_o,
-  output logic [3*P*cube5_pkg::sample_w(VoxelW, FracW)-1:0] smp_o
+  output logic [(3*P+2*Edges)*cube5_pkg::sample_w(VoxelW, FracW)-1:0] smp_o
 );
 
   localparam int unsigned SampleW = cube5_pkg::sample_w(VoxelW, FracW);
-  localparam int unsigned BeatW   = P * VoxelW;
+  localparam int unsigned BeatW   = (P + 3 * Edges) * VoxelW;   // a beat with its edge voxels
+  localparam int unsigned NTri    = 3 * P + 2 * Edges;
   localparam int unsigned TriInW  = cube5_pkg::trilin_in_w(VoxelW, WeightW);
   localparam int unsigned StepW   = cube5_frame_pkg::StepW;
   localparam int unsigned LagW    = $clog2(MaxDim*MaxDim/P+1) + 1;
 
+  if (Edges > 1) begin : gen_bad_edges
+    $fatal(1, "cube5_frame_interp: Edges must be 0 or 1");
+  end
   if (WeightW > StepW) begin : gen_bad_weight_w
     $fatal(1, "cube5_frame_interp: WeightW must not exceed StepW");
   end
@@ -66,7 +87,8 @@ module cube5_frame_interp #(
   cube5_frame_vwin #(
     .P      (P),
     .VoxelW (VoxelW),
-    .MaxDim (MaxDim)
+    .MaxDim (MaxDim),
+    .Extra  (3 * Edges)
   ) u_vwin (
     .clk_i       (clk_i),
     .rst_ni      (rst_ni),
@@ -145,7 +167,24 @@ module cube5_frame_interp #(
   // ---------------------------------------------------------------------------
   // Corners: lane l's 2x2 voxels at level L, with the zero rules
   // ---------------------------------------------------------------------------
-  logic [3*P*TriInW-1:0] tri_in;
+  logic [3*P*TriInW-1:0]  tri_in;      // the lanes' interpolators
+  logic [NTri*TriInW-1:0] tri_all;     // and the section's two edge interpolators
+
+  // Edge voxels of the lo_prev (row b) and hi_prev (row b + 1) taps, level L at
+  // [L*3*VoxelW +: 3*VoxelW] as lo, hi0, hi1 (zeros when Edges = 0). Levels 0 and 2 read hi0 only
+  // (the corners a + 1 of the last lane), level 1 all three.
+  logic [9*VoxelW-1:0] eg_lo, eg_hi;
+  logic                unused_eg;
+  if (Edges != 0) begin : gen_edges
+    for (genvar lv = 0; lv < 3; lv++) begin : gen_level
+      assign eg_lo[lv*3*VoxelW +: 3*VoxelW] = taps[(4*lv + 0)*BeatW + P*VoxelW +: 3*VoxelW];
+      assign eg_hi[lv*3*VoxelW +: 3*VoxelW] = taps[(4*lv + 2)*BeatW + P*VoxelW +: 3*VoxelW];
+    end
+  end else begin : gen_no_edges
+    assign eg_lo = '0;
+    assign eg_hi = '0;
+  end
+  assign unused_eg = ^{eg_lo, eg_hi};
   logic                  unused_taps;   // of the next beats only lane 0 is read
 
   always_comb begin
@@ -173,8 +212,17 @@ module cube5_frame_interp #(
           v10 = lo_prev[(l+1)*VoxelW +: VoxelW];
           v11 = hi_prev[(l+1)*VoxelW +: VoxelW];
         end else begin
-          v10 = last_beat ? '0 : lo_next;
-          v11 = last_beat ? '0 : hi_next;
+          // Past the row: the section's hi0 (Edges = 1), or 0 at the face's edge.
+          v10 = lo_next;
+          v11 = hi_next;
+          if (last_beat) begin
+            v10 = '0;
+            v11 = '0;
+            if (Edges != 0 && edge_hi_on_i) begin
+              v10 = eg_lo[(3*lv + 1)*VoxelW +: VoxelW];
+              v11 = eg_hi[(3*lv + 1)*VoxelW +: VoxelW];
+            end
+          end
         end
         if (last_row) begin
           v01 = '0;
@@ -193,11 +241,48 @@ module cube5_frame_interp #(
     end
   end
 
+  // The section's edge samples at level 1 (slice s, never masked): e = 0 at A0 - 1 from lo and
+  // lane 0, e = 1 at A0 + ns from hi0 and hi1; row b + 1 is 0 past the last row.
+  if (Edges != 0) begin : gen_edge_tri
+    logic [2*TriInW-1:0] tri_edge;
+    always_comb begin
+      for (int unsigned e = 0; e < 2; e++) begin
+        logic [VoxelW-1:0] v00, v10, v01, v11;
+        if (e == 0) begin
+          v00 = eg_lo[3*VoxelW +: VoxelW];
+          v10 = taps[(4 + 0)*BeatW +: VoxelW];
+          v01 = eg_hi[3*VoxelW +: VoxelW];
+          v11 = taps[(4 + 2)*BeatW +: VoxelW];
+        end else begin
+          v00 = eg_lo[4*VoxelW +: VoxelW];
+          v10 = eg_lo[5*VoxelW +: VoxelW];
+          v01 = eg_hi[4*VoxelW +: VoxelW];
+          v11 = eg_hi[5*VoxelW +: VoxelW];
+        end
+        if (last_row) begin
+          v01 = '0;
+          v11 = '0;
+        end
+        if ((e == 0 && !edge_lo_on_i) || (e == 1 && !edge_hi_on_i)) begin
+          v00 = '0;
+          v10 = '0;
+          v01 = '0;
+          v11 = '0;
+        end
+        tri_edge[e*TriInW +: TriInW] = {cube5_pkg::TrilinModeLerp, WeightW'(0), wy, wx,
+                                        {4*VoxelW{1'b0}}, v11, v01, v10, v00};
+      end
+    end
+    assign tri_all = {tri_edge, tri_in};
+  end else begin : gen_no_edge_tri
+    assign tri_all = tri_in;
+  end
+
   // ---------------------------------------------------------------------------
   // Corner register (keeps the window's muxes and masks off the interpolators' first stage)
   // ---------------------------------------------------------------------------
   logic                  tri_in_valid_q;
-  logic [3*P*TriInW-1:0] tri_in_q;
+  logic [NTri*TriInW-1:0] tri_in_q;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -208,15 +293,15 @@ module cube5_frame_interp #(
   end
 
   always_ff @(posedge clk_i) begin
-    if (fire) tri_in_q <= tri_in;
+    if (fire) tri_in_q <= tri_all;
   end
 
   // ---------------------------------------------------------------------------
   // 3P interpolators, never stalled
   // ---------------------------------------------------------------------------
-  logic [3*P-1:0] tri_ready, tri_valid;
+  logic [NTri-1:0] tri_ready, tri_valid;
 
-  for (genvar i = 0; i < 3 * P; i++) begin : gen_trilin
+  for (genvar i = 0; i < NTri; i++) begin : gen_trilin
     cube5_trilin #(
       .VoxelW  (VoxelW),
       .WeightW (WeightW),
@@ -238,7 +323,8 @@ module cube5_frame_interp #(
   // Unused position bits: the weights need only the fractions, the masks only the flags.
   logic unused_pos;
   assign unused_pos = ^{pos_m, pos_b, pos_s, tx[TW-1:StepW], ty[TW-1:StepW], first_beat,
-                        first_row, tri_valid[3*P-1:1], unused_taps};
+                        first_row, tri_valid[NTri-1:1], unused_taps,
+                        unused_eg, edge_lo_on_i, edge_hi_on_i};
   if (WeightW < StepW) begin : gen_unused_frac
     logic unused_frac;
     assign unused_frac = ^{tx[StepW-WeightW-1:0], ty[StepW-WeightW-1:0]};

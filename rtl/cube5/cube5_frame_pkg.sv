@@ -37,6 +37,14 @@ package cube5_frame_pkg;
   /// The 2-bit `op` field of a command; 1..3 are reserved and answered by one error item.
   localparam logic [1:0] OpRender = 2'd0;  // render one frame
 
+  /// Source = 1 (a frame fed by a beat stream): the first bit of an input item
+  /// (docs/numerics/frame.md, "Sections").
+  // a command: op, sec_a0, sec_ns, sec_first, sec_last
+  localparam logic [0:0] InKindCmd  = 1'd0;
+  // a beam of cube5_section_buf: P voxels, lo, hi0, hi1, row_first, row_last, slice_last, last,
+  // error
+  localparam logic [0:0] InKindBeat = 1'd1;
+
   /// Configuration port: the top three address bits select a region (5..7 are ignored).
   localparam int unsigned CfgRegionW = 3;
   // frame registers
@@ -114,6 +122,25 @@ package cube5_frame_pkg;
   function automatic int unsigned out_w(int unsigned acc_w, int unsigned z_w,
                                         int unsigned color_w);
     out_w = coxel_w(acc_w, z_w, color_w) + 1 + 2 * CntW;
+  endfunction
+
+  /// Source = 1: bits of a command's payload: op (2), sec_a0 (m), sec_ns (m + 1), sec_first,
+  /// sec_last.
+  function automatic int unsigned sec_cmd_w(int unsigned max_dim_log2);
+    sec_cmd_w = 2 + max_dim_log2 + (max_dim_log2 + 1) + 2;
+  endfunction
+
+  /// Source = 1: bits of a beat (cube5_section_buf's output beam): P lanes, lo, hi0, hi1, five
+  /// marks.
+  function automatic int unsigned sec_beat_w(int unsigned p, int unsigned voxel_w);
+    sec_beat_w = (p + 3) * voxel_w + 5;
+  endfunction
+
+  /// Bits of in_data_i: the 2-bit op (Source = 0), or the kind bit and the longer payload.
+  function automatic int unsigned in_w(int unsigned source, int unsigned p, int unsigned voxel_w,
+                                       int unsigned max_dim_log2);
+    in_w = (source == 0) ? 2
+         : 1 + max2(sec_cmd_w(max_dim_log2), sec_beat_w(p, voxel_w));
   endfunction
 
 endpackage

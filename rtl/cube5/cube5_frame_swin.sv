@@ -12,12 +12,18 @@
 //   C(u + nbr)  = y+ register           (row b+1: item v - 1)
 //   A(u), B(u)  = a delay of nbr + 1 items
 // The first nbr + 1 items of a frame only fill the window; each later item issues one block, one
-// cycle later (an output register).
+// cycle later (an output register). Items may come with gaps: everything advances per item.
+//
+// Edges = 1 (a section of the face): each item also carries S_s(A0 - 1) and S_s(A0 + ns) of its
+// row, which travel with C; they are x- of lane 0 on the row's first beat and x+ of lane P-1 on its
+// last, in place of the zeros of a whole row.
 module cube5_frame_swin #(
   parameter int unsigned P       = 4,
   parameter int unsigned MaxDim  = 64,
   parameter int unsigned SampleW = 16,
-  parameter int unsigned DimW    = 7
+  parameter int unsigned DimW    = 7,
+  /// 1: items carry the section's edge samples (above).
+  parameter int unsigned Edges   = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -32,7 +38,7 @@ module cube5_frame_swin #(
 
   /// Samples of one anchor beat (cube5_frame_interp's layout: level 0 A, 1 C, 2 B; lane-minor).
   input  logic smp_valid_i,
-  input  logic [3*P*SampleW-1:0] smp_i,
+  input  logic [(3*P+2*Edges)*SampleW-1:0] smp_i,
 
   /// One anchor beat's neighbourhoods, lane l at [l*7*SampleW +: 7*SampleW] as
   /// C, x-, x+, y-, y+, B, A (SampleW each, LSB first).
@@ -42,21 +48,36 @@ module cube5_frame_swin #(
 
   localparam int unsigned BeatW = P * SampleW;
   localparam int unsigned RowLenW = $clog2(MaxDim/P+1);
+  localparam int unsigned CW      = BeatW + 2 * Edges * SampleW;   // C with the edge samples
 
   logic [BeatW-1:0] cur_a, cur_c, cur_b;
   assign cur_a = smp_i[0*BeatW +: BeatW];
   assign cur_c = smp_i[1*BeatW +: BeatW];
   assign cur_b = smp_i[2*BeatW +: BeatW];
 
+  logic [CW-1:0]      cur_cx, row1x;
+  logic [SampleW-1:0] ctr_elo, ctr_ehi;   // the centre item's S_s(A0 - 1), S_s(A0 + ns)
+  logic [BeatW-1:0]   ctr_q;
+  logic [CW-1:0]      ctrx_q;
+  if (Edges != 0) begin : gen_edges
+    assign cur_cx  = {smp_i[3*BeatW +: 2*SampleW], cur_c};
+    assign ctr_elo = ctrx_q[BeatW +: SampleW];
+    assign ctr_ehi = ctrx_q[BeatW + SampleW +: SampleW];
+  end else begin : gen_no_edges
+    assign cur_cx  = cur_c;
+    assign ctr_elo = '0;
+    assign ctr_ehi = '0;
+  end
+
   // ---------------------------------------------------------------------------
   // Delay lines
   // ---------------------------------------------------------------------------
-  logic [BeatW-1:0]   row1, row2, ctr_q, yp_q;
+  logic [BeatW-1:0]   row1, row2, yp_q;
   logic [SampleW-1:0] xm_q;     // lane P-1 of the beat before the centre
   logic [2*BeatW-1:0] ab_d;
 
   cube5_frame_delay #(
-    .Width (BeatW),
+    .Width (CW),
     .Depth (MaxDim / P)
   ) u_row1 (
     .clk_i   (clk_i),
@@ -64,9 +85,11 @@ module cube5_frame_swin #(
     .clear_i (start_i),
     .en_i    (smp_valid_i),
     .len_i   (row_len_i),
-    .d_i     (cur_c),
-    .q_o     (row1)
+    .d_i     (cur_cx),
+    .q_o     (row1x)
   );
+  assign row1  = row1x[0 +: BeatW];
+  assign ctr_q = ctrx_q[0 +: BeatW];
 
   cube5_frame_delay #(
     .Width (BeatW),
@@ -100,7 +123,7 @@ module cube5_frame_swin #(
   always_ff @(posedge clk_i) begin
     if (smp_valid_i) begin
       yp_q  <= cur_c;
-      ctr_q <= row1;
+      ctrx_q <= row1x;
       xm_q  <= ctr_q[(P-1)*SampleW +: SampleW];
     end
   end
@@ -181,11 +204,13 @@ module cube5_frame_swin #(
         xm = ctr_q[(l-1)*SampleW +: SampleW];
       end else begin
         xm = first_beat ? '0 : xm_q;
+        if (Edges != 0 && first_beat) xm = ctr_elo;
       end
       if (l + 1 < P) begin
         xp = ctr_q[(l+1)*SampleW +: SampleW];
       end else begin
         xp = last_beat ? '0 : row1[0 +: SampleW];
+        if (Edges != 0 && last_beat) xp = ctr_ehi;
       end
       ym = first_row ? '0 : row2[l*SampleW +: SampleW];
       yp = last_row ? '0 : yp_q[l*SampleW +: SampleW];
@@ -214,6 +239,7 @@ module cube5_frame_swin #(
   assign nb_o       = nb_q;
 
   logic unused_pos;
-  assign unused_pos = ^{pos_m, pos_b, pos_s, unused_tx, unused_ty, first_slice, last_slice};
+  assign unused_pos = ^{pos_m, pos_b, pos_s, unused_tx, unused_ty, first_slice, last_slice,
+                        row1};
 
 endmodule

@@ -18,7 +18,10 @@ module cube5_frame_vwin #(
   /// Voxel width.
   parameter int unsigned VoxelW = 12,
   /// Largest volume edge.
-  parameter int unsigned MaxDim = 64
+  parameter int unsigned MaxDim = 64,
+  /// Voxels carried beside the P lanes of each beat (3: a sectioned frame's edge voxels lo, hi0,
+  /// hi1; 0: none). They travel through every delay line with their beat.
+  parameter int unsigned Extra  = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -30,15 +33,15 @@ module cube5_frame_vwin #(
   /// nbr - 1 and nbs - 1 (the FIFO lengths; nbr >= 2).
   input  logic [$clog2(MaxDim/P+1)-1:0] row_len_i,
   input  logic [$clog2(MaxDim*MaxDim/P+1)-1:0] slice_len_i,
-  /// Beat t, lane l at [l*VoxelW +: VoxelW].
-  input  logic [P*VoxelW-1:0] beat_i,
+  /// Beat t, lane l at [l*VoxelW +: VoxelW], then the Extra voxels.
+  input  logic [(P+Extra)*VoxelW-1:0] beat_i,
 
-  /// Taps, tap (L, q) at [(4*L + q)*P*VoxelW +: P*VoxelW], q = 0 lo_prev, 1 lo_cur, 2 hi_prev,
-  /// 3 hi_cur.
-  output logic [12*P*VoxelW-1:0] taps_o
+  /// Taps, tap (L, q) at [(4*L + q)*BeatW +: BeatW], BeatW = (P + Extra) VoxelW, q = 0 lo_prev,
+  /// 1 lo_cur, 2 hi_prev, 3 hi_cur.
+  output logic [12*(P+Extra)*VoxelW-1:0] taps_o
 );
 
-  localparam int unsigned BeatW = P * VoxelW;
+  localparam int unsigned BeatW = (P + Extra) * VoxelW;
 
   // Per level L at [L*BeatW +: BeatW] (flat vectors: these are registers, not RAMs).
   logic [3*BeatW-1:0] lvl;        // hi_cur of each level

@@ -63,11 +63,13 @@ impl FrameRtl {
         Ok(Self { variant, cfg })
     }
 
-    /// Every RTL build of cube5_frame, in `.variants` order.
+    /// Every RTL build of cube5_frame with its skewed memory (`Source = 0`), in `.variants`
+    /// order; the beat-stream ones are `FrameRtl::streams` (frame_stream.rs).
     pub fn all() -> Vec<FrameRtl> {
         variants_of(TOP)
             .into_iter()
             .map(|v| Self::from_variant(v).unwrap_or_else(|e| panic!("{e}")))
+            .filter(|r| !r.stream)
             .collect()
     }
 

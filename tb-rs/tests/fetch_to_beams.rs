@@ -10,7 +10,7 @@
 mod support;
 
 use cube5_model::units::cube5_section_buf::{
-    frame_dims, section_beams, Beam, SbufIn, SectionBufConfig, SectionCmd,
+    frame_dims, section_beams, Beam, SectionBufConfig, SectionCmd,
 };
 use cube5_model::units::cube5_vol_fetch::{
     dram_image, FetchCmd, FetchItem, VolFetch, VolFetchConfig,
@@ -18,7 +18,9 @@ use cube5_model::units::cube5_vol_fetch::{
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{axi_mem_setup, axi_protocol_clean, configs, random_blocked_volume, seed};
+use support::{
+    axi_mem_setup, axi_protocol_clean, configs, random_blocked_volume, section_buf_input, seed,
+};
 
 #[test]
 fn dram_to_beams_through_both_rtl_units() {
@@ -103,18 +105,9 @@ fn one_case(
         "{fv}: the fetch's items equal its model's"
     );
     // The buffer: each section command, then the items of its sweep (up to `last`).
-    let mut input = Vec::new();
+    let input = section_buf_input(&cmds, items);
     let mut want: Vec<Beam> = Vec::new();
-    let mut it = items.into_iter();
     for c in &cmds {
-        input.push(SbufIn::Section(*c));
-        for item in it.by_ref() {
-            let last = item.last;
-            input.push(SbufIn::Item(item));
-            if last {
-                break;
-            }
-        }
         want.extend(section_beams(&scfg, &vol, &lut, c).unwrap());
     }
     let mut sbuf = RtlStream::new(sv, scfg, s as u32).unwrap();

@@ -37,6 +37,14 @@ pub const REUSE_MIN: u64 = COMPOS_LATENCY + 2;
 /// render one frame
 pub const OP_RENDER: u32 = 0;
 
+// Source = 1 (a frame fed by a beat stream): the first bit of an input item
+// (docs/numerics/frame.md, "Sections").
+/// a command: op, sec_a0, sec_ns, sec_first, sec_last
+pub const KIND_CMD: u32 = 0;
+/// a beam of cube5_section_buf: P voxels, lo, hi0, hi1, row_first, row_last, slice_last, last,
+/// error
+pub const KIND_BEAT: u32 = 1;
+
 // Configuration port: the top three address bits select a region (5..7 are ignored).
 pub const CFG_REGION_W: u32 = 3;
 /// frame registers

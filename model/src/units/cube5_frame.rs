@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 mod fast;
 pub use fast::{render_base_plane, render_base_plane_stats, render_sweep, SweepStats, SweepVolume};
+pub mod sections;
 
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;
@@ -54,6 +55,9 @@ pub struct FrameConfig {
     /// then renders MIP only, each sample classified by the shader's 1-D table alone
     /// (docs/numerics/frame.md, "A frame without gradient and shader").
     pub shade: bool,
+    /// Where the beams come from (`Source`): the skewed memory inside (false), or a beat stream a
+    /// section at a time (true; docs/numerics/frame.md, "Sections").
+    pub stream: bool,
 }
 
 impl FrameConfig {
@@ -68,6 +72,7 @@ impl FrameConfig {
         shader: ShaderConfig::DEFAULT,
         compos: ComposConfig::DEFAULT,
         shade: true,
+        stream: false,
     };
 
     /// The largest volume edge (`MaxDim`).
@@ -87,6 +92,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         let (mut block, mut mem_latency) = (d.block, d.mem_latency);
         let (mut t, mut g, mut s, mut c) = (d.trilin, d.gradient, d.shader, d.compos);
         let mut shade = u32::from(d.shade);
+        let mut source = u32::from(d.stream);
         crate::unit::set_params(
             Self::TOP,
             params,
@@ -111,8 +117,14 @@ impl crate::unit::UnitConfig for FrameConfig {
                 ("AccW", &mut c.acc_w),
                 ("ZW", &mut c.z_w),
                 ("Shade", &mut shade),
+                ("Source", &mut source),
             ],
         )?;
+        if source > 1 {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: Source = {source} must be 0 (the skewed memory) or 1 (a beat stream)"
+            )));
+        }
         if shade > 1 {
             return Err(ModelError::Config(format!(
                 "cube5_frame: Shade = {shade} must be 0 (no gradient, no shader: MIP only) or 1"
@@ -140,6 +152,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             shader: s,
             compos: c,
             shade: shade == 1,
+            stream: source == 1,
         })
     }
 
@@ -167,6 +180,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             ("AccW", i(c.acc_w)),
             ("ZW", i(c.z_w)),
             ("Shade", i64::from(self.shade)),
+            ("Source", i64::from(self.stream)),
         ]
     }
 }
@@ -471,12 +485,29 @@ pub fn sample_input(
     cfg: &TrilinConfig,
 ) -> TrilinIn {
     let v = |da: usize, db: usize| params.voxel(vol, a + da, b + db, c.k);
+    bilinear_input(c, [v(0, 0), v(1, 0), v(0, 1), v(1, 1)], cfg)
+}
+
+/// The interpolation input of a bilinear sample of the corners `[(a, b), (a+1, b), (a, b+1),
+/// (a+1, b+1)]` with slice `c`'s weights (the fractions truncated to `WeightW` bits).
+pub fn bilinear_input(c: &SliceConst, corners: [u32; 4], cfg: &TrilinConfig) -> TrilinIn {
     let w = |f: u32| f >> (STEP_W - cfg.weight_w);
+    let [v00, v10, v01, v11] = corners;
     TrilinIn {
-        voxels: [v(0, 0), v(1, 0), v(0, 1), v(1, 1), 0, 0, 0, 0],
+        voxels: [v00, v10, v01, v11, 0, 0, 0, 0],
         weights: [w(c.frac_x), w(c.frac_y), 0],
         mode: TrilinMode::Lerp,
     }
+}
+
+/// The contract's zero rule: slice `t` or anchor `(a, b)` outside the volume's face and slices.
+pub fn outside_face(params: &FrameParams, t: i64, a: i64, b: i64) -> bool {
+    t < 0
+        || t >= params.nk as i64
+        || a < 0
+        || b < 0
+        || a >= params.ni as i64
+        || b >= params.nj as i64
 }
 
 /// The bilinear sample of slice number `t` (processing order; zero outside `0..nk`) at anchor
@@ -490,13 +521,7 @@ pub fn sample_at(
     b: i64,
     trilin: &Trilin,
 ) -> u32 {
-    if t < 0
-        || t >= params.nk as i64
-        || a < 0
-        || b < 0
-        || a >= params.ni as i64
-        || b >= params.nj as i64
-    {
+    if outside_face(params, t, a, b) {
         return 0;
     }
     let other = params.slice(t as usize);
@@ -520,17 +545,21 @@ pub fn neighbourhood(
     b: usize,
     trilin: &Trilin,
 ) -> [u32; 7] {
+    neighbourhood_from(c, a, b, |t, a, b| {
+        sample_at(params, vol, c, t, a, b, trilin)
+    })
+}
+
+/// The seven samples of anchor `(a, b)`'s neighbourhood in slice `c`, in [`N6_OFFSETS`] order
+/// (`[C, x-, x+, y-, y+, B, A]`), each `at(t, a', b')` = `S'(t)` at anchor `(a', b')`.
+pub fn neighbourhood_from(
+    c: &SliceConst,
+    a: usize,
+    b: usize,
+    at: impl Fn(i64, i64, i64) -> u32,
+) -> [u32; 7] {
     let (a, b, s) = (a as i64, b as i64, c.s as i64);
-    let at = |t, da, db| sample_at(params, vol, c, t, a + da, b + db, trilin);
-    [
-        at(s, 0, 0),
-        at(s, -1, 0),
-        at(s, 1, 0),
-        at(s, 0, -1),
-        at(s, 0, 1),
-        at(s - 1, 0, 0),
-        at(s + 1, 0, 0),
-    ]
+    N6_OFFSETS.map(|(di, dj, dk)| at(s + i64::from(dk), a + i64::from(di), b + i64::from(dj)))
 }
 
 /// One plane of samples in anchor order (`b` outer, `a` inner), for slice `s`.

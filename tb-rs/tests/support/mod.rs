@@ -534,3 +534,25 @@ pub fn random_blocked_volume(
     }
     (vol, lut)
 }
+
+/// `cube5_section_buf`'s input for `cmds`: each section command, then the fetch's items of its
+/// sweep, up to the one marked `last` (the items of all the sweeps, in order).
+pub fn section_buf_input(
+    cmds: &[cube5_model::units::cube5_section_buf::SectionCmd],
+    items: Vec<cube5_model::units::cube5_vol_fetch::FetchItem>,
+) -> Vec<cube5_model::units::cube5_section_buf::SbufIn> {
+    use cube5_model::units::cube5_section_buf::SbufIn;
+    let mut input = Vec::new();
+    let mut it = items.into_iter();
+    for c in cmds {
+        input.push(SbufIn::Section(*c));
+        for item in it.by_ref() {
+            let last = item.last;
+            input.push(SbufIn::Item(item));
+            if last {
+                break;
+            }
+        }
+    }
+    input
+}

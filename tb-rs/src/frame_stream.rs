@@ -1,0 +1,329 @@
+//! Driving `cube5_frame` with `Source = 1`: the frame fed by a beat stream a section at a time
+//! (issue 12; docs/numerics/frame.md, "Sections"). One input stream carries the section commands
+//! and the beats of each section (a kind bit first): the volume read in the section's order with
+//! its edge voxels (`cube5_frame::sections::section_beats`, the beams `cube5_section_buf`
+//! delivers). The image is compared with the frame model's whole-frame base plane
+//! (`render_base_plane`, what [`Expected`] holds): sections must change no bit.
+
+use crate::error::{Mismatch, TbError};
+use crate::frame::{ray_trail, Expected, FrameOut, FrameRtl, Render, Rendered, REG_MODE};
+use crate::rtl::{RtlStream, Traffic};
+use crate::variants::variants_of;
+use cube5_model::bits::BitWriter;
+use cube5_model::regs::cube5_frame::{KIND_BEAT, KIND_CMD, OP_RENDER};
+use cube5_model::unit::StreamCodec;
+use cube5_model::units::cube5_frame::sections::{section_beats, section_order, Section};
+use cube5_model::units::cube5_section_buf::Beam;
+
+impl FrameRtl {
+    /// The configurations fed by a beat stream (`Source = 1`), in `.variants` order.
+    pub fn streams() -> Vec<FrameRtl> {
+        variants_of(crate::frame::TOP)
+            .into_iter()
+            .map(|v| FrameRtl::from_variant(v).unwrap_or_else(|e| panic!("{e}")))
+            .filter(|r| r.stream)
+            .collect()
+    }
+}
+
+/// A section command: `op`, the first anchor, the columns, first and last section of a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SecCmd {
+    pub op: u32,
+    pub a0: u32,
+    pub ns: u32,
+    pub first: bool,
+    pub last: bool,
+}
+
+/// One input item of a stream frame.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum StreamIn {
+    Cmd(SecCmd),
+    Beat(Beam),
+}
+
+/// The stream frame's codec: commands and beats in, the frame's output items out.
+#[derive(Debug, Clone, Copy)]
+pub struct StreamFrame(pub FrameRtl);
+
+impl StreamFrame {
+    fn m(&self) -> u32 {
+        self.0.max_dim_log2
+    }
+
+    fn cmd_w(&self) -> u32 {
+        2 + self.m() + (self.m() + 1) + 2
+    }
+
+    fn beat_w(&self) -> u32 {
+        (self.0.p as u32 + 3) * self.0.trilin.voxel_w + 5
+    }
+}
+
+impl StreamCodec for StreamFrame {
+    type In = StreamIn;
+    type Out = FrameOut;
+
+    fn in_width(&self) -> u32 {
+        1 + self.cmd_w().max(self.beat_w())
+    }
+
+    fn out_width(&self) -> u32 {
+        self.0.out_width()
+    }
+
+    fn pack_in(&self, item: &StreamIn) -> Vec<u32> {
+        let mut w = BitWriter::new();
+        match item {
+            StreamIn::Cmd(c) => {
+                w.put(u64::from(KIND_CMD), 1);
+                w.put(u64::from(c.op), 2);
+                w.put(u64::from(c.a0), self.m());
+                w.put(u64::from(c.ns), self.m() + 1);
+                w.put(u64::from(c.first), 1);
+                w.put(u64::from(c.last), 1);
+            }
+            StreamIn::Beat(b) => {
+                let vw = self.0.trilin.voxel_w;
+                w.put(u64::from(KIND_BEAT), 1);
+                for &v in b.lanes.iter().chain([&b.lo, &b.hi0, &b.hi1]) {
+                    w.put(u64::from(v), vw);
+                }
+                for f in [b.row_first, b.row_last, b.slice_last, b.last, b.error] {
+                    w.put(u64::from(f), 1);
+                }
+            }
+        }
+        while w.len() < self.in_width() {
+            let pad = (self.in_width() - w.len()).min(64);
+            w.put(0, pad);
+        }
+        w.finish(self.in_width())
+    }
+
+    fn unpack_out(&self, words: &[u32]) -> FrameOut {
+        self.0.unpack_out(words)
+    }
+}
+
+/// The input items of a whole frame swept in sections of `width` anchors (in the order of
+/// `section_order`), and the beats among them.
+pub fn frame_items(
+    rtl: &FrameRtl,
+    e: &Expected,
+    width: usize,
+) -> Result<(Vec<StreamIn>, u64), TbError> {
+    let order =
+        section_order(&e.params, width, rtl.p).map_err(|x| TbError::setup(rtl.variant.name, x))?;
+    Ok(items_of(rtl, e, &order, true))
+}
+
+/// The items of `order`'s sections: each command then its beats; the first section starts the
+/// frame, the last (when `last`) ends it with the read-out.
+pub fn items_of(
+    rtl: &FrameRtl,
+    e: &Expected,
+    order: &[Section],
+    last: bool,
+) -> (Vec<StreamIn>, u64) {
+    let mut items = Vec::new();
+    let mut beats = 0u64;
+    for (n, sec) in order.iter().enumerate() {
+        items.push(StreamIn::Cmd(SecCmd {
+            op: OP_RENDER,
+            a0: sec.a0 as u32,
+            ns: sec.ns as u32,
+            first: n == 0,
+            last: last && n + 1 == order.len(),
+        }));
+        let b = section_beats(&e.params, &e.seen, *sec, rtl.p);
+        beats += b.len() as u64;
+        items.extend(b.into_iter().map(StreamIn::Beat));
+    }
+    (items, beats)
+}
+
+/// A stream frame with its tables loaded.
+pub struct StreamBench {
+    pub rtl: FrameRtl,
+    pub dut: RtlStream<StreamFrame>,
+    loaded: Option<(Render, u64, bool)>,
+}
+
+impl StreamBench {
+    /// Opens the DUT and waits out the compositing buffer's clear pass after reset (a command
+    /// refused for a reserved render mode; `load` rewrites the mode register).
+    pub fn new(rtl: FrameRtl, dut_seed: u32) -> Result<Self, TbError> {
+        let dut = RtlStream::new(rtl.variant, StreamFrame(rtl), dut_seed)?;
+        let mut bench = Self {
+            rtl,
+            dut,
+            loaded: None,
+        };
+        bench.write(&[rtl.reg(REG_MODE, 3)])?;
+        let out = bench.refused()?;
+        if !out.error {
+            return Err(TbError::from(Mismatch {
+                variant: rtl.variant.name.to_string(),
+                what: "a render in a reserved mode was not refused".into(),
+                ..Default::default()
+            }));
+        }
+        Ok(bench)
+    }
+
+    pub fn write(&mut self, writes: &[(u32, Vec<u32>)]) -> Result<(), TbError> {
+        for (a, d) in writes {
+            self.dut.write_config(*a, d)?;
+        }
+        Ok(())
+    }
+
+    /// One whole-face command that must be refused: its one output item.
+    pub fn refused(&mut self) -> Result<FrameOut, TbError> {
+        let cmd = StreamIn::Cmd(SecCmd {
+            op: OP_RENDER,
+            a0: 0,
+            ns: 0,
+            first: true,
+            last: true,
+        });
+        let d = self.dut.drive(&[cmd], &Traffic::full_speed(), 1, 200_000)?;
+        match d.outputs.as_slice() {
+            [one] => Ok(one.value.clone()),
+            _ => Err(TbError::from(Mismatch {
+                variant: self.rtl.variant.name.to_string(),
+                what: format!("{} items for a refused command", d.outputs.len()),
+                ..Default::default()
+            })),
+        }
+    }
+
+    /// The tables and frame registers of `e` (no empty slices skipped: Source = 1 ignores Skip).
+    pub fn load(&mut self, e: &Expected) -> Result<(), TbError> {
+        let u = &e.units;
+        let key = (
+            u.render,
+            u.compos.lut().ratio().unwrap_or(0.0).to_bits(),
+            u.compos.regs()
+                == cube5_model::units::cube5_compos::ComposRegs::defaults(&self.rtl.compos),
+        );
+        if self.loaded != Some(key) {
+            let w = u.config_writes(&self.rtl);
+            self.write(&w)?;
+            self.loaded = Some(key);
+        }
+        let w = self.rtl.frame_writes(&e.params, u.render, u.tf2d, (0, 0));
+        self.write(&w)
+    }
+
+    /// Drives a frame's items until its W H pixels are out.
+    pub fn drive(
+        &mut self,
+        e: &Expected,
+        items: &[StreamIn],
+        traffic: &Traffic,
+    ) -> Result<Rendered, TbError> {
+        let n = (e.w * e.h) as u64;
+        let start = self.dut.cycle();
+        let limit = 60 * (items.len() as u64 + n) + 200_000;
+        let driven = self.dut.drive(items, traffic, n, limit)?;
+        Ok(Rendered {
+            pixels: driven.outputs.iter().map(|t| t.value.clone()).collect(),
+            taken_at: driven.outputs.iter().map(|t| t.cycle).collect(),
+            cycles: self.dut.cycle() - start,
+            protocol_errors: driven.stats.protocol_errors,
+            limit,
+        })
+    }
+
+    /// Loads `e`, renders it in sections of `width` and compares every pixel with the frame
+    /// model's image; returns the cycles of the drive and the frame's own sweep counter.
+    pub fn check(
+        &mut self,
+        e: &Expected,
+        width: usize,
+        traffic: &Traffic,
+        seed: u64,
+    ) -> Result<(u64, u32), TbError> {
+        self.load(e)?;
+        let (items, beats) = frame_items(&self.rtl, e, width)?;
+        let got = self.drive(e, &items, traffic)?;
+        self.compare(e, &got, beats, &format!("S = {width}"), seed)
+    }
+
+    /// Every pixel and channel, the error flag and the beats counted, against the model.
+    pub fn compare(
+        &self,
+        e: &Expected,
+        got: &Rendered,
+        beats: u64,
+        how: &str,
+        seed: u64,
+    ) -> Result<(u64, u32), TbError> {
+        let rtl = self.rtl;
+        let ctx = format!(
+            "{} view {} {:?}, {:?}, {how}, {:?}, seed {seed}",
+            rtl.variant, e.view, e.dir, e.units.render, e.params
+        );
+        let fail = |item: usize, what: String, trail: String| {
+            Err(TbError::from(Mismatch {
+                variant: rtl.variant.name.to_string(),
+                seed,
+                item: item as u64,
+                input: ctx.clone(),
+                what,
+                trail,
+                ..Default::default()
+            }))
+        };
+        if got.protocol_errors > 0 {
+            return fail(0, "a stalled output changed".into(), String::new());
+        }
+        let n = e.w * e.h;
+        if got.pixels.len() != n {
+            return Err(TbError::Deadlock {
+                variant: rtl.variant.name.to_string(),
+                seed,
+                cycle: got.cycles,
+                what: format!(
+                    "{} of {n} pixels within {} cycles ({ctx})",
+                    got.pixels.len(),
+                    got.limit
+                ),
+            });
+        }
+        for (i, px) in got.pixels.iter().enumerate() {
+            let (r, q) = (i % e.w, i / e.w);
+            if px.error {
+                return fail(
+                    i,
+                    format!("pixel ({r}, {q}) carries the error flag"),
+                    String::new(),
+                );
+            }
+            if u64::from(px.reads) != beats {
+                return fail(
+                    i,
+                    format!(
+                        "pixel ({r}, {q}) counts {} beats, the stream had {beats}",
+                        px.reads
+                    ),
+                    String::new(),
+                );
+            }
+            if px.coxel != e.want[i] {
+                return fail(
+                    i,
+                    format!(
+                        "pixel ({r}, {q}) of {} x {}: RTL {:?}, model {:?}",
+                        e.w, e.h, px.coxel, e.want[i]
+                    ),
+                    ray_trail(&e.params, &e.seen, &e.units, r, q),
+                );
+            }
+        }
+        Ok((got.cycles, got.pixels[0].cycles))
+    }
+}
