@@ -216,6 +216,9 @@ fn modes(mode: FrameMode) -> (ShaderMode, ComposMode) {
             },
             ComposMode::FrontToBack,
         ),
+        m => unreachable!(
+            "the fast path renders Mip and Composite, not {m:?}: FrameUnits::fast_path"
+        ),
     }
 }
 
@@ -567,6 +570,12 @@ pub fn render_sweep(
     units: &FrameUnits,
 ) -> (BasePlane, SweepStats) {
     assert!(
+        units.fast_path(),
+        "render_sweep: {:?} (tf2d {}) is not a fast-path frame",
+        units.mode,
+        units.tf2d
+    );
+    assert!(
         sv.axes == [params.axis_i, params.axis_j, params.axis_k]
             && [sv.ni, sv.nj, sv.nk] == [params.ni, params.nj, params.nk],
         "render_sweep: {sv:?} is not in the sweep order of {params:?}"
@@ -695,6 +704,7 @@ pub fn render_sweep(
                 (FrameMode::Composite, true) => {
                     sweep_band(&slices, q, rows, w, &mut band, FrameMode::Composite, true)
                 }
+                (m, _) => unreachable!("the fast path renders Mip and Composite, not {m:?}"),
             }
         })
         .reduce(SweepStats::default, SweepStats::add);
