@@ -1269,8 +1269,13 @@ fn frame_entries(entries: &mut [PlanEntry], scene: &Scene, vol: &Volume) {
                 e.needed = zero > 0.0;
                 e.detail = if e.needed {
                     format!(
-                        "{:.0}% of {SKIP_BLOCK}^3 blocks are zero: their beams are not read, whole empty slices at the sweep's ends are skipped",
-                        100.0 * zero
+                        "{:.0}% of {SKIP_BLOCK}^3 blocks are zero: their beams are not read, {}",
+                        100.0 * zero,
+                        if scene.render.mode == CompositeMode::Minip {
+                            "every slice is swept (a zero sample is MinIP's minimum)"
+                        } else {
+                            "whole empty slices at the sweep's ends are skipped"
+                        }
                     )
                 } else {
                     "no block is zero".into()
