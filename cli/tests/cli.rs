@@ -160,10 +160,10 @@ fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
         assert!(!dir.join("rtl.png").exists(), "{name}: no image on refusal");
     };
     bad(
-        "cosim-xray.toml",
-        "[volume]\nsize = 16\n[render]\nmode = \"xray\"\n",
+        "cosim-samples.toml",
+        "[volume]\nsize = 16\n[quality]\nsamples_per_slice = 2\n",
         &[],
-        "render.mode = \"xray\" (the frame composites and takes maxima)",
+        "quality.samples_per_slice = 2 (the frame takes one per slice)",
     );
     bad(
         "cosim-big.toml",

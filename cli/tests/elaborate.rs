@@ -65,8 +65,8 @@ fn elaborate_prints_the_configuration_and_why() {
 #[test]
 fn elaborate_refuses_naming_the_field() {
     assert_refused(
-        &cube5(&["elaborate", &scene_path("bubbles-minip")]),
-        &["bubbles-minip.toml", "render.mode = \"minip\""],
+        &cube5(&["elaborate", &scene_path("head-bone-lights")]),
+        &["head-bone-lights.toml", "light[0].colour"],
     );
     assert_refused(
         &cube5(&["elaborate", &scene_path("head-mip"), "-p", "3"]),

@@ -63,7 +63,7 @@ impl FrameRegs {
         view: 6,
         dx: 0x3_fffe,
         dy: 12,
-        mode: 5,
+        mode: 9,
         skip: 0x0302,
     };
 

@@ -901,7 +901,8 @@ pub fn render_er_f64_with(
                     *c
                 }
             }
-            FrameMode::Composite => {
+            // Composite (`frame_mode` refuses the other modes).
+            _ => {
                 let [r, g, b, a] = tf.lookup(d);
                 if a <= 0.0 {
                     return *c;

@@ -165,6 +165,10 @@ pub struct RenderSpec {
 pub struct TransferSpec {
     pub preset: Option<String>,
     pub points: Option<Vec<TfPoint>>,
+    /// The 2-D transfer function (density x gradient magnitude, `cube5_shader`'s `tf2d`):
+    /// opacity grows with the gradient magnitude up to this fraction of the table's magnitude
+    /// range, in (0, 1] (`ClassLut::boundary`). Frame scenes of composite and first-opaque only.
+    pub boundary: Option<f64>,
 }
 
 /// The pipeline model's knobs: a scene's `[quality]` table is read straight into `render::Quality`.
@@ -553,7 +557,10 @@ impl Scene {
                         "give either `preset` or `points`, not both".into(),
                     )
                 }
-                (None, None) => return bad("transfer", "give `preset` or `points`".into()),
+                (None, None) if t.boundary.is_none() => {
+                    return bad("transfer", "give `preset` or `points`".into())
+                }
+                (None, None) => {}
                 (Some(p), None) => {
                     if !TF_PRESETS.contains(&p.as_str()) {
                         return bad(
@@ -573,6 +580,26 @@ impl Scene {
                         return bad(&format!("transfer.{field}"), rest.to_string());
                     }
                 }
+            }
+        }
+        if let Some(b) = self.transfer.as_ref().and_then(|t| t.boundary) {
+            if !(b > 0.0 && b <= 1.0) {
+                return bad("transfer.boundary", format!("{b} is outside (0, 1]"));
+            }
+            if self.gi.is_some() {
+                return bad(
+                    "transfer.boundary",
+                    "the GI-Cube processor model classifies by density alone (no 2-D transfer function)".into(),
+                );
+            }
+            if !r.mode.classifies() {
+                return bad(
+                    "transfer.boundary",
+                    format!(
+                        "the 2-D transfer function classifies by the transfer function (composite, first-opaque); render.mode = \"{}\" classifies by density alone",
+                        r.mode.name()
+                    ),
+                );
             }
         }
         let m = &self.shading;
@@ -764,6 +791,11 @@ impl Scene {
             ));
         }
         Ok(vol)
+    }
+
+    /// The 2-D transfer function's `transfer.boundary`, if asked for.
+    pub fn boundary(&self) -> Option<f64> {
+        self.transfer.as_ref().and_then(|t| t.boundary)
     }
 
     pub fn transfer_function(&self) -> TransferFunction {
@@ -1095,6 +1127,24 @@ impl Plan {
             },
         );
         let what_if = crate::scene_render::not_expressible(scene);
+        if scene.boundary().is_some()
+            && !(scene.run.renderer == Renderer::Pipeline && what_if.is_empty())
+        {
+            return Err(ModelError::Config(format!(
+                "transfer.boundary: the 2-D transfer function runs on the frame model only, and this scene renders on {} ({})",
+                match scene.run.renderer {
+                    Renderer::Pipeline => "the what-if pipeline",
+                    Renderer::Reference => "the f64 reference",
+                    Renderer::Slabs => "the slab model",
+                    Renderer::Er => "the ER-perspective model",
+                },
+                if what_if.is_empty() {
+                    "run.renderer".to_string()
+                } else {
+                    what_if.join("; ")
+                }
+            )));
+        }
         let model = match scene.run.renderer {
             Renderer::Reference => "f64 reference renderer (not the hardware)".to_string(),
             Renderer::Slabs => format!(
@@ -1130,7 +1180,20 @@ impl Plan {
             }
             Renderer::Pipeline if what_if.is_empty() => {
                 frame_entries(&mut entries, scene, vol);
-                "frame (cube5_frame's bits, then the warp)".to_string()
+                if matches!(mode, CompositeMode::Composite | CompositeMode::Mip)
+                    && scene.boundary().is_none()
+                {
+                    "frame (cube5_frame's bits, then the warp)".to_string()
+                } else {
+                    format!(
+                        "frame (cube5_frame's bits, then the warp; {}: the exact per-sample frame model, since the fast path covers MIP and composite with the 1-D table: the same bits, slower)",
+                        if scene.boundary().is_some() {
+                            "transfer.boundary"
+                        } else {
+                            mode.name()
+                        }
+                    )
+                }
             }
             Renderer::Pipeline => format!(
                 "what-if pipeline (not the hardware: {})",
@@ -1177,12 +1240,18 @@ impl fmt::Display for Plan {
 /// unlit); the gradient is the 6-neighbourhood at orthogonal positions, and the
 /// sweep skips whole empty slices at its ends (blocks of zeros), not transparent blocks.
 fn frame_entries(entries: &mut [PlanEntry], scene: &Scene, vol: &Volume) {
-    let mip = scene.render.mode == CompositeMode::Mip;
+    // MIP, MinIP and X-ray are unlit: their frames have no gradient and no shader.
+    let mip = crate::scene_render::frame_mode(scene.render.mode).unlit();
+    let name = match scene.render.mode {
+        CompositeMode::Mip => "MIP",
+        CompositeMode::Minip => "MinIP",
+        _ => "X-ray",
+    };
     for e in entries.iter_mut() {
         match e.unit {
             Unit::Gradient if mip => {
                 e.needed = false;
-                e.detail = "MIP is unlit; its frame has Shade = 0, no gradient unit".into();
+                e.detail = format!("{name} is unlit; its frame has Shade = 0, no gradient unit");
             }
             Unit::Gradient => {
                 e.detail = "6-neighbourhood at orthogonal positions".into();
@@ -1200,8 +1269,13 @@ fn frame_entries(entries: &mut [PlanEntry], scene: &Scene, vol: &Volume) {
                 e.needed = zero > 0.0;
                 e.detail = if e.needed {
                     format!(
-                        "{:.0}% of {SKIP_BLOCK}^3 blocks are zero: their beams are not read, whole empty slices at the sweep's ends are skipped",
-                        100.0 * zero
+                        "{:.0}% of {SKIP_BLOCK}^3 blocks are zero: their beams are not read, {}",
+                        100.0 * zero,
+                        if scene.render.mode == CompositeMode::Minip {
+                            "every slice is swept (a zero sample is MinIP's minimum)"
+                        } else {
+                            "whole empty slices at the sweep's ends are skipped"
+                        }
                     )
                 } else {
                     "no block is zero".into()

@@ -174,9 +174,14 @@ pub fn elaborate(scene: &Scene, dims: [usize; 3], pipelines: Option<usize>) -> R
     }
 
     let mut left_out = Vec::new();
-    if scene.render.mode == CompositeMode::Mip {
+    if crate::scene_render::frame_mode(scene.render.mode).unlit() {
         config.shade = false;
-        let why = "render.mode = \"mip\": the maximum of the classified density (the contract's density ramp), unlit; no reflectance map is read and no gradient is needed";
+        let what = match scene.render.mode {
+            CompositeMode::Mip => "the maximum",
+            CompositeMode::Minip => "the minimum",
+            _ => "the sum",
+        };
+        let why = format!("render.mode = \"{}\": {what} of the classified density (the contract's density ramp), unlit; no reflectance map is read and no gradient is needed", scene.render.mode.name());
         left_out.push(LeftOut {
             unit: "cube5_gradient",
             why: format!("{why} (its neighbours B, A, x-, x+, y-, y+ go with it)"),
@@ -185,7 +190,10 @@ pub fn elaborate(scene: &Scene, dims: [usize; 3], pipelines: Option<usize>) -> R
             unit: "cube5_shader",
             why: format!("{why}; each pipeline keeps the shader's 1-D classification table (cube5_frame_class)"),
         });
-        choices.push(("Shade = 0".into(), "render.mode = \"mip\"".into()));
+        choices.push((
+            "Shade = 0".into(),
+            format!("render.mode = \"{}\"", scene.render.mode.name()),
+        ));
     } else {
         let how = if scene.render.shading {
             "render.shading = true: the reflectance map of the lights, by the gradient"
@@ -229,6 +237,11 @@ mod tests {
         // (scene, P, MaxDim, shade, params of the .variants line) or the refused fields.
         let built: &[(&str, usize, usize, bool, &str)] = &[
             ("head-mip", 4, 128, false, "P=4 MaxDim=128 Shade=0"),
+            ("head-minip", 4, 128, false, "P=4 MaxDim=128 Shade=0"),
+            ("head-xray", 4, 128, false, "P=4 MaxDim=128 Shade=0"),
+            ("bubbles-minip", 4, 32, false, "P=4 MaxDim=32 Shade=0"),
+            ("head-first-opaque", 4, 128, true, "P=4 MaxDim=128"),
+            ("head-2dtf", 4, 128, true, "P=4 MaxDim=128"),
             ("head", 4, 128, true, "P=4 MaxDim=128"),
             ("head-nifti", 4, 64, true, "P=4 MaxDim=64"),
             (
@@ -240,15 +253,7 @@ mod tests {
             ),
         ];
         let refused: &[(&str, &[&str])] = &[
-            ("bubbles-minip", &["render.mode = \"minip\""]),
-            (
-                "head-xray",
-                &["render.mode = \"xray\"", "quality.samples_per_slice"],
-            ),
-            (
-                "head-bone-lights",
-                &["render.mode = \"first-opaque\"", "light[0].colour"],
-            ),
+            ("head-bone-lights", &["light[0].colour"]),
             ("cube3-6.1", &["quality.interpolation", "quality.gradient"]),
             (
                 "sphere-sheared",
@@ -290,10 +295,8 @@ mod tests {
                     assert!(e.full().is_none(), "{name}");
                 } else {
                     assert_eq!(units, ["cube5_gradient", "cube5_shader"], "{name}");
-                    assert!(e
-                        .left_out
-                        .iter()
-                        .all(|l| l.why.contains("render.mode = \"mip\"")));
+                    let mode = format!("render.mode = \"{}\"", s.render.mode.name());
+                    assert!(e.left_out.iter().all(|l| l.why.contains(&mode)));
                     assert!(e.full().unwrap().config.shade, "{name}");
                 }
             } else if let Some((_, fields)) = refused.iter().find(|r| r.0 == name) {
@@ -368,8 +371,11 @@ mod tests {
         );
         let w = why("[volume]\nsize = 16\n[quality]\nalpha_bits = 3\n", None);
         assert!(w.contains("quality.alpha_bits"), "{w}");
-        let w = why("[volume]\nsize = 16\n[render]\nmode = \"minip\"\n", None);
-        assert!(w.contains("render.mode"), "{w}");
+        let w = why(
+            "[volume]\nsize = 16\n[quality]\nsamples_per_slice = 2\n",
+            None,
+        );
+        assert!(w.contains("quality.samples_per_slice"), "{w}");
         let e = Scene::parse("[volume]\nsize = 16\n[run]\npipelines = 3\n", "p3.toml")
             .unwrap_err()
             .to_string();

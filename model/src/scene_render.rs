@@ -1,13 +1,14 @@
 //! What `cube5 render` runs for a scene: the frame model (`units::cube5_frame`, bit-exact with the
 //! RTL frame) for every scene the hardware can express, else a what-if model named as such.
 //!
-//! A scene is one frame of `cube5_frame` when its mode is composite or MIP, its projection
+//! A scene is one frame of `cube5_frame` when its projection is
 //! parallel, and its `[quality]` asks for nothing the frame does not compute (bilinear samples on
 //! the slices, one sample per slice, one ray per voxel, the 6-neighbourhood gradient at orthogonal
 //! positions). Its widths become the frame's parameters (`FrameConfig`), so a width is a knob of
 //! the one model, not of a second one. Everything else (sheared or tri-linear interpolation, more
-//! samples per slice, supersampling, the 10- and 26-neighbourhood gradients, X-ray, MinIP and
-//! first-opaque) runs on the what-if pipeline model `render::render_pipeline`, and `plan:` says so.
+//! samples per slice, supersampling, the 10- and 26-neighbourhood gradients) runs on the what-if
+//! pipeline model `render::render_pipeline`, and `plan:` says so. Every render mode is a frame
+//! mode (MIP, composite, MinIP, X-ray, first-opaque).
 
 use crate::camera::Camera;
 use crate::error::{ModelError, Result};
@@ -18,8 +19,8 @@ use crate::scene::Scene;
 use crate::transfer::TransferFunction;
 use crate::unit::UnitConfig;
 use crate::units::cube5_frame::{
-    self, BasePlane, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepStats,
-    SweepVolume,
+    self, BasePlane, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, ModeOptions,
+    SweepStats, SweepVolume,
 };
 use crate::units::cube5_shader::{DistantLight, Phong};
 use crate::units::cube5_skewmem::BlockLut;
@@ -36,13 +37,6 @@ pub fn not_expressible(scene: &Scene) -> Vec<String> {
         return vec![
             "the scene has a [gi] section: it renders on the GI-Cube processor model, and there is no GI-Cube RTL yet".into(),
         ];
-    }
-    match scene.render.mode {
-        CompositeMode::Composite | CompositeMode::Mip => {}
-        m => why.push(format!(
-            "render.mode = \"{}\" (the frame composites and takes maxima)",
-            m.name()
-        )),
     }
     if scene.view.projection != Projection::Parallel {
         why.push("view.projection = \"perspective\" (the frame is parallel only)".into());
@@ -85,6 +79,17 @@ pub fn not_expressible(scene: &Scene) -> Vec<String> {
         }
     }
     why
+}
+
+/// The frame's render mode of a scene's `render.mode` (every mode is one).
+pub fn frame_mode(mode: CompositeMode) -> FrameMode {
+    match mode {
+        CompositeMode::Composite => FrameMode::Composite,
+        CompositeMode::Mip => FrameMode::Mip,
+        CompositeMode::Minip => FrameMode::Minip,
+        CompositeMode::Xray => FrameMode::Xray,
+        CompositeMode::FirstOpaque => FrameMode::FirstOpaque,
+    }
 }
 
 /// The frame configuration of a scene's widths (`[quality]`), on the RTL's defaults otherwise;
@@ -230,16 +235,7 @@ impl FrameJob {
     /// Sets up one frame of `scene` on `raw` at `cfg` for `p` pipelines (the set-up refuses
     /// dimensions that are not multiples of `p`; the image does not depend on `p`).
     pub fn new(scene: &Scene, raw: &Volume, cfg: FrameConfig, p: usize) -> Result<Self> {
-        let mode = match scene.render.mode {
-            CompositeMode::Composite => FrameMode::Composite,
-            CompositeMode::Mip => FrameMode::Mip,
-            m => {
-                return Err(ModelError::Config(format!(
-                    "render.mode = \"{}\": the frame renders composite and MIP",
-                    m.name()
-                )))
-            }
-        };
+        let mode = frame_mode(scene.render.mode);
         let vol = at_voxel_width(raw, cfg.trilin.voxel_w)?;
         let dir = scene.render_params().direction()?;
         let setup = FrameSetup::new(vol.dims, vol.spacing, dir, p)?;
@@ -249,19 +245,15 @@ impl FrameJob {
         let look = Look {
             tf: scene.transfer_function(),
             phong: scene_phong(scene, &setup.params),
-            early_termination: match mode {
-                FrameMode::Composite => Some(scene.render.early_termination),
-                FrameMode::Mip => None,
-            },
+            early_termination: (mode == FrameMode::Composite)
+                .then_some(scene.render.early_termination),
         };
-        let units = FrameUnits::with_config(
-            &cfg,
-            mode,
-            &setup,
-            &look.tf,
-            &look.phong,
-            look.early_termination,
-        )?;
+        let opts = ModeOptions {
+            early_termination: look.early_termination,
+            threshold: scene.render.threshold,
+            boundary: scene.boundary(),
+        };
+        let units = FrameUnits::with_options(&cfg, mode, &setup, &look.tf, &look.phong, &opts)?;
         let sweep = SweepVolume::new(&setup.params, &seen).ok_or_else(|| {
             ModelError::Volume(format!(
                 "volume of {:?} voxels does not fit the frame's set-up",
@@ -285,7 +277,12 @@ impl FrameJob {
     /// The base plane, bit-exact with the RTL frame, and what the sweep did.
     pub fn render(&self) -> FrameRun {
         let params = &self.setup.params;
-        let (base, model) = cube5_frame::render_sweep(params, &self.sweep, &self.units);
+        let (base, model) = if self.units.fast_path() {
+            cube5_frame::render_sweep(params, &self.sweep, &self.units)
+        } else {
+            // The fast path lacks this mode (or the 2-D table): the exact model, same bits.
+            cube5_frame::render_exact_stats(params, &self.seen, &self.units)
+        };
         let (skipped_slices, in_skipped) = self.lut_counts;
         let swept = params.nk - skipped_slices.0 - skipped_slices.1;
         FrameRun {
@@ -430,8 +427,10 @@ mod tests {
         ));
         assert_eq!(why.len(), 3, "{why:?}");
         assert!(why[0].contains("sheared") && why[2].contains("gradient = 10"));
-        let why = not_expressible(&scene("[render]\nmode = \"xray\"\n"));
-        assert!(why[0].contains("xray"), "{why:?}");
+        for mode in ["minip", "xray", "first-opaque"] {
+            let why = not_expressible(&scene(&format!("[render]\nmode = \"{mode}\"\n")));
+            assert!(why.is_empty(), "{mode} is a frame mode: {why:?}");
+        }
         let why = not_expressible(&scene(
             "[[light]]\ndirection = [1, 0, 0]\ncolour = [1.0, 0.5, 0.5]\n[[light]]\ndirection = [0, 1, 0]\ncolour = [2.0, 2.0, 2.0]\n",
         ));
@@ -439,6 +438,28 @@ mod tests {
         assert!(why[0].contains("light[0].colour"), "{why:?}");
         let why = not_expressible(&scene("[quality]\nacc_bits = 8\n"));
         assert!(why[0].contains("widths"), "{why:?}");
+    }
+
+    #[test]
+    fn the_2d_transfer_function_is_refused_off_the_frame() {
+        let vol = crate::phantom::head_phantom(16, 12).unwrap();
+        for (text, names) in [
+            (
+                "[quality]\nsamples_per_slice = 2\n",
+                "quality.samples_per_slice",
+            ),
+            ("[run]\nrenderer = \"reference\"\n", "run.renderer"),
+        ] {
+            let s = scene(&format!("[transfer]\nboundary = 0.5\n{text}"));
+            let e = crate::scene::Plan::new(&s, &vol).unwrap_err().to_string();
+            assert!(e.contains("transfer.boundary") && e.contains(names), "{e}");
+        }
+        let s = scene("[transfer]\nboundary = 0.5\n");
+        let plan = crate::scene::Plan::new(&s, &vol).unwrap().to_string();
+        assert!(
+            plan.contains("transfer.boundary: the exact per-sample frame model"),
+            "{plan}"
+        );
     }
 
     #[test]

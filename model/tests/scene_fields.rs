@@ -98,12 +98,14 @@ fn cases() -> Vec<Case> {
         c("render.shading", "", "[render]\nshading = false\n", Frame),
         c("render.step", "", "[render]\nstep = 0.5\n", Reference { because: "" }),
         c("render.early_termination", "", "[render]\nearly_termination = 0.3\n", Frame),
-        c("render.threshold", "[render]\nmode = \"first-opaque\"\n", "[render]\nmode = \"first-opaque\"\nthreshold = 0.2\n", Reference { because: "render.mode" }),
+        c("render.threshold", "[render]\nmode = \"first-opaque\"\n", "[render]\nmode = \"first-opaque\"\nthreshold = 0.2\n", Frame),
         // [transfer]
         c("transfer.preset", "", "[transfer]\npreset = \"bone\"\n", Frame),
         c("transfer.points", "", "[transfer]\npoints = [{ density = 0.0, rgba = [0, 0, 0, 0] }, { density = 1.0, rgba = [1, 1, 1, 0.5] }]\n", Frame),
         c("transfer.points.density", "[transfer]\npoints = [{ density = 0.0, rgba = [0, 0, 0, 0] }, { density = 1.0, rgba = [1, 1, 1, 0.5] }]\n", "[transfer]\npoints = [{ density = 0.2, rgba = [0, 0, 0, 0] }, { density = 1.0, rgba = [1, 1, 1, 0.5] }]\n", Frame),
         c("transfer.points.rgba", "[transfer]\npoints = [{ density = 0.0, rgba = [0, 0, 0, 0] }, { density = 1.0, rgba = [1, 1, 1, 0.5] }]\n", "[transfer]\npoints = [{ density = 0.0, rgba = [0, 0, 0, 0] }, { density = 1.0, rgba = [1, 0, 1, 0.5] }]\n", Frame),
+        c("transfer.boundary", "", "[transfer]\nboundary = 0.25\n", Frame),
+        c("transfer.boundary", "[render]\nmode = \"mip\"\n", "[render]\nmode = \"mip\"\n[transfer]\nboundary = 0.25\n", Refused),
         // [shading]: the Phong coefficients.
         c("shading.ambient", "", "[shading]\nambient = 0.5\n", Frame),
         c("shading.diffuse", "", "[shading]\ndiffuse = 0.2\n", Frame),
@@ -157,6 +159,7 @@ fn cases() -> Vec<Case> {
         c("view.fov", GI_PERSPECTIVE, "[view]\nfov = 50.0\n", Processor),
         c("view.zoom", GI, "[view]\nzoom = 1.5\n", Processor),
         c("render.mode", GI, "[render]\nmode = \"mip\"\n", Refused),
+        c("transfer.boundary", GI, "[transfer]\nboundary = 0.25\n", Refused),
         c("render.shading", GI, "[render]\nshading = false\n", Refused),
         c("shading.ambient", GI, "[shading]\nambient = 0.5\n", Refused),
         c("light", GI, "[[light]]\ndirection = [0.0, 0.0, -1.0]\n", Refused),

@@ -48,7 +48,7 @@ package cube5_accel_regs_pkg;
   localparam int unsigned RegView      = 5;  // RW: axis_k [1:0], k_reversed [2]
   localparam int unsigned RegDx        = 6;  // RW: dx [17:0]
   localparam int unsigned RegDy        = 7;  // RW: dy [17:0]
-  localparam int unsigned RegMode      = 8;  // RW: render [1:0], tf2d [2]
+  localparam int unsigned RegMode      = 8;  // RW: render [2:0], tf2d [3]
   localparam int unsigned RegSkip      = 9;  // RW: front (m + 1), back (m + 1)
   localparam int unsigned RegVolBaseLo = 10;  // RW
   localparam int unsigned RegVolBaseHi = 11;  // RW
@@ -109,8 +109,8 @@ package cube5_accel_regs_pkg;
   localparam int unsigned RegDyDyLsb           = 0;
   localparam int unsigned RegDyDyW             = 18;
   localparam int unsigned RegModeRenderLsb     = 0;
-  localparam int unsigned RegModeRenderW       = 2;
-  localparam int unsigned RegModeTf2dLsb       = 2;
+  localparam int unsigned RegModeRenderW       = 3;
+  localparam int unsigned RegModeTf2dLsb       = 3;
   localparam int unsigned RegModeTf2dW         = 1;
   localparam int unsigned RegTableAddrIndexLsb = 0;
   localparam int unsigned RegTableAddrIndexW   = 16;
@@ -141,7 +141,7 @@ package cube5_accel_regs_pkg;
   localparam logic [735:0] AxilMask = {
       32'h000fffff, 32'hffffffff, 32'h000fffff, 32'hffffffff, 32'hffffffff, 32'hffffffff,
       32'hffffffff, 32'h00000000, 32'h00000000, 32'hffffffff, 32'hffffffff, 32'hffffffff,
-      32'hffffffff, 32'hffffffff, 32'h00000007, 32'h0003ffff, 32'h0003ffff, 32'h00000007,
+      32'hffffffff, 32'hffffffff, 32'h0000000f, 32'h0003ffff, 32'h0003ffff, 32'h00000007,
       32'hffffffff, 32'h00000003, 32'h00000003, 32'h000000f7, 32'h00000003
   };
   // reset values

@@ -47,9 +47,9 @@ module cube5_frame #(
   parameter int unsigned ExtraW     = 4,
   parameter int unsigned AccW       = 20,
   parameter int unsigned ZW         = 12,
-  /// Units of the pipelines: 1 gradient and shader (every mode); 0 neither, for MIP only: each
-  /// pipeline classifies its sample with the shader's 1-D table alone (cube5_frame_class;
-  /// docs/numerics/frame.md, "A frame without gradient and shader").
+  /// Units of the pipelines: 1 gradient and shader (every mode); 0 neither, for the unlit modes
+  /// only (MIP, MinIP, X-ray): each pipeline classifies its sample with the shader's 1-D table
+  /// alone (cube5_frame_class; docs/numerics/frame.md, "A frame without gradient and shader").
   parameter int unsigned Shade      = 1,
   /// Where the beams come from: 0 the skewed memory inside (cube5_skewmem, loaded through the
   /// configuration port); 1 the input stream, a section at a time (above).
@@ -140,7 +140,7 @@ module cube5_frame #(
     $fatal(1, "cube5_frame: ClassIdxW must not exceed the sample width");
   end
   if (Shade > 1) begin : gen_bad_shade
-    $fatal(1, "cube5_frame: Shade must be 0 (no gradient, no shader: MIP only) or 1");
+    $fatal(1, "cube5_frame: Shade must be 0 (no gradient, no shader: MIP, MinIP, X-ray) or 1");
   end
   if (Source > 1) begin : gen_bad_source
     $fatal(1, "cube5_frame: Source must be 0 (the skewed memory) or 1 (a beat stream)");
@@ -177,7 +177,7 @@ module cube5_frame #(
   logic [1:0]           axis_k_q;
   logic                 k_rev_q;
   logic signed [DW-1:0] dx_q, dy_q;
-  logic [1:0]           render_q;
+  logic [2:0]           render_q;
   logic                 tf2d_q;
   logic [2*DimW-1:0]    skip_q;             // empty slices skipped: before, after
   logic                 we_dims, we_view, we_dx, we_dy, we_mode, we_skip;
@@ -194,8 +194,36 @@ module cube5_frame #(
     if (we_view) {k_rev_q, axis_k_q} <= cfg_data_i[2:0];
     if (we_dx)   dx_q <= cfg_data_i[DW-1:0];
     if (we_dy)   dy_q <= cfg_data_i[DW-1:0];
-    if (we_mode) {tf2d_q, render_q} <= cfg_data_i[2:0];
+    if (we_mode) {tf2d_q, render_q} <= cfg_data_i[3:0];
     if (we_skip) skip_q <= cfg_data_i[0 +: 2*DimW];
+  end
+
+  // What the render mode asks of the pipelines (docs/numerics/frame.md, "Render modes"): the
+  // shader runs unlit for MIP, MinIP and X-ray; the compositing unit's mode; the coxel a ray
+  // starts from (MinIP: A all ones, above every sample, so the first sample always wins).
+  logic       unlit, minip;
+  logic [2:0] co_mode;
+  always_comb begin
+    unlit   = 1'b0;
+    minip   = 1'b0;
+    co_mode = cube5_frame_pkg::ComposFrontToBack;
+    unique case (render_q)
+      cube5_frame_pkg::RenderMip: begin
+        unlit   = 1'b1;
+        co_mode = cube5_frame_pkg::ComposMax;
+      end
+      cube5_frame_pkg::RenderMinip: begin
+        unlit   = 1'b1;
+        minip   = 1'b1;
+        co_mode = cube5_frame_pkg::ComposMin;
+      end
+      cube5_frame_pkg::RenderXray: begin
+        unlit   = 1'b1;
+        co_mode = cube5_frame_pkg::ComposXraySum;
+      end
+      cube5_frame_pkg::RenderFirstOpaque: co_mode = cube5_frame_pkg::ComposFirstOpaque;
+      default: ;  // Composite (the refused codes never sweep)
+    endcase
   end
 
   // ---------------------------------------------------------------------------
@@ -260,10 +288,9 @@ module cube5_frame #(
     endcase
     dims_ok_d = dim_ok(nx) && dim_ok(ny) && dim_ok(nz);
     view_ok_d = (axis_k_q != 2'd3)
-                && (render_q == cube5_frame_pkg::RenderMip
-                    || render_q == cube5_frame_pkg::RenderComposite)
-                // Without gradient and shader: MIP with the 1-D classification only.
-                && (Shade != 0 || (render_q == cube5_frame_pkg::RenderMip && !tf2d_q))
+                && (render_q <= cube5_frame_pkg::RenderFirstOpaque)
+                // Without gradient and shader: the unlit modes with the 1-D classification only.
+                && (Shade != 0 || (unlit && !tf2d_q))
                 && (dx_q <= one_step) && (dx_q >= -one_step)
                 && (dy_q <= one_step) && (dy_q >= -one_step);
   end
@@ -749,8 +776,6 @@ module cube5_frame #(
 
   logic               rgba_valid;
   logic [P*RgbaW-1:0] rgba;
-  logic               is_mip;
-  assign is_mip = (render_q == cube5_frame_pkg::RenderMip);
 
   if (Shade != 0) begin : gen_shade
     cube5_frame_shade #(
@@ -773,7 +798,7 @@ module cube5_frame #(
       .clk_i         (clk_i),
       .rst_ni        (rst_ni),
       .start_i       (start),
-      .shader_mode_i ({is_mip, tf2d_q}),
+      .shader_mode_i ({unlit, tf2d_q}),
       .nb_valid_i    (nb_valid),
       .nb_i          (nb),
       .cfg_valid_i   (cfg_shader),
@@ -812,7 +837,8 @@ module cube5_frame #(
   logic [P*StoreW-1:0] upd_cox, upd_res;
   logic [P*RgbaW-1:0] upd_pay;
   logic [DimW-1:0]    upd_depth;
-  logic [StoreW-1:0]  cb_out_cox;
+  logic [StoreW-1:0]  cb_out_cox, empty_cox;
+  logic [P-1:0]       upd_past;
   logic [DimW-1:0]    cb_max_sx;   // max sx + A0: the section's anchors land A0 columns right
   logic               cb_rst_n;    // reset, or a wipe of a frame left without its last section
   assign cb_max_sx = max_sx_q + DimW'(sa0);
@@ -832,6 +858,7 @@ module cube5_frame #(
     .clk_i        (clk_i),
     .rst_ni       (cb_rst_n),
     .clear_busy_o (cbuf_clear_busy),
+    .empty_cox_i  (empty_cox),
     .start_i      (start),
     .nbr_i        (nbr),
     .nj_i         (nj_q),
@@ -849,6 +876,7 @@ module cube5_frame #(
     .upd_cox_o    (upd_cox),
     .upd_pay_o    (upd_pay),
     .upd_depth_o  (upd_depth),
+    .upd_past_o   (upd_past),
     .upd_valid_i  (co_valid[0]),
     .upd_cox_i    (upd_res),
     .ro_start_i   (ro_start),
@@ -863,8 +891,9 @@ module cube5_frame #(
 
   // "No geometry" depth, all ones (written out: Yosys 0.23 reads a '1 localparam as 1).
   localparam logic [ZW-1:0] ZNone = {ZW{1'b1}};
-  logic [2:0] co_mode;
-  assign co_mode = is_mip ? cube5_frame_pkg::ComposMax : cube5_frame_pkg::ComposFrontToBack;
+  // The coxel a ray starts from, stored fields {terminated, A, B, G, R}: all 0, or for MinIP
+  // A = 2^(AccW+1) - 1 (compos.md, Min: "preloaded with A >= 2^F").
+  assign empty_cox = minip ? {1'b0, {ChanW{1'b1}}, {3*ChanW{1'b0}}} : '0;
 
   // Stored coxel {terminated, A, B, G, R} <-> compos coxel {terminated, gB, gG, gR, Z, A, B, G, R}.
   function automatic logic [CoxelW-1:0] full_coxel(logic [StoreW-1:0] st);
@@ -872,9 +901,12 @@ module cube5_frame #(
   endfunction
 
   for (genvar j = 0; j < P; j++) begin : gen_compos
+    // MinIP leaves out the samples past a far face: at depth Znone the depth test passes them by.
+    logic [ZW-1:0]   co_depth;
     logic [CInW-1:0] co_in;
-    assign co_in = {co_mode, ZW'(upd_depth), upd_pay[j*RgbaW +: RgbaW],
-                    full_coxel(upd_cox[j*StoreW +: StoreW])};
+    assign co_depth = (minip && upd_past[j]) ? ZNone : ZW'(upd_depth);
+    assign co_in    = {co_mode, co_depth, upd_pay[j*RgbaW +: RgbaW],
+                       full_coxel(upd_cox[j*StoreW +: StoreW])};
 
     cube5_compos #(
       .ColorW (ColorW),

@@ -33,6 +33,8 @@ module cube5_frame_cbuf #(
 
   /// The buffer is clearing its valid bits after reset (no frame may start).
   output logic clear_busy_o,
+  /// The coxel of a word whose valid bit is clear (a ray no sample has reached yet in this frame).
+  input  logic [CoxW-1:0] empty_cox_i,
 
   /// New frame: position counters to the first anchor.
   input  logic start_i,
@@ -53,12 +55,15 @@ module cube5_frame_cbuf #(
   input  logic in_valid_i,
   input  logic [P*PayW-1:0] in_pay_i,
 
-  /// To the update units, bank j at [j*... +: ...]: the coxel (0 when its word was not written in
-  /// this frame), the sample, the slice number s of the beat.
+  /// To the update units, bank j at [j*... +: ...]: the coxel (empty_cox_i when its word was not
+  /// written in this frame), the sample, the slice number s of the beat.
   output logic upd_valid_o,
   output logic [P*CoxW-1:0] upd_cox_o,
   output logic [P*PayW-1:0] upd_pay_o,
   output logic [DimW-1:0]   upd_depth_o,
+  /// Bank j's sample lies past a far face (anchor a = ni - 1 with fx(s) != 0, or b = nj - 1 with
+  /// fy(s) != 0: its interpolation reads the zeros there); MinIP leaves such samples out.
+  output logic [P-1:0]      upd_past_o,
   /// Back from the update units, in the same order.
   input  logic upd_valid_i,
   input  logic [P*CoxW-1:0] upd_cox_i,
@@ -69,7 +74,7 @@ module cube5_frame_cbuf #(
   input  logic [DimW:0] h_i,
   output logic out_valid_o,
   input  logic out_ready_i,
-  /// The pixel's coxel (0 when no sample reached it).
+  /// The pixel's coxel (empty_cox_i when no sample reached it).
   output logic [CoxW-1:0] out_cox_o,
   /// The read-out has issued its last read.
   output logic ro_busy_o
@@ -173,7 +178,15 @@ module cube5_frame_cbuf #(
 
   logic [P*AddrW-1:0] sw_addr;  // bank j's word for this beat
   logic [P*PayW-1:0]  pay_rot;  // bank j's sample
+  logic [P-1:0]       past, past_rot;  // lane l's, bank j's sample past a far face
   logic               unused_col;
+
+  always_comb begin
+    for (int unsigned l = 0; l < P; l++) begin
+      past[l] = ((ty[StepW-1:0] != '0) && (pos_b == nj_i - DimW'(1)))
+                || ((tx[StepW-1:0] != '0) && (pos_m == nbr_i - DimW'(1)) && (l == P - 1));
+    end
+  end
 
   if (P > 1) begin : gen_rotate
     // Bank j serves lane (j - rot) mod P; below rot it holds the next word of the row.
@@ -186,12 +199,14 @@ module cube5_frame_cbuf #(
         lane = LaneW'(j) - rot;
         sw_addr[j*AddrW +: AddrW] = {q_row[QW-1:0], col[ColW-1:0]};
         pay_rot[j*PayW +: PayW]   = in_pay_i[lane*PayW +: PayW];
+        past_rot[j]               = past[lane];
         unused_col ^= ^col[DimW-1:ColW];
       end
     end
   end else begin : gen_single
     assign sw_addr    = {q_row[QW-1:0], col_base[ColW-1:0]};
     assign pay_rot    = in_pay_i;
+    assign past_rot   = past;
     assign unused_col = ^rot;
   end
 
@@ -282,6 +297,7 @@ module cube5_frame_cbuf #(
   logic               sw_rd_q;
   logic [P*PayW-1:0]  pay_q;
   logic [DimW-1:0]    depth_q;
+  logic [P-1:0]       past_q;
 
   for (genvar j = 0; j < P; j++) begin : gen_bank
     logic [WordW-1:0] mem_q [Depth];
@@ -331,18 +347,20 @@ module cube5_frame_cbuf #(
     if (in_valid_i) begin
       pay_q   <= pay_rot;
       depth_q <= pos_s;
+      past_q  <= past_rot;
     end
   end
 
-  // A word whose valid bit is clear is the empty coxel (all stored fields 0).
+  // A word whose valid bit is clear is the empty coxel (the frame's, by render mode).
   always_comb begin
     for (int unsigned j = 0; j < P; j++) begin
-      upd_cox_o[j*CoxW +: CoxW] = rd_word[j*WordW + CoxW] ? rd_word[j*WordW +: CoxW] : '0;
+      upd_cox_o[j*CoxW +: CoxW] = rd_word[j*WordW + CoxW] ? rd_word[j*WordW +: CoxW] : empty_cox_i;
     end
   end
   assign upd_valid_o = sw_rd_q;
   assign upd_pay_o   = pay_q;
   assign upd_depth_o = depth_q;
+  assign upd_past_o  = past_q;
 
   // ---------------------------------------------------------------------------
   // Output FIFO of the read-out
@@ -352,7 +370,7 @@ module cube5_frame_cbuf #(
   logic             out_empty, unused_out_full;
 
   assign ro_word = rd_word[ro_bank_q*WordW +: WordW];
-  assign ro_cox  = ro_word[CoxW] ? ro_word[CoxW-1:0] : '0;
+  assign ro_cox  = ro_word[CoxW] ? ro_word[CoxW-1:0] : empty_cox_i;
 
   cube5_frame_fifo #(
     .Width (CoxW),

@@ -1,8 +1,9 @@
 // cube5_frame_class: per pipeline, the classification of one sample without gradient and shader
 // (docs/numerics/frame.md, "A frame without gradient and shader"): the frame's `Shade = 0` form of
-// steps 2 to 4, for MIP only. Each pipeline keeps the shader's 1-D classification table (patent
-// [45]: density to RGBA), written at the shader's own configuration addresses (region 0 of
-// docs/numerics/shader.md; texel and zero-entry writes are ignored, there is no reflectance map),
+// steps 2 to 4, for the unlit modes (MIP, MinIP, X-ray). Each pipeline keeps the shader's 1-D
+// classification table (patent [45]: density to RGBA), written at the shader's own configuration
+// addresses (region 0 of docs/numerics/shader.md; texel and zero-entry writes are ignored, there
+// is no reflectance map),
 // and reads entry `C >> (SampleW - ClassIdxW)` of the neighbourhood's centre sample C. That is
 // exactly what cube5_shader returns in mode `unlit` with `tf2d = 0` (`rgb' = rgb`, `a' = a`), so
 // the frame's image does not change; the gradient, its neighbours (x-, x+, y-, y+, B, A) and the

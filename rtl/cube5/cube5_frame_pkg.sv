@@ -58,20 +58,31 @@ package cube5_frame_pkg;
   // compositing tables and registers (every pipeline)
   localparam logic [2:0] CfgRegionCompos = 3'd4;
 
-  /// Render modes (the 2-bit field `render` of register Mode); 2 and 3 are refused.
-  localparam logic [1:0] RenderMip       = 2'd0;  // maximum intensity projection
-  localparam logic [1:0] RenderComposite = 2'd1;  // front-to-back compositing
+  /// Render modes (the 3-bit field `render` of register Mode); 5 to 7 are refused.
+  // maximum intensity projection
+  localparam logic [2:0] RenderMip         = 3'd0;
+  // front-to-back compositing
+  localparam logic [2:0] RenderComposite   = 3'd1;
+  // minimum intensity projection (unlit; untouched coxels read A = all ones)
+  localparam logic [2:0] RenderMinip       = 3'd2;
+  // X-ray: the saturating sum of the samples, shifted by XrayShift (unlit)
+  localparam logic [2:0] RenderXray        = 3'd3;
+  // the shaded colour of the first sample whose alpha reaches FoThreshold
+  localparam logic [2:0] RenderFirstOpaque = 3'd4;
 
   /// Compositing modes the frame uses (docs/numerics/compos.md).
   localparam logic [2:0] ComposFrontToBack = 3'd0;  // for Composite
   localparam logic [2:0] ComposMax         = 3'd2;  // for Mip
+  localparam logic [2:0] ComposMin         = 3'd3;  // for Minip
+  localparam logic [2:0] ComposXraySum     = 3'd4;  // for Xray
+  localparam logic [2:0] ComposFirstOpaque = 3'd5;  // for FirstOpaque
 
   /// Registers by word offset (region 0, `off` = the offset), access, fields LSB first.
   localparam int unsigned RegDims = 0;  // WO: nx (m + 1), ny (m + 1), nz (m + 1)
   localparam int unsigned RegView = 1;  // WO: axis_k [1:0], k_reversed [2]
   localparam int unsigned RegDx   = 2;  // WO: dx [17:0]
   localparam int unsigned RegDy   = 3;  // WO: dy [17:0]
-  localparam int unsigned RegMode = 4;  // WO: render [1:0], tf2d [2]
+  localparam int unsigned RegMode = 4;  // WO: render [2:0], tf2d [3]
   localparam int unsigned RegSkip = 5;  // WO: front (m + 1), back (m + 1)
 
   /// Fields whose place does not depend on parameters: lowest bit, width.
@@ -84,8 +95,8 @@ package cube5_frame_pkg;
   localparam int unsigned RegDyDyLsb          = 0;
   localparam int unsigned RegDyDyW            = 18;
   localparam int unsigned RegModeRenderLsb    = 0;
-  localparam int unsigned RegModeRenderW      = 2;
-  localparam int unsigned RegModeTf2dLsb      = 2;
+  localparam int unsigned RegModeRenderW      = 3;
+  localparam int unsigned RegModeTf2dLsb      = 3;
   localparam int unsigned RegModeTf2dW        = 1;
   // END generated
 

@@ -19,7 +19,7 @@ use cube5_model::unit::StreamCodec;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_compos::{self, Compos, ComposConfig, ComposRegs, Coxel, OpacityLut};
 use cube5_model::units::cube5_frame::{
-    self, FrameConfig, FrameMode, FrameParams, FrameSetup, FrameUnits, SweepAccesses,
+    self, FrameConfig, FrameParams, FrameSetup, FrameUnits, ModeOptions, SweepAccesses,
 };
 use cube5_model::units::cube5_gradient::{Gradient, GradientConfig};
 use cube5_model::units::cube5_shader::{
@@ -117,25 +117,15 @@ impl FrameRtl {
 /// depend on the latencies.
 pub use cube5_model::regs::cube5_frame::{
     CLASS_LATENCY, COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK, REGION_COMPOS,
-    REGION_FRAME, REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE, REG_SKIP,
-    REG_VIEW, TRILIN_LATENCY,
+    REGION_FRAME, REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE, REG_MODE_RENDER,
+    REG_MODE_TF2D, REG_SKIP, REG_VIEW, TRILIN_LATENCY,
 };
 
-/// The frame's two renderings (docs/numerics/frame.md, "The pipeline of one sample").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Render {
-    Mip,
-    Composite,
-}
+/// The frame's renderings (docs/numerics/frame.md, "Render modes"): the model's modes.
+pub use cube5_model::units::cube5_frame::FrameMode as Render;
 
-impl Render {
-    fn mode(self) -> FrameMode {
-        match self {
-            Render::Mip => FrameMode::Mip,
-            Render::Composite => FrameMode::Composite,
-        }
-    }
-}
+/// A `render` code the frame refuses (the field's top code; the modes take 0..=4).
+pub const RENDER_REFUSED: u32 = (1 << REG_MODE_RENDER.width) - 1;
 
 /// One output item: a base-plane coxel and the frame's status.
 #[derive(Debug, Clone, PartialEq)]
@@ -203,10 +193,6 @@ impl FrameRtl {
         dims[params.axis_j] = params.nj as u32;
         dims[params.axis_k] = params.nk as u32;
         let step = |d: i32| (d as u32) & ((1 << 18) - 1);
-        let render_bits = match render {
-            Render::Mip => 0,
-            Render::Composite => 1,
-        };
         vec![
             self.dims_reg(dims),
             self.reg(
@@ -215,7 +201,10 @@ impl FrameRtl {
             ),
             self.reg(REG_DX, step(params.dx)),
             self.reg(REG_DY, step(params.dy)),
-            self.reg(REG_MODE, render_bits | u32::from(tf2d) << 2),
+            self.reg(
+                REG_MODE,
+                render.code() << REG_MODE_RENDER.lsb | u32::from(tf2d) << REG_MODE_TF2D.lsb,
+            ),
             self.reg(
                 REG_SKIP,
                 (skip.0 | skip.1 << (self.max_dim_log2 + 1)) as u32,
@@ -383,37 +372,56 @@ pub struct Look {
     pub tf: TransferFunction,
     pub phong: Phong,
     pub early_termination: bool,
+    /// First-opaque's threshold and the 2-D transfer function (`cube5_frame::ModeOptions`).
+    pub threshold: f64,
+    pub boundary: Option<f64>,
+    /// X-ray: `XrayShift` in place of the set-up's (a sum that saturates, for the tests).
+    pub xray_shift: Option<u32>,
 }
 
 impl Default for Look {
-    /// The head phantom's transfer function, two lights, no early termination.
+    /// The head phantom's transfer function, two lights, no early termination, first-opaque at
+    /// 0.5, the 1-D table.
     fn default() -> Self {
         Self {
             tf: TransferFunction::head_default(),
             phong: Phong::two_lights(),
             early_termination: false,
+            threshold: 0.5,
+            boundary: None,
+            xray_shift: None,
+        }
+    }
+}
+
+impl Look {
+    /// The model's options of this look.
+    pub fn options(&self) -> ModeOptions {
+        ModeOptions {
+            early_termination: self.early_termination.then_some(cube5_frame::ET_DEFAULT),
+            threshold: self.threshold,
+            boundary: self.boundary,
         }
     }
 }
 
 impl Units {
+    /// The units of `render` for the view of `setup`: the MIP and composite tables written out
+    /// here (the test bench's own reading of the contract), the other modes' compositing
+    /// registers from the model's `cube5_frame::mode_regs`.
     pub fn new(
         rtl: &FrameRtl,
         render: Render,
-        ratio: f64,
+        setup: &FrameSetup,
         look: &Look,
     ) -> Result<Self, ModelError> {
         let rmap = ReflectanceMap::from_lights(&rtl.shader, &look.phong)?;
-        let tables = match render {
-            Render::Mip => ShaderTables {
-                class: density_ramp(&rtl.shader)?,
-                rmap,
-            },
-            Render::Composite => ShaderTables {
-                class: ClassLut::from_transfer(&rtl.shader, &look.tf)?,
-                rmap,
-            },
+        let class = match (render, look.boundary) {
+            (Render::Mip, _) => density_ramp(&rtl.shader)?,
+            (Render::Composite, None) => ClassLut::from_transfer(&rtl.shader, &look.tf)?,
+            _ => cube5_frame::class_table(&rtl.shader, render, &look.tf, look.boundary)?,
         };
+        let tables = ShaderTables { class, rmap };
         let c = rtl.compos;
         let (lut, regs) = match render {
             Render::Mip => (
@@ -424,12 +432,16 @@ impl Units {
                 },
             ),
             Render::Composite => (
-                OpacityLut::new(ratio, &c)?,
+                OpacityLut::new(setup.opacity_ratio, &c)?,
                 if look.early_termination {
                     ComposRegs::defaults(&c)
                 } else {
                     ComposRegs::without_termination(&c)
                 },
+            ),
+            m => (
+                OpacityLut::new(1.0, &c)?,
+                cube5_frame::mode_regs(&c, m, setup, &look.options()),
             ),
         };
         Ok(Self {
@@ -438,7 +450,7 @@ impl Units {
             shader: Shader::new(rtl.shader, tables)?,
             compos: Compos::new(c, lut, regs)?,
             render,
-            tf2d: false,
+            tf2d: look.boundary.is_some(),
         })
     }
 
@@ -448,13 +460,33 @@ impl Units {
         w
     }
 
-    /// One sample's way through gradient, adapter, shader: the compositing unit's sample.
-    pub fn shaded(&self, nb: [u32; 7], s: usize) -> cube5_compos::Sample {
+    /// One sample's way through gradient, adapter, shader: the compositing unit's sample at
+    /// `depth` (the slice number, or MinIP's `Znone` past a far face: `FrameMode::sample_depth`).
+    pub fn shaded(&self, nb: [u32; 7], depth: u32) -> cube5_compos::Sample {
         let mode = ShaderMode {
             tf2d: self.tf2d,
-            unlit: self.render == Render::Mip,
+            unlit: self.render.unlit(),
         };
-        cube5_frame::shade_n6(&self.gradient, &self.shader, &nb, mode, s as u32)
+        cube5_compos::Sample {
+            mode: self.render.compos_mode(),
+            ..cube5_frame::shade_n6(&self.gradient, &self.shader, &nb, mode, depth)
+        }
+    }
+
+    /// The compositing depth of the sample at anchor `ab` of slice `c`.
+    pub fn depth(
+        &self,
+        params: &FrameParams,
+        c: &cube5_frame::SliceConst,
+        ab: (usize, usize),
+    ) -> u32 {
+        self.render
+            .sample_depth(params, c, ab, &self.compos.config())
+    }
+
+    /// The coxel every ray starts from (MinIP: `A` all ones).
+    pub fn initial_coxel(&self) -> Coxel {
+        self.render.initial_coxel(&self.compos.config())
     }
 }
 
@@ -490,23 +522,25 @@ pub fn model_image(
     vol: &Volume,
     units: &Units,
 ) -> (usize, usize, Vec<Coxel>) {
-    let init = Coxel::empty(&units.compos.config());
+    let init = units.initial_coxel();
     cube5_frame::fold_rays(params, vol, &units.trilin, init, |cox, c, (a, b), _| {
         let nb = cube5_frame::neighbourhood(params, vol, c, a, b, &units.trilin);
-        units.compos.step(cox, &units.shaded(nb, c.s))
+        units
+            .compos
+            .step(cox, &units.shaded(nb, units.depth(params, c, (a, b))))
     })
 }
 
 /// The samples of ray (r, q) (base-plane pixel), for a mismatch report.
 pub fn ray_trail(params: &FrameParams, vol: &Volume, units: &Units, r: usize, q: usize) -> String {
     let mut trail = String::new();
-    let init = Coxel::empty(&units.compos.config());
+    let init = units.initial_coxel();
     let _ = cube5_frame::fold_rays(params, vol, &units.trilin, init, |cox, c, (a, b), x| {
         if params.pixel_of(c, a, b) != (r, q) {
             return *cox;
         }
         let nb = cube5_frame::neighbourhood(params, vol, c, a, b, &units.trilin);
-        let smp = units.shaded(nb, c.s);
+        let smp = units.shaded(nb, units.depth(params, c, (a, b)));
         let next = units.compos.step(cox, &smp);
         if trail.len() < 4000 {
             trail.push_str(&format!(
@@ -544,17 +578,20 @@ impl Expected {
     ) -> Result<Self, ModelError> {
         // The set-up is that of P = 1: the image does not depend on P (only the set-up's check
         // that the dimensions are multiples of P does).
-        let setup = FrameSetup::new(seen.dims, seen.spacing, dir.into(), 1)?;
+        let mut setup = FrameSetup::new(seen.dims, seen.spacing, dir.into(), 1)?;
+        if let Some(x) = look.xray_shift {
+            setup.xray_shift = x;
+        }
         let params = setup.params;
         // The model's own base plane at the variant's widths
         // (cube5_model::units::cube5_frame::render_base_plane): what `cube5 render` computes.
-        let fu = FrameUnits::with_config(
+        let fu = FrameUnits::with_options(
             &rtl.cfg,
-            render.mode(),
+            render,
             &setup,
             &look.tf,
             &look.phong,
-            look.early_termination.then_some(cube5_frame::ET_DEFAULT),
+            &look.options(),
         )?;
         let bp = cube5_frame::render_base_plane(&params, seen, &fu);
         let units = Units {
@@ -563,7 +600,7 @@ impl Expected {
             shader: fu.shader,
             compos: fu.compos,
             render,
-            tf2d: false,
+            tf2d: fu.tf2d,
         };
         let (w, h, want) = (bp.width, bp.height, bp.coxels);
         Ok(Expected {
@@ -594,11 +631,8 @@ impl Expected {
                 gradient: u.gradient,
                 shader: u.shader,
                 compos: u.compos,
-                render: match u.mode {
-                    FrameMode::Mip => Render::Mip,
-                    FrameMode::Composite => Render::Composite,
-                },
-                tf2d: false,
+                render: u.mode,
+                tf2d: u.tf2d,
             },
             w: run.base.width,
             h: run.base.height,
@@ -633,8 +667,9 @@ pub struct FrameBench {
     pub dut: RtlStream<FrameRtl>,
     pub dims: [usize; 3],
     pub lut: BlockLut,
-    /// The tables loaded last (render mode, opacity ratio, early termination): reloaded on change.
-    pub loaded: Option<(Render, u64, bool)>,
+    /// The tables loaded last (render mode, 2-D table, opacity ratio, compositing registers):
+    /// reloaded on change.
+    pub loaded: Option<(Render, bool, u64, ComposRegs)>,
     /// Skip the empty slices before and after each sweep (`cube5_frame::empty_slices`) when a zero
     /// sample composites as the identity.
     pub skip_empty: bool,
@@ -665,7 +700,7 @@ impl FrameBench {
         // After reset the compositing buffer clears its valid bits (4 MaxDim^2 / P cycles) before
         // it takes a command; a command refused for a reserved render mode waits that out, so the
         // frames measured after it are steady-state frames. `load` rewrites the mode register.
-        bench.write(&[rtl.reg(REG_MODE, 3)])?;
+        bench.write(&[rtl.reg(REG_MODE, RENDER_REFUSED)])?;
         bench.refused(OP_RENDER)?;
         Ok(bench)
     }
@@ -690,20 +725,19 @@ impl FrameBench {
         let u = &e.units;
         let key = (
             u.render,
+            u.tf2d,
             u.compos.lut().ratio().unwrap_or(0.0).to_bits(),
-            u.compos.regs() == ComposRegs::defaults(&self.rtl.compos),
+            u.compos.regs(),
         );
         if self.loaded != Some(key) {
             let w = u.config_writes(&self.rtl);
             self.write(&w)?;
             self.loaded = Some(key);
         }
-        // A zero sample leaves a coxel unchanged under MIP, and under `over` when density 0
-        // classifies as alpha 0: only then may empty slices be left out (docs/numerics/frame.md).
-        let zero_is_identity = match u.render {
-            Render::Mip => true,
-            Render::Composite => !u.tf2d && u.shader.tables().class.entries()[0].a == 0,
-        };
+        // Only when a zero sample leaves every coxel unchanged may empty slices be left out
+        // (docs/numerics/frame.md, "Skipping empty slices").
+        let zero_is_identity =
+            cube5_frame::zero_sample_is_identity(u.render, u.tf2d, &u.shader, &u.compos);
         self.skip = if self.skip_empty && zero_is_identity {
             cube5_frame::empty_slices(&e.params, &self.lut)
         } else {

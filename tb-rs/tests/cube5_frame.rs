@@ -340,8 +340,8 @@ fn refused_configurations_answer_one_error_item() {
             "every slice skipped",
             vec![rtl.reg(REG_SKIP, 8 | 8 << (rtl.max_dim_log2 + 1))],
         ),
-        ("render mode 2", vec![rtl.reg(REG_MODE, 2)]),
-        ("render mode 3", vec![rtl.reg(REG_MODE, 3)]),
+        ("render mode 5", vec![rtl.reg(REG_MODE, 5)]),
+        ("render mode 7", vec![rtl.reg(REG_MODE, RENDER_REFUSED)]),
         (
             "a dimension not a multiple of P",
             vec![rtl.dims_reg([16, 18, 16])],
@@ -611,7 +611,14 @@ fn frames_without_gradient_and_shader_mip_bit_exact_composite_refused() {
             eprintln!("{} {:?} Mip: {n} views bit-exact", rtl.variant, vol.dims);
             // The last view the frame accepts: refused in the other modes, then rendered again.
             let good = rendered.pop().unwrap();
-            for (what, mode) in [("composite", 1), ("MIP with the 2-D classification", 4)] {
+            for (what, mode) in [
+                ("composite", Render::Composite.code()),
+                ("first-opaque", Render::FirstOpaque.code()),
+                (
+                    "MIP with the 2-D classification",
+                    Render::Mip.code() | 1 << REG_MODE_TF2D.lsb,
+                ),
+            ] {
                 must(bench.load(&good));
                 must(bench.write(&[rtl.reg(REG_MODE, mode)]));
                 let out = must(bench.refused(OP_RENDER));
@@ -722,7 +729,7 @@ fn test_side_fold_agrees_with_the_model_base_plane() {
             )
             .unwrap();
             let bp = cube5_frame::render_base_plane(&p, &vol, &fu);
-            let units = Units::new(&self::p(1), render, setup.opacity_ratio, &look).unwrap();
+            let units = Units::new(&self::p(1), render, &setup, &look).unwrap();
             let (w, h, mine) = model_image(&p, &vol, &units);
             assert_eq!((w, h), (bp.width, bp.height));
             assert!(

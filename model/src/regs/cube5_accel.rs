@@ -96,12 +96,12 @@ pub const REG_DY: u32 = 7;
 /// Field `dy` of `Dy`.
 pub const REG_DY_DY: Field = Field::new(0, 18);
 /// `Mode` (RW): as cube5_frame's Mode: `render` 0 `Mip`, 1 `Composite`; `tf2d`. Fields: render
-/// [1:0], tf2d [2].
+/// [2:0], tf2d [3].
 pub const REG_MODE: u32 = 8;
 /// Field `render` of `Mode`.
-pub const REG_MODE_RENDER: Field = Field::new(0, 2);
+pub const REG_MODE_RENDER: Field = Field::new(0, 3);
 /// Field `tf2d` of `Mode`.
-pub const REG_MODE_TF2D: Field = Field::new(2, 1);
+pub const REG_MODE_TF2D: Field = Field::new(3, 1);
 /// `Skip` (RW): as cube5_frame's Skip: empty slices left out of the sweep. Fields: front (m + 1),
 /// back (m + 1).
 pub const REG_SKIP: u32 = 9;
@@ -174,7 +174,7 @@ pub const REGISTERS: [Register; 21] = [
 /// every bit where a field's place depends on parameters, 0 where no register is.
 pub const AXIL_MASK: [u32; 23] = [
     0x00000003, 0x000000f7, 0x00000003, 0x00000003, 0xffffffff, 0x00000007, 0x0003ffff, 0x0003ffff,
-    0x00000007, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x00000000, 0x00000000,
+    0x0000000f, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x00000000, 0x00000000,
     0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x000fffff, 0xffffffff, 0x000fffff,
 ];
 

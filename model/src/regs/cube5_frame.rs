@@ -58,17 +58,29 @@ pub const REGION_SHADER: u32 = 3;
 /// compositing tables and registers (every pipeline)
 pub const REGION_COMPOS: u32 = 4;
 
-// Render modes (the 2-bit field `render` of register Mode); 2 and 3 are refused.
+// Render modes (the 3-bit field `render` of register Mode); 5 to 7 are refused.
 /// maximum intensity projection
 pub const RENDER_MIP: u32 = 0;
 /// front-to-back compositing
 pub const RENDER_COMPOSITE: u32 = 1;
+/// minimum intensity projection (unlit; untouched coxels read A = all ones)
+pub const RENDER_MINIP: u32 = 2;
+/// X-ray: the saturating sum of the samples, shifted by XrayShift (unlit)
+pub const RENDER_XRAY: u32 = 3;
+/// the shaded colour of the first sample whose alpha reaches FoThreshold
+pub const RENDER_FIRST_OPAQUE: u32 = 4;
 
 // Compositing modes the frame uses (docs/numerics/compos.md).
 /// for Composite
 pub const COMPOS_FRONT_TO_BACK: u32 = 0;
 /// for Mip
 pub const COMPOS_MAX: u32 = 2;
+/// for Minip
+pub const COMPOS_MIN: u32 = 3;
+/// for Xray
+pub const COMPOS_XRAY_SUM: u32 = 4;
+/// for FirstOpaque
+pub const COMPOS_FIRST_OPAQUE: u32 = 5;
 
 // Registers by word offset (region 0, `off` = the offset).
 /// `Dims` (WO): volume dimensions (volume axes); also the skewed memory's dimensions register.
@@ -89,13 +101,13 @@ pub const REG_DX_DX: Field = Field::new(0, 18);
 pub const REG_DY: u32 = 3;
 /// Field `dy` of `Dy`.
 pub const REG_DY_DY: Field = Field::new(0, 18);
-/// `Mode` (WO): `render` 0 `Mip`, 1 `Composite`; `tf2d` is the shader's 2-D classification bit.
-/// Fields: render [1:0], tf2d [2].
+/// `Mode` (WO): `render` 0 `Mip`, 1 `Composite`, 2 `Minip`, 3 `Xray`, 4 `FirstOpaque`; `tf2d` is
+/// the shader's 2-D classification bit. Fields: render [2:0], tf2d [3].
 pub const REG_MODE: u32 = 4;
 /// Field `render` of `Mode`.
-pub const REG_MODE_RENDER: Field = Field::new(0, 2);
+pub const REG_MODE_RENDER: Field = Field::new(0, 3);
 /// Field `tf2d` of `Mode`.
-pub const REG_MODE_TF2D: Field = Field::new(2, 1);
+pub const REG_MODE_TF2D: Field = Field::new(3, 1);
 /// `Skip` (WO): empty slices left out of the sweep: it covers `s = front ..= nk - 1 - back` (0, 0:
 /// every slice; see *Skipping empty slices*). Fields: front (m + 1), back (m + 1).
 pub const REG_SKIP: u32 = 5;

@@ -23,7 +23,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 mod fast;
-pub use fast::{render_base_plane, render_base_plane_stats, render_sweep, SweepStats, SweepVolume};
+pub use fast::{
+    render_base_plane as render_base_plane_fast,
+    render_base_plane_stats as render_base_plane_stats_fast, render_sweep, SweepStats, SweepVolume,
+};
 pub mod sections;
 
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
@@ -52,8 +55,8 @@ pub struct FrameConfig {
     pub shader: ShaderConfig,
     pub compos: ComposConfig,
     /// Gradient and shader in every pipeline (`Shade = 1`), or neither (`Shade = 0`): the frame
-    /// then renders MIP only, each sample classified by the shader's 1-D table alone
-    /// (docs/numerics/frame.md, "A frame without gradient and shader").
+    /// then renders the unlit modes only (MIP, MinIP, X-ray), each sample classified by the
+    /// shader's 1-D table alone (docs/numerics/frame.md, "A frame without gradient and shader").
     pub shade: bool,
     /// Where the beams come from (`Source`): the skewed memory inside (false), or a beat stream a
     /// section at a time (true; docs/numerics/frame.md, "Sections").
@@ -127,7 +130,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         }
         if shade > 1 {
             return Err(ModelError::Config(format!(
-                "cube5_frame: Shade = {shade} must be 0 (no gradient, no shader: MIP only) or 1"
+                "cube5_frame: Shade = {shade} must be 0 (no gradient, no shader: MIP, MinIP, X-ray) or 1"
             )));
         }
         if !max_dim.is_power_of_two() {
@@ -211,6 +214,10 @@ pub struct FrameSetup {
     pub opacity_ratio: f64,
     /// The view direction in voxel space (not normalized).
     pub voxel_dir: DVec3,
+    /// The X-ray sum's shift (`XrayShift`, 0..=15): `round(log2(n))` for the `n` samples the
+    /// volume's diagonal holds at this view's sample spacing, so a sum reads about as the f64
+    /// reference's density integral over the diagonal (docs/numerics/frame.md, "Render modes").
+    pub xray_shift: u32,
 }
 
 /// Constants of one slice (integers only).
@@ -298,10 +305,17 @@ impl FrameSetup {
             spacing[axis_k],
         );
         let min_spacing = spacing.iter().copied().fold(f64::INFINITY, f64::min);
+        let diag = DVec3::new(
+            dims[0] as f64 * spacing[0],
+            dims[1] as f64 * spacing[1],
+            dims[2] as f64 * spacing[2],
+        )
+        .length();
         Ok(Self {
             params,
             opacity_ratio: along.length() / min_spacing,
             voxel_dir: d,
+            xray_shift: (diag / along.length()).log2().round().clamp(0.0, 15.0) as u32,
         })
     }
 }
@@ -647,13 +661,124 @@ pub fn warp(
     }
 }
 
-/// What the frame composites (docs/numerics/frame.md, "The pipeline of one sample").
+/// What the frame composites (docs/numerics/frame.md, "Render modes"; the frame's `render`
+/// field, `cube5_frame.regs.toml`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum FrameMode {
     /// Maximum intensity projection: density ramp LUT, unlit, compositing `Max`.
     Mip,
     /// Front-to-back `over` with classification and reflectance-map shading.
     Composite,
+    /// Minimum intensity projection: density ramp LUT, unlit, compositing `Min` from a coxel of
+    /// `A = 2^(AccW+1) - 1` ([`FrameMode::initial_coxel`]).
+    Minip,
+    /// X-ray: density ramp LUT, unlit, compositing `XraySum` at the set-up's `XrayShift`.
+    Xray,
+    /// The shaded colour of the first sample whose classified alpha reaches the threshold:
+    /// transfer function, lit, compositing `FirstOpaque`, opacity LUT bypassed.
+    FirstOpaque,
+}
+
+impl FrameMode {
+    pub const ALL: [Self; 5] = [
+        Self::Mip,
+        Self::Composite,
+        Self::Minip,
+        Self::Xray,
+        Self::FirstOpaque,
+    ];
+
+    /// The `render` field's code (`RENDER_*`, generated from `cube5_frame.regs.toml`).
+    pub fn code(self) -> u32 {
+        use crate::regs::cube5_frame as r;
+        match self {
+            Self::Mip => r::RENDER_MIP,
+            Self::Composite => r::RENDER_COMPOSITE,
+            Self::Minip => r::RENDER_MINIP,
+            Self::Xray => r::RENDER_XRAY,
+            Self::FirstOpaque => r::RENDER_FIRST_OPAQUE,
+        }
+    }
+
+    /// The shader runs unlit and the class table is the density ramp (MIP, MinIP, X-ray); a
+    /// frame without gradient and shader renders exactly these.
+    pub fn unlit(self) -> bool {
+        matches!(self, Self::Mip | Self::Minip | Self::Xray)
+    }
+
+    /// The compositing unit's mode.
+    pub fn compos_mode(self) -> ComposMode {
+        match self {
+            Self::Mip => ComposMode::Max,
+            Self::Composite => ComposMode::FrontToBack,
+            Self::Minip => ComposMode::Min,
+            Self::Xray => ComposMode::XraySum,
+            Self::FirstOpaque => ComposMode::FirstOpaque,
+        }
+    }
+
+    /// The coxel every ray starts from, and what a ray no sample reaches reads out: the empty
+    /// coxel, except for MinIP, whose `A` is all ones (above every corrected alpha, so the first
+    /// sample always wins `Min`) and whose colour stays 0 (black, as the f64 reference shows a ray
+    /// without samples).
+    pub fn initial_coxel(self, cfg: &ComposConfig) -> Coxel {
+        let mut c = Coxel::empty(cfg);
+        if self == Self::Minip {
+            c.rgba[3] = cfg.chan_max();
+        }
+        c
+    }
+
+    /// The compositing depth of the sample at anchor `(a, b)` of slice `c`: the slice number `s`,
+    /// except that MinIP leaves out the samples past a far face (anchor `a = ni - 1` with
+    /// `fx(s) != 0`, or `b = nj - 1` with `fy(s) != 0`: they lie beyond the last voxel and their
+    /// interpolation reads the zeros there), giving them depth `Znone`, which the compositing
+    /// unit's depth test passes by. The f64 reference takes MinIP over the samples inside the
+    /// volume alike.
+    pub fn sample_depth(
+        self,
+        params: &FrameParams,
+        c: &SliceConst,
+        (a, b): (usize, usize),
+        cfg: &ComposConfig,
+    ) -> u32 {
+        let past = (a + 1 == params.ni && c.frac_x != 0) || (b + 1 == params.nj && c.frac_y != 0);
+        if self == Self::Minip && past {
+            cfg.z_none()
+        } else {
+            c.s as u32
+        }
+    }
+
+    /// The model's fast path (`fast.rs`) renders this mode; the others run the exact per-sample
+    /// model ([`render_base_plane_reference`]): the same bits, slower.
+    pub fn fast_path(self) -> bool {
+        matches!(self, Self::Mip | Self::Composite)
+    }
+}
+
+/// What a frame's tables depend on beyond the mode and the view (the scene's `[render]` and
+/// `[transfer]` fields).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModeOptions {
+    /// Early termination at this accumulated opacity (`Composite` only; `None` or >= 1: off).
+    pub early_termination: Option<f64>,
+    /// First-opaque: the classified alpha (0..=1, the transfer function's per-voxel opacity) that
+    /// counts as opaque.
+    pub threshold: f64,
+    /// The 2-D transfer function: opacity grows with the gradient magnitude up to this fraction of
+    /// the table's magnitude range ([`ClassLut::boundary`]); `None`: the 1-D table.
+    pub boundary: Option<f64>,
+}
+
+impl Default for ModeOptions {
+    fn default() -> Self {
+        Self {
+            early_termination: None,
+            threshold: 0.5,
+            boundary: None,
+        }
+    }
 }
 
 /// The four unit models of one pipeline, with their tables loaded.
@@ -667,6 +792,8 @@ pub struct FrameUnits {
     /// The frame has gradient and shader ([`FrameConfig::shade`]); without them a sample is
     /// classified by the shader's 1-D table alone ([`classify_only`]).
     pub shade: bool,
+    /// The shader's 2-D classification (`tf2d`: density and gradient magnitude).
+    pub tf2d: bool,
 }
 
 /// The base-plane image: the final coxel of every ray, row-major.
@@ -730,19 +857,86 @@ pub fn density_ramp(cfg: &ShaderConfig) -> Result<ClassLut> {
 }
 
 /// The compositing registers of a frame: MIP bypasses the opacity LUT; composite terminates at
-/// `threshold` of the coxel's opacity scale (rounded down), off when absent or >= 1.
+/// `threshold` of the coxel's opacity scale (rounded down), off when absent or >= 1. The other
+/// modes: [`mode_regs`].
 pub fn compos_regs(cfg: &ComposConfig, mode: FrameMode, threshold: Option<f64>) -> ComposRegs {
     let off = ComposRegs::without_termination(cfg);
     match (mode, threshold) {
-        (FrameMode::Mip, _) => ComposRegs {
-            lut_bypass: true,
-            ..off
-        },
         (FrameMode::Composite, Some(t)) if t < 1.0 => ComposRegs {
             et_threshold: (t.max(0.0) * cfg.one() as f64) as u64,
             ..off
         },
         (FrameMode::Composite, _) => off,
+        _ => ComposRegs {
+            lut_bypass: true,
+            ..off
+        },
+    }
+}
+
+/// The compositing registers of a frame in any mode (docs/numerics/frame.md, "Render modes"):
+/// [`compos_regs`], with X-ray's shift and first-opaque's threshold `FoThreshold =
+/// ceil(threshold 2^Q)`, at most `2^Q` (so a sample is opaque exactly when its alpha code, read
+/// as `U(alpha, AlphaW, Q)`, reaches the threshold on the corrected-alpha scale).
+pub fn mode_regs(
+    cfg: &ComposConfig,
+    mode: FrameMode,
+    setup: &FrameSetup,
+    opts: &ModeOptions,
+) -> ComposRegs {
+    let regs = compos_regs(cfg, mode, opts.early_termination);
+    let one = (1u64 << cfg.q()) as f64;
+    ComposRegs {
+        xray_shift: if mode == FrameMode::Xray {
+            setup.xray_shift
+        } else {
+            regs.xray_shift
+        },
+        fo_threshold: if mode == FrameMode::FirstOpaque {
+            (opts.threshold.clamp(0.0, 1.0) * one).ceil() as u64
+        } else {
+            regs.fo_threshold
+        },
+        ..regs
+    }
+}
+
+/// A sample of density 0 leaves every coxel of the frame unchanged, so the sweep may leave out
+/// empty slices (docs/numerics/frame.md, "Skipping empty slices"): never for MinIP (0 is the
+/// minimum), and otherwise when class entry 0 (the 1-D table) composites as the identity: alpha 0
+/// under `over` and `FirstOpaque` (below its threshold), colour and alpha 0 under the X-ray sum;
+/// always under `Max`.
+pub fn zero_sample_is_identity(
+    mode: FrameMode,
+    tf2d: bool,
+    shader: &Shader,
+    compos: &Compos,
+) -> bool {
+    let e = shader.tables().class.entries()[0];
+    match mode {
+        FrameMode::Mip => true,
+        FrameMode::Minip => false,
+        FrameMode::Xray => e.r == 0 && e.g == 0 && e.b == 0 && e.a == 0,
+        FrameMode::Composite => !tf2d && e.a == 0,
+        FrameMode::FirstOpaque => !tf2d && compos.corrected(e.a) < compos.regs().fo_threshold,
+    }
+}
+
+/// The classification table of a frame: the density ramp for the unlit modes, else the transfer
+/// function, as a 1-D table or (with `boundary`) the 2-D table of [`ClassLut::boundary`].
+pub fn class_table(
+    cfg: &ShaderConfig,
+    mode: FrameMode,
+    tf: &TransferFunction,
+    boundary: Option<f64>,
+) -> Result<ClassLut> {
+    match (mode.unlit(), boundary) {
+        (true, None) => density_ramp(cfg),
+        (true, Some(_)) => Err(ModelError::Config(
+            "cube5_frame: the 2-D transfer function classifies by the transfer function: composite and first-opaque only".into(),
+        )),
+        (false, None) => ClassLut::from_transfer(cfg, tf),
+        (false, Some(b)) => ClassLut::boundary(cfg, tf, b),
     }
 }
 
@@ -771,20 +965,36 @@ impl FrameUnits {
         phong: &Phong,
         early_termination: Option<f64>,
     ) -> Result<Self> {
-        if !cfg.shade && mode != FrameMode::Mip {
-            return Err(ModelError::Config(
-                "cube5_frame: Shade = 0 (no gradient, no shader) renders MIP only; a composite frame needs Shade = 1".into(),
-            ));
+        let opts = ModeOptions {
+            early_termination,
+            ..ModeOptions::default()
+        };
+        Self::with_options(cfg, mode, setup, tf, phong, &opts)
+    }
+
+    /// As [`FrameUnits::with_config`], for every mode: first-opaque's threshold and the 2-D
+    /// transfer function in `opts`.
+    pub fn with_options(
+        cfg: &FrameConfig,
+        mode: FrameMode,
+        setup: &FrameSetup,
+        tf: &TransferFunction,
+        phong: &Phong,
+        opts: &ModeOptions,
+    ) -> Result<Self> {
+        if !cfg.shade && !mode.unlit() {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: Shade = 0 (no gradient, no shader) renders MIP, MinIP and X-ray only; a {mode:?} frame needs Shade = 1"
+            )));
         }
         let rmap = ReflectanceMap::from_lights(&cfg.shader, phong)?;
-        let (class, ratio) = match mode {
-            FrameMode::Mip => (density_ramp(&cfg.shader)?, 1.0),
-            FrameMode::Composite => (
-                ClassLut::from_transfer(&cfg.shader, tf)?,
-                setup
-                    .opacity_ratio
-                    .clamp(OpacityLut::RATIO_MIN, OpacityLut::RATIO_MAX),
-            ),
+        let class = class_table(&cfg.shader, mode, tf, opts.boundary)?;
+        let ratio = if mode == FrameMode::Composite {
+            setup
+                .opacity_ratio
+                .clamp(OpacityLut::RATIO_MIN, OpacityLut::RATIO_MAX)
+        } else {
+            1.0
         };
         Ok(Self {
             trilin: Trilin::new(cfg.trilin)?,
@@ -793,11 +1003,30 @@ impl FrameUnits {
             compos: Compos::new(
                 cfg.compos,
                 OpacityLut::new(ratio, &cfg.compos)?,
-                compos_regs(&cfg.compos, mode, early_termination),
+                mode_regs(&cfg.compos, mode, setup, opts),
             )?,
             mode,
             shade: cfg.shade,
+            tf2d: opts.boundary.is_some(),
         })
+    }
+
+    /// The shader's mode of every sample of this frame.
+    pub fn shader_mode(&self) -> ShaderMode {
+        ShaderMode {
+            tf2d: self.tf2d,
+            unlit: self.mode.unlit(),
+        }
+    }
+
+    /// The fast path renders this frame (its mode, the 1-D table).
+    pub fn fast_path(&self) -> bool {
+        self.mode.fast_path() && !self.tf2d
+    }
+
+    /// The coxel every ray starts from ([`FrameMode::initial_coxel`]).
+    pub fn initial_coxel(&self) -> Coxel {
+        self.mode.initial_coxel(&self.compos.config())
     }
 
     /// The shaded sample of anchor `(a, b)` in slice `c` (steps 1-4 of the contract).
@@ -809,16 +1038,22 @@ impl FrameUnits {
         a: usize,
         b: usize,
     ) -> Sample {
+        let mode = self.mode.compos_mode();
+        let depth = self
+            .mode
+            .sample_depth(params, c, (a, b), &self.compos.config());
         if !self.shade {
             let centre = sample_at(params, vol, c, c.s as i64, a as i64, b as i64, &self.trilin);
-            return classify_only(&self.shader, centre, c.s as u32);
+            return Sample {
+                mode,
+                ..classify_only(&self.shader, centre, depth)
+            };
         }
         let n = neighbourhood(params, vol, c, a, b, &self.trilin);
-        let mode = ShaderMode {
-            tf2d: false,
-            unlit: self.mode == FrameMode::Mip,
-        };
-        shade_n6(&self.gradient, &self.shader, &n, mode, c.s as u32)
+        Sample {
+            mode,
+            ..shade_n6(&self.gradient, &self.shader, &n, self.shader_mode(), depth)
+        }
     }
 }
 
@@ -912,7 +1147,7 @@ pub fn render_base_plane_reference(
     units: &FrameUnits,
 ) -> BasePlane {
     let (w, h) = params.base_plane_size();
-    let init = Coxel::empty(&units.compos.config());
+    let init = units.initial_coxel();
     let mut coxels = vec![init; w * h];
     for s in 0..params.nk {
         let c = params.slice(s);
@@ -932,6 +1167,44 @@ pub fn render_base_plane_reference(
         height: h,
         coxels,
     }
+}
+
+/// The base-plane image of a frame, bit-exact with `cube5_frame`: the fast path where it covers the
+/// frame ([`FrameUnits::fast_path`]), else the exact per-sample model
+/// ([`render_base_plane_reference`]: the same bits, slower).
+pub fn render_base_plane(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
+    render_base_plane_stats(params, vol, units).0
+}
+
+/// [`render_base_plane`] with the counts of what its sweep computed and skipped.
+pub fn render_base_plane_stats(
+    params: &FrameParams,
+    vol: &Volume,
+    units: &FrameUnits,
+) -> (BasePlane, SweepStats) {
+    if units.fast_path() {
+        render_base_plane_stats_fast(params, vol, units)
+    } else {
+        render_exact_stats(params, vol, units)
+    }
+}
+
+/// The exact per-sample model with the counts of a sweep that skips nothing (every sample shaded).
+pub fn render_exact_stats(
+    params: &FrameParams,
+    vol: &Volume,
+    units: &FrameUnits,
+) -> (BasePlane, SweepStats) {
+    let bp = render_base_plane_reference(params, vol, units);
+    let anchors = params.samples() as u64;
+    let stats = SweepStats {
+        anchors,
+        samples: anchors,
+        shaded: anchors,
+        rays_terminated: bp.coxels.iter().filter(|c| c.terminated).count() as u64,
+        ..SweepStats::default()
+    };
+    (bp, stats)
 }
 
 impl BasePlane {
@@ -961,6 +1234,238 @@ mod tests {
             }
         }
         Volume::new([n; 3], [1.0; 3], 12, data).unwrap()
+    }
+
+    /// The f64 bilinear density of anchor `(a, b)` in slice `c` at the exact fractions (zeros
+    /// past the far faces), on 0..1.
+    fn f64_sample(params: &FrameParams, vol: &Volume, c: &SliceConst, a: usize, b: usize) -> f64 {
+        let unit = f64::from(1u32 << STEP_W);
+        let (fx, fy) = (f64::from(c.frac_x) / unit, f64::from(c.frac_y) / unit);
+        let v = |i: usize, j: usize| f64::from(params.voxel(vol, i, j, c.k));
+        let top = v(a, b) * (1.0 - fx) + v(a + 1, b) * fx;
+        let bot = v(a, b + 1) * (1.0 - fx) + v(a + 1, b + 1) * fx;
+        (top * (1.0 - fy) + bot * fy) / f64::from((1u32 << vol.bits) - 1)
+    }
+
+    /// MinIP and X-ray against the f64 ideal of the same samples: the minimum over the samples
+    /// inside the volume (none: 0) and the sum over every sample, divided by `2^XrayShift`. The
+    /// bound per sample is the truncated 8-bit weights (`2 * 2^-8` of the full scale), the class
+    /// index (`2^-12`), the ramp's colour code (`1/255`), and for X-ray the shifted sum's rounding
+    /// (half a coxel LSB per sample); the measured maxima are printed.
+    #[test]
+    fn minip_and_xray_follow_the_f64_samples() {
+        let cfg = FrameConfig::DEFAULT;
+        let one = cfg.compos.one() as f64;
+        let per_sample = 2.0 / 256.0 + 1.0 / 4095.0 + 1.0 / 255.0;
+        let tf = TransferFunction::head_default();
+        for vol in [
+            crate::phantom::bubbles_phantom(24, 12).unwrap(),
+            crate::phantom::head_phantom(24, 12).unwrap(),
+        ] {
+            for v in [[0.3, -0.7, 1.0], [-1.0, 0.4, 0.2], [0.1, 1.0, -0.45]] {
+                let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), 4).unwrap();
+                let params = setup.params;
+                let phong = frame_phong(&params, &[]);
+                let unit =
+                    |mode| FrameUnits::with_config(&cfg, mode, &setup, &tf, &phong, None).unwrap();
+                let (umin, uxr) = (unit(FrameMode::Minip), unit(FrameMode::Xray));
+                let (bmin, bxr) = (
+                    render_base_plane(&params, &vol, &umin),
+                    render_base_plane(&params, &vol, &uxr),
+                );
+                let lo = fold_rays(
+                    &params,
+                    &vol,
+                    &umin.trilin,
+                    f64::INFINITY,
+                    |m, c, (a, b), _| {
+                        let inside = !((a + 1 == params.ni && c.frac_x != 0)
+                            || (b + 1 == params.nj && c.frac_y != 0));
+                        if inside {
+                            m.min(f64_sample(&params, &vol, c, a, b))
+                        } else {
+                            *m
+                        }
+                    },
+                )
+                .2;
+                let sum = fold_rays(
+                    &params,
+                    &vol,
+                    &uxr.trilin,
+                    (0.0, 0usize),
+                    |m, c, (a, b), _| (m.0 + f64_sample(&params, &vol, c, a, b), m.1 + 1),
+                )
+                .2;
+                let scale = f64::from(1u32 << setup.xray_shift);
+                let (mut emin, mut exr) = (0.0f64, 0.0f64);
+                for i in 0..lo.len() {
+                    let want = if lo[i].is_finite() { lo[i] } else { 0.0 };
+                    let got = bmin.coxels[i].rgba[0] as f64 / one;
+                    assert!(
+                        (got - want).abs() <= per_sample,
+                        "{v:?} ray {i}: MinIP {got} vs f64 {want}"
+                    );
+                    emin = emin.max((got - want).abs());
+                    if !lo[i].is_finite() {
+                        assert_eq!(bmin.coxels[i], umin.initial_coxel(), "{v:?} ray {i}");
+                    }
+                    let (s, n) = sum[i];
+                    let got = bxr.coxels[i].rgba[0] as f64 / one;
+                    let bound = n as f64 / scale * per_sample + n as f64 / one;
+                    assert!(
+                        (got - s / scale).abs() <= bound,
+                        "{v:?} ray {i}: X-ray {got} vs f64 {}",
+                        s / scale
+                    );
+                    exr = exr.max((got - s / scale).abs());
+                }
+                eprintln!(
+                    "{:?} {v:?}: MinIP max |error| {emin:.5}, X-ray (shift {}) {exr:.5} (of 1.0)",
+                    vol.dims, setup.xray_shift
+                );
+            }
+        }
+    }
+
+    /// The unlit modes render the same with and without gradient and shader; the lit ones are
+    /// refused without them.
+    #[test]
+    fn unlit_modes_render_the_same_without_gradient_and_shader() {
+        use crate::unit::UnitConfig;
+        let vol = crate::phantom::bubbles_phantom(16, 12).unwrap();
+        let tf = TransferFunction::head_default();
+        let full = FrameConfig::DEFAULT;
+        let bare = FrameConfig::from_params(&[("Shade", 0)]).unwrap();
+        let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::new(0.4, -0.2, 1.0), 4).unwrap();
+        let phong = frame_phong(&setup.params, &[]);
+        for mode in FrameMode::ALL {
+            let units =
+                |cfg: &FrameConfig| FrameUnits::with_config(cfg, mode, &setup, &tf, &phong, None);
+            if mode.unlit() {
+                let (uf, ub) = (units(&full).unwrap(), units(&bare).unwrap());
+                assert_eq!(
+                    render_base_plane(&setup.params, &vol, &uf),
+                    render_base_plane(&setup.params, &vol, &ub),
+                    "{mode:?}"
+                );
+            } else {
+                let e = units(&bare).unwrap_err().to_string();
+                assert!(e.contains("Shade = 0"), "{mode:?}: {e}");
+            }
+        }
+    }
+
+    /// First-opaque: each ray's coxel is the shaded sample of the first anchor (in slice order)
+    /// whose classified alpha, read as `U(alpha, AlphaW, Q)`, reaches `ceil(threshold 2^Q)`, with
+    /// `A = 1.0` and the ray terminated; a ray without one stays empty. The threshold compares
+    /// with the classified alpha as the transfer function's per-voxel opacity (the f64
+    /// reference's `a >= threshold`) to within one alpha code.
+    #[test]
+    fn first_opaque_takes_the_first_sample_at_the_threshold() {
+        use crate::units::cube5_compos::unit_code;
+        let vol = crate::phantom::head_phantom(24, 12).unwrap();
+        let cfg = FrameConfig::DEFAULT;
+        let c = cfg.compos;
+        let pt = |density, rgba| crate::transfer::TfPoint { density, rgba };
+        let tf = TransferFunction {
+            points: vec![
+                pt(0.0, [0.0; 4]),
+                pt(0.15, [0.9, 0.7, 0.6, 0.0]),
+                pt(0.5, [0.9, 0.6, 0.5, 0.6]),
+                pt(1.0, [1.0, 1.0, 1.0, 0.95]),
+            ],
+        };
+        for (v, t) in [([0.3, -0.7, 1.0], 0.5), ([-1.0, 0.4, 0.2], 0.2)] {
+            let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), 4).unwrap();
+            let params = setup.params;
+            let phong = frame_phong(&params, &[]);
+            let opts = ModeOptions {
+                threshold: t,
+                ..ModeOptions::default()
+            };
+            let u =
+                FrameUnits::with_options(&cfg, FrameMode::FirstOpaque, &setup, &tf, &phong, &opts)
+                    .unwrap();
+            let fo = u.compos.regs().fo_threshold;
+            let q1 = (1u64 << c.q()) as f64;
+            assert!(fo as f64 >= t * q1 && (fo as f64) < t * q1 + 1.0);
+            let bp = render_base_plane(&params, &vol, &u);
+            let want = fold_rays(&params, &vol, &u.trilin, None, |hit, sc, (a, b), _| {
+                if hit.is_some() {
+                    return *hit;
+                }
+                let smp = u.shaded_sample(&params, &vol, sc, a, b);
+                (unit_code(smp.alpha, c.alpha_w, c.q()) >= fo).then_some(smp.rgb)
+            })
+            .2;
+            let mut hits = 0;
+            for (i, (got, w)) in bp.coxels.iter().zip(&want).enumerate() {
+                match w {
+                    Some(rgb) => {
+                        hits += 1;
+                        let cw = rgb.map(|x| unit_code(x, c.color_w, c.acc_w));
+                        assert_eq!(got.rgba, [cw[0], cw[1], cw[2], c.one()], "{v:?} ray {i}");
+                        assert!(got.terminated, "{v:?} ray {i}");
+                    }
+                    None => assert_eq!(*got, u.initial_coxel(), "{v:?} ray {i}"),
+                }
+            }
+            assert!(hits > 0 && hits < want.len(), "{v:?}: {hits} hits");
+        }
+    }
+
+    /// The 2-D table of boundary emphasis: each density bin's colour is the 1-D transfer
+    /// function's at its centre, its alpha grows with the magnitude bin to the function's alpha
+    /// at `boundary` of the range and stays there; the frame reads the 2-D index (the image
+    /// changes) and the exact model renders it (no fast path).
+    #[test]
+    fn the_boundary_table_grows_with_the_magnitude() {
+        let cfg = FrameConfig::DEFAULT.shader;
+        let tf = TransferFunction::head_default();
+        let t = ClassLut::boundary(&cfg, &tf, 0.25).unwrap();
+        let mags = 1usize << cfg.mag_idx_w;
+        let den_n = (cfg.class_entries() / mags) as f64;
+        for den in 0..cfg.class_entries() / mags {
+            let row = &t.entries()[den * mags..(den + 1) * mags];
+            let f = tf.lookup((den as f64 + 0.5) / den_n);
+            let full = (f[3].clamp(0.0, 1.0) * f64::from(cfg.alpha_max())).round() as u32;
+            assert!(row.windows(2).all(|w| w[0].a <= w[1].a), "den {den}");
+            assert_eq!(row[mags - 1].a, full, "den {den}");
+            assert_eq!(row[mags / 4].a, full, "den {den}: at the boundary");
+            assert!(row
+                .iter()
+                .all(|e| e.r == row[0].r && e.g == row[0].g && e.b == row[0].b));
+        }
+        assert!(ClassLut::boundary(&cfg, &tf, 0.0).is_err());
+        let vol = crate::phantom::head_phantom(16, 12).unwrap();
+        let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::new(0.3, 0.2, 1.0), 4).unwrap();
+        let phong = frame_phong(&setup.params, &[]);
+        let fc = FrameConfig::DEFAULT;
+        let one = FrameUnits::with_options(
+            &fc,
+            FrameMode::Composite,
+            &setup,
+            &tf,
+            &phong,
+            &ModeOptions::default(),
+        )
+        .unwrap();
+        let opts = ModeOptions {
+            boundary: Some(0.25),
+            ..ModeOptions::default()
+        };
+        let two = FrameUnits::with_options(&fc, FrameMode::Composite, &setup, &tf, &phong, &opts)
+            .unwrap();
+        assert!(one.fast_path() && !two.fast_path() && two.tf2d);
+        assert_ne!(
+            render_base_plane(&setup.params, &vol, &one),
+            render_base_plane(&setup.params, &vol, &two)
+        );
+        assert!(
+            FrameUnits::with_options(&fc, FrameMode::Mip, &setup, &tf, &phong, &opts).is_err(),
+            "MIP classifies by density alone"
+        );
     }
 
     /// Skipping the empty slices before and after the sweep (leaving their samples out of the

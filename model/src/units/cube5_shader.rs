@@ -274,6 +274,36 @@ impl ClassLut {
         })
     }
 
+    /// The 2-D table of boundary emphasis (docs/numerics/shader.md, "A 2-D table from a transfer
+    /// function"), laid out density-major as the 2-D index reads it: entry `(den, m)` is the
+    /// transfer function at the centre of density bin `den` (`DenW = ClassIdxW - MagIdxW` bits),
+    /// its alpha scaled by `min(1, t_m / boundary)`, where `t_m = (m + 1/2) / 2^MagIdxW` is the
+    /// centre of magnitude bin `m` as a fraction of the table's magnitude range (`2^(MagIdxW +
+    /// MagShift)` raw magnitude steps; the last bin takes every larger magnitude). So homogeneous
+    /// regions fade and boundaries keep their opacity. `boundary` in `(0, 1]`.
+    pub fn boundary(cfg: &ShaderConfig, tf: &TransferFunction, boundary: f64) -> Result<Self> {
+        tf.validate()?;
+        if !(boundary > 0.0 && boundary <= 1.0) {
+            return Err(ModelError::Config(format!(
+                "shader: boundary {boundary} outside (0, 1]"
+            )));
+        }
+        let den_n = f64::from(1u32 << (cfg.class_idx_w - cfg.mag_idx_w));
+        let mag_n = f64::from(1u32 << cfg.mag_idx_w);
+        let q = |x: f64, max: u32| (x.clamp(0.0, 1.0) * f64::from(max)).round() as u32;
+        Self::from_fn(cfg, |idx| {
+            let (den, m) = (idx >> cfg.mag_idx_w, idx & ((1 << cfg.mag_idx_w) - 1));
+            let v = tf.lookup((den as f64 + 0.5) / den_n);
+            let weight = (((m as f64 + 0.5) / mag_n) / boundary).min(1.0);
+            Rgba {
+                r: q(v[0], cfg.color_max()),
+                g: q(v[1], cfg.color_max()),
+                b: q(v[2], cfg.color_max()),
+                a: q(v[3] * weight, cfg.alpha_max()),
+            }
+        })
+    }
+
     pub fn entries(&self) -> &[Rgba] {
         &self.entries
     }

@@ -245,6 +245,9 @@ fn modes(mode: FrameMode) -> (ShaderMode, ComposMode) {
             },
             ComposMode::FrontToBack,
         ),
+        m => unreachable!(
+            "the fast path renders Mip and Composite, not {m:?}: FrameUnits::fast_path"
+        ),
     }
 }
 
@@ -637,6 +640,12 @@ pub fn render_sweep(
     sv: &SweepVolume,
     units: &FrameUnits,
 ) -> (BasePlane, SweepStats) {
+    assert!(
+        units.fast_path(),
+        "render_sweep: {:?} (tf2d {}) is not a fast-path frame",
+        units.mode,
+        units.tf2d
+    );
     assert!(
         sv.axes == [params.axis_i, params.axis_j, params.axis_k]
             && [sv.ni, sv.nj, sv.nk] == [params.ni, params.nj, params.nk],
