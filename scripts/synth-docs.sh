@@ -105,7 +105,7 @@ awk -v mode="$mode" -v begin="$begin" -v end="$end" -v docs="$docs" -v out="$tmp
         for (j = 1; j <= n; j++) {
           k = order[j]; v = (k in run) ? run[k] : (k in doc) ? doc[k] : ""
           if (v == "") continue
-          # Fmax: this run's place and route, else the last one written (kept while SYNTH_FMAX=0
+          # Fmax: the place and route of this run, else the last one written (kept while SYNTH_FMAX=0
           # runs, which place nothing); "-" for a configuration not flagged fmax/fmax85.
           fm = !(k in placed) ? "-" : (k in runf) ? runf[k] : (k in docf) ? docf[k] : "not placed yet"
           split(k, t, " "); gsub(/\|/, " | ", v)
