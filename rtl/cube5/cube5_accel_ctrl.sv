@@ -286,7 +286,7 @@ module cube5_accel_ctrl #(
     // Refusals, the first that applies (docs/numerics/accel_ctrl.md, "Refused frames").
     if (axis_q == 2'd3) code_a = cube5_accel_regs_pkg::CodeAxisK;
     else if (bad_dim(nx_q) || bad_dim(ny_q) || bad_dim(nz_q)) code_a = cube5_accel_regs_pkg::CodeDims;
-    else if (mode_q[1:0] >= 2'd2) code_a = cube5_accel_regs_pkg::CodeRender;
+    else if (mode_q >= 3'd2) code_a = cube5_accel_regs_pkg::CodeRender;
     else if (bad_step(dx_q) || bad_step(dy_q)) code_a = cube5_accel_regs_pkg::CodeStep;
     else if ({1'b0, front_q} + {1'b0, back_q} >= {1'b0, nk}) code_a = cube5_accel_regs_pkg::CodeSkip;
     else code_a = cube5_accel_regs_pkg::CodeNone;
