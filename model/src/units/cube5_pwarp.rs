@@ -801,17 +801,6 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    fn random_base(rng: &mut ChaCha8Rng, w: usize, h: usize, color_w: u32) -> BaseCodes {
-        let max = (1u32 << color_w) - 1;
-        BaseCodes {
-            width: w,
-            height: h,
-            codes: (0..w * h)
-                .map(|_| std::array::from_fn(|_| rng.random_range(0..=max)))
-                .collect(),
-        }
-    }
-
     fn random_map(rng: &mut ChaCha8Rng, out: (u32, u32), base: (u32, u32)) -> Projective {
         Projective::tilted(
             out,
@@ -839,7 +828,7 @@ mod tests {
             let setup = PwarpSetup::new(&map, (40, 30), out).unwrap();
             assert_eq!(setup.samples(), u64::from(out.0 * out.1), "{map:?}");
             let cfg = PwarpConfig::DEFAULT;
-            let base = random_base(&mut rng, 40, 30, 8);
+            let base = BaseCodes::random(&mut rng, 40, 30, 8);
             assert!(warp_image(&cfg, &setup, &base).is_ok(), "{map:?} {out:?}");
         }
     }
@@ -859,7 +848,7 @@ mod tests {
             let out = (rng.random_range(1..=64), rng.random_range(1..=64));
             let map = random_map(&mut rng, out, (bw, bh));
             let setup = PwarpSetup::new(&map, (bw, bh), out).unwrap();
-            let base = random_base(&mut rng, bw as usize, bh as usize, cfg.color_w);
+            let base = BaseCodes::random(&mut rng, bw as usize, bh as usize, cfg.color_w);
             let got = unit.run(&frame_items(&cfg, &setup, &base));
             assert_eq!(got, warp_samples(&cfg, &setup, &base));
         }
@@ -876,7 +865,7 @@ mod tests {
             let out = (rng.random_range(8..=256), rng.random_range(8..=256));
             let map = random_map(&mut rng, out, (bw, bh));
             let setup = PwarpSetup::new(&map, (bw, bh), out).unwrap();
-            let base = random_base(&mut rng, bw as usize, bh as usize, cfg.color_w);
+            let base = BaseCodes::random(&mut rng, bw as usize, bh as usize, cfg.color_w);
             let got = warp_samples(&cfg, &setup, &base);
             let want = reference_at_samples(&map, &setup, &base, cfg.color_w);
             let mut k = 0;

@@ -245,6 +245,18 @@ pub struct BaseCodes {
 }
 
 impl BaseCodes {
+    /// A `w x h` plane of uniformly random `ColorW`-bit codes (test and benchmark data).
+    pub fn random(rng: &mut impl rand::Rng, w: usize, h: usize, color_w: u32) -> Self {
+        let max = (1u32 << color_w) - 1;
+        Self {
+            width: w,
+            height: h,
+            codes: (0..w * h)
+                .map(|_| std::array::from_fn(|_| rng.random_range(0..=max)))
+                .collect(),
+        }
+    }
+
     /// Texel `(x, y)`, 0 outside the base plane.
     pub fn texel(&self, x: i64, y: i64) -> [u32; 3] {
         if x < 0 || y < 0 || x >= self.width as i64 || y >= self.height as i64 {
@@ -701,17 +713,6 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    fn random_base(rng: &mut ChaCha8Rng, w: usize, h: usize, color_w: u32) -> BaseCodes {
-        let max = (1u32 << color_w) - 1;
-        BaseCodes {
-            width: w,
-            height: h,
-            codes: (0..w * h)
-                .map(|_| std::array::from_fn(|_| rng.random_range(0..=max)))
-                .collect(),
-        }
-    }
-
     fn random_affine(rng: &mut ChaCha8Rng, w: usize, h: usize, out: u32) -> Affine {
         let ang: f64 = rng.random_range(0.0..std::f64::consts::TAU);
         let zoom: f64 = rng.random_range(0.25..4.0);
@@ -748,7 +749,7 @@ mod tests {
     fn identity_returns_the_codes() {
         let cfg = WarpConfig::DEFAULT;
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let base = random_base(&mut rng, 9, 7, 8);
+        let base = BaseCodes::random(&mut rng, 9, 7, 8);
         let regs = WarpRegs::set_up(
             &Affine {
                 x0: 0.0,
@@ -784,7 +785,7 @@ mod tests {
                 let mb = cfg.max_base as usize;
                 let (w, h) = (rng.random_range(1..=mb), rng.random_range(1..=mb));
                 let out = rng.random_range(1..=cfg.max_out.min(40));
-                let base = random_base(&mut rng, w, h, cfg.color_w);
+                let base = BaseCodes::random(&mut rng, w, h, cfg.color_w);
                 let a = random_affine(&mut rng, w, h, out);
                 let regs = WarpRegs::set_up(&a, (w as u32, h as u32), (out, out + 1)).unwrap();
                 let mut unit = Warp::new(cfg).unwrap();
@@ -824,7 +825,7 @@ mod tests {
             for _ in 0..40 {
                 let (w, h) = (rng.random_range(1..=24), rng.random_range(1..=24));
                 let out = rng.random_range(1..=64);
-                let base = random_base(&mut rng, w, h, cfg.color_w);
+                let base = BaseCodes::random(&mut rng, w, h, cfg.color_w);
                 let mut a = random_affine(&mut rng, w, h, out);
                 a.x0 += rng.random_range(-2.0 * w as f64..2.0 * w as f64);
                 a.y0 += rng.random_range(-2.0 * h as f64..2.0 * h as f64);
@@ -849,7 +850,7 @@ mod tests {
             for _ in 0..30 {
                 let (w, h) = (rng.random_range(1..=40), rng.random_range(1..=40));
                 let out = rng.random_range(1..=96);
-                let base = random_base(&mut rng, w, h, cfg.color_w);
+                let base = BaseCodes::random(&mut rng, w, h, cfg.color_w);
                 let a = random_affine(&mut rng, w, h, out);
                 let regs = WarpRegs::set_up(&a, (w as u32, h as u32), (out, out)).unwrap();
                 let got = warp_image(&cfg, &regs, &base);
