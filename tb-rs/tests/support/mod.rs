@@ -11,6 +11,8 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::fmt::Debug;
 
+pub mod warp;
+
 /// Random items per configuration in the long co-simulation runs (the acceptance figure).
 pub const MILLION: usize = 1_000_000;
 
