@@ -21,8 +21,8 @@ use cube5_model::units::cube5_warp::BaseCodes;
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::warp::{check_frames, random_base, WarpFrame};
-use support::{configs, gate_configs, seed};
+use support::warp::{self, check_frames, random_base, WarpFrame};
+use support::{configs, seed};
 
 /// One frame of the warp: its set-up, base plane, what it is (for a mismatch report).
 #[derive(Debug, Clone)]
@@ -294,32 +294,15 @@ fn directed_frames(cfg: &PwarpConfig, rng: &mut ChaCha8Rng) -> Vec<Frame> {
 
 #[test]
 fn directed_extremes_under_idle_and_backpressure() {
-    for (i, (variant, cfg)) in configs::<PwarpConfig>().into_iter().enumerate() {
-        let s = seed(1530 + i as u64);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let frames = directed_frames(&cfg, &mut rng);
-        for (idle, stall) in [(0.0, 0.0), (0.3, 0.3), (0.0, 0.7)] {
-            let t = Traffic::random(&mut rng, idle, stall);
-            check_frames(variant, cfg, &frames, &t, s, None);
-        }
-        eprintln!("{variant}: {} directed frames bit-exact", frames.len());
-    }
+    warp::directed_under_idle_and_backpressure(directed_frames, 1530);
 }
 
 #[test]
 fn a_reset_in_mid_stream() {
-    for (i, (variant, cfg)) in configs::<PwarpConfig>().into_iter().enumerate() {
-        let s = seed(1540 + i as u64);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        for _ in 0..6 {
-            let frames: Vec<Frame> = (0..6)
-                .map(|_| random_frame(&mut rng, &cfg, 12, 8, 32))
-                .collect();
-            let t = Traffic::random(&mut rng, 0.2, 0.3);
-            let cut = rng.random_range(1..3000);
-            check_frames(variant, cfg, &frames, &t, s, Some((3, cut)));
-        }
-    }
+    warp::a_reset_in_mid_stream(
+        |rng, cfg: &PwarpConfig| random_frame(rng, cfg, 12, 8, 32),
+        1540,
+    );
 }
 
 /// Full speed: texels loaded, then every line's items back to back. Lines of at least six samples
@@ -390,41 +373,23 @@ fn one_sample_per_clock_over_a_frame() {
 
 #[test]
 fn gate_level_smoke() {
-    for (variant, cfg) in gate_configs::<PwarpConfig>() {
-        let s = seed(1560);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let mut frames: Vec<Frame> = (0..8)
-            .map(|_| random_frame(&mut rng, &cfg, 16, 8, 24))
-            .collect();
-        frames.extend(directed_frames(&cfg, &mut rng));
-        let t = Traffic::random(&mut rng, 0.2, 0.2);
-        check_frames(variant, cfg, &frames, &t, s, Some((4, 900)));
-        eprintln!("{variant}: gate-level smoke, {} frames", frames.len());
-    }
+    warp::gate_level_smoke(
+        8,
+        |rng, cfg: &PwarpConfig| random_frame(rng, cfg, 16, 8, 24),
+        directed_frames,
+        1560,
+    );
 }
 
 #[test]
 fn a_model_with_the_wrong_weight_width_is_caught() {
-    let (variant, cfg) = configs::<PwarpConfig>()[0];
-    let s = seed(1570);
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let frames: Vec<Frame> = (0..4)
-        .map(|_| random_frame(&mut rng, &cfg, 32, 16, 32))
-        .collect();
-    let items: Vec<PwarpIn> = frames.iter().flat_map(|f| f.items(&cfg)).collect();
-    let wrong = PwarpConfig {
-        weight_w: cfg.weight_w - 1,
-        ..cfg
-    };
-    let want = Pwarp::new(wrong).unwrap().run(&items);
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    let n = want.len() as u64;
-    let driven = dut
-        .drive(&items, &Traffic::full_speed(), n, 1 << 24)
-        .unwrap();
-    let got: Vec<PwarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-    assert!(
-        got != want,
-        "{variant}: a one-bit-narrower weight went unnoticed"
+    warp::a_wrong_model_is_caught(
+        |rng, cfg: &PwarpConfig| random_frame(rng, cfg, 32, 16, 32),
+        |cfg| PwarpConfig {
+            weight_w: cfg.weight_w - 1,
+            ..cfg
+        },
+        "a one-bit-narrower weight",
+        1570,
     );
 }

@@ -19,8 +19,8 @@ use cube5_model::units::cube5_warp::{
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::warp::{check_frames, random_base, WarpFrame};
-use support::{configs, gate_configs, seed};
+use support::warp::{self, check_frames, random_base, WarpFrame};
+use support::{configs, seed};
 
 /// One frame of the warp: registers, base plane, what it is (for a mismatch report).
 #[derive(Debug, Clone)]
@@ -343,33 +343,16 @@ fn directed_frames(cfg: &WarpConfig, rng: &mut ChaCha8Rng) -> Vec<Frame> {
 
 #[test]
 fn directed_extremes_under_idle_and_backpressure() {
-    for (i, (variant, cfg)) in configs::<WarpConfig>().into_iter().enumerate() {
-        let s = seed(1430 + i as u64);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let frames = directed_frames(&cfg, &mut rng);
-        for (idle, stall) in [(0.0, 0.0), (0.3, 0.3), (0.0, 0.7)] {
-            let t = Traffic::random(&mut rng, idle, stall);
-            check_frames(variant, cfg, &frames, &t, s, None);
-        }
-        eprintln!("{variant}: {} directed frames bit-exact", frames.len());
-    }
+    warp::directed_under_idle_and_backpressure(directed_frames, 1430);
 }
 
 #[test]
 fn a_reset_in_mid_stream() {
-    for (i, (variant, cfg)) in configs::<WarpConfig>().into_iter().enumerate() {
-        let s = seed(1440 + i as u64);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        // Small base planes, so the reset lands as often in an image as in a base plane's load.
-        for _ in 0..6 {
-            let frames: Vec<Frame> = (0..6)
-                .map(|_| random_frame_within(&mut rng, &cfg, 12, 8, cfg.max_out.min(32)))
-                .collect();
-            let t = Traffic::random(&mut rng, 0.2, 0.3);
-            let cut = rng.random_range(1..3000);
-            check_frames(variant, cfg, &frames, &t, s, Some((3, cut)));
-        }
-    }
+    // Small base planes, so the reset lands as often in an image as in a base plane's load.
+    warp::a_reset_in_mid_stream(
+        |rng, cfg: &WarpConfig| random_frame_within(rng, cfg, 12, 8, cfg.max_out.min(32)),
+        1440,
+    );
 }
 
 #[test]
@@ -413,43 +396,25 @@ fn one_pixel_per_clock_over_a_frame() {
 
 #[test]
 fn gate_level_smoke() {
-    for (variant, cfg) in gate_configs::<WarpConfig>() {
-        let s = seed(1460);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let mut frames: Vec<Frame> = (0..12)
-            .map(|_| random_frame(&mut rng, &cfg, 8, cfg.max_out.min(24)))
-            .collect();
-        frames.extend(directed_frames(&cfg, &mut rng));
-        let t = Traffic::random(&mut rng, 0.2, 0.2);
-        check_frames(variant, cfg, &frames, &t, s, Some((4, 900)));
-        eprintln!("{variant}: gate-level smoke, {} frames", frames.len());
-    }
+    warp::gate_level_smoke(
+        12,
+        |rng, cfg: &WarpConfig| random_frame(rng, cfg, 8, cfg.max_out.min(24)),
+        directed_frames,
+        1460,
+    );
 }
 
 #[test]
 fn a_model_with_the_wrong_weight_width_is_caught() {
     // The comparison bites: the default configuration's RTL against a model one weight bit
     // narrower must differ on random warps.
-    let (variant, cfg) = configs::<WarpConfig>()[0];
-    let s = seed(1470);
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let frames: Vec<Frame> = (0..4)
-        .map(|_| random_frame(&mut rng, &cfg, 16, cfg.max_out.min(32)))
-        .collect();
-    let items: Vec<WarpIn> = frames.iter().flat_map(|f| f.items(&cfg)).collect();
-    let wrong = WarpConfig {
-        weight_w: cfg.weight_w - 1,
-        ..cfg
-    };
-    let want = Warp::new(wrong).unwrap().run(&items);
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    let n = want.len() as u64;
-    let driven = dut
-        .drive(&items, &Traffic::full_speed(), n, 1 << 24)
-        .unwrap();
-    let got: Vec<WarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-    assert!(
-        got != want,
-        "{variant}: a one-bit-narrower weight went unnoticed"
+    warp::a_wrong_model_is_caught(
+        |rng, cfg: &WarpConfig| random_frame(rng, cfg, 16, cfg.max_out.min(32)),
+        |cfg| WarpConfig {
+            weight_w: cfg.weight_w - 1,
+            ..cfg
+        },
+        "a one-bit-narrower weight",
+        1470,
     );
 }

@@ -2,18 +2,19 @@
 //! outputs, so a frame is driven here (registers, base plane, emitting items) rather than through
 //! `check_stream` (one out per item), and a difference is named by frame and position.
 
-use cube5_model::unit::{StreamCodec, StreamUnit};
+use super::{configs, gate_configs, seed};
+use cube5_model::unit::{StreamCodec, StreamUnit, UnitConfig};
 use cube5_model::units::cube5_warp::BaseCodes;
 use cube5_tb::rtl::{RtlStream, Traffic};
 use cube5_tb::Variant;
-use rand::Rng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::fmt::Debug;
 
 /// One frame of a warp test: the items it sends, and how one of its outputs is named.
 pub trait WarpFrame {
     /// The unit's configuration (its codec).
-    type Cfg: StreamCodec<In: Clone + Debug, Out: Clone + Debug + PartialEq> + Copy;
+    type Cfg: StreamCodec<In: Clone + Debug, Out: Clone + Debug + PartialEq> + UnitConfig + Copy;
     /// The golden model.
     type Gold: StreamUnit<
         In = <Self::Cfg as StreamCodec>::In,
@@ -137,4 +138,81 @@ fn compare<F: WarpFrame>(
         got[k],
         want[k]
     );
+}
+
+/// On every configuration: `directed` frames (seed `seed_no` + the configuration's index) at full
+/// speed, under idle and back-pressure, and under heavy back-pressure.
+pub fn directed_under_idle_and_backpressure<F: WarpFrame>(
+    directed: impl Fn(&F::Cfg, &mut ChaCha8Rng) -> Vec<F>,
+    seed_no: u64,
+) {
+    for (i, (variant, cfg)) in configs::<F::Cfg>().into_iter().enumerate() {
+        let s = seed(seed_no + i as u64);
+        let mut rng = ChaCha8Rng::seed_from_u64(s);
+        let frames = directed(&cfg, &mut rng);
+        for (idle, stall) in [(0.0, 0.0), (0.3, 0.3), (0.0, 0.7)] {
+            let t = Traffic::random(&mut rng, idle, stall);
+            check_frames(variant, cfg, &frames, &t, s, None);
+        }
+        eprintln!("{variant}: {} directed frames bit-exact", frames.len());
+    }
+}
+
+/// On every configuration, six times: six `random` frames, both sides reset at a random cycle in
+/// the first three, the last three after the reset.
+pub fn a_reset_in_mid_stream<F: WarpFrame>(
+    random: impl Fn(&mut ChaCha8Rng, &F::Cfg) -> F,
+    seed_no: u64,
+) {
+    for (i, (variant, cfg)) in configs::<F::Cfg>().into_iter().enumerate() {
+        let s = seed(seed_no + i as u64);
+        let mut rng = ChaCha8Rng::seed_from_u64(s);
+        for _ in 0..6 {
+            let frames: Vec<F> = (0..6).map(|_| random(&mut rng, &cfg)).collect();
+            let t = Traffic::random(&mut rng, 0.2, 0.3);
+            let cut = rng.random_range(1..3000);
+            check_frames(variant, cfg, &frames, &t, s, Some((3, cut)));
+        }
+    }
+}
+
+/// On every gate-level build: `n` `random` frames and the `directed` ones under idle and
+/// back-pressure, with a reset 900 cycles into the first four.
+pub fn gate_level_smoke<F: WarpFrame>(
+    n: usize,
+    random: impl Fn(&mut ChaCha8Rng, &F::Cfg) -> F,
+    directed: impl Fn(&F::Cfg, &mut ChaCha8Rng) -> Vec<F>,
+    seed_no: u64,
+) {
+    for (variant, cfg) in gate_configs::<F::Cfg>() {
+        let s = seed(seed_no);
+        let mut rng = ChaCha8Rng::seed_from_u64(s);
+        let mut frames: Vec<F> = (0..n).map(|_| random(&mut rng, &cfg)).collect();
+        frames.extend(directed(&cfg, &mut rng));
+        let t = Traffic::random(&mut rng, 0.2, 0.2);
+        check_frames(variant, cfg, &frames, &t, s, Some((4, 900)));
+        eprintln!("{variant}: gate-level smoke, {} frames", frames.len());
+    }
+}
+
+/// The comparison bites: the first configuration's RTL against the model of `wrong(cfg)` must
+/// differ on four `random` frames.
+pub fn a_wrong_model_is_caught<F: WarpFrame>(
+    random: impl Fn(&mut ChaCha8Rng, &F::Cfg) -> F,
+    wrong: impl Fn(F::Cfg) -> F::Cfg,
+    what: &str,
+    seed_no: u64,
+) {
+    let (variant, cfg) = configs::<F::Cfg>()[0];
+    let mut rng = ChaCha8Rng::seed_from_u64(seed(seed_no));
+    let frames: Vec<F> = (0..4).map(|_| random(&mut rng, &cfg)).collect();
+    let items: Vec<_> = frames.iter().flat_map(|f| f.items(&cfg)).collect();
+    let want = F::gold(wrong(cfg)).run(&items);
+    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
+    let n = want.len() as u64;
+    let driven = dut
+        .drive(&items, &Traffic::full_speed(), n, 1 << 24)
+        .unwrap();
+    let got: Vec<_> = driven.outputs.iter().map(|t| t.value.clone()).collect();
+    assert!(got != want, "{variant}: {what} went unnoticed");
 }
