@@ -12,8 +12,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi_mem_setup, axi_protocol_clean, axi_random_image, compare_ar, compare_axi_outputs, configs,
-    gate_configs, seed, with_waves,
+    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_ar, compare_axi_outputs,
+    configs, seed, with_waves,
 };
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
@@ -104,21 +104,17 @@ fn check(
 }
 
 fn must(variant: &'static Variant, cfg: AxiRdConfig, seed: u64, case: &Case) -> Report {
-    match check(variant, cfg, seed, case) {
-        Ok(r) => {
-            eprintln!(
-                "{variant}: seed {seed}: {} beats, {} bursts in {} cycles ({:.4} beats/clock), RREADY low {} cycles, {} bursts dropped at reset",
-                r.beats,
-                r.bursts,
-                r.cycles,
-                r.beats_per_cycle(),
-                r.rready_low,
-                r.dropped_at_reset
-            );
-            r
-        }
-        Err(e) => panic!("{e}"),
-    }
+    axi::must_pass(variant, seed, check(variant, cfg, seed, case), |r| {
+        format!(
+            "{} beats, {} bursts in {} cycles ({:.4} beats/clock), RREADY low {} cycles, {} bursts dropped at reset",
+            r.beats,
+            r.bursts,
+            r.cycles,
+            r.beats_per_cycle(),
+            r.rready_low,
+            r.dropped_at_reset
+        )
+    })
 }
 
 /// The item a beat belongs to, for a mismatch report.
@@ -202,12 +198,7 @@ fn run(
         cfg.check_cmd(c)
             .map_err(|e| TbError::setup(variant.name, e))?;
     }
-    let mut dut = RtlStream::new(variant, cfg, seed as u32)?;
-    dut.axi_setup(&case.setup)?;
-    dut.axi_load(case.mem.base, &case.mem.bytes)?;
-    if let Some((path, (from, to))) = &trace {
-        dut.trace_window(path, *from, *to);
-    }
+    let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut report = Report::default();
     let (mem, traffic) = (&case.mem, &case.traffic);
     match &case.reset {
@@ -234,17 +225,8 @@ fn run(
                 Some(*at),
                 &mut report,
             )?;
-            dut.reset();
-            let c = dut.axi_counters();
-            if c.in_flight != 0 {
-                return Err(TbError::Protocol {
-                    variant: variant.name.to_string(),
-                    seed,
-                    cycle: dut.cycle(),
-                    what: format!("{} bursts still in flight after the reset", c.in_flight),
-                });
-            }
-            report.dropped_at_reset = c.dropped_at_reset;
+            report.dropped_at_reset =
+                axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, false)?;
             drive_and_compare(
                 &mut dut,
                 variant,
@@ -268,11 +250,7 @@ fn random_case(cfg: AxiRdConfig, seed: u64, n: usize) -> Case {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mem = random_image(cfg, &mut rng);
     let cmds = random_cmds(cfg, &mem, n, &mut rng);
-    let bw = if rng.random_bool(0.5) {
-        (rng.random_range(1..=2 * cfg.bytes()), 2)
-    } else {
-        (0, 1)
-    };
+    let bw = axi::random_bandwidth(&mut rng, 2 * cfg.bytes());
     let gaps = (rng.random_range(0..500), rng.random_range(0..500));
     let setup = mem_setup(cfg, &mem, (10, 190), gaps, bw, rng.random());
     let stall = rng.random_range(0.0..0.6);
@@ -288,21 +266,17 @@ fn random_case(cfg: AxiRdConfig, seed: u64, n: usize) -> Case {
 
 #[test]
 fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
-    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
-        for k in 0..4 {
-            let s = seed(100 + 10 * i as u64 + k);
-            let case = random_case(cfg, s, 300);
-            let r = must(variant, cfg, s, &case);
-            assert!(
-                r.beats > 1000,
-                "{variant}: the case reads enough beats (seed {s})"
-            );
-            assert_eq!(
-                r.rready_low, 0,
-                "{variant}: RREADY never holds the bus (seed {s})"
-            );
-        }
-    }
+    axi::random_runs(4, |variant, cfg: AxiRdConfig, s| {
+        let r = must(variant, cfg, s, &random_case(cfg, s, 300));
+        assert!(
+            r.beats > 1000,
+            "{variant}: the case reads enough beats (seed {s})"
+        );
+        assert_eq!(
+            r.rready_low, 0,
+            "{variant}: RREADY never holds the bus (seed {s})"
+        );
+    });
 }
 
 /// The acceptance figure (docs/adding-a-unit.md): at least 1,000,000 random beats per
@@ -310,26 +284,20 @@ fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
 /// back-pressure, the third of them reset in mid-stream.
 #[test]
 fn a_million_random_beats_per_config() {
-    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
-        let mut beats = 0u64;
-        let mut k = 0u64;
-        while beats < 1_000_000 {
-            let s = seed(600 + 100 * i as u64 + k);
-            let mut case = random_case(cfg, s, 2000);
-            if k == 2 {
-                let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-                let after = random_cmds(cfg, &case.mem, 2000, &mut rng);
-                case.reset = Some((rng.random_range(1000..100_000), after));
-            }
-            let r = must(variant, cfg, s, &case);
-            assert_eq!(
-                r.rready_low, 0,
-                "{variant}: RREADY never holds the bus (seed {s})"
-            );
-            beats += r.beats;
-            k += 1;
+    axi::a_million_per_config(|variant, cfg: AxiRdConfig, s, k| {
+        let mut case = random_case(cfg, s, 2000);
+        if k == 2 {
+            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+            let after = random_cmds(cfg, &case.mem, 2000, &mut rng);
+            case.reset = Some((rng.random_range(1000..100_000), after));
         }
-    }
+        let r = must(variant, cfg, s, &case);
+        assert_eq!(
+            r.rready_low, 0,
+            "{variant}: RREADY never holds the bus (seed {s})"
+        );
+        r.beats
+    });
 }
 
 /// Length 1, 4 KB crossings, the longest command, the top of the image and of the address space,
@@ -446,24 +414,16 @@ fn directed_extremes() {
 
 #[test]
 fn reset_in_mid_stream_leaves_nothing_outstanding_and_the_next_commands_are_exact() {
-    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
-        let mut dropped = 0;
-        for k in 0..3 {
-            let s = seed(400 + 10 * i as u64 + k);
-            let mut case = random_case(cfg, s, 100);
-            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let after = random_cmds(cfg, &case.mem, 100, &mut rng);
-            // Early enough that bursts are in flight (latency >= 10 cycles).
-            case.reset = Some((rng.random_range(30..3000), after));
-            let r = must(variant, cfg, s, &case);
-            assert!(r.beats > 0);
-            dropped += r.dropped_at_reset;
-        }
-        assert!(
-            dropped > 0,
-            "{variant}: some reset landed with bursts in flight"
-        );
-    }
+    axi::resets_land_with_bursts_in_flight(|variant, cfg: AxiRdConfig, s| {
+        let mut case = random_case(cfg, s, 100);
+        let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+        let after = random_cmds(cfg, &case.mem, 100, &mut rng);
+        // Early enough that bursts are in flight (latency >= 10 cycles).
+        case.reset = Some((rng.random_range(30..3000), after));
+        let r = must(variant, cfg, s, &case);
+        assert!(r.beats > 0);
+        r.dropped_at_reset
+    });
 }
 
 /// Throughput: fixed latency 100, no gaps, output always taken, long commands. Where the credit
@@ -544,18 +504,19 @@ fn throughput_against_latency_and_bandwidth() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    for (variant, cfg) in gate_configs::<AxiRdConfig>() {
-        let s = seed(500);
-        let case = random_case(cfg, s, 60);
-        must(variant, cfg, s, &case);
-        let mut case = random_case(cfg, s + 1, 30);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        case.reset = Some((
-            rng.random_range(30..500),
-            random_cmds(cfg, &case.mem, 30, &mut rng),
-        ));
-        must(variant, cfg, s + 1, &case);
-    }
+    axi::gate_smoke(
+        |variant, cfg: AxiRdConfig, s| {
+            must(variant, cfg, s, &random_case(cfg, s, 60));
+        },
+        |variant, cfg, s, rng| {
+            let mut case = random_case(cfg, s, 30);
+            case.reset = Some((
+                rng.random_range(30..500),
+                random_cmds(cfg, &case.mem, 30, rng),
+            ));
+            must(variant, cfg, s, &case);
+        },
+    );
 }
 
 /// The checks bite: a model whose image differs in one byte disagrees on the beat holding it (the
@@ -645,7 +606,7 @@ fn the_axi_checker_reports_a_violation() {
         addr: mem.base + 0x3000,
         len: 4 * cfg.max_burst,
     }];
-    for (setup, rule) in [
+    let refusals = vec![
         (
             AxiMemSetup {
                 data_bytes: 2 * cfg.bytes(),
@@ -667,7 +628,8 @@ fn the_axi_checker_reports_a_violation() {
             },
             "declares at most",
         ),
-    ] {
+    ];
+    axi::assert_checker_refuses(variant, refusals, |setup, s| {
         let case = Case {
             setup,
             traffic: Traffic::full_speed(),
@@ -675,14 +637,6 @@ fn the_axi_checker_reports_a_violation() {
             mem: mem.clone(),
             reset: None,
         };
-        match check(variant, cfg, 77, &case) {
-            Err(e @ TbError::Protocol { .. }) => {
-                let text = e.to_string();
-                assert!(text.contains(rule), "{text}");
-                assert!(text.contains("CUBE5_SEED=77"), "{text}");
-            }
-            Err(e) => panic!("{variant}: expected a protocol error about {rule}, got {e}"),
-            Ok(r) => panic!("{variant}: the checker let it pass ({r:?})"),
-        }
-    }
+        check(variant, cfg, s, &case)
+    });
 }

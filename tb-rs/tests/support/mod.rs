@@ -11,6 +11,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::fmt::Debug;
 
+pub mod axi;
 pub mod warp;
 
 /// Random items per configuration in the long co-simulation runs (the acceptance figure).
