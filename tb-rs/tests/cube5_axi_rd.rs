@@ -12,7 +12,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_ar, compare_axi_outputs,
+    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts,
     configs, seed, with_waves,
 };
 
@@ -152,9 +152,15 @@ fn drive_and_compare(
     let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
     axi_protocol_clean(dut, &driven.stats, variant, seed)?;
     // AR first: a wrong burst explains a wrong beat.
-    let n_ars = compare_ar(dut, &bursts, cfg.size(), variant, seed, |k| {
-        format!("burst #{k} of commands {cmds:?}")
-    })?;
+    let n_ars = compare_bursts(
+        &dut.axi_take_ar()?,
+        "AR",
+        &bursts,
+        cfg.size(),
+        variant,
+        seed,
+        |k| format!("burst #{k} of commands {cmds:?}"),
+    )?;
     compare_axi_outputs(
         dut,
         &driven,

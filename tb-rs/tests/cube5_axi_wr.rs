@@ -14,7 +14,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_aw, compare_axi_outputs,
+    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts,
     configs, seed, with_waves,
 };
 
@@ -198,17 +198,25 @@ fn drive_and_compare(
     let driven = dut.drive(&work.cmds, &case.traffic, want.done.len() as u64, limit)?;
     axi_protocol_clean(dut, &driven.stats, variant, seed)?;
     let cmds = &work.cmds;
-    let n_aws = compare_aw(dut, &want.bursts, cfg.size(), variant, seed, |k| {
-        let mut at = 0;
-        for (i, c) in cmds.iter().enumerate() {
-            let n = cfg.bursts(c).len();
-            if k < at + n {
-                return format!("burst {} of command #{i} ({c})", k - at);
+    let n_aws = compare_bursts(
+        &dut.axi_take_aw()?,
+        "AW",
+        &want.bursts,
+        cfg.size(),
+        variant,
+        seed,
+        |k| {
+            let mut at = 0;
+            for (i, c) in cmds.iter().enumerate() {
+                let n = cfg.bursts(c).len();
+                if k < at + n {
+                    return format!("burst {} of command #{i} ({c})", k - at);
+                }
+                at += n;
             }
-            at += n;
-        }
-        "(no command: an extra burst)".into()
-    })?;
+            "(no command: an extra burst)".into()
+        },
+    )?;
     compare_axi_outputs(
         dut,
         &driven,

@@ -17,7 +17,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi, axi_mem_setup, axi_protocol_clean, compare_ar, compare_axi_outputs, configs, seed,
+    axi, axi_mem_setup, axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, seed,
     with_waves,
 };
 
@@ -281,9 +281,15 @@ fn drive_and_compare(
     let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
     axi_protocol_clean(dut, &driven.stats, variant, seed)?;
     // AR first: a wrong burst explains a wrong item.
-    let n_ars = compare_ar(dut, &bursts, cfg.axi_rd().size(), variant, seed, |k| {
-        format!("burst #{k} of {} read commands", run.reads.len())
-    })?;
+    let n_ars = compare_bursts(
+        &dut.axi_take_ar()?,
+        "AR",
+        &bursts,
+        cfg.axi_rd().size(),
+        variant,
+        seed,
+        |k| format!("burst #{k} of {} read commands", run.reads.len()),
+    )?;
     compare_axi_outputs(
         dut,
         &driven,
