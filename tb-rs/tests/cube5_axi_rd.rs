@@ -7,7 +7,7 @@ mod support;
 
 use cube5_model::units::cube5_axi_rd::{AxiMemImage, AxiRdCmd, AxiRdConfig};
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
-use cube5_tb::{Mismatch, TbError, Variant};
+use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
@@ -174,18 +174,13 @@ fn drive_and_compare(
     )?;
     if exact {
         let any_err = want.iter().any(|b| b.resp != 0);
-        if dut.axi_counters().err_flag != any_err {
-            return Err(TbError::from(Mismatch {
-                variant: variant.name.to_string(),
-                seed,
-                cycle: dut.cycle(),
-                input: format!("{} commands", cmds.len()),
-                rtl: format!("err_o = {}", !any_err),
-                model: format!("err_o = {any_err}"),
-                what: "err_o differs (sticky: some beat's RRESP != OKAY since reset)".into(),
-                ..Default::default()
-            }));
-        }
+        axi::err_flag_matches(
+            dut,
+            (variant, seed),
+            cmds.len(),
+            any_err,
+            "some beat's RRESP",
+        )?;
     }
     report.beats += driven.outputs.len() as u64;
     report.bursts += n_ars as u64;
@@ -207,44 +202,22 @@ fn run(
     let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut report = Report::default();
     let (mem, traffic) = (&case.mem, &case.traffic);
-    match &case.reset {
-        None => drive_and_compare(
-            &mut dut,
-            variant,
-            cfg,
-            seed,
-            &case.cmds,
-            mem,
-            traffic,
-            None,
-            &mut report,
-        )?,
-        Some((at, after)) => {
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                &case.cmds,
-                mem,
-                traffic,
-                Some(*at),
-                &mut report,
-            )?;
-            report.dropped_at_reset =
-                axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, false)?;
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                after,
-                mem,
-                traffic,
-                None,
-                &mut report,
-            )?;
-        }
+    let go = |dut: &mut RtlStream<AxiRdConfig>,
+              cmds: &[AxiRdCmd],
+              cut: Option<u64>,
+              report: &mut Report| {
+        drive_and_compare(dut, variant, cfg, seed, cmds, mem, traffic, cut, report)
+    };
+    go(
+        &mut dut,
+        &case.cmds,
+        case.reset.as_ref().map(|r| r.0),
+        &mut report,
+    )?;
+    if let Some((_, after)) = &case.reset {
+        report.dropped_at_reset =
+            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, false)?;
+        go(&mut dut, after, None, &mut report)?;
     }
     report.rready_low = dut.axi_counters().rready_low;
     Ok(report)
@@ -545,23 +518,27 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
         reset: None,
     };
     // The model with one byte of the image changed: the beat differs, and the report names it.
+    // Each run on a fresh DUT holding the image, against a model of `model_cfg` over `model_mem`.
+    let mismatch = |model_cfg: AxiRdConfig, cmds: &[AxiRdCmd], model_mem: &AxiMemImage| {
+        let mut dut = axi::open(variant, cfg, 1, (&case.setup, &case.mem), &None).unwrap();
+        let mut report = Report::default();
+        let traffic = &case.traffic;
+        drive_and_compare(
+            &mut dut,
+            variant,
+            model_cfg,
+            1,
+            cmds,
+            model_mem,
+            traffic,
+            None,
+            &mut report,
+        )
+        .unwrap_err()
+    };
     let mut wrong = case.clone();
     wrong.mem.bytes[(4096 - b) as usize] ^= 1;
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    dut.axi_setup(&case.setup).unwrap();
-    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
-    let err = drive_and_compare(
-        &mut dut,
-        variant,
-        cfg,
-        1,
-        &cmds,
-        &wrong.mem,
-        &case.traffic,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
+    let err = mismatch(cfg, &cmds, &wrong.mem);
     let m = err.mismatch().expect("a mismatch");
     assert_eq!(m.item, 0);
     assert!(m.input.contains("command #0"), "{}", m.input);
@@ -578,21 +555,7 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
         addr: mem.base,
         len: cfg.max_burst,
     }];
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    dut.axi_setup(&case.setup).unwrap();
-    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
-    let err = drive_and_compare(
-        &mut dut,
-        variant,
-        half,
-        1,
-        &long,
-        &mem,
-        &case.traffic,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
+    let err = mismatch(half, &long, &mem);
     let m = err.mismatch().expect("a mismatch");
     assert!(m.what.starts_with("AR burst differs"), "{err}");
     assert_eq!(m.item, 0);

@@ -9,7 +9,7 @@ mod support;
 use cube5_model::units::cube5_axi_rd::AxiMemImage;
 use cube5_model::units::cube5_axi_wr::{AxiWrCmd, AxiWrConfig, AxiWrExpect};
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
-use cube5_tb::{Mismatch, TbError, Variant};
+use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
@@ -229,24 +229,14 @@ fn drive_and_compare(
         |k| describe_done(cmds, k),
     )?;
     let after = dut.axi_wr_counters();
-    let mismatch = |cycle: u64, input: String, rtl: String, model: String, what: &str| {
-        TbError::from(Mismatch {
-            variant: variant.name.to_string(),
-            seed,
-            cycle,
-            input,
-            rtl,
-            model,
-            what: what.into(),
-            ..Default::default()
-        })
+    let mismatch = |input: String, rtl: String, model: String, what: &str| {
+        axi::mismatch(dut, (variant, seed), input, rtl, model, what)
     };
     let image = dut.axi_image()?;
     if exact {
         if let Some(at) = (0..image.len()).find(|&i| image[i] != want.image[i]) {
             let addr = mem.base + at as u64;
             return Err(mismatch(
-                dut.cycle(),
                 describe_byte(cfg, work, addr),
                 format!("{:#04x}", image[at]),
                 format!("{:#04x}", want.image[at]),
@@ -259,7 +249,6 @@ fn drive_and_compare(
         );
         if (beats, bytes) != (want.beats, want.strobed_bytes) {
             return Err(mismatch(
-                dut.cycle(),
                 format!("{} commands", cmds.len()),
                 format!("{beats} W beats, {bytes} strobed bytes"),
                 format!(
@@ -269,15 +258,7 @@ fn drive_and_compare(
                 "W beat or strobe count differs",
             ));
         }
-        if dut.axi_counters().err_flag != want.any_err {
-            return Err(mismatch(
-                dut.cycle(),
-                format!("{} commands", cmds.len()),
-                format!("err_o = {}", !want.any_err),
-                format!("err_o = {}", want.any_err),
-                "err_o differs (sticky: some BRESP != OKAY since reset)",
-            ));
-        }
+        axi::err_flag_matches(dut, (variant, seed), cmds.len(), want.any_err, "some BRESP")?;
     } else {
         // Cut by a reset: every byte no command touches is unchanged.
         let ib = u64::from(cfg.item_bytes());
@@ -292,7 +273,6 @@ fn drive_and_compare(
         }
         if let Some(at) = (0..image.len()).find(|&i| !touched[i] && image[i] != mem.bytes[i]) {
             return Err(mismatch(
-                dut.cycle(),
                 format!("byte {:#x}, inside no command", mem.base + at as u64),
                 format!("{:#04x}", image[at]),
                 format!("{:#04x} (unchanged)", mem.bytes[at]),
@@ -326,52 +306,35 @@ fn run(
     }
     let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut report = Report::default();
-    match &case.reset {
-        None => drive_and_compare(
-            &mut dut,
+    let go = |dut: &mut RtlStream<AxiWrConfig>,
+              work: &Work,
+              mem: &AxiMemImage,
+              cut: Option<u64>,
+              report: &mut Report| {
+        drive_and_compare(
+            dut,
             variant,
             cfg,
             seed,
-            &case.work,
-            &case.work.items,
-            &case.mem,
+            work,
+            &work.items,
+            mem,
             case,
-            None,
-            &mut report,
-        )?,
-        Some((at, after)) => {
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                &case.work,
-                &case.work.items,
-                &case.mem,
-                case,
-                Some(*at),
-                &mut report,
-            )?;
-            report.dropped_at_reset =
-                axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, true)?;
-            // The next work starts from the memory as the cut run left it.
-            let mem = AxiMemImage {
-                bytes: dut.axi_image()?,
-                ..case.mem.clone()
-            };
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                after,
-                &after.items,
-                &mem,
-                case,
-                None,
-                &mut report,
-            )?;
-        }
+            cut,
+            report,
+        )
+    };
+    let cut = case.reset.as_ref().map(|r| r.0);
+    go(&mut dut, &case.work, &case.mem, cut, &mut report)?;
+    if let Some((_, after)) = &case.reset {
+        report.dropped_at_reset =
+            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, true)?;
+        // The next work starts from the memory as the cut run left it.
+        let mem = AxiMemImage {
+            bytes: dut.axi_image()?,
+            ..case.mem.clone()
+        };
+        go(&mut dut, after, &mem, None, &mut report)?;
     }
     Ok(report)
 }
@@ -724,29 +687,30 @@ fn the_comparison_and_the_checker_bite() {
         reset: None,
     };
     must(variant, cfg, 1, &case);
-    let fresh = || {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        dut.axi_setup(&case.setup).unwrap();
-        dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
-        dut
+    // Each run on a fresh DUT holding the image, its RTL items against a model of `model_cfg`.
+    let mismatch = |model_cfg: AxiWrConfig, rtl_items: &[Vec<u8>]| {
+        let mut dut = axi::open(variant, cfg, 1, (&case.setup, &case.mem), &None).unwrap();
+        let mut report = Report::default();
+        let mem = &case.mem;
+        drive_and_compare(
+            &mut dut,
+            variant,
+            model_cfg,
+            1,
+            &work,
+            rtl_items,
+            mem,
+            &case,
+            None,
+            &mut report,
+        )
+        .unwrap_err()
     };
 
     // The RTL's item 1 differs in its first byte.
     let mut rtl_items = work.items.clone();
     rtl_items[1][0] ^= 1;
-    let err = drive_and_compare(
-        &mut fresh(),
-        variant,
-        cfg,
-        1,
-        &work,
-        &rtl_items,
-        &case.mem,
-        &case,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
+    let err = mismatch(cfg, &rtl_items);
     let m = err.mismatch().expect("a mismatch");
     assert!(m.what.starts_with("memory byte differs"), "{err}");
     assert!(
@@ -760,19 +724,7 @@ fn the_comparison_and_the_checker_bite() {
         max_burst: cfg.max_burst / 2,
         ..cfg
     };
-    let err = drive_and_compare(
-        &mut fresh(),
-        variant,
-        half,
-        1,
-        &work,
-        &work.items,
-        &case.mem,
-        &case,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
+    let err = mismatch(half, &work.items);
     let m = err.mismatch().expect("a mismatch");
     assert!(m.what.starts_with("AW burst differs"), "{err}");
 

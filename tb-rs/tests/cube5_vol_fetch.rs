@@ -511,25 +511,41 @@ fn reset_in_mid_sweep_leaves_nothing_outstanding_and_the_next_sweeps_are_exact()
     });
 }
 
+/// A volume of `blocks` with every block present: its LUT writes and its image (no SLVERR
+/// window).
+fn present_volume(
+    cfg: VolFetchConfig,
+    blocks: [u32; 3],
+    rng: &mut ChaCha8Rng,
+) -> (Vec<FetchCmd>, AxiMemImage) {
+    let mut lut = random_lut(cfg, blocks, rng);
+    all_present(&mut lut);
+    let mut mem = random_image(cfg, blocks.iter().product(), rng);
+    (mem.slverr_lo, mem.slverr_hi) = (0, 0);
+    (lut, mem)
+}
+
+/// The sweep over every block of a volume at `base`, along z, front to back.
+fn whole_sweep(base: u64, blocks: [u32; 3]) -> Sweep {
+    Sweep {
+        base,
+        blocks,
+        axis_k: 2,
+        reversed: false,
+        sec_lo: 0,
+        sec_hi: blocks[0],
+    }
+}
+
 /// Voxels per clock over a whole-volume sweep with every block present, full-speed output,
 /// fixed latency `lat` and bandwidth `bw` bytes/cycle as `(num, den)` (`num = 0`: the bus).
 fn throughput(variant: &'static Variant, cfg: VolFetchConfig, lat: u32, bw: (u32, u32)) -> f64 {
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let nb = cfg.nb().min(4);
     let blocks = [nb, nb, nb.min(4)];
-    let mut lut = random_lut(cfg, blocks, &mut rng);
-    all_present(&mut lut);
-    let mut mem = random_image(cfg, blocks.iter().product(), &mut rng);
+    let (lut, mut mem) = present_volume(cfg, blocks, &mut rng);
     mem.base = 0x1000 * u64::from(cfg.addr_w > 16);
-    (mem.slverr_lo, mem.slverr_hi) = (0, 0);
-    let sweep = Sweep {
-        base: mem.base,
-        blocks,
-        axis_k: 2,
-        reversed: false,
-        sec_lo: 0,
-        sec_hi: blocks[0],
-    };
+    let sweep = whole_sweep(mem.base, blocks);
     let case = Case {
         lut,
         cmds: vec![FetchCmd::Sweep(sweep); 2],
@@ -669,26 +685,11 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_skip() {
     let (variant, cfg) = configs::<VolFetchConfig>()[0];
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let blocks = [2, 2, 2];
-    let mut lut = random_lut(cfg, blocks, &mut rng);
-    all_present(&mut lut);
-    let mut mem = random_image(cfg, 8, &mut rng);
-    (mem.slverr_lo, mem.slverr_hi) = (0, 0);
-    let sweep = Sweep {
-        base: mem.base,
-        blocks,
-        axis_k: 2,
-        reversed: false,
-        sec_lo: 0,
-        sec_hi: 2,
-    };
+    let (lut, mem) = present_volume(cfg, blocks, &mut rng);
+    let sweep = whole_sweep(mem.base, blocks);
     let traffic = Traffic::full_speed();
     let setup = mem_setup(cfg, &mem, (10, 0), (0, 0), (0, 1), 1);
-    let open = || {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        dut.axi_setup(&setup).unwrap();
-        dut.axi_load(mem.base, &mem.bytes).unwrap();
-        dut
-    };
+    let open = || axi::open(variant, cfg, 1, (&setup, &mem), &None).unwrap();
     // One byte of the first block's slot changed in the model's memory.
     let first_ptr = match lut[0] {
         FetchCmd::Lut { entry, .. } => entry.ptr,

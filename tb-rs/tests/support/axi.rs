@@ -7,7 +7,7 @@ use super::{configs, gate_configs, seed};
 use cube5_model::unit::{StreamCodec, UnitConfig};
 use cube5_model::units::cube5_axi_rd::AxiMemImage;
 use cube5_tb::rtl::{AxiMemSetup, RtlStream};
-use cube5_tb::{TbError, Variant};
+use cube5_tb::{Mismatch, TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::fmt::Debug;
@@ -157,4 +157,48 @@ pub fn random_runs<C: UnitConfig + Copy>(n: u64, run: impl Fn(&'static Variant, 
             run(variant, cfg, seed(100 + 10 * i as u64 + k));
         }
     }
+}
+
+/// A mismatch found after a run at `dut`'s cycle: `input` names what was sent, `rtl` and `model`
+/// what each did.
+pub fn mismatch<C: StreamCodec>(
+    dut: &RtlStream<C>,
+    (variant, seed): (&'static Variant, u64),
+    input: String,
+    rtl: String,
+    model: String,
+    what: &str,
+) -> TbError {
+    TbError::from(Mismatch {
+        variant: variant.name.to_string(),
+        seed,
+        cycle: dut.cycle(),
+        input,
+        rtl,
+        model,
+        what: what.into(),
+        ..Default::default()
+    })
+}
+
+/// `err_o` against the model's after `cmds` commands: sticky, set by `some` (the response that
+/// is not OKAY, e.g. "some BRESP") since reset.
+pub fn err_flag_matches<C: StreamCodec>(
+    dut: &RtlStream<C>,
+    (variant, seed): (&'static Variant, u64),
+    cmds: usize,
+    want: bool,
+    some: &str,
+) -> Result<(), TbError> {
+    if dut.axi_counters().err_flag == want {
+        return Ok(());
+    }
+    Err(mismatch(
+        dut,
+        (variant, seed),
+        format!("{cmds} commands"),
+        format!("err_o = {}", !want),
+        format!("err_o = {want}"),
+        &format!("err_o differs (sticky: {some} != OKAY since reset)"),
+    ))
 }
