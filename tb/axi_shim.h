@@ -42,6 +42,23 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
     top_->out_ready_i = 0;
   }
 
+  /// Resets the top and the subordinate together (bursts in flight are dropped on both sides):
+  /// `idle` idles the top's inputs; a manager for which `still_valid` names a VALID still high
+  /// out of reset (else nullptr) breaks the protocol.
+  template <class Idle, class StillValid>
+  void reset_with_mem(uint32_t cycles, Idle idle, StillValid still_valid) {
+    top_->rst_ni = 0;
+    top_->in_valid_i = 0;
+    top_->out_ready_i = 0;
+    idle();
+    mem_.reset();
+    for (uint32_t i = 0; i < cycles; ++i) this->tick();
+    top_->rst_ni = 1;
+    top_->eval();
+    if (const char* what = still_valid()) axi_violation(what);
+    has_stalled_ = false;
+  }
+
   /// Records a protocol error of the manager found outside the subordinate's own checks.
   void axi_violation(const char* what) {
     AxiStats& st = mem_.stats;
@@ -122,9 +139,7 @@ template <class V>
 class AxiShim final : public AxiTopBase<V> {
   using B = AxiTopBase<V>;
   using B::cycle_;
-  using B::has_stalled_;
   using B::mem_;
-  using B::tick;
   using B::top_;
 
  public:
@@ -137,17 +152,13 @@ class AxiShim final : public AxiTopBase<V> {
   /// Resets the top and the subordinate together: bursts in flight are dropped on both sides. A
   /// manager still driving ARVALID out of reset is a protocol error.
   void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    top_->in_valid_i = 0;
-    top_->out_ready_i = 0;
-    top_->m_axi_arready_i = 0;
-    top_->m_axi_rvalid_i = 0;
-    mem_.reset();
-    for (uint32_t i = 0; i < cycles; ++i) tick();
-    top_->rst_ni = 1;
-    top_->eval();
-    if (top_->m_axi_arvalid_o) this->axi_violation("ARVALID high out of reset");
-    has_stalled_ = false;
+    this->reset_with_mem(
+        cycles,
+        [this] {
+          top_->m_axi_arready_i = 0;
+          top_->m_axi_rvalid_i = 0;
+        },
+        [this] { return top_->m_axi_arvalid_o ? "ARVALID high out of reset" : nullptr; });
   }
 
   RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t* idle,

@@ -15,9 +15,7 @@ template <class V>
 class AxiWrShim final : public AxiTopBase<V> {
   using B = AxiTopBase<V>;
   using B::cycle_;
-  using B::has_stalled_;
   using B::mem_;
-  using B::tick;
   using B::top_;
 
  public:
@@ -30,17 +28,12 @@ class AxiWrShim final : public AxiTopBase<V> {
   /// and so are the queued data items. A manager still driving AWVALID or WVALID out of reset is
   /// a protocol error.
   void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    idle_inputs();
-    mem_.reset();
     data_.clear();
     data_next_ = 0;
-    for (uint32_t i = 0; i < cycles; ++i) tick();
-    top_->rst_ni = 1;
-    top_->eval();
-    if (top_->m_axi_awvalid_o || top_->m_axi_wvalid_o)
-      this->axi_violation("AWVALID or WVALID high out of reset");
-    has_stalled_ = false;
+    this->reset_with_mem(cycles, [this] { idle_inputs(); }, [this] {
+      return top_->m_axi_awvalid_o || top_->m_axi_wvalid_o ? "AWVALID or WVALID high out of reset"
+                                                           : nullptr;
+    });
   }
 
   bool feed_data(const uint32_t* items, size_t n, uint32_t words, const uint8_t* idle,
