@@ -440,14 +440,7 @@ fn directed_extremes() {
                 cmds.push(FetchCmd::Sweep(Sweep { sec_hi: 1, ..whole }));
             }
         }
-        let ok = Sweep {
-            base,
-            blocks,
-            axis_k: 2,
-            reversed: false,
-            sec_lo: 0,
-            sec_hi: blocks[0],
-        };
+        let ok = Sweep::whole(base, blocks);
         let bbus = u64::from(cfg.data_w / 8);
         for bad in [
             Sweep { axis_k: 3, ..ok },
@@ -525,18 +518,6 @@ fn present_volume(
     (lut, mem)
 }
 
-/// The sweep over every block of a volume at `base`, along z, front to back.
-fn whole_sweep(base: u64, blocks: [u32; 3]) -> Sweep {
-    Sweep {
-        base,
-        blocks,
-        axis_k: 2,
-        reversed: false,
-        sec_lo: 0,
-        sec_hi: blocks[0],
-    }
-}
-
 /// Voxels per clock over a whole-volume sweep with every block present, full-speed output,
 /// fixed latency `lat` and bandwidth `bw` bytes/cycle as `(num, den)` (`num = 0`: the bus).
 fn throughput(variant: &'static Variant, cfg: VolFetchConfig, lat: u32, bw: (u32, u32)) -> f64 {
@@ -545,7 +526,7 @@ fn throughput(variant: &'static Variant, cfg: VolFetchConfig, lat: u32, bw: (u32
     let blocks = [nb, nb, nb.min(4)];
     let (lut, mut mem) = present_volume(cfg, blocks, &mut rng);
     mem.base = 0x1000 * u64::from(cfg.addr_w > 16);
-    let sweep = whole_sweep(mem.base, blocks);
+    let sweep = Sweep::whole(mem.base, blocks);
     let case = Case {
         lut,
         cmds: vec![FetchCmd::Sweep(sweep); 2],
@@ -686,7 +667,7 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_skip() {
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let blocks = [2, 2, 2];
     let (lut, mem) = present_volume(cfg, blocks, &mut rng);
-    let sweep = whole_sweep(mem.base, blocks);
+    let sweep = Sweep::whole(mem.base, blocks);
     let traffic = Traffic::full_speed();
     let setup = mem_setup(cfg, &mem, (10, 0), (0, 0), (0, 1), 1);
     let open = || axi::open(variant, cfg, 1, (&setup, &mem), &None).unwrap();
