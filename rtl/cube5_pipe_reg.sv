@@ -46,4 +46,12 @@ module cube5_pipe_reg #(
   assign in_ready_o = ready;
   assign out_data_o = data_q;
 
+`ifndef SYNTHESIS
+  // A stalled output holds its item (STYLE.md rule 3); for the tops whose output this stage is,
+  // their own output.
+  OutputHoldsWhileStalled: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
+    else $error("cube5_pipe_reg: output changed while stalled");
+`endif
+
 endmodule

@@ -25,12 +25,12 @@
 namespace cube5 {
 
 template <class V>
-class AccelCtrlShim final : public ClockedTop<V> {
-  using C = ClockedTop<V>;
-  using C::ctx_;
-  using C::cycle_;
-  using C::tick;
-  using C::top_;
+class AccelCtrlShim final : public AxilTopBase<V> {
+  using B = AxilTopBase<V>;
+  using B::cycle_;
+  using B::mgr_;
+  using B::seed_;
+  using B::top_;
 
  public:
   static constexpr uint32_t kRecordWords = 6;
@@ -41,7 +41,7 @@ class AccelCtrlShim final : public ClockedTop<V> {
   static constexpr uint32_t kKnobCplDelay = 0, kKnobDoneDelay = 1, kKnobFrameErr = 2,
                             kKnobErrRow = 3, kKnobLastBit = 4;
 
-  AccelCtrlShim(uint32_t seed, PortWidths widths) : C(seed, widths), seed_(seed) {
+  AccelCtrlShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     idle_inputs();
     top_->eval();
   }
@@ -53,30 +53,17 @@ class AccelCtrlShim final : public ClockedTop<V> {
   }
 
   void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    idle_inputs();
-    mgr_.reset();
     cpl_.clear();
     done_at_ = kNever;
     for (auto& h : held_) h.valid = false;
-    for (uint32_t i = 0; i < cycles; ++i) {
-      top_->eval();
-      tick();
-    }
-    top_->rst_ni = 1;
-    top_->eval();
-    if (top_->s_axil_bvalid_o || top_->s_axil_rvalid_o) mgr_.error(cycle_, "BVALID or RVALID high out of reset");
+    this->reset_with_mgr(cycles, [this] { idle_inputs(); }, [] {});
   }
 
   RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t*, size_t,
                const uint8_t* stall, size_t stall_len, uint64_t expect_out, uint64_t max_cycles,
                std::vector<uint32_t>& out, uint32_t out_words) override {
     RunStats st;
-    if (in_words != AxilMgr::kItemWords || out_words != kRecordWords) {
-      st.protocol_errors = 1;
-      return st;
-    }
-    mgr_.load(items, n_items);
+    if (!this->start_run(st, items, n_items, in_words, out_words, kRecordWords)) return st;
     uint64_t responses = 0;
     auto stalled = [&](uint64_t off) { return stall_len && stall[(cycle_ + off) % stall_len]; };
     while (st.cycles < max_cycles && (n_items == 0 || !mgr_.all_issued() || responses < expect_out)) {
@@ -132,17 +119,9 @@ class AccelCtrlShim final : public ClockedTop<V> {
                          static_cast<uint32_t>(top_->table_data_o)};
         record(out, 3, 0, 0, w, 2);
       }
-      tick();
-      ++st.cycles;
-      if (ctx_->gotFinish()) {
-        st.finished = true;
-        break;
-      }
+      if (!this->end_cycle(st)) break;
     }
-    st.consumed = mgr_.issued();
-    st.produced = responses;
-    st.protocol_errors = mgr_.errors() + port_errors_;
-    st.first_protocol_error_cycle = port_errors_ ? first_port_error_ : mgr_.first_error_cycle();
+    this->end_run(st, responses, port_errors_, first_port_error_);
     idle_inputs();
     top_->eval();
     return st;
@@ -223,8 +202,6 @@ class AccelCtrlShim final : public ClockedTop<V> {
     top_->wr_cpl_resp_i = 0;
   }
 
-  uint32_t seed_;
-  AxilMgr mgr_;
   std::vector<uint32_t> tmp_;
   std::deque<Cpl> cpl_;
   uint64_t done_at_ = kNever;

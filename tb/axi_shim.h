@@ -42,6 +42,23 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
     top_->out_ready_i = 0;
   }
 
+  /// Resets the top and the subordinate together (bursts in flight are dropped on both sides):
+  /// `idle` idles the top's inputs; a manager for which `still_valid` names a VALID still high
+  /// out of reset (else nullptr) breaks the protocol.
+  template <class Idle, class StillValid>
+  void reset_with_mem(uint32_t cycles, Idle idle, StillValid still_valid) {
+    top_->rst_ni = 0;
+    top_->in_valid_i = 0;
+    top_->out_ready_i = 0;
+    idle();
+    mem_.reset();
+    for (uint32_t i = 0; i < cycles; ++i) this->tick();
+    top_->rst_ni = 1;
+    top_->eval();
+    if (const char* what = still_valid()) axi_violation(what);
+    has_stalled_ = false;
+  }
+
   /// Records a protocol error of the manager found outside the subordinate's own checks.
   void axi_violation(const char* what) {
     AxiStats& st = mem_.stats;
@@ -49,6 +66,50 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
       st.first_error_cycle = cycle_;
       st.first_error = what;
     }
+  }
+
+  /// Before eval: command `next` offered unless `idle` says idle or none is left, the output
+  /// taken unless `stall` says stalled. Returns {offered, taken}.
+  std::pair<bool, bool> drive_stream(const uint32_t* items, size_t n_items, uint32_t in_words,
+                                     size_t next, const uint8_t* idle, size_t idle_len,
+                                     const uint8_t* stall, size_t stall_len) {
+    const bool offer = next < n_items && !(idle_len && idle[cycle_ % idle_len]);
+    const bool take = !(stall_len && stall[cycle_ % stall_len]);
+    top_->in_valid_i = offer;
+    if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
+    top_->out_ready_i = take;
+    return {offer, take};
+  }
+
+  /// An address channel's payload as the subordinate observes it (AR or AW).
+  static ArIn addr_in(bool valid, uint64_t addr, uint32_t len, uint32_t size, uint32_t burst,
+                      uint32_t id) {
+    return ArIn{valid, addr, len, size, burst, id};
+  }
+
+  /// After eval and the subordinate's observation: the command taken (if `offered`), the output
+  /// watched, the clock ticked. False once the top has called $finish.
+  bool end_cycle(RunStats& st, bool offered, size_t& next, bool take, std::vector<uint32_t>& out,
+                 uint32_t out_words) {
+    if (offered && top_->in_ready_o) {
+      ++next;
+      ++st.consumed;
+    }
+    watch_output(st, take, out, out_words);
+    this->tick();
+    ++st.cycles;
+    if (this->ctx_->gotFinish()) {
+      st.finished = true;
+      return false;
+    }
+    return true;
+  }
+
+  /// After a run: the stream's inputs idle.
+  void idle_stream() {
+    top_->in_valid_i = 0;
+    top_->out_ready_i = 0;
+    top_->eval();
   }
 
   /// After eval: the output's stall rule, and the output taken this cycle (if `take`) appended to
@@ -78,9 +139,7 @@ template <class V>
 class AxiShim final : public AxiTopBase<V> {
   using B = AxiTopBase<V>;
   using B::cycle_;
-  using B::has_stalled_;
   using B::mem_;
-  using B::tick;
   using B::top_;
 
  public:
@@ -93,17 +152,13 @@ class AxiShim final : public AxiTopBase<V> {
   /// Resets the top and the subordinate together: bursts in flight are dropped on both sides. A
   /// manager still driving ARVALID out of reset is a protocol error.
   void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    top_->in_valid_i = 0;
-    top_->out_ready_i = 0;
-    top_->m_axi_arready_i = 0;
-    top_->m_axi_rvalid_i = 0;
-    mem_.reset();
-    for (uint32_t i = 0; i < cycles; ++i) tick();
-    top_->rst_ni = 1;
-    top_->eval();
-    if (top_->m_axi_arvalid_o) this->axi_violation("ARVALID high out of reset");
-    has_stalled_ = false;
+    this->reset_with_mem(
+        cycles,
+        [this] {
+          top_->m_axi_arready_i = 0;
+          top_->m_axi_rvalid_i = 0;
+        },
+        [this] { return top_->m_axi_arvalid_o ? "ARVALID high out of reset" : nullptr; });
   }
 
   RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t* idle,
@@ -113,12 +168,8 @@ class AxiShim final : public AxiTopBase<V> {
     size_t next = 0;
     std::vector<uint32_t> rwords;
     while (st.cycles < max_cycles && (next < n_items || st.produced < expect_out)) {
-      const bool offer = next < n_items && !(idle_len && idle[cycle_ % idle_len]);
-      const bool take = !(stall_len && stall[cycle_ % stall_len]);
-      top_->in_valid_i = offer;
-      if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
-      top_->out_ready_i = take;
-
+      const auto [offer, take] =
+          this->drive_stream(items, n_items, in_words, next, idle, idle_len, stall, stall_len);
       const ReadOut& r = mem_.read.drive(cycle_);
       top_->m_axi_arready_i = r.arready;
       top_->m_axi_rvalid_i = r.rvalid;
@@ -134,29 +185,13 @@ class AxiShim final : public AxiTopBase<V> {
       top_->eval();
 
       mem_.read.observe(cycle_,
-                        ArIn{static_cast<bool>(top_->m_axi_arvalid_o),
-                             static_cast<uint64_t>(top_->m_axi_araddr_o),
-                             static_cast<uint32_t>(top_->m_axi_arlen_o),
-                             static_cast<uint32_t>(top_->m_axi_arsize_o),
-                             static_cast<uint32_t>(top_->m_axi_arburst_o),
-                             static_cast<uint32_t>(top_->m_axi_arid_o)},
+                        B::addr_in(top_->m_axi_arvalid_o, top_->m_axi_araddr_o,
+                                   top_->m_axi_arlen_o, top_->m_axi_arsize_o,
+                                   top_->m_axi_arburst_o, top_->m_axi_arid_o),
                         top_->m_axi_rready_o);
-
-      if (offer && top_->in_ready_o) {
-        ++next;
-        ++st.consumed;
-      }
-      this->watch_output(st, take, out, out_words);
-      tick();
-      ++st.cycles;
-      if (this->ctx_->gotFinish()) {
-        st.finished = true;
-        break;
-      }
+      if (!this->end_cycle(st, offer, next, take, out, out_words)) break;
     }
-    top_->in_valid_i = 0;
-    top_->out_ready_i = 0;
-    top_->eval();
+    this->idle_stream();
     return st;
   }
 };

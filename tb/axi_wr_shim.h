@@ -15,9 +15,7 @@ template <class V>
 class AxiWrShim final : public AxiTopBase<V> {
   using B = AxiTopBase<V>;
   using B::cycle_;
-  using B::has_stalled_;
   using B::mem_;
-  using B::tick;
   using B::top_;
 
  public:
@@ -30,17 +28,12 @@ class AxiWrShim final : public AxiTopBase<V> {
   /// and so are the queued data items. A manager still driving AWVALID or WVALID out of reset is
   /// a protocol error.
   void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    idle_inputs();
-    mem_.reset();
     data_.clear();
     data_next_ = 0;
-    for (uint32_t i = 0; i < cycles; ++i) tick();
-    top_->rst_ni = 1;
-    top_->eval();
-    if (top_->m_axi_awvalid_o || top_->m_axi_wvalid_o)
-      this->axi_violation("AWVALID or WVALID high out of reset");
-    has_stalled_ = false;
+    this->reset_with_mem(cycles, [this] { idle_inputs(); }, [this] {
+      return top_->m_axi_awvalid_o || top_->m_axi_wvalid_o ? "AWVALID or WVALID high out of reset"
+                                                           : nullptr;
+    });
   }
 
   bool feed_data(const uint32_t* items, size_t n, uint32_t words, const uint8_t* idle,
@@ -62,16 +55,13 @@ class AxiWrShim final : public AxiTopBase<V> {
     std::vector<uint32_t> wwords((nb + 3) / 4 + 1), swords(nb / 32 + 2);
     WIn w;
     while (st.cycles < max_cycles && (next < n_items || st.produced < expect_out)) {
-      const bool offer = next < n_items && !(idle_len && idle[cycle_ % idle_len]);
-      const bool take = !(stall_len && stall[cycle_ % stall_len]);
+      const auto [offer, take] =
+          this->drive_stream(items, n_items, in_words, next, idle, idle_len, stall, stall_len);
       const bool dat_offer = data_next_ < n_data &&
                              !(!data_idle_.empty() && data_idle_[cycle_ % data_idle_.size()]);
-      top_->in_valid_i = offer;
-      if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
       top_->dat_valid_i = dat_offer;
       if (dat_offer)
         write_port(top_->dat_data_i, data_.data() + data_next_ * data_words_, data_words_);
-      top_->out_ready_i = take;
 
       const WriteOut& o = mem_.write.drive(cycle_);
       top_->m_axi_awready_i = o.awready;
@@ -92,31 +82,15 @@ class AxiWrShim final : public AxiTopBase<V> {
         w.strb[i] = static_cast<uint8_t>((swords[i / 32] >> (i % 32)) & 1);
       }
       mem_.write.observe(cycle_,
-                         ArIn{static_cast<bool>(top_->m_axi_awvalid_o),
-                              static_cast<uint64_t>(top_->m_axi_awaddr_o),
-                              static_cast<uint32_t>(top_->m_axi_awlen_o),
-                              static_cast<uint32_t>(top_->m_axi_awsize_o),
-                              static_cast<uint32_t>(top_->m_axi_awburst_o),
-                              static_cast<uint32_t>(top_->m_axi_awid_o)},
+                         B::addr_in(top_->m_axi_awvalid_o, top_->m_axi_awaddr_o,
+                                    top_->m_axi_awlen_o, top_->m_axi_awsize_o,
+                                    top_->m_axi_awburst_o, top_->m_axi_awid_o),
                          w, top_->m_axi_bready_o);
-
-      if (offer && top_->in_ready_o) {
-        ++next;
-        ++st.consumed;
-      }
       if (dat_offer && top_->dat_ready_o) ++data_next_;
-      this->watch_output(st, take, out, out_words);
-      tick();
-      ++st.cycles;
-      if (this->ctx_->gotFinish()) {
-        st.finished = true;
-        break;
-      }
+      if (!this->end_cycle(st, offer, next, take, out, out_words)) break;
     }
-    top_->in_valid_i = 0;
     top_->dat_valid_i = 0;
-    top_->out_ready_i = 0;
-    top_->eval();
+    this->idle_stream();
     return st;
   }
 

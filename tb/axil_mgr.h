@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "clocked_top.h"
+
 namespace cube5 {
 
 /// The hardware-side stimulus of cube5_axil in `cycle` for a shim seeded `seed`: bits 31:0 drive
@@ -310,6 +312,77 @@ class AxilMgr {
   std::string first_error_;
   Prev prev_;
   MgrOut out_;
+};
+
+/// What the shims of tops with an AXI4-Lite subordinate port share (AxilShim in tb/axil_shim.h,
+/// AccelCtrlShim in tb/accel_ctrl_shim.h) beyond ClockedTop: the manager, the reset of both, and
+/// a run's start, clock and counts.
+template <class V>
+class AxilTopBase : public ClockedTop<V> {
+  using C = ClockedTop<V>;
+
+ protected:
+  using C::ctx_;
+  using C::cycle_;
+  using C::tick;
+  using C::top_;
+
+  AxilTopBase(uint32_t seed, PortWidths widths) : C(seed, widths), seed_(seed) {}
+
+  /// Resets the top and the manager together (transactions in flight are dropped on both sides):
+  /// `idle` idles the top's inputs, `settle` drives what it needs before each eval. A subordinate
+  /// still driving BVALID or RVALID out of reset is a protocol error.
+  template <class Idle, class Settle>
+  void reset_with_mgr(uint32_t cycles, Idle idle, Settle settle) {
+    top_->rst_ni = 0;
+    idle();
+    mgr_.reset();
+    for (uint32_t i = 0; i < cycles; ++i) {
+      settle();
+      top_->eval();
+      tick();
+    }
+    top_->rst_ni = 1;
+    settle();
+    top_->eval();
+    if (top_->s_axil_bvalid_o || top_->s_axil_rvalid_o)
+      mgr_.error(cycle_, "BVALID or RVALID high out of reset");
+  }
+
+  /// A run's start: the transactions loaded; false (a protocol error in `st`) when the item or
+  /// record words are not the shim's.
+  bool start_run(RunStats& st, const uint32_t* items, size_t n_items, uint32_t in_words,
+                 uint32_t out_words, uint32_t record_words) {
+    if (in_words != AxilMgr::kItemWords || out_words != record_words) {
+      st.protocol_errors = 1;
+      return false;
+    }
+    mgr_.load(items, n_items);
+    return true;
+  }
+
+  /// The clock of a run's cycle. False once the top has called $finish.
+  bool end_cycle(RunStats& st) {
+    tick();
+    ++st.cycles;
+    if (ctx_->gotFinish()) {
+      st.finished = true;
+      return false;
+    }
+    return true;
+  }
+
+  /// A run's counts: `responses` B and R responses, the manager's protocol errors and `extra`
+  /// more (the shim's own, the first at `first_extra`).
+  void end_run(RunStats& st, uint64_t responses, uint64_t extra = 0, uint64_t first_extra = 0) {
+    st.consumed = mgr_.issued();
+    st.produced = responses;
+    st.protocol_errors = mgr_.errors() + extra;
+    st.first_protocol_error_cycle = extra ? first_extra : mgr_.first_error_cycle();
+  }
+
+  uint32_t seed_;
+  AxilMgr mgr_;
 };
 
 }  // namespace cube5

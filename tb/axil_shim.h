@@ -12,15 +12,15 @@
 namespace cube5 {
 
 template <class V>
-class AxilShim final : public ClockedTop<V> {
-  using C = ClockedTop<V>;
-  using C::ctx_;
-  using C::cycle_;
-  using C::tick;
-  using C::top_;
+class AxilShim final : public AxilTopBase<V> {
+  using B = AxilTopBase<V>;
+  using B::cycle_;
+  using B::mgr_;
+  using B::seed_;
+  using B::top_;
 
  public:
-  AxilShim(uint32_t seed, PortWidths widths) : C(seed, widths), seed_(seed) {
+  AxilShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     idle_inputs();
     top_->eval();
   }
@@ -28,18 +28,7 @@ class AxilShim final : public ClockedTop<V> {
   /// Resets the top and the manager together: transactions in flight are dropped on both sides.
   /// A subordinate still driving BVALID or RVALID out of reset is a protocol error.
   void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    idle_inputs();
-    mgr_.reset();
-    for (uint32_t i = 0; i < cycles; ++i) {
-      drive_hw();
-      top_->eval();
-      tick();
-    }
-    top_->rst_ni = 1;
-    drive_hw();
-    top_->eval();
-    if (top_->s_axil_bvalid_o || top_->s_axil_rvalid_o) mgr_.error(cycle_, "BVALID or RVALID high out of reset");
+    this->reset_with_mgr(cycles, [this] { idle_inputs(); }, [this] { drive_hw(); });
   }
 
   /// Items are transactions (AxilMgr::kItemWords words each), outputs are response and interrupt
@@ -50,11 +39,7 @@ class AxilShim final : public ClockedTop<V> {
                const uint8_t* stall, size_t stall_len, uint64_t expect_out, uint64_t max_cycles,
                std::vector<uint32_t>& out, uint32_t out_words) override {
     RunStats st;
-    if (in_words != AxilMgr::kItemWords || out_words != AxilMgr::kRecordWords) {
-      st.protocol_errors = 1;
-      return st;
-    }
-    mgr_.load(items, n_items);
+    if (!this->start_run(st, items, n_items, in_words, out_words, AxilMgr::kRecordWords)) return st;
     uint64_t responses = 0;
     while (st.cycles < max_cycles && (!mgr_.all_issued() || responses < expect_out)) {
       const bool bready = !(stall_len && stall[cycle_ % stall_len]);
@@ -70,17 +55,9 @@ class AxilShim final : public ClockedTop<V> {
       s.wr_stb = top_->hw_wr_stb_o;
       s.rd_stb = top_->hw_rd_stb_o;
       responses += mgr_.observe(cycle_, s, out);
-      tick();
-      ++st.cycles;
-      if (ctx_->gotFinish()) {
-        st.finished = true;
-        break;
-      }
+      if (!this->end_cycle(st)) break;
     }
-    st.consumed = mgr_.issued();
-    st.produced = responses;
-    st.protocol_errors = mgr_.errors();
-    st.first_protocol_error_cycle = mgr_.first_error_cycle();
+    this->end_run(st, responses);
     idle_inputs();
     drive_hw();
     top_->eval();
@@ -96,9 +73,6 @@ class AxilShim final : public ClockedTop<V> {
     top_->hw_i = static_cast<uint32_t>(h);
     top_->hw_set_i = static_cast<bool>((h >> 32) & 1);  // bit 32: the set flag
   }
-
-  uint32_t seed_;
-  AxilMgr mgr_;
 };
 
 }  // namespace cube5

@@ -90,11 +90,6 @@ module cube5_rblock #(
     .out_data_o  (out_data_o)
   );
 
-`ifndef SYNTHESIS
-  // A stalled output holds its item (STYLE.md rule 3).
-  OutputHoldsWhileStalled: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
-    else $error("cube5_rblock: output changed while stalled");
-`endif
+  // A stalled output holds its item: asserted in cube5_pipe_reg.
 
 endmodule

@@ -1,9 +1,7 @@
-// cube5_warp_sample: cube5_warp's bilinear stage as a module, used by cube5_pwarp (contracts
+// cube5_warp_sample: the bilinear stage of cube5_warp and cube5_pwarp (contracts
 // docs/numerics/warp.md, "Bilinear filter" and "Block RAM", and docs/numerics/pwarp.md): the base
 // plane in four block-RAM banks by texel parity, and per issued position the four taps read in one
 // clock, widened to U(0.16), three rounded lerps per channel, 8-bit RGB. `meta_i` rides along.
-// (cube5_warp keeps its inline copy: instantiating this module there makes Yosys 0.23 rename the
-// cube5_warp top to `$paramod...`, which the gate-level build cannot find.)
 //
 //   issue (x_i, y_i, bank addresses) -> [banks' output registers, S1] -> [S1r] -> taps by parity,
 //   widening [S2] -> two lerps along x [S3] -> lerp along y [S4] -> 8-bit rounding [S5] -> out

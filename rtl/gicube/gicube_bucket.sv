@@ -166,11 +166,6 @@ module gicube_bucket #(
     .out_data_o  (out_data_o)
   );
 
-`ifndef SYNTHESIS
-  // A stalled output holds its item (STYLE.md rule 3).
-  OutputHoldsWhileStalled: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
-    else $error("gicube_bucket: output changed while stalled");
-`endif
+  // A stalled output holds its item: asserted in cube5_pipe_reg.
 
 endmodule

@@ -7,13 +7,13 @@ mod support;
 
 use cube5_model::units::cube5_axi_rd::{AxiMemImage, AxiRdCmd, AxiRdConfig};
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
-use cube5_tb::{Mismatch, TbError, Variant};
+use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi_mem_setup, axi_protocol_clean, axi_random_image, compare_ar, compare_axi_outputs, configs,
-    gate_configs, seed, with_waves,
+    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts,
+    configs, seed, with_waves,
 };
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
@@ -104,21 +104,17 @@ fn check(
 }
 
 fn must(variant: &'static Variant, cfg: AxiRdConfig, seed: u64, case: &Case) -> Report {
-    match check(variant, cfg, seed, case) {
-        Ok(r) => {
-            eprintln!(
-                "{variant}: seed {seed}: {} beats, {} bursts in {} cycles ({:.4} beats/clock), RREADY low {} cycles, {} bursts dropped at reset",
-                r.beats,
-                r.bursts,
-                r.cycles,
-                r.beats_per_cycle(),
-                r.rready_low,
-                r.dropped_at_reset
-            );
-            r
-        }
-        Err(e) => panic!("{e}"),
-    }
+    axi::must_pass(variant, seed, check(variant, cfg, seed, case), |r| {
+        format!(
+            "{} beats, {} bursts in {} cycles ({:.4} beats/clock), RREADY low {} cycles, {} bursts dropped at reset",
+            r.beats,
+            r.bursts,
+            r.cycles,
+            r.beats_per_cycle(),
+            r.rready_low,
+            r.dropped_at_reset
+        )
+    })
 }
 
 /// The item a beat belongs to, for a mismatch report.
@@ -156,9 +152,15 @@ fn drive_and_compare(
     let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
     axi_protocol_clean(dut, &driven.stats, variant, seed)?;
     // AR first: a wrong burst explains a wrong beat.
-    let n_ars = compare_ar(dut, &bursts, cfg.size(), variant, seed, |k| {
-        format!("burst #{k} of commands {cmds:?}")
-    })?;
+    let n_ars = compare_bursts(
+        &dut.axi_take_ar()?,
+        "AR",
+        &bursts,
+        cfg.size(),
+        variant,
+        seed,
+        |k| format!("burst #{k} of commands {cmds:?}"),
+    )?;
     compare_axi_outputs(
         dut,
         &driven,
@@ -172,18 +174,13 @@ fn drive_and_compare(
     )?;
     if exact {
         let any_err = want.iter().any(|b| b.resp != 0);
-        if dut.axi_counters().err_flag != any_err {
-            return Err(TbError::from(Mismatch {
-                variant: variant.name.to_string(),
-                seed,
-                cycle: dut.cycle(),
-                input: format!("{} commands", cmds.len()),
-                rtl: format!("err_o = {}", !any_err),
-                model: format!("err_o = {any_err}"),
-                what: "err_o differs (sticky: some beat's RRESP != OKAY since reset)".into(),
-                ..Default::default()
-            }));
-        }
+        axi::err_flag_matches(
+            dut,
+            (variant, seed),
+            cmds.len(),
+            any_err,
+            "some beat's RRESP",
+        )?;
     }
     report.beats += driven.outputs.len() as u64;
     report.bursts += n_ars as u64;
@@ -202,61 +199,25 @@ fn run(
         cfg.check_cmd(c)
             .map_err(|e| TbError::setup(variant.name, e))?;
     }
-    let mut dut = RtlStream::new(variant, cfg, seed as u32)?;
-    dut.axi_setup(&case.setup)?;
-    dut.axi_load(case.mem.base, &case.mem.bytes)?;
-    if let Some((path, (from, to))) = &trace {
-        dut.trace_window(path, *from, *to);
-    }
+    let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut report = Report::default();
     let (mem, traffic) = (&case.mem, &case.traffic);
-    match &case.reset {
-        None => drive_and_compare(
-            &mut dut,
-            variant,
-            cfg,
-            seed,
-            &case.cmds,
-            mem,
-            traffic,
-            None,
-            &mut report,
-        )?,
-        Some((at, after)) => {
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                &case.cmds,
-                mem,
-                traffic,
-                Some(*at),
-                &mut report,
-            )?;
-            dut.reset();
-            let c = dut.axi_counters();
-            if c.in_flight != 0 {
-                return Err(TbError::Protocol {
-                    variant: variant.name.to_string(),
-                    seed,
-                    cycle: dut.cycle(),
-                    what: format!("{} bursts still in flight after the reset", c.in_flight),
-                });
-            }
-            report.dropped_at_reset = c.dropped_at_reset;
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                after,
-                mem,
-                traffic,
-                None,
-                &mut report,
-            )?;
-        }
+    let go = |dut: &mut RtlStream<AxiRdConfig>,
+              cmds: &[AxiRdCmd],
+              cut: Option<u64>,
+              report: &mut Report| {
+        drive_and_compare(dut, variant, cfg, seed, cmds, mem, traffic, cut, report)
+    };
+    go(
+        &mut dut,
+        &case.cmds,
+        case.reset.as_ref().map(|r| r.0),
+        &mut report,
+    )?;
+    if let Some((_, after)) = &case.reset {
+        report.dropped_at_reset =
+            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, false)?;
+        go(&mut dut, after, None, &mut report)?;
     }
     report.rready_low = dut.axi_counters().rready_low;
     Ok(report)
@@ -268,11 +229,7 @@ fn random_case(cfg: AxiRdConfig, seed: u64, n: usize) -> Case {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mem = random_image(cfg, &mut rng);
     let cmds = random_cmds(cfg, &mem, n, &mut rng);
-    let bw = if rng.random_bool(0.5) {
-        (rng.random_range(1..=2 * cfg.bytes()), 2)
-    } else {
-        (0, 1)
-    };
+    let bw = axi::random_bandwidth(&mut rng, 2 * cfg.bytes());
     let gaps = (rng.random_range(0..500), rng.random_range(0..500));
     let setup = mem_setup(cfg, &mem, (10, 190), gaps, bw, rng.random());
     let stall = rng.random_range(0.0..0.6);
@@ -288,21 +245,17 @@ fn random_case(cfg: AxiRdConfig, seed: u64, n: usize) -> Case {
 
 #[test]
 fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
-    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
-        for k in 0..4 {
-            let s = seed(100 + 10 * i as u64 + k);
-            let case = random_case(cfg, s, 300);
-            let r = must(variant, cfg, s, &case);
-            assert!(
-                r.beats > 1000,
-                "{variant}: the case reads enough beats (seed {s})"
-            );
-            assert_eq!(
-                r.rready_low, 0,
-                "{variant}: RREADY never holds the bus (seed {s})"
-            );
-        }
-    }
+    axi::random_runs(4, |variant, cfg: AxiRdConfig, s| {
+        let r = must(variant, cfg, s, &random_case(cfg, s, 300));
+        assert!(
+            r.beats > 1000,
+            "{variant}: the case reads enough beats (seed {s})"
+        );
+        assert_eq!(
+            r.rready_low, 0,
+            "{variant}: RREADY never holds the bus (seed {s})"
+        );
+    });
 }
 
 /// The acceptance figure (docs/adding-a-unit.md): at least 1,000,000 random beats per
@@ -310,26 +263,20 @@ fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
 /// back-pressure, the third of them reset in mid-stream.
 #[test]
 fn a_million_random_beats_per_config() {
-    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
-        let mut beats = 0u64;
-        let mut k = 0u64;
-        while beats < 1_000_000 {
-            let s = seed(600 + 100 * i as u64 + k);
-            let mut case = random_case(cfg, s, 2000);
-            if k == 2 {
-                let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-                let after = random_cmds(cfg, &case.mem, 2000, &mut rng);
-                case.reset = Some((rng.random_range(1000..100_000), after));
-            }
-            let r = must(variant, cfg, s, &case);
-            assert_eq!(
-                r.rready_low, 0,
-                "{variant}: RREADY never holds the bus (seed {s})"
-            );
-            beats += r.beats;
-            k += 1;
+    axi::a_million_per_config(|variant, cfg: AxiRdConfig, s, k| {
+        let mut case = random_case(cfg, s, 2000);
+        if k == 2 {
+            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+            let after = random_cmds(cfg, &case.mem, 2000, &mut rng);
+            case.reset = Some((rng.random_range(1000..100_000), after));
         }
-    }
+        let r = must(variant, cfg, s, &case);
+        assert_eq!(
+            r.rready_low, 0,
+            "{variant}: RREADY never holds the bus (seed {s})"
+        );
+        r.beats
+    });
 }
 
 /// Length 1, 4 KB crossings, the longest command, the top of the image and of the address space,
@@ -446,24 +393,16 @@ fn directed_extremes() {
 
 #[test]
 fn reset_in_mid_stream_leaves_nothing_outstanding_and_the_next_commands_are_exact() {
-    for (i, (variant, cfg)) in configs::<AxiRdConfig>().into_iter().enumerate() {
-        let mut dropped = 0;
-        for k in 0..3 {
-            let s = seed(400 + 10 * i as u64 + k);
-            let mut case = random_case(cfg, s, 100);
-            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let after = random_cmds(cfg, &case.mem, 100, &mut rng);
-            // Early enough that bursts are in flight (latency >= 10 cycles).
-            case.reset = Some((rng.random_range(30..3000), after));
-            let r = must(variant, cfg, s, &case);
-            assert!(r.beats > 0);
-            dropped += r.dropped_at_reset;
-        }
-        assert!(
-            dropped > 0,
-            "{variant}: some reset landed with bursts in flight"
-        );
-    }
+    axi::resets_land_with_bursts_in_flight(|variant, cfg: AxiRdConfig, s| {
+        let mut case = random_case(cfg, s, 100);
+        let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+        let after = random_cmds(cfg, &case.mem, 100, &mut rng);
+        // Early enough that bursts are in flight (latency >= 10 cycles).
+        case.reset = Some((rng.random_range(30..3000), after));
+        let r = must(variant, cfg, s, &case);
+        assert!(r.beats > 0);
+        r.dropped_at_reset
+    });
 }
 
 /// Throughput: fixed latency 100, no gaps, output always taken, long commands. Where the credit
@@ -544,18 +483,19 @@ fn throughput_against_latency_and_bandwidth() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    for (variant, cfg) in gate_configs::<AxiRdConfig>() {
-        let s = seed(500);
-        let case = random_case(cfg, s, 60);
-        must(variant, cfg, s, &case);
-        let mut case = random_case(cfg, s + 1, 30);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        case.reset = Some((
-            rng.random_range(30..500),
-            random_cmds(cfg, &case.mem, 30, &mut rng),
-        ));
-        must(variant, cfg, s + 1, &case);
-    }
+    axi::gate_smoke(
+        |variant, cfg: AxiRdConfig, s| {
+            must(variant, cfg, s, &random_case(cfg, s, 60));
+        },
+        |variant, cfg, s, rng| {
+            let mut case = random_case(cfg, s, 30);
+            case.reset = Some((
+                rng.random_range(30..500),
+                random_cmds(cfg, &case.mem, 30, rng),
+            ));
+            must(variant, cfg, s, &case);
+        },
+    );
 }
 
 /// The checks bite: a model whose image differs in one byte disagrees on the beat holding it (the
@@ -578,23 +518,27 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
         reset: None,
     };
     // The model with one byte of the image changed: the beat differs, and the report names it.
+    // Each run on a fresh DUT holding the image, against a model of `model_cfg` over `model_mem`.
+    let mismatch = |model_cfg: AxiRdConfig, cmds: &[AxiRdCmd], model_mem: &AxiMemImage| {
+        let mut dut = axi::open(variant, cfg, 1, (&case.setup, &case.mem), &None).unwrap();
+        let mut report = Report::default();
+        let traffic = &case.traffic;
+        drive_and_compare(
+            &mut dut,
+            variant,
+            model_cfg,
+            1,
+            cmds,
+            model_mem,
+            traffic,
+            None,
+            &mut report,
+        )
+        .unwrap_err()
+    };
     let mut wrong = case.clone();
     wrong.mem.bytes[(4096 - b) as usize] ^= 1;
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    dut.axi_setup(&case.setup).unwrap();
-    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
-    let err = drive_and_compare(
-        &mut dut,
-        variant,
-        cfg,
-        1,
-        &cmds,
-        &wrong.mem,
-        &case.traffic,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
+    let err = mismatch(cfg, &cmds, &wrong.mem);
     let m = err.mismatch().expect("a mismatch");
     assert_eq!(m.item, 0);
     assert!(m.input.contains("command #0"), "{}", m.input);
@@ -611,21 +555,7 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
         addr: mem.base,
         len: cfg.max_burst,
     }];
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    dut.axi_setup(&case.setup).unwrap();
-    dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
-    let err = drive_and_compare(
-        &mut dut,
-        variant,
-        half,
-        1,
-        &long,
-        &mem,
-        &case.traffic,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
+    let err = mismatch(half, &long, &mem);
     let m = err.mismatch().expect("a mismatch");
     assert!(m.what.starts_with("AR burst differs"), "{err}");
     assert_eq!(m.item, 0);
@@ -645,7 +575,7 @@ fn the_axi_checker_reports_a_violation() {
         addr: mem.base + 0x3000,
         len: 4 * cfg.max_burst,
     }];
-    for (setup, rule) in [
+    let refusals = vec![
         (
             AxiMemSetup {
                 data_bytes: 2 * cfg.bytes(),
@@ -667,7 +597,8 @@ fn the_axi_checker_reports_a_violation() {
             },
             "declares at most",
         ),
-    ] {
+    ];
+    axi::assert_checker_refuses(variant, refusals, |setup, s| {
         let case = Case {
             setup,
             traffic: Traffic::full_speed(),
@@ -675,14 +606,6 @@ fn the_axi_checker_reports_a_violation() {
             mem: mem.clone(),
             reset: None,
         };
-        match check(variant, cfg, 77, &case) {
-            Err(e @ TbError::Protocol { .. }) => {
-                let text = e.to_string();
-                assert!(text.contains(rule), "{text}");
-                assert!(text.contains("CUBE5_SEED=77"), "{text}");
-            }
-            Err(e) => panic!("{variant}: expected a protocol error about {rule}, got {e}"),
-            Ok(r) => panic!("{variant}: the checker let it pass ({r:?})"),
-        }
-    }
+        check(variant, cfg, s, &case)
+    });
 }

@@ -9,13 +9,13 @@ mod support;
 use cube5_model::units::cube5_axi_rd::AxiMemImage;
 use cube5_model::units::cube5_axi_wr::{AxiWrCmd, AxiWrConfig, AxiWrExpect};
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
-use cube5_tb::{Mismatch, TbError, Variant};
+use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi_mem_setup, axi_protocol_clean, axi_random_image, compare_aw, compare_axi_outputs, configs,
-    gate_configs, seed, with_waves,
+    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts,
+    configs, seed, with_waves,
 };
 
 /// Commands and the items they take.
@@ -123,22 +123,18 @@ fn check(
 }
 
 fn must(variant: &'static Variant, cfg: AxiWrConfig, seed: u64, case: &Case) -> Report {
-    match check(variant, cfg, seed, case) {
-        Ok(r) => {
-            eprintln!(
-                "{variant}: seed {seed}: {} items, {} beats, {} bursts in {} cycles ({:.4} beats/clock, {:.3} bytes/clock), {} bursts dropped at reset",
-                r.items,
-                r.beats,
-                r.bursts,
-                r.cycles,
-                r.beats_per_cycle(),
-                r.bytes_per_cycle(),
-                r.dropped_at_reset
-            );
-            r
-        }
-        Err(e) => panic!("{e}"),
-    }
+    axi::must_pass(variant, seed, check(variant, cfg, seed, case), |r| {
+        format!(
+            "{} items, {} beats, {} bursts in {} cycles ({:.4} beats/clock, {:.3} bytes/clock), {} bursts dropped at reset",
+            r.items,
+            r.beats,
+            r.bursts,
+            r.cycles,
+            r.beats_per_cycle(),
+            r.bytes_per_cycle(),
+            r.dropped_at_reset
+        )
+    })
 }
 
 /// The command whose completion is number `k` (zero-length commands complete nothing).
@@ -202,17 +198,25 @@ fn drive_and_compare(
     let driven = dut.drive(&work.cmds, &case.traffic, want.done.len() as u64, limit)?;
     axi_protocol_clean(dut, &driven.stats, variant, seed)?;
     let cmds = &work.cmds;
-    let n_aws = compare_aw(dut, &want.bursts, cfg.size(), variant, seed, |k| {
-        let mut at = 0;
-        for (i, c) in cmds.iter().enumerate() {
-            let n = cfg.bursts(c).len();
-            if k < at + n {
-                return format!("burst {} of command #{i} ({c})", k - at);
+    let n_aws = compare_bursts(
+        &dut.axi_take_aw()?,
+        "AW",
+        &want.bursts,
+        cfg.size(),
+        variant,
+        seed,
+        |k| {
+            let mut at = 0;
+            for (i, c) in cmds.iter().enumerate() {
+                let n = cfg.bursts(c).len();
+                if k < at + n {
+                    return format!("burst {} of command #{i} ({c})", k - at);
+                }
+                at += n;
             }
-            at += n;
-        }
-        "(no command: an extra burst)".into()
-    })?;
+            "(no command: an extra burst)".into()
+        },
+    )?;
     compare_axi_outputs(
         dut,
         &driven,
@@ -225,24 +229,14 @@ fn drive_and_compare(
         |k| describe_done(cmds, k),
     )?;
     let after = dut.axi_wr_counters();
-    let mismatch = |cycle: u64, input: String, rtl: String, model: String, what: &str| {
-        TbError::from(Mismatch {
-            variant: variant.name.to_string(),
-            seed,
-            cycle,
-            input,
-            rtl,
-            model,
-            what: what.into(),
-            ..Default::default()
-        })
+    let mismatch = |input: String, rtl: String, model: String, what: &str| {
+        axi::mismatch(dut, (variant, seed), input, rtl, model, what)
     };
     let image = dut.axi_image()?;
     if exact {
         if let Some(at) = (0..image.len()).find(|&i| image[i] != want.image[i]) {
             let addr = mem.base + at as u64;
             return Err(mismatch(
-                dut.cycle(),
                 describe_byte(cfg, work, addr),
                 format!("{:#04x}", image[at]),
                 format!("{:#04x}", want.image[at]),
@@ -255,7 +249,6 @@ fn drive_and_compare(
         );
         if (beats, bytes) != (want.beats, want.strobed_bytes) {
             return Err(mismatch(
-                dut.cycle(),
                 format!("{} commands", cmds.len()),
                 format!("{beats} W beats, {bytes} strobed bytes"),
                 format!(
@@ -265,15 +258,7 @@ fn drive_and_compare(
                 "W beat or strobe count differs",
             ));
         }
-        if dut.axi_counters().err_flag != want.any_err {
-            return Err(mismatch(
-                dut.cycle(),
-                format!("{} commands", cmds.len()),
-                format!("err_o = {}", !want.any_err),
-                format!("err_o = {}", want.any_err),
-                "err_o differs (sticky: some BRESP != OKAY since reset)",
-            ));
-        }
+        axi::err_flag_matches(dut, (variant, seed), cmds.len(), want.any_err, "some BRESP")?;
     } else {
         // Cut by a reset: every byte no command touches is unchanged.
         let ib = u64::from(cfg.item_bytes());
@@ -288,7 +273,6 @@ fn drive_and_compare(
         }
         if let Some(at) = (0..image.len()).find(|&i| !touched[i] && image[i] != mem.bytes[i]) {
             return Err(mismatch(
-                dut.cycle(),
                 format!("byte {:#x}, inside no command", mem.base + at as u64),
                 format!("{:#04x}", image[at]),
                 format!("{:#04x} (unchanged)", mem.bytes[at]),
@@ -320,71 +304,37 @@ fn run(
         cfg.check_cmd(c)
             .map_err(|e| TbError::setup(variant.name, e))?;
     }
-    let mut dut = RtlStream::new(variant, cfg, seed as u32)?;
-    dut.axi_setup(&case.setup)?;
-    dut.axi_load(case.mem.base, &case.mem.bytes)?;
-    if let Some((path, (from, to))) = &trace {
-        dut.trace_window(path, *from, *to);
-    }
+    let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut report = Report::default();
-    match &case.reset {
-        None => drive_and_compare(
-            &mut dut,
+    let go = |dut: &mut RtlStream<AxiWrConfig>,
+              work: &Work,
+              mem: &AxiMemImage,
+              cut: Option<u64>,
+              report: &mut Report| {
+        drive_and_compare(
+            dut,
             variant,
             cfg,
             seed,
-            &case.work,
-            &case.work.items,
-            &case.mem,
+            work,
+            &work.items,
+            mem,
             case,
-            None,
-            &mut report,
-        )?,
-        Some((at, after)) => {
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                &case.work,
-                &case.work.items,
-                &case.mem,
-                case,
-                Some(*at),
-                &mut report,
-            )?;
-            dut.reset();
-            let c = dut.axi_wr_counters();
-            if c.in_flight != 0 {
-                return Err(TbError::Protocol {
-                    variant: variant.name.to_string(),
-                    seed,
-                    cycle: dut.cycle(),
-                    what: format!(
-                        "{} write bursts still in flight after the reset",
-                        c.in_flight
-                    ),
-                });
-            }
-            report.dropped_at_reset = c.dropped_at_reset;
-            // The next work starts from the memory as the cut run left it.
-            let mem = AxiMemImage {
-                bytes: dut.axi_image()?,
-                ..case.mem.clone()
-            };
-            drive_and_compare(
-                &mut dut,
-                variant,
-                cfg,
-                seed,
-                after,
-                &after.items,
-                &mem,
-                case,
-                None,
-                &mut report,
-            )?;
-        }
+            cut,
+            report,
+        )
+    };
+    let cut = case.reset.as_ref().map(|r| r.0);
+    go(&mut dut, &case.work, &case.mem, cut, &mut report)?;
+    if let Some((_, after)) = &case.reset {
+        report.dropped_at_reset =
+            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, true)?;
+        // The next work starts from the memory as the cut run left it.
+        let mem = AxiMemImage {
+            bytes: dut.axi_image()?,
+            ..case.mem.clone()
+        };
+        go(&mut dut, after, &mem, None, &mut report)?;
     }
     Ok(report)
 }
@@ -395,11 +345,7 @@ fn random_case(cfg: AxiWrConfig, seed: u64, n: usize) -> Case {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mem = random_image(cfg, &mut rng);
     let work = random_work(cfg, &mem, n, &mut rng);
-    let bw = if rng.random_bool(0.5) {
-        (rng.random_range(1..=2 * cfg.bytes()), 2)
-    } else {
-        (0, 1)
-    };
+    let bw = axi::random_bandwidth(&mut rng, 2 * cfg.bytes());
     let gaps = (
         rng.random_range(0..500),
         rng.random_range(0..500),
@@ -422,17 +368,13 @@ fn random_case(cfg: AxiWrConfig, seed: u64, n: usize) -> Case {
 
 #[test]
 fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
-    for (i, (variant, cfg)) in configs::<AxiWrConfig>().into_iter().enumerate() {
-        for k in 0..4 {
-            let s = seed(100 + 10 * i as u64 + k);
-            let case = random_case(cfg, s, 200);
-            let r = must(variant, cfg, s, &case);
-            assert!(
-                r.items > 1000,
-                "{variant}: the case writes enough items (seed {s})"
-            );
-        }
-    }
+    axi::random_runs(4, |variant, cfg: AxiWrConfig, s| {
+        let r = must(variant, cfg, s, &random_case(cfg, s, 200));
+        assert!(
+            r.items > 1000,
+            "{variant}: the case writes enough items (seed {s})"
+        );
+    });
 }
 
 /// The acceptance figure (docs/adding-a-unit.md): at least 1,000,000 random items per
@@ -440,22 +382,15 @@ fn random_commands_with_latency_gaps_backpressure_and_bandwidth_limits() {
 /// back-pressure, the third of them reset in mid-stream.
 #[test]
 fn a_million_random_items_per_config() {
-    for (i, (variant, cfg)) in configs::<AxiWrConfig>().into_iter().enumerate() {
-        let mut items = 0u64;
-        let mut k = 0u64;
-        while items < 1_000_000 {
-            let s = seed(600 + 100 * i as u64 + k);
-            let mut case = random_case(cfg, s, 2000);
-            if k == 2 {
-                let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-                let after = random_work(cfg, &case.mem, 2000, &mut rng);
-                case.reset = Some((rng.random_range(1000..100_000), after));
-            }
-            let r = must(variant, cfg, s, &case);
-            items += r.items;
-            k += 1;
+    axi::a_million_per_config(|variant, cfg: AxiWrConfig, s, k| {
+        let mut case = random_case(cfg, s, 2000);
+        if k == 2 {
+            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+            let after = random_work(cfg, &case.mem, 2000, &mut rng);
+            case.reset = Some((rng.random_range(1000..100_000), after));
         }
-    }
+        must(variant, cfg, s, &case).items
+    });
 }
 
 /// One item at every lane, 4 KB crossings, commands sharing a beat, the longest command, the top
@@ -596,24 +531,16 @@ fn directed_extremes() {
 
 #[test]
 fn reset_in_mid_stream_leaves_nothing_outstanding_and_the_next_commands_are_exact() {
-    for (i, (variant, cfg)) in configs::<AxiWrConfig>().into_iter().enumerate() {
-        let mut dropped = 0;
-        for k in 0..3 {
-            let s = seed(400 + 10 * i as u64 + k);
-            let mut case = random_case(cfg, s, 100);
-            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let after = random_work(cfg, &case.mem, 100, &mut rng);
-            // Early enough that bursts are in flight (B latency >= 10 cycles).
-            case.reset = Some((rng.random_range(30..3000), after));
-            let r = must(variant, cfg, s, &case);
-            assert!(r.items > 0);
-            dropped += r.dropped_at_reset;
-        }
-        assert!(
-            dropped > 0,
-            "{variant}: some reset landed with bursts in flight"
-        );
-    }
+    axi::resets_land_with_bursts_in_flight(|variant, cfg: AxiWrConfig, s| {
+        let mut case = random_case(cfg, s, 100);
+        let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+        let after = random_work(cfg, &case.mem, 100, &mut rng);
+        // Early enough that bursts are in flight (B latency >= 10 cycles).
+        case.reset = Some((rng.random_range(30..3000), after));
+        let r = must(variant, cfg, s, &case);
+        assert!(r.items > 0);
+        r.dropped_at_reset
+    });
 }
 
 /// W beats and bytes per cycle over 64 commands of 256 beats at fixed B latency `lat` and
@@ -711,18 +638,19 @@ fn throughput_against_latency_and_bandwidth() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    for (variant, cfg) in gate_configs::<AxiWrConfig>() {
-        let s = seed(500);
-        let case = random_case(cfg, s, 60);
-        must(variant, cfg, s, &case);
-        let mut case = random_case(cfg, s + 1, 30);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        case.reset = Some((
-            rng.random_range(30..500),
-            random_work(cfg, &case.mem, 30, &mut rng),
-        ));
-        must(variant, cfg, s + 1, &case);
-    }
+    axi::gate_smoke(
+        |variant, cfg: AxiWrConfig, s| {
+            must(variant, cfg, s, &random_case(cfg, s, 60));
+        },
+        |variant, cfg, s, rng| {
+            let mut case = random_case(cfg, s, 30);
+            case.reset = Some((
+                rng.random_range(30..500),
+                random_work(cfg, &case.mem, 30, rng),
+            ));
+            must(variant, cfg, s, &case);
+        },
+    );
 }
 
 /// The checks bite: RTL items with one byte changed disagree with the model on the memory byte
@@ -759,29 +687,30 @@ fn the_comparison_and_the_checker_bite() {
         reset: None,
     };
     must(variant, cfg, 1, &case);
-    let fresh = || {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        dut.axi_setup(&case.setup).unwrap();
-        dut.axi_load(case.mem.base, &case.mem.bytes).unwrap();
-        dut
+    // Each run on a fresh DUT holding the image, its RTL items against a model of `model_cfg`.
+    let mismatch = |model_cfg: AxiWrConfig, rtl_items: &[Vec<u8>]| {
+        let mut dut = axi::open(variant, cfg, 1, (&case.setup, &case.mem), &None).unwrap();
+        let mut report = Report::default();
+        let mem = &case.mem;
+        drive_and_compare(
+            &mut dut,
+            variant,
+            model_cfg,
+            1,
+            &work,
+            rtl_items,
+            mem,
+            &case,
+            None,
+            &mut report,
+        )
+        .unwrap_err()
     };
 
     // The RTL's item 1 differs in its first byte.
     let mut rtl_items = work.items.clone();
     rtl_items[1][0] ^= 1;
-    let err = drive_and_compare(
-        &mut fresh(),
-        variant,
-        cfg,
-        1,
-        &work,
-        &rtl_items,
-        &case.mem,
-        &case,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
+    let err = mismatch(cfg, &rtl_items);
     let m = err.mismatch().expect("a mismatch");
     assert!(m.what.starts_with("memory byte differs"), "{err}");
     assert!(
@@ -795,24 +724,12 @@ fn the_comparison_and_the_checker_bite() {
         max_burst: cfg.max_burst / 2,
         ..cfg
     };
-    let err = drive_and_compare(
-        &mut fresh(),
-        variant,
-        half,
-        1,
-        &work,
-        &work.items,
-        &case.mem,
-        &case,
-        None,
-        &mut Report::default(),
-    )
-    .unwrap_err();
+    let err = mismatch(half, &work.items);
     let m = err.mismatch().expect("a mismatch");
     assert!(m.what.starts_with("AW burst differs"), "{err}");
 
     // The checker.
-    for (setup, rule) in [
+    let refusals = vec![
         (
             AxiMemSetup {
                 data_bytes: 2 * cfg.bytes(),
@@ -834,19 +751,12 @@ fn the_comparison_and_the_checker_bite() {
             },
             "declares at most",
         ),
-    ] {
+    ];
+    axi::assert_checker_refuses(variant, refusals, |setup, s| {
         let bad = Case {
             setup,
             ..case.clone()
         };
-        match check(variant, cfg, 77, &bad) {
-            Err(e @ TbError::Protocol { .. }) => {
-                let text = e.to_string();
-                assert!(text.contains(rule), "{text}");
-                assert!(text.contains("CUBE5_SEED=77"), "{text}");
-            }
-            Err(e) => panic!("{variant}: expected a protocol error about {rule}, got {e}"),
-            Ok(r) => panic!("{variant}: the checker let it pass ({r:?})"),
-        }
-    }
+        check(variant, cfg, s, &bad)
+    });
 }

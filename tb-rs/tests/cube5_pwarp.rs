@@ -19,10 +19,10 @@ use cube5_model::units::cube5_pwarp::{
 };
 use cube5_model::units::cube5_warp::BaseCodes;
 use cube5_tb::rtl::{RtlStream, Traffic};
-use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{configs, gate_configs, seed};
+use support::warp::{self, check_frames, random_base, WarpFrame};
+use support::{configs, seed};
 
 /// One frame of the warp: its set-up, base plane, what it is (for a mismatch report).
 #[derive(Debug, Clone)]
@@ -34,13 +34,50 @@ struct Frame {
     extra: Vec<PwarpIn>,
 }
 
-impl Frame {
+impl WarpFrame for Frame {
+    type Cfg = PwarpConfig;
+    type Gold = Pwarp;
+    const OUT: &'static str = "sample";
+
+    fn gold(cfg: PwarpConfig) -> Pwarp {
+        Pwarp::new(cfg).unwrap()
+    }
+
     fn items(&self, cfg: &PwarpConfig) -> Vec<PwarpIn> {
         let mut items = frame_items(cfg, &self.setup, &self.base);
         items.extend(self.extra.iter().copied());
         items
     }
 
+    /// The sample's line, registers and coordinates.
+    fn describe(&self, i: usize, mut at: usize) -> String {
+        let s = &self.setup;
+        for (j, l) in s.lines.iter().enumerate() {
+            if at < l.n as usize {
+                let i64at = at as i64;
+                let unit = f64::from(1u32 << COORD_FRAC_W);
+                let (x, y) = (l.x + i64at * l.xs, l.y + i64at * l.ys);
+                return format!(
+                    "frame {i} ({}), base plane {}x{}, image {}x{}, slope {} neg {} transpose {}, line {j} {l:?}, sample {at} at base-plane ({:.6}, {:.6}) = fixed ({x}, {y})",
+                    self.what,
+                    self.base.width,
+                    self.base.height,
+                    s.out_w,
+                    s.out_h,
+                    s.slope,
+                    s.neg,
+                    s.transpose,
+                    x as f64 / unit,
+                    y as f64 / unit
+                );
+            }
+            at -= l.n as usize;
+        }
+        format!("frame {i} ({}): sample {at} of its extra items", self.what)
+    }
+}
+
+impl Frame {
     fn new(map: &Projective, base: BaseCodes, out: (u32, u32), what: String) -> Self {
         let size = (base.width as u32, base.height as u32);
         Self {
@@ -49,24 +86,6 @@ impl Frame {
             what: format!("{what}: {map:?}"),
             extra: Vec::new(),
         }
-    }
-}
-
-fn random_base(rng: &mut ChaCha8Rng, w: usize, h: usize, color_w: u32) -> BaseCodes {
-    let max = (1u32 << color_w) - 1;
-    let flat = rng.random_bool(0.1);
-    BaseCodes {
-        width: w,
-        height: h,
-        codes: (0..w * h)
-            .map(|_| {
-                if flat {
-                    [max; 3]
-                } else {
-                    std::array::from_fn(|_| rng.random_range(0..=max))
-                }
-            })
-            .collect(),
     }
 }
 
@@ -105,127 +124,6 @@ fn random_frame(
     Frame::new(&map, base, out, "random view".into())
 }
 
-/// Runs `frames` through the RTL under `traffic` and through the model, and compares every
-/// sample; with `reset_after` = (frames, cycles), resets both that many cycles into the run of the
-/// first `frames` frames, then runs the rest (each complete) after the reset. Panics with the seed,
-/// the frame, the line, the sample, its registers and both outputs on the first difference.
-/// Returns the cycles taken.
-fn check_frames(
-    variant: &'static Variant,
-    cfg: PwarpConfig,
-    frames: &[Frame],
-    traffic: &Traffic,
-    seed: u64,
-    reset_after: Option<(usize, u64)>,
-) -> u64 {
-    let mut dut = RtlStream::new(variant, cfg, seed as u32).unwrap();
-    let mut gold = Pwarp::new(cfg).unwrap();
-    let (before, after) = match reset_after {
-        Some((n, _)) => frames.split_at(n.min(frames.len())),
-        None => (&frames[..0], frames),
-    };
-    let mut cycles = 0;
-    if let Some((_, cut)) = reset_after {
-        let items: Vec<PwarpIn> = before.iter().flat_map(|f| f.items(&cfg)).collect();
-        let driven = dut.drive(&items, traffic, u64::MAX, cut).unwrap();
-        let consumed = driven.stats.consumed as usize;
-        let want = gold.run(&items[..consumed]);
-        let got: Vec<PwarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-        assert!(
-            got.len() <= want.len(),
-            "{variant}: seed {seed}: extra outputs before the reset"
-        );
-        compare(variant, seed, before, &got, &want[..got.len()], &cfg);
-        eprintln!(
-            "{variant}: reset after {} cycles: {consumed} of {} items taken, {} samples out (of {} the model owes)",
-            driven.stats.cycles,
-            items.len(),
-            got.len(),
-            want.len()
-        );
-        dut.reset();
-        gold.reset();
-        cycles += driven.stats.cycles;
-    }
-    let items: Vec<PwarpIn> = after.iter().flat_map(|f| f.items(&cfg)).collect();
-    let want = gold.run(&items);
-    let n = want.len() as u64;
-    let driven = dut
-        .drive(&items, traffic, n, 64 * (n + items.len() as u64) + 10_000)
-        .unwrap();
-    assert_eq!(
-        driven.stats.protocol_errors, 0,
-        "{variant}: seed {seed}: a stalled output dropped valid or changed"
-    );
-    let got: Vec<PwarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-    compare(variant, seed, after, &got, &want, &cfg);
-    assert_eq!(
-        got.len(),
-        want.len(),
-        "{variant}: seed {seed}: the RTL produced {} of {} samples (deadlock or lost sample)",
-        got.len(),
-        want.len()
-    );
-    assert_eq!(driven.stats.consumed, items.len() as u64);
-    cycles + driven.stats.cycles
-}
-
-/// The first differing sample, named by frame, line, sample, its registers and coordinates.
-fn compare(
-    variant: &Variant,
-    seed: u64,
-    frames: &[Frame],
-    got: &[PwarpOut],
-    want: &[PwarpOut],
-    cfg: &PwarpConfig,
-) {
-    let Some(k) = (0..got.len().min(want.len())).find(|&k| got[k] != want[k]) else {
-        return;
-    };
-    let mut at = k;
-    let mut who = String::from("(past the frames)");
-    'frames: for (i, f) in frames.iter().enumerate() {
-        let n = Pwarp::new(*cfg).unwrap().run(&f.items(cfg)).len();
-        if at >= n {
-            at -= n;
-            continue;
-        }
-        let s = &f.setup;
-        for (j, l) in s.lines.iter().enumerate() {
-            if at < l.n as usize {
-                let i64at = at as i64;
-                let unit = f64::from(1u32 << COORD_FRAC_W);
-                let (x, y) = (l.x + i64at * l.xs, l.y + i64at * l.ys);
-                who = format!(
-                    "frame {i} ({}), base plane {}x{}, image {}x{}, slope {} neg {} transpose {}, line {j} {l:?}, sample {at} at base-plane ({:.6}, {:.6}) = fixed ({x}, {y})",
-                    f.what,
-                    f.base.width,
-                    f.base.height,
-                    s.out_w,
-                    s.out_h,
-                    s.slope,
-                    s.neg,
-                    s.transpose,
-                    x as f64 / unit,
-                    y as f64 / unit
-                );
-                break 'frames;
-            }
-            at -= l.n as usize;
-        }
-        who = format!("frame {i} ({}): sample {at} of its extra items", f.what);
-        break;
-    }
-    panic!(
-        "{variant}: seed {seed}: sample #{k} differs: {who}\n  RTL   {:?}\n  model {:?}",
-        got[k], want[k]
-    );
-}
-
-fn traffic(rng: &mut ChaCha8Rng, idle: f64, stall: f64) -> Traffic {
-    Traffic::random(rng, idle, stall)
-}
-
 /// `n` random views per configuration, images `lo..=hi` pixels a side (bounded by `MaxOut`),
 /// base planes up to `base_hi` texels a side.
 fn random_views(n: usize, lo: u32, hi: u32, base_hi: usize, seed_no: u64) {
@@ -247,7 +145,7 @@ fn random_views(n: usize, lo: u32, hi: u32, base_hi: usize, seed_no: u64) {
                 f.what
             );
         }
-        let t = traffic(&mut rng, 0.2, 0.3);
+        let t = Traffic::random(&mut rng, 0.2, 0.3);
         let cycles = check_frames(variant, cfg, &frames, &t, s, None);
         let samples: u64 = frames.iter().map(|f| f.setup.samples()).sum();
         let lines: usize = frames.iter().map(|f| f.setup.lines.len()).sum();
@@ -396,32 +294,15 @@ fn directed_frames(cfg: &PwarpConfig, rng: &mut ChaCha8Rng) -> Vec<Frame> {
 
 #[test]
 fn directed_extremes_under_idle_and_backpressure() {
-    for (i, (variant, cfg)) in configs::<PwarpConfig>().into_iter().enumerate() {
-        let s = seed(1530 + i as u64);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let frames = directed_frames(&cfg, &mut rng);
-        for (idle, stall) in [(0.0, 0.0), (0.3, 0.3), (0.0, 0.7)] {
-            let t = traffic(&mut rng, idle, stall);
-            check_frames(variant, cfg, &frames, &t, s, None);
-        }
-        eprintln!("{variant}: {} directed frames bit-exact", frames.len());
-    }
+    warp::directed_under_idle_and_backpressure(directed_frames, 1530);
 }
 
 #[test]
 fn a_reset_in_mid_stream() {
-    for (i, (variant, cfg)) in configs::<PwarpConfig>().into_iter().enumerate() {
-        let s = seed(1540 + i as u64);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        for _ in 0..6 {
-            let frames: Vec<Frame> = (0..6)
-                .map(|_| random_frame(&mut rng, &cfg, 12, 8, 32))
-                .collect();
-            let t = traffic(&mut rng, 0.2, 0.3);
-            let cut = rng.random_range(1..3000);
-            check_frames(variant, cfg, &frames, &t, s, Some((3, cut)));
-        }
-    }
+    warp::a_reset_in_mid_stream(
+        |rng, cfg: &PwarpConfig| random_frame(rng, cfg, 12, 8, 32),
+        1540,
+    );
 }
 
 /// Full speed: texels loaded, then every line's items back to back. Lines of at least six samples
@@ -492,41 +373,23 @@ fn one_sample_per_clock_over_a_frame() {
 
 #[test]
 fn gate_level_smoke() {
-    for (variant, cfg) in gate_configs::<PwarpConfig>() {
-        let s = seed(1560);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let mut frames: Vec<Frame> = (0..8)
-            .map(|_| random_frame(&mut rng, &cfg, 16, 8, 24))
-            .collect();
-        frames.extend(directed_frames(&cfg, &mut rng));
-        let t = traffic(&mut rng, 0.2, 0.2);
-        check_frames(variant, cfg, &frames, &t, s, Some((4, 900)));
-        eprintln!("{variant}: gate-level smoke, {} frames", frames.len());
-    }
+    warp::gate_level_smoke(
+        8,
+        |rng, cfg: &PwarpConfig| random_frame(rng, cfg, 16, 8, 24),
+        directed_frames,
+        1560,
+    );
 }
 
 #[test]
 fn a_model_with_the_wrong_weight_width_is_caught() {
-    let (variant, cfg) = configs::<PwarpConfig>()[0];
-    let s = seed(1570);
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let frames: Vec<Frame> = (0..4)
-        .map(|_| random_frame(&mut rng, &cfg, 32, 16, 32))
-        .collect();
-    let items: Vec<PwarpIn> = frames.iter().flat_map(|f| f.items(&cfg)).collect();
-    let wrong = PwarpConfig {
-        weight_w: cfg.weight_w - 1,
-        ..cfg
-    };
-    let want = Pwarp::new(wrong).unwrap().run(&items);
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    let n = want.len() as u64;
-    let driven = dut
-        .drive(&items, &Traffic::full_speed(), n, 1 << 24)
-        .unwrap();
-    let got: Vec<PwarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-    assert!(
-        got != want,
-        "{variant}: a one-bit-narrower weight went unnoticed"
+    warp::a_wrong_model_is_caught(
+        |rng, cfg: &PwarpConfig| random_frame(rng, cfg, 32, 16, 32),
+        |cfg| PwarpConfig {
+            weight_w: cfg.weight_w - 1,
+            ..cfg
+        },
+        "a one-bit-narrower weight",
+        1570,
     );
 }

@@ -79,15 +79,7 @@ fn random_inputs(
                 input.push(SbufIn::Section(bad));
                 want.push(section_beams(&cfg, &vol, &lut, &bad).unwrap()[0].clone());
             }
-            1 => input.push(SbufIn::Item(FetchItem {
-                lanes: vec![1; cfg.p as usize],
-                blk: [0; 3],
-                word: 0,
-                skip: false,
-                last: false,
-                error: false,
-                resp_err: false,
-            })),
+            1 => input.push(SbufIn::Item(FetchItem::stray(cfg.p))),
             _ => {}
         }
         let (i, w) = section(cfg, &vol, &lut, cmd);
@@ -199,46 +191,25 @@ fn run(
     }
     let mut report = Report::default();
     let limit = 10_000 + 8 * (input.len() + want.len()) as u64;
-    let Some(cut) = reset_at else {
+    let go = |dut: &mut RtlStream<SectionBufConfig>,
+              input: &[SbufIn],
+              want: &[Beam],
+              (limit, whole): (u64, bool),
+              report: &mut Report| {
         drive(
-            variant,
-            seed,
-            &mut dut,
-            input,
-            &want,
-            traffic,
-            limit,
-            true,
-            &mut report,
-        )?;
+            variant, seed, dut, input, want, traffic, limit, whole, report,
+        )
+    };
+    let Some(cut) = reset_at else {
+        go(&mut dut, input, &want, (limit, true), &mut report)?;
         return Ok(report.described(variant, seed, ""));
     };
-    let taken = drive(
-        variant,
-        seed,
-        &mut dut,
-        input,
-        &want,
-        traffic,
-        cut,
-        false,
-        &mut report,
-    )?;
+    let taken = go(&mut dut, input, &want, (cut, false), &mut report)?;
     dut.reset();
     gold.reset();
     let rest = &input[taken..];
     let after = gold.run(rest);
-    drive(
-        variant,
-        seed,
-        &mut dut,
-        rest,
-        &after,
-        traffic,
-        limit,
-        true,
-        &mut report,
-    )?;
+    go(&mut dut, rest, &after, (limit, true), &mut report)?;
     Ok(report.described(variant, seed, ", reset once"))
 }
 

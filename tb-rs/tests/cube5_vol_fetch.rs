@@ -17,8 +17,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi_mem_setup, axi_protocol_clean, compare_ar, compare_axi_outputs, configs, gate_configs,
-    seed, with_waves,
+    axi, axi_mem_setup, axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, seed,
+    with_waves,
 };
 
 /// One run: LUT writes (loaded first, in full), then commands (sweeps and more LUT writes), the
@@ -182,11 +182,7 @@ fn random_case(cfg: VolFetchConfig, seed: u64, sweeps: usize, max_blocks: u32) -
     let lut = random_lut(cfg, blocks, &mut rng);
     let mem = random_image(cfg, blocks.iter().product(), &mut rng);
     let cmds = random_cmds(cfg, blocks, mem.base, &lut, sweeps, &mut rng);
-    let bw = if rng.random_bool(0.5) {
-        (rng.random_range(1..=cfg.data_w / 4), 2)
-    } else {
-        (0, 1)
-    };
+    let bw = axi::random_bandwidth(&mut rng, cfg.data_w / 4);
     let gaps = (rng.random_range(0..400), rng.random_range(0..400));
     let setup = mem_setup(cfg, &mem, (10, 190), gaps, bw, rng.random());
     let stall = rng.random_range(0.0..0.6);
@@ -211,22 +207,33 @@ fn check(
 }
 
 fn must(variant: &'static Variant, cfg: VolFetchConfig, seed: u64, case: &Case) -> Report {
-    match check(variant, cfg, seed, case) {
-        Ok(r) => {
-            eprintln!(
-                "{variant}: seed {seed}: {} items ({} blocks read, {} skipped), {} bursts in {} cycles ({:.3} voxels/clock), {} bursts dropped at reset",
-                r.items,
-                r.blocks_read,
-                r.blocks_skipped,
-                r.bursts,
-                r.cycles,
-                r.voxels_per_clock(),
-                r.dropped_at_reset
-            );
-            r
-        }
-        Err(e) => panic!("{e}"),
-    }
+    axi::must_pass(variant, seed, check(variant, cfg, seed, case), |r| {
+        format!(
+            "{} items ({} blocks read, {} skipped), {} bursts in {} cycles ({:.3} voxels/clock), {} bursts dropped at reset",
+            r.items,
+            r.blocks_read,
+            r.blocks_skipped,
+            r.bursts,
+            r.cycles,
+            r.voxels_per_clock(),
+            r.dropped_at_reset
+        )
+    })
+}
+
+/// `sweeps` random sweeps over the volume of `case`'s first sweep (a case starts with one), its
+/// memory and LUT: the commands after a reset.
+fn random_after(
+    cfg: VolFetchConfig,
+    case: &Case,
+    sweeps: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<FetchCmd> {
+    let blocks = match case.cmds[0] {
+        FetchCmd::Sweep(sw) => sw.blocks,
+        FetchCmd::Lut { .. } => unreachable!("a case starts with a sweep"),
+    };
+    random_cmds(cfg, blocks, case.mem.base, &case.lut, sweeps, rng)
 }
 
 /// The command an item belongs to, for a mismatch report.
@@ -274,9 +281,15 @@ fn drive_and_compare(
     let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
     axi_protocol_clean(dut, &driven.stats, variant, seed)?;
     // AR first: a wrong burst explains a wrong item.
-    let n_ars = compare_ar(dut, &bursts, cfg.axi_rd().size(), variant, seed, |k| {
-        format!("burst #{k} of {} read commands", run.reads.len())
-    })?;
+    let n_ars = compare_bursts(
+        &dut.axi_take_ar()?,
+        "AR",
+        &bursts,
+        cfg.axi_rd().size(),
+        variant,
+        seed,
+        |k| format!("burst #{k} of {} read commands", run.reads.len()),
+    )?;
     compare_axi_outputs(
         dut,
         &driven,
@@ -326,13 +339,8 @@ fn run(
     case: &Case,
     trace: Option<(PathBuf, (u64, u64))>,
 ) -> Result<Report, TbError> {
-    let mut dut = RtlStream::new(variant, cfg, seed as u32)?;
+    let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut gold = VolFetch::new(cfg).map_err(|e| TbError::setup(variant.name, e))?;
-    dut.axi_setup(&case.setup)?;
-    dut.axi_load(case.mem.base, &case.mem.bytes)?;
-    if let Some((path, (from, to))) = &trace {
-        dut.trace_window(path, *from, *to);
-    }
     let mut report = Report::default();
     let (mem, traffic) = (&case.mem, &case.traffic);
     let go = |dut: &mut RtlStream<VolFetchConfig>,
@@ -351,17 +359,8 @@ fn run(
         &mut report,
     )?;
     if let Some((_, after)) = &case.reset {
-        dut.reset();
-        let c = dut.axi_counters();
-        if c.in_flight != 0 {
-            return Err(TbError::Protocol {
-                variant: variant.name.to_string(),
-                seed,
-                cycle: dut.cycle(),
-                what: format!("{} bursts still in flight after the reset", c.in_flight),
-            });
-        }
-        report.dropped_at_reset = c.dropped_at_reset;
+        report.dropped_at_reset =
+            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, false)?;
         go(&mut dut, &mut gold, after, None, &mut report)?;
     }
     Ok(report)
@@ -369,17 +368,13 @@ fn run(
 
 #[test]
 fn random_sweeps_with_latency_gaps_backpressure_and_bandwidth_limits() {
-    for (i, (variant, cfg)) in configs::<VolFetchConfig>().into_iter().enumerate() {
-        for k in 0..3 {
-            let s = seed(100 + 10 * i as u64 + k);
-            let case = random_case(cfg, s, 4, 48);
-            let r = must(variant, cfg, s, &case);
-            assert!(
-                r.items > 100,
-                "{variant}: the case delivers enough (seed {s})"
-            );
-        }
-    }
+    axi::random_runs(3, |variant, cfg: VolFetchConfig, s| {
+        let r = must(variant, cfg, s, &random_case(cfg, s, 4, 48));
+        assert!(
+            r.items > 100,
+            "{variant}: the case delivers enough (seed {s})"
+        );
+    });
 }
 
 /// The acceptance figure (docs/adding-a-unit.md): at least 1,000,000 random items per
@@ -387,25 +382,15 @@ fn random_sweeps_with_latency_gaps_backpressure_and_bandwidth_limits() {
 #[test]
 #[ignore = "sim-full: a million items per configuration, about 40 s of simulation"]
 fn a_million_random_items_per_config() {
-    for (i, (variant, cfg)) in configs::<VolFetchConfig>().into_iter().enumerate() {
-        let mut items = 0u64;
-        let mut k = 0u64;
-        while items < 1_000_000 {
-            let s = seed(600 + 100 * i as u64 + k);
-            let mut case = random_case(cfg, s, 12, 128);
-            if k % 3 == 2 {
-                let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-                let blocks = match case.cmds[0] {
-                    FetchCmd::Sweep(sw) => sw.blocks,
-                    FetchCmd::Lut { .. } => unreachable!("a case starts with a sweep"),
-                };
-                let after = random_cmds(cfg, blocks, case.mem.base, &case.lut, 6, &mut rng);
-                case.reset = Some((rng.random_range(100..20_000), after));
-            }
-            items += must(variant, cfg, s, &case).items;
-            k += 1;
+    axi::a_million_per_config(|variant, cfg: VolFetchConfig, s, k| {
+        let mut case = random_case(cfg, s, 12, 128);
+        if k % 3 == 2 {
+            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+            let after = random_after(cfg, &case, 6, &mut rng);
+            case.reset = Some((rng.random_range(100..20_000), after));
         }
-    }
+        must(variant, cfg, s, &case).items
+    });
 }
 
 /// All blocks present, all empty, a one-block section at each end, the largest volume the LUT
@@ -455,14 +440,7 @@ fn directed_extremes() {
                 cmds.push(FetchCmd::Sweep(Sweep { sec_hi: 1, ..whole }));
             }
         }
-        let ok = Sweep {
-            base,
-            blocks,
-            axis_k: 2,
-            reversed: false,
-            sec_lo: 0,
-            sec_hi: blocks[0],
-        };
+        let ok = Sweep::whole(base, blocks);
         let bbus = u64::from(cfg.data_w / 8);
         for bad in [
             Sweep { axis_k: 3, ..ok },
@@ -515,27 +493,29 @@ fn directed_extremes() {
 
 #[test]
 fn reset_in_mid_sweep_leaves_nothing_outstanding_and_the_next_sweeps_are_exact() {
-    for (i, (variant, cfg)) in configs::<VolFetchConfig>().into_iter().enumerate() {
-        let mut dropped = 0;
-        for k in 0..3 {
-            let s = seed(400 + 10 * i as u64 + k);
-            let mut case = random_case(cfg, s, 3, 48);
-            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let blocks = match case.cmds[0] {
-                FetchCmd::Sweep(sw) => sw.blocks,
-                FetchCmd::Lut { .. } => unreachable!("a case starts with a sweep"),
-            };
-            case.setup.r_gap_permille = 0;
-            let after = random_cmds(cfg, blocks, case.mem.base, &case.lut, 2, &mut rng);
-            // Early enough that bursts are in flight (latency >= 10 cycles).
-            case.reset = Some((rng.random_range(30..1500), after));
-            dropped += must(variant, cfg, s, &case).dropped_at_reset;
-        }
-        assert!(
-            dropped > 0,
-            "{variant}: some reset landed with bursts in flight"
-        );
-    }
+    axi::resets_land_with_bursts_in_flight(|variant, cfg: VolFetchConfig, s| {
+        let mut case = random_case(cfg, s, 3, 48);
+        let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+        case.setup.r_gap_permille = 0;
+        let after = random_after(cfg, &case, 2, &mut rng);
+        // Early enough that bursts are in flight (latency >= 10 cycles).
+        case.reset = Some((rng.random_range(30..1500), after));
+        must(variant, cfg, s, &case).dropped_at_reset
+    });
+}
+
+/// A volume of `blocks` with every block present: its LUT writes and its image (no SLVERR
+/// window).
+fn present_volume(
+    cfg: VolFetchConfig,
+    blocks: [u32; 3],
+    rng: &mut ChaCha8Rng,
+) -> (Vec<FetchCmd>, AxiMemImage) {
+    let mut lut = random_lut(cfg, blocks, rng);
+    all_present(&mut lut);
+    let mut mem = random_image(cfg, blocks.iter().product(), rng);
+    (mem.slverr_lo, mem.slverr_hi) = (0, 0);
+    (lut, mem)
 }
 
 /// Voxels per clock over a whole-volume sweep with every block present, full-speed output,
@@ -544,19 +524,9 @@ fn throughput(variant: &'static Variant, cfg: VolFetchConfig, lat: u32, bw: (u32
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let nb = cfg.nb().min(4);
     let blocks = [nb, nb, nb.min(4)];
-    let mut lut = random_lut(cfg, blocks, &mut rng);
-    all_present(&mut lut);
-    let mut mem = random_image(cfg, blocks.iter().product(), &mut rng);
+    let (lut, mut mem) = present_volume(cfg, blocks, &mut rng);
     mem.base = 0x1000 * u64::from(cfg.addr_w > 16);
-    (mem.slverr_lo, mem.slverr_hi) = (0, 0);
-    let sweep = Sweep {
-        base: mem.base,
-        blocks,
-        axis_k: 2,
-        reversed: false,
-        sec_lo: 0,
-        sec_hi: blocks[0],
-    };
+    let sweep = Sweep::whole(mem.base, blocks);
     let case = Case {
         lut,
         cmds: vec![FetchCmd::Sweep(sweep); 2],
@@ -676,20 +646,17 @@ fn head_phantom_128_and_256_behind_a_ddr_like_channel() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    for (variant, cfg) in gate_configs::<VolFetchConfig>() {
-        let s = seed(500);
-        let case = random_case(cfg, s, 2, 16);
-        must(variant, cfg, s, &case);
-        let mut case = random_case(cfg, s + 1, 1, 16);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let blocks = match case.cmds[0] {
-            FetchCmd::Sweep(sw) => sw.blocks,
-            FetchCmd::Lut { .. } => unreachable!("a case starts with a sweep"),
-        };
-        let after = random_cmds(cfg, blocks, case.mem.base, &case.lut, 1, &mut rng);
-        case.reset = Some((rng.random_range(30..300), after));
-        must(variant, cfg, s + 1, &case);
-    }
+    axi::gate_smoke(
+        |variant, cfg: VolFetchConfig, s| {
+            must(variant, cfg, s, &random_case(cfg, s, 2, 16));
+        },
+        |variant, cfg, s, rng| {
+            let mut case = random_case(cfg, s, 1, 16);
+            let after = random_after(cfg, &case, 1, rng);
+            case.reset = Some((rng.random_range(30..300), after));
+            must(variant, cfg, s, &case);
+        },
+    );
 }
 
 /// The checks bite: a model whose memory differs in one byte disagrees on the item holding it,
@@ -699,26 +666,11 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_skip() {
     let (variant, cfg) = configs::<VolFetchConfig>()[0];
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let blocks = [2, 2, 2];
-    let mut lut = random_lut(cfg, blocks, &mut rng);
-    all_present(&mut lut);
-    let mut mem = random_image(cfg, 8, &mut rng);
-    (mem.slverr_lo, mem.slverr_hi) = (0, 0);
-    let sweep = Sweep {
-        base: mem.base,
-        blocks,
-        axis_k: 2,
-        reversed: false,
-        sec_lo: 0,
-        sec_hi: 2,
-    };
+    let (lut, mem) = present_volume(cfg, blocks, &mut rng);
+    let sweep = Sweep::whole(mem.base, blocks);
     let traffic = Traffic::full_speed();
     let setup = mem_setup(cfg, &mem, (10, 0), (0, 0), (0, 1), 1);
-    let open = || {
-        let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-        dut.axi_setup(&setup).unwrap();
-        dut.axi_load(mem.base, &mem.bytes).unwrap();
-        dut
-    };
+    let open = || axi::open(variant, cfg, 1, (&setup, &mem), &None).unwrap();
     // One byte of the first block's slot changed in the model's memory.
     let first_ptr = match lut[0] {
         FetchCmd::Lut { entry, .. } => entry.ptr,

@@ -17,10 +17,10 @@ use cube5_model::units::cube5_warp::{
     frame_items, Affine, BaseCodes, Warp, WarpConfig, WarpIn, WarpOut, WarpRegs,
 };
 use cube5_tb::rtl::{RtlStream, Traffic};
-use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{configs, gate_configs, seed};
+use support::warp::{self, check_frames, random_base, WarpFrame};
+use support::{configs, seed};
 
 /// One frame of the warp: registers, base plane, what it is (for a mismatch report).
 #[derive(Debug, Clone)]
@@ -32,29 +32,41 @@ struct Frame {
     extra: Vec<WarpIn>,
 }
 
-impl Frame {
+impl WarpFrame for Frame {
+    type Cfg = WarpConfig;
+    type Gold = Warp;
+    const OUT: &'static str = "pixel";
+
+    fn gold(cfg: WarpConfig) -> Warp {
+        Warp::new(cfg).unwrap()
+    }
+
     fn items(&self, cfg: &WarpConfig) -> Vec<WarpIn> {
         let mut items = frame_items(cfg, &self.regs, &self.base);
         items.extend(self.extra.iter().copied());
         items
     }
-}
 
-fn random_base(rng: &mut ChaCha8Rng, w: usize, h: usize, color_w: u32) -> BaseCodes {
-    let max = (1u32 << color_w) - 1;
-    let flat = rng.random_bool(0.1);
-    BaseCodes {
-        width: w,
-        height: h,
-        codes: (0..w * h)
-            .map(|_| {
-                if flat {
-                    [max; 3]
-                } else {
-                    std::array::from_fn(|_| rng.random_range(0..=max))
-                }
-            })
-            .collect(),
+    /// The pixel's position, coordinates and registers.
+    fn describe(&self, i: usize, at: usize) -> String {
+        let r = self.regs;
+        let (px, py) = (
+            at as i64 % i64::from(r.out_w),
+            at as i64 / i64::from(r.out_w),
+        );
+        let (x, y) = (
+            r.x0 + px * r.xpx + py * r.xpy,
+            r.y0 + px * r.ypx + py * r.ypy,
+        );
+        let unit = f64::from(1u32 << COORD_FRAC_W);
+        format!(
+            "frame {i} ({}), base plane {}x{}, pixel ({px}, {py}) at base-plane ({:.6}, {:.6}) = fixed ({x}, {y}), registers {r:?}",
+            self.what,
+            self.base.width,
+            self.base.height,
+            x as f64 / unit,
+            y as f64 / unit
+        )
     }
 }
 
@@ -112,120 +124,6 @@ fn random_frame_within(
     }
 }
 
-/// Runs `frames` through the RTL under `traffic` and through the model, and compares every pixel;
-/// with `reset_after` = (frames, cycles), resets both that many cycles into the run of the first
-/// `frames` frames, then runs the rest (each complete) after the reset. Panics with the seed, the
-/// frame, the pixel, its registers and both outputs on the first difference.
-fn check_frames(
-    variant: &'static Variant,
-    cfg: WarpConfig,
-    frames: &[Frame],
-    traffic: &Traffic,
-    seed: u64,
-    reset_after: Option<(usize, u64)>,
-) -> u64 {
-    let mut dut = RtlStream::new(variant, cfg, seed as u32).unwrap();
-    let mut gold = Warp::new(cfg).unwrap();
-    let (before, after) = match reset_after {
-        Some((n, _)) => frames.split_at(n.min(frames.len())),
-        None => (&frames[..0], frames),
-    };
-    let mut cycles = 0;
-    if let Some((_, cut)) = reset_after {
-        let items: Vec<WarpIn> = before.iter().flat_map(|f| f.items(&cfg)).collect();
-        let driven = dut.drive(&items, traffic, u64::MAX, cut).unwrap();
-        let consumed = driven.stats.consumed as usize;
-        let want = gold.run(&items[..consumed]);
-        let got: Vec<WarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-        assert!(
-            got.len() <= want.len(),
-            "{variant}: seed {seed}: extra outputs before the reset"
-        );
-        compare(variant, seed, before, &got, &want[..got.len()], &cfg);
-        eprintln!(
-            "{variant}: reset after {} cycles: {consumed} of {} items taken, {} pixels out (of {} the model owes)",
-            driven.stats.cycles,
-            items.len(),
-            got.len(),
-            want.len()
-        );
-        dut.reset();
-        gold.reset();
-        cycles += driven.stats.cycles;
-    }
-    let items: Vec<WarpIn> = after.iter().flat_map(|f| f.items(&cfg)).collect();
-    let want = gold.run(&items);
-    let n = want.len() as u64;
-    let driven = dut
-        .drive(&items, traffic, n, 64 * (n + items.len() as u64) + 10_000)
-        .unwrap();
-    assert_eq!(
-        driven.stats.protocol_errors, 0,
-        "{variant}: seed {seed}: a stalled output dropped valid or changed"
-    );
-    let got: Vec<WarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-    compare(variant, seed, after, &got, &want, &cfg);
-    assert_eq!(
-        got.len(),
-        want.len(),
-        "{variant}: seed {seed}: the RTL produced {} of {} pixels (deadlock or lost pixel)",
-        got.len(),
-        want.len()
-    );
-    assert_eq!(driven.stats.consumed, items.len() as u64);
-    cycles + driven.stats.cycles
-}
-
-/// The first differing pixel, named by frame, position, coordinates and registers.
-fn compare(
-    variant: &Variant,
-    seed: u64,
-    frames: &[Frame],
-    got: &[WarpOut],
-    want: &[WarpOut],
-    cfg: &WarpConfig,
-) {
-    let Some(k) = (0..got.len().min(want.len())).find(|&k| got[k] != want[k]) else {
-        return;
-    };
-    // Which frame and pixel: count each frame's pixels as the model emits them.
-    let mut at = k;
-    let mut who = String::from("(past the frames)");
-    for (i, f) in frames.iter().enumerate() {
-        let n = Warp::new(*cfg).unwrap().run(&f.items(cfg)).len();
-        if at < n {
-            let r = f.regs;
-            let (px, py) = (
-                at as i64 % i64::from(r.out_w),
-                at as i64 / i64::from(r.out_w),
-            );
-            let (x, y) = (
-                r.x0 + px * r.xpx + py * r.xpy,
-                r.y0 + px * r.ypx + py * r.ypy,
-            );
-            let unit = f64::from(1u32 << COORD_FRAC_W);
-            who = format!(
-                "frame {i} ({}), base plane {}x{}, pixel ({px}, {py}) at base-plane ({:.6}, {:.6}) = fixed ({x}, {y}), registers {r:?}",
-                f.what,
-                f.base.width,
-                f.base.height,
-                x as f64 / unit,
-                y as f64 / unit
-            );
-            break;
-        }
-        at -= n;
-    }
-    panic!(
-        "{variant}: seed {seed}: pixel #{k} differs: {who}\n  RTL   {:?}\n  model {:?}",
-        got[k], want[k]
-    );
-}
-
-fn traffic(rng: &mut ChaCha8Rng, idle: f64, stall: f64) -> Traffic {
-    Traffic::random(rng, idle, stall)
-}
-
 /// `n` random warps per configuration, images `lo..=hi` pixels a side (bounded by `MaxOut`),
 /// base planes up to `base_hi` texels a side but every tenth up to `MaxBase` (loading a large
 /// base plane costs a clock per texel).
@@ -244,7 +142,7 @@ fn random_warps(n: usize, lo: u32, hi: u32, base_hi: usize, seed_no: u64) {
                 random_frame_within(&mut rng, &cfg, b, lo.min(hi), hi)
             })
             .collect();
-        let t = traffic(&mut rng, 0.2, 0.3);
+        let t = Traffic::random(&mut rng, 0.2, 0.3);
         let cycles = check_frames(variant, cfg, &frames, &t, s, None);
         let pixels: u64 = frames
             .iter()
@@ -307,7 +205,7 @@ fn the_warps_of_frame_views() {
         let s = seed(1420 + i as u64);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let frames = view_frames(&cfg, &mut rng, cfg.max_out.min(64));
-        let t = traffic(&mut rng, 0.2, 0.2);
+        let t = Traffic::random(&mut rng, 0.2, 0.2);
         check_frames(variant, cfg, &frames, &t, s, None);
         eprintln!("{variant}: {} frame views bit-exact", frames.len());
     }
@@ -445,33 +343,16 @@ fn directed_frames(cfg: &WarpConfig, rng: &mut ChaCha8Rng) -> Vec<Frame> {
 
 #[test]
 fn directed_extremes_under_idle_and_backpressure() {
-    for (i, (variant, cfg)) in configs::<WarpConfig>().into_iter().enumerate() {
-        let s = seed(1430 + i as u64);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let frames = directed_frames(&cfg, &mut rng);
-        for (idle, stall) in [(0.0, 0.0), (0.3, 0.3), (0.0, 0.7)] {
-            let t = traffic(&mut rng, idle, stall);
-            check_frames(variant, cfg, &frames, &t, s, None);
-        }
-        eprintln!("{variant}: {} directed frames bit-exact", frames.len());
-    }
+    warp::directed_under_idle_and_backpressure(directed_frames, 1430);
 }
 
 #[test]
 fn a_reset_in_mid_stream() {
-    for (i, (variant, cfg)) in configs::<WarpConfig>().into_iter().enumerate() {
-        let s = seed(1440 + i as u64);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        // Small base planes, so the reset lands as often in an image as in a base plane's load.
-        for _ in 0..6 {
-            let frames: Vec<Frame> = (0..6)
-                .map(|_| random_frame_within(&mut rng, &cfg, 12, 8, cfg.max_out.min(32)))
-                .collect();
-            let t = traffic(&mut rng, 0.2, 0.3);
-            let cut = rng.random_range(1..3000);
-            check_frames(variant, cfg, &frames, &t, s, Some((3, cut)));
-        }
-    }
+    // Small base planes, so the reset lands as often in an image as in a base plane's load.
+    warp::a_reset_in_mid_stream(
+        |rng, cfg: &WarpConfig| random_frame_within(rng, cfg, 12, 8, cfg.max_out.min(32)),
+        1440,
+    );
 }
 
 #[test]
@@ -515,43 +396,25 @@ fn one_pixel_per_clock_over_a_frame() {
 
 #[test]
 fn gate_level_smoke() {
-    for (variant, cfg) in gate_configs::<WarpConfig>() {
-        let s = seed(1460);
-        let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let mut frames: Vec<Frame> = (0..12)
-            .map(|_| random_frame(&mut rng, &cfg, 8, cfg.max_out.min(24)))
-            .collect();
-        frames.extend(directed_frames(&cfg, &mut rng));
-        let t = traffic(&mut rng, 0.2, 0.2);
-        check_frames(variant, cfg, &frames, &t, s, Some((4, 900)));
-        eprintln!("{variant}: gate-level smoke, {} frames", frames.len());
-    }
+    warp::gate_level_smoke(
+        12,
+        |rng, cfg: &WarpConfig| random_frame(rng, cfg, 8, cfg.max_out.min(24)),
+        directed_frames,
+        1460,
+    );
 }
 
 #[test]
 fn a_model_with_the_wrong_weight_width_is_caught() {
     // The comparison bites: the default configuration's RTL against a model one weight bit
     // narrower must differ on random warps.
-    let (variant, cfg) = configs::<WarpConfig>()[0];
-    let s = seed(1470);
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let frames: Vec<Frame> = (0..4)
-        .map(|_| random_frame(&mut rng, &cfg, 16, cfg.max_out.min(32)))
-        .collect();
-    let items: Vec<WarpIn> = frames.iter().flat_map(|f| f.items(&cfg)).collect();
-    let wrong = WarpConfig {
-        weight_w: cfg.weight_w - 1,
-        ..cfg
-    };
-    let want = Warp::new(wrong).unwrap().run(&items);
-    let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
-    let n = want.len() as u64;
-    let driven = dut
-        .drive(&items, &Traffic::full_speed(), n, 1 << 24)
-        .unwrap();
-    let got: Vec<WarpOut> = driven.outputs.iter().map(|t| t.value).collect();
-    assert!(
-        got != want,
-        "{variant}: a one-bit-narrower weight went unnoticed"
+    warp::a_wrong_model_is_caught(
+        |rng, cfg: &WarpConfig| random_frame(rng, cfg, 16, cfg.max_out.min(32)),
+        |cfg| WarpConfig {
+            weight_w: cfg.weight_w - 1,
+            ..cfg
+        },
+        "a one-bit-narrower weight",
+        1470,
     );
 }

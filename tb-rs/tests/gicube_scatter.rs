@@ -61,6 +61,15 @@ fn base(cfg: &ScatterConfig) -> ScatterIn {
 }
 
 /// Every material extreme on one geometry, over many ray bits.
+/// `base` with direction `dir` and gradient `grad`.
+fn at(cfg: &ScatterConfig, dir: [i32; 3], grad: [i32; 3]) -> ScatterIn {
+    ScatterIn {
+        dir,
+        grad,
+        ..base(cfg)
+    }
+}
+
 fn with_materials(cfg: &ScatterConfig, geo: ScatterIn, rays: u32) -> Vec<ScatterIn> {
     let one = cfg.mat_one();
     let mut out = Vec::new();
@@ -104,15 +113,7 @@ fn zero_gradient_and_zero_direction() {
         let mut items = Vec::new();
         for dir in [[one, 0, 0], [0, 0, 0], [-one, one, -one], [1, 0, 0]] {
             for grad in [[0, 0, 0], [1, 0, 0], [0, 0, -1]] {
-                items.extend(with_materials(
-                    &cfg,
-                    ScatterIn {
-                        dir,
-                        grad,
-                        ..base(&cfg)
-                    },
-                    8,
-                ));
+                items.extend(with_materials(&cfg, at(&cfg, dir, grad), 8));
             }
         }
         let model = Scatter::new(cfg).unwrap();
@@ -234,15 +235,7 @@ fn directions_along_an_axis() {
                     for gv in [g.0, g.1, 1, -1] {
                         let mut grad = [0; 3];
                         grad[gaxis] = gv;
-                        items.extend(with_materials(
-                            &cfg,
-                            ScatterIn {
-                                dir,
-                                grad,
-                                ..base(&cfg)
-                            },
-                            1,
-                        ));
+                        items.extend(with_materials(&cfg, at(&cfg, dir, grad), 1));
                     }
                 }
             }

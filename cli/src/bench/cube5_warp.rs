@@ -15,17 +15,6 @@ use std::time::Instant;
 
 pub const TOP: &str = WarpConfig::TOP;
 
-fn random_base(rng: &mut ChaCha8Rng, side: usize, color_w: u32) -> BaseCodes {
-    let max = (1u32 << color_w) - 1;
-    BaseCodes {
-        width: side,
-        height: side,
-        codes: (0..side * side)
-            .map(|_| std::array::from_fn(|_| rng.random_range(0..=max)))
-            .collect(),
-    }
-}
-
 /// The base plane rotated by `deg` and magnified `zoom` times about its centre onto `out^2` pixels.
 fn rotation(side: usize, out: u32, deg: f64, zoom: f64) -> Affine {
     let s = side as f64 / f64::from(out) / zoom;
@@ -53,7 +42,7 @@ pub fn run(n_items: usize) -> Result<()> {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let side = cfg.max_base.min(128) as usize;
         let out = ((n_items as f64).sqrt() as u32).clamp(4, cfg.max_out);
-        let base = random_base(&mut rng, side, cfg.color_w);
+        let base = BaseCodes::random(&mut rng, side, side, cfg.color_w);
         let regs = WarpRegs::set_up(
             &rotation(side, out, 30.0, 1.3),
             (side as u32, side as u32),
@@ -108,7 +97,7 @@ pub fn run(n_items: usize) -> Result<()> {
         let out = cfg.max_out.min(128);
         let mut s = ErrorStats::default();
         for _ in 0..20 {
-            let base = random_base(&mut rng, side, cfg.color_w);
+            let base = BaseCodes::random(&mut rng, side, side, cfg.color_w);
             let a = rotation(
                 side,
                 out,

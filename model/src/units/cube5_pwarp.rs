@@ -7,16 +7,19 @@
 //! the same at the scanlines' sample points (what the contract's error bound is stated against),
 //! and [`read_counts`] the source reads of patent [84]-[87] against the naive inverse warp's.
 
-use crate::bits::{BitReader, BitWriter};
+use crate::bits::BitReader;
 use crate::error::{ModelError, Result};
 use crate::regs::cube5_pwarp::{
-    OP_LINE, OP_TEXEL, OP_WRITE, REG_BASE_H, REG_BASE_W, REG_MODE, REG_PHASE, REG_SLOPE, REG_X,
-    REG_XS, REG_Y, REG_YS, SLOPE_FRAC_W,
+    OP_LINE, REG_BASE_H, REG_BASE_W, REG_MODE, REG_PHASE, REG_SLOPE, REG_X, REG_XS, REG_Y, REG_YS,
+    SLOPE_FRAC_W,
 };
 use crate::regs::cube5_warp::{COORD_FRAC_W, COORD_LIMIT, COORD_W, OUT_CODE_W, REG_ADDR_W};
 use crate::render::ImageF64;
 use crate::unit::{StreamCodec, StreamUnit};
-use crate::units::cube5_warp::{bilinear_f64, pixel_at, BaseCodes, TexelMem, WarpConfig};
+use crate::units::cube5_warp::{
+    bilinear_f64, pixel_at, run_items, BaseCodes, BaseColorW, TexelMem, WarpConfig, WarpIn,
+    WarpItems,
+};
 use std::collections::HashSet;
 
 /// One configuration of the `cube5_pwarp` RTL (the parameters of the same names).
@@ -407,35 +410,16 @@ pub fn frame_items(cfg: &PwarpConfig, setup: &PwarpSetup, base: &BaseCodes) -> V
     items
 }
 
-/// One input item: `op`, `addr`, `payload` (`cube5_warp`'s packing).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PwarpIn {
-    pub op: u32,
-    pub addr: u32,
-    pub payload: u64,
+/// One input item: `cube5_warp`'s (`op`, `addr`, `payload`), whose op 2 is `Line` here.
+pub type PwarpIn = WarpIn;
+
+impl BaseColorW for PwarpConfig {
+    fn color_w(&self) -> u32 {
+        self.color_w
+    }
 }
 
-impl PwarpIn {
-    pub fn write(addr: u32, data: u64) -> Self {
-        Self {
-            op: OP_WRITE,
-            addr,
-            payload: data,
-        }
-    }
-
-    pub fn texel(cfg: &PwarpConfig, rgb: [u32; 3]) -> Self {
-        let c = cfg.color_w;
-        let m = (1u64 << c) - 1;
-        Self {
-            op: OP_TEXEL,
-            addr: 0,
-            payload: (u64::from(rgb[0]) & m)
-                | (u64::from(rgb[1]) & m) << c
-                | (u64::from(rgb[2]) & m) << (2 * c),
-        }
-    }
-
+impl WarpIn {
     /// `Line` with `U0`, `V0` (`o` bits each) and `N` (`o + 1` bits), LSB first.
     pub fn line(cfg: &PwarpConfig, u0: u32, v0: u32, n: u32) -> Self {
         let o = cfg.out_log2();
@@ -694,6 +678,10 @@ impl Pwarp {
     fn stored(&self, x: i64, y: i64) -> [u32; 3] {
         self.tex.stored(x, y, (self.regs.base_w, self.regs.base_h))
     }
+}
+
+impl WarpItems for Pwarp {
+    type Out = PwarpOut;
 
     fn write(&mut self, addr: u32, data: u64) {
         let field = |w: u32| (data & ((1u64 << w) - 1)) as u32;
@@ -716,6 +704,22 @@ impl Pwarp {
             _ => {}
         }
     }
+
+    fn store(&mut self, payload: u64) {
+        self.tex.store(payload, self.cfg.color_w, self.regs.base_w);
+    }
+
+    fn restart(&mut self) {
+        self.tex.restart();
+    }
+
+    /// The samples of a `Line`: `U0`, `V0` (`o` bits each), `N` (`o + 1` bits), LSB first.
+    fn emit(&self, payload: u64, out: &mut Vec<PwarpOut>) {
+        let o = self.cfg.out_log2();
+        let f = |lsb: u32, w: u32| ((payload >> lsb) & ((1u64 << w) - 1)) as u32;
+        let line = (f(0, o), f(o, o), f(2 * o, o + 1));
+        line_samples(&self.cfg, &self.regs, line, |x, y| self.stored(x, y), out);
+    }
 }
 
 impl StreamUnit for Pwarp {
@@ -724,33 +728,7 @@ impl StreamUnit for Pwarp {
 
     /// Every sample of the `Line` items among `inputs`.
     fn run(&mut self, inputs: &[PwarpIn]) -> Vec<PwarpOut> {
-        let mut out = Vec::new();
-        let o = self.cfg.out_log2();
-        for it in inputs {
-            match it.op & 3 {
-                OP_WRITE => {
-                    self.write(it.addr & ((1 << REG_ADDR_W) - 1), it.payload);
-                    self.tex.restart();
-                }
-                OP_TEXEL => self
-                    .tex
-                    .store(it.payload, self.cfg.color_w, self.regs.base_w),
-                OP_LINE => {
-                    let f = |lsb: u32, w: u32| ((it.payload >> lsb) & ((1u64 << w) - 1)) as u32;
-                    let line = (f(0, o), f(o, o), f(2 * o, o + 1));
-                    line_samples(
-                        &self.cfg,
-                        &self.regs,
-                        line,
-                        |x, y| self.stored(x, y),
-                        &mut out,
-                    );
-                    self.tex.restart();
-                }
-                _ => {}
-            }
-        }
-        out
+        run_items(self, inputs)
     }
 
     /// Registers and texel position to 0; the block RAM keeps its contents (not reset).
@@ -773,11 +751,7 @@ impl StreamCodec for PwarpConfig {
     }
 
     fn pack_in(&self, item: &PwarpIn) -> Vec<u32> {
-        let mut w = BitWriter::new();
-        w.put(item.payload, self.pay_w());
-        w.put(u64::from(item.addr), REG_ADDR_W);
-        w.put(u64::from(item.op), 2);
-        w.finish(self.in_width())
+        item.pack(self.pay_w())
     }
 
     fn unpack_out(&self, words: &[u32]) -> PwarpOut {
@@ -800,17 +774,6 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-
-    fn random_base(rng: &mut ChaCha8Rng, w: usize, h: usize, color_w: u32) -> BaseCodes {
-        let max = (1u32 << color_w) - 1;
-        BaseCodes {
-            width: w,
-            height: h,
-            codes: (0..w * h)
-                .map(|_| std::array::from_fn(|_| rng.random_range(0..=max)))
-                .collect(),
-        }
-    }
 
     fn random_map(rng: &mut ChaCha8Rng, out: (u32, u32), base: (u32, u32)) -> Projective {
         Projective::tilted(
@@ -839,7 +802,7 @@ mod tests {
             let setup = PwarpSetup::new(&map, (40, 30), out).unwrap();
             assert_eq!(setup.samples(), u64::from(out.0 * out.1), "{map:?}");
             let cfg = PwarpConfig::DEFAULT;
-            let base = random_base(&mut rng, 40, 30, 8);
+            let base = BaseCodes::random(&mut rng, 40, 30, 8);
             assert!(warp_image(&cfg, &setup, &base).is_ok(), "{map:?} {out:?}");
         }
     }
@@ -859,7 +822,7 @@ mod tests {
             let out = (rng.random_range(1..=64), rng.random_range(1..=64));
             let map = random_map(&mut rng, out, (bw, bh));
             let setup = PwarpSetup::new(&map, (bw, bh), out).unwrap();
-            let base = random_base(&mut rng, bw as usize, bh as usize, cfg.color_w);
+            let base = BaseCodes::random(&mut rng, bw as usize, bh as usize, cfg.color_w);
             let got = unit.run(&frame_items(&cfg, &setup, &base));
             assert_eq!(got, warp_samples(&cfg, &setup, &base));
         }
@@ -876,7 +839,7 @@ mod tests {
             let out = (rng.random_range(8..=256), rng.random_range(8..=256));
             let map = random_map(&mut rng, out, (bw, bh));
             let setup = PwarpSetup::new(&map, (bw, bh), out).unwrap();
-            let base = random_base(&mut rng, bw as usize, bh as usize, cfg.color_w);
+            let base = BaseCodes::random(&mut rng, bw as usize, bh as usize, cfg.color_w);
             let got = warp_samples(&cfg, &setup, &base);
             let want = reference_at_samples(&map, &setup, &base, cfg.color_w);
             let mut k = 0;

@@ -686,15 +686,7 @@ mod tests {
             let out = unit.run(&[SbufIn::Section(bad)]);
             assert_eq!(out, vec![Beam::error(c.p)]);
         }
-        let stray = FetchItem {
-            lanes: vec![1; 4],
-            blk: [0; 3],
-            word: 0,
-            skip: false,
-            last: false,
-            error: false,
-            resp_err: false,
-        };
+        let stray = FetchItem::stray(4);
         assert!(unit.run(&[SbufIn::Item(stray)]).is_empty());
     }
 

@@ -267,6 +267,18 @@ pub struct Sweep {
 }
 
 impl Sweep {
+    /// The sweep over every block of a volume of `blocks` at `base`: along z, front to back.
+    pub fn whole(base: u64, blocks: [u32; 3]) -> Self {
+        Self {
+            base,
+            blocks,
+            axis_k: 2,
+            reversed: false,
+            sec_lo: 0,
+            sec_hi: blocks[0],
+        }
+    }
+
     /// The whole-face sweep of a frame (`FrameParams`: slice axis and direction) over a volume
     /// of `dims` voxels in blocks of `block`.
     pub fn of_frame(params: &FrameParams, dims: [usize; 3], block: u32, base: u64) -> Self {
@@ -353,6 +365,21 @@ pub struct FetchItem {
     pub last: bool,
     pub error: bool,
     pub resp_err: bool,
+}
+
+impl FetchItem {
+    /// `p` voxels of 1 in block (0, 0, 0), word 0, no flags: an item no section asked for.
+    pub fn stray(p: u32) -> Self {
+        Self {
+            lanes: vec![1; p as usize],
+            blk: [0; 3],
+            word: 0,
+            skip: false,
+            last: false,
+            error: false,
+            resp_err: false,
+        }
+    }
 }
 
 /// What a command list produces: the output items and the reader's commands, in order.
@@ -888,14 +915,7 @@ mod tests {
     fn refused_sweeps_answer_one_error_item() {
         let c = VolFetchConfig { max_dim: 32, ..C };
         let mut unit = VolFetch::new(c).unwrap();
-        let ok = Sweep {
-            base: 0,
-            blocks: [4, 4, 4],
-            axis_k: 2,
-            reversed: false,
-            sec_lo: 0,
-            sec_hi: 4,
-        };
+        let ok = Sweep::whole(0, [4, 4, 4]);
         for bad in [
             Sweep { axis_k: 3, ..ok },
             Sweep {

@@ -245,6 +245,18 @@ pub struct BaseCodes {
 }
 
 impl BaseCodes {
+    /// A `w x h` plane of uniformly random `ColorW`-bit codes (test and benchmark data).
+    pub fn random(rng: &mut impl rand::Rng, w: usize, h: usize, color_w: u32) -> Self {
+        let max = (1u32 << color_w) - 1;
+        Self {
+            width: w,
+            height: h,
+            codes: (0..w * h)
+                .map(|_| std::array::from_fn(|_| rng.random_range(0..=max)))
+                .collect(),
+        }
+    }
+
     /// Texel `(x, y)`, 0 outside the base plane.
     pub fn texel(&self, x: i64, y: i64) -> [u32; 3] {
         if x < 0 || y < 0 || x >= self.width as i64 || y >= self.height as i64 {
@@ -447,7 +459,8 @@ pub fn error_bound(cfg: &WarpConfig, px: u32, py: u32) -> f64 {
     0.5 + 255.0 * (e_u + e_l + 2.0 * e_w + 2.0 * e_c)
 }
 
-/// One input item (`docs/numerics/warp.md`, "Input item"): `op`, `addr`, `payload`.
+/// One input item (`docs/numerics/warp.md`, "Input item"): `op`, `addr`, `payload`; also
+/// `cube5_pwarp`'s (`PwarpIn`), whose op 2 is `Line`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct WarpIn {
     pub op: u32,
@@ -464,8 +477,9 @@ impl WarpIn {
         }
     }
 
-    pub fn texel(cfg: &WarpConfig, rgb: [u32; 3]) -> Self {
-        let c = cfg.color_w;
+    /// `Texel` with codes `rgb` of the configuration's `ColorW` bits.
+    pub fn texel(cfg: &impl BaseColorW, rgb: [u32; 3]) -> Self {
+        let c = cfg.color_w();
         let m = (1u64 << c) - 1;
         Self {
             op: OP_TEXEL,
@@ -483,6 +497,61 @@ impl WarpIn {
             payload: 0,
         }
     }
+
+    /// The item as the RTL's `in_data_i`: payload (`pay_w` bits), addr, op, LSB first.
+    pub fn pack(&self, pay_w: u32) -> Vec<u32> {
+        let mut w = BitWriter::new();
+        w.put(self.payload, pay_w);
+        w.put(u64::from(self.addr), REG_ADDR_W);
+        w.put(u64::from(self.op), 2);
+        w.finish(pay_w + REG_ADDR_W + 2)
+    }
+}
+
+/// A configuration whose base plane holds codes of `ColorW` bits (both warps').
+pub trait BaseColorW {
+    fn color_w(&self) -> u32;
+}
+
+impl BaseColorW for WarpConfig {
+    fn color_w(&self) -> u32 {
+        self.color_w
+    }
+}
+
+/// A warp's stream model around its own registers: both warps take items alike (a `Write`
+/// restarts the texel position, a `Texel` stores and advances it, op 2 (`Go`, `Line`) emits and
+/// restarts it, op 3 does nothing).
+pub(crate) trait WarpItems {
+    type Out;
+    /// Register `addr` written with `data`.
+    fn write(&mut self, addr: u32, data: u64);
+    /// A `Texel` item's payload stored at the texel position.
+    fn store(&mut self, payload: u64);
+    /// The texel position back to (0, 0).
+    fn restart(&mut self);
+    /// The outputs of an op-2 item with `payload`.
+    fn emit(&self, payload: u64, out: &mut Vec<Self::Out>);
+}
+
+/// The outputs of `inputs` on `unit`.
+pub(crate) fn run_items<U: WarpItems>(unit: &mut U, inputs: &[WarpIn]) -> Vec<U::Out> {
+    let mut out = Vec::new();
+    for it in inputs {
+        match it.op & 3 {
+            OP_WRITE => {
+                unit.write(it.addr & ((1 << REG_ADDR_W) - 1), it.payload);
+                unit.restart();
+            }
+            OP_TEXEL => unit.store(it.payload),
+            OP_GO => {
+                unit.emit(it.payload, &mut out);
+                unit.restart();
+            }
+            _ => {}
+        }
+    }
+    out
 }
 
 /// One output pixel: 8-bit R, G, B, `last` (end of a row, `tlast`), `user` (frame start, `tuser`).
@@ -586,6 +655,10 @@ impl Warp {
     fn stored(&self, x: i64, y: i64) -> [u32; 3] {
         self.tex.stored(x, y, (self.regs.base_w, self.regs.base_h))
     }
+}
+
+impl WarpItems for Warp {
+    type Out = WarpOut;
 
     fn write(&mut self, addr: u32, data: u64) {
         let field = |w: u32| (data & ((1u64 << w) - 1)) as u32;
@@ -610,8 +683,16 @@ impl Warp {
         }
     }
 
+    fn store(&mut self, payload: u64) {
+        self.tex.store(payload, self.cfg.color_w, self.regs.base_w);
+    }
+
+    fn restart(&mut self) {
+        self.tex.restart();
+    }
+
     /// The image of a `Go`: exact steps from `X0, Y0`, raster order.
-    fn emit(&self, out: &mut Vec<WarpOut>) {
+    fn emit(&self, _payload: u64, out: &mut Vec<WarpOut>) {
         let r = self.regs;
         let (mut row_x, mut row_y) = (r.x0, r.y0);
         for py in 0..r.out_h {
@@ -637,24 +718,7 @@ impl StreamUnit for Warp {
 
     /// Every output pixel of the `Go` items among `inputs` (a `Go` emits `OutW x OutH` of them).
     fn run(&mut self, inputs: &[WarpIn]) -> Vec<WarpOut> {
-        let mut out = Vec::new();
-        for it in inputs {
-            match it.op & 3 {
-                OP_WRITE => {
-                    self.write(it.addr & ((1 << REG_ADDR_W) - 1), it.payload);
-                    self.tex.restart();
-                }
-                OP_TEXEL => self
-                    .tex
-                    .store(it.payload, self.cfg.color_w, self.regs.base_w),
-                OP_GO => {
-                    self.emit(&mut out);
-                    self.tex.restart();
-                }
-                _ => {}
-            }
-        }
-        out
+        run_items(self, inputs)
     }
 
     /// Registers and texel position to 0; the block RAM keeps its contents (not reset).
@@ -677,11 +741,7 @@ impl StreamCodec for WarpConfig {
     }
 
     fn pack_in(&self, item: &WarpIn) -> Vec<u32> {
-        let mut w = BitWriter::new();
-        w.put(item.payload, self.pay_w());
-        w.put(u64::from(item.addr), REG_ADDR_W);
-        w.put(u64::from(item.op), 2);
-        w.finish(self.in_width())
+        item.pack(self.pay_w())
     }
 
     fn unpack_out(&self, words: &[u32]) -> WarpOut {
@@ -700,17 +760,6 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-
-    fn random_base(rng: &mut ChaCha8Rng, w: usize, h: usize, color_w: u32) -> BaseCodes {
-        let max = (1u32 << color_w) - 1;
-        BaseCodes {
-            width: w,
-            height: h,
-            codes: (0..w * h)
-                .map(|_| std::array::from_fn(|_| rng.random_range(0..=max)))
-                .collect(),
-        }
-    }
 
     fn random_affine(rng: &mut ChaCha8Rng, w: usize, h: usize, out: u32) -> Affine {
         let ang: f64 = rng.random_range(0.0..std::f64::consts::TAU);
@@ -748,7 +797,7 @@ mod tests {
     fn identity_returns_the_codes() {
         let cfg = WarpConfig::DEFAULT;
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let base = random_base(&mut rng, 9, 7, 8);
+        let base = BaseCodes::random(&mut rng, 9, 7, 8);
         let regs = WarpRegs::set_up(
             &Affine {
                 x0: 0.0,
@@ -784,7 +833,7 @@ mod tests {
                 let mb = cfg.max_base as usize;
                 let (w, h) = (rng.random_range(1..=mb), rng.random_range(1..=mb));
                 let out = rng.random_range(1..=cfg.max_out.min(40));
-                let base = random_base(&mut rng, w, h, cfg.color_w);
+                let base = BaseCodes::random(&mut rng, w, h, cfg.color_w);
                 let a = random_affine(&mut rng, w, h, out);
                 let regs = WarpRegs::set_up(&a, (w as u32, h as u32), (out, out + 1)).unwrap();
                 let mut unit = Warp::new(cfg).unwrap();
@@ -824,7 +873,7 @@ mod tests {
             for _ in 0..40 {
                 let (w, h) = (rng.random_range(1..=24), rng.random_range(1..=24));
                 let out = rng.random_range(1..=64);
-                let base = random_base(&mut rng, w, h, cfg.color_w);
+                let base = BaseCodes::random(&mut rng, w, h, cfg.color_w);
                 let mut a = random_affine(&mut rng, w, h, out);
                 a.x0 += rng.random_range(-2.0 * w as f64..2.0 * w as f64);
                 a.y0 += rng.random_range(-2.0 * h as f64..2.0 * h as f64);
@@ -849,7 +898,7 @@ mod tests {
             for _ in 0..30 {
                 let (w, h) = (rng.random_range(1..=40), rng.random_range(1..=40));
                 let out = rng.random_range(1..=96);
-                let base = random_base(&mut rng, w, h, cfg.color_w);
+                let base = BaseCodes::random(&mut rng, w, h, cfg.color_w);
                 let a = random_affine(&mut rng, w, h, out);
                 let regs = WarpRegs::set_up(&a, (w as u32, h as u32), (out, out)).unwrap();
                 let got = warp_image(&cfg, &regs, &base);

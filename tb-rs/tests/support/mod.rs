@@ -11,6 +11,9 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::fmt::Debug;
 
+pub mod axi;
+pub mod warp;
+
 /// Random items per configuration in the long co-simulation runs (the acceptance figure).
 pub const MILLION: usize = 1_000_000;
 
@@ -325,35 +328,10 @@ pub fn axi_protocol_clean<C: StreamCodec>(
     Ok(())
 }
 
-/// The AR handshakes since the last call against the model's bursts, in order (address, beats,
-/// ARSIZE = `size`, INCR, ID 0); `context` names burst `k` for the report. Returns the count.
-pub fn compare_ar<C: StreamCodec>(
-    dut: &mut RtlStream<C>,
-    bursts: &[cube5_model::units::cube5_axi_rd::Burst],
-    size: u32,
-    variant: &'static Variant,
-    seed: u64,
-    context: impl Fn(usize) -> String,
-) -> Result<usize, cube5_tb::TbError> {
-    let ars = dut.axi_take_ar()?;
-    compare_handshakes(&ars, "AR", bursts, size, variant, seed, context)
-}
-
-/// The AW handshakes since the last call against the model's bursts, as `compare_ar` does for AR.
-pub fn compare_aw<C: StreamCodec>(
-    dut: &mut RtlStream<C>,
-    bursts: &[cube5_model::units::cube5_axi_rd::Burst],
-    size: u32,
-    variant: &'static Variant,
-    seed: u64,
-    context: impl Fn(usize) -> String,
-) -> Result<usize, cube5_tb::TbError> {
-    let aws = dut.axi_take_aw()?;
-    compare_handshakes(&aws, "AW", bursts, size, variant, seed, context)
-}
-
-/// Address-channel handshakes (`ch` is "AR" or "AW") against the model's bursts, in order.
-fn compare_handshakes(
+/// Address-channel handshakes (`dut.axi_take_ar()` or `axi_take_aw()`; `ch` is "AR" or "AW")
+/// against the model's bursts, in order (address, beats, `size`, INCR, ID 0); `context` names burst
+/// `k` for the report. Returns the count.
+pub fn compare_bursts(
     ars: &[cube5_tb::rtl::ArHandshake],
     ch: &str,
     bursts: &[cube5_model::units::cube5_axi_rd::Burst],

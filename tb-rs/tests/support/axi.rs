@@ -1,0 +1,204 @@
+//! The run scaffolding the AXI manager tests (cube5_axi_rd, cube5_axi_wr, cube5_vol_fetch) share:
+//! opening a top with its subordinate loaded, a reset that must leave nothing in flight, the
+//! random subordinate, the pass line, the checker's refusals, and the test loops over the
+//! configurations. The comparisons themselves are in `support` (`compare_*`, `axi_protocol_clean`).
+
+use super::{configs, gate_configs, seed};
+use cube5_model::unit::{StreamCodec, UnitConfig};
+use cube5_model::units::cube5_axi_rd::AxiMemImage;
+use cube5_tb::rtl::{AxiMemSetup, RtlStream};
+use cube5_tb::{Mismatch, TbError, Variant};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::fmt::Debug;
+use std::path::PathBuf;
+
+/// `variant` on `cfg`, its subordinate set up with `setup` and holding `mem`, recording the
+/// waveform window of `trace` (set by `with_waves` on a re-run after a mismatch).
+pub fn open<C: StreamCodec>(
+    variant: &'static Variant,
+    cfg: C,
+    seed: u64,
+    (setup, mem): (&AxiMemSetup, &AxiMemImage),
+    trace: &Option<(PathBuf, (u64, u64))>,
+) -> Result<RtlStream<C>, TbError> {
+    let mut dut = RtlStream::new(variant, cfg, seed as u32)?;
+    dut.axi_setup(setup)?;
+    dut.axi_load(mem.base, &mem.bytes)?;
+    if let Some((path, (from, to))) = trace {
+        dut.trace_window(path, *from, *to);
+    }
+    Ok(dut)
+}
+
+/// Resets `dut`; no burst may still be in flight on the subordinate (its write side with
+/// `write`). Returns the bursts the reset dropped.
+pub fn reset_leaves_nothing_in_flight<C: StreamCodec>(
+    dut: &mut RtlStream<C>,
+    variant: &'static Variant,
+    seed: u64,
+    write: bool,
+) -> Result<u64, TbError> {
+    dut.reset();
+    let (in_flight, dropped, what) = if write {
+        let c = dut.axi_wr_counters();
+        (c.in_flight, c.dropped_at_reset, "write bursts")
+    } else {
+        let c = dut.axi_counters();
+        (c.in_flight, c.dropped_at_reset, "bursts")
+    };
+    if in_flight != 0 {
+        return Err(TbError::Protocol {
+            variant: variant.name.to_string(),
+            seed,
+            cycle: dut.cycle(),
+            what: format!("{in_flight} {what} still in flight after the reset"),
+        });
+    }
+    Ok(dropped)
+}
+
+/// A bandwidth limit of `U(1..=twice)` half-bytes per cycle on half the seeds, else none.
+pub fn random_bandwidth(rng: &mut ChaCha8Rng, twice: u32) -> (u32, u32) {
+    if rng.random_bool(0.5) {
+        (rng.random_range(1..=twice), 2)
+    } else {
+        (0, 1)
+    }
+}
+
+/// A passing run's report, after its line (`line`, behind the variant and seed); a failure
+/// panics with its report.
+pub fn must_pass<R>(
+    variant: &'static Variant,
+    seed: u64,
+    run: Result<R, TbError>,
+    line: impl Fn(&R) -> String,
+) -> R {
+    match run {
+        Ok(r) => {
+            eprintln!("{variant}: seed {seed}: {}", line(&r));
+            r
+        }
+        Err(e) => panic!("{e}"),
+    }
+}
+
+/// The subordinate's checker bites, and its report reaches the test: each `(setup, rule)` run
+/// (`check`, at seed 77) fails as a protocol error naming the rule and the seed.
+pub fn assert_checker_refuses<R: Debug>(
+    variant: &'static Variant,
+    refusals: Vec<(AxiMemSetup, &str)>,
+    check: impl Fn(AxiMemSetup, u64) -> Result<R, TbError>,
+) {
+    for (setup, rule) in refusals {
+        match check(setup, 77) {
+            Err(e @ TbError::Protocol { .. }) => {
+                let text = e.to_string();
+                assert!(text.contains(rule), "{text}");
+                assert!(text.contains("CUBE5_SEED=77"), "{text}");
+            }
+            Err(e) => panic!("{variant}: expected a protocol error about {rule}, got {e}"),
+            Ok(r) => panic!("{variant}: the checker let it pass ({r:?})"),
+        }
+    }
+}
+
+/// On every configuration, three runs (seeds 400 + 10 x the configuration's index + k) that each
+/// reset in mid-stream and return the bursts the reset dropped; some reset must land with bursts
+/// in flight.
+pub fn resets_land_with_bursts_in_flight<C: UnitConfig + Copy>(
+    run: impl Fn(&'static Variant, C, u64) -> u64,
+) {
+    for (i, (variant, cfg)) in configs::<C>().into_iter().enumerate() {
+        let dropped: u64 = (0..3)
+            .map(|k| run(variant, cfg, seed(400 + 10 * i as u64 + k)))
+            .sum();
+        assert!(
+            dropped > 0,
+            "{variant}: some reset landed with bursts in flight"
+        );
+    }
+}
+
+/// On every configuration: runs (seeds 600 + 100 x the configuration's index + k, `k` from 0)
+/// until they have taken a million items; `run` gets `k` and returns the items of its run.
+pub fn a_million_per_config<C: UnitConfig + Copy>(
+    run: impl Fn(&'static Variant, C, u64, u64) -> u64,
+) {
+    for (i, (variant, cfg)) in configs::<C>().into_iter().enumerate() {
+        let mut items = 0u64;
+        let mut k = 0u64;
+        while items < 1_000_000 {
+            items += run(variant, cfg, seed(600 + 100 * i as u64 + k), k);
+            k += 1;
+        }
+    }
+}
+
+/// On every gate-level build (seed 500): `plain(variant, cfg, 500)`, then `with_reset(variant,
+/// cfg, 501, rng)` with `rng` seeded 500 (for the reset's cycle and the work after it).
+pub fn gate_smoke<C: UnitConfig + Copy>(
+    plain: impl Fn(&'static Variant, C, u64),
+    with_reset: impl Fn(&'static Variant, C, u64, &mut ChaCha8Rng),
+) {
+    for (variant, cfg) in gate_configs::<C>() {
+        let s = seed(500);
+        plain(variant, cfg, s);
+        let mut rng = ChaCha8Rng::seed_from_u64(s);
+        with_reset(variant, cfg, s + 1, &mut rng);
+    }
+}
+
+/// On every configuration, `n` random runs (seeds 100 + 10 x the configuration's index + k).
+pub fn random_runs<C: UnitConfig + Copy>(n: u64, run: impl Fn(&'static Variant, C, u64)) {
+    for (i, (variant, cfg)) in configs::<C>().into_iter().enumerate() {
+        for k in 0..n {
+            run(variant, cfg, seed(100 + 10 * i as u64 + k));
+        }
+    }
+}
+
+/// A mismatch found after a run at `dut`'s cycle: `input` names what was sent, `rtl` and `model`
+/// what each did.
+pub fn mismatch<C: StreamCodec>(
+    dut: &RtlStream<C>,
+    (variant, seed): (&'static Variant, u64),
+    input: String,
+    rtl: String,
+    model: String,
+    what: &str,
+) -> TbError {
+    TbError::from(Mismatch {
+        variant: variant.name.to_string(),
+        seed,
+        cycle: dut.cycle(),
+        input,
+        rtl,
+        model,
+        what: what.into(),
+        ..Default::default()
+    })
+}
+
+/// `err_o` against the model's after `cmds` commands: sticky, set by `some` (the response that
+/// is not OKAY, e.g. "some BRESP") since reset.
+pub fn err_flag_matches<C: StreamCodec>(
+    dut: &RtlStream<C>,
+    (variant, seed): (&'static Variant, u64),
+    cmds: usize,
+    want: bool,
+    some: &str,
+) -> Result<(), TbError> {
+    if dut.axi_counters().err_flag == want {
+        return Ok(());
+    }
+    Err(mismatch(
+        dut,
+        (variant, seed),
+        format!("{cmds} commands"),
+        format!("err_o = {}", !want),
+        format!("err_o = {want}"),
+        &format!("err_o differs (sticky: {some} != OKAY since reset)"),
+    ))
+}
