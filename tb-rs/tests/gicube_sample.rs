@@ -92,6 +92,21 @@ fn random_samples_with_idle_backpressure_and_reset() {
     }
 }
 
+/// The output stalled nine clocks in ten and the input never idle: every stage and both FIFOs
+/// full most of the time (15 items between the input and the shade stage, the FIFOs' most), the
+/// irradiance trilin still never stalled (its assertion is on in the simulation).
+#[test]
+fn a_full_pipeline_under_heavy_back_pressure() {
+    for (i, (variant, cfg)) in configs::<SampleRtlConfig>().into_iter().enumerate() {
+        let s = seed(1680 + i as u64);
+        let check = StreamCheck::new(s, 10_000)
+            .with_traffic(0.0, 0.9)
+            .with_reset_in_batch(0)
+            .with_batch(2_500);
+        random_run_across_a_reset(variant, cfg, s, check);
+    }
+}
+
 /// Tables at the extremes: every entry opaque white, or alpha 1 code, or the entry equal to its
 /// index's bits (so every index bit reaches the output), with `dr` at 16 and 1024 and the
 /// threshold at 1, 4096 or off.
