@@ -14,6 +14,7 @@ use cube5_model::units::cube5_axil::AxilConfig;
 use cube5_model::units::cube5_pwarp::PwarpConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
+use cube5_model::units::gicube_sample::SampleRtlConfig;
 use cube5_model::units::gicube_step::StepConfig;
 use cube5_model::units::{
     cube5_axi_rd::AxiRdConfig, cube5_compos::ComposConfig, cube5_frame::FrameConfig,
@@ -77,6 +78,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == RayQueuesConfig::TOP => agree::<RayQueuesConfig>(v),
         t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
         t if t == StepConfig::TOP => agree::<StepConfig>(v),
+        t if t == SampleRtlConfig::TOP => agree::<SampleRtlConfig>(v),
         other => Err(format!(
             "top {other} has no model configuration (UnitConfig)"
         )),

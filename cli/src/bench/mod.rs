@@ -19,6 +19,7 @@ mod cube5_warp;
 mod gicube_bucket;
 mod gicube_packet_loop;
 mod gicube_ray_queues;
+mod gicube_sample;
 mod gicube_scatter;
 mod gicube_sorter;
 mod gicube_step;
@@ -97,6 +98,11 @@ const BENCHES: &[Bench] = &[
         top: gicube_step::TOP,
         alias: "step",
         run: gicube_step::run,
+    },
+    Bench {
+        top: gicube_sample::TOP,
+        alias: "sample",
+        run: gicube_sample::run,
     },
     Bench {
         top: cube5_skewmem::TOP,

@@ -1,0 +1,393 @@
+// gicube_sample: the GI-Cube block processor's sample datapath (patent [353], [379]-[380], [383];
+// parts I, J, K and L of docs/gicube-rtl.md; contract docs/numerics/gicube_sample.md). Per item,
+// one sample of one ray: the tri-linear density of the cell's eight voxels (cube5_trilin), its
+// classification (cube5_shader, 1-D, unlit), the sample colour (0 for a lighting ray; for a lit
+// rendering ray the classified colour times the tri-linear irradiance of the corners, a second
+// cube5_trilin and three 8 x 16-bit products), and one front-to-back compositing step onto the
+// packet's colour and opacity (cube5_compos with its opacity LUT and termination threshold).
+//
+//   in ─┬─► cube5_trilin (density, 3) ─► cube5_shader (class, 12) ─► shade (1) ─► cube5_compos (6) ─► out
+//       ├─► cube5_trilin (irradiance, 3, never stalls) ──► irr FIFO ──────────┤
+//       └─► side FIFO (colour, opacity, lighting, irr_en) ────────────────────┘
+//
+// The packet fields and the irradiance wait in two small FIFOs, read when the classified sample
+// reaches the shade stage; they hold at most the items inside the density trilin and the shader
+// (one a stage), so they never fill and need no credit. A lighting ray composites a black sample,
+// which leaves its colour unchanged (C + rnd(w 0) = C), so no bypass carries the colour around the
+// compositor. Latency 22, one item per clock when the output is never stalled.
+module gicube_sample #(
+  /// Bits per voxel, 4..16.
+  parameter int unsigned VoxelW = 8
+) (
+  input  logic clk_i,
+  input  logic rst_ni,
+
+  /// Input item valid.
+  input  logic in_valid_i,
+  /// Unit can take an item this cycle.
+  output logic in_ready_o,
+  /// voxels[8] (VoxelW), weights x, y, z (U(0.8)), irr_en, irr[8] (U(2.14)), red, green, blue,
+  /// opacity (U(0.12)), lighting; LSB first.
+  input  logic [gicube_sample_pkg::in_w(VoxelW)-1:0] in_data_i,
+
+  /// Output item valid.
+  output logic out_valid_o,
+  /// Consumer takes the item this cycle.
+  input  logic out_ready_i,
+  /// red, green, blue, opacity (U(0.12)), terminated; LSB first.
+  output logic [gicube_sample_pkg::OutW-1:0] out_data_o,
+
+  /// Configuration write this cycle (tables and registers; they survive reset).
+  input  logic cfg_valid_i,
+  /// Bit 13 clear: classification entry (the index below); set: cube5_compos word (bits 12:0).
+  input  logic [gicube_sample_pkg::CfgAddrW-1:0] cfg_addr_i,
+  /// r, g, b (8 each), a (12) for a classification entry; the cube5_compos word in bits 12:0.
+  input  logic [gicube_sample_pkg::CfgDataW-1:0] cfg_data_i
+);
+
+  // ---------------------------------------------------------------------------
+  // Widths
+  // ---------------------------------------------------------------------------
+  localparam int unsigned WeightW   = gicube_sample_pkg::WeightW;
+  localparam int unsigned FracW     = gicube_sample_pkg::SampleFracW;
+  localparam int unsigned IrrW      = gicube_sample_pkg::IrrW;
+  localparam int unsigned IrrFracW  = gicube_sample_pkg::IrrFracW;
+  localparam int unsigned ChanW     = gicube_sample_pkg::ChanW;
+  localparam int unsigned ColorW    = gicube_sample_pkg::ColorW;
+  localparam int unsigned AlphaW    = gicube_sample_pkg::AlphaW;
+  localparam int unsigned CfgAW     = gicube_sample_pkg::CfgAddrW;
+  localparam int unsigned InW       = gicube_sample_pkg::in_w(VoxelW);
+  localparam int unsigned SampleW   = VoxelW + FracW;
+  localparam int unsigned ClassIdxW = gicube_sample_pkg::class_idx_w(VoxelW);
+
+  // cube5_shader: only its classification table is used; the reflectance map is the smallest the
+  // unit allows (its divider sets the latency: div_stages(1, 1) + 9 = 12 stages).
+  localparam int unsigned RmLog2    = 1;
+  localparam int unsigned RmFracW   = 1;
+  localparam int unsigned DiffW     = 2;
+  localparam int unsigned SpecW     = 1;
+  localparam int unsigned ShGradW   = cube5_shader_pkg::grad_w(VoxelW, FracW);
+  localparam int unsigned ShInW     = cube5_shader_pkg::in_w(VoxelW, FracW);
+  localparam int unsigned ShCfgAW   = cube5_shader_pkg::cfg_addr_w(ClassIdxW, RmLog2);
+  localparam int unsigned ShCfgDW   = cube5_shader_pkg::cfg_data_w(ColorW, AlphaW, DiffW, SpecW);
+  localparam int unsigned ShStages  = cube5_shader_pkg::div_stages(RmLog2, RmFracW) + 9;
+
+  // cube5_compos: ColorW 8, AlphaW 12, ExtraW 0, AccW 12, ZW 1.
+  localparam int unsigned AccW      = 12;
+  localparam int unsigned CxChanW   = AccW + 1;  // U(1.12)
+  localparam int unsigned ZW        = 1;
+  localparam int unsigned CoxelW    = cube5_compos_pkg::coxel_w(ColorW, AccW, ZW);
+  localparam int unsigned CxInW     = cube5_compos_pkg::in_w(ColorW, AlphaW, AccW, ZW);
+
+  // The FIFOs hold at most the items in the density trilin (3) and the shader.
+  localparam int unsigned FifoAW    = $clog2(3 + ShStages);
+  localparam int unsigned FifoDepth = 1 << FifoAW;
+
+  // Input fields, LSB first.
+  localparam int unsigned WeightsLsb  = 8 * VoxelW;
+  localparam int unsigned IrrEnBit    = WeightsLsb + 3 * WeightW;
+  localparam int unsigned IrrLsb      = IrrEnBit + 1;
+  localparam int unsigned ColorLsb    = IrrLsb + 8 * IrrW;
+  localparam int unsigned OpacityLsb  = ColorLsb + 3 * ChanW;
+  localparam int unsigned LightingBit = OpacityLsb + ChanW;
+
+  // Side FIFO entry: colour, opacity, lighting, irr_en (LSB first).
+  localparam int unsigned SideW = 4 * ChanW + 2;
+
+  // Elaboration checks mirror SampleConfig::validate in the model.
+  if (VoxelW < 4 || VoxelW > 16) begin : gen_bad_voxel_w
+    $fatal(1, "gicube_sample: VoxelW must be 4..16");
+  end
+  if (LightingBit != InW - 1) begin : gen_bad_packing
+    $fatal(1, "gicube_sample: input packing and gicube_sample_pkg::in_w disagree");
+  end
+
+  logic in_fire;
+
+  // ---------------------------------------------------------------------------
+  // Configuration: the region bit routes a write to the shader's classification region or to
+  // cube5_compos's word address
+  // ---------------------------------------------------------------------------
+  logic                cfg_class, cfg_compos;
+  logic [ShCfgAW-1:0]  sh_cfg_addr;
+  logic [ShCfgDW-1:0]  sh_cfg_data;
+
+  always_comb begin
+    cfg_class   = cfg_valid_i && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionClass
+                  && cfg_addr_i[CfgAW-2:ClassIdxW] == '0;
+    cfg_compos  = cfg_valid_i && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionCompos;
+    // Region 0 (classification) of the shader's map at the entry's index.
+    sh_cfg_addr = {cube5_shader_pkg::RegionClass, (ShCfgAW-2)'(cfg_addr_i[ClassIdxW-1:0])};
+    sh_cfg_data = ShCfgDW'(cfg_data_i);
+  end
+
+  // ---------------------------------------------------------------------------
+  // I: the density sample, U(VoxelW.4)
+  // ---------------------------------------------------------------------------
+  logic               tri_in_ready, tri_out_valid, tri_out_ready;
+  logic [SampleW-1:0] tri_sample;
+
+  cube5_trilin #(
+    .VoxelW  (VoxelW),
+    .WeightW (WeightW),
+    .FracW   (FracW)
+  ) u_trilin (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (in_valid_i),
+    .in_ready_o  (tri_in_ready),
+    .in_data_i   ({cube5_pkg::TrilinModeLerp, in_data_i[0 +: 8*VoxelW + 3*WeightW]}),
+    .out_valid_o (tri_out_valid),
+    .out_ready_i (tri_out_ready),
+    .out_data_o  (tri_sample)
+  );
+
+  assign in_ready_o = tri_in_ready;
+  assign in_fire    = in_valid_i && tri_in_ready;
+
+  // ---------------------------------------------------------------------------
+  // L (first half): the irradiance, U(2.14). Never stalled (its output goes to a FIFO that never
+  // fills), so it takes an item exactly when the density trilin does.
+  // ---------------------------------------------------------------------------
+  logic            irr_in_ready, irr_valid;
+  logic [IrrW-1:0] irr_sample;
+  logic [8*IrrW+3*WeightW+1:0] irr_in;
+
+  assign irr_in = {cube5_pkg::TrilinModeLerp, in_data_i[WeightsLsb +: 3*WeightW],
+                   in_data_i[IrrLsb +: 8*IrrW]};
+
+  cube5_trilin #(
+    .VoxelW  (IrrW),
+    .WeightW (WeightW),
+    .FracW   (0)
+  ) u_irr_trilin (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (in_fire),
+    .in_ready_o  (irr_in_ready),
+    .in_data_i   (irr_in),
+    .out_valid_o (irr_valid),
+    .out_ready_i (1'b1),
+    .out_data_o  (irr_sample)
+  );
+
+  // ---------------------------------------------------------------------------
+  // J: classification (unlit, 1-D: the index is the sample's top ClassIdxW bits)
+  // ---------------------------------------------------------------------------
+  logic                              sh_in_ready, sh_out_valid, sh_out_ready;
+  logic [ShInW-1:0]                  sh_in;
+  logic [3*ColorW+AlphaW-1:0]        sh_rgba;
+
+  always_comb begin
+    sh_in = '0;  // gradient and magnitude 0
+    sh_in[0 +: SampleW] = tri_sample;
+    sh_in[SampleW + 4*ShGradW + cube5_shader_pkg::ModeUnlit] = 1'b1;
+  end
+
+  cube5_shader #(
+    .VoxelW    (VoxelW),
+    .FracW     (FracW),
+    .ClassIdxW (ClassIdxW),
+    .MagIdxW   (1),
+    .MagShift  (0),
+    .ColorW    (ColorW),
+    .AlphaW    (AlphaW),
+    .RmLog2    (RmLog2),
+    .RmFracW   (RmFracW),
+    .DiffW     (DiffW),
+    .SpecW     (SpecW)
+  ) u_shader (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (tri_out_valid),
+    .in_ready_o  (sh_in_ready),
+    .in_data_i   (sh_in),
+    .out_valid_o (sh_out_valid),
+    .out_ready_i (sh_out_ready),
+    .out_data_o  (sh_rgba),
+    .cfg_valid_i (cfg_class),
+    .cfg_addr_i  (sh_cfg_addr),
+    .cfg_data_i  (sh_cfg_data)
+  );
+
+  assign tri_out_ready = sh_in_ready;
+
+  // ---------------------------------------------------------------------------
+  // The FIFOs: packet fields written as the item enters, the irradiance as it leaves its trilin,
+  // both read as the classified sample enters the shade stage (pop)
+  // ---------------------------------------------------------------------------
+  logic              pop;
+  logic [FifoAW-1:0] side_wp_d, side_wp_q, irr_wp_d, irr_wp_q, rp_d, rp_q;
+  logic [SideW-1:0]  side_mem [FifoDepth];
+  logic [IrrW-1:0]   irr_mem [FifoDepth];
+  logic [SideW-1:0]  side_rd;
+  logic [IrrW-1:0]   irr_rd;
+
+  always_comb begin
+    side_wp_d = in_fire   ? side_wp_q + FifoAW'(1) : side_wp_q;
+    irr_wp_d  = irr_valid ? irr_wp_q + FifoAW'(1) : irr_wp_q;
+    rp_d      = pop       ? rp_q + FifoAW'(1) : rp_q;
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      side_wp_q <= '0;
+      irr_wp_q  <= '0;
+      rp_q      <= '0;
+    end else begin
+      side_wp_q <= side_wp_d;
+      irr_wp_q  <= irr_wp_d;
+      rp_q      <= rp_d;
+    end
+  end
+
+  // Memories: one write port, one asynchronous read port (distributed RAM on ECP5).
+  always_ff @(posedge clk_i) begin
+    if (in_fire) begin
+      side_mem[side_wp_q] <= {in_data_i[IrrEnBit], in_data_i[LightingBit],
+                              in_data_i[ColorLsb +: 4*ChanW]};
+    end
+    if (irr_valid) begin
+      irr_mem[irr_wp_q] <= irr_sample;
+    end
+  end
+
+  assign side_rd = side_mem[rp_q];
+  assign irr_rd  = irr_mem[rp_q];
+
+  // ---------------------------------------------------------------------------
+  // L (second half), the shade stage: rgb = 0 (lighting), e * I (lit), or e; products registered
+  // ---------------------------------------------------------------------------
+  localparam int unsigned ProdW = ColorW + IrrW;
+
+  logic                      shd_en, shd_valid, cx_in_ready;
+  logic                      rd_lighting, rd_irr_en;
+  logic [3*ProdW-1:0]        prod_d, prod_q;
+  logic [4*ChanW-1:0]        pkt_q;      // red, green, blue, opacity
+  logic [AlphaW-1:0]         alpha_q;
+
+  cube5_valid_chain #(
+    .Stages (1)
+  ) u_shd_valid (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (sh_out_valid),
+    .out_ready_i (cx_in_ready),
+    .ready_o     (shd_en),
+    .out_valid_o (shd_valid)
+  );
+
+  assign sh_out_ready = shd_en;
+  assign pop          = sh_out_valid && shd_en;
+  assign rd_lighting  = side_rd[4*ChanW];
+  assign rd_irr_en    = side_rd[4*ChanW+1];
+
+  localparam logic [IrrW-1:0] IrrOne = IrrW'(1) << IrrFracW;
+
+  logic [IrrW-1:0] irr_f;
+
+  always_comb begin
+    // An unlit sample's colour passes as e * 1.0, rounded back to e below.
+    irr_f = rd_irr_en ? irr_rd : IrrOne;
+    for (int c = 0; c < 3; c++) begin
+      logic [ColorW-1:0] e;
+      // A lighting ray's sample is black.
+      e = rd_lighting ? '0 : sh_rgba[c*ColorW +: ColorW];
+      prod_d[c*ProdW +: ProdW] = ProdW'(e) * ProdW'(irr_f);
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (shd_en) begin
+      prod_q  <= prod_d;
+      pkt_q   <= side_rd[0 +: 4*ChanW];
+      alpha_q <= sh_rgba[3*ColorW +: AlphaW];
+    end
+  end
+
+  // rgb_c = min(255, rnd(e_c I, 14)); with I = 1.0 the product is e_c << 14 and rounds to e_c.
+  logic [3*ColorW-1:0] shd_rgb;
+
+  always_comb begin
+    for (int c = 0; c < 3; c++) begin
+      logic [ProdW-IrrFracW:0] r;
+      r = (ProdW-IrrFracW+1)'((prod_q[c*ProdW +: ProdW] + (ProdW'(1) << (IrrFracW - 1)))
+                              >> IrrFracW);
+      shd_rgb[c*ColorW +: ColorW] = (r >> ColorW) != '0 ? {ColorW{1'b1}} : r[ColorW-1:0];
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // K: compositing. Coxel (R, G, B, A = the packet's channels, U(1.12); Z = 1; no geometry; not
+  // terminated), sample (rgb, alpha, depth 0, front to back).
+  // ---------------------------------------------------------------------------
+  logic [CxInW-1:0]  cx_in;
+  logic [CoxelW-1:0] cx_out;
+
+  always_comb begin
+    cx_in = '0;
+    for (int c = 0; c < 4; c++) begin
+      cx_in[c*CxChanW +: CxChanW] = CxChanW'(pkt_q[c*ChanW +: ChanW]);
+    end
+    cx_in[4*CxChanW +: ZW]                      = ZW'(1);
+    cx_in[CoxelW +: 3*ColorW]                   = shd_rgb;
+    cx_in[CoxelW + 3*ColorW +: AlphaW]          = alpha_q;
+    cx_in[CoxelW + 3*ColorW + AlphaW + ZW +: 3] = cube5_compos_pkg::ModeFrontToBack;
+  end
+
+  cube5_compos #(
+    .ColorW (ColorW),
+    .AlphaW (AlphaW),
+    .ExtraW (0),
+    .AccW   (AccW),
+    .ZW     (ZW)
+  ) u_compos (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .cfg_valid_i (cfg_compos),
+    .cfg_addr_i  (cfg_addr_i[AlphaW:0]),
+    .cfg_data_i  (cfg_data_i[AccW:0]),
+    .in_valid_i  (shd_valid),
+    .in_ready_o  (cx_in_ready),
+    .in_data_i   (cx_in),
+    .out_valid_o (out_valid_o),
+    .out_ready_i (out_ready_i),
+    .out_data_o  (cx_out)
+  );
+
+  // ---------------------------------------------------------------------------
+  // Out: each channel min(c', 4095); terminated
+  // ---------------------------------------------------------------------------
+  always_comb begin
+    for (int c = 0; c < 4; c++) begin
+      logic [CxChanW-1:0] v;
+      v = cx_out[c*CxChanW +: CxChanW];
+      out_data_o[c*ChanW +: ChanW] = v[ChanW] ? {ChanW{1'b1}} : v[ChanW-1:0];
+    end
+    out_data_o[4*ChanW] = cx_out[CoxelW-1];
+  end
+
+  // Bits not read: the irradiance trilin's ready (always 1), the compositor's Z and geometry out.
+  logic unused_bits;
+  assign unused_bits = ^{irr_in_ready, cx_out[4*CxChanW +: ZW + 3*ColorW]};
+
+`ifndef SYNTHESIS
+  // A stalled output holds its item (STYLE.md rule 3).
+  OutputHoldsWhileStalled: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
+    else $error("gicube_sample: output changed while stalled");
+  // The irradiance trilin is never stalled, so it takes every item the density trilin takes.
+  IrrTrilinNeverStalls: assert property (@(posedge clk_i) disable iff (!rst_ni) irr_in_ready)
+    else $error("gicube_sample: irradiance trilin not ready");
+  // The irradiance of the item popped has been written (it left its trilin at least 12 clocks
+  // earlier than the classified sample).
+  IrrBeforePop: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      pop |-> irr_wp_q != rp_q)
+    else $error("gicube_sample: popped an irradiance not yet written");
+  // The FIFOs never hold more than their depth (one entry per item in the trilin and shader).
+  SideFifoNeverOverflows: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      in_fire && !pop |-> side_wp_q + FifoAW'(1) != rp_q)
+    else $error("gicube_sample: side FIFO overflow");
+`endif
+
+endmodule
