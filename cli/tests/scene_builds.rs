@@ -248,3 +248,35 @@ fn prefilter_refusals_name_the_field() {
         "the reference ignores volume.prefilter"
     );
 }
+
+/// `cube5 elaborate` lists the pre-pass unit as built beside the frame, with its reason, its
+/// `.variants` line and its area (from the checked-in row's cache, else the line saying it is
+/// not synthesized); `--spec` names both tops for `make cosim`.
+#[test]
+fn elaborate_lists_the_pre_pass_unit() {
+    let scene = scene_path("head-prefilter");
+    let out = cube5(&["elaborate", &scene]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    for needle in [
+        "needs cube5_frame p4m128 (P=4 MaxDim=128)",
+        "built beside it: cube5_sepconv t13w0o2 (TapW=13 WeightFracW=0 OutShift=2): volume.prefilter = \"gauss\"",
+        "cube5_sepconv .variants line: t13w0o2  TapW=13 WeightFracW=0 OutShift=2",
+        "the pre-pass unit cube5_sepconv t13w0o2",
+    ] {
+        assert!(stdout.contains(needle), "`{needle}` missing:\n{stdout}");
+    }
+    assert!(
+        stdout.contains("t13w0o2 adds (Yosys synth_ecp5): ")
+            || stdout.contains("t13w0o2: not synthesized yet"),
+        "{stdout}"
+    );
+    let out = cube5(&["elaborate", "--spec", &scene]);
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim(),
+        "cube5_frame@P=4:MaxDim=128,cube5_sepconv@TapW=13:WeightFracW=0:OutShift=2"
+    );
+    // Without the field, no pre-pass unit.
+    let out = cube5(&["elaborate", &scene_path("head-unshaded")]);
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("cube5_sepconv"));
+}
