@@ -370,7 +370,6 @@ mod tests {
                     Some(pf) => {
                         assert_eq!(name, "head-prefilter");
                         assert_eq!(pf.spec(), spec);
-                        assert_eq!(pf.name(), "t13w0o2");
                         assert!(pf.why.contains("volume.prefilter = \"gauss\""));
                         assert_eq!(e.tops(), format!("{},{spec}", e.spec()));
                     }

@@ -66,7 +66,7 @@ fn the_rtl_pre_pass_is_the_models_voxel_for_voxel() {
     let kernels = built_kernels(12);
     assert!(
         kernels.contains(&Prefilter::Gauss),
-        "cube5_sepconv t13w0o2 is built"
+        "the pre-pass of 12-bit voxels (gauss) is built"
     );
     let s = seed(700);
     for kernel in kernels {
