@@ -7,7 +7,7 @@
 use crate::load_scene;
 use anyhow::{anyhow, Context, Result};
 use cube5_model::scene::Scene;
-use cube5_model::scene_elab::{elaborate, Elaboration};
+use cube5_model::scene_elab::{elaborate, Elaboration, PrefilterBuild};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -46,7 +46,7 @@ pub fn run(args: ElaborateArgs) -> Result<()> {
     let (scene, origin) = load_valid(args.scene.as_deref())?;
     let e = derive(&scene, &origin, args.pipelines)?;
     if args.spec {
-        println!("{}", e.spec());
+        println!("{}", e.tops());
         return Ok(());
     }
     for line in report(&e, &origin) {
@@ -78,7 +78,42 @@ pub fn report(e: &Elaboration, origin: &str) -> Vec<String> {
     }
     out.push(format!(".variants line: {}", e.variants_line()));
     out.push(format!("build: {}", built(e)));
+    if let Some(pf) = &e.prefilter {
+        out.push(format!(
+            "  built beside it: cube5_sepconv {} ({}): {}",
+            pf.name(),
+            pf.spec()
+                .split_once('@')
+                .map_or(String::new(), |(_, p)| p.replace(':', " ")),
+            pf.why
+        ));
+        out.push(format!(
+            "cube5_sepconv .variants line: {}",
+            pf.variants_line()
+        ));
+        out.push(format!("build: {}", built_prefilter(pf)));
+    }
     out
+}
+
+/// Whether this build of `cube5` has the pre-pass unit.
+#[cfg(feature = "rtl")]
+fn built_prefilter(pf: &PrefilterBuild) -> String {
+    match cube5_tb::prefilter::sepconv_variant(&pf.config) {
+        Ok(v) => format!("{v} (built in this cube5; CUBE5_TOPS={})", pf.spec()),
+        Err(_) => format!(
+            "not built in this cube5 (`make cosim SCENE=...` or CUBE5_TOPS={} builds it)",
+            pf.spec()
+        ),
+    }
+}
+
+#[cfg(not(feature = "rtl"))]
+fn built_prefilter(pf: &PrefilterBuild) -> String {
+    format!(
+        "this cube5 has no RTL (feature `rtl`); CUBE5_TOPS={} builds it",
+        pf.spec()
+    )
 }
 
 /// Whether this build of `cube5` has the configuration, under which name.
@@ -132,6 +167,11 @@ impl std::fmt::Display for Area {
 /// The ECP5 area of `e` from scripts/synth.sh (`SYNTH_SPEC`): synthesized when `run`, else only
 /// a cached row; `None` when there is none (or no repository beside this `cube5`).
 pub fn area(e: &Elaboration, run: bool) -> Result<Option<Area>> {
+    area_of("cube5_frame", &e.name(), &e.spec(), run)
+}
+
+/// The ECP5 area of configuration `name` of `top`, given as the `CUBE5_TOPS`-style `spec`.
+pub fn area_of(top: &str, name: &str, spec: &str, run: bool) -> Result<Option<Area>> {
     let repo = cube5_model::repo_root();
     let script = repo.join("scripts/synth.sh");
     if !script.exists() {
@@ -139,7 +179,7 @@ pub fn area(e: &Elaboration, run: bool) -> Result<Option<Area>> {
     }
     let out = Command::new(&script)
         .current_dir(&repo)
-        .env("SYNTH_SPEC", e.spec())
+        .env("SYNTH_SPEC", spec)
         .env("SYNTH_FLOWS", "ecp5")
         .env("SYNTH_FMAX", "0")
         .env("SYNTH_CACHED", if run { "0" } else { "1" })
@@ -148,7 +188,7 @@ pub fn area(e: &Elaboration, run: bool) -> Result<Option<Area>> {
     if !out.status.success() {
         return Err(anyhow!(
             "scripts/synth.sh for {} failed: {}",
-            e.spec(),
+            spec,
             String::from_utf8_lossy(&out.stderr)
                 .lines()
                 .last()
@@ -156,7 +196,7 @@ pub fn area(e: &Elaboration, run: bool) -> Result<Option<Area>> {
         ));
     }
     let text = String::from_utf8_lossy(&out.stdout);
-    let head = format!("| cube5_frame | {} |", e.name());
+    let head = format!("| {top} | {name} |");
     let Some(row) = text.lines().find(|l| l.starts_with(&head)) else {
         return Ok(None);
     };
@@ -209,6 +249,15 @@ pub fn area_lines(e: &Elaboration, run: bool) -> Result<Vec<String>> {
                 f.map_or(format!("not synthesized yet{how}"), |f| f.to_string())
             )),
         }
+    }
+    if let Some(pf) = &e.prefilter {
+        let name = pf.name();
+        out.push(match area_of("cube5_sepconv", &name, &pf.spec(), run)? {
+            Some(a) => {
+                format!("the pre-pass unit cube5_sepconv {name} adds (Yosys synth_ecp5): {a}")
+            }
+            None => format!("the pre-pass unit cube5_sepconv {name}: not synthesized yet{how}"),
+        });
     }
     Ok(out)
 }

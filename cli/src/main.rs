@@ -269,6 +269,9 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let plan = Plan::new(&scene, &vol)?;
     say!("plan: {plan}");
+    // The f64 reference sees the pre-filter's f64 ideal (`volume.prefilter`; the frame filters
+    // its own memory's voxels on the sepconv model).
+    let ref_vol = cube5_model::prefilter::reference_volume(&vol, scene.prefilter())?;
     if scene.run.target.uses_rtl() {
         let done = cosim_for_render(&scene, &args)?;
         if done {
@@ -292,7 +295,7 @@ fn render(args: RenderArgs) -> Result<()> {
         let start = std::time::Instant::now();
         let out = match scene.run.renderer {
             Renderer::Reference => {
-                let img = render_reference(&vol, &tf, &params)?;
+                let img = render_reference(&ref_vol, &tf, &params)?;
                 let what = format!(
                     "f64 reference renderer, step {}{}",
                     params.step,
@@ -383,7 +386,7 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let secs = best;
     if args.compare && scene.run.renderer != Renderer::Reference {
-        let reference = render_reference(&vol, &tf, &params)?;
+        let reference = render_reference(&ref_vol, &tf, &params)?;
         let e = image_error(&img, &reference);
         say!(
             "error against the f64 reference: PSNR {:.1} dB, max abs {:.1}/255, relative Euclidean {:.3}%",

@@ -19,6 +19,7 @@ pub mod camera;
 pub mod er_perspective;
 pub mod error;
 pub mod phantom;
+pub mod prefilter;
 pub mod regmap;
 pub mod regs;
 pub mod render;

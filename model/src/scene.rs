@@ -11,6 +11,7 @@ use crate::camera;
 use crate::er_perspective::{ErMerge, ErScheme};
 use crate::error::{ModelError, Result};
 use crate::phantom::{phantom_by_name, PHANTOMS};
+use crate::prefilter::Prefilter;
 use crate::render::{
     CompositeMode, Light, Material, Projection, Quality, RenderParams, SliceSetup, View,
 };
@@ -78,6 +79,9 @@ pub struct VolumeSpec {
     pub spacing: Option<[f64; 3]>,
     /// Raw files: header bytes to skip.
     pub offset: u64,
+    /// The 3-pass separable pre-filter over the volume before the frame (`none`, `gauss`,
+    /// `gauss-narrow`; `crate::prefilter`). A string so an unknown kernel is refused by name.
+    pub prefilter: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -232,6 +236,7 @@ impl Default for VolumeSpec {
             endian: None,
             spacing: None,
             offset: 0,
+            prefilter: None,
         }
     }
 }
@@ -582,6 +587,23 @@ impl Scene {
                 }
             }
         }
+        if let Some(name) = &v.prefilter {
+            if Prefilter::from_name(name).is_none() {
+                return bad(
+                    "volume.prefilter",
+                    format!(
+                        "unknown kernel `{name}` (known: {})",
+                        crate::prefilter::PREFILTER_NAMES.join(", ")
+                    ),
+                );
+            }
+            if self.gi.is_some() && self.prefilter() != Prefilter::None {
+                return bad(
+                    "volume.prefilter",
+                    "the GI-Cube processor model has no pre-pass (the pre-filter runs before cube5_frame)".into(),
+                );
+            }
+        }
         if let Some(b) = self.transfer.as_ref().and_then(|t| t.boundary) {
             if !(b > 0.0 && b <= 1.0) {
                 return bad("transfer.boundary", format!("{b} is outside (0, 1]"));
@@ -793,6 +815,16 @@ impl Scene {
         Ok(vol)
     }
 
+    /// The pre-filter `volume.prefilter` asks for (`Prefilter::None` when unset; `validate`
+    /// refuses unknown names).
+    pub fn prefilter(&self) -> Prefilter {
+        self.volume
+            .prefilter
+            .as_deref()
+            .and_then(Prefilter::from_name)
+            .unwrap_or_default()
+    }
+
     /// The 2-D transfer function's `transfer.boundary`, if asked for.
     pub fn boundary(&self) -> Option<f64> {
         self.transfer.as_ref().and_then(|t| t.boundary)
@@ -943,6 +975,8 @@ pub enum Unit {
     Warp,
     /// ER-perspective (exponential regions).
     Perspective,
+    /// The 3-pass separable pre-filter over the volume (`cube5_sepconv`, `volume.prefilter`).
+    Prefilter,
 }
 
 impl Unit {
@@ -959,6 +993,7 @@ impl Unit {
             Self::EmptySpaceSkip => "empty-space skip",
             Self::Warp => "warp",
             Self::Perspective => "perspective",
+            Self::Prefilter => "prefilter",
         }
     }
 }
@@ -1127,6 +1162,56 @@ impl Plan {
             },
         );
         let what_if = crate::scene_render::not_expressible(scene);
+        let kernel = scene.prefilter();
+        if kernel != Prefilter::None
+            && !matches!(scene.run.renderer, Renderer::Pipeline | Renderer::Reference)
+        {
+            return Err(ModelError::Config(format!(
+                "volume.prefilter: the pre-pass runs before the frame model (and, as its f64 ideal, the reference); this scene renders on the {} model (run.renderer)",
+                scene.run.renderer.name()
+            )));
+        }
+        if kernel != Prefilter::None
+            && scene.run.renderer == Renderer::Pipeline
+            && !what_if.is_empty()
+        {
+            return Err(ModelError::Config(format!(
+                "volume.prefilter: the pre-pass runs before the frame model only, and this scene renders on the what-if pipeline ({})",
+                what_if.join("; ")
+            )));
+        }
+        // The frame's memory width (the pre-pass filters what the memory holds).
+        let voxel_w = crate::scene_render::frame_config(scene)
+            .map_or(q.voxel_width(vol.bits), |c| c.trilin.voxel_w);
+        match kernel.sepconv_config(voxel_w) {
+            None => add(Unit::Prefilter, false, "volume.prefilter unset".into()),
+            Some(cfg) if scene.run.renderer == Renderer::Reference => add(
+                Unit::Prefilter,
+                true,
+                format!(
+                    "{} {}, the f64 ideal (TapW would be {})",
+                    kernel.name(),
+                    kernel.describe(),
+                    cfg.tap_w
+                ),
+            ),
+            Some(cfg) => {
+                let n = vol.data.len() as u64;
+                add(
+                    Unit::Prefilter,
+                    true,
+                    format!(
+                        "ran: 3-pass {} {} along x, y, z on one cube5_sepconv (TapW={} WeightFracW=0 OutShift={}), edges replicated: {} samples, {} cycles",
+                        kernel.name(),
+                        kernel.describe(),
+                        cfg.tap_w,
+                        cfg.out_shift,
+                        3 * n,
+                        3 * (n + crate::prefilter::SEPCONV_LATENCY)
+                    ),
+                )
+            }
+        }
         if scene.boundary().is_some()
             && !(scene.run.renderer == Renderer::Pipeline && what_if.is_empty())
         {

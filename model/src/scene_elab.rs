@@ -4,11 +4,13 @@
 //! `run.target = "rtl"` run on exactly it, `make cosim SCENE=...` builds it.
 
 use crate::error::{ModelError, Result};
+use crate::prefilter::Prefilter;
 use crate::render::CompositeMode;
 use crate::scene::{Scene, RTL_MAX_EDGE};
 use crate::scene_render::{frame_config, not_expressible};
 use crate::unit::UnitConfig;
 use crate::units::cube5_frame::FrameConfig;
+use crate::units::cube5_sepconv::SepconvConfig;
 
 /// Pipelines when the scene does not say (`run.pipelines`): the patent's design point, four
 /// pipelines at 133 MHz for 256^3 at 30 Hz ([250]).
@@ -21,6 +23,57 @@ pub struct LeftOut {
     pub why: String,
 }
 
+/// The `cube5_sepconv` a pre-filtered scene builds beside the frame (`volume.prefilter`): one
+/// stage running the three passes over the volume before the frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PrefilterBuild {
+    pub kernel: Prefilter,
+    pub config: SepconvConfig,
+    /// The scene's reason and what the parameters follow from.
+    pub why: String,
+}
+
+impl PrefilterBuild {
+    /// The parameters, all three (each differs from the unit's default).
+    pub fn params(&self) -> Vec<(&'static str, i64)> {
+        self.config.to_params()
+    }
+
+    /// Its name by the naming rule (`t13w0o2`).
+    pub fn name(&self) -> String {
+        rule_name(&self.params())
+    }
+
+    /// The `CUBE5_TOPS` entry that builds it.
+    pub fn spec(&self) -> String {
+        format!(
+            "{}@{}",
+            SepconvConfig::TOP,
+            assignments(&self.params(), ":")
+        )
+    }
+
+    /// Its `.variants` line.
+    pub fn variants_line(&self) -> String {
+        format!("{}  {}", self.name(), assignments(&self.params(), " "))
+    }
+}
+
+/// `Param=value`, joined by `sep`.
+fn assignments(params: &[(&'static str, i64)], sep: &str) -> String {
+    let kv: Vec<String> = params.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    kv.join(sep)
+}
+
+/// The naming rule (docs/adding-a-unit.md, "Naming a variant"): each parameter's initial and
+/// value.
+fn rule_name(params: &[(&'static str, i64)]) -> String {
+    params
+        .iter()
+        .map(|(k, v)| format!("{}{v}", k[..1].to_ascii_lowercase()))
+        .collect()
+}
+
 /// The configuration of `cube5_frame` a scene needs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Elaboration {
@@ -29,6 +82,8 @@ pub struct Elaboration {
     pub choices: Vec<(String, String)>,
     /// The units left out of every pipeline, with the reason.
     pub left_out: Vec<LeftOut>,
+    /// The pre-pass unit built beside the frame, when the scene asks for one.
+    pub prefilter: Option<PrefilterBuild>,
 }
 
 impl Elaboration {
@@ -56,7 +111,16 @@ impl Elaboration {
             },
             choices: Vec::new(),
             left_out: Vec::new(),
+            prefilter: None,
         })
+    }
+
+    /// Every `CUBE5_TOPS` entry the scene's run needs: the frame's, then the pre-pass unit's.
+    pub fn tops(&self) -> String {
+        match &self.prefilter {
+            Some(pf) => format!("{},{}", self.spec(), pf.spec()),
+            None => self.spec(),
+        }
     }
 
     /// The `CUBE5_TOPS` entry that builds exactly this configuration (tb-rs/build.rs:
@@ -67,21 +131,13 @@ impl Elaboration {
 
     /// `Param=value` for each of [`Elaboration::params`], joined by `sep`.
     pub fn assignments(&self, sep: &str) -> String {
-        let kv: Vec<String> = self
-            .params()
-            .iter()
-            .map(|(k, v)| format!("{k}={v}"))
-            .collect();
-        kv.join(sep)
+        assignments(&self.params(), sep)
     }
 
     /// The configuration's name by the naming rule (docs/adding-a-unit.md, "Naming a variant"):
     /// each parameter's initial and value, in [`Elaboration::params`] order (`p4m128s0`).
     pub fn name(&self) -> String {
-        self.params()
-            .iter()
-            .map(|(k, v)| format!("{}{v}", k[..1].to_ascii_lowercase()))
-            .collect()
+        rule_name(&self.params())
     }
 
     /// The configuration as a `.variants` line (generated in the build, flag `sim`).
@@ -208,10 +264,27 @@ pub fn elaborate(scene: &Scene, dims: [usize; 3], pipelines: Option<usize>) -> R
             ),
         ));
     }
+    let kernel = scene.prefilter();
+    let prefilter = kernel
+        .sepconv_config(config.trilin.voxel_w)
+        .map(|sep| PrefilterBuild {
+            kernel,
+            config: sep,
+            why: format!(
+                "volume.prefilter = \"{}\": the 3-pass {} filter along x, y, z over the volume before the frame ([204]-[205]); TapW = VoxelW + 1 = {} (voxels zero-extended), WeightFracW = 0 (w = {} is an integer), OutShift = {} (the kernel's sum {} is a shift)",
+                kernel.name(),
+                kernel.describe(),
+                sep.tap_w,
+                kernel.weight().unwrap_or(0),
+                sep.out_shift,
+                kernel.weight().unwrap_or(0) + 2
+            ),
+        });
     Ok(Elaboration {
         config,
         choices,
         left_out,
+        prefilter,
     })
 }
 
@@ -244,6 +317,8 @@ mod tests {
             ("head-2dtf", 4, 128, true, "P=4 MaxDim=128"),
             ("head", 4, 128, true, "P=4 MaxDim=128"),
             ("head-nifti", 4, 64, true, "P=4 MaxDim=64"),
+            ("head-prefilter", 4, 128, true, "P=4 MaxDim=128"),
+            ("head-unshaded", 4, 128, true, "P=4 MaxDim=128"),
             (
                 "head-narrow",
                 2,
@@ -289,6 +364,17 @@ mod tests {
                     format!("cube5_frame@{}", line.replace(' ', ":")),
                     "{name}"
                 );
+                // Only the pre-filtered scene builds the pre-pass unit beside the frame.
+                let spec = "cube5_sepconv@TapW=13:WeightFracW=0:OutShift=2";
+                match &e.prefilter {
+                    Some(pf) => {
+                        assert_eq!(name, "head-prefilter");
+                        assert_eq!(pf.spec(), spec);
+                        assert!(pf.why.contains("volume.prefilter = \"gauss\""));
+                        assert_eq!(e.tops(), format!("{},{spec}", e.spec()));
+                    }
+                    None => assert_ne!(name, "head-prefilter"),
+                }
                 let units: Vec<&str> = e.left_out.iter().map(|l| l.unit).collect();
                 if shade {
                     assert!(units.is_empty(), "{name}: {units:?}");

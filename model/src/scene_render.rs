@@ -145,6 +145,12 @@ pub fn at_voxel_width(vol: &Volume, w: u32) -> Result<Volume> {
     Volume::new(vol.dims, vol.spacing, w, data)
 }
 
+/// `vol` (at the frame's voxel width, as its memory is loaded) after the scene's pre-pass
+/// (`volume.prefilter`: the three passes of `cube5_sepconv`'s model), or as it is without one.
+pub fn prefiltered(scene: &Scene, vol: &Volume) -> Result<Volume> {
+    Ok(crate::prefilter::apply(vol, scene.prefilter())?.map_or_else(|| vol.clone(), |r| r.volume))
+}
+
 /// The scene's lights and material in the frame's axes (the reflectance map's input).
 pub fn scene_phong(scene: &Scene, params: &FrameParams) -> Phong {
     params_phong(&scene.render_params(), params)
@@ -236,7 +242,7 @@ impl FrameJob {
     /// dimensions that are not multiples of `p`; the image does not depend on `p`).
     pub fn new(scene: &Scene, raw: &Volume, cfg: FrameConfig, p: usize) -> Result<Self> {
         let mode = frame_mode(scene.render.mode);
-        let vol = at_voxel_width(raw, cfg.trilin.voxel_w)?;
+        let vol = prefiltered(scene, &at_voxel_width(raw, cfg.trilin.voxel_w)?)?;
         let dir = scene.render_params().direction()?;
         let setup = FrameSetup::new(vol.dims, vol.spacing, dir, p)?;
         // Blocks whose voxels are all 0 are marked empty: the memory skips their beams.

@@ -77,6 +77,11 @@ fn cases() -> Vec<Case> {
         c("volume.endian", RAW_FILE, "[volume]\nfile = \"fields.raw\"\ndims = [20, 18, 16]\ntype = \"u16\"\nendian = \"big\"\n", Frame),
         c("volume.spacing", RAW_FILE, "[volume]\nfile = \"fields.raw\"\ndims = [20, 18, 16]\ntype = \"u16\"\nspacing = [1.0, 1.0, 2.0]\n", Frame),
         c("volume.offset", RAW_FILE, "[volume]\nfile = \"fields.raw\"\ndims = [20, 18, 15]\ntype = \"u16\"\noffset = 720\n", Frame),
+        // The 3-pass pre-filter before the frame; an unknown kernel, and a GI scene, refuse it.
+        c("volume.prefilter", "", "[volume]\nprefilter = \"gauss\"\n", Frame),
+        c("volume.prefilter", "", "[volume]\nprefilter = \"gauss-narrow\"\n", Frame),
+        c("volume.prefilter", "", "[volume]\nprefilter = \"sobel\"\n", Refused),
+        c("volume.prefilter", GI, "[volume]\nprefilter = \"gauss\"\n", Refused),
         // [view]
         c("view.azimuth", "", "[view]\nazimuth = 10.0\n", Frame),
         c("view.elevation", "", "[view]\nelevation = 40.0\n", Frame),

@@ -7,6 +7,7 @@
 //! - [`harness`]: the scoreboard (`check_stream`, `must_match`) and the run presets.
 //! - [`frame`]: driving `cube5_frame` against the frame model, pixel by pixel.
 //! - [`frame_stream`]: `cube5_frame` fed by a beat stream in sections (`Source = 1`).
+//! - [`prefilter`]: the 3-pass pre-filter over a volume through `cube5_sepconv`.
 //! - [`error`]: the one error type, `TbError` (`Setup | Protocol | Deadlock | Mismatch`).
 
 pub mod axil;
@@ -15,6 +16,7 @@ pub mod ffi;
 pub mod frame;
 pub mod frame_stream;
 pub mod harness;
+pub mod prefilter;
 pub mod rtl;
 pub mod variants;
 
