@@ -364,3 +364,105 @@ pub fn frame_items(cfg: &ErConfig, job: &ErJob) -> Result<Vec<ErIn>> {
     out.push(item(OP_EMIT, 0, 0));
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::er_perspective::{ErMerge, ErScheme};
+    use crate::phantom::head_phantom;
+    use crate::render::{Projection, RenderParams};
+    use crate::transfer::TransferFunction;
+
+    fn job(n: usize, fov: f64) -> ErJob {
+        let params = RenderParams {
+            width: 16,
+            height: 16,
+            direction: Some([0.2, -0.1, 1.0]),
+            projection: Projection::Perspective,
+            fov,
+            ..RenderParams::default()
+        };
+        let scheme = ErScheme {
+            rays_per_voxel: 1,
+            merge: ErMerge::Bartlett,
+        };
+        let vol = head_phantom(n, 12).unwrap();
+        let tf = TransferFunction::head_default();
+        ErJob::new(
+            &vol,
+            &tf,
+            &params,
+            &ErConfig::DEFAULT.frame_config(),
+            scheme,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn parameters_round_trip_and_bad_ones_are_refused() {
+        let cfg = ErConfig::DEFAULT;
+        assert_eq!(ErConfig::from_params(&cfg.to_params()).unwrap(), cfg);
+        for bad in [
+            ("MaxDim", 48),
+            ("MaxRays", 2),
+            ("MaxRays", 1 << 15),
+            ("Nope", 1),
+        ] {
+            assert!(ErConfig::from_params(&[bad]).is_err(), "{bad:?}");
+        }
+        // ZW must number every slice.
+        assert!(ErConfig::from_params(&[("MaxDim", 512), ("ZW", 8)]).is_err());
+    }
+
+    /// The sweep's items: the frame's registers and tables, one `Clear` with the farthest
+    /// region's extent, a `Merge` per region boundary just before the first slice of the nearer
+    /// region, the slices from `nk - 1` down to 0, one `Emit`; fields where the contract puts them.
+    #[test]
+    fn a_frame_is_clear_slices_and_merges_back_to_front_then_emit() {
+        let j = job(16, 90.0);
+        let cfg = ErConfig::DEFAULT;
+        let items = frame_items(&cfg, &j).unwrap();
+        let layout = j.setup.layout();
+        let ops: Vec<u32> = items.iter().map(|i| i.op).collect();
+        let clear = ops.iter().position(|&o| o == OP_CLEAR).unwrap();
+        assert!(ops[..clear]
+            .iter()
+            .all(|&o| [OP_WRITE, OP_SHADER, OP_COMPOS].contains(&o)));
+        assert_eq!(ops.last(), Some(&OP_EMIT));
+        let sweep = &items[clear + 1..items.len() - 1];
+        let merges = sweep.iter().filter(|i| i.op == OP_MERGE).count();
+        assert_eq!(merges, layout.regions() - 1);
+        let slices: Vec<u128> = sweep
+            .iter()
+            .filter(|i| i.op == OP_SLICE)
+            .map(|i| i.payload >> (4 * RAY_W + SPACING_W))
+            .collect();
+        let nk = j.setup.params().nk;
+        assert_eq!(slices, (0..nk as u128).rev().collect::<Vec<_>>());
+        let first = &items[clear];
+        let e = layout.extent[layout.regions() - 1];
+        assert_eq!(first.payload & 0xffff, (e.m0 as u128) & 0xffff);
+        assert_eq!((first.payload >> 32) & 0xffff, e.width() as u128);
+        // The volume: Dims, then ni nj nk voxels.
+        let p = j.setup.params();
+        let vol = volume_items(&cfg, &j).unwrap();
+        assert_eq!(vol.len(), 1 + p.ni * p.nj * p.nk);
+        assert_eq!(REG_DIMS_NK.get(vol[0].payload as u64), p.nk as u64);
+    }
+
+    #[test]
+    fn a_volume_or_region_beyond_the_configuration_is_refused() {
+        let small = ErConfig {
+            max_dim_log2: 3,
+            ..ErConfig::DEFAULT
+        };
+        let err = check_job(&small, &job(16, 40.0)).unwrap_err().to_string();
+        assert!(err.contains("MaxDim"), "{err}");
+        let narrow = ErConfig {
+            max_rays: 8,
+            ..ErConfig::DEFAULT
+        };
+        let err = check_job(&narrow, &job(16, 40.0)).unwrap_err().to_string();
+        assert!(err.contains("MaxRays"), "{err}");
+    }
+}
