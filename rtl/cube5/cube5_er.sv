@@ -1,5 +1,6 @@
 // cube5_er: the ER-Perspective sweep (patent [155]-[197]; contract docs/numerics/er_perspective.md,
-// "The RTL: cube5_er"). A first, sequential version: one sample every seven clocks.
+// "The RTL: cube5_er"). A first, sequential version: one composite sample every seven clocks, one
+// MIP sample a clock.
 //
 // The volume sits in four parity-interleaved block-RAM banks (bank i%2 + 2 (j%2)), so the 2 x 2
 // voxels of one bilinear sample are one read of every bank. The host sends the per-slice ray
@@ -280,7 +281,11 @@ module cube5_er #(
   logic signed [PosW-1:0] x0_q, x0_d, x_q, x_d, y_q, y_d;
   logic [2:0]             tap_q, tap_d;
   logic [7:0]             inflight_q, inflight_d;
-  logic                   ray_issue, ray_done;
+  logic                   ray_issue, ray_done, last_tap;
+
+  // MIP shades unlit: the shader ignores the gradient, so a MIP ray takes its C tap alone (one
+  // clock per sample) and the gradient sees zeros for the six neighbours.
+  assign last_tap = mip_q ? 1'b1 : (tap_q == 3'd6);
 
   // X = EI + m H and Y = EJ + n H of the slice's first ray (exact integer products).
   logic signed [PosW-1:0] x_first, y_first;
@@ -407,13 +412,13 @@ module cube5_er #(
   always_comb begin
     gk_d  = gk_q;
     gnb_d = gnb_q;
-    if (tr_valid) begin
+    if (tr_valid && !mip_q) begin
       gk_d = (gk_q == 3'd6) ? 3'd0 : gk_q + 3'd1;
       if (gk_q != 3'd6) gnb_d[gk_q*SampleW +: SampleW] = tr_out;
     end
   end
-  assign nb_valid = tr_valid && (gk_q == 3'd6);
-  assign nb       = {tr_out, gnb_q};
+  assign nb_valid = tr_valid && (mip_q || gk_q == 3'd6);
+  assign nb       = mip_q ? {(6*SampleW)'(0), tr_out} : {tr_out, gnb_q};
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -519,7 +524,7 @@ module cube5_er #(
 
   cube5_frame_fifo #(
     .Width (BufAW),
-    .Depth (16)
+    .Depth (32)
   ) u_fifo_a (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
@@ -805,7 +810,7 @@ module cube5_er #(
       end
 
       StSlice: begin
-        if (tap_q == 3'd6) begin
+        if (last_tap) begin
           tap_d = '0;
           if (m_q == sm1_q) begin
             m_d = sm0_q;
