@@ -629,6 +629,11 @@ module cube5_er #(
     m_raddr = BufAW'(m_row + (2*RayW)'(RayW'(om)));
   end
 
+  // The tap's place in its coxel's nine.
+  logic m_first, m_last;
+  assign m_first = (mu_q == 2'd0) && (mv_q == 2'd0);
+  assign m_last  = (mu_q == 2'd2) && (mv_q == 2'd2);
+
   // Tent weights (1, 2, 1) x (1, 2, 1), or 16 on the centre alone.
   logic [4:0] m_w;
   always_comb begin
@@ -653,8 +658,8 @@ module cube5_er #(
     end
   end
   always_ff @(posedge clk_i) begin
-    mq_first_q <= (mu_q == 2'd0) && (mv_q == 2'd0);
-    mq_last_q  <= (mu_q == 2'd2) && (mv_q == 2'd2);
+    mq_first_q <= m_first;
+    mq_last_q  <= m_last;
     mq_in_q    <= m_in;
     mq_w_q     <= m_w;
     mq_wa_q    <= mwa_q;
