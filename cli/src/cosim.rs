@@ -53,6 +53,14 @@ pub fn run(args: CosimArgs) -> Result<()> {
             );
         }
     }
+    if scene.run.renderer == cube5_model::scene::Renderer::Er {
+        // ER-perspective runs on its own top, cube5_er, not on cube5_frame.
+        let matched = cosim_er(&scene, &origin, &args.out_dir, args.seed)?;
+        if !matched {
+            bail!("the RTL ER-perspective base plane differs from the model (report above)");
+        }
+        return Ok(());
+    }
     let rtl = variant_for(&scene, &origin, args.pipelines)?;
     let result = cosim_scene(&scene, &origin, rtl, &args.out_dir, args.seed)?;
     if !result.matched {
@@ -358,4 +366,104 @@ pub fn frame_cost_section(scene: &Scene) -> Result<String> {
          per clock, which does not shrink with P.\n",
     );
     Ok(md)
+}
+
+/// One ER-perspective frame of `scene` (`run.renderer = "er"`) on `cube5_er` and on the model
+/// (`ErJob::render`, what `cube5 render` computes), compared coxel by coxel; prints the samples
+/// per slice against the N^2 .. 4N^2 bound and the clocks, writes both base planes. Refused,
+/// naming the build, when no built cube5_er configuration holds the scene.
+pub fn cosim_er(scene: &Scene, origin: &str, out_dir: &Path, seed: u32) -> Result<bool> {
+    use cube5_model::er_perspective::ErJob;
+    use cube5_tb::er::{er_variants, first_difference, ErBench};
+    let raw = scene.build_volume()?;
+    let params = scene.render_params();
+    let tf = scene.transfer_function();
+    let want = frame_config(scene)?;
+    let mut refusals = Vec::new();
+    let mut chosen = None;
+    for v in er_variants().into_iter().filter(|v| v.built) {
+        let bench = ErBench::new(v, seed)?;
+        if (bench.cfg.trilin, bench.cfg.shader, bench.cfg.compos)
+            != (want.trilin, want.shader, want.compos)
+        {
+            refusals.push(format!("{v}: other unit widths than the scene's"));
+            continue;
+        }
+        let job = ErJob::new(&raw, &tf, &params, &bench.cfg.frame_config(), scene.er())?;
+        match bench.check(&job) {
+            Ok(()) => {
+                chosen = Some((bench, job));
+                break;
+            }
+            Err(e) => refusals.push(e),
+        }
+    }
+    let Some((mut bench, job)) = chosen else {
+        bail!(
+            "{origin}: no built cube5_er configuration runs this scene ({}); `CUBE5_TOPS=cube5_er` builds them",
+            if refusals.is_empty() {
+                "none built".to_string()
+            } else {
+                refusals.join("; ")
+            }
+        );
+    };
+    std::fs::create_dir_all(out_dir)
+        .with_context(|| format!("output directory {}", out_dir.display()))?;
+    let v = bench.variant();
+    say!(
+        "cosim: {origin}: ER-perspective ({}), {} on {v}",
+        scene.er().describe(),
+        scene.render.mode.name()
+    );
+    let t = Instant::now();
+    let want = job.render();
+    let model_secs = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let load = bench.load(&job)?;
+    let got = bench.frame(&job, &Traffic::full_speed())?;
+    let sim_secs = t.elapsed().as_secs_f64();
+    let st = &want.stats;
+    let matched = match first_difference(&got, &want) {
+        None => {
+            say!(
+                "MATCH: {} x {} base-plane coxels, every field bit-exact",
+                want.extent.width(),
+                want.extent.height()
+            );
+            true
+        }
+        Some(d) => {
+            say!("MISMATCH: {d}");
+            false
+        }
+    };
+    say!(
+        "plan: ER-perspective model (cube5_er RTL): {}",
+        st.describe()
+    );
+    say!(
+        "cycles: volume load {load}, sweep {} ({:.2} clocks per sample; {} samples), frame {} with read-out; simulated {:.2} Mcycles/s; model {:.2} s",
+        got.sweep_cycles,
+        got.sweep_cycles as f64 / st.samples.max(1) as f64,
+        st.samples,
+        got.cycles,
+        (load + got.cycles) as f64 / sim_secs / 1e6,
+        model_secs
+    );
+    let cfg = bench.cfg.compos;
+    let (w, h) = (want.extent.width(), want.extent.height());
+    let mut rtl_coxels = got.coxels.clone();
+    rtl_coxels.resize(w * h, Coxel::empty(&cfg));
+    for (who, coxels) in [("model", &want.coxels), ("rtl", &rtl_coxels)] {
+        let bp = BasePlane {
+            width: w,
+            height: h,
+            coxels: coxels.clone(),
+        };
+        let path = out_dir.join(format!("{who}-er-base-plane.png"));
+        write_png_atomically(&base_plane_png(&bp, &cfg), &path)?;
+        say!("wrote {}", path.display());
+    }
+    Ok(matched)
 }

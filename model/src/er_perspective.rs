@@ -294,6 +294,22 @@ impl ErSetup {
         })
     }
 
+    /// This set-up with the eye moved to `eye` (physical coordinates), the view's axes, scheme
+    /// and image size kept (tests and hosts that place the eye, e.g. inside the bounding sphere).
+    pub fn with_eye_at(&self, eye: [f64; 3]) -> Result<Self> {
+        let mut s = Self::with_eye(
+            self.frame,
+            self.scheme,
+            DVec3::from_array(eye),
+            self.dir,
+            (self.right, self.up),
+            self.tan_half,
+            self.spacing,
+        )?;
+        s.size = self.size;
+        Ok(s)
+    }
+
     pub fn params(&self) -> &FrameParams {
         &self.frame.params
     }

@@ -6,11 +6,13 @@
 //! - [`rtl`]: one Verilated streaming top behind the model's `StreamUnit` trait.
 //! - [`harness`]: the scoreboard (`check_stream`, `must_match`) and the run presets.
 //! - [`frame`]: driving `cube5_frame` against the frame model, pixel by pixel.
+//! - [`er`]: driving `cube5_er` (ER-Perspective) against `ErJob::render`, coxel by coxel.
 //! - [`frame_stream`]: `cube5_frame` fed by a beat stream in sections (`Source = 1`).
 //! - [`prefilter`]: the 3-pass pre-filter over a volume through `cube5_sepconv`.
 //! - [`error`]: the one error type, `TbError` (`Setup | Protocol | Deadlock | Mismatch`).
 
 pub mod axil;
+pub mod er;
 pub mod error;
 pub mod ffi;
 pub mod frame;

@@ -11,6 +11,7 @@ use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_accel_ctrl::AccelCtrlConfig;
 use cube5_model::units::cube5_axi_wr::AxiWrConfig;
 use cube5_model::units::cube5_axil::AxilConfig;
+use cube5_model::units::cube5_er::ErConfig;
 use cube5_model::units::cube5_pwarp::PwarpConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
@@ -79,6 +80,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
         t if t == StepConfig::TOP => agree::<StepConfig>(v),
         t if t == SampleRtlConfig::TOP => agree::<SampleRtlConfig>(v),
+        t if t == ErConfig::TOP => agree::<ErConfig>(v),
         other => Err(format!(
             "top {other} has no model configuration (UnitConfig)"
         )),

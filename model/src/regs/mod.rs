@@ -5,6 +5,7 @@
 pub mod cube5_accel;
 pub mod cube5_axil_regs;
 pub mod cube5_compos;
+pub mod cube5_er;
 pub mod cube5_frame;
 pub mod cube5_pwarp;
 pub mod cube5_warp;

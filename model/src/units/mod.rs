@@ -11,6 +11,7 @@ pub mod cube5_axi_rd;
 pub mod cube5_axi_wr;
 pub mod cube5_axil;
 pub mod cube5_compos;
+pub mod cube5_er;
 pub mod cube5_frame;
 pub mod cube5_gradient;
 pub mod cube5_pwarp;
