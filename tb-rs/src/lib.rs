@@ -6,9 +6,11 @@
 //! - [`rtl`]: one Verilated streaming top behind the model's `StreamUnit` trait.
 //! - [`harness`]: the scoreboard (`check_stream`, `must_match`) and the run presets.
 //! - [`frame`]: driving `cube5_frame` against the frame model, pixel by pixel.
+//! - [`accel`]: the accelerator top `cube5_accel` driven as a host would, image compared in memory.
 //! - [`frame_stream`]: `cube5_frame` fed by a beat stream in sections (`Source = 1`).
 //! - [`error`]: the one error type, `TbError` (`Setup | Protocol | Deadlock | Mismatch`).
 
+pub mod accel;
 pub mod axil;
 pub mod error;
 pub mod ffi;
