@@ -234,6 +234,8 @@ pub struct AccelBench {
     /// What the tables hold: (volume LUT loaded, the frame's configuration writes).
     loaded: Option<Vec<(u32, Vec<u32>)>>,
     lut_loaded: Option<Vec<(u32, u32, Vec<u32>)>>,
+    /// The memory's AR, R and AW counters when the frame started.
+    at_start: (u64, u64, u64),
 }
 
 /// The image's place in memory: right after the volume, 4 KB aligned.
@@ -261,6 +263,7 @@ impl AccelBench {
             host_stall: Vec::new(),
             loaded: None,
             lut_loaded: None,
+            at_start: (0, 0, 0),
         })
     }
 
@@ -363,14 +366,38 @@ impl AccelBench {
         env: &MemEnv,
         mem_seed: u64,
     ) -> Result<FrameRun, TbError> {
+        let img_base = self.start(e, vol, lut, env, mem_seed)?;
+        self.finish(e, img_base, mem_seed)
+    }
+
+    /// The memory loaded and set up, the tables, registers and bases written, the frame started;
+    /// the image base.
+    pub fn start(
+        &mut self,
+        e: &Expected,
+        vol: &Volume,
+        lut: &BlockLut,
+        env: &MemEnv,
+        mem_seed: u64,
+    ) -> Result<u64, TbError> {
         let rtl = self.rtl;
         let img_base = self.load_memory(e, vol, lut, env, mem_seed)?;
         self.host_stall = env.host_stall.clone();
-        let before = self.dut.axi_counters();
-        let aw_before = self.dut.axi_wr_counters().aw_accepted;
+        let c = self.dut.axi_counters();
+        self.at_start = (
+            c.ar_accepted,
+            c.r_beats,
+            self.dut.axi_wr_counters().aw_accepted,
+        );
         let mut host = AccelHost::new(&mut *self, 0);
         start_frame(&mut host, &rtl, e, lut, img_base).map_err(host_err)?;
-        let limit = 200_000 + 40 * (e.params.ni * e.params.nj * e.params.nk / rtl.p) as u64;
+        self.flush(None)?;
+        Ok(img_base)
+    }
+
+    /// Waits for the interrupt, reads the status and the counters, compares the image.
+    pub fn finish(&mut self, e: &Expected, img_base: u64, seed: u64) -> Result<FrameRun, TbError> {
+        let limit = 200_000 + 40 * (e.params.ni * e.params.nj * e.params.nk / self.rtl.p) as u64;
         self.wait_irq(limit)?;
         let mut host = AccelHost::new(&mut *self, 0);
         let st = host.wait_done(1).map_err(host_err)?;
@@ -382,12 +409,18 @@ impl AccelBench {
         let run = FrameRun {
             cycles: c.cycles,
             samples: c.samples,
-            ar: after.ar_accepted - before.ar_accepted,
-            r_beats: after.r_beats - before.r_beats,
-            aw: self.dut.axi_wr_counters().aw_accepted - aw_before,
+            ar: after.ar_accepted - self.at_start.0,
+            r_beats: after.r_beats - self.at_start.1,
+            aw: self.dut.axi_wr_counters().aw_accepted - self.at_start.2,
         };
-        self.compare(e, img_base, mem_seed)?;
+        self.compare(e, img_base, seed)?;
         Ok(run)
+    }
+
+    /// `cycles` clock cycles with the host idle (stops early at the interrupt).
+    pub fn idle(&mut self, cycles: u64) -> Result<(), TbError> {
+        let d = self.dut.drive(&[], &Traffic::full_speed(), 0, cycles)?;
+        self.clean(&d.stats)
     }
 
     /// The volume and a filled image area in the memory, the memory's behaviour; the image base.
@@ -430,7 +463,7 @@ impl AccelBench {
     }
 
     /// Every byte of the image in memory against the model's pixels.
-    fn compare(&self, e: &Expected, img_base: u64, seed: u64) -> Result<(), TbError> {
+    pub fn compare(&self, e: &Expected, img_base: u64, seed: u64) -> Result<(), TbError> {
         let mem = self.dut.axi_image()?;
         let at = (img_base - VOL_BASE) as usize;
         for (i, c) in e.want.iter().enumerate() {

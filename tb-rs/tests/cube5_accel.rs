@@ -14,7 +14,7 @@ use cube5_model::volume::Volume;
 use cube5_tb::accel::{AccelBench, AccelRtl, FrameRun, MemEnv};
 use cube5_tb::frame::{Expected, Look, Render};
 use cube5_tb::TbError;
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::rc::Rc;
 use support::seed;
@@ -73,21 +73,139 @@ fn frame(
     run
 }
 
-/// The first step: the 64^3 head phantom at P = 4, a face view, composite, a quiet memory.
+/// Faces (DX = DY = 0), exactly 45 degrees (DX = 2^16), obliques with DX < 0 and a reversed sweep.
+const VIEWS: &[(&str, [f64; 3])] = &[
+    ("+z", [0.0, 0.0, 1.0]),
+    ("-x", [-1.0, 0.0, 0.0]),
+    ("45 xz", [1.0, 0.0, 1.0]),
+    ("oblique dx<0", [-0.6, 0.3, 1.0]),
+    ("oblique -z", [0.37, 0.81, -1.0]),
+];
+
+/// The 64^3 head phantom at P = 4: every view composite (shaded), three in MIP, each under its
+/// own random memory (latency 10..200, gaps on all five channels, the host's B and R
+/// back-pressured): the image in memory bit-exact.
 #[test]
-fn head_64_p4_face_composite() {
+fn head_64_p4_every_view_composite_and_mip() {
     let s = seed(0xacce1);
     let rtl = rtl(4, 64);
     let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
     let mut bench = must(AccelBench::new(rtl, s));
-    frame(
-        &mut bench,
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    for (n, &view) in VIEWS.iter().enumerate() {
+        let env = MemEnv::random(&mut rng);
+        frame(
+            &mut bench,
+            &vol,
+            &lut,
+            view,
+            Render::Composite,
+            &env,
+            s + n as u64,
+        );
+        if n % 2 == 0 {
+            frame(
+                &mut bench,
+                &vol,
+                &lut,
+                view,
+                Render::Mip,
+                &env,
+                s + 100 + n as u64,
+            );
+        }
+    }
+}
+
+/// A blob with holes (the bubbles phantom, 64^3) at P = 4: a face and 45 degrees, both modes.
+#[test]
+fn bubbles_64_p4() {
+    let s = seed(0xacce2);
+    let rtl = rtl(4, 64);
+    let (vol, lut) = scene(bubbles_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
+    let mut bench = must(AccelBench::new(rtl, s));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    for (view, render) in [
+        (VIEWS[1], Render::Composite),
+        (VIEWS[2], Render::Mip),
+        (VIEWS[3], Render::Composite),
+    ] {
+        let env = MemEnv::random(&mut rng);
+        frame(&mut bench, &vol, &lut, view, render, &env, rng.random());
+    }
+}
+
+/// P = 1: the 64^3 head at 45 degrees (composite) and an oblique view with DX < 0 (MIP).
+#[test]
+fn head_64_p1() {
+    let s = seed(0xacce3);
+    let rtl = rtl(1, 64);
+    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
+    let mut bench = must(AccelBench::new(rtl, s));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    for (view, render) in [(VIEWS[2], Render::Composite), (VIEWS[3], Render::Mip)] {
+        let env = MemEnv::random(&mut rng);
+        frame(&mut bench, &vol, &lut, view, render, &env, rng.random());
+    }
+}
+
+/// A reset in the middle of a frame (reads and writes in flight are dropped on both sides; none
+/// is outstanding after it), then the tables reloaded and the same frame exact.
+#[test]
+fn reset_mid_frame_then_an_exact_frame() {
+    let s = seed(0xacce4);
+    let rtl = rtl(4, 64);
+    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
+    let mut bench = must(AccelBench::new(rtl, s));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let env = MemEnv::random(&mut rng);
+    let view = VIEWS[4];
+    let e = Expected::new(
+        &rtl.frame,
         &vol,
-        &lut,
-        ("+z", [0.0, 0.0, 1.0]),
+        view.0,
+        view.1,
         Render::Composite,
-        &MemEnv::quiet(),
-        s,
+        &Look::default(),
+    )
+    .unwrap();
+    must(bench.start(&e, &vol, &lut, &env, s));
+    must(bench.idle(30_000));
+    let before = bench.dut.axi_counters();
+    assert!(before.in_flight > 0, "reads in flight at the reset");
+    bench.reset();
+    let after = bench.dut.axi_counters();
+    assert_eq!(after.in_flight, 0, "no read outstanding after the reset");
+    assert_eq!(
+        bench.dut.axi_wr_counters().in_flight,
+        0,
+        "no write outstanding after the reset"
     );
-    let _ = (bubbles_phantom, ChaCha8Rng::seed_from_u64(s));
+    let run = must(bench.frame(&e, &vol, &lut, &env, s + 1));
+    report(&rtl, "after a reset mid-frame", 64, &run);
+}
+
+/// The comparison fails when the model disagrees: a frame of one view against another's image.
+#[test]
+fn the_check_fails_when_the_model_disagrees() {
+    let s = seed(0xacce5);
+    let rtl = rtl(4, 64);
+    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
+    let mut bench = must(AccelBench::new(rtl, s));
+    let look = Look::default();
+    let e = Expected::new(&rtl.frame, &vol, "+z", [0.0, 0.0, 1.0], Render::Mip, &look).unwrap();
+    let other = Expected::new(
+        &rtl.frame,
+        &vol,
+        "+z",
+        [0.0, 0.0, 1.0],
+        Render::Composite,
+        &look,
+    )
+    .unwrap();
+    let img_base = must(bench.start(&e, &vol, &lut, &MemEnv::quiet(), s));
+    match bench.finish(&other, img_base, s) {
+        Err(TbError::Mismatch(m)) => eprintln!("as it should: {}", m.what),
+        other => panic!("a MIP image passed as the composite one: {other:?}"),
+    }
 }
