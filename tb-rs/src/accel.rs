@@ -114,6 +114,15 @@ impl AccelRtl {
             .min_by_key(|r| r.frame.max_dim_log2)
     }
 
+    /// The build with `p` pipelines and the widest sections (the throughput configuration), and
+    /// among those the largest memory.
+    pub fn widest(p: usize) -> Option<AccelRtl> {
+        Self::all()
+            .into_iter()
+            .filter(|r| r.p == p)
+            .max_by_key(|r| (r.section, r.frame.max_dim_log2))
+    }
+
     /// The table loads of the frame's configuration writes (shader tables, opacity LUT and
     /// compositing registers): (table, first index, words), runs of consecutive entries.
     pub fn table_loads(&self, writes: &[(u32, Vec<u32>)]) -> Vec<(u32, u32, Vec<u32>)> {

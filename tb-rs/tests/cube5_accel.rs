@@ -209,3 +209,71 @@ fn the_check_fails_when_the_model_disagrees() {
         other => panic!("a MIP image passed as the composite one: {other:?}"),
     }
 }
+
+/// A DDR-like memory: latency `lat` + U(0..20), no gaps, `bw` bytes per cycle shared by reads and
+/// writes.
+fn ddr(lat: u32, bw: u32) -> MemEnv {
+    MemEnv {
+        latency: (lat, 20),
+        gaps: [0; 5],
+        bw: (bw, 1),
+        host_stall: Vec::new(),
+    }
+}
+
+/// Whole-frame cycles of the throughput configuration (P = 4, 4^3 blocks, 32-anchor sections,
+/// 128-bit bus) on the 64^3 head: a fast memory and a DDR-like one (latency 100..120, 12
+/// bytes/cycle), a face and 45 degrees; every image exact.
+#[test]
+fn throughput_of_the_wide_configuration() {
+    let s = seed(0xacce6);
+    let rtl = AccelRtl::widest(4).expect("a P = 4 build of cube5_accel");
+    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
+    let mut bench = must(AccelBench::new(rtl, s));
+    for (env, what) in [
+        (ddr(20, 0), "fast memory"),
+        (ddr(100, 12), "DDR-like 12 B/cycle"),
+    ] {
+        for view in [VIEWS[0], VIEWS[2]] {
+            let run = frame(&mut bench, &vol, &lut, view, Render::Composite, &env, s);
+            eprintln!("  ({what})");
+            assert!(
+                run.rate(rtl.p) > 0.3,
+                "{}: {:.3}",
+                rtl.variant,
+                run.rate(rtl.p)
+            );
+        }
+    }
+}
+
+/// 128^3 frames (head phantom and bubbles) at P = 4 on the throughput configuration, faces, 45
+/// degrees and an oblique view, composite and MIP, random memory.
+#[test]
+#[ignore = "sim-full: 128^3 frames, about 10 s each"]
+fn frames_128_p4() {
+    let s = seed(0xacce7);
+    let rtl = AccelRtl::widest(4).expect("a P = 4 build of cube5_accel");
+    let mut bench = must(AccelBench::new(rtl, s));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    for vol in [
+        head_phantom(128, 12).unwrap(),
+        bubbles_phantom(128, 12).unwrap(),
+    ] {
+        let (vol, lut) = scene(vol, rtl.fetch.block_dim);
+        for (n, &view) in VIEWS.iter().enumerate() {
+            let render = [Render::Composite, Render::Mip][n % 2];
+            let env = MemEnv::random(&mut rng);
+            frame(&mut bench, &vol, &lut, view, render, &env, rng.random());
+        }
+        frame(
+            &mut bench,
+            &vol,
+            &lut,
+            VIEWS[2],
+            Render::Composite,
+            &ddr(100, 12),
+            s,
+        );
+    }
+}
