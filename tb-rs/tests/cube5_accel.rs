@@ -277,3 +277,29 @@ fn frames_128_p4() {
         );
     }
 }
+
+/// P = 8 at 128^3 (head, 45 degrees and an oblique view, composite and MIP) and one 256^3 head
+/// frame at 45 degrees with the DDR-like memory.
+#[test]
+#[ignore = "sim-full: P = 8 and 256^3 frames, minutes each"]
+fn frames_p8_and_256() {
+    let s = seed(0xacce8);
+    let rtl = AccelRtl::widest(8).expect("a P = 8 build of cube5_accel");
+    let mut bench = must(AccelBench::new(rtl, s));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let (vol, lut) = scene(head_phantom(128, 12).unwrap(), rtl.fetch.block_dim);
+    for (view, render) in [(VIEWS[2], Render::Composite), (VIEWS[3], Render::Mip)] {
+        let env = MemEnv::random(&mut rng);
+        frame(&mut bench, &vol, &lut, view, render, &env, rng.random());
+    }
+    let (vol, lut) = scene(head_phantom(256, 12).unwrap(), rtl.fetch.block_dim);
+    frame(
+        &mut bench,
+        &vol,
+        &lut,
+        VIEWS[2],
+        Render::Composite,
+        &ddr(100, 12),
+        s,
+    );
+}
