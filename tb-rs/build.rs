@@ -246,6 +246,7 @@ fn main() {
         "stream_shim.h",
         "clocked_top.h",
         "axi_mem.h",
+        "axi_ports.h",
         "axi_shim.h",
         "axil_mgr.h",
         "axil_shim.h",
@@ -731,11 +732,23 @@ impl Shim {
     fn stamp_headers(self) -> &'static [&'static str] {
         match self {
             Shim::Stream => &[],
-            Shim::Axi => &["clocked_top.h", "axi_mem.h", "axi_shim.h"],
-            Shim::AxiWr => &["clocked_top.h", "axi_mem.h", "axi_shim.h", "axi_wr_shim.h"],
+            Shim::Axi => &["clocked_top.h", "axi_mem.h", "axi_ports.h", "axi_shim.h"],
+            Shim::AxiWr => &[
+                "clocked_top.h",
+                "axi_mem.h",
+                "axi_ports.h",
+                "axi_shim.h",
+                "axi_wr_shim.h",
+            ],
             Shim::Axil => &["clocked_top.h", "axil_mgr.h", "axil_shim.h"],
             Shim::AccelCtrl => &["clocked_top.h", "axil_mgr.h", "accel_ctrl_shim.h"],
-            Shim::Accel => &["clocked_top.h", "axi_mem.h", "axil_mgr.h", "accel_shim.h"],
+            Shim::Accel => &[
+                "clocked_top.h",
+                "axi_mem.h",
+                "axi_ports.h",
+                "axil_mgr.h",
+                "accel_shim.h",
+            ],
         }
     }
 }

@@ -10,9 +10,9 @@
 #pragma once
 
 #include "axi_mem.h"
+#include "axi_ports.h"
 #include "axil_mgr.h"
 #include "clocked_top.h"
-#include "stream_shim.h"
 
 namespace cube5 {
 
@@ -64,61 +64,19 @@ class AccelShim final : public ClockedTop<V>, public AxiHost {
     mgr_.load(items, n_items);
     uint64_t responses = 0;
     auto stalled = [&](uint64_t off) { return stall_len && stall[(cycle_ + off) % stall_len]; };
-    const uint32_t nb = mem_.cfg.data_bytes;
-    std::vector<uint32_t> rwords, wwords((nb + 3) / 4 + 1), swords(nb / 32 + 2);
-    WIn w;
+    std::vector<uint32_t> rwords;
     while (st.cycles < max_cycles) {
       if (n_items == 0 ? static_cast<bool>(top_->irq_o) : mgr_.all_issued() && responses >= expect_out)
         break;
       axil_drive(*top_, mgr_.drive(!stalled(0), !stalled(2053)));
-      const ReadOut& r = mem_.read.drive(cycle_);
-      top_->m_axi_arready_i = r.arready;
-      top_->m_axi_rvalid_i = r.rvalid;
-      if (r.rvalid) {
-        rwords.assign((r.rdata.size() + 3) / 4, 0);
-        for (size_t i = 0; i < r.rdata.size(); ++i)
-          rwords[i / 4] |= static_cast<uint32_t>(r.rdata[i]) << (8 * (i % 4));
-        write_port(top_->m_axi_rdata_i, rwords.data(), static_cast<uint32_t>(rwords.size()));
-        top_->m_axi_rresp_i = r.rresp;
-        top_->m_axi_rlast_i = r.rlast;
-        top_->m_axi_rid_i = r.rid;
-      }
-      const WriteOut& o = mem_.write.drive(cycle_);
-      top_->m_axi_awready_i = o.awready;
-      top_->m_axi_wready_i = o.wready;
-      top_->m_axi_bvalid_i = o.bvalid;
-      top_->m_axi_bresp_i = o.bresp;
-      top_->m_axi_bid_i = o.bid;
+      axi_read_drive(*top_, mem_, cycle_, rwords);
+      axi_write_drive(*top_, mem_, cycle_);
       top_->eval();
 
       const SubOut s = axil_sub(*top_);
       responses += mgr_.observe(cycle_, s, out);
-      mem_.read.observe(cycle_,
-                        ArIn{static_cast<bool>(top_->m_axi_arvalid_o),
-                             static_cast<uint64_t>(top_->m_axi_araddr_o),
-                             static_cast<uint32_t>(top_->m_axi_arlen_o),
-                             static_cast<uint32_t>(top_->m_axi_arsize_o),
-                             static_cast<uint32_t>(top_->m_axi_arburst_o),
-                             static_cast<uint32_t>(top_->m_axi_arid_o)},
-                        top_->m_axi_rready_o);
-      w.valid = top_->m_axi_wvalid_o;
-      w.last = top_->m_axi_wlast_o;
-      read_port(top_->m_axi_wdata_o, wwords.data(), static_cast<uint32_t>(wwords.size()));
-      read_port(top_->m_axi_wstrb_o, swords.data(), static_cast<uint32_t>(swords.size()));
-      w.data.resize(nb);
-      w.strb.resize(nb);
-      for (uint32_t i = 0; i < nb; ++i) {
-        w.data[i] = static_cast<uint8_t>(wwords[i / 4] >> (8 * (i % 4)));
-        w.strb[i] = static_cast<uint8_t>((swords[i / 32] >> (i % 32)) & 1);
-      }
-      mem_.write.observe(cycle_,
-                         ArIn{static_cast<bool>(top_->m_axi_awvalid_o),
-                              static_cast<uint64_t>(top_->m_axi_awaddr_o),
-                              static_cast<uint32_t>(top_->m_axi_awlen_o),
-                              static_cast<uint32_t>(top_->m_axi_awsize_o),
-                              static_cast<uint32_t>(top_->m_axi_awburst_o),
-                              static_cast<uint32_t>(top_->m_axi_awid_o)},
-                         w, top_->m_axi_bready_o);
+      axi_read_observe(*top_, mem_, cycle_);
+      wobs_.observe(*top_, mem_, cycle_);
       tick();
       ++st.cycles;
       if (ctx_->gotFinish()) {
@@ -155,6 +113,7 @@ class AccelShim final : public ClockedTop<V>, public AxiHost {
 
   AxilMgr mgr_;
   AxiMem mem_;
+  AxiWriteObserver wobs_;
 };
 
 }  // namespace cube5

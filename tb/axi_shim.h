@@ -5,6 +5,7 @@
 #pragma once
 
 #include "axi_mem.h"
+#include "axi_ports.h"
 #include "clocked_top.h"
 #include "stream_shim.h"
 
@@ -119,28 +120,9 @@ class AxiShim final : public AxiTopBase<V> {
       if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
       top_->out_ready_i = take;
 
-      const ReadOut& r = mem_.read.drive(cycle_);
-      top_->m_axi_arready_i = r.arready;
-      top_->m_axi_rvalid_i = r.rvalid;
-      if (r.rvalid) {
-        rwords.assign((r.rdata.size() + 3) / 4, 0);
-        for (size_t i = 0; i < r.rdata.size(); ++i)
-          rwords[i / 4] |= static_cast<uint32_t>(r.rdata[i]) << (8 * (i % 4));
-        write_port(top_->m_axi_rdata_i, rwords.data(), static_cast<uint32_t>(rwords.size()));
-        top_->m_axi_rresp_i = r.rresp;
-        top_->m_axi_rlast_i = r.rlast;
-        top_->m_axi_rid_i = r.rid;
-      }
+      axi_read_drive(*top_, mem_, cycle_, rwords);
       top_->eval();
-
-      mem_.read.observe(cycle_,
-                        ArIn{static_cast<bool>(top_->m_axi_arvalid_o),
-                             static_cast<uint64_t>(top_->m_axi_araddr_o),
-                             static_cast<uint32_t>(top_->m_axi_arlen_o),
-                             static_cast<uint32_t>(top_->m_axi_arsize_o),
-                             static_cast<uint32_t>(top_->m_axi_arburst_o),
-                             static_cast<uint32_t>(top_->m_axi_arid_o)},
-                        top_->m_axi_rready_o);
+      axi_read_observe(*top_, mem_, cycle_);
 
       if (offer && top_->in_ready_o) {
         ++next;

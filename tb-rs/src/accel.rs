@@ -365,22 +365,9 @@ impl AccelBench {
         self.lut_loaded = None;
     }
 
-    /// Renders `e` from `vol` (in memory with `lut`) under `env` and compares the image in memory
-    /// with the model's.
-    pub fn frame(
-        &mut self,
-        e: &Expected,
-        vol: &Volume,
-        lut: &BlockLut,
-        env: &MemEnv,
-        mem_seed: u64,
-    ) -> Result<FrameRun, TbError> {
-        let img_base = self.start(e, vol, lut, env, mem_seed)?;
-        self.finish(e, img_base, mem_seed)
-    }
-
-    /// The memory loaded and set up, the tables, registers and bases written, the frame started;
-    /// the image base.
+    /// The memory loaded with `vol` (blocked by `lut`) and set up as `env`, the tables, registers
+    /// and bases written, the frame of `e` started; the image base. [`AccelBench::finish`] then
+    /// waits for its end and compares the image in memory with the model's.
     pub fn start(
         &mut self,
         e: &Expected,

@@ -27,52 +27,6 @@ fn rtl(p: usize, n: usize) -> AccelRtl {
     AccelRtl::with(p, n).unwrap_or_else(|| panic!("no cube5_accel variant with P = {p} for {n}^3"))
 }
 
-/// A volume and its block LUT (empty blocks at threshold 0: they read as zeros, as the model sees
-/// them).
-fn scene(vol: Volume, block: u32) -> (Rc<Volume>, BlockLut) {
-    let lut = BlockLut::from_volume(&vol, block as usize, 0).unwrap();
-    (Rc::new(vol), lut)
-}
-
-fn report(rtl: &AccelRtl, what: &str, n: usize, run: &FrameRun) {
-    eprintln!(
-        "{}: {n}^3 {what}: {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
-        rtl.variant,
-        run.cycles,
-        run.samples,
-        run.rate(rtl.p),
-        run.ar,
-        run.r_beats,
-        run.aw
-    );
-}
-
-/// One frame of `vol` along `dir`: rendered, read back from memory, compared.
-#[allow(clippy::too_many_arguments)]
-fn frame(
-    bench: &mut AccelBench,
-    vol: &Rc<Volume>,
-    lut: &BlockLut,
-    view: (&str, [f64; 3]),
-    render: Render,
-    env: &MemEnv,
-    s: u64,
-) -> FrameRun {
-    let e = Expected::new(
-        &bench.rtl.frame,
-        vol,
-        view.0,
-        view.1,
-        render,
-        &Look::default(),
-    )
-    .unwrap();
-    let run = must(bench.frame(&e, vol, lut, env, s));
-    let rtl = bench.rtl;
-    report(&rtl, &format!("{} {render:?}", view.0), vol.dims[0], &run);
-    run
-}
-
 /// Faces (DX = DY = 0), exactly 45 degrees (DX = 2^16), obliques with DX < 0 and a reversed sweep.
 const VIEWS: &[(&str, [f64; 3])] = &[
     ("+z", [0.0, 0.0, 1.0]),
@@ -82,71 +36,115 @@ const VIEWS: &[(&str, [f64; 3])] = &[
     ("oblique -z", [0.37, 0.81, -1.0]),
 ];
 
-/// The 64^3 head phantom at P = 4: every view composite (shaded), three in MIP, each under its
-/// own random memory (latency 10..200, gaps on all five channels, the host's B and R
-/// back-pressured): the image in memory bit-exact.
-#[test]
-fn head_64_p4_every_view_composite_and_mip() {
-    let s = seed(0xacce1);
-    let rtl = rtl(4, 64);
-    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
-    let mut bench = must(AccelBench::new(rtl, s));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    for (n, &view) in VIEWS.iter().enumerate() {
-        let env = MemEnv::random(&mut rng);
-        frame(
-            &mut bench,
-            &vol,
-            &lut,
-            view,
-            Render::Composite,
-            &env,
-            s + n as u64,
+type View = (&'static str, [f64; 3]);
+
+/// A DDR-like memory: latency `lat` + U(0..20), no gaps, `bw` bytes per cycle shared by reads and
+/// writes (0: unlimited).
+fn ddr(lat: u32, bw: u32) -> MemEnv {
+    MemEnv {
+        latency: (lat, 20),
+        gaps: [0; 5],
+        bw: (bw, 1),
+        host_stall: Vec::new(),
+    }
+}
+
+/// A bench on one build with a volume in its memory and a seeded generator for the memories.
+struct Case {
+    bench: AccelBench,
+    vol: Rc<Volume>,
+    /// The volume's block LUT (empty blocks at threshold 0: they read as zeros, as the model
+    /// sees them).
+    lut: BlockLut,
+    rng: ChaCha8Rng,
+}
+
+impl Case {
+    fn new(rtl: AccelRtl, vol: Volume, s: u64) -> Self {
+        let lut = BlockLut::from_volume(&vol, rtl.fetch.block_dim as usize, 0).unwrap();
+        Self {
+            bench: must(AccelBench::new(rtl, s)),
+            vol: Rc::new(vol),
+            lut,
+            rng: ChaCha8Rng::seed_from_u64(s),
+        }
+    }
+
+    /// Another volume in the memory.
+    fn with(mut self, vol: Volume) -> Self {
+        self.lut = BlockLut::from_volume(&vol, self.bench.rtl.fetch.block_dim as usize, 0).unwrap();
+        self.vol = Rc::new(vol);
+        self
+    }
+
+    fn expect(&self, view: View, render: Render) -> Expected {
+        let rtl = &self.bench.rtl.frame;
+        Expected::new(rtl, &self.vol, view.0, view.1, render, &Look::default()).unwrap()
+    }
+
+    /// One frame under `env`: rendered, read back from memory, compared; its figures printed.
+    fn frame(&mut self, view: View, render: Render, env: &MemEnv, what: &str) -> FrameRun {
+        let e = self.expect(view, render);
+        let mem_seed = self.rng.random();
+        let img_base = must(self.bench.start(&e, &self.vol, &self.lut, env, mem_seed));
+        let run = must(self.bench.finish(&e, img_base, mem_seed));
+        let rtl = self.bench.rtl;
+        eprintln!(
+            "{}: {}^3 {} {render:?}{what}: {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
+            rtl.variant,
+            self.vol.dims[0],
+            view.0,
+            run.cycles,
+            run.samples,
+            run.rate(rtl.p),
+            run.ar,
+            run.r_beats,
+            run.aw
         );
-        if n % 2 == 0 {
-            frame(
-                &mut bench,
-                &vol,
-                &lut,
-                view,
-                Render::Mip,
-                &env,
-                s + 100 + n as u64,
-            );
+        run
+    }
+
+    /// Frames each under its own random memory (latency 10..200, gaps on all five channels, the
+    /// host's B and R back-pressured).
+    fn random(&mut self, frames: &[(View, Render)]) {
+        for &(view, render) in frames {
+            let env = MemEnv::random(&mut self.rng);
+            self.frame(view, render, &env, "");
         }
     }
 }
 
-/// A blob with holes (the bubbles phantom, 64^3) at P = 4: a face and 45 degrees, both modes.
+use Render::{Composite, Mip};
+
+/// The 64^3 head phantom at P = 4: every view composite (shaded), three in MIP: the image in
+/// memory bit-exact.
+#[test]
+fn head_64_p4_every_view_composite_and_mip() {
+    let s = seed(0xacce1);
+    let mut c = Case::new(rtl(4, 64), head_phantom(64, 12).unwrap(), s);
+    let mut frames: Vec<(View, Render)> = VIEWS.iter().map(|&v| (v, Composite)).collect();
+    frames.extend([VIEWS[0], VIEWS[2], VIEWS[4]].map(|v| (v, Mip)));
+    c.random(&frames);
+}
+
+/// A blob with holes (the bubbles phantom, 64^3) at P = 4: a face, 45 degrees, an oblique view.
 #[test]
 fn bubbles_64_p4() {
     let s = seed(0xacce2);
-    let rtl = rtl(4, 64);
-    let (vol, lut) = scene(bubbles_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
-    let mut bench = must(AccelBench::new(rtl, s));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    for (view, render) in [
-        (VIEWS[1], Render::Composite),
-        (VIEWS[2], Render::Mip),
-        (VIEWS[3], Render::Composite),
-    ] {
-        let env = MemEnv::random(&mut rng);
-        frame(&mut bench, &vol, &lut, view, render, &env, rng.random());
-    }
+    let mut c = Case::new(rtl(4, 64), bubbles_phantom(64, 12).unwrap(), s);
+    c.random(&[
+        (VIEWS[1], Composite),
+        (VIEWS[2], Mip),
+        (VIEWS[3], Composite),
+    ]);
 }
 
 /// P = 1: the 64^3 head at 45 degrees (composite) and an oblique view with DX < 0 (MIP).
 #[test]
 fn head_64_p1() {
     let s = seed(0xacce3);
-    let rtl = rtl(1, 64);
-    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
-    let mut bench = must(AccelBench::new(rtl, s));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    for (view, render) in [(VIEWS[2], Render::Composite), (VIEWS[3], Render::Mip)] {
-        let env = MemEnv::random(&mut rng);
-        frame(&mut bench, &vol, &lut, view, render, &env, rng.random());
-    }
+    let mut c = Case::new(rtl(1, 64), head_phantom(64, 12).unwrap(), s);
+    c.random(&[(VIEWS[2], Composite), (VIEWS[3], Mip)]);
 }
 
 /// A reset in the middle of a frame (reads and writes in flight are dropped on both sides; none
@@ -154,70 +152,36 @@ fn head_64_p1() {
 #[test]
 fn reset_mid_frame_then_an_exact_frame() {
     let s = seed(0xacce4);
-    let rtl = rtl(4, 64);
-    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
-    let mut bench = must(AccelBench::new(rtl, s));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let env = MemEnv::random(&mut rng);
-    let view = VIEWS[4];
-    let e = Expected::new(
-        &rtl.frame,
-        &vol,
-        view.0,
-        view.1,
-        Render::Composite,
-        &Look::default(),
-    )
-    .unwrap();
-    must(bench.start(&e, &vol, &lut, &env, s));
-    must(bench.idle(30_000));
-    let before = bench.dut.axi_counters();
-    assert!(before.in_flight > 0, "reads in flight at the reset");
-    bench.reset();
-    let after = bench.dut.axi_counters();
-    assert_eq!(after.in_flight, 0, "no read outstanding after the reset");
-    assert_eq!(
-        bench.dut.axi_wr_counters().in_flight,
-        0,
-        "no write outstanding after the reset"
+    let mut c = Case::new(rtl(4, 64), head_phantom(64, 12).unwrap(), s);
+    let env = MemEnv::random(&mut c.rng);
+    let e = c.expect(VIEWS[4], Composite);
+    must(c.bench.start(&e, &c.vol, &c.lut, &env, s));
+    must(c.bench.idle(30_000));
+    assert!(
+        c.bench.dut.axi_counters().in_flight > 0,
+        "reads in flight at the reset"
     );
-    let run = must(bench.frame(&e, &vol, &lut, &env, s + 1));
-    report(&rtl, "after a reset mid-frame", 64, &run);
+    c.bench.reset();
+    assert_eq!(
+        c.bench.dut.axi_counters().in_flight,
+        0,
+        "no read outstanding after the reset"
+    );
+    let wr = c.bench.dut.axi_wr_counters();
+    assert_eq!(wr.in_flight, 0, "no write outstanding after the reset");
+    c.frame(VIEWS[4], Composite, &env, " after a reset mid-frame");
 }
 
-/// The comparison fails when the model disagrees: a frame of one view against another's image.
+/// The comparison fails when the model disagrees: a MIP frame against the composite image.
 #[test]
 fn the_check_fails_when_the_model_disagrees() {
     let s = seed(0xacce5);
-    let rtl = rtl(4, 64);
-    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
-    let mut bench = must(AccelBench::new(rtl, s));
-    let look = Look::default();
-    let e = Expected::new(&rtl.frame, &vol, "+z", [0.0, 0.0, 1.0], Render::Mip, &look).unwrap();
-    let other = Expected::new(
-        &rtl.frame,
-        &vol,
-        "+z",
-        [0.0, 0.0, 1.0],
-        Render::Composite,
-        &look,
-    )
-    .unwrap();
-    let img_base = must(bench.start(&e, &vol, &lut, &MemEnv::quiet(), s));
-    match bench.finish(&other, img_base, s) {
+    let mut c = Case::new(rtl(4, 64), head_phantom(64, 12).unwrap(), s);
+    let (e, other) = (c.expect(VIEWS[0], Mip), c.expect(VIEWS[0], Composite));
+    let img_base = must(c.bench.start(&e, &c.vol, &c.lut, &MemEnv::quiet(), s));
+    match c.bench.finish(&other, img_base, s) {
         Err(TbError::Mismatch(m)) => eprintln!("as it should: {}", m.what),
         other => panic!("a MIP image passed as the composite one: {other:?}"),
-    }
-}
-
-/// A DDR-like memory: latency `lat` + U(0..20), no gaps, `bw` bytes per cycle shared by reads and
-/// writes.
-fn ddr(lat: u32, bw: u32) -> MemEnv {
-    MemEnv {
-        latency: (lat, 20),
-        gaps: [0; 5],
-        bw: (bw, 1),
-        host_stall: Vec::new(),
     }
 }
 
@@ -228,53 +192,41 @@ fn ddr(lat: u32, bw: u32) -> MemEnv {
 fn throughput_of_the_wide_configuration() {
     let s = seed(0xacce6);
     let rtl = AccelRtl::widest(4).expect("a P = 4 build of cube5_accel");
-    let (vol, lut) = scene(head_phantom(64, 12).unwrap(), rtl.fetch.block_dim);
-    let mut bench = must(AccelBench::new(rtl, s));
+    let mut c = Case::new(rtl, head_phantom(64, 12).unwrap(), s);
     for (env, what) in [
-        (ddr(20, 0), "fast memory"),
-        (ddr(100, 12), "DDR-like 12 B/cycle"),
+        (ddr(20, 0), ", fast memory"),
+        (ddr(100, 12), ", DDR-like 12 B/cycle"),
     ] {
         for view in [VIEWS[0], VIEWS[2]] {
-            let run = frame(&mut bench, &vol, &lut, view, Render::Composite, &env, s);
-            eprintln!("  ({what})");
+            let rate = c.frame(view, Composite, &env, what).rate(rtl.p);
             assert!(
-                run.rate(rtl.p) > 0.3,
-                "{}: {:.3}",
-                rtl.variant,
-                run.rate(rtl.p)
+                rate > 0.8,
+                "{}: {rate:.3} samples/clock/pipeline",
+                rtl.variant
             );
         }
     }
 }
 
-/// 128^3 frames (head phantom and bubbles) at P = 4 on the throughput configuration, faces, 45
-/// degrees and an oblique view, composite and MIP, random memory.
+/// 128^3 frames (head phantom and bubbles) at P = 4 on the throughput configuration: every view,
+/// composite and MIP alternately, random memories; then 45 degrees with the DDR-like memory.
 #[test]
-#[ignore = "sim-full: 128^3 frames, about 10 s each"]
+#[ignore = "sim-full: 128^3 frames, about 20 s each"]
 fn frames_128_p4() {
     let s = seed(0xacce7);
     let rtl = AccelRtl::widest(4).expect("a P = 4 build of cube5_accel");
-    let mut bench = must(AccelBench::new(rtl, s));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    for vol in [
-        head_phantom(128, 12).unwrap(),
-        bubbles_phantom(128, 12).unwrap(),
-    ] {
-        let (vol, lut) = scene(vol, rtl.fetch.block_dim);
-        for (n, &view) in VIEWS.iter().enumerate() {
-            let render = [Render::Composite, Render::Mip][n % 2];
-            let env = MemEnv::random(&mut rng);
-            frame(&mut bench, &vol, &lut, view, render, &env, rng.random());
+    let frames: Vec<(View, Render)> = VIEWS
+        .iter()
+        .enumerate()
+        .map(|(n, &v)| (v, [Composite, Mip][n % 2]))
+        .collect();
+    let mut c = Case::new(rtl, head_phantom(128, 12).unwrap(), s);
+    for next in [Some(bubbles_phantom(128, 12).unwrap()), None] {
+        c.random(&frames);
+        c.frame(VIEWS[2], Composite, &ddr(100, 12), ", DDR-like 12 B/cycle");
+        if let Some(v) = next {
+            c = c.with(v);
         }
-        frame(
-            &mut bench,
-            &vol,
-            &lut,
-            VIEWS[2],
-            Render::Composite,
-            &ddr(100, 12),
-            s,
-        );
     }
 }
 
@@ -285,21 +237,8 @@ fn frames_128_p4() {
 fn frames_p8_and_256() {
     let s = seed(0xacce8);
     let rtl = AccelRtl::widest(8).expect("a P = 8 build of cube5_accel");
-    let mut bench = must(AccelBench::new(rtl, s));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let (vol, lut) = scene(head_phantom(128, 12).unwrap(), rtl.fetch.block_dim);
-    for (view, render) in [(VIEWS[2], Render::Composite), (VIEWS[3], Render::Mip)] {
-        let env = MemEnv::random(&mut rng);
-        frame(&mut bench, &vol, &lut, view, render, &env, rng.random());
-    }
-    let (vol, lut) = scene(head_phantom(256, 12).unwrap(), rtl.fetch.block_dim);
-    frame(
-        &mut bench,
-        &vol,
-        &lut,
-        VIEWS[2],
-        Render::Composite,
-        &ddr(100, 12),
-        s,
-    );
+    let mut c = Case::new(rtl, head_phantom(128, 12).unwrap(), s);
+    c.random(&[(VIEWS[2], Composite), (VIEWS[3], Mip)]);
+    let mut c = c.with(head_phantom(256, 12).unwrap());
+    c.frame(VIEWS[2], Composite, &ddr(100, 12), ", DDR-like 12 B/cycle");
 }
