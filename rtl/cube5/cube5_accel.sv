@@ -168,6 +168,9 @@ module cube5_accel #(
   if (ShDataW > 64 || ChanW > 32 || 3 * DimW > 32) begin : gen_bad_cfg
     $fatal(1, "cube5_accel: a table entry must fit two words of the table window");
   end
+  if (Section < 2 * P) begin : gen_bad_section
+    $fatal(1, "cube5_accel: Section must be at least 2 P (the frame's rows hold two beats or more)");
+  end
   if (FcLast + 1 != FrCmdW) begin : gen_bad_fc
     $fatal(1, "cube5_accel: the frame command's fields do not add up");
   end
@@ -342,6 +345,7 @@ module cube5_accel #(
   logic [FrInW-1:0]   fr_in_data;
   logic               fr_out_valid, fr_out_ready;
   logic [FrOutW-1:0]  fr_out_data;
+  logic               fr_error;     // the frame's output item is its error item
   logic               cfg_valid;
   logic [CfgAddrW-1:0] cfg_addr;
   logic [CfgDataW-1:0] cfg_data;
@@ -420,7 +424,7 @@ module cube5_accel #(
 
   // The frame's done: its first read-out item (the error item of a refused frame is its only).
   assign done_valid = fr_out_valid && fr_out_ready && readout_q;
-  assign done_error = fr_out_data[cube5_frame_pkg::coxel_w(AccW, ZW, ColorW)];
+  assign done_error = fr_error;
 
   // ---------------------------------------------------------------------------
   // Coxels to pixels: four codes, one register stage.
@@ -443,14 +447,38 @@ module cube5_accel #(
     assign unused_low = ^scaled[AccW-1:0];
   end
 
-  assign fr_out_ready = !pix_valid_q || wr_dat_ready;
+  // After an error item of the frame (a section it refused) the frame's output is dropped and
+  // the writer gets zero pixels for every pixel of the rows the core has commanded, so that the
+  // frame ends (with IrqStatus.error, code Frame) instead of waiting for pixels that never come;
+  // the next frame's first section ends it. `owed_q`: pixels commanded minus pixels handed over.
+  localparam int unsigned OwedW = 2 * DimW + 3;
+  logic                    flush_q;
+  logic signed [OwedW-1:0] owed_q;
+  logic                    wr_dat_valid;
+  logic [ItemW-1:0]        wr_dat;
+
+  assign fr_error     = fr_out_data[cube5_frame_pkg::coxel_w(AccW, ZW, ColorW)];
+  assign fr_out_ready = flush_q || !pix_valid_q || wr_dat_ready;
+  assign wr_dat_valid = flush_q ? owed_q > 0 : pix_valid_q;
+  assign wr_dat       = flush_q ? '0 : pix_q;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
       pix_valid_q <= 1'b0;
-    end else if (fr_out_ready) begin
-      pix_valid_q <= fr_out_valid;
-      if (fr_out_valid) pix_q <= pix_d;
+      flush_q     <= 1'b0;
+      owed_q      <= '0;
+    end else begin
+      if (fr_out_ready) begin
+        pix_valid_q <= fr_out_valid && !flush_q && !fr_error;
+        if (fr_out_valid) pix_q <= pix_d;
+      end
+      if (fr_out_valid && fr_out_ready && fr_error) begin
+        flush_q     <= 1'b1;
+        pix_valid_q <= 1'b0;
+      end
+      if (fr_q == FrCmd && rc_valid && fr_in_ready && rc_data[FcFirst]) flush_q <= 1'b0;
+      owed_q <= owed_q + ((wc_valid && wc_ready) ? OwedW'(wc_data[AddrW +: LenW]) : '0)
+                       - OwedW'(wr_dat_valid && wr_dat_ready);
     end
   end
 
@@ -465,7 +493,7 @@ module cube5_accel #(
   ) u_wr (
     .clk_i, .rst_ni,
     .in_valid_i(wc_valid), .in_ready_o(wc_ready), .in_data_i(wc_data),
-    .dat_valid_i(pix_valid_q), .dat_ready_o(wr_dat_ready), .dat_data_i(pix_q),
+    .dat_valid_i(wr_dat_valid), .dat_ready_o(wr_dat_ready), .dat_data_i(wr_dat),
     .out_valid_o(cpl_valid), .out_ready_i(1'b1), .out_data_o(cpl_data),
     .err_o(wr_err),
     .m_axi_awaddr_o, .m_axi_awlen_o, .m_axi_awsize_o, .m_axi_awburst_o, .m_axi_awid_o,

@@ -8,7 +8,9 @@
 
 mod support;
 
+use cube5_model::accel_host::{AccelHost, HostError};
 use cube5_model::phantom::{bubbles_phantom, head_phantom};
+use cube5_model::regs::cube5_accel::CODE_FRAME;
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
 use cube5_tb::accel::{AccelBench, AccelRtl, FrameRun, MemEnv};
@@ -147,6 +149,19 @@ fn head_64_p1() {
     c.random(&[(VIEWS[2], Composite), (VIEWS[3], Mip)]);
 }
 
+/// The synthesizable configuration (16^3, the frame's narrow widths): the 16^3 head in every
+/// view, composite and MIP.
+#[test]
+fn narrow_16_p4() {
+    let s = seed(0xacce9);
+    let mut c = Case::new(rtl(4, 16), head_phantom(16, 8).unwrap(), s);
+    let frames: Vec<(View, Render)> = VIEWS
+        .iter()
+        .flat_map(|&v| [(v, Composite), (v, Mip)])
+        .collect();
+    c.random(&frames);
+}
+
 /// A reset in the middle of a frame (reads and writes in flight are dropped on both sides; none
 /// is outstanding after it), then the tables reloaded and the same frame exact.
 #[test]
@@ -170,6 +185,33 @@ fn reset_mid_frame_then_an_exact_frame() {
     let wr = c.bench.dut.axi_wr_counters();
     assert_eq!(wr.in_flight, 0, "no write outstanding after the reset");
     c.frame(VIEWS[4], Composite, &env, " after a reset mid-frame");
+}
+
+/// A frame whose last section the frame refuses (36 anchors in sections of 16: the last has 4,
+/// fewer than 2P): the frame ends with IrqStatus.error and code Frame (the writer is fed zeros
+/// for the rows the core commanded, nothing hangs). The frames after it are not exact without a
+/// reset (docs/accel.md, *A section the frame refuses*): after `rst_ni` the next frame is.
+#[test]
+fn a_section_the_frame_refuses_ends_the_frame_with_an_error() {
+    let s = seed(0xacceb);
+    let mut c = Case::new(rtl(4, 64), head_phantom(36, 12).unwrap(), s);
+    let e = c.expect(VIEWS[0], Composite);
+    must(c.bench.start(&e, &c.vol, &c.lut, &MemEnv::quiet(), s));
+    must(c.bench.wait_irq(400_000));
+    let mut host = AccelHost::new(&mut c.bench, 0);
+    assert!(
+        matches!(host.wait_done(1), Err(HostError::Frame(_))),
+        "the frame ends with an error"
+    );
+    assert_eq!(host.status_code().unwrap(), CODE_FRAME);
+    c.bench.reset();
+    let mut c = c.with(head_phantom(32, 12).unwrap());
+    c.frame(
+        VIEWS[2],
+        Composite,
+        &MemEnv::quiet(),
+        " after a refused section and a reset",
+    );
 }
 
 /// The comparison fails when the model disagrees: a MIP frame against the composite image.
