@@ -18,8 +18,9 @@
 // command, then the buffer's beams up to the section's last). The frame's read-out becomes one
 // 32-bit pixel per coxel, R, G, B, A each `min(2^ColorW - 1, (c (2^ColorW - 1) + 2^(AccW - 1))
 // >> AccW)` (docs/numerics/warp.md, "Base-plane codes", applied to all four channels), R in the
-// lowest byte. The frame's done goes to the core with the first read-out item of a frame; the core
-// ends the frame when every row's write has completed as well.
+// lowest byte. The frame's done goes to the core with the first read-out item of a frame (once the
+// last section's beams are in); the core ends the frame when every row's write has completed as
+// well. After an error item of the frame (a section it refused) the writer is fed zero pixels.
 module cube5_accel #(
   /// Pipelines: voxels per beam (1, 2, 4, 8).
   parameter int unsigned P           = 4,
@@ -422,9 +423,40 @@ module cube5_accel #(
     .cfg_valid_i(cfg_valid), .cfg_addr_i(cfg_addr), .cfg_data_i(cfg_data)
   );
 
-  // The frame's done: its first read-out item (the error item of a refused frame is its only).
-  assign done_valid = fr_out_valid && fr_out_ready && readout_q;
-  assign done_error = fr_error;
+  // The frame's done: its first read-out item (or its error item), passed on once the beams of
+  // the frame's last section are all in (at once for a read-out, which follows them; an error
+  // item can come before them), so that the frame never ends while the data path still streams.
+  logic cur_last_q;   // the section being passed is the frame's last
+  logic last_in_q;    // the last section's beams are all in
+  logic done_pend_q, done_err_q;
+  logic done_ev;
+
+  assign done_ev    = fr_out_valid && fr_out_ready && readout_q;
+  assign done_valid = (done_ev || done_pend_q) && last_in_q;
+  assign done_error = done_pend_q ? done_err_q : fr_error;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      cur_last_q  <= 1'b0;
+      last_in_q   <= 1'b0;
+      done_pend_q <= 1'b0;
+      done_err_q  <= 1'b0;
+    end else begin
+      if (fr_q == FrCmd && rc_valid && fr_in_ready) begin
+        cur_last_q <= rc_data[FcLast];
+        if (rc_data[FcFirst]) last_in_q <= 1'b0;
+      end
+      if (fr_q == FrBeams && sb_out_valid && fr_in_ready && sb_out_data[SbLastBit] && cur_last_q) begin
+        last_in_q <= 1'b1;
+      end
+      if (done_valid) begin
+        done_pend_q <= 1'b0;
+      end else if (done_ev) begin
+        done_pend_q <= 1'b1;
+        done_err_q  <= fr_error;
+      end
+    end
+  end
 
   // ---------------------------------------------------------------------------
   // Coxels to pixels: four codes, one register stage.
