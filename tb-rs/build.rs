@@ -246,11 +246,13 @@ fn main() {
         "stream_shim.h",
         "clocked_top.h",
         "axi_mem.h",
+        "axi_ports.h",
         "axi_shim.h",
         "axil_mgr.h",
         "axil_shim.h",
         "axi_wr_shim.h",
         "accel_ctrl_shim.h",
+        "accel_shim.h",
         "stream_dut.h",
         "stream_dut.cpp",
     ] {
@@ -601,7 +603,7 @@ fn compile_variant(
     let header = fs::read_to_string(mdir.join(format!("{prefix}.h"))).map_err(|e| e.to_string())?;
     // An AXI4-Lite top has no stream ports: its items are AxilShim's transactions and records.
     let shim = Shim::of(v);
-    let (in_bits, out_bits) = if shim == Shim::Axil {
+    let (in_bits, out_bits) = if shim == Shim::Axil || shim == Shim::Accel {
         (AXIL_ITEM_BITS, AXIL_RECORD_BITS)
     } else if shim == Shim::AccelCtrl {
         (AXIL_ITEM_BITS, ACCEL_CTRL_RECORD_BITS)
@@ -666,16 +668,18 @@ enum Shim {
     AxiWr,
     Axil,
     AccelCtrl,
+    Accel,
 }
 
 impl Shim {
     /// In `Shim as usize` order.
-    const ALL: [Shim; 5] = [
+    const ALL: [Shim; 6] = [
         Shim::Stream,
         Shim::Axi,
         Shim::AxiWr,
         Shim::Axil,
         Shim::AccelCtrl,
+        Shim::Accel,
     ];
 
     fn of(v: &Variant) -> Shim {
@@ -686,7 +690,9 @@ impl Shim {
             .find(|f| f.file_name().is_some_and(|n| n.to_string_lossy() == own))
             .and_then(|f| fs::read_to_string(f).ok())
             .unwrap_or_default();
-        if text.contains("m_axi_awvalid_o") {
+        if text.contains("s_axil_awvalid_i") && text.contains("m_axi_arvalid_o") {
+            Shim::Accel
+        } else if text.contains("m_axi_awvalid_o") {
             Shim::AxiWr
         } else if text.contains("m_axi_arvalid_o") {
             Shim::Axi
@@ -706,6 +712,7 @@ impl Shim {
             Shim::AxiWr => "axi_wr_shim.h",
             Shim::Axil => "axil_shim.h",
             Shim::AccelCtrl => "accel_ctrl_shim.h",
+            Shim::Accel => "accel_shim.h",
         }
     }
 
@@ -716,6 +723,7 @@ impl Shim {
             Shim::AxiWr => "AxiWrShim",
             Shim::Axil => "AxilShim",
             Shim::AccelCtrl => "AccelCtrlShim",
+            Shim::Accel => "AccelShim",
         }
     }
 
@@ -724,10 +732,23 @@ impl Shim {
     fn stamp_headers(self) -> &'static [&'static str] {
         match self {
             Shim::Stream => &[],
-            Shim::Axi => &["clocked_top.h", "axi_mem.h", "axi_shim.h"],
-            Shim::AxiWr => &["clocked_top.h", "axi_mem.h", "axi_shim.h", "axi_wr_shim.h"],
+            Shim::Axi => &["clocked_top.h", "axi_mem.h", "axi_ports.h", "axi_shim.h"],
+            Shim::AxiWr => &[
+                "clocked_top.h",
+                "axi_mem.h",
+                "axi_ports.h",
+                "axi_shim.h",
+                "axi_wr_shim.h",
+            ],
             Shim::Axil => &["clocked_top.h", "axil_mgr.h", "axil_shim.h"],
             Shim::AccelCtrl => &["clocked_top.h", "axil_mgr.h", "accel_ctrl_shim.h"],
+            Shim::Accel => &[
+                "clocked_top.h",
+                "axi_mem.h",
+                "axi_ports.h",
+                "axil_mgr.h",
+                "accel_shim.h",
+            ],
         }
     }
 }

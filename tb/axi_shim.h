@@ -5,6 +5,7 @@
 #pragma once
 
 #include "axi_mem.h"
+#include "axi_ports.h"
 #include "clocked_top.h"
 #include "stream_shim.h"
 
@@ -79,12 +80,6 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
     if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
     top_->out_ready_i = take;
     return {offer, take};
-  }
-
-  /// An address channel's payload as the subordinate observes it (AR or AW).
-  static ArIn addr_in(bool valid, uint64_t addr, uint32_t len, uint32_t size, uint32_t burst,
-                      uint32_t id) {
-    return ArIn{valid, addr, len, size, burst, id};
   }
 
   /// After eval and the subordinate's observation: the command taken (if `offered`), the output
@@ -170,25 +165,9 @@ class AxiShim final : public AxiTopBase<V> {
     while (st.cycles < max_cycles && (next < n_items || st.produced < expect_out)) {
       const auto [offer, take] =
           this->drive_stream(items, n_items, in_words, next, idle, idle_len, stall, stall_len);
-      const ReadOut& r = mem_.read.drive(cycle_);
-      top_->m_axi_arready_i = r.arready;
-      top_->m_axi_rvalid_i = r.rvalid;
-      if (r.rvalid) {
-        rwords.assign((r.rdata.size() + 3) / 4, 0);
-        for (size_t i = 0; i < r.rdata.size(); ++i)
-          rwords[i / 4] |= static_cast<uint32_t>(r.rdata[i]) << (8 * (i % 4));
-        write_port(top_->m_axi_rdata_i, rwords.data(), static_cast<uint32_t>(rwords.size()));
-        top_->m_axi_rresp_i = r.rresp;
-        top_->m_axi_rlast_i = r.rlast;
-        top_->m_axi_rid_i = r.rid;
-      }
+      axi_read_drive(*top_, mem_, cycle_, rwords);
       top_->eval();
-
-      mem_.read.observe(cycle_,
-                        B::addr_in(top_->m_axi_arvalid_o, top_->m_axi_araddr_o,
-                                   top_->m_axi_arlen_o, top_->m_axi_arsize_o,
-                                   top_->m_axi_arburst_o, top_->m_axi_arid_o),
-                        top_->m_axi_rready_o);
+      axi_read_observe(*top_, mem_, cycle_);
       if (!this->end_cycle(st, offer, next, take, out, out_words)) break;
     }
     this->idle_stream();

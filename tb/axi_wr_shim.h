@@ -51,9 +51,6 @@ class AxiWrShim final : public AxiTopBase<V> {
     RunStats st;
     size_t next = 0;
     const size_t n_data = data_words_ ? data_.size() / data_words_ : 0;
-    const uint32_t nb = static_cast<uint32_t>(mem_.cfg.data_bytes);
-    std::vector<uint32_t> wwords((nb + 3) / 4 + 1), swords(nb / 32 + 2);
-    WIn w;
     while (st.cycles < max_cycles && (next < n_items || st.produced < expect_out)) {
       const auto [offer, take] =
           this->drive_stream(items, n_items, in_words, next, idle, idle_len, stall, stall_len);
@@ -63,29 +60,9 @@ class AxiWrShim final : public AxiTopBase<V> {
       if (dat_offer)
         write_port(top_->dat_data_i, data_.data() + data_next_ * data_words_, data_words_);
 
-      const WriteOut& o = mem_.write.drive(cycle_);
-      top_->m_axi_awready_i = o.awready;
-      top_->m_axi_wready_i = o.wready;
-      top_->m_axi_bvalid_i = o.bvalid;
-      top_->m_axi_bresp_i = o.bresp;
-      top_->m_axi_bid_i = o.bid;
+      axi_write_drive(*top_, mem_, cycle_);
       top_->eval();
-
-      w.valid = top_->m_axi_wvalid_o;
-      w.last = top_->m_axi_wlast_o;
-      read_port(top_->m_axi_wdata_o, wwords.data(), static_cast<uint32_t>(wwords.size()));
-      read_port(top_->m_axi_wstrb_o, swords.data(), static_cast<uint32_t>(swords.size()));
-      w.data.resize(nb);
-      w.strb.resize(nb);
-      for (uint32_t i = 0; i < nb; ++i) {
-        w.data[i] = static_cast<uint8_t>(wwords[i / 4] >> (8 * (i % 4)));
-        w.strb[i] = static_cast<uint8_t>((swords[i / 32] >> (i % 32)) & 1);
-      }
-      mem_.write.observe(cycle_,
-                         B::addr_in(top_->m_axi_awvalid_o, top_->m_axi_awaddr_o,
-                                    top_->m_axi_awlen_o, top_->m_axi_awsize_o,
-                                    top_->m_axi_awburst_o, top_->m_axi_awid_o),
-                         w, top_->m_axi_bready_o);
+      wobs_.observe(*top_, mem_, cycle_);
       if (dat_offer && top_->dat_ready_o) ++data_next_;
       if (!this->end_cycle(st, offer, next, take, out, out_words)) break;
     }
@@ -108,6 +85,7 @@ class AxiWrShim final : public AxiTopBase<V> {
   uint32_t data_words_ = 0;
   size_t data_next_ = 0;
   std::vector<uint8_t> data_idle_;
+  AxiWriteObserver wobs_;
 };
 
 }  // namespace cube5

@@ -7,10 +7,12 @@
 //! - [`harness`]: the scoreboard (`check_stream`, `must_match`) and the run presets.
 //! - [`frame`]: driving `cube5_frame` against the frame model, pixel by pixel.
 //! - [`er`]: driving `cube5_er` (ER-Perspective) against `ErJob::render`, coxel by coxel.
+//! - [`accel`]: the accelerator top `cube5_accel` driven as a host would, image compared in memory.
 //! - [`frame_stream`]: `cube5_frame` fed by a beat stream in sections (`Source = 1`).
 //! - [`prefilter`]: the 3-pass pre-filter over a volume through `cube5_sepconv`.
 //! - [`error`]: the one error type, `TbError` (`Setup | Protocol | Deadlock | Mismatch`).
 
+pub mod accel;
 pub mod axil;
 pub mod er;
 pub mod error;

@@ -1,0 +1,543 @@
+// cube5_accel: the Cube-5 accelerator top (issue 12; docs/accel.md). The volume in external memory,
+// read over AXI4 as blocks; the base-plane image written back over AXI4; host control over
+// AXI4-Lite with an interrupt.
+//
+//   host ── AXI4-Lite ──► cube5_accel_ctrl ── sweep ──► cube5_vol_fetch ── AR/R ──┐
+//                              │ table port  ── section ─┐    │ items               │
+//                              │ (Block: the fetch's LUT) ▼    ▼                     │
+//                              │               cube5_section_buf (op 1, then op 0)   ├─ m_axi_*
+//                              │ frame section ──► cube5_frame (Source = 1) ◄─ beams │
+//                              │ (sec_first: frame registers through cfg first)      │
+//                              │                     │ coxels ─► codes (RGBA, a byte each)
+//                              └── row commands ──► cube5_axi_wr ── AW/W/B ──────────┘
+//
+// Three small sequencers join the control core's independent command ports to the units' single
+// input streams: the fetch's input (a pending Block-table write, else the sweep), the buffer's
+// input (a section command, then the fetch's items up to the sweep's last), and the frame's input
+// (the frame registers through the configuration port on a frame's first section, the section
+// command, then the buffer's beams up to the section's last). The frame's read-out becomes one
+// 32-bit pixel per coxel, R, G, B, A each `min(2^ColorW - 1, (c (2^ColorW - 1) + 2^(AccW - 1))
+// >> AccW)` (docs/numerics/warp.md, "Base-plane codes", applied to all four channels), R in the
+// lowest byte. The frame's done goes to the core with the first read-out item of a frame (once the
+// last section's beams are in); the core ends the frame when every row's write has completed as
+// well. After an error item of the frame (a section it refused) the writer is fed zero pixels.
+module cube5_accel #(
+  /// Pipelines: voxels per beam (1, 2, 4, 8).
+  parameter int unsigned P           = 4,
+  /// Largest volume edge, a power of two.
+  parameter int unsigned MaxDim      = 64,
+  /// Voxel bits (the low bits of the 16-bit words in memory).
+  parameter int unsigned VoxelW      = 12,
+  /// Block edge of the volume's layout in memory.
+  parameter int unsigned BlockDim    = 8,
+  /// Section width in anchors (the section buffer's columns).
+  parameter int unsigned Section     = 16,
+  /// AXI4 byte address width and data width (one port: read channels for the volume, write
+  /// channels for the image).
+  parameter int unsigned AddrW       = 32,
+  parameter int unsigned DataW       = 64,
+  /// Longest burst in beats, reads and writes.
+  parameter int unsigned MaxBurst    = 16,
+  /// Read bursts in flight (the fetch's prefetch) and write bursts in flight.
+  parameter int unsigned Outstanding = 8,
+  parameter int unsigned WrOutstanding = 4,
+  /// AXI4 ID width (the top issues ID 0 on both directions).
+  parameter int unsigned IdW         = 4,
+  /// The frame's widths (cube5_frame).
+  parameter int unsigned WeightW     = 8,
+  parameter int unsigned FracW       = 4,
+  parameter int unsigned ClassIdxW   = 12,
+  parameter int unsigned MagIdxW     = 4,
+  parameter int unsigned MagShift    = 10,
+  parameter int unsigned ColorW      = 8,
+  parameter int unsigned AlphaW      = 12,
+  parameter int unsigned RmLog2      = 3,
+  parameter int unsigned RmFracW     = 4,
+  parameter int unsigned DiffW       = 9,
+  parameter int unsigned SpecW       = 8,
+  parameter int unsigned ExtraW      = 4,
+  parameter int unsigned AccW        = 20,
+  parameter int unsigned ZW          = 12
+) (
+  input  logic clk_i,
+  input  logic rst_ni,
+
+  // ---- AXI4-Lite subordinate: the host registers (docs/accel-regs.md) ----
+  input  logic        s_axil_awvalid_i,
+  output logic        s_axil_awready_o,
+  input  logic [9:0]  s_axil_awaddr_i,
+  input  logic        s_axil_wvalid_i,
+  output logic        s_axil_wready_o,
+  input  logic [31:0] s_axil_wdata_i,
+  input  logic [3:0]  s_axil_wstrb_i,
+  output logic        s_axil_bvalid_o,
+  input  logic        s_axil_bready_i,
+  output logic [1:0]  s_axil_bresp_o,
+  input  logic        s_axil_arvalid_i,
+  output logic        s_axil_arready_o,
+  input  logic [9:0]  s_axil_araddr_i,
+  output logic        s_axil_rvalid_o,
+  input  logic        s_axil_rready_i,
+  output logic [31:0] s_axil_rdata_o,
+  output logic [1:0]  s_axil_rresp_o,
+  /// Level interrupt: |(IrqStatus & IrqEnable).
+  output logic        irq_o,
+  /// Sticky: some AXI4 response (R or B) since reset was not OKAY.
+  output logic        err_o,
+
+  // ---- AXI4 manager: the volume (AR, R) and the image (AW, W, B) ----
+  output logic [AddrW-1:0]   m_axi_araddr_o,
+  output logic [7:0]         m_axi_arlen_o,
+  output logic [2:0]         m_axi_arsize_o,
+  output logic [1:0]         m_axi_arburst_o,
+  output logic [IdW-1:0]     m_axi_arid_o,
+  output logic               m_axi_arvalid_o,
+  input  logic               m_axi_arready_i,
+  input  logic [DataW-1:0]   m_axi_rdata_i,
+  input  logic [1:0]         m_axi_rresp_i,
+  input  logic               m_axi_rlast_i,
+  input  logic [IdW-1:0]     m_axi_rid_i,
+  input  logic               m_axi_rvalid_i,
+  output logic               m_axi_rready_o,
+  output logic [AddrW-1:0]   m_axi_awaddr_o,
+  output logic [7:0]         m_axi_awlen_o,
+  output logic [2:0]         m_axi_awsize_o,
+  output logic [1:0]         m_axi_awburst_o,
+  output logic [IdW-1:0]     m_axi_awid_o,
+  output logic               m_axi_awvalid_o,
+  input  logic               m_axi_awready_i,
+  output logic [DataW-1:0]   m_axi_wdata_o,
+  output logic [DataW/8-1:0] m_axi_wstrb_o,
+  output logic               m_axi_wlast_o,
+  output logic               m_axi_wvalid_o,
+  input  logic               m_axi_wready_i,
+  input  logic [1:0]         m_axi_bresp_i,
+  input  logic [IdW-1:0]     m_axi_bid_i,
+  input  logic               m_axi_bvalid_i,
+  output logic               m_axi_bready_o
+);
+
+  // ---------------------------------------------------------------------------
+  // Widths
+  // ---------------------------------------------------------------------------
+  localparam int unsigned M        = $clog2(MaxDim);
+  localparam int unsigned DimW     = M + 1;
+  localparam int unsigned NbW      = $clog2(MaxDim / BlockDim);
+  localparam int unsigned WordW    = cube5_vol_fetch_pkg::word_w(P, BlockDim);
+  localparam int unsigned PixelBytes = 4;
+  localparam int unsigned ItemW    = 8 * PixelBytes;
+  localparam int unsigned LenW     = 16;
+  localparam int unsigned FeCmdW   = cube5_vol_fetch_pkg::cmd_w(AddrW, MaxDim, BlockDim);
+  localparam int unsigned FeOutW   = cube5_vol_fetch_pkg::out_w(P, VoxelW, MaxDim, BlockDim);
+  localparam int unsigned SweepW   = AddrW + 5 * NbW + 7;
+  localparam int unsigned LutW     = 6 * NbW + 2;
+  localparam int unsigned SbInW    = cube5_section_buf_pkg::in_w(P, VoxelW, MaxDim, BlockDim);
+  localparam int unsigned SbOutW   = cube5_section_buf_pkg::out_w(P, VoxelW);
+  localparam int unsigned SbCmdW   = 4 * M + 6;
+  localparam int unsigned FrInW    = cube5_frame_pkg::in_w(1, P, VoxelW, M);
+  localparam int unsigned FrOutW   = cube5_frame_pkg::out_w(AccW, ZW, ColorW);
+  localparam int unsigned FrSecW   = cube5_frame_pkg::sec_cmd_w(M);
+  localparam int unsigned FrCmdW   = 7 * M + 50;
+  localparam int unsigned BlkW     = cube5_skewmem_pkg::blk_w(M, BlockDim);
+  localparam int unsigned ShAddrW  = cube5_shader_pkg::cfg_addr_w(ClassIdxW, RmLog2);
+  localparam int unsigned ShDataW  = cube5_shader_pkg::cfg_data_w(ColorW, AlphaW, DiffW, SpecW);
+  localparam int unsigned OffW     = cube5_frame_pkg::cfg_off_w(M, BlkW, ShAddrW, AlphaW);
+  localparam int unsigned CfgAddrW = cube5_frame_pkg::CfgRegionW + OffW;
+  localparam int unsigned CfgDataW = cube5_frame_pkg::cfg_data_w(M, VoxelW, BlkW, ShDataW, AccW);
+  localparam int unsigned ChanW    = AccW + 1;
+  // Fields of the streams (LSB first; docs/numerics/vol_fetch.md, section_buf.md).
+  localparam int unsigned FeLastBit = P * VoxelW + 3 * NbW + WordW + 1;
+  localparam int unsigned SbLastBit = (P + 3) * VoxelW + 3;
+  // Fields of the control core's frame command (docs/numerics/accel_ctrl.md).
+  localparam int unsigned FcDims   = 0;
+  localparam int unsigned FcView   = FcDims + 3 * DimW;
+  localparam int unsigned FcDx     = FcView + 3;
+  localparam int unsigned FcDy     = FcDx + 18;
+  localparam int unsigned FcMode   = FcDy + 18;
+  localparam int unsigned FcSkip   = FcMode + 3;
+  localparam int unsigned FcA0     = FcSkip + 2 * DimW;
+  localparam int unsigned FcNs     = FcA0 + M;
+  localparam int unsigned FcFirst  = FcNs + DimW;
+  localparam int unsigned FcLast   = FcFirst + 1;
+
+  if (ColorW > 8) begin : gen_bad_color
+    $fatal(1, "cube5_accel: ColorW must be at most 8 (a pixel is four byte codes)");
+  end
+  if (3 * NbW + 2 > 32) begin : gen_bad_lut
+    $fatal(1, "cube5_accel: a block LUT entry must fit the 32-bit table window");
+  end
+  if (ShDataW > 64 || ChanW > 32 || 3 * DimW > 32) begin : gen_bad_cfg
+    $fatal(1, "cube5_accel: a table entry must fit two words of the table window");
+  end
+  if (Section < 2 * P) begin : gen_bad_section
+    $fatal(1, "cube5_accel: Section must be at least 2 P (the frame's rows hold two beats or more)");
+  end
+  if (FcLast + 1 != FrCmdW) begin : gen_bad_fc
+    $fatal(1, "cube5_accel: the frame command's fields do not add up");
+  end
+
+  // ---------------------------------------------------------------------------
+  // The control core
+  // ---------------------------------------------------------------------------
+  logic              fc_valid, fc_ready;   // fetch sweep
+  logic [SweepW-1:0] fc_data;
+  logic              sc_valid, sc_ready;   // buffer section
+  logic [SbCmdW-1:0] sc_data;
+  logic              rc_valid, rc_ready;   // frame section
+  logic [FrCmdW-1:0] rc_data;
+  logic              wc_valid, wc_ready;   // writer row
+  logic [AddrW+LenW-1:0] wc_data;
+  logic              done_valid, done_error;
+  logic              cpl_valid;
+  logic [17:0]       cpl_data;
+  logic              tbl_valid;
+  logic [3:0]        tbl_id;
+  logic [15:0]       tbl_index;
+  logic [31:0]       tbl_data;
+
+  cube5_accel_ctrl #(
+    .P(P), .MaxDim(MaxDim), .BlockDim(BlockDim), .Section(Section), .AddrW(AddrW),
+    .DataW(DataW), .PixelBytes(PixelBytes), .LenW(LenW)
+  ) u_ctrl (
+    .clk_i, .rst_ni,
+    .s_axil_awvalid_i, .s_axil_awready_o, .s_axil_awaddr_i, .s_axil_wvalid_i, .s_axil_wready_o,
+    .s_axil_wdata_i, .s_axil_wstrb_i, .s_axil_bvalid_o, .s_axil_bready_i, .s_axil_bresp_o,
+    .s_axil_arvalid_i, .s_axil_arready_o, .s_axil_araddr_i, .s_axil_rvalid_o, .s_axil_rready_i,
+    .s_axil_rdata_o, .s_axil_rresp_o, .irq_o,
+    .fetch_cmd_valid_o(fc_valid), .fetch_cmd_ready_i(fc_ready), .fetch_cmd_data_o(fc_data),
+    .sbuf_cmd_valid_o(sc_valid), .sbuf_cmd_ready_i(sc_ready), .sbuf_cmd_data_o(sc_data),
+    .frame_cmd_valid_o(rc_valid), .frame_cmd_ready_i(rc_ready), .frame_cmd_data_o(rc_data),
+    .wr_cmd_valid_o(wc_valid), .wr_cmd_ready_i(wc_ready), .wr_cmd_data_o(wc_data),
+    .frame_done_valid_i(done_valid), .frame_done_error_i(done_error),
+    .wr_cpl_valid_i(cpl_valid), .wr_cpl_resp_i(cpl_data[1:0]),
+    .table_valid_o(tbl_valid), .table_id_o(tbl_id), .table_index_o(tbl_index),
+    .table_data_o(tbl_data)
+  );
+
+  // ---------------------------------------------------------------------------
+  // Table writes: Block to the fetch's LUT; Class, Reflect, Opacity to the frame's
+  // configuration port. Each waits in a one-entry register until its unit takes it (the host's
+  // AXI4-Lite writes are several cycles apart).
+  // ---------------------------------------------------------------------------
+  logic             blk_pend_q;
+  logic [LutW-1:0]  blk_q;          // {masked, empty, ptr, index}
+  logic             tcfg_pend_q;
+  logic [CfgAddrW-1:0] tcfg_addr_q;
+  logic [CfgDataW-1:0] tcfg_data_q;
+  logic [31:0]      class_lo_q;     // the low word of a classification entry
+  logic             fe_in_ready;
+  logic             seq_we;         // the frame-register sequencer writes this cycle
+
+  // The shader's address of a table entry: Class entries at region 0 (two words each, low first),
+  // Reflect's index i at the shader's address 2^(ShAddrW - 2) + i (its texels, then the
+  // zero-gradient entry); Opacity's index is the compositing unit's address.
+  logic [ShAddrW-1:0] sh_addr;
+  always_comb begin
+    if (tbl_id == cube5_accel_regs_pkg::TableClass) begin
+      sh_addr = ShAddrW'(tbl_index[15:1]);
+    end else begin
+      sh_addr = ShAddrW'(32'(tbl_index) + (32'd1 << (ShAddrW - 2)));
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      blk_pend_q  <= 1'b0;
+      tcfg_pend_q <= 1'b0;
+    end else begin
+      if (blk_pend_q && fe_in_ready) blk_pend_q <= 1'b0;
+      if (tcfg_pend_q && !seq_we) tcfg_pend_q <= 1'b0;
+      if (tbl_valid) begin
+        unique case (tbl_id)
+          cube5_accel_regs_pkg::TableBlock: begin
+            blk_pend_q <= 1'b1;
+            blk_q      <= {tbl_data[3*NbW+1:0], (3*NbW)'(tbl_index)};
+          end
+          cube5_accel_regs_pkg::TableClass: begin
+            if (!tbl_index[0]) begin
+              class_lo_q <= tbl_data;
+            end else begin
+              tcfg_pend_q <= 1'b1;
+              tcfg_addr_q <= {cube5_frame_pkg::CfgRegionShader, OffW'(sh_addr)};
+              tcfg_data_q <= CfgDataW'({tbl_data, class_lo_q});
+            end
+          end
+          cube5_accel_regs_pkg::TableReflect: begin
+            tcfg_pend_q <= 1'b1;
+            tcfg_addr_q <= {cube5_frame_pkg::CfgRegionShader, OffW'(sh_addr)};
+            tcfg_data_q <= CfgDataW'(tbl_data);
+          end
+          cube5_accel_regs_pkg::TableOpacity: begin
+            tcfg_pend_q <= 1'b1;
+            tcfg_addr_q <= {cube5_frame_pkg::CfgRegionCompos, OffW'(tbl_index)};
+            tcfg_data_q <= CfgDataW'(tbl_data);
+          end
+          default: ;
+        endcase
+      end
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // The fetch: a pending LUT write first, else the core's sweep.
+  // ---------------------------------------------------------------------------
+  logic              fe_in_valid;
+  logic [FeCmdW-1:0] fe_in_data;
+  logic              fe_out_valid, fe_out_ready;
+  logic [FeOutW-1:0] fe_out_data;
+  logic              fe_err;
+
+  assign fe_in_valid = blk_pend_q || fc_valid;
+  assign fe_in_data  = blk_pend_q ? FeCmdW'({blk_q, 1'b0}) : FeCmdW'({fc_data, 1'b1});
+  assign fc_ready    = fe_in_ready && !blk_pend_q;
+
+  cube5_vol_fetch #(
+    .AddrW(AddrW), .DataW(DataW), .P(P), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim),
+    .MaxBurst(MaxBurst), .Outstanding(Outstanding), .IdW(IdW)
+  ) u_fetch (
+    .clk_i, .rst_ni,
+    .in_valid_i(fe_in_valid), .in_ready_o(fe_in_ready), .in_data_i(fe_in_data),
+    .out_valid_o(fe_out_valid), .out_ready_i(fe_out_ready), .out_data_o(fe_out_data),
+    .err_o(fe_err),
+    .m_axi_araddr_o, .m_axi_arlen_o, .m_axi_arsize_o, .m_axi_arburst_o, .m_axi_arid_o,
+    .m_axi_arvalid_o, .m_axi_arready_i, .m_axi_rdata_i, .m_axi_rresp_i, .m_axi_rlast_i,
+    .m_axi_rid_i, .m_axi_rvalid_i, .m_axi_rready_o
+  );
+
+  // ---------------------------------------------------------------------------
+  // The section buffer: a section command (op 1), then the fetch's items of its sweep (op 0) up
+  // to the item marked last.
+  // ---------------------------------------------------------------------------
+  logic             sb_items_q;     // passing the fetch's items
+  logic             sb_in_valid, sb_in_ready;
+  logic [SbInW-1:0] sb_in_data;
+  logic             sb_out_valid, sb_out_ready;
+  logic [SbOutW-1:0] sb_out_data;
+
+  assign sb_in_valid  = sb_items_q ? fe_out_valid : sc_valid;
+  assign sb_in_data   = sb_items_q ? SbInW'({fe_out_data, 1'b0}) : SbInW'({sc_data, 1'b1});
+  assign fe_out_ready = sb_items_q && sb_in_ready;
+  assign sc_ready     = !sb_items_q && sb_in_ready;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      sb_items_q <= 1'b0;
+    end else if (sb_in_valid && sb_in_ready) begin
+      sb_items_q <= sb_items_q ? !fe_out_data[FeLastBit] : 1'b1;
+    end
+  end
+
+  cube5_section_buf #(
+    .P(P), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim), .Section(Section)
+  ) u_sbuf (
+    .clk_i, .rst_ni,
+    .in_valid_i(sb_in_valid), .in_ready_o(sb_in_ready), .in_data_i(sb_in_data),
+    .out_valid_o(sb_out_valid), .out_ready_i(sb_out_ready), .out_data_o(sb_out_data)
+  );
+
+  // ---------------------------------------------------------------------------
+  // The frame: on a frame's first section its six registers through the configuration port,
+  // then the section command, then the buffer's beams up to the section's last.
+  // ---------------------------------------------------------------------------
+  typedef enum logic [1:0] {FrIdle, FrRegs, FrCmd, FrBeams} fr_state_e;
+  fr_state_e          fr_q;
+  logic [2:0]         reg_q;        // the register being written
+  logic               fr_in_valid, fr_in_ready;
+  logic [FrInW-1:0]   fr_in_data;
+  logic               fr_out_valid, fr_out_ready;
+  logic [FrOutW-1:0]  fr_out_data;
+  logic               fr_error;     // the frame's output item is its error item
+  logic               cfg_valid;
+  logic [CfgAddrW-1:0] cfg_addr;
+  logic [CfgDataW-1:0] cfg_data;
+  logic [CfgDataW-1:0] reg_word;
+  logic [FrSecW-1:0]  sec_cmd;
+  logic               readout_q;    // a frame started and its first pixel not yet out
+
+  always_comb begin
+    unique case (reg_q)
+      3'd0:    reg_word = CfgDataW'(rc_data[FcDims +: 3*DimW]);
+      3'd1:    reg_word = CfgDataW'(rc_data[FcView +: 3]);
+      3'd2:    reg_word = CfgDataW'(rc_data[FcDx +: 18]);
+      3'd3:    reg_word = CfgDataW'(rc_data[FcDy +: 18]);
+      3'd4:    reg_word = CfgDataW'(rc_data[FcMode +: 3]);   // tf2d 0
+      default: reg_word = CfgDataW'(rc_data[FcSkip +: 2*DimW]);
+    endcase
+  end
+
+  assign seq_we    = fr_q == FrRegs;
+  assign cfg_valid = seq_we || tcfg_pend_q;
+  assign cfg_addr  = seq_we ? {cube5_frame_pkg::CfgRegionFrame, OffW'(reg_q)} : tcfg_addr_q;
+  assign cfg_data  = seq_we ? reg_word : tcfg_data_q;
+
+  // {op 0 (render), sec_a0, sec_ns, sec_first, sec_last}, LSB first.
+  assign sec_cmd = {rc_data[FcLast], rc_data[FcFirst], rc_data[FcNs +: DimW],
+                    rc_data[FcA0 +: M], 2'b00};
+
+  assign fr_in_valid  = (fr_q == FrCmd && rc_valid) || (fr_q == FrBeams && sb_out_valid);
+  assign fr_in_data   = fr_q == FrBeams ? FrInW'({sb_out_data, cube5_frame_pkg::InKindBeat})
+                                        : FrInW'({sec_cmd, cube5_frame_pkg::InKindCmd});
+  assign sb_out_ready = fr_q == FrBeams && fr_in_ready;
+  assign rc_ready     = fr_q == FrCmd && fr_in_ready;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      fr_q      <= FrIdle;
+      reg_q     <= 3'd0;
+      readout_q <= 1'b0;
+    end else begin
+      unique case (fr_q)
+        FrIdle: begin
+          if (rc_valid) begin
+            reg_q <= 3'd0;
+            fr_q  <= rc_data[FcFirst] ? FrRegs : FrCmd;
+          end
+        end
+        FrRegs: begin
+          reg_q <= reg_q + 3'd1;
+          if (reg_q == 3'(cube5_frame_pkg::RegSkip)) fr_q <= FrCmd;
+        end
+        FrCmd: begin
+          if (rc_valid && fr_in_ready) begin
+            fr_q <= FrBeams;
+            if (rc_data[FcFirst]) readout_q <= 1'b1;
+          end
+        end
+        default: begin
+          if (sb_out_valid && fr_in_ready && sb_out_data[SbLastBit]) fr_q <= FrIdle;
+        end
+      endcase
+      if (fr_out_valid && fr_out_ready) readout_q <= 1'b0;
+    end
+  end
+
+  cube5_frame #(
+    .P(P), .MaxDim(MaxDim), .VoxelW(VoxelW), .WeightW(WeightW), .FracW(FracW),
+    .BlockDim(BlockDim), .ClassIdxW(ClassIdxW), .MagIdxW(MagIdxW), .MagShift(MagShift),
+    .ColorW(ColorW), .AlphaW(AlphaW), .RmLog2(RmLog2), .RmFracW(RmFracW), .DiffW(DiffW),
+    .SpecW(SpecW), .ExtraW(ExtraW), .AccW(AccW), .ZW(ZW), .Shade(1), .Source(1)
+  ) u_frame (
+    .clk_i, .rst_ni,
+    .in_valid_i(fr_in_valid), .in_ready_o(fr_in_ready), .in_data_i(fr_in_data),
+    .out_valid_o(fr_out_valid), .out_ready_i(fr_out_ready), .out_data_o(fr_out_data),
+    .cfg_valid_i(cfg_valid), .cfg_addr_i(cfg_addr), .cfg_data_i(cfg_data)
+  );
+
+  // The frame's done: its first read-out item (or its error item), passed on once the beams of
+  // the frame's last section are all in (at once for a read-out, which follows them; an error
+  // item can come before them), so that the frame never ends while the data path still streams.
+  logic cur_last_q;   // the section being passed is the frame's last
+  logic last_in_q;    // the last section's beams are all in
+  logic done_pend_q, done_err_q;
+  logic done_ev;
+
+  assign done_ev    = fr_out_valid && fr_out_ready && readout_q;
+  assign done_valid = (done_ev || done_pend_q) && last_in_q;
+  assign done_error = done_pend_q ? done_err_q : fr_error;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      cur_last_q  <= 1'b0;
+      last_in_q   <= 1'b0;
+      done_pend_q <= 1'b0;
+      done_err_q  <= 1'b0;
+    end else begin
+      if (fr_q == FrCmd && rc_valid && fr_in_ready) begin
+        cur_last_q <= rc_data[FcLast];
+        if (rc_data[FcFirst]) last_in_q <= 1'b0;
+      end
+      if (fr_q == FrBeams && sb_out_valid && fr_in_ready && sb_out_data[SbLastBit] && cur_last_q) begin
+        last_in_q <= 1'b1;
+      end
+      if (done_valid) begin
+        done_pend_q <= 1'b0;
+      end else if (done_ev) begin
+        done_pend_q <= 1'b1;
+        done_err_q  <= fr_error;
+      end
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Coxels to pixels: four codes, one register stage.
+  // ---------------------------------------------------------------------------
+  logic             pix_valid_q;
+  logic [ItemW-1:0] pix_q, pix_d;
+  logic             wr_dat_ready;
+
+  for (genvar c = 0; c < 4; c++) begin : gen_code
+    logic [ChanW-1:0]          chan;
+    logic [ChanW+ColorW:0]     scaled;
+    logic [ChanW+ColorW-AccW:0] code;
+    assign chan   = fr_out_data[c*ChanW +: ChanW];
+    assign scaled = ((ChanW+ColorW+1)'(chan) << ColorW) - (ChanW+ColorW+1)'(chan)
+                    + ((ChanW+ColorW+1)'(1) << (AccW - 1));
+    assign code   = scaled[ChanW+ColorW:AccW];
+    assign pix_d[8*c +: 8] = 8'(code > (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1)
+                                ? (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1) : code);
+    logic unused_low;
+    assign unused_low = ^scaled[AccW-1:0];
+  end
+
+  // After an error item of the frame (a section it refused) the frame's output is dropped and
+  // the writer gets zero pixels for every pixel of the rows the core has commanded, so that the
+  // frame ends (with IrqStatus.error, code Frame) instead of waiting for pixels that never come;
+  // the next frame's first section ends it. `owed_q`: pixels commanded minus pixels handed over.
+  localparam int unsigned OwedW = 2 * DimW + 3;
+  logic                    flush_q;
+  logic signed [OwedW-1:0] owed_q;
+  logic                    wr_dat_valid;
+  logic [ItemW-1:0]        wr_dat;
+
+  assign fr_error     = fr_out_data[cube5_frame_pkg::coxel_w(AccW, ZW, ColorW)];
+  assign fr_out_ready = flush_q || !pix_valid_q || wr_dat_ready;
+  assign wr_dat_valid = flush_q ? owed_q > 0 : pix_valid_q;
+  assign wr_dat       = flush_q ? '0 : pix_q;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      pix_valid_q <= 1'b0;
+      flush_q     <= 1'b0;
+      owed_q      <= '0;
+    end else begin
+      if (fr_out_ready) begin
+        pix_valid_q <= fr_out_valid && !flush_q && !fr_error;
+        if (fr_out_valid) pix_q <= pix_d;
+      end
+      if (fr_out_valid && fr_out_ready && fr_error) begin
+        flush_q     <= 1'b1;
+        pix_valid_q <= 1'b0;
+      end
+      if (fr_q == FrCmd && rc_valid && fr_in_ready && rc_data[FcFirst]) flush_q <= 1'b0;
+      owed_q <= owed_q + ((wc_valid && wc_ready) ? OwedW'(wc_data[AddrW +: LenW]) : '0)
+                       - OwedW'(wr_dat_valid && wr_dat_ready);
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // The image writer.
+  // ---------------------------------------------------------------------------
+  logic wr_err;
+
+  cube5_axi_wr #(
+    .AddrW(AddrW), .DataW(DataW), .ItemW(ItemW), .LenW(LenW), .MaxBurst(MaxBurst),
+    .Outstanding(WrOutstanding), .IdW(IdW)
+  ) u_wr (
+    .clk_i, .rst_ni,
+    .in_valid_i(wc_valid), .in_ready_o(wc_ready), .in_data_i(wc_data),
+    .dat_valid_i(wr_dat_valid), .dat_ready_o(wr_dat_ready), .dat_data_i(wr_dat),
+    .out_valid_o(cpl_valid), .out_ready_i(1'b1), .out_data_o(cpl_data),
+    .err_o(wr_err),
+    .m_axi_awaddr_o, .m_axi_awlen_o, .m_axi_awsize_o, .m_axi_awburst_o, .m_axi_awid_o,
+    .m_axi_awvalid_o, .m_axi_awready_i, .m_axi_wdata_o, .m_axi_wstrb_o, .m_axi_wlast_o,
+    .m_axi_wvalid_o, .m_axi_wready_i, .m_axi_bresp_i, .m_axi_bid_i, .m_axi_bvalid_i,
+    .m_axi_bready_o
+  );
+
+  assign err_o = fe_err || wr_err;
+
+  // The rest of the frame's output item (counters) and of the completion (its count).
+  logic unused;
+  assign unused = ^{fr_out_data[FrOutW-1:4*ChanW], cpl_data[17:2]};
+
+endmodule
