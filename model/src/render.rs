@@ -556,6 +556,34 @@ impl RayAcc {
             CompositeMode::Composite => self.color.to_array(),
         }
     }
+
+    /// The ray's colour with opaque geometry of colour `geo` behind its samples
+    /// (docs/numerics/frame.md, "Opaque geometry"): the compositing unit's flush in f64, the
+    /// geometry under the ray's colour, weighted by the transparency `1 - min(A, 1)` the mode's
+    /// accumulator leaves (composite: the opacity; MIP, X-ray: the peak, the sum; MinIP: the
+    /// minimum, none without a sample; first-opaque: 0 or 1), and nothing once the ray finished
+    /// (early termination, first-opaque's hit).
+    pub(crate) fn finish_over(
+        &self,
+        f: &Field,
+        mode: CompositeMode,
+        finished: bool,
+        geo: [f64; 3],
+    ) -> [f64; 3] {
+        let c = self.finish(f, mode);
+        if finished {
+            return c;
+        }
+        let a = match mode {
+            CompositeMode::Composite => self.alpha,
+            CompositeMode::Mip => self.peak,
+            CompositeMode::Minip => self.low,
+            CompositeMode::Xray => self.sum / f.diag,
+            CompositeMode::FirstOpaque => 0.0,
+        };
+        let t = 1.0 - a.min(1.0);
+        std::array::from_fn(|i| c[i] + t * geo[i])
+    }
 }
 
 /// The eye of a perspective view and the tangent of half its field of view (zoom applied): the eye
@@ -606,6 +634,18 @@ pub fn render_reference(
     tf: &TransferFunction,
     params: &RenderParams,
 ) -> Result<ImageF64> {
+    render_reference_geometry(vol, tf, params, &[])
+}
+
+/// [`render_reference`] with opaque solids in the volume (`geometry`, voxel coordinates): each
+/// ray's samples at or behind the first surface it meets are left out, and the surface's colour
+/// goes under the ray's ([`RayAcc::finish_over`]).
+pub fn render_reference_geometry(
+    vol: &Volume,
+    tf: &TransferFunction,
+    params: &RenderParams,
+    geometry: &[crate::geometry::Solid],
+) -> Result<ImageF64> {
     params.validate()?;
     tf.validate()?;
     let dir = params.direction()?;
@@ -615,17 +655,29 @@ pub fn render_reference(
     let aspect = f64::from(params.width) / f64::from(params.height);
 
     // One ray: origin, unit direction; samples at origin + dir * (k * step).
+    let spacing = DVec3::from_array(vol.spacing);
     let trace = |origin: DVec3, rd: DVec3| -> [f64; 3] {
         let mut acc = RayAcc::default();
+        // The first opaque surface: samples at t >= t_hit are hidden.
+        let hit = crate::geometry::first_hit(geometry, origin / spacing, rd / spacing);
+        let t_hit = hit.map_or(f64::INFINITY, |h| h.0);
+        let mut finished = false;
         if let Some((k0, k1)) = field.clip(origin, rd) {
             for k in k0..=k1 {
-                let w = origin + rd * (k as f64 * field.step_world);
-                if acc.add(&field, tf, params, w, rd) {
+                let t = k as f64 * field.step_world;
+                if t >= t_hit {
+                    break;
+                }
+                if acc.add(&field, tf, params, origin + rd * t, rd) {
+                    finished = true;
                     break;
                 }
             }
         }
-        acc.finish(&field, params.mode)
+        match hit {
+            Some((_, geo)) => acc.finish_over(&field, params.mode, finished, geo),
+            None => acc.finish(&field, params.mode),
+        }
     };
 
     Ok(image_of(params, |ndc_x, ndc_y| match params.projection {
