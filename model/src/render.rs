@@ -1395,6 +1395,51 @@ mod tests {
         assert!(lum[16 * 32 + 16] > 0.1, "centre pixel sees the head");
     }
 
+    /// Opaque geometry in the f64 reference: a box that wraps the whole volume hides every sample
+    /// (each ray enters it before the volume), so every ray that meets it shows its colour, in
+    /// every mode but MinIP (no sample: `A` above 1, nothing shows); rays that miss it see nothing.
+    #[test]
+    fn geometry_around_the_volume_hides_it() {
+        let vol = head_phantom(24, 12).unwrap();
+        let boxed = [crate::geometry::Solid::Box {
+            min: [-2.0; 3],
+            max: [26.0; 3],
+            colour: [0.2, 0.4, 0.6],
+        }];
+        for mode in [
+            CompositeMode::Composite,
+            CompositeMode::Mip,
+            CompositeMode::Xray,
+            CompositeMode::FirstOpaque,
+            CompositeMode::Minip,
+        ] {
+            let params = RenderParams {
+                width: 32,
+                height: 32,
+                mode,
+                ..Default::default()
+            };
+            let tf = TransferFunction::head_default();
+            let img = render_reference_geometry(&vol, &tf, &params, &boxed).unwrap();
+            let centre = img.rgb[16 * 32 + 16];
+            let want = if mode == CompositeMode::Minip {
+                [0.0; 3]
+            } else {
+                [0.2, 0.4, 0.6]
+            };
+            assert!(
+                centre.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12),
+                "{mode:?}: {centre:?}"
+            );
+            assert_eq!(img.rgb[0], [0.0; 3], "{mode:?}: the corner misses the box");
+            // Without the box the centre shows the head (MinIP's minimum crosses air: black).
+            if mode != CompositeMode::Minip {
+                let plain = render_reference(&vol, &tf, &params).unwrap();
+                assert_ne!(plain.rgb[16 * 32 + 16], centre, "{mode:?}");
+            }
+        }
+    }
+
     #[test]
     fn bad_params_refused() {
         let vol = head_phantom(8, 12).unwrap();

@@ -252,7 +252,7 @@ impl GeometrySpec {
             ));
         }
         for (i, b) in self.boxes.iter().enumerate() {
-            let f = |x: &str| format!("geometry.box[{i}].{x}");
+            let f = |x: &str| format!("geometry.box.{x} (box {i})");
             if !finite(&b.min) {
                 return Some((f("min"), format!("{:?} is not finite", b.min)));
             }
@@ -273,7 +273,7 @@ impl GeometrySpec {
             }
         }
         for (i, s) in self.spheres.iter().enumerate() {
-            let f = |x: &str| format!("geometry.sphere[{i}].{x}");
+            let f = |x: &str| format!("geometry.sphere.{x} (sphere {i})");
             if !finite(&s.centre) {
                 return Some((f("centre"), format!("{:?} is not finite", s.centre)));
             }

@@ -1266,6 +1266,16 @@ pub fn render_base_plane_reference(
     vol: &Volume,
     units: &FrameUnits,
 ) -> BasePlane {
+    let mut bp = render_rays(params, vol, units);
+    if units.geometry.is_some() {
+        bp.coxels = bp.coxels.iter().map(|c| units.read_out(c)).collect();
+    }
+    bp
+}
+
+/// The coxels of every ray after its last sample, before the read-out (with geometry, the
+/// read-out's flush follows: [`FrameUnits::read_out`]).
+fn render_rays(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
     let (w, h) = params.base_plane_size();
     let mut coxels: Vec<Coxel> = (0..w * h).map(|i| units.initial_coxel_at(i)).collect();
     for s in 0..params.nk {
@@ -1280,9 +1290,6 @@ pub fn render_base_plane_reference(
             let at = q * w + r;
             coxels[at] = units.compos.step(&coxels[at], sample);
         }
-    }
-    if units.geometry.is_some() {
-        coxels = coxels.iter().map(|c| units.read_out(c)).collect();
     }
     BasePlane {
         width: w,
@@ -1317,13 +1324,19 @@ pub fn render_exact_stats(
     vol: &Volume,
     units: &FrameUnits,
 ) -> (BasePlane, SweepStats) {
-    let bp = render_base_plane_reference(params, vol, units);
+    // Rays the compositing unit terminated: counted before the read-out's flush (which marks
+    // every ray of a frame with geometry terminated).
+    let mut bp = render_rays(params, vol, units);
+    let rays_terminated = bp.coxels.iter().filter(|c| c.terminated).count() as u64;
+    if units.geometry.is_some() {
+        bp.coxels = bp.coxels.iter().map(|c| units.read_out(c)).collect();
+    }
     let anchors = params.samples() as u64;
     let stats = SweepStats {
         anchors,
         samples: anchors,
         shaded: anchors,
-        rays_terminated: bp.coxels.iter().filter(|c| c.terminated).count() as u64,
+        rays_terminated,
         ..SweepStats::default()
     };
     (bp, stats)
