@@ -54,3 +54,37 @@ pub fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
     ]);
     (out, png)
 }
+
+/// The example scene `scenes/NAME.toml` with each `(from, to)` replaced (each `from` must be in
+/// it, so a changed scene fails loudly), written to the scratch directory as TAG.toml.
+pub fn example_scene_with(name: &str, tag: &str, edits: &[(&str, &str)]) -> PathBuf {
+    let path = cube5_model::repo_root().join(format!("scenes/{name}.toml"));
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{name}: the scene has no `{from}` any more");
+        text = text.replace(from, to);
+    }
+    let f = scratch(&format!("{tag}.toml"));
+    std::fs::write(&f, text).unwrap();
+    f
+}
+
+/// `cube5 cosim SCENE -o DIR` (DIR emptied first): must succeed and print MATCH; returns stdout.
+pub fn cosim_matches(scene: &std::path::Path, dir: &std::path::Path) -> String {
+    let _ = std::fs::remove_dir_all(dir);
+    let out = cube5(&[
+        "cosim",
+        scene.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{}: {stdout}{}",
+        scene.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("MATCH"), "{}: {stdout}", scene.display());
+    stdout
+}
