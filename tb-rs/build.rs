@@ -9,7 +9,7 @@
 //! two builds can share the cache. `make clean-cache` empties it.
 //! `CUBE5_TOPS=entry[,entry...]` restricts the build (for quick iteration on one unit): an entry
 //! is a top, a build name, or a top with parameter values (`cube5_frame:P=4`); CI and `make
-//! test` leave it unset and build everything.
+//! test` leave it unset and build everything but the `full` lines (`CUBE5_FULL=1`: those too).
 
 use sha2::{Digest, Sha256};
 use std::env;
@@ -240,6 +240,7 @@ fn main() {
     let vlt = repo.join("rtl/lint/verilator.vlt");
 
     println!("cargo:rerun-if-env-changed=CUBE5_TOPS");
+    println!("cargo:rerun-if-env-changed=CUBE5_FULL");
     println!("cargo:rerun-if-changed=src/ffi.rs");
     for f in [
         "dut_core.h",
@@ -270,6 +271,7 @@ fn main() {
         .ok()
         .filter(|s| !s.trim().is_empty())
         .map(|s| s.split(',').map(|t| t.trim().to_string()).collect());
+    let full = env::var("CUBE5_FULL").is_ok_and(|v| v == "1");
     let cache = Cache::open(&out);
     // Every line's resolved top-level parameters, as Verilator elaborates them (defaults
     // included): the variant table carries them so a test can hold the model to every one.
@@ -298,6 +300,8 @@ fn main() {
             only.as_ref()
                 .is_none_or(|o| o.iter().any(|t| selects(t, v)))
         })
+        // `full` lines serve only the runs too long for CI: built for `make sim-full` alone.
+        .filter(|v| full || !v.flags.iter().any(|f| f == "full"))
         .cloned()
         .collect();
 

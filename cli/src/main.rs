@@ -20,7 +20,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use cube5_model::er_perspective::render_er;
 use cube5_model::phantom::{phantom_by_name, PHANTOMS};
-use cube5_model::render::{render_pipeline, render_reference, ImageF64, Projection};
+use cube5_model::render::{render_pipeline, render_reference_geometry, ImageF64, Projection};
 use cube5_model::scene::{Plan, Renderer, Scene, Target};
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
 use cube5_model::slab_perspective::render_slabs;
@@ -282,6 +282,12 @@ fn render(args: RenderArgs) -> Result<()> {
     let tf = scene.transfer_function();
     let what_if = not_expressible(&scene);
     let repeat = args.repeat.max(1);
+    // Opaque geometry ([geometry]): the f64 reference intersects it exactly.
+    let solids = scene
+        .geometry
+        .as_ref()
+        .map(|g| g.solids())
+        .unwrap_or_default();
     // The frame's set-up (volume at VoxelW, block LUT, tables) is made once; a frame is the sweep
     // and the warp.
     let job = match scene.run.renderer {
@@ -295,7 +301,7 @@ fn render(args: RenderArgs) -> Result<()> {
         let start = std::time::Instant::now();
         let out = match scene.run.renderer {
             Renderer::Reference => {
-                let img = render_reference(&ref_vol, &tf, &params)?;
+                let img = render_reference_geometry(&ref_vol, &tf, &params, &solids)?;
                 let what = format!(
                     "f64 reference renderer, step {}{}",
                     params.step,
@@ -386,7 +392,7 @@ fn render(args: RenderArgs) -> Result<()> {
     }
     let secs = best;
     if args.compare && scene.run.renderer != Renderer::Reference {
-        let reference = render_reference(&ref_vol, &tf, &params)?;
+        let reference = render_reference_geometry(&ref_vol, &tf, &params, &solids)?;
         let e = image_error(&img, &reference);
         say!(
             "error against the f64 reference: PSNR {:.1} dB, max abs {:.1}/255, relative Euclidean {:.3}%",

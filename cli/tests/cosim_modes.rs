@@ -55,3 +55,36 @@ fn every_mode_scene_downsized_matches_the_rtl_frame() {
         assert!(dir.join("rtl.png").exists(), "{name}");
     }
 }
+
+/// `cube5 cosim` of the ER-perspective example scene at 32^3 (issue 14): it runs on `cube5_er`,
+/// not on the frame, and its base plane MATCHes the model's, every coxel field.
+#[test]
+fn the_er_perspective_scene_downsized_matches_the_rtl() {
+    let path = cube5_model::repo_root().join("scenes/head-perspective-er.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.contains("size = 96"),
+        "the scene's volume size changed"
+    );
+    let scene = scratch("modes-head-perspective-er.toml");
+    std::fs::write(&scene, text.replace("size = 96", "size = 32")).unwrap();
+    let dir = scratch("modes-head-perspective-er-out");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = cube5(&[
+        "cosim",
+        scene.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("MATCH") && stdout.contains("cube5_er"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("plan: ER-perspective"), "{stdout}");
+}

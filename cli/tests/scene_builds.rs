@@ -68,8 +68,14 @@ const SCENES: &[Wanted] = &[
         left_out: &[],
         prefilter: Some("TapW=13 WeightFracW=0 OutShift=2"),
     },
-    // The fifth scene of issue 17's acceptance, geometry with the depth test (`[geometry]`), goes
-    // here: its entry names the configuration with the depth test and what it leaves out.
+    // Volume and opaque geometry: the depth test (`DepthTest = 1`, a 48^3 volume in a 64^3 memory).
+    Wanted {
+        scene: "head-geometry",
+        mode: "composite",
+        config: "p4m64d1",
+        left_out: &[],
+        prefilter: None,
+    },
 ];
 
 fn scene_path(name: &str) -> String {

@@ -18,6 +18,7 @@ pub mod bits;
 pub mod camera;
 pub mod er_perspective;
 pub mod error;
+pub mod geometry;
 pub mod phantom;
 pub mod prefilter;
 pub mod regmap;

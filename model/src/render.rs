@@ -556,6 +556,34 @@ impl RayAcc {
             CompositeMode::Composite => self.color.to_array(),
         }
     }
+
+    /// The ray's colour with opaque geometry of colour `geo` behind its samples
+    /// (docs/numerics/frame.md, "Opaque geometry"): the compositing unit's flush in f64, the
+    /// geometry under the ray's colour, weighted by the transparency `1 - min(A, 1)` the mode's
+    /// accumulator leaves (composite: the opacity; MIP, X-ray: the peak, the sum; MinIP: the
+    /// minimum, none without a sample; first-opaque: 0 or 1), and nothing once the ray finished
+    /// (early termination, first-opaque's hit).
+    pub(crate) fn finish_over(
+        &self,
+        f: &Field,
+        mode: CompositeMode,
+        finished: bool,
+        geo: [f64; 3],
+    ) -> [f64; 3] {
+        let c = self.finish(f, mode);
+        if finished {
+            return c;
+        }
+        let a = match mode {
+            CompositeMode::Composite => self.alpha,
+            CompositeMode::Mip => self.peak,
+            CompositeMode::Minip => self.low,
+            CompositeMode::Xray => self.sum / f.diag,
+            CompositeMode::FirstOpaque => 0.0,
+        };
+        let t = 1.0 - a.min(1.0);
+        std::array::from_fn(|i| c[i] + t * geo[i])
+    }
 }
 
 /// The eye of a perspective view and the tangent of half its field of view (zoom applied): the eye
@@ -606,6 +634,18 @@ pub fn render_reference(
     tf: &TransferFunction,
     params: &RenderParams,
 ) -> Result<ImageF64> {
+    render_reference_geometry(vol, tf, params, &[])
+}
+
+/// [`render_reference`] with opaque solids in the volume (`geometry`, voxel coordinates): each
+/// ray's samples at or behind the first surface it meets are left out, and the surface's colour
+/// goes under the ray's ([`RayAcc::finish_over`]).
+pub fn render_reference_geometry(
+    vol: &Volume,
+    tf: &TransferFunction,
+    params: &RenderParams,
+    geometry: &[crate::geometry::Solid],
+) -> Result<ImageF64> {
     params.validate()?;
     tf.validate()?;
     let dir = params.direction()?;
@@ -615,17 +655,29 @@ pub fn render_reference(
     let aspect = f64::from(params.width) / f64::from(params.height);
 
     // One ray: origin, unit direction; samples at origin + dir * (k * step).
+    let spacing = DVec3::from_array(vol.spacing);
     let trace = |origin: DVec3, rd: DVec3| -> [f64; 3] {
         let mut acc = RayAcc::default();
+        // The first opaque surface: samples at t >= t_hit are hidden.
+        let hit = crate::geometry::first_hit(geometry, origin / spacing, rd / spacing);
+        let t_hit = hit.map_or(f64::INFINITY, |h| h.0);
+        let mut finished = false;
         if let Some((k0, k1)) = field.clip(origin, rd) {
             for k in k0..=k1 {
-                let w = origin + rd * (k as f64 * field.step_world);
-                if acc.add(&field, tf, params, w, rd) {
+                let t = k as f64 * field.step_world;
+                if t >= t_hit {
+                    break;
+                }
+                if acc.add(&field, tf, params, origin + rd * t, rd) {
+                    finished = true;
                     break;
                 }
             }
         }
-        acc.finish(&field, params.mode)
+        match hit {
+            Some((_, geo)) => acc.finish_over(&field, params.mode, finished, geo),
+            None => acc.finish(&field, params.mode),
+        }
     };
 
     Ok(image_of(params, |ndc_x, ndc_y| match params.projection {
@@ -1341,6 +1393,51 @@ mod tests {
         let lum: Vec<f64> = img.rgb.iter().map(|c| c.iter().sum()).collect();
         assert!(lum[0] < 1e-6, "corner pixel is background");
         assert!(lum[16 * 32 + 16] > 0.1, "centre pixel sees the head");
+    }
+
+    /// Opaque geometry in the f64 reference: a box that wraps the whole volume hides every sample
+    /// (each ray enters it before the volume), so every ray that meets it shows its colour, in
+    /// every mode but MinIP (no sample: `A` above 1, nothing shows); rays that miss it see nothing.
+    #[test]
+    fn geometry_around_the_volume_hides_it() {
+        let vol = head_phantom(24, 12).unwrap();
+        let boxed = [crate::geometry::Solid::Box {
+            min: [-2.0; 3],
+            max: [26.0; 3],
+            colour: [0.2, 0.4, 0.6],
+        }];
+        for mode in [
+            CompositeMode::Composite,
+            CompositeMode::Mip,
+            CompositeMode::Xray,
+            CompositeMode::FirstOpaque,
+            CompositeMode::Minip,
+        ] {
+            let params = RenderParams {
+                width: 32,
+                height: 32,
+                mode,
+                ..Default::default()
+            };
+            let tf = TransferFunction::head_default();
+            let img = render_reference_geometry(&vol, &tf, &params, &boxed).unwrap();
+            let centre = img.rgb[16 * 32 + 16];
+            let want = if mode == CompositeMode::Minip {
+                [0.0; 3]
+            } else {
+                [0.2, 0.4, 0.6]
+            };
+            assert!(
+                centre.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12),
+                "{mode:?}: {centre:?}"
+            );
+            assert_eq!(img.rgb[0], [0.0; 3], "{mode:?}: the corner misses the box");
+            // Without the box the centre shows the head (MinIP's minimum crosses air: black).
+            if mode != CompositeMode::Minip {
+                let plain = render_reference(&vol, &tf, &params).unwrap();
+                assert_ne!(plain.rgb[16 * 32 + 16], centre, "{mode:?}");
+            }
+        }
     }
 
     #[test]

@@ -49,6 +49,9 @@ pub struct Scene {
     /// Volumetric global illumination on the GI-Cube processor model (`scene_gi`); none: the
     /// slice-order pipeline.
     pub gi: Option<GiSpec>,
+    /// Opaque boxes and spheres mixed with the volume (`[geometry]`): the frame's depth test
+    /// ([62], [217]-[218]); none: no geometry.
+    pub geometry: Option<GeometrySpec>,
     /// The file the scene was loaded from (relative volume paths start from its directory).
     #[serde(skip)]
     pub source: Option<PathBuf>,
@@ -173,6 +176,123 @@ pub struct TransferSpec {
     /// opacity grows with the gradient magnitude up to this fraction of the table's magnitude
     /// range, in (0, 1] (`ClassLut::boundary`). Frame scenes of composite and first-opaque only.
     pub boundary: Option<f64>,
+}
+
+/// Opaque geometry (`[geometry]`, docs/scenes.md): boxes and spheres in voxel coordinates, each
+/// with its colour, that the host rasterizes into the base plane's RGBA-Z image.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct GeometrySpec {
+    /// `[[geometry.box]]`: axis-aligned boxes.
+    #[serde(rename = "box")]
+    pub boxes: Vec<BoxSpec>,
+    /// `[[geometry.sphere]]`.
+    #[serde(rename = "sphere")]
+    pub spheres: Vec<SphereSpec>,
+}
+
+/// An opaque axis-aligned box `min ..= max` (voxel coordinates).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    /// R, G, B in 0..=1; white when absent.
+    #[serde(default = "white", alias = "color")]
+    pub colour: [f64; 3],
+}
+
+/// An opaque sphere (voxel coordinates).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereSpec {
+    pub centre: [f64; 3],
+    pub radius: f64,
+    /// R, G, B in 0..=1; white when absent.
+    #[serde(default = "white", alias = "color")]
+    pub colour: [f64; 3],
+}
+
+fn white() -> [f64; 3] {
+    [1.0; 3]
+}
+
+impl GeometrySpec {
+    /// The solids, boxes first.
+    pub fn solids(&self) -> Vec<crate::geometry::Solid> {
+        use crate::geometry::Solid;
+        let boxes = self.boxes.iter().map(|b| Solid::Box {
+            min: b.min,
+            max: b.max,
+            colour: b.colour,
+        });
+        let spheres = self.spheres.iter().map(|s| Solid::Sphere {
+            centre: s.centre,
+            radius: s.radius,
+            colour: s.colour,
+        });
+        boxes.chain(spheres).collect()
+    }
+
+    /// `2 boxes, 1 sphere`.
+    pub fn describe(&self) -> String {
+        let n =
+            |k: usize, one: &str, many: &str| format!("{k} {}", if k == 1 { one } else { many });
+        format!(
+            "{}, {}",
+            n(self.boxes.len(), "box", "boxes"),
+            n(self.spheres.len(), "sphere", "spheres")
+        )
+    }
+
+    /// The first field that is wrong, and why.
+    fn refusal(&self) -> Option<(String, String)> {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        let colour_ok = |c: &[f64; 3]| c.iter().all(|x| (0.0..=1.0).contains(x));
+        if self.boxes.is_empty() && self.spheres.is_empty() {
+            return Some((
+                "geometry".into(),
+                "give at least one [[geometry.box]] or [[geometry.sphere]]".into(),
+            ));
+        }
+        for (i, b) in self.boxes.iter().enumerate() {
+            let f = |x: &str| format!("geometry.box.{x} (box {i})");
+            if !finite(&b.min) {
+                return Some((f("min"), format!("{:?} is not finite", b.min)));
+            }
+            if !finite(&b.max) {
+                return Some((f("max"), format!("{:?} is not finite", b.max)));
+            }
+            if (0..3).any(|a| b.max[a] < b.min[a]) {
+                return Some((
+                    f("max"),
+                    format!("{:?} is below min {:?} on some axis", b.max, b.min),
+                ));
+            }
+            if !colour_ok(&b.colour) {
+                return Some((
+                    f("colour"),
+                    format!("{:?}: each channel must be in 0..=1", b.colour),
+                ));
+            }
+        }
+        for (i, s) in self.spheres.iter().enumerate() {
+            let f = |x: &str| format!("geometry.sphere.{x} (sphere {i})");
+            if !finite(&s.centre) {
+                return Some((f("centre"), format!("{:?} is not finite", s.centre)));
+            }
+            if !(s.radius.is_finite() && s.radius > 0.0) {
+                return Some((f("radius"), format!("{} must be finite and > 0", s.radius)));
+            }
+            if !colour_ok(&s.colour) {
+                return Some((
+                    f("colour"),
+                    format!("{:?}: each channel must be in 0..=1", s.colour),
+                ));
+            }
+        }
+        None
+    }
 }
 
 /// The pipeline model's knobs: a scene's `[quality]` table is read straight into `render::Quality`.
@@ -664,6 +784,26 @@ impl Scene {
                 return bad(&field, m);
             }
         }
+        if let Some(g) = &self.geometry {
+            if let Some((field, m)) = g.refusal() {
+                return bad(&field, m);
+            }
+            if self.gi.is_some() {
+                return bad(
+                    "geometry",
+                    "the GI-Cube processor model has no depth test (no opaque geometry)".into(),
+                );
+            }
+            if matches!(self.run.renderer, Renderer::Slabs | Renderer::Er) {
+                return bad(
+                    "geometry",
+                    format!(
+                        "opaque geometry renders on the frame (renderer \"pipeline\") and the f64 reference (\"reference\"), not on renderer \"{}\"",
+                        self.run.renderer.name()
+                    ),
+                );
+            }
+        }
         if self.run.renderer == Renderer::Pipeline
             && self.view.projection == Projection::Perspective
             && self.gi.is_none()
@@ -1117,7 +1257,17 @@ impl Plan {
             _ => (false, format!("{mname} must see every sample")),
         };
         add(Unit::EarlyTermination, et, et_detail);
-        add(Unit::DepthTest, false, "no geometry in the scene".into());
+        match &scene.geometry {
+            Some(g) => add(
+                Unit::DepthTest,
+                true,
+                format!(
+                    "[geometry]: {}, rasterized into the base plane's RGBA-Z image; samples at or behind it are left out, its colour goes under each ray",
+                    g.describe()
+                ),
+            ),
+            None => add(Unit::DepthTest, false, "no geometry in the scene".into()),
+        }
         add(
             Unit::Supersampling,
             q.supersampling > 1,
@@ -1162,6 +1312,15 @@ impl Plan {
             },
         );
         let what_if = crate::scene_render::not_expressible(scene);
+        if scene.geometry.is_some()
+            && scene.run.renderer == Renderer::Pipeline
+            && !what_if.is_empty()
+        {
+            return Err(ModelError::Config(format!(
+                "geometry: opaque geometry runs on the frame model and the f64 reference, and this scene renders on the what-if pipeline ({})",
+                what_if.join("; ")
+            )));
+        }
         let kernel = scene.prefilter();
         if kernel != Prefilter::None
             && !matches!(scene.run.renderer, Renderer::Pipeline | Renderer::Reference)
@@ -1267,13 +1426,16 @@ impl Plan {
                 frame_entries(&mut entries, scene, vol);
                 if matches!(mode, CompositeMode::Composite | CompositeMode::Mip)
                     && scene.boundary().is_none()
+                    && scene.geometry.is_none()
                 {
                     "frame (cube5_frame's bits, then the warp)".to_string()
                 } else {
                     format!(
-                        "frame (cube5_frame's bits, then the warp; {}: the exact per-sample frame model, since the fast path covers MIP and composite with the 1-D table: the same bits, slower)",
+                        "frame (cube5_frame's bits, then the warp; {}: the exact per-sample frame model, since the fast path covers MIP and composite with the 1-D table and no geometry: the same bits, slower)",
                         if scene.boundary().is_some() {
                             "transfer.boundary"
+                        } else if scene.geometry.is_some() {
+                            "[geometry]"
                         } else {
                             mode.name()
                         }

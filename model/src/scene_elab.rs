@@ -280,6 +280,19 @@ pub fn elaborate(scene: &Scene, dims: [usize; 3], pipelines: Option<usize>) -> R
                 kernel.weight().unwrap_or(0) + 2
             ),
         });
+    match &scene.geometry {
+        Some(g) => choices.push((
+            "DepthTest = 1".into(),
+            format!(
+                "[geometry]: {}: the compositing buffer is preloaded with its RGBA-Z image and every sample is depth-tested",
+                g.describe()
+            ),
+        )),
+        None => choices.push((
+            "DepthTest = 0".into(),
+            "no [geometry] in the scene: the depth test is left out (no Z or geometry colour per coxel, no flush at the read-out)".into(),
+        )),
+    }
     Ok(Elaboration {
         config,
         choices,
@@ -315,6 +328,7 @@ mod tests {
             ("bubbles-minip", 4, 32, false, "P=4 MaxDim=32 Shade=0"),
             ("head-first-opaque", 4, 128, true, "P=4 MaxDim=128"),
             ("head-2dtf", 4, 128, true, "P=4 MaxDim=128"),
+            ("head-geometry", 4, 64, true, "P=4 MaxDim=64 DepthTest=1"),
             ("head", 4, 128, true, "P=4 MaxDim=128"),
             ("head-nifti", 4, 64, true, "P=4 MaxDim=64"),
             ("head-prefilter", 4, 128, true, "P=4 MaxDim=128"),

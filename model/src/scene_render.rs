@@ -110,22 +110,28 @@ pub fn frame_config(scene: &Scene) -> Result<FrameConfig> {
             slot.1 = i64::from(v);
         }
     }
-    FrameConfig::from_params(&params).map_err(|e| {
-        // Name the scene's fields behind the parameters the frame refuses.
-        let e = e.to_string();
-        let fields: Vec<String> = widths
-            .iter()
-            .filter(|(name, _, _)| e.contains(name))
-            .map(|(name, field, v)| match v {
-                Some(v) => format!("quality.{field} = {v} ({name})"),
-                None => format!("quality.{field} unset ({name})"),
-            })
-            .collect();
-        ModelError::Config(format!(
-            "{}: the frame cannot take these widths: {e}",
-            fields.join(", ")
-        ))
-    })
+    FrameConfig::from_params(&params)
+        .map(|cfg| FrameConfig {
+            // Opaque geometry needs the depth test (`DepthTest = 1`); without it, nothing pays.
+            depth_test: scene.geometry.is_some(),
+            ..cfg
+        })
+        .map_err(|e| {
+            // Name the scene's fields behind the parameters the frame refuses.
+            let e = e.to_string();
+            let fields: Vec<String> = widths
+                .iter()
+                .filter(|(name, _, _)| e.contains(name))
+                .map(|(name, field, v)| match v {
+                    Some(v) => format!("quality.{field} = {v} ({name})"),
+                    None => format!("quality.{field} unset ({name})"),
+                })
+                .collect();
+            ModelError::Config(format!(
+                "{}: the frame cannot take these widths: {e}",
+                fields.join(", ")
+            ))
+        })
 }
 
 /// The volume at voxel width `w`: `v << (w - bits)` or `v >> (bits - w)`, the same integers the
@@ -259,7 +265,29 @@ impl FrameJob {
             threshold: scene.render.threshold,
             boundary: scene.boundary(),
         };
-        let units = FrameUnits::with_options(&cfg, mode, &setup, &look.tf, &look.phong, &opts)?;
+        let mut units = FrameUnits::with_options(&cfg, mode, &setup, &look.tf, &look.phong, &opts)?;
+        // The depth test: the buffer is preloaded with the geometry's RGBA-Z image (none: every
+        // pixel at Znone), rasterized by the host on this view's base plane.
+        match (&scene.geometry, cfg.depth_test) {
+            (Some(g), true) => {
+                let img = crate::geometry::rasterize(&setup.params, &g.solids(), &cfg.compos);
+                units.set_geometry(&setup.params, img)?;
+            }
+            (None, true) => {
+                let (w, h) = setup.params.base_plane_size();
+                units.set_geometry(
+                    &setup.params,
+                    cube5_frame::GeometryImage::none(w, h, &cfg.compos),
+                )?;
+            }
+            (Some(_), false) => {
+                return Err(ModelError::Config(
+                    "geometry: this cube5_frame configuration has no depth test (DepthTest = 0)"
+                        .into(),
+                ))
+            }
+            (None, false) => {}
+        }
         let sweep = SweepVolume::new(&setup.params, &seen).ok_or_else(|| {
             ModelError::Volume(format!(
                 "volume of {:?} voxels does not fit the frame's set-up",

@@ -171,8 +171,27 @@ fn cases() -> Vec<Case> {
         c("quality.supersampling", GI, "[quality]\nsupersampling = 2\n", Refused),
         c("run.target", GI, "[run]\ntarget = \"rtl\"\n", Refused),
         c("run.renderer", GI, "[run]\nrenderer = \"reference\"\n", Processor),
+        // [geometry]: opaque boxes and spheres, rasterized into the depth test's RGBA-Z table.
+        c("geometry.box", "", BOX, Frame),
+        c("geometry.box.min", BOX, "[[geometry.box]]\nmin = [2.0, 6.0, 2.0]\nmax = [16.0, 12.0, 14.0]\n", Frame),
+        c("geometry.box.max", BOX, "[[geometry.box]]\nmin = [4.0, 4.0, 4.0]\nmax = [20.0, 12.0, 14.0]\n", Frame),
+        c("geometry.box.max", BOX, "[[geometry.box]]\nmin = [4.0, 4.0, 4.0]\nmax = [16.0, 1.0, 14.0]\n", Refused),
+        c("geometry.box.colour", BOX, "[[geometry.box]]\nmin = [4.0, 4.0, 4.0]\nmax = [16.0, 12.0, 14.0]\ncolour = [1.0, 0.0, 0.0]\n", Frame),
+        c("geometry.box.colour", BOX, "[[geometry.box]]\nmin = [4.0, 4.0, 4.0]\nmax = [16.0, 12.0, 14.0]\ncolour = [1.5, 0.0, 0.0]\n", Refused),
+        c("geometry.box.color", BOX, "[[geometry.box]]\nmin = [4.0, 4.0, 4.0]\nmax = [16.0, 12.0, 14.0]\ncolor = [1.0, 0.0, 0.0]\n", Frame),
+        c("geometry.sphere", "", SPHERE, Frame),
+        c("geometry.sphere.centre", SPHERE, "[[geometry.sphere]]\ncentre = [10.0, 14.0, 12.0]\nradius = 6.0\n", Frame),
+        c("geometry.sphere.radius", SPHERE, "[[geometry.sphere]]\ncentre = [12.0, 12.0, 12.0]\nradius = 4.0\n", Frame),
+        c("geometry.sphere.radius", SPHERE, "[[geometry.sphere]]\ncentre = [12.0, 12.0, 12.0]\nradius = 0.0\n", Refused),
+        c("geometry.sphere.colour", SPHERE, "[[geometry.sphere]]\ncentre = [12.0, 12.0, 12.0]\nradius = 6.0\ncolour = [0.0, 1.0, 0.0]\n", Frame),
+        c("geometry.sphere.color", SPHERE, "[[geometry.sphere]]\ncentre = [12.0, 12.0, 12.0]\nradius = 6.0\ncolor = [0.0, 1.0, 0.0]\n", Frame),
     ]
 }
+
+/// An opaque box cutting the 24^3 head (voxel coordinates), white.
+const BOX: &str = "[[geometry.box]]\nmin = [4.0, 4.0, 4.0]\nmax = [16.0, 12.0, 14.0]\n";
+/// An opaque sphere in the 24^3 head, white.
+const SPHERE: &str = "[[geometry.sphere]]\ncentre = [12.0, 12.0, 12.0]\nradius = 6.0\n";
 
 /// A GI scene (the GI-Cube processor model): the head, its default light, one sample per voxel.
 const GI: &str = "[render]\nstep = 1.0\n[gi]\npasses = 2\n";
@@ -227,6 +246,15 @@ fn every_field() -> BTreeSet<String> {
         ("quality", "[quality]\n__probe = 1\n"),
         ("run", "[run]\n__probe = 1\n"),
         ("gi", "[gi]\n__probe = 1\n"),
+        ("geometry", "[geometry]\n__probe = 1\n"),
+        (
+            "geometry.box",
+            "[[geometry.box]]\nmin = [0, 0, 0]\nmax = [1, 1, 1]\n__probe = 1\n",
+        ),
+        (
+            "geometry.sphere",
+            "[[geometry.sphere]]\ncentre = [0, 0, 0]\nradius = 1\n__probe = 1\n",
+        ),
         (
             "transfer.points",
             "[transfer]\npoints = [{ density = 0.0, rgba = [0, 0, 0, 0], __probe = 1 }]\n",

@@ -53,7 +53,12 @@ module cube5_frame #(
   parameter int unsigned Shade      = 1,
   /// Where the beams come from: 0 the skewed memory inside (cube5_skewmem, loaded through the
   /// configuration port); 1 the input stream, a section at a time (above).
-  parameter int unsigned Source     = 0
+  parameter int unsigned Source     = 0,
+  /// The depth test against opaque geometry ([62], [217]-[218]; docs/numerics/frame.md, "Opaque
+  /// geometry"): 1 keeps a per-pixel RGBA-Z table (configuration region 5) beside the compositing
+  /// buffer, every ray starts from its pixel's Z and colour, and the read-out flushes the geometry
+  /// colour under each ray through one more cube5_compos (mode Flush). 0: none of it.
+  parameter int unsigned DepthTest  = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -122,6 +127,10 @@ module cube5_frame #(
   localparam int unsigned ReuseMin = cube5_frame_pkg::ReuseMin;
   localparam int unsigned InW      = cube5_frame_pkg::in_w(Source, P, VoxelW, M);
   localparam int unsigned XBeatW   = (P + 3 * Source) * VoxelW;  // a beat and its edge voxels
+  localparam int unsigned GeoW     = ZW + 3 * ColorW;       // a coxel's Z, gR, gG, gB
+  localparam int unsigned CbGeoW   = (DepthTest != 0) ? GeoW : 0;   // the buffer's table
+  localparam int unsigned CbGeoPW  = (DepthTest != 0) ? GeoW : 1;
+  localparam int unsigned CfgDataW = cube5_frame_pkg::cfg_data_w(M, VoxelW, BlkW, ShDataW, AccW);
 
   // Elaboration checks.
   if (P != 1 && P != 2 && P != 4 && P != 8) begin : gen_bad_p
@@ -145,6 +154,12 @@ module cube5_frame #(
   if (Source > 1) begin : gen_bad_source
     $fatal(1, "cube5_frame: Source must be 0 (the skewed memory) or 1 (a beat stream)");
   end
+  if (DepthTest > 1) begin : gen_bad_depth_test
+    $fatal(1, "cube5_frame: DepthTest must be 0 or 1");
+  end
+  if (DepthTest != 0 && (GeoW > CfgDataW || 2 * DimW > OffW)) begin : gen_bad_geo_cfg
+    $fatal(1, "cube5_frame: a geometry word (ZW + 3 ColorW) must fit the configuration data, a pixel's (R, Q) its offset");
+  end
   if (OffW + cube5_frame_pkg::CfgRegionW > 32) begin : gen_bad_cfg
     $fatal(1, "cube5_frame: the configuration address must fit 32 bits");
   end
@@ -165,12 +180,13 @@ module cube5_frame #(
   assign cfg_on     = cfg_valid_i && state_q != StSetup1 && state_q != StSetup2
                       && state_q != StSetup3 && state_q != StSweep;
 
-  logic cfg_frame, cfg_voxel, cfg_block, cfg_shader, cfg_compos;
+  logic cfg_frame, cfg_voxel, cfg_block, cfg_shader, cfg_compos, cfg_geo;
   assign cfg_frame  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionFrame;
   assign cfg_voxel  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionVoxel && Source == 0;
   assign cfg_block  = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionBlock && Source == 0;
   assign cfg_shader = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionShader;
   assign cfg_compos = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionCompos;
+  assign cfg_geo    = cfg_on && cfg_region == cube5_frame_pkg::CfgRegionGeometry && DepthTest != 0;
 
   // Frame registers (configuration: not reset).
   logic [3*DimW-1:0]    dims_q;             // nx, ny, nz
@@ -838,6 +854,9 @@ module cube5_frame #(
   logic [P*RgbaW-1:0] upd_pay;
   logic [DimW-1:0]    upd_depth;
   logic [StoreW-1:0]  cb_out_cox, empty_cox;
+  logic [P*CbGeoPW-1:0] cb_upd_geo;
+  logic [CbGeoPW-1:0] cb_out_geo;
+  logic               cb_out_ready;
   logic [P-1:0]       upd_past;
   logic [DimW-1:0]    cb_max_sx;   // max sx + A0: the section's anchors land A0 columns right
   logic               cb_rst_n;    // reset, or a wipe of a frame left without its last section
@@ -853,7 +872,9 @@ module cube5_frame #(
     .CoxW   (StoreW),
     .DimW   (DimW),
     .TW     (TW),
-    .DW     (DW)
+    .DW     (DW),
+    .GeoW   (CbGeoW),
+    .GeoPW  (CbGeoPW)
   ) u_cbuf (
     .clk_i        (clk_i),
     .rst_ni       (cb_rst_n),
@@ -877,15 +898,21 @@ module cube5_frame #(
     .upd_pay_o    (upd_pay),
     .upd_depth_o  (upd_depth),
     .upd_past_o   (upd_past),
+    .upd_geo_o    (cb_upd_geo),
     .upd_valid_i  (co_valid[0]),
     .upd_cox_i    (upd_res),
     .ro_start_i   (ro_start),
     .w_i          (w_q),
     .h_i          (h_q),
     .out_valid_o  (cb_out_valid),
-    .out_ready_i  (out_ready_i && state_q == StReadout),
+    .out_ready_i  (cb_out_ready),
     .out_cox_o    (cb_out_cox),
-    .ro_busy_o    (ro_busy)
+    .out_geo_o    (cb_out_geo),
+    .ro_busy_o    (ro_busy),
+    .geo_we_i     (cfg_geo),
+    .geo_r_i      (cfg_off[0 +: DimW]),
+    .geo_q_i      (cfg_off[DimW +: DimW]),
+    .geo_data_i   (cfg_data_i[CbGeoPW-1:0])
   );
   assign unused_ro_busy = ro_busy;
 
@@ -895,10 +922,24 @@ module cube5_frame #(
   // A = 2^(AccW+1) - 1 (compos.md, Min: "preloaded with A >= 2^F").
   assign empty_cox = minip ? {1'b0, {ChanW{1'b1}}, {3*ChanW{1'b0}}} : '0;
 
-  // Stored coxel {terminated, A, B, G, R} <-> compos coxel {terminated, gB, gG, gR, Z, A, B, G, R}.
-  function automatic logic [CoxelW-1:0] full_coxel(logic [StoreW-1:0] st);
-    full_coxel = {st[4*ChanW], {3*ColorW{1'b0}}, ZNone, st[4*ChanW-1:0]};
+  // Stored coxel {terminated, A, B, G, R} and geometry {gB, gG, gR, Z} <-> compos coxel
+  // {terminated, gB, gG, gR, Z, A, B, G, R}.
+  function automatic logic [CoxelW-1:0] full_coxel(logic [StoreW-1:0] st, logic [GeoW-1:0] geo);
+    full_coxel = {st[4*ChanW], geo, st[4*ChanW-1:0]};
   endfunction
+
+  // Each bank's geometry: the table's word (DepthTest), or none (Znone, colour 0).
+  logic [P*GeoW-1:0] upd_geo;
+  logic [GeoW-1:0]   out_geo;
+  if (DepthTest != 0) begin : gen_geo
+    assign upd_geo = cb_upd_geo;
+    assign out_geo = cb_out_geo;
+  end else begin : gen_no_geo
+    assign upd_geo = {P{{3*ColorW{1'b0}}, ZNone}};
+    assign out_geo = {{3*ColorW{1'b0}}, ZNone};
+    logic unused_cb_geo;
+    assign unused_cb_geo = ^{cb_upd_geo, cb_out_geo};
+  end
 
   for (genvar j = 0; j < P; j++) begin : gen_compos
     // MinIP leaves out the samples past a far face: at depth Znone the depth test passes them by.
@@ -906,7 +947,7 @@ module cube5_frame #(
     logic [CInW-1:0] co_in;
     assign co_depth = (minip && upd_past[j]) ? ZNone : ZW'(upd_depth);
     assign co_in    = {co_mode, co_depth, upd_pay[j*RgbaW +: RgbaW],
-                       full_coxel(upd_cox[j*StoreW +: StoreW])};
+                       full_coxel(upd_cox[j*StoreW +: StoreW], upd_geo[j*GeoW +: GeoW])};
 
     cube5_compos #(
       .ColorW (ColorW),
@@ -938,11 +979,45 @@ module cube5_frame #(
   // ---------------------------------------------------------------------------
   // Output: the base-plane image, or one error item
   // ---------------------------------------------------------------------------
+  // The read-out's coxel: as the buffer holds it, or (DepthTest) after a Flush item through one
+  // more compositing unit, which puts the geometry colour under the ray (compos.md, rule 2).
+  logic              ro_valid;
+  logic [CoxelW-1:0] ro_cox, cb_full;
+  assign cb_full = full_coxel(cb_out_cox, out_geo);
+  if (DepthTest != 0) begin : gen_flush
+    logic            fl_ready;
+    logic [CInW-1:0] fl_in;
+    assign fl_in        = {cube5_frame_pkg::ComposFlush, {ZW{1'b0}}, {RgbaW{1'b0}}, cb_full};
+    assign cb_out_ready = fl_ready && state_q == StReadout;
+    cube5_compos #(
+      .ColorW (ColorW),
+      .AlphaW (AlphaW),
+      .ExtraW (ExtraW),
+      .AccW   (AccW),
+      .ZW     (ZW)
+    ) u_flush (
+      .clk_i       (clk_i),
+      .rst_ni      (rst_ni),
+      .in_valid_i  (cb_out_valid && state_q == StReadout),
+      .in_ready_o  (fl_ready),
+      .in_data_i   (fl_in),
+      .out_valid_o (ro_valid),
+      .out_ready_i (out_ready_i),
+      .out_data_o  (ro_cox),
+      .cfg_valid_i (cfg_compos),
+      .cfg_addr_i  (cfg_off[CoAddrW-1:0]),
+      .cfg_data_i  (cfg_data_i[CoDataW-1:0])
+    );
+  end else begin : gen_no_flush
+    assign cb_out_ready = out_ready_i && state_q == StReadout;
+    assign ro_valid     = cb_out_valid;
+    assign ro_cox       = cb_full;
+  end
+
   logic error_item;
   assign error_item  = (state_q == StError);
-  assign out_valid_o = error_item || (state_q == StReadout && cb_out_valid);
-  assign out_data_o  = {cycles_q, reads_q, error_item,
-                        error_item ? CoxelW'(0) : full_coxel(cb_out_cox)};
+  assign out_valid_o = error_item || (state_q == StReadout && ro_valid);
+  assign out_data_o  = {cycles_q, reads_q, error_item, error_item ? CoxelW'(0) : ro_cox};
 
   logic unused_top;
   assign unused_top = ^{co_ready, co_valid, co_out, cfg_data_i, cfg_off, unused_in};

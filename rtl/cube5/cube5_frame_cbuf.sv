@@ -17,6 +17,12 @@
 // volumes where that is not longer than the update loop (docs/frame-rtl.md). The read-out streams the
 // W x H coxels (q outer, r inner) and clears each word's valid bit behind it; after reset the buffer
 // clears every valid bit once (clear_busy_o) before the first frame.
+//
+// GeoW > 0 (the frame's DepthTest = 1; docs/numerics/frame.md, "Opaque geometry"): beside each
+// bank a geometry table of GeoW-bit words {Z, gR, gG, gB}, one per base-plane pixel at the coxel's
+// own address, written through geo_we_i (a table like the frame's others: kept through reset and
+// read-outs). It is read with every coxel (upd_geo_o) and every read-out word (out_geo_o): the
+// coxel's Z and geometry colour, which the buffer itself never stores.
 module cube5_frame_cbuf #(
   parameter int unsigned P      = 4,
   parameter int unsigned MaxDim = 64,
@@ -26,7 +32,11 @@ module cube5_frame_cbuf #(
   parameter int unsigned CoxW   = 85,
   parameter int unsigned DimW   = 7,
   parameter int unsigned TW     = 25,
-  parameter int unsigned DW     = 18
+  parameter int unsigned DW     = 18,
+  /// Geometry table word width (Z and three colours), 0: no table.
+  parameter int unsigned GeoW   = 0,
+  /// Port width of the geometry words: GeoW, or 1 when there is no table.
+  parameter int unsigned GeoPW  = 1
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -64,6 +74,8 @@ module cube5_frame_cbuf #(
   /// Bank j's sample lies past a far face (anchor a = ni - 1 with fx(s) != 0, or b = nj - 1 with
   /// fy(s) != 0: its interpolation reads the zeros there); MinIP leaves such samples out.
   output logic [P-1:0]      upd_past_o,
+  /// Bank j's geometry word (GeoW > 0; else 0), beside upd_cox_o.
+  output logic [P*GeoPW-1:0] upd_geo_o,
   /// Back from the update units, in the same order.
   input  logic upd_valid_i,
   input  logic [P*CoxW-1:0] upd_cox_i,
@@ -76,8 +88,16 @@ module cube5_frame_cbuf #(
   input  logic out_ready_i,
   /// The pixel's coxel (empty_cox_i when no sample reached it).
   output logic [CoxW-1:0] out_cox_o,
+  /// The pixel's geometry word (GeoW > 0; else 0).
+  output logic [GeoPW-1:0] out_geo_o,
   /// The read-out has issued its last read.
-  output logic ro_busy_o
+  output logic ro_busy_o,
+
+  /// Geometry table write (GeoW > 0): base-plane pixel (R, Q) gets geo_data_i.
+  input  logic geo_we_i,
+  input  logic [DimW-1:0] geo_r_i,
+  input  logic [DimW-1:0] geo_q_i,
+  input  logic [GeoPW-1:0] geo_data_i
 );
 
   localparam int unsigned StepW = cube5_frame_pkg::StepW;
@@ -90,6 +110,9 @@ module cube5_frame_cbuf #(
   localparam int unsigned WordW = CoxW + 1;            // valid bit on top
   localparam int unsigned OutDepth = 4;
 
+  if (GeoPW != ((GeoW > 0) ? GeoW : 1)) begin : gen_bad_geo
+    $fatal(1, "cube5_frame_cbuf: GeoPW must be GeoW (1 without a geometry table)");
+  end
   if (P < 1 || (1 << LogP) != P || P > MaxDim) begin : gen_bad_p
     $fatal(1, "cube5_frame_cbuf: P must be a power of two, at most MaxDim");
   end
@@ -294,6 +317,7 @@ module cube5_frame_cbuf #(
   // The banks: one read and one write port each
   // ---------------------------------------------------------------------------
   logic [P*WordW-1:0] rd_word;
+  logic [P*GeoPW-1:0] geo_word;
   logic               sw_rd_q;
   logic [P*PayW-1:0]  pay_q;
   logic [DimW-1:0]    depth_q;
@@ -333,6 +357,33 @@ module cube5_frame_cbuf #(
     end
 
     assign rd_word[j*WordW +: WordW] = rd_q;
+
+    if (GeoW > 0) begin : gen_geo
+      // The geometry table of this bank: written by the host, read beside the coxel.
+      logic [GeoW-1:0] geo_q [Depth];
+      logic [GeoW-1:0] geo_rd_q;
+      logic            geo_we;
+      logic [AddrW-1:0] geo_wa;
+      logic [DimW-1:0]  geo_col;
+      logic             unused_geo_col;
+      assign geo_col = geo_r_i >> LogP;
+      assign geo_wa  = {geo_q_i[QW-1:0], geo_col[ColW-1:0]};
+      assign unused_geo_col = ^geo_col;
+      if (P > 1) begin : gen_geo_bank
+        assign geo_we = geo_we_i && (geo_r_i[LogP-1:0] == LogP'(j));
+      end else begin : gen_geo_bank1
+        assign geo_we = geo_we_i;
+      end
+      always_ff @(posedge clk_i) begin
+        if (geo_we) geo_q[geo_wa] <= geo_data_i;
+      end
+      always_ff @(posedge clk_i) begin
+        if (re) geo_rd_q <= geo_q[ra];
+      end
+      assign geo_word[j*GeoPW +: GeoPW] = geo_rd_q;
+    end else begin : gen_no_geo
+      assign geo_word[j*GeoPW +: GeoPW] = '0;
+    end
   end
 
   always_ff @(posedge clk_i) begin
@@ -357,6 +408,7 @@ module cube5_frame_cbuf #(
       upd_cox_o[j*CoxW +: CoxW] = rd_word[j*WordW + CoxW] ? rd_word[j*WordW +: CoxW] : empty_cox_i;
     end
   end
+  assign upd_geo_o   = geo_word;
   assign upd_valid_o = sw_rd_q;
   assign upd_pay_o   = pay_q;
   assign upd_depth_o = depth_q;
@@ -372,20 +424,43 @@ module cube5_frame_cbuf #(
   assign ro_word = rd_word[ro_bank_q*WordW +: WordW];
   assign ro_cox  = ro_word[CoxW] ? ro_word[CoxW-1:0] : empty_cox_i;
 
-  cube5_frame_fifo #(
-    .Width (CoxW),
-    .Depth (OutDepth)
-  ) u_out (
-    .clk_i   (clk_i),
-    .rst_ni  (rst_ni),
-    .clear_i (ro_start_i),
-    .push_i  (ro_rd_q),
-    .d_i     (ro_cox),
-    .pop_i   (out_pop),
-    .q_o     (out_cox_o),
-    .empty_o (out_empty),
-    .full_o  (unused_out_full)
-  );
+  if (GeoW > 0) begin : gen_out_geo
+    // The read-out word's geometry travels with its coxel.
+    logic [GeoW-1:0] ro_geo;
+    assign ro_geo = geo_word[ro_bank_q*GeoPW +: GeoPW];
+    cube5_frame_fifo #(
+      .Width (CoxW + GeoW),
+      .Depth (OutDepth)
+    ) u_out (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (ro_start_i),
+      .push_i  (ro_rd_q),
+      .d_i     ({ro_geo, ro_cox}),
+      .pop_i   (out_pop),
+      .q_o     ({out_geo_o, out_cox_o}),
+      .empty_o (out_empty),
+      .full_o  (unused_out_full)
+    );
+  end else begin : gen_out
+    cube5_frame_fifo #(
+      .Width (CoxW),
+      .Depth (OutDepth)
+    ) u_out (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (ro_start_i),
+      .push_i  (ro_rd_q),
+      .d_i     (ro_cox),
+      .pop_i   (out_pop),
+      .q_o     (out_cox_o),
+      .empty_o (out_empty),
+      .full_o  (unused_out_full)
+    );
+    logic unused_geo_in;
+    assign unused_geo_in = ^{geo_we_i, geo_r_i, geo_q_i, geo_data_i};
+    assign out_geo_o = '0;
+  end
 
   assign out_valid_o = !out_empty;
   assign out_pop     = out_valid_o && out_ready_i;

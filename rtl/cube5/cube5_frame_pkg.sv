@@ -45,18 +45,22 @@ package cube5_frame_pkg;
   // error
   localparam logic [0:0] InKindBeat = 1'd1;
 
-  /// Configuration port: the top three address bits select a region (5..7 are ignored).
+  /// Configuration port: the top three address bits select a region (6 and 7 are ignored; 5 without
+  /// DepthTest).
   localparam int unsigned CfgRegionW = 3;
   // frame registers
-  localparam logic [2:0] CfgRegionFrame  = 3'd0;
+  localparam logic [2:0] CfgRegionFrame    = 3'd0;
   // one voxel: offset x + 2^m y + 2^2m z
-  localparam logic [2:0] CfgRegionVoxel  = 3'd1;
+  localparam logic [2:0] CfgRegionVoxel    = 3'd1;
   // skewed memory block LUT entry
-  localparam logic [2:0] CfgRegionBlock  = 3'd2;
+  localparam logic [2:0] CfgRegionBlock    = 3'd2;
   // shader tables (every pipeline)
-  localparam logic [2:0] CfgRegionShader = 3'd3;
+  localparam logic [2:0] CfgRegionShader   = 3'd3;
   // compositing tables and registers (every pipeline)
-  localparam logic [2:0] CfgRegionCompos = 3'd4;
+  localparam logic [2:0] CfgRegionCompos   = 3'd4;
+  // DepthTest = 1: the opaque geometry's RGBA-Z table, one word per base-plane pixel: offset R +
+  // 2^(m+1) Q, data Z, gR, gG, gB
+  localparam logic [2:0] CfgRegionGeometry = 3'd5;
 
   /// Render modes (the 3-bit field `render` of register Mode); 5 to 7 are refused.
   // maximum intensity projection
@@ -71,11 +75,18 @@ package cube5_frame_pkg;
   localparam logic [2:0] RenderFirstOpaque = 3'd4;
 
   /// Compositing modes the frame uses (docs/numerics/compos.md).
-  localparam logic [2:0] ComposFrontToBack = 3'd0;  // for Composite
-  localparam logic [2:0] ComposMax         = 3'd2;  // for Mip
-  localparam logic [2:0] ComposMin         = 3'd3;  // for Minip
-  localparam logic [2:0] ComposXraySum     = 3'd4;  // for Xray
-  localparam logic [2:0] ComposFirstOpaque = 3'd5;  // for FirstOpaque
+  // for Composite
+  localparam logic [2:0] ComposFrontToBack = 3'd0;
+  // for Mip
+  localparam logic [2:0] ComposMax         = 3'd2;
+  // for Minip
+  localparam logic [2:0] ComposMin         = 3'd3;
+  // for Xray
+  localparam logic [2:0] ComposXraySum     = 3'd4;
+  // for FirstOpaque
+  localparam logic [2:0] ComposFirstOpaque = 3'd5;
+  // DepthTest = 1: the read-out's end of every ray, the geometry colour under it
+  localparam logic [2:0] ComposFlush       = 3'd6;
 
   /// Registers by word offset (region 0, `off` = the offset), access, fields LSB first.
   localparam int unsigned RegDims = 0;  // WO: nx (m + 1), ny (m + 1), nz (m + 1)

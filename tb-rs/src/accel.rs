@@ -15,9 +15,8 @@ use crate::rtl::{AxiMemSetup, RtlStream, Traffic};
 use crate::variants::{variants_of, Variant};
 use cube5_model::accel_host::{AccelHost, FrameRegs, HostError, RegBus};
 use cube5_model::regs::cube5_accel::{TABLE_BLOCK, TABLE_CLASS, TABLE_OPACITY, TABLE_REFLECT};
-use cube5_model::unit::UnitConfig;
+use cube5_model::units::cube5_accel::AccelConfig;
 use cube5_model::units::cube5_axil::{AxilCodec, AxilRecordKind, AxilTxn, RESP_OKAY};
-use cube5_model::units::cube5_frame::FrameConfig;
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::units::cube5_vol_fetch::{dram_image, FetchCmd, VolFetchConfig};
 use cube5_model::volume::Volume;
@@ -27,41 +26,6 @@ pub const TOP: &str = "cube5_accel";
 
 /// Bytes per pixel of the image in memory: R, G, B, A codes, R at the lowest address.
 pub const PIXEL_BYTES: usize = 4;
-
-/// The frame's parameters that `cube5_accel` passes through to it.
-const FRAME_PARAMS: &[&str] = &[
-    "P",
-    "MaxDim",
-    "VoxelW",
-    "WeightW",
-    "FracW",
-    "BlockDim",
-    "ClassIdxW",
-    "MagIdxW",
-    "MagShift",
-    "ColorW",
-    "AlphaW",
-    "RmLog2",
-    "RmFracW",
-    "DiffW",
-    "SpecW",
-    "ExtraW",
-    "AccW",
-    "ZW",
-];
-
-/// The fetch's parameters that `cube5_accel` passes through to it (the top's `Outstanding` is
-/// the fetch's).
-const FETCH_PARAMS: &[&str] = &[
-    "AddrW",
-    "DataW",
-    "P",
-    "VoxelW",
-    "MaxDim",
-    "BlockDim",
-    "MaxBurst",
-    "Outstanding",
-];
 
 /// One build of `cube5_accel` and the configurations of the units inside it.
 #[derive(Debug, Clone, Copy)]
@@ -76,25 +40,20 @@ pub struct AccelRtl {
 
 impl AccelRtl {
     pub fn from_variant(variant: &'static Variant) -> Result<Self, TbError> {
-        let param = |n: &str| {
-            variant
-                .param(n)
-                .ok_or_else(|| TbError::setup(variant.name, format!("no parameter {n}")))
-        };
-        let pick = |names: &[&'static str]| -> Result<Vec<(&'static str, i64)>, TbError> {
-            names.iter().map(|&n| Ok((n, param(n)?))).collect()
-        };
-        let mut fp = pick(FRAME_PARAMS)?;
-        fp.push(("Source", 1));
-        let cfg = FrameConfig::from_params(&fp).map_err(|e| TbError::setup(variant.name, e))?;
-        let fetch = VolFetchConfig::from_params(&pick(FETCH_PARAMS)?)
+        // The top's parameters split into its units' configurations in one place, the model's
+        // `AccelConfig` (tests/variant_table.rs holds it to the RTL's parameters).
+        let ac: AccelConfig = variant
+            .config()
             .map_err(|e| TbError::setup(variant.name, e))?;
         Ok(Self {
             variant,
-            frame: FrameRtl { variant, cfg },
-            fetch,
-            p: param("P")? as usize,
-            section: param("Section")? as usize,
+            frame: FrameRtl {
+                variant,
+                cfg: ac.frame,
+            },
+            fetch: ac.fetch,
+            p: ac.frame.p,
+            section: ac.section as usize,
         })
     }
 

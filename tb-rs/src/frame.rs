@@ -13,13 +13,15 @@ use crate::rtl::{RtlStream, Traffic};
 use crate::variants::{variants_of, Variant};
 use cube5_model::bits::{BitReader, BitWriter};
 use cube5_model::error::ModelError;
+use cube5_model::geometry::{self, Solid};
 use cube5_model::scene_render::{FrameJob, FrameRun};
 use cube5_model::transfer::TransferFunction;
 use cube5_model::unit::StreamCodec;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_compos::{self, Compos, ComposConfig, ComposRegs, Coxel, OpacityLut};
 use cube5_model::units::cube5_frame::{
-    self, FrameConfig, FrameParams, FrameSetup, FrameUnits, ModeOptions, SweepAccesses,
+    self, FrameConfig, FrameParams, FrameSetup, FrameUnits, GeometryImage, ModeOptions,
+    SweepAccesses,
 };
 use cube5_model::units::cube5_gradient::{Gradient, GradientConfig};
 use cube5_model::units::cube5_shader::{
@@ -29,6 +31,7 @@ use cube5_model::units::cube5_skewmem::{BlockLut, SkewConfig, SkewDims, SkewMem}
 use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig};
 use cube5_model::volume::Volume;
 use std::rc::Rc;
+use std::sync::Arc;
 
 // -------------------------------------------------------------------------------------------------
 // The RTL configurations and the frame's stream and configuration formats
@@ -74,11 +77,11 @@ impl FrameRtl {
     }
 
     /// The configuration with `p` pipelines and the largest memory: the default widths that
-    /// `cube5 cosim` and the whole-frame tests run (with gradient and shader).
+    /// `cube5 cosim` and the whole-frame tests run (with gradient and shader, no depth test).
     pub fn with_pipelines(p: usize) -> Option<FrameRtl> {
         Self::all()
             .into_iter()
-            .filter(|r| r.p == p && r.default_widths() && r.shade)
+            .filter(|r| r.p == p && r.default_widths() && r.shade && !r.depth_test)
             .max_by_key(|r| r.max_dim_log2)
     }
 
@@ -87,13 +90,21 @@ impl FrameRtl {
     pub fn smallest(p: usize) -> Option<FrameRtl> {
         Self::all()
             .into_iter()
-            .filter(|r| r.p == p && r.shade)
+            .filter(|r| r.p == p && r.shade && !r.depth_test)
             .min_by_key(|r| r.max_dim_log2)
     }
 
     /// The configurations without gradient and shader (`Shade = 0`, MIP only).
     pub fn without_shade() -> Vec<FrameRtl> {
-        Self::all().into_iter().filter(|r| !r.shade).collect()
+        Self::all()
+            .into_iter()
+            .filter(|r| !r.shade && !r.depth_test)
+            .collect()
+    }
+
+    /// The configurations with the depth test (`DepthTest = 1`).
+    pub fn with_depth_test() -> Vec<FrameRtl> {
+        Self::all().into_iter().filter(|r| r.depth_test).collect()
     }
 
     /// The pipeline counts of the default-width configurations ([`FrameRtl::with_pipelines`]),
@@ -101,7 +112,7 @@ impl FrameRtl {
     pub fn pipeline_counts() -> Vec<usize> {
         let mut ps: Vec<usize> = Self::all()
             .iter()
-            .filter(|r| r.default_widths() && r.shade)
+            .filter(|r| r.default_widths() && r.shade && !r.depth_test)
             .map(|r| r.p)
             .collect();
         ps.sort_unstable();
@@ -117,8 +128,8 @@ impl FrameRtl {
 /// depend on the latencies.
 pub use cube5_model::regs::cube5_frame::{
     CLASS_LATENCY, COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK, REGION_COMPOS,
-    REGION_FRAME, REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE, REG_MODE_RENDER,
-    REG_MODE_TF2D, REG_SKIP, REG_VIEW, TRILIN_LATENCY,
+    REGION_FRAME, REGION_GEOMETRY, REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE,
+    REG_MODE_RENDER, REG_MODE_TF2D, REG_SKIP, REG_VIEW, TRILIN_LATENCY,
 };
 
 /// The frame's renderings (docs/numerics/frame.md, "Render modes"): the model's modes.
@@ -277,6 +288,28 @@ impl FrameRtl {
             .collect()
     }
 
+    /// The geometry table's writes (`DepthTest = 1`, configuration region 5): one word
+    /// `{Z, gR, gG, gB}` per base-plane pixel `(R, Q)` at offset `R + 2^(m+1) Q`.
+    pub fn geometry_writes(&self, g: &GeometryImage) -> Vec<(u32, Vec<u32>)> {
+        let (m1, zw, cw) = (self.max_dim_log2 + 1, self.compos.z_w, self.compos.color_w);
+        g.pixels
+            .iter()
+            .enumerate()
+            .map(|(i, px)| {
+                let (r, q) = ((i % g.width) as u32, (i / g.width) as u32);
+                let mut w = BitWriter::new();
+                w.put(u64::from(px.z), zw);
+                for c in px.rgb {
+                    w.put(u64::from(c), cw);
+                }
+                (
+                    self.addr(REGION_GEOMETRY, r | q << m1),
+                    w.finish(zw + 3 * cw),
+                )
+            })
+            .collect()
+    }
+
     /// Cycles from a sample's neighbourhood to its shaded sample: gradient and shader, or the
     /// classification table alone without them (`Shade = 0`).
     pub fn shade_latency(&self) -> u64 {
@@ -377,6 +410,9 @@ pub struct Look {
     pub boundary: Option<f64>,
     /// X-ray: `XrayShift` in place of the set-up's (a sum that saturates, for the tests).
     pub xray_shift: Option<u32>,
+    /// Opaque solids rasterized into the geometry table of a `DepthTest = 1` frame (none: every
+    /// pixel at `Znone`).
+    pub geometry: Vec<Solid>,
 }
 
 impl Default for Look {
@@ -390,6 +426,7 @@ impl Default for Look {
             threshold: 0.5,
             boundary: None,
             xray_shift: None,
+            geometry: Vec::new(),
         }
     }
 }
@@ -564,6 +601,8 @@ pub struct Expected {
     pub w: usize,
     pub h: usize,
     pub want: Vec<Coxel>,
+    /// The geometry table of a `DepthTest = 1` frame (the model's preload).
+    pub geometry: Option<Arc<GeometryImage>>,
 }
 
 impl Expected {
@@ -585,7 +624,7 @@ impl Expected {
         let params = setup.params;
         // The model's own base plane at the variant's widths
         // (cube5_model::units::cube5_frame::render_base_plane): what `cube5 render` computes.
-        let fu = FrameUnits::with_options(
+        let mut fu = FrameUnits::with_options(
             &rtl.cfg,
             render,
             &setup,
@@ -593,6 +632,11 @@ impl Expected {
             &look.phong,
             &look.options(),
         )?;
+        if rtl.depth_test {
+            let g = geometry::rasterize(&params, &look.geometry, &rtl.compos);
+            fu.set_geometry(&params, g)?;
+        }
+        let geometry = fu.geometry.clone();
         let bp = cube5_frame::render_base_plane(&params, seen, &fu);
         let units = Units {
             trilin: fu.trilin,
@@ -612,6 +656,7 @@ impl Expected {
             w,
             h,
             want,
+            geometry,
         })
     }
 }
@@ -637,6 +682,7 @@ impl Expected {
             w: run.base.width,
             h: run.base.height,
             want: run.base.coxels,
+            geometry: u.geometry.clone(),
         }
     }
 }
@@ -746,7 +792,21 @@ impl FrameBench {
         let w = self
             .rtl
             .frame_writes(&e.params, u.render, u.tf2d, self.skip);
-        self.write(&w)
+        self.write(&w)?;
+        // The depth test's table, every frame (it is the view's base plane).
+        if self.rtl.depth_test {
+            let none;
+            let g = match &e.geometry {
+                Some(g) => g.as_ref(),
+                None => {
+                    none = GeometryImage::none(e.w, e.h, &self.rtl.compos);
+                    &none
+                }
+            };
+            let w = self.rtl.geometry_writes(g);
+            self.write(&w)?;
+        }
+        Ok(())
     }
 
     /// Renders one frame on the RTL and compares every pixel and channel with the model's image.

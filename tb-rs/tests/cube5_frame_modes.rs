@@ -4,7 +4,8 @@
 //! (`cube5_frame::render_base_plane`, the exact per-sample model for these modes), under random
 //! back-pressure on the read-out on every frame; the model's image is also checked against the
 //! test bench's own fold of the unit models (`model_image`). Small volumes (16^3), P = 4, with and
-//! without gradient and shader.
+//! without gradient and shader; and the depth test against opaque geometry (`DepthTest = 1`,
+//! docs/numerics/frame.md, "Opaque geometry") in every mode.
 
 mod support;
 
@@ -28,7 +29,7 @@ fn must<T>(r: Result<T, cube5_tb::TbError>) -> T {
 fn p4(shade: bool) -> FrameRtl {
     FrameRtl::all()
         .into_iter()
-        .filter(|r| r.p == 4 && r.default_widths() && r.shade == shade)
+        .filter(|r| r.p == 4 && r.default_widths() && r.shade == shade && !r.depth_test)
         .max_by_key(|r| r.max_dim_log2)
         .unwrap_or_else(|| {
             panic!(
@@ -113,11 +114,15 @@ fn modes_bit_exact(
                 look,
             )
             .unwrap();
-            let (w, h, fold) = model_image(&e.params, &seen, &units);
-            assert!(
-                (w, h) == (e.w, e.h) && fold == e.want,
-                "{render:?} {name}: the frame model differs from the unit models' fold"
-            );
+            // (The fold knows no geometry: frames with the depth test are checked against the
+            // model alone, and the model's geometry against its own rules in the model's tests.)
+            if !rtl.depth_test {
+                let (w, h, fold) = model_image(&e.params, &seen, &units);
+                assert!(
+                    (w, h) == (e.w, e.h) && fold == e.want,
+                    "{render:?} {name}: the frame model differs from the unit models' fold"
+                );
+            }
             let traffic = Traffic::random(&mut rng, 0.0, 0.3);
             let st = must(bench.check(&e, &traffic, s + 100 * vi as u64 + n as u64));
             eprintln!(
@@ -264,4 +269,94 @@ fn shade_0_refuses_first_opaque_and_the_2d_table() {
     }
     must(bench.load(&good));
     must(bench.render_and_compare(&good, &Traffic::full_speed(), s));
+}
+
+/// Opaque boxes and spheres, seeded, inside and around a 16^3 volume (some in front of it, some
+/// cutting it, some behind), with random colours.
+fn random_solids(s: u64) -> Vec<cube5_model::geometry::Solid> {
+    use cube5_model::geometry::Solid;
+    use rand::Rng;
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let mut v = Vec::new();
+    for i in 0..4 {
+        let c: [f64; 3] = std::array::from_fn(|_| rng.random_range(0.0..1.0));
+        let at: [f64; 3] = std::array::from_fn(|_| rng.random_range(-4.0..20.0));
+        if i % 2 == 0 {
+            let size: [f64; 3] = std::array::from_fn(|_| rng.random_range(1.0..7.0));
+            v.push(Solid::Box {
+                min: at,
+                max: std::array::from_fn(|a| at[a] + size[a]),
+                colour: c,
+            });
+        } else {
+            v.push(Solid::Sphere {
+                centre: at,
+                radius: rng.random_range(1.5..6.0),
+                colour: c,
+            });
+        }
+    }
+    v
+}
+
+/// The depth test (`DepthTest = 1`): every mode against random opaque boxes and spheres, on a
+/// frame with a geometry table and the read-out's flush, bit-exact with the model; the geometry
+/// hides samples and shows through (the image differs from the same frame without geometry),
+/// and a frame without geometry (every pixel at `Znone`) has the image of the frame without the
+/// depth test, each ray marked terminated by the flush.
+#[test]
+fn depth_test_against_opaque_geometry_bit_exact() {
+    let s = seed(76);
+    let Some(rtl) = FrameRtl::with_depth_test().into_iter().next() else {
+        panic!("no cube5_frame variant with DepthTest = 1");
+    };
+    let vols = [head_phantom(16, 12).unwrap(), slab_volume(s)];
+    for (n, render) in Render::ALL.into_iter().enumerate() {
+        let look = Look {
+            tf: dense_tf(),
+            geometry: random_solids(s + n as u64),
+            early_termination: render == Render::Composite,
+            ..Look::default()
+        };
+        let frames = modes_bit_exact(rtl, &vols, render, &look, s + n as u64);
+        let plain = Expected::new(
+            &p4(true),
+            &frames[0].seen,
+            VIEWS[0].0,
+            VIEWS[0].1,
+            render,
+            &Look {
+                geometry: Vec::new(),
+                ..look.clone()
+            },
+        )
+        .unwrap();
+        let z_none = frames[0].units.compos.config().z_none();
+        let g = frames[0].geometry.as_ref().unwrap();
+        let hit = g.pixels.iter().filter(|p| p.z != z_none).count();
+        assert!(
+            hit > 0 && hit < g.pixels.len(),
+            "{render:?}: {hit} of {} pixels see geometry",
+            g.pixels.len()
+        );
+        assert!(
+            plain.want != frames[0].want,
+            "{render:?}: the geometry changes the image"
+        );
+    }
+    // No geometry: the image of the frame without the depth test, every ray terminated.
+    let look = Look::default();
+    let frames = modes_bit_exact(rtl, &vols[..1], Render::Composite, &look, s + 9);
+    let plain = Expected::new(
+        &p4(true),
+        &frames[0].seen,
+        VIEWS[0].0,
+        VIEWS[0].1,
+        Render::Composite,
+        &look,
+    )
+    .unwrap();
+    for (a, b) in frames[0].want.iter().zip(&plain.want) {
+        assert!(a.terminated && a.rgba == b.rgba && a.z == b.z && a.geo == b.geo);
+    }
 }

@@ -8,6 +8,7 @@
 //! Needs no RTL build: the table carries the parameters Verilator elaborated.
 
 use cube5_model::unit::UnitConfig;
+use cube5_model::units::cube5_accel::AccelConfig;
 use cube5_model::units::cube5_accel_ctrl::AccelCtrlConfig;
 use cube5_model::units::cube5_axi_wr::AxiWrConfig;
 use cube5_model::units::cube5_axil::AxilConfig;
@@ -81,6 +82,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == StepConfig::TOP => agree::<StepConfig>(v),
         t if t == SampleRtlConfig::TOP => agree::<SampleRtlConfig>(v),
         t if t == ErConfig::TOP => agree::<ErConfig>(v),
+        t if t == AccelConfig::TOP => agree::<AccelConfig>(v),
         other => Err(format!(
             "top {other} has no model configuration (UnitConfig)"
         )),

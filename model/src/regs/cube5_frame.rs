@@ -45,7 +45,8 @@ pub const KIND_CMD: u32 = 0;
 /// error
 pub const KIND_BEAT: u32 = 1;
 
-// Configuration port: the top three address bits select a region (5..7 are ignored).
+// Configuration port: the top three address bits select a region (6 and 7 are ignored; 5 without
+// DepthTest).
 pub const CFG_REGION_W: u32 = 3;
 /// frame registers
 pub const REGION_FRAME: u32 = 0;
@@ -57,6 +58,9 @@ pub const REGION_BLOCK: u32 = 2;
 pub const REGION_SHADER: u32 = 3;
 /// compositing tables and registers (every pipeline)
 pub const REGION_COMPOS: u32 = 4;
+/// DepthTest = 1: the opaque geometry's RGBA-Z table, one word per base-plane pixel: offset R +
+/// 2^(m+1) Q, data Z, gR, gG, gB
+pub const REGION_GEOMETRY: u32 = 5;
 
 // Render modes (the 3-bit field `render` of register Mode); 5 to 7 are refused.
 /// maximum intensity projection
@@ -81,6 +85,8 @@ pub const COMPOS_MIN: u32 = 3;
 pub const COMPOS_XRAY_SUM: u32 = 4;
 /// for FirstOpaque
 pub const COMPOS_FIRST_OPAQUE: u32 = 5;
+/// DepthTest = 1: the read-out's end of every ray, the geometry colour under it
+pub const COMPOS_FLUSH: u32 = 6;
 
 // Registers by word offset (region 0, `off` = the offset).
 /// `Dims` (WO): volume dimensions (volume axes); also the skewed memory's dimensions register.

@@ -61,6 +61,10 @@ pub struct FrameConfig {
     /// Where the beams come from (`Source`): the skewed memory inside (false), or a beat stream a
     /// section at a time (true; docs/numerics/frame.md, "Sections").
     pub stream: bool,
+    /// The depth test against opaque geometry (`DepthTest`): a per-pixel RGBA-Z table that every
+    /// ray starts from, and the read-out's flush of the geometry colour under each ray
+    /// (docs/numerics/frame.md, "Opaque geometry").
+    pub depth_test: bool,
 }
 
 impl FrameConfig {
@@ -76,6 +80,7 @@ impl FrameConfig {
         compos: ComposConfig::DEFAULT,
         shade: true,
         stream: false,
+        depth_test: false,
     };
 
     /// The largest volume edge (`MaxDim`).
@@ -96,6 +101,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         let (mut t, mut g, mut s, mut c) = (d.trilin, d.gradient, d.shader, d.compos);
         let mut shade = u32::from(d.shade);
         let mut source = u32::from(d.stream);
+        let mut depth_test = u32::from(d.depth_test);
         crate::unit::set_params(
             Self::TOP,
             params,
@@ -121,8 +127,14 @@ impl crate::unit::UnitConfig for FrameConfig {
                 ("ZW", &mut c.z_w),
                 ("Shade", &mut shade),
                 ("Source", &mut source),
+                ("DepthTest", &mut depth_test),
             ],
         )?;
+        if depth_test > 1 {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: DepthTest = {depth_test} must be 0 or 1"
+            )));
+        }
         if source > 1 {
             return Err(ModelError::Config(format!(
                 "cube5_frame: Source = {source} must be 0 (the skewed memory) or 1 (a beat stream)"
@@ -156,6 +168,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             compos: c,
             shade: shade == 1,
             stream: source == 1,
+            depth_test: depth_test == 1,
         })
     }
 
@@ -184,6 +197,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             ("ZW", i(c.z_w)),
             ("Shade", i64::from(self.shade)),
             ("Source", i64::from(self.stream)),
+            ("DepthTest", i64::from(self.depth_test)),
         ]
     }
 }
@@ -794,6 +808,72 @@ pub struct FrameUnits {
     pub shade: bool,
     /// The shader's 2-D classification (`tf2d`: density and gradient magnitude).
     pub tf2d: bool,
+    /// The opaque geometry's RGBA-Z image the compositing buffer is preloaded with (a frame with
+    /// `DepthTest = 1`; [`FrameUnits::set_geometry`]); `None`: no geometry, no flush.
+    pub geometry: Option<std::sync::Arc<GeometryImage>>,
+}
+
+/// One base-plane pixel of the opaque geometry (docs/numerics/frame.md, "Opaque geometry"): the
+/// depth `z` in slices from the front of the first opaque surface along the pixel's ray (samples
+/// at slices `s >= z` are hidden; `Znone = 2^ZW - 1`: no surface) and its colour codes
+/// (`ColorW` bits each).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GeoPixel {
+    pub z: u32,
+    pub rgb: [u32; 3],
+}
+
+/// The RGBA-Z image of the opaque geometry on the base plane, row-major (`q` outer, `r` inner),
+/// `width` x `height` = the frame's base plane: the table `DepthTest = 1` preloads per coxel.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GeometryImage {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<GeoPixel>,
+}
+
+impl GeometryImage {
+    /// No geometry anywhere: every pixel at `Znone`, colour 0.
+    pub fn none(width: usize, height: usize, cfg: &ComposConfig) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![
+                GeoPixel {
+                    z: cfg.z_none(),
+                    rgb: [0; 3],
+                };
+                width * height
+            ],
+        }
+    }
+
+    /// Refuses an image that is not `params`' base plane, or whose depths or colours do not fit
+    /// the compositing unit's widths.
+    pub fn check(&self, params: &FrameParams, cfg: &ComposConfig) -> Result<()> {
+        let (w, h) = params.base_plane_size();
+        if (self.width, self.height) != (w, h) || self.pixels.len() != w * h {
+            return Err(ModelError::Config(format!(
+                "geometry image {} x {} ({} pixels) is not the frame's {w} x {h} base plane",
+                self.width,
+                self.height,
+                self.pixels.len()
+            )));
+        }
+        let cmax = (1u32 << cfg.color_w) - 1;
+        if let Some((i, p)) = self
+            .pixels
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.z > cfg.z_none() || p.rgb.iter().any(|&c| c > cmax))
+        {
+            return Err(ModelError::Config(format!(
+                "geometry pixel {i}: depth {} or colour {:?} does not fit ZW = {}, ColorW = {}",
+                p.z, p.rgb, cfg.z_w, cfg.color_w
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// The base-plane image: the final coxel of every ray, row-major.
@@ -1008,7 +1088,46 @@ impl FrameUnits {
             mode,
             shade: cfg.shade,
             tf2d: opts.boundary.is_some(),
+            geometry: None,
         })
+    }
+
+    /// Preloads the compositing buffer with the opaque geometry's RGBA-Z image (`DepthTest = 1`):
+    /// every ray starts from its pixel's depth and colour, and the read-out flushes the geometry
+    /// colour under the ray. The image must be `params`' base plane.
+    pub fn set_geometry(&mut self, params: &FrameParams, g: GeometryImage) -> Result<()> {
+        g.check(params, &self.compos.config())?;
+        self.geometry = Some(std::sync::Arc::new(g));
+        Ok(())
+    }
+
+    /// The coxel ray `idx` (row-major base-plane pixel) starts from: the mode's initial coxel,
+    /// with the geometry's depth and colour where the buffer is preloaded.
+    pub fn initial_coxel_at(&self, idx: usize) -> Coxel {
+        let mut c = self.initial_coxel();
+        if let Some(p) = self.geometry.as_ref().and_then(|g| g.pixels.get(idx)) {
+            c.z = p.z;
+            c.geo = p.rgb;
+        }
+        c
+    }
+
+    /// The read-out of a preloaded buffer: one `Flush` item per coxel, which composites the
+    /// geometry colour under the ray (compos rule 2; `Znone`: only `terminated` is set). Without
+    /// geometry the coxel leaves as it is.
+    pub fn read_out(&self, c: &Coxel) -> Coxel {
+        if self.geometry.is_none() {
+            return *c;
+        }
+        self.compos.step(
+            c,
+            &Sample {
+                rgb: [0; 3],
+                alpha: 0,
+                depth: 0,
+                mode: ComposMode::Flush,
+            },
+        )
     }
 
     /// The shader's mode of every sample of this frame.
@@ -1019,9 +1138,10 @@ impl FrameUnits {
         }
     }
 
-    /// The fast path renders this frame (its mode, the 1-D table).
+    /// The fast path renders this frame (its mode, the 1-D table, no geometry: a frame with
+    /// geometry runs the exact per-sample model).
     pub fn fast_path(&self) -> bool {
-        self.mode.fast_path() && !self.tf2d
+        self.mode.fast_path() && !self.tf2d && self.geometry.is_none()
     }
 
     /// The coxel every ray starts from ([`FrameMode::initial_coxel`]).
@@ -1146,9 +1266,18 @@ pub fn render_base_plane_reference(
     vol: &Volume,
     units: &FrameUnits,
 ) -> BasePlane {
+    let mut bp = render_rays(params, vol, units);
+    if units.geometry.is_some() {
+        bp.coxels = bp.coxels.iter().map(|c| units.read_out(c)).collect();
+    }
+    bp
+}
+
+/// The coxels of every ray after its last sample, before the read-out (with geometry, the
+/// read-out's flush follows: [`FrameUnits::read_out`]).
+fn render_rays(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
     let (w, h) = params.base_plane_size();
-    let init = units.initial_coxel();
-    let mut coxels = vec![init; w * h];
+    let mut coxels: Vec<Coxel> = (0..w * h).map(|i| units.initial_coxel_at(i)).collect();
     for s in 0..params.nk {
         let c = params.slice(s);
         // Samples of one plane are independent: shade them in parallel, composite in order.
@@ -1195,13 +1324,19 @@ pub fn render_exact_stats(
     vol: &Volume,
     units: &FrameUnits,
 ) -> (BasePlane, SweepStats) {
-    let bp = render_base_plane_reference(params, vol, units);
+    // Rays the compositing unit terminated: counted before the read-out's flush (which marks
+    // every ray of a frame with geometry terminated).
+    let mut bp = render_rays(params, vol, units);
+    let rays_terminated = bp.coxels.iter().filter(|c| c.terminated).count() as u64;
+    if units.geometry.is_some() {
+        bp.coxels = bp.coxels.iter().map(|c| units.read_out(c)).collect();
+    }
     let anchors = params.samples() as u64;
     let stats = SweepStats {
         anchors,
         samples: anchors,
         shaded: anchors,
-        rays_terminated: bp.coxels.iter().filter(|c| c.terminated).count() as u64,
+        rays_terminated,
         ..SweepStats::default()
     };
     (bp, stats)
@@ -1759,5 +1894,127 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("Shade = 2"), "{e}");
+    }
+
+    /// The depth test (docs/numerics/frame.md, "Opaque geometry"): geometry at depth 0 hides every
+    /// sample and the pixel is the geometry colour, opaque; at depth `Z` the ray keeps exactly the
+    /// samples of slices `s < Z` (the same frame over a volume whose slices `s >= Z` are cut off
+    /// would differ only where the cut slices reach back through interpolation, so the check is on
+    /// the samples themselves: every coxel equals the fold of its samples before `Z`, then the
+    /// flush); `Znone` everywhere is the frame without geometry, each ray terminated by the flush.
+    #[test]
+    fn geometry_hides_the_samples_behind_it_and_shows_under_the_ray() {
+        use crate::units::cube5_compos::unit_code;
+        let vol = crate::phantom::head_phantom(16, 12).unwrap();
+        let tf = TransferFunction::head_default();
+        let cfg = FrameConfig {
+            depth_test: true,
+            ..FrameConfig::DEFAULT
+        };
+        let c = cfg.compos;
+        for v in [[0.3, -0.7, 1.0], [-1.0, 0.4, 0.2]] {
+            let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), 4).unwrap();
+            let params = setup.params;
+            let (w, h) = params.base_plane_size();
+            let phong = frame_phong(&params, &[]);
+            for mode in FrameMode::ALL {
+                let base = FrameUnits::with_options(
+                    &cfg,
+                    mode,
+                    &setup,
+                    &tf,
+                    &phong,
+                    &ModeOptions::default(),
+                )
+                .unwrap();
+                let plain = render_base_plane_reference(&params, &vol, &base);
+                // Znone everywhere: the plain frame, terminated.
+                let mut u = base.clone();
+                u.set_geometry(&params, GeometryImage::none(w, h, &c))
+                    .unwrap();
+                let none = render_base_plane_reference(&params, &vol, &u);
+                for (a, b) in none.coxels.iter().zip(&plain.coxels) {
+                    assert_eq!(
+                        *a,
+                        Coxel {
+                            terminated: true,
+                            ..*b
+                        },
+                        "{mode:?}"
+                    );
+                }
+                // Depth 0: the geometry colour, opaque (MinIP: its A stays all ones, T = 0).
+                let g = GeoPixel {
+                    z: 0,
+                    rgb: [40, 200, 255],
+                };
+                let mut u = base.clone();
+                u.set_geometry(
+                    &params,
+                    GeometryImage {
+                        width: w,
+                        height: h,
+                        pixels: vec![g; w * h],
+                    },
+                )
+                .unwrap();
+                let front = render_base_plane_reference(&params, &vol, &u);
+                for px in &front.coxels {
+                    if mode == FrameMode::Minip {
+                        assert_eq!(px.rgba, [0, 0, 0, c.chan_max()]);
+                    } else {
+                        let want: [u64; 3] = g.rgb.map(|x| unit_code(x, c.color_w, c.acc_w));
+                        assert_eq!(px.rgba[..3], want, "{mode:?}");
+                        assert_eq!(px.rgba[3], c.one(), "{mode:?}");
+                    }
+                }
+                // A depth per pixel: the fold of the ray's samples before it, then the flush.
+                let pixels: Vec<GeoPixel> = (0..w * h)
+                    .map(|i| GeoPixel {
+                        z: if i % 7 == 3 {
+                            c.z_none()
+                        } else {
+                            (i * 5 % 19) as u32
+                        },
+                        rgb: [(i % 256) as u32, 9, 200],
+                    })
+                    .collect();
+                let mut u = base.clone();
+                let gi = GeometryImage {
+                    width: w,
+                    height: h,
+                    pixels,
+                };
+                u.set_geometry(&params, gi.clone()).unwrap();
+                let got = render_base_plane_reference(&params, &vol, &u);
+                let mut want: Vec<Coxel> = (0..w * h).map(|i| u.initial_coxel_at(i)).collect();
+                for s in 0..params.nk {
+                    let sc = params.slice(s);
+                    for b in 0..params.nj {
+                        for a in 0..params.ni {
+                            let (r, q) = params.pixel_of(&sc, a, b);
+                            let at = q * w + r;
+                            if (s as u32) < gi.pixels[at].z {
+                                let smp = base.shaded_sample(&params, &vol, &sc, a, b);
+                                want[at] = base.compos.step(&want[at], &smp);
+                            }
+                        }
+                    }
+                }
+                let want: Vec<Coxel> = want.iter().map(|x| u.read_out(x)).collect();
+                assert!(got.coxels == want, "{mode:?} {v:?}");
+                assert!(!u.fast_path());
+            }
+        }
+        // The image must be the frame's base plane, its codes within the widths.
+        let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::Z, 4).unwrap();
+        let mut u = FrameUnits::new(FrameMode::Mip, &setup, &tf, &Phong::two_lights()).unwrap();
+        assert!(u
+            .set_geometry(&setup.params, GeometryImage::none(3, 3, &c))
+            .is_err());
+        let (w, h) = setup.params.base_plane_size();
+        let mut g = GeometryImage::none(w, h, &c);
+        g.pixels[0].rgb[1] = 256;
+        assert!(u.set_geometry(&setup.params, g).is_err());
     }
 }

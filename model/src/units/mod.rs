@@ -6,6 +6,7 @@
 //! Slice-order (Cube-5) units first, then the GI-Cube block processor's (patent [25]-[29],
 //! [346]-[392]).
 
+pub mod cube5_accel;
 pub mod cube5_accel_ctrl;
 pub mod cube5_axi_rd;
 pub mod cube5_axi_wr;

@@ -23,8 +23,11 @@ use std::collections::BTreeSet;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-/// The flags a `.variants` line may carry.
-pub const FLAGS: &[&str] = &["gate", "mutant", "fmax", "fmax85", "ooc", "sim", "bram"];
+/// The flags a `.variants` line may carry. `full`: a configuration only the runs too long for CI
+/// use (`make sim-full`); the test bench builds it only when `CUBE5_FULL=1`.
+pub const FLAGS: &[&str] = &[
+    "gate", "mutant", "fmax", "fmax85", "ooc", "sim", "bram", "full",
+];
 
 /// Words allowed as the leading token of a variant name (schemes that no single parameter
 /// initial says): the ray-bucketing schemes of `gicube_bucket`.

@@ -1,0 +1,173 @@
+//! The accelerator top `cube5_accel` (docs/accel.md): its configuration, i.e. how the top's
+//! parameters split into the configurations of the units inside it. What the top computes is the
+//! frame model's image (`cube5_frame` with `Source = 1`, fed by `cube5_vol_fetch` and
+//! `cube5_section_buf`); this module is the one place that maps the top's parameters onto them.
+
+use crate::unit::UnitConfig;
+use crate::units::cube5_frame::FrameConfig;
+use crate::units::cube5_vol_fetch::VolFetchConfig;
+use crate::{ModelError, Result};
+
+/// The top's parameters that it passes through to the frame (which also gets `Source = 1`).
+pub const FRAME_PARAMS: &[&str] = &[
+    "P",
+    "MaxDim",
+    "VoxelW",
+    "WeightW",
+    "FracW",
+    "BlockDim",
+    "ClassIdxW",
+    "MagIdxW",
+    "MagShift",
+    "ColorW",
+    "AlphaW",
+    "RmLog2",
+    "RmFracW",
+    "DiffW",
+    "SpecW",
+    "ExtraW",
+    "AccW",
+    "ZW",
+];
+
+/// The top's parameters that it passes through to the volume fetch (the top's `Outstanding` is
+/// the fetch's read bursts in flight).
+pub const FETCH_PARAMS: &[&str] = &[
+    "AddrW",
+    "DataW",
+    "P",
+    "VoxelW",
+    "MaxDim",
+    "BlockDim",
+    "MaxBurst",
+    "Outstanding",
+];
+
+/// The top's own parameters, with the RTL's defaults: the section width (anchors), the image
+/// writer's bursts in flight and the AXI ID width.
+const OWN_PARAMS: &[(&str, i64)] = &[("Section", 16), ("WrOutstanding", 4), ("IdW", 4)];
+
+/// The defaults of the parameters the top passes on, where the top's default differs from (or
+/// must not depend on) the unit's: the RTL's values (`rtl/cube5/cube5_accel.sv`).
+const PASSED_DEFAULTS: &[(&str, i64)] = &[
+    ("P", 4),
+    ("MaxDim", 64),
+    ("VoxelW", 12),
+    ("BlockDim", 8),
+    ("AddrW", 32),
+    ("DataW", 64),
+    ("MaxBurst", 16),
+    ("Outstanding", 8),
+    ("WeightW", 8),
+    ("FracW", 4),
+    ("ClassIdxW", 12),
+    ("MagIdxW", 4),
+    ("MagShift", 10),
+    ("ColorW", 8),
+    ("AlphaW", 12),
+    ("RmLog2", 3),
+    ("RmFracW", 4),
+    ("DiffW", 9),
+    ("SpecW", 8),
+    ("ExtraW", 4),
+    ("AccW", 20),
+    ("ZW", 12),
+];
+
+/// One configuration of `cube5_accel`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AccelConfig {
+    /// The frame inside (`Source = 1`): its image is the top's.
+    pub frame: FrameConfig,
+    pub fetch: VolFetchConfig,
+    /// Anchors per section (`Section`).
+    pub section: u32,
+    /// Image write bursts in flight (`WrOutstanding`).
+    pub wr_outstanding: u32,
+    /// AXI ID width (`IdW`).
+    pub id_w: u32,
+}
+
+impl UnitConfig for AccelConfig {
+    const TOP: &'static str = "cube5_accel";
+
+    fn from_params(params: &[(&str, i64)]) -> Result<Self> {
+        let mut all: Vec<(&'static str, i64)> = PASSED_DEFAULTS
+            .iter()
+            .chain(OWN_PARAMS.iter())
+            .copied()
+            .collect();
+        for &(name, value) in params {
+            let Some(slot) = all.iter_mut().find(|(n, _)| *n == name) else {
+                let known: Vec<&str> = all.iter().map(|(n, _)| *n).collect();
+                return Err(ModelError::Config(format!(
+                    "cube5_accel: unknown parameter {name} (known: {})",
+                    known.join(", ")
+                )));
+            };
+            slot.1 = value;
+        }
+        let get = |n: &str| all.iter().find(|(k, _)| *k == n).map_or(0, |&(_, v)| v);
+        let pick = |names: &[&'static str]| -> Vec<(&'static str, i64)> {
+            names.iter().map(|&n| (n, get(n))).collect()
+        };
+        let mut fp = pick(FRAME_PARAMS);
+        fp.push(("Source", 1));
+        let own = |n: &str| {
+            u32::try_from(get(n)).map_err(|_| {
+                ModelError::Config(format!("cube5_accel: {n} = {} is out of range", get(n)))
+            })
+        };
+        let c = Self {
+            frame: FrameConfig::from_params(&fp)?,
+            fetch: VolFetchConfig::from_params(&pick(FETCH_PARAMS))?,
+            section: own("Section")?,
+            wr_outstanding: own("WrOutstanding")?,
+            id_w: own("IdW")?,
+        };
+        if c.section < 2 * get("P") as u32 {
+            return Err(ModelError::Config(format!(
+                "cube5_accel: Section = {} must be at least 2 P = {}",
+                c.section,
+                2 * get("P")
+            )));
+        }
+        Ok(c)
+    }
+
+    fn to_params(&self) -> Vec<(&'static str, i64)> {
+        let frame = self.frame.to_params();
+        let fetch = self.fetch.to_params();
+        let from = |list: &[(&'static str, i64)], n: &str| {
+            list.iter().find(|(k, _)| *k == n).map(|&(_, v)| v)
+        };
+        let mut out: Vec<(&'static str, i64)> = Vec::new();
+        for &n in FRAME_PARAMS.iter().chain(FETCH_PARAMS) {
+            if out.iter().any(|(k, _)| *k == n) {
+                continue;
+            }
+            let v = from(&frame, n).or_else(|| from(&fetch, n)).unwrap_or(0);
+            out.push((n, v));
+        }
+        out.extend([
+            ("Section", i64::from(self.section)),
+            ("WrOutstanding", i64::from(self.wr_outstanding)),
+            ("IdW", i64::from(self.id_w)),
+        ]);
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_defaults_round_trip_and_bad_parameters_are_refused() {
+        let c = AccelConfig::from_params(&[]).unwrap();
+        let back = AccelConfig::from_params(&c.to_params()).unwrap();
+        assert_eq!(c, back);
+        assert!(AccelConfig::from_params(&[("Bogus", 1)]).is_err());
+        assert!(AccelConfig::from_params(&[("Section", 4), ("P", 4)]).is_err());
+    }
+}
