@@ -48,7 +48,10 @@ fn the_geometry_scene_matches_the_rtl_frame_with_the_depth_test() {
     let scene = example_scene_with(
         "head-geometry",
         "geometry-head-geometry",
-        &[("width = 256", "width = 48"), ("height = 256", "height = 48")],
+        &[
+            ("width = 256", "width = 48"),
+            ("height = 256", "height = 48"),
+        ],
     );
     let dir = scratch("geometry-out");
     let stdout = cosim_matches(&scene, &dir);

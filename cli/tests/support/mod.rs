@@ -61,7 +61,10 @@ pub fn example_scene_with(name: &str, tag: &str, edits: &[(&str, &str)]) -> Path
     let path = cube5_model::repo_root().join(format!("scenes/{name}.toml"));
     let mut text = std::fs::read_to_string(&path).unwrap();
     for (from, to) in edits {
-        assert!(text.contains(from), "{name}: the scene has no `{from}` any more");
+        assert!(
+            text.contains(from),
+            "{name}: the scene has no `{from}` any more"
+        );
         text = text.replace(from, to);
     }
     let f = scratch(&format!("{tag}.toml"));
