@@ -39,7 +39,7 @@ pub fn not_expressible(scene: &Scene) -> Vec<String> {
         ];
     }
     if scene.view.projection != Projection::Parallel {
-        why.push("view.projection = \"perspective\" (the frame is parallel only)".into());
+        why.push("view.projection = \"perspective\" (the frame is parallel only; the hardware's perspective is ER-perspective on cube5_er: run.renderer = \"er\")".into());
     }
     if q.interpolation != Interpolation::BilinearSlice {
         why.push(format!(
