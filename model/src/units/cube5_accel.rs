@@ -4,31 +4,13 @@
 //! `cube5_section_buf`); this module is the one place that maps the top's parameters onto them.
 
 use crate::unit::UnitConfig;
-use crate::units::cube5_frame::FrameConfig;
+use crate::units::cube5_frame::{FrameConfig, UNIT_WIDTH_PARAMS};
 use crate::units::cube5_vol_fetch::VolFetchConfig;
 use crate::{ModelError, Result};
 
-/// The top's parameters that it passes through to the frame (which also gets `Source = 1`).
-pub const FRAME_PARAMS: &[&str] = &[
-    "P",
-    "MaxDim",
-    "VoxelW",
-    "WeightW",
-    "FracW",
-    "BlockDim",
-    "ClassIdxW",
-    "MagIdxW",
-    "MagShift",
-    "ColorW",
-    "AlphaW",
-    "RmLog2",
-    "RmFracW",
-    "DiffW",
-    "SpecW",
-    "ExtraW",
-    "AccW",
-    "ZW",
-];
+/// The top's parameters that it passes through to the frame besides the units' widths
+/// ([`UNIT_WIDTH_PARAMS`]); the frame also gets `Source = 1`.
+pub const FRAME_PARAMS: &[&str] = &["P", "MaxDim", "BlockDim"];
 
 /// The top's parameters that it passes through to the volume fetch (the top's `Outstanding` is
 /// the fetch's read bursts in flight).
@@ -112,6 +94,7 @@ impl UnitConfig for AccelConfig {
             names.iter().map(|&n| (n, get(n))).collect()
         };
         let mut fp = pick(FRAME_PARAMS);
+        fp.extend(pick(UNIT_WIDTH_PARAMS));
         fp.push(("Source", 1));
         let own = |n: &str| {
             u32::try_from(get(n)).map_err(|_| {
@@ -142,7 +125,11 @@ impl UnitConfig for AccelConfig {
             list.iter().find(|(k, _)| *k == n).map(|&(_, v)| v)
         };
         let mut out: Vec<(&'static str, i64)> = Vec::new();
-        for &n in FRAME_PARAMS.iter().chain(FETCH_PARAMS) {
+        for &n in FRAME_PARAMS
+            .iter()
+            .chain(UNIT_WIDTH_PARAMS)
+            .chain(FETCH_PARAMS)
+        {
             if out.iter().any(|(k, _)| *k == n) {
                 continue;
             }

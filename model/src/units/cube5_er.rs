@@ -13,6 +13,7 @@ use crate::regs::cube5_er::{
 };
 use crate::unit::{StreamCodec, UnitConfig};
 use crate::units::cube5_compos::{self, ComposConfig, Coxel};
+use crate::units::cube5_frame::UNIT_WIDTH_PARAMS;
 use crate::units::cube5_frame::{FrameConfig, FrameMode};
 use crate::units::cube5_gradient::GradientConfig;
 use crate::units::cube5_shader::ShaderConfig;
@@ -66,30 +67,22 @@ impl UnitConfig for ErConfig {
         let d = Self::DEFAULT;
         let mut max_dim = 1u32 << d.max_dim_log2;
         let mut max_rays = d.max_rays;
-        let (mut t, mut g, mut s, mut c) = (d.trilin, d.gradient, d.shader, d.compos);
-        crate::unit::set_params(
-            Self::TOP,
-            params,
-            &mut [
-                ("MaxDim", &mut max_dim),
-                ("MaxRays", &mut max_rays),
-                ("VoxelW", &mut t.voxel_w),
-                ("WeightW", &mut t.weight_w),
-                ("FracW", &mut t.frac_w),
-                ("ClassIdxW", &mut s.class_idx_w),
-                ("MagIdxW", &mut s.mag_idx_w),
-                ("MagShift", &mut s.mag_shift),
-                ("ColorW", &mut c.color_w),
-                ("AlphaW", &mut c.alpha_w),
-                ("RmLog2", &mut s.rm_log2),
-                ("RmFracW", &mut s.rm_frac_w),
-                ("DiffW", &mut s.diff_w),
-                ("SpecW", &mut s.spec_w),
-                ("ExtraW", &mut c.extra_w),
-                ("AccW", &mut c.acc_w),
-                ("ZW", &mut c.z_w),
-            ],
-        )?;
+        // The units' widths are the frame's parameters of the same names: mapped onto the units
+        // (and derived between them) once, by `FrameConfig`.
+        let mut widths = Vec::new();
+        for &(name, value) in params {
+            if UNIT_WIDTH_PARAMS.contains(&name) {
+                widths.push((name, value));
+            } else {
+                crate::unit::set_params(
+                    Self::TOP,
+                    &[(name, value)],
+                    &mut [("MaxDim", &mut max_dim), ("MaxRays", &mut max_rays)],
+                )?;
+            }
+        }
+        let f = FrameConfig::from_params(&widths)?;
+        let c = f.compos;
         if !max_dim.is_power_of_two() || !(4..=512).contains(&max_dim) {
             return Err(ModelError::Config(format!(
                 "cube5_er: MaxDim = {max_dim} must be a power of two in 4..=512"
@@ -101,13 +94,6 @@ impl UnitConfig for ErConfig {
                 RAY_W - 1
             )));
         }
-        (g.voxel_w, g.weight_w, g.frac_w) = (t.voxel_w, t.weight_w, t.frac_w);
-        (s.voxel_w, s.frac_w) = (t.voxel_w, t.frac_w);
-        (s.color_w, s.alpha_w) = (c.color_w, c.alpha_w);
-        t.validate()?;
-        g.validate()?;
-        s.validate()?;
-        c.validate()?;
         if c.z_w > 16 || (1u64 << c.z_w) < u64::from(max_dim) {
             return Err(ModelError::Config(format!(
                 "cube5_er: ZW = {} must hold every slice number of MaxDim = {max_dim}",
@@ -117,35 +103,25 @@ impl UnitConfig for ErConfig {
         Ok(Self {
             max_dim_log2: max_dim.trailing_zeros(),
             max_rays,
-            trilin: t,
-            gradient: g,
-            shader: s,
+            trilin: f.trilin,
+            gradient: f.gradient,
+            shader: f.shader,
             compos: c,
         })
     }
 
     fn to_params(&self) -> Vec<(&'static str, i64)> {
-        let (t, s, c) = (&self.trilin, &self.shader, &self.compos);
-        let i = i64::from;
-        vec![
+        let mut out = vec![
             ("MaxDim", 1i64 << self.max_dim_log2),
-            ("MaxRays", i(self.max_rays)),
-            ("VoxelW", i(t.voxel_w)),
-            ("WeightW", i(t.weight_w)),
-            ("FracW", i(t.frac_w)),
-            ("ClassIdxW", i(s.class_idx_w)),
-            ("MagIdxW", i(s.mag_idx_w)),
-            ("MagShift", i(s.mag_shift)),
-            ("ColorW", i(c.color_w)),
-            ("AlphaW", i(c.alpha_w)),
-            ("RmLog2", i(s.rm_log2)),
-            ("RmFracW", i(s.rm_frac_w)),
-            ("DiffW", i(s.diff_w)),
-            ("SpecW", i(s.spec_w)),
-            ("ExtraW", i(c.extra_w)),
-            ("AccW", i(c.acc_w)),
-            ("ZW", i(c.z_w)),
-        ]
+            ("MaxRays", i64::from(self.max_rays)),
+        ];
+        out.extend(
+            self.frame_config()
+                .to_params()
+                .into_iter()
+                .filter(|(n, _)| UNIT_WIDTH_PARAMS.contains(n)),
+        );
+        out
     }
 }
 

@@ -37,6 +37,26 @@ pub const STEP_W: u32 = 16;
 /// variant's `MaxDim`.
 pub const MAX_DIM: usize = 512;
 
+/// The frame's parameters that set the widths of its units (trilin, gradient, shader, compos): the
+/// tops built around the same units (`cube5_er`, `cube5_accel`) take them under the same names.
+pub const UNIT_WIDTH_PARAMS: &[&str] = &[
+    "VoxelW",
+    "WeightW",
+    "FracW",
+    "ClassIdxW",
+    "MagIdxW",
+    "MagShift",
+    "ColorW",
+    "AlphaW",
+    "RmLog2",
+    "RmFracW",
+    "DiffW",
+    "SpecW",
+    "ExtraW",
+    "AccW",
+    "ZW",
+];
+
 /// One configuration of the `cube5_frame` RTL: pipelines, memory and the widths of its units.
 /// Several frame parameters set more than one unit (`VoxelW` sets trilin, gradient and shader;
 /// `ColorW` and `AlphaW` set shader and compos), so the units always agree.
