@@ -52,6 +52,8 @@ package gicube_pkg;
 
   /// Bit offset of the start point (x, y, z, PosW each) within a packet.
   localparam int unsigned PacketStartLsb = 24;
+  /// Bit offset of the 6-bit flags field within a packet.
+  localparam int unsigned PacketFlagsLsb = 226;
 
   // ---------------------------------------------------------------------------
   // Queue bucketing (docs/numerics/gicube_bucket.md)

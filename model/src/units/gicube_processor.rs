@@ -21,10 +21,9 @@ use crate::units::cube5_compos::{corrected_alpha, rnd};
 use crate::units::cube5_shader::ClassLut;
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
-use crate::units::gicube_ray_queues::RayQueues;
+use crate::units::gicube_queue_front::{Chooser, FrontTraffic, QueueFront};
 use crate::units::gicube_sample::{SampleConfig, SampleIn, Sampler};
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
-use crate::units::gicube_sorter::{Sorter, SorterConfig, SorterIn};
 use crate::units::gicube_step::{StepConfig, Stepper};
 use crate::volume::Volume;
 
@@ -36,7 +35,7 @@ pub use crate::units::gicube_sample::{
 /// `E (12) + T (12) + dr (8) + w_c (24) - IRR_FRAC_W`: the splat's rounding shift.
 pub const DEPOSIT_SHIFT: u32 = 12 + 12 + POS_FRAC_W + 3 * POS_FRAC_W - IRR_FRAC_W;
 /// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
-pub const SORTER_SLOTS: usize = 2;
+pub use crate::units::gicube_queue_front::SORTER_SLOTS;
 
 /// How the processor picks the next active queue.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -407,45 +406,18 @@ impl BlockCache {
     }
 }
 
-/// One step the frame loop made on its ray queues (`RayQueues`): a pop of the active queue, or a
-/// push of a ray into a queue (re-queued, moved or from the host).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum QueueOp {
-    Pop(u32),
-    Push(u32, RayPacket),
-}
+/// One step the frame loop made on its ray queues (`RayQueues`, inside the queue front end): a
+/// pop of the active queue, or a push of a ray into a queue (re-queued, moved or from the host).
+pub type QueueOp = crate::units::gicube_queue_front::QueueOp<RayPacket>;
 
-/// `queues.pop(q)`, logged.
-fn pop_logged(
-    queues: &mut RayQueues<RayPacket>,
-    log: &mut Option<&mut Vec<QueueOp>>,
-    q: u32,
-) -> Option<RayPacket> {
-    if let Some(l) = log.as_deref_mut() {
-        l.push(QueueOp::Pop(q));
-    }
-    queues.pop(q)
-}
-
-/// `queues.push(q, ray)`, logged.
-fn push_logged(
-    queues: &mut RayQueues<RayPacket>,
-    log: &mut Option<&mut Vec<QueueOp>>,
-    q: u32,
-    ray: RayPacket,
-) -> std::result::Result<(), RayPacket> {
-    if let Some(l) = log.as_deref_mut() {
-        l.push(QueueOp::Push(q, ray));
-    }
-    queues.push(q, ray)
-}
+/// What a traced frame records: the queue steps and the front end's input of every cycle.
+type FrontTrace = (Vec<QueueOp>, Vec<FrontTraffic<RayPacket>>);
 
 /// What one pipeline cycle did to a ray.
 enum Outcome {
-    /// Still in the same block: back to the tail of the same queue.
-    Stay(RayPacket),
-    /// Entered another block (queue number).
-    Move(RayPacket, u32),
+    /// Still in the volume: re-queued through the ring to the block it is in now (the front
+    /// end buckets it: the same queue, or the one it entered).
+    Next(RayPacket),
     /// Finished: exited the volume or terminated.
     Done(RayPacket),
 }
@@ -717,11 +689,7 @@ impl Processor {
             return Outcome::Done(ray);
         }
         ray.start = s.next;
-        if s.queue == q {
-            Outcome::Stay(ray)
-        } else {
-            Outcome::Move(ray, s.queue)
-        }
+        Outcome::Next(ray)
     }
 
     /// Renders a frame: the host makes the rays (`host_rays`), offers the head of its list in
@@ -742,9 +710,24 @@ impl Processor {
     ) -> Result<(ProcessorFrame, Vec<QueueOp>)> {
         let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
         let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
-        let mut log = Vec::new();
-        let f = self.run(packets, cam.width, cam.height, None, Some(&mut log))?;
-        Ok((f, log))
+        let mut trace = FrontTrace::default();
+        let f = self.run(packets, cam.width, cam.height, None, Some(&mut trace))?;
+        Ok((f, trace.0))
+    }
+
+    /// `render`, and every processor cycle's input to the queue front end (`take`, the ring's
+    /// ray, the host's offer), in order: the traffic that the RTL front end
+    /// (`gicube_queue_front`) replays in the co-simulation.
+    pub fn render_front_traced(
+        &self,
+        cam: &Camera,
+        proj: Projection,
+    ) -> Result<(ProcessorFrame, Vec<FrontTraffic<RayPacket>>)> {
+        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
+        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let mut trace = FrontTrace::default();
+        let f = self.run(packets, cam.width, cam.height, None, Some(&mut trace))?;
+        Ok((f, trace.1))
     }
 
     /// The lighting pass of volumetric GI ([358]-[363], low albedo, single scattering): lighting
@@ -800,7 +783,7 @@ impl Processor {
         w: u32,
         h: u32,
         mut irr: Option<&mut Vec<u16>>,
-        mut log: Option<&mut Vec<QueueOp>>,
+        trace: Option<&mut FrontTrace>,
     ) -> Result<ProcessorFrame> {
         let rays = packets.len();
         let packets_lives = packets
@@ -810,24 +793,28 @@ impl Processor {
             .unwrap_or(1);
         let mut feed: VecDeque<RayPacket> = packets.into();
         let nq = self.queues();
-        let queue_w = (32 - (nq - 1).leading_zeros()).max(1);
-        let imp_w = (32 - self.cfg.queue_len.leading_zeros()).max(2);
-        let scfg = SorterConfig::new(
-            self.cfg.ranks.min(1 << queue_w),
-            queue_w,
-            imp_w,
+        // The queue front end (arbiter, bucketing, ray queues, sorter): the one description of a
+        // processor cycle's queue traffic (`gicube_queue_front`, the RTL's model).
+        let chooser = match self.cfg.order {
+            QueueOrder::Sorter => Chooser::Sorter,
+            QueueOrder::Scan => Chooser::Scan,
+        };
+        let mut front: QueueFront<RayPacket> = QueueFront::new(
+            self.cfg.block_log2,
+            self.blocks,
             self.cfg.queue_len,
+            self.cfg.ranks,
+            chooser,
         )?;
-        let mut sorter = Sorter::new(scfg)?;
-        // The ray queues: the one description of them (`gicube_ray_queues`, the RTL's model).
-        let mut queues: RayQueues<RayPacket> = RayQueues::new(nq, self.cfg.queue_len);
+        if trace.is_some() {
+            front.trace();
+        }
         let mut counts = ProcessorCounts {
             rays_made: rays as u64,
             ..Default::default()
         };
         let mut rgb = vec![[0u16; 3]; (w * h) as usize];
         let mut done = vec![false; (w * h) as usize];
-        let mut scan_active: Option<u32> = None;
         let mut cache = BlockCache::new(self.cfg.block_log2);
         let mut last_active: Option<u32> = None;
         // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
@@ -838,8 +825,8 @@ impl Processor {
             2 * u64::from(self.side) * 256 / u64::from(self.cfg.step) + u64::from(nq) + 64;
         let bound = 64 + 8 * rays as u64 * lives * per_path;
 
-        while !feed.is_empty() || queues.total() > 0 {
-            let held = u64::from(queues.total());
+        while !feed.is_empty() || front.total() > 0 {
+            let held = u64::from(front.total());
             counts.cycles += 1;
             if counts.cycles > bound {
                 return Err(ModelError::Config(format!(
@@ -847,117 +834,66 @@ impl Processor {
                 )));
             }
             counts.occupancy_sum += held;
-            let mut updates: Vec<SorterIn> = Vec::with_capacity(SORTER_SLOTS);
-            // The active queue.
-            let active = match self.cfg.order {
-                QueueOrder::Sorter => sorter.active().map(|e| e.queue),
-                QueueOrder::Scan => {
-                    if scan_active.is_none_or(|q| queues.is_empty(q)) && held > 0 {
-                        let from = scan_active.map_or(0, |q| q + 1);
-                        scan_active = (0..nq)
-                            .map(|i| (from + i) % nq)
-                            .find(|&q| !queues.is_empty(q));
-                    }
-                    scan_active
+            // The host offers the head of its list (it clips its rays to the volume: a packet
+            // outside it is a bug); a ray it is not taken stays at the head.
+            let offer = match feed.front() {
+                Some(ray) if self.queue_of(ray.start).is_none() => {
+                    return Err(ModelError::Config(format!(
+                        "gicube processor: host ray of pixel ({}, {}) starts outside the volume",
+                        ray.u, ray.v
+                    )))
                 }
+                o => o.copied(),
             };
-            if active.is_some() && active != last_active {
-                counts.activations += 1;
-            }
-            last_active = active;
-            match active.and_then(|q| pop_logged(&mut queues, &mut log, q).map(|r| (q, r))) {
-                Some((q, ray)) => match self.advance(
-                    ray,
-                    q,
-                    &mut counts,
-                    &mut cache,
-                    irr.as_deref_mut().map(|v| v.as_mut_slice()),
-                ) {
-                    Outcome::Stay(ray) => {
-                        // Its own queue has the slot the pop freed.
-                        if push_logged(&mut queues, &mut log, q, ray).is_err() {
-                            return Err(ModelError::Config(format!(
-                                "gicube processor: queue {q} full after its own pop"
-                            )));
-                        }
-                    }
-                    Outcome::Move(ray, q2) => {
-                        updates.push(SorterIn::add(q, -1));
-                        match push_logged(&mut queues, &mut log, q2, ray) {
-                            Ok(()) => updates.push(SorterIn::add(q2, 1)),
-                            Err(mut ray) => {
-                                counts.rays_overflowed += 1;
-                                ray.flags |= flag::OVERFLOW;
-                                feed.push_back(ray);
+            let c = front.cycle(
+                true,
+                |popped| {
+                    let Some((q, ray)) = popped else {
+                        return Ok(None);
+                    };
+                    let irr = irr.as_deref_mut().map(|v| v.as_mut_slice());
+                    match self.advance(ray, q, &mut counts, &mut cache, irr) {
+                        Outcome::Next(ray) => Ok(Some(ray)),
+                        Outcome::Done(ray) => {
+                            counts.rays_finished += 1;
+                            let i = (u32::from(ray.v) * w + u32::from(ray.u)) as usize;
+                            if done[i] {
+                                return Err(ModelError::Config(format!(
+                                    "gicube processor: pixel ({}, {}) finished twice",
+                                    ray.u, ray.v
+                                )));
                             }
+                            done[i] = true;
+                            rgb[i] = ray.color;
+                            Ok(None)
                         }
-                    }
-                    Outcome::Done(ray) => {
-                        updates.push(SorterIn::add(q, -1));
-                        counts.rays_finished += 1;
-                        let i = (u32::from(ray.v) * w + u32::from(ray.u)) as usize;
-                        if done[i] {
-                            return Err(ModelError::Config(format!(
-                                "gicube processor: pixel ({}, {}) finished twice",
-                                ray.u, ray.v
-                            )));
-                        }
-                        done[i] = true;
-                        rgb[i] = ray.color;
                     }
                 },
-                None => {
-                    if held > 0 {
-                        counts.idle_cycles += 1;
-                    }
-                }
+                offer,
+            )?;
+            if c.active.is_some() && c.active != last_active {
+                counts.activations += 1;
             }
-            // The host's offer, in a free sorter slot. A ray whose queue is full is not accepted
-            // (the port's ready is low): it stays at the head of the host's list.
-            if updates.len() < SORTER_SLOTS {
-                if let Some(&ray) = feed.front() {
-                    let qh = self.queue_of(ray.start).ok_or_else(|| {
-                        // The host clips rays to the volume: a packet outside it is a bug.
-                        ModelError::Config(format!(
-                            "gicube processor: host ray of pixel ({}, {}) starts outside the volume",
-                            ray.u, ray.v
-                        ))
-                    })?;
-                    if !queues.is_full(qh) {
-                        let mut ray = ray;
-                        feed.pop_front();
-                        ray.flags &= !flag::OVERFLOW;
-                        counts.rays_in += 1;
-                        if push_logged(&mut queues, &mut log, qh, ray).is_err() {
-                            return Err(ModelError::Config(format!(
-                                "gicube processor: queue {qh} refused a ray it had room for"
-                            )));
-                        }
-                        updates.push(SorterIn::add(qh, 1));
-                    } else {
-                        counts.host_stalls += 1;
-                    }
-                }
+            last_active = c.active;
+            if c.popped.is_none() && held > 0 {
+                counts.idle_cycles += 1;
             }
-            for u in &updates {
-                counts.max_queue = counts.max_queue.max(queues.len(u.queue));
+            if let Some(ray) = c.ring_ovf {
+                // Returned with OVERFLOW set; the host offers it again after the rays it holds.
+                counts.rays_overflowed += 1;
+                feed.push_back(ray);
             }
-            if self.cfg.order == QueueOrder::Sorter {
-                for s in 0..SORTER_SLOTS {
-                    sorter.step(updates.get(s).unwrap_or(&SorterIn::NOOP));
-                }
-                // The sorter's counters are the queue lengths (criterion 1 of [373]).
-                for u in &updates {
-                    let len = queues.len(u.queue);
-                    if sorter.importance(u.queue) != len {
-                        return Err(ModelError::Config(format!(
-                            "gicube processor: sorter counter {} of queue {} holds {len} rays",
-                            sorter.importance(u.queue),
-                            u.queue
-                        )));
-                    }
-                }
+            if c.host_taken {
+                feed.pop_front();
+                counts.rays_in += 1;
             }
+            counts.host_stalls += u64::from(c.host_stall);
+            for u in &c.updates {
+                counts.max_queue = counts.max_queue.max(front.queues().len(u.queue));
+            }
+        }
+        if let Some(t) = trace {
+            *t = front.take_trace();
         }
         Ok(ProcessorFrame {
             width: w,

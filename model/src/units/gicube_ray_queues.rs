@@ -300,7 +300,7 @@ impl StreamUnit for RayQueuesUnit {
     }
 }
 
-fn put_ray(w: &mut BitWriter, ray: &Ray, width: u32) {
+pub(crate) fn put_ray(w: &mut BitWriter, ray: &Ray, width: u32) {
     let mut left = width;
     for word in ray {
         if left == 0 {
@@ -312,7 +312,7 @@ fn put_ray(w: &mut BitWriter, ray: &Ray, width: u32) {
     }
 }
 
-fn get_ray(r: &mut BitReader, width: u32) -> Ray {
+pub(crate) fn get_ray(r: &mut BitReader, width: u32) -> Ray {
     let mut ray = [0u32; DATA_WORDS];
     let mut left = width;
     for word in &mut ray {

@@ -27,6 +27,7 @@ pub mod cube5_warp;
 pub mod gicube_bucket;
 pub mod gicube_packet_loop;
 pub mod gicube_processor;
+pub mod gicube_queue_front;
 pub mod gicube_ray_queues;
 pub mod gicube_sample;
 pub mod gicube_scatter;
