@@ -411,7 +411,7 @@ impl BlockCache {
 pub type QueueOp = crate::units::gicube_queue_front::QueueOp<RayPacket>;
 
 /// What a traced frame records: the queue steps and the front end's input of every cycle.
-type FrontTrace = (Vec<QueueOp>, Vec<FrontTraffic<RayPacket>>);
+type FrontTrace = crate::units::gicube_queue_front::FrontTrace<RayPacket>;
 
 /// What one pipeline cycle did to a ray.
 enum Outcome {

@@ -91,6 +91,9 @@ pub struct FrontTraffic<T> {
     pub host: Option<T>,
 }
 
+/// What a traced front end records: its queue steps and every cycle's input.
+pub type FrontTrace<T> = (Vec<QueueOp<T>>, Vec<FrontTraffic<T>>);
+
 /// What one processor cycle did (contract, "One cycle" and "Output").
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrontCycle<T> {
@@ -125,7 +128,7 @@ pub struct QueueFront<T> {
     chooser: Chooser,
     sorter: Sorter,
     scan: Option<u32>,
-    trace: Option<(Vec<QueueOp<T>>, Vec<FrontTraffic<T>>)>,
+    trace: Option<FrontTrace<T>>,
 }
 
 impl<T: FrontRay> QueueFront<T> {
@@ -164,7 +167,7 @@ impl<T: FrontRay> QueueFront<T> {
     }
 
     /// The recorded queue steps and cycle inputs.
-    pub fn take_trace(&mut self) -> (Vec<QueueOp<T>>, Vec<FrontTraffic<T>>) {
+    pub fn take_trace(&mut self) -> FrontTrace<T> {
         self.trace.take().unwrap_or_default()
     }
 
@@ -649,7 +652,7 @@ pub fn directed_items(cfg: QueueFrontConfig) -> Vec<FrontIn> {
         let blocks = cfg.vol_blocks;
         let b = [q / (blocks * blocks), (q / blocks) % blocks, q % blocks];
         let side = 256 << cfg.block_log2;
-        let corner = if kind % 2 == 0 { side - 1 } else { 0 };
+        let corner = if kind.is_multiple_of(2) { side - 1 } else { 0 };
         with_start(bits, b.map(|c| c * side + corner))
     };
     let mut v: Vec<FrontIn> = Vec::new();
