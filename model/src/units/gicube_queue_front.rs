@@ -663,19 +663,17 @@ pub fn directed_items(cfg: QueueFrontConfig) -> Vec<FrontIn> {
     let idle = FrontIn::default();
     go(&mut unit, &mut v, idle);
     go(&mut unit, &mut v, FrontIn { take: true, ..idle });
+    fn host_only(host_ray: Ray) -> FrontIn {
+        FrontIn {
+            host: true,
+            host_ray,
+            ..FrontIn::default()
+        }
+    }
     // The host fills the first and the last block's queue, and one more each (stalls).
     for q in [0, last] {
         for k in 0..=cfg.queue_len {
-            let r = ray(q, k);
-            go(
-                &mut unit,
-                &mut v,
-                FrontIn {
-                    host: true,
-                    host_ray: r,
-                    ..idle
-                },
-            );
+            go(&mut unit, &mut v, host_only(ray(q, k)));
         }
     }
     // Stays, moves and overflows on the active queue, the host offering to a full queue or an
@@ -708,16 +706,7 @@ pub fn directed_items(cfg: QueueFrontConfig) -> Vec<FrontIn> {
     // Every block's queue filled by the host, then everything drained with nothing re-queued.
     for q in 0..blocks {
         for k in 0..cfg.queue_len {
-            let r = ray(q, k + q);
-            go(
-                &mut unit,
-                &mut v,
-                FrontIn {
-                    host: true,
-                    host_ray: r,
-                    ..idle
-                },
-            );
+            go(&mut unit, &mut v, host_only(ray(q, k + q)));
         }
     }
     let drain = FrontIn { take: true, ..idle };
