@@ -16,14 +16,14 @@ use cube5_model::units::gicube_queue_front::{
     QueueFrontConfig, QueueFrontUnit, OVERFLOW_BIT,
 };
 use cube5_model::units::gicube_ray_queues::Ray;
-use cube5_tb::harness::StreamCheck;
+use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;
 use support::{
-    configs, directed_on_every_config, gate_smoke_then_directed, million_across_a_reset,
-    must_match_across_a_reset, must_match_items, random_items, seed,
+    configs, directed_on_every_config, expect_mismatch, gate_smoke_then_directed,
+    million_across_a_reset, must_match_across_a_reset, must_match_items, random_items, seed,
 };
 
 fn traffic(cfg: QueueFrontConfig) -> impl FnMut(&mut ChaCha8Rng) -> FrontIn {
@@ -111,6 +111,33 @@ fn one_cycle_per_four_clocks_when_never_stalled() {
             driven.stats.cycles
         );
     }
+}
+
+/// The scoreboard bites: a model whose sorter has two ranks fewer (another active queue now and
+/// then, so other rays to the pipeline) is caught.
+#[test]
+fn a_model_with_fewer_sorter_ranks_is_caught() {
+    let (variant, cfg) = configs::<QueueFrontConfig>()[0];
+    let other = QueueFrontConfig {
+        ranks: cfg.ranks - 2,
+        ..cfg
+    };
+    let mut check = StreamCheck::new(seed(1770), 20_000).with_traffic(0.1, 0.1);
+    check.waveform_on_mismatch = false;
+    let err = expect_mismatch(
+        check_stream(
+            variant,
+            cfg,
+            &mut QueueFrontUnit::new(other).unwrap(),
+            &mut traffic(cfg),
+            &check,
+        ),
+        "a sorter of fewer ranks picks another active queue",
+    );
+    eprintln!(
+        "{variant}: a model of {} ranks caught at item {}",
+        other.ranks, err.item
+    );
 }
 
 #[test]
