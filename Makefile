@@ -2,7 +2,7 @@
 CARGO ?= cargo
 DEMO_DIR ?= out
 
-.PHONY: setup demo test sim sim-full lint synth bench bench-peer tradeoff regs fmt clippy clean clean-cache
+.PHONY: setup demo test sim sim-full lint synth bench bench-accel bench-peer tradeoff regs fmt clippy clean clean-cache
 .PHONY: cosim
 
 # The build cache of verilated and compiled RTL variants (shared by every clone on the machine).
@@ -65,6 +65,13 @@ synth:
 ## builds twice as fast; docs/ci.md). The -O2 objects are cached beside the -O1 ones.
 bench: setup
 	CUBE5_RTL_CXX_OPT=-O2 $(CARGO) run --release -q -p cube5-cli -- bench
+
+## The accelerator's whole-frame benchmark (docs/accel.md, *Measured*): cube5_accel's MaxDim 256
+## configurations at P = 1, 2, 4, 8 (`full` lines, minutes of build each) render the 128^3 and
+## 256^3 head with the DDR-like memory; prints the table (cycles, samples/clock/pipeline, frames/s
+## at the units' lowest placed Fmax) and writes it to target/bench-accel.md.
+bench-accel: setup
+	CUBE5_FULL=1 CUBE5_TOPS=cube5_accel $(CARGO) test --release -p cube5-tb --test cube5_accel -- --ignored --nocapture benchmark_table
 
 ## The peer benchmark (issue 13): cube5's model against VTK's vtkFixedPointVolumeRayCastMapper on
 ## the same 256^3 volume, transfer function and view, with both times and their ratio

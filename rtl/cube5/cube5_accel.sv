@@ -137,7 +137,7 @@ module cube5_accel #(
   localparam int unsigned FrInW    = cube5_frame_pkg::in_w(1, P, VoxelW, M);
   localparam int unsigned FrOutW   = cube5_frame_pkg::out_w(AccW, ZW, ColorW);
   localparam int unsigned FrSecW   = cube5_frame_pkg::sec_cmd_w(M);
-  localparam int unsigned FrCmdW   = 7 * M + 50;
+  localparam int unsigned FrCmdW   = 7 * M + 51;
   localparam int unsigned BlkW     = cube5_skewmem_pkg::blk_w(M, BlockDim);
   localparam int unsigned ShAddrW  = cube5_shader_pkg::cfg_addr_w(ClassIdxW, RmLog2);
   localparam int unsigned ShDataW  = cube5_shader_pkg::cfg_data_w(ColorW, AlphaW, DiffW, SpecW);
@@ -154,7 +154,7 @@ module cube5_accel #(
   localparam int unsigned FcDx     = FcView + 3;
   localparam int unsigned FcDy     = FcDx + 18;
   localparam int unsigned FcMode   = FcDy + 18;
-  localparam int unsigned FcSkip   = FcMode + 3;
+  localparam int unsigned FcSkip   = FcMode + 4;
   localparam int unsigned FcA0     = FcSkip + 2 * DimW;
   localparam int unsigned FcNs     = FcA0 + M;
   localparam int unsigned FcFirst  = FcNs + DimW;
@@ -360,7 +360,7 @@ module cube5_accel #(
       3'd1:    reg_word = CfgDataW'(rc_data[FcView +: 3]);
       3'd2:    reg_word = CfgDataW'(rc_data[FcDx +: 18]);
       3'd3:    reg_word = CfgDataW'(rc_data[FcDy +: 18]);
-      3'd4:    reg_word = CfgDataW'(rc_data[FcMode +: 3]);   // tf2d 0
+      3'd4:    reg_word = CfgDataW'(rc_data[FcMode +: 4]);   // render, tf2d
       default: reg_word = CfgDataW'(rc_data[FcSkip +: 2*DimW]);
     endcase
   end

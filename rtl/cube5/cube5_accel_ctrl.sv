@@ -61,7 +61,7 @@ module cube5_accel_ctrl #(
   /// The frame's section: Dims, View, Dx, Dy, Mode, Skip, sec_a0, sec_ns, sec_first, sec_last.
   output logic        frame_cmd_valid_o,
   input  logic        frame_cmd_ready_i,
-  output logic [7*$clog2(MaxDim)+49:0] frame_cmd_data_o,
+  output logic [7*$clog2(MaxDim)+50:0] frame_cmd_data_o,
   /// cube5_axi_wr's command: addr, len (pixels).
   output logic        wr_cmd_valid_o,
   input  logic        wr_cmd_ready_i,
@@ -203,7 +203,7 @@ module cube5_accel_ctrl #(
   logic [1:0]       axis_q;
   logic             rev_q;
   logic [17:0]      dx_q, dy_q;
-  logic [2:0]       mode_q;
+  logic [3:0]       mode_q;           // Mode: render (3), tf2d (1)
   logic [AddrW-1:0] vbase_q, ibase_q;
   logic [63:0]      vbase_w, ibase_w;
 
@@ -219,7 +219,7 @@ module cube5_accel_ctrl #(
       rev_q   <= reg_q[RegView*32 + 2];
       dx_q    <= reg_q[RegDx*32 +: 18];
       dy_q    <= reg_q[RegDy*32 +: 18];
-      mode_q  <= reg_q[RegMode*32 +: 3];
+      mode_q  <= reg_q[RegMode*32 +: 4];
       front_q <= reg_q[RegSkip*32 + 0*M1 +: M1];
       back_q  <= reg_q[RegSkip*32 + 1*M1 +: M1];
       vbase_q <= vbase_w[AddrW-1:0];
@@ -286,7 +286,7 @@ module cube5_accel_ctrl #(
     // Refusals, the first that applies (docs/numerics/accel_ctrl.md, "Refused frames").
     if (axis_q == 2'd3) code_a = cube5_accel_regs_pkg::CodeAxisK;
     else if (bad_dim(nx_q) || bad_dim(ny_q) || bad_dim(nz_q)) code_a = cube5_accel_regs_pkg::CodeDims;
-    else if (mode_q >= 3'd2) code_a = cube5_accel_regs_pkg::CodeRender;
+    else if (mode_q[2:0] >= 3'd5) code_a = cube5_accel_regs_pkg::CodeRender;
     else if (bad_step(dx_q) || bad_step(dy_q)) code_a = cube5_accel_regs_pkg::CodeStep;
     else if ({1'b0, front_q} + {1'b0, back_q} >= {1'b0, nk}) code_a = cube5_accel_regs_pkg::CodeSkip;
     else code_a = cube5_accel_regs_pkg::CodeNone;

@@ -10,7 +10,7 @@ package cube5_accel_regs_pkg;
   localparam logic [3:0] CodeAxisK    = 4'd1;
   // a dimension outside `P ..= MaxDim` or not a multiple of `P`
   localparam logic [3:0] CodeDims     = 4'd2;
-  // `render` >= 2
+  // `render` >= 5 (the frame's `Render` encodings are 0 to 4)
   localparam logic [3:0] CodeRender   = 4'd3;
   // `|DX|` or `|DY|` above `2^16`
   localparam logic [3:0] CodeStep     = 4'd4;

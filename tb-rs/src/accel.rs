@@ -482,7 +482,7 @@ fn start_frame(
     }
     let regs = rtl
         .frame
-        .frame_writes(&e.params, e.units.render, false, (0, 0));
+        .frame_writes(&e.params, e.units.render, e.units.tf2d, (0, 0));
     let word = |i: usize| regs[i].1[0];
     host.write_frame(&FrameRegs {
         dims: word(0),

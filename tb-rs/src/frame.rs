@@ -527,6 +527,92 @@ impl Units {
     }
 }
 
+/// The acceptance views of whole frames (one list for every frame-level test bench: cube5_frame,
+/// cube5_accel): the six faces, exactly 45 degrees and 45 +- 1e-3, 45 degrees between two
+/// negative axes, the space diagonal, obliques (DX < 0 and reversed sweeps among them).
+pub const VIEWS: &[(&str, [f64; 3])] = &[
+    ("+z", [0.0, 0.0, 1.0]),
+    ("-z", [0.0, 0.0, -1.0]),
+    ("+x", [1.0, 0.0, 0.0]),
+    ("-x", [-1.0, 0.0, 0.0]),
+    ("+y", [0.0, 1.0, 0.0]),
+    ("-y", [0.0, -1.0, 0.0]),
+    ("45 xz", [1.0, 0.0, 1.0]),
+    ("45+1e-3 xz", [1.0 + 1e-3, 0.0, 1.0]),
+    ("45-1e-3 xz", [1.0 - 1e-3, 0.0, 1.0]),
+    ("45 -x-y", [-1.0, -1.0, 0.0]),
+    ("diagonal", [1.0, 1.0, 1.0]),
+    OBLIQUE_Z,
+    ("oblique y", [0.6, -1.0, 0.3]),
+    ("oblique x", [0.9, 0.45, -0.2]),
+];
+
+/// The oblique view most single-frame tests render.
+pub const OBLIQUE_Z: (&str, [f64; 3]) = ("oblique z", [-0.37, 0.81, -1.0]);
+
+/// A non-cubic volume: two overlapping soft ellipsoids, some noise, and an empty corner (so the
+/// block LUT has empty blocks to skip).
+pub fn blob_volume(dims: [usize; 3], bits: u32, seed: u64) -> Volume {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let max = f64::from((1u32 << bits) - 1);
+    let [nx, ny, nz] = dims;
+    let c = [nx as f64 * 0.55, ny as f64 * 0.45, nz as f64 * 0.5];
+    let mut data = Vec::with_capacity(nx * ny * nz);
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let p = [x as f64, y as f64, z as f64];
+                let d1 = ((p[0] - c[0]) / (nx as f64 * 0.35)).powi(2)
+                    + ((p[1] - c[1]) / (ny as f64 * 0.3)).powi(2)
+                    + ((p[2] - c[2]) / (nz as f64 * 0.4)).powi(2);
+                let d2 = ((p[0] - c[0] * 0.6) / (nx as f64 * 0.15)).powi(2)
+                    + ((p[1] - c[1] * 1.4) / (ny as f64 * 0.2)).powi(2)
+                    + ((p[2] - c[2]) / (nz as f64 * 0.25)).powi(2);
+                let mut v = 0.45 * (1.0 - d1).max(0.0) + 0.6 * (1.0 - d2).max(0.0);
+                if x < nx / 4 && y < ny / 4 {
+                    v = 0.0;
+                } else if v > 0.0 {
+                    v += rng.random_range(0.0..0.08);
+                }
+                data.push((v.min(1.0) * max).round() as u16);
+            }
+        }
+    }
+    Volume::new(dims, [1.0; 3], bits, data).expect("a valid volume")
+}
+
+/// `vol` resampled to `dims` (nearest voxel: the voxel whose centre is nearest along each axis),
+/// for the non-cubic acceptance volumes made from the cubic phantoms.
+pub fn resampled(vol: &Volume, dims: [usize; 3]) -> Volume {
+    let src = vol.dims;
+    let at = |a: usize, d: usize| ((2 * d + 1) * src[a] / (2 * dims[a])).min(src[a] - 1);
+    let mut data = Vec::with_capacity(dims.iter().product());
+    for z in 0..dims[2] {
+        for y in 0..dims[1] {
+            for x in 0..dims[0] {
+                data.push(vol.data[at(0, x) + src[0] * (at(1, y) + src[1] * at(2, z))]);
+            }
+        }
+    }
+    Volume::new(dims, [1.0; 3], vol.bits, data).expect("a valid volume")
+}
+
+/// A transfer function with opaque tissue: first-opaque needs samples that reach the threshold, and
+/// the 2-D table changes the image (the mode tests of cube5_frame and cube5_accel).
+pub fn dense_tf() -> TransferFunction {
+    use cube5_model::transfer::TfPoint;
+    let p = |density, rgba| TfPoint { density, rgba };
+    TransferFunction {
+        points: vec![
+            p(0.0, [0.0; 4]),
+            p(0.1, [0.9, 0.7, 0.6, 0.0]),
+            p(0.4, [0.9, 0.6, 0.5, 0.55]),
+            p(1.0, [1.0, 1.0, 1.0, 0.95]),
+        ],
+    }
+}
+
 /// A sparse scene for the empty-space figures: an `n`^3 volume whose voxels are random (seeded)
 /// inside the box `lo..hi` and 0 elsewhere.
 pub fn sparse_box_volume(n: usize, lo: [usize; 3], hi: [usize; 3], seed: u64) -> Volume {

@@ -13,8 +13,9 @@ use cube5_model::phantom::{bubbles_phantom, head_phantom};
 use cube5_model::regs::cube5_accel::CODE_FRAME;
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
-use cube5_tb::accel::{AccelBench, AccelRtl, FrameRun, MemEnv};
-use cube5_tb::frame::{Expected, Look, Render};
+use cube5_tb::accel::{AccelBench, AccelRtl, FrameRun, MemEnv, TOP};
+use cube5_tb::frame::{blob_volume, dense_tf, resampled, Expected, Look, Render, VIEWS};
+use cube5_tb::variants::gate_variants_of;
 use cube5_tb::TbError;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -29,14 +30,20 @@ fn rtl(p: usize, n: usize) -> AccelRtl {
     AccelRtl::with(p, n).unwrap_or_else(|| panic!("no cube5_accel variant with P = {p} for {n}^3"))
 }
 
-/// Faces (DX = DY = 0), exactly 45 degrees (DX = 2^16), obliques with DX < 0 and a reversed sweep.
-const VIEWS: &[(&str, [f64; 3])] = &[
-    ("+z", [0.0, 0.0, 1.0]),
-    ("-x", [-1.0, 0.0, 0.0]),
-    ("45 xz", [1.0, 0.0, 1.0]),
-    ("oblique dx<0", [-0.6, 0.3, 1.0]),
-    ("oblique -z", [0.37, 0.81, -1.0]),
-];
+/// The acceptance view called `name` (`cube5_tb::frame::VIEWS`: the six faces, exactly 45
+/// degrees, obliques with DX < 0 and reversed sweeps).
+fn view(name: &str) -> View {
+    *VIEWS
+        .iter()
+        .find(|v| v.0 == name)
+        .unwrap_or_else(|| panic!("no view {name}"))
+}
+
+/// The views of the lighter runs: a face, another face (a sweep along x), exactly 45 degrees, an
+/// oblique view with DX < 0 and a reversed sweep, an oblique view with a reversed sweep.
+fn some_views() -> [View; 5] {
+    ["+z", "-x", "45 xz", "oblique z", "oblique x"].map(view)
+}
 
 type View = (&'static str, [f64; 3]);
 
@@ -80,22 +87,33 @@ impl Case {
     }
 
     fn expect(&self, view: View, render: Render) -> Expected {
+        self.expect_with(view, render, &Look::default())
+    }
+
+    fn expect_with(&self, view: View, render: Render, look: &Look) -> Expected {
         let rtl = &self.bench.rtl.frame;
-        Expected::new(rtl, &self.vol, view.0, view.1, render, &Look::default()).unwrap()
+        Expected::new(rtl, &self.vol, view.0, view.1, render, look).unwrap()
     }
 
     /// One frame under `env`: rendered, read back from memory, compared; its figures printed.
     fn frame(&mut self, view: View, render: Render, env: &MemEnv, what: &str) -> FrameRun {
         let e = self.expect(view, render);
+        self.frame_of(&e, env, what)
+    }
+
+    /// The frame of `e` under `env`.
+    fn frame_of(&mut self, e: &Expected, env: &MemEnv, what: &str) -> FrameRun {
         let mem_seed = self.rng.random();
-        let img_base = must(self.bench.start(&e, &self.vol, &self.lut, env, mem_seed));
-        let run = must(self.bench.finish(&e, img_base, mem_seed));
+        let img_base = must(self.bench.start(e, &self.vol, &self.lut, env, mem_seed));
+        let run = must(self.bench.finish(e, img_base, mem_seed));
         let rtl = self.bench.rtl;
+        let [nx, ny, nz] = self.vol.dims;
+        let render = e.units.render;
         eprintln!(
-            "{}: {}^3 {} {render:?}{what}: {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
+            "{}: {nx}x{ny}x{nz} {} {render:?}{}{what}: {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
             rtl.variant,
-            self.vol.dims[0],
-            view.0,
+            e.view,
+            if e.units.tf2d { " 2-D TF" } else { "" },
             run.cycles,
             run.samples,
             run.rate(rtl.p),
@@ -124,8 +142,9 @@ use Render::{Composite, Mip};
 fn head_64_p4_every_view_composite_and_mip() {
     let s = seed(0xacce1);
     let mut c = Case::new(rtl(4, 64), head_phantom(64, 12).unwrap(), s);
-    let mut frames: Vec<(View, Render)> = VIEWS.iter().map(|&v| (v, Composite)).collect();
-    frames.extend([VIEWS[0], VIEWS[2], VIEWS[4]].map(|v| (v, Mip)));
+    let mut frames: Vec<(View, Render)> =
+        some_views().into_iter().map(|v| (v, Composite)).collect();
+    frames.extend([view("+z"), view("45 xz"), view("oblique x")].map(|v| (v, Mip)));
     c.random(&frames);
 }
 
@@ -135,9 +154,9 @@ fn bubbles_64_p4() {
     let s = seed(0xacce2);
     let mut c = Case::new(rtl(4, 64), bubbles_phantom(64, 12).unwrap(), s);
     c.random(&[
-        (VIEWS[1], Composite),
-        (VIEWS[2], Mip),
-        (VIEWS[3], Composite),
+        (view("-x"), Composite),
+        (view("45 xz"), Mip),
+        (view("oblique z"), Composite),
     ]);
 }
 
@@ -146,7 +165,7 @@ fn bubbles_64_p4() {
 fn head_64_p1() {
     let s = seed(0xacce3);
     let mut c = Case::new(rtl(1, 64), head_phantom(64, 12).unwrap(), s);
-    c.random(&[(VIEWS[2], Composite), (VIEWS[3], Mip)]);
+    c.random(&[(view("45 xz"), Composite), (view("oblique z"), Mip)]);
 }
 
 /// The synthesizable configuration (16^3, the frame's narrow widths): the 16^3 head in every
@@ -155,9 +174,9 @@ fn head_64_p1() {
 fn narrow_16_p4() {
     let s = seed(0xacce9);
     let mut c = Case::new(rtl(4, 16), head_phantom(16, 8).unwrap(), s);
-    let frames: Vec<(View, Render)> = VIEWS
-        .iter()
-        .flat_map(|&v| [(v, Composite), (v, Mip)])
+    let frames: Vec<(View, Render)> = some_views()
+        .into_iter()
+        .flat_map(|v| [(v, Composite), (v, Mip)])
         .collect();
     c.random(&frames);
 }
@@ -169,7 +188,7 @@ fn reset_mid_frame_then_an_exact_frame() {
     let s = seed(0xacce4);
     let mut c = Case::new(rtl(4, 64), head_phantom(64, 12).unwrap(), s);
     let env = MemEnv::random(&mut c.rng);
-    let e = c.expect(VIEWS[4], Composite);
+    let e = c.expect(view("oblique x"), Composite);
     must(c.bench.start(&e, &c.vol, &c.lut, &env, s));
     must(c.bench.idle(30_000));
     assert!(
@@ -184,7 +203,12 @@ fn reset_mid_frame_then_an_exact_frame() {
     );
     let wr = c.bench.dut.axi_wr_counters();
     assert_eq!(wr.in_flight, 0, "no write outstanding after the reset");
-    c.frame(VIEWS[4], Composite, &env, " after a reset mid-frame");
+    c.frame(
+        view("oblique x"),
+        Composite,
+        &env,
+        " after a reset mid-frame",
+    );
 }
 
 /// A frame whose last section the frame refuses (36 anchors in sections of 16: the last has 4,
@@ -195,7 +219,7 @@ fn reset_mid_frame_then_an_exact_frame() {
 fn a_section_the_frame_refuses_ends_the_frame_with_an_error() {
     let s = seed(0xacceb);
     let mut c = Case::new(rtl(4, 64), head_phantom(36, 12).unwrap(), s);
-    let e = c.expect(VIEWS[0], Composite);
+    let e = c.expect(view("+z"), Composite);
     must(c.bench.start(&e, &c.vol, &c.lut, &MemEnv::quiet(), s));
     must(c.bench.wait_irq(400_000));
     let mut host = AccelHost::new(&mut c.bench, 0);
@@ -206,7 +230,7 @@ fn a_section_the_frame_refuses_ends_the_frame_with_an_error() {
     assert_eq!(host.status_code().unwrap(), CODE_FRAME);
     let mut c = c.with(head_phantom(32, 12).unwrap());
     c.frame(
-        VIEWS[2],
+        view("45 xz"),
         Composite,
         &MemEnv::quiet(),
         " after a refused section",
@@ -218,12 +242,127 @@ fn a_section_the_frame_refuses_ends_the_frame_with_an_error() {
 fn the_check_fails_when_the_model_disagrees() {
     let s = seed(0xacce5);
     let mut c = Case::new(rtl(4, 64), head_phantom(64, 12).unwrap(), s);
-    let (e, other) = (c.expect(VIEWS[0], Mip), c.expect(VIEWS[0], Composite));
+    let (e, other) = (c.expect(view("+z"), Mip), c.expect(view("+z"), Composite));
     let img_base = must(c.bench.start(&e, &c.vol, &c.lut, &MemEnv::quiet(), s));
     match c.bench.finish(&other, img_base, s) {
         Err(TbError::Mismatch(m)) => eprintln!("as it should: {}", m.what),
         other => panic!("a MIP image passed as the composite one: {other:?}"),
     }
+}
+
+/// X-ray (the set-up's shift, and 0: sums that saturate), first-opaque, the 2-D transfer function
+/// in composite (with early termination) and in first-opaque.
+fn newer_modes() -> Vec<(Render, Look)> {
+    let dense = Look {
+        tf: dense_tf(),
+        ..Look::default()
+    };
+    vec![
+        (Render::Xray, Look::default()),
+        (
+            Render::Xray,
+            Look {
+                xray_shift: Some(0),
+                ..Look::default()
+            },
+        ),
+        (
+            Render::FirstOpaque,
+            Look {
+                threshold: 0.3,
+                ..dense.clone()
+            },
+        ),
+        (
+            Composite,
+            Look {
+                boundary: Some(0.25),
+                early_termination: true,
+                ..dense.clone()
+            },
+        ),
+        (
+            Render::FirstOpaque,
+            Look {
+                boundary: Some(0.25),
+                threshold: 0.3,
+                ..dense
+            },
+        ),
+    ]
+}
+
+/// The frame's other modes through the accelerator's registers (`Mode.render` 3 and 4 and
+/// `Mode.tf2d`; their compositing registers, XrayShift and FoThreshold, through the Opacity table
+/// window): X-ray with the set-up's shift and with 0 (sums that saturate), first-opaque, the 2-D
+/// transfer function in composite (with early termination) and in first-opaque; bit-exact on the
+/// narrow 16^3 configuration and at 64^3. MinIP: `minip_through_the_registers`.
+#[test]
+fn newer_modes_through_the_registers() {
+    let s = seed(0xacce10);
+    modes_bit_exact(&newer_modes(), s);
+}
+
+/// MinIP (`Mode.render` 2) through the registers, as `newer_modes_through_the_registers`. Fails
+/// today in the frame fed by sections (`Source = 1`, never co-simulated in MinIP before): a ray
+/// the model's samples reach reads untouched (A all ones) when the view has `fx(s) != 0` and the
+/// face has two sections or more (faces and 45 degrees pass; obliques pass on 32^3 in one 32-anchor
+/// section and fail on 64^3 in two). cube5_frame_cbuf's `past` (a sample past a far face, which
+/// MinIP leaves out) compares the beat with `nbr`, the *section's* beats per row, so it drops the
+/// last anchor of every section, not only the face's (docs/accel.md, *Modes*).
+#[test]
+#[ignore = "sim-full: fails in cube5_frame (Source = 1): MinIP's past-a-far-face test at every section's last anchor"]
+fn minip_through_the_registers() {
+    modes_bit_exact(&[(Render::Minip, Look::default())], seed(0xacce18));
+}
+
+/// The frames of `modes` ((render, look)) on the 16^3 head (narrow configuration, two views) and
+/// the 64^3 head (one view), each under its own random memory.
+fn modes_bit_exact(modes: &[(Render, Look)], s: u64) {
+    for (n, bits, views) in [
+        (16, 8, &["45 xz", "oblique z"][..]),
+        (64, 12, &["oblique x"][..]),
+    ] {
+        let mut c = Case::new(rtl(4, n), head_phantom(n, bits).unwrap(), s);
+        for (render, look) in modes {
+            for &v in views {
+                let e = c.expect_with(view(v), *render, look);
+                let env = MemEnv::random(&mut c.rng);
+                c.frame_of(&e, &env, "");
+            }
+        }
+    }
+}
+
+/// Frames of a non-cubic volume at `p` pipelines, each under its own random memory: the head
+/// phantom resampled to `dims` (faces along each axis, 45 degrees, obliques; composite and MIP),
+/// then the blob (a face, 45 degrees between two negative axes, an oblique view).
+fn non_cubic(p: usize, dims: [usize; 3], s: u64) {
+    let n = dims.into_iter().max().unwrap();
+    let head = resampled(&head_phantom(n, 12).unwrap(), dims);
+    let mut c = Case::new(rtl(p, n), head, s);
+    c.random(&[
+        (view("+z"), Composite),
+        (view("+x"), Mip),
+        (view("-y"), Composite),
+        (view("45 xz"), Composite),
+        (view("oblique z"), Mip),
+        (view("oblique y"), Composite),
+    ]);
+    let mut c = c.with(blob_volume(dims, 12, s));
+    c.random(&[
+        (view("-z"), Composite),
+        (view("45 -x-y"), Composite),
+        (view("oblique x"), Mip),
+    ]);
+}
+
+/// A non-cubic volume whose edges are no power of two and not all multiples of the block edge
+/// (60 x 44 x 28 at P = 4 with 8^3 blocks and 16-anchor sections: partial blocks on every axis,
+/// a last section of 12 anchors).
+#[test]
+fn non_cubic_60x44x28_p4() {
+    non_cubic(4, [60, 44, 28], seed(0xacce11));
 }
 
 /// Whole-frame cycles of the throughput configuration (P = 4, 4^3 blocks, 32-anchor sections,
@@ -232,13 +371,13 @@ fn the_check_fails_when_the_model_disagrees() {
 #[test]
 fn throughput_of_the_wide_configuration() {
     let s = seed(0xacce6);
-    let rtl = AccelRtl::widest(4).expect("a P = 4 build of cube5_accel");
+    let rtl = rtl(4, 128);
     let mut c = Case::new(rtl, head_phantom(64, 12).unwrap(), s);
     for (env, what) in [
         (ddr(20, 0), ", fast memory"),
         (ddr(100, 12), ", DDR-like 12 B/cycle"),
     ] {
-        for view in [VIEWS[0], VIEWS[2]] {
+        for view in [view("+z"), view("45 xz")] {
             let rate = c.frame(view, Composite, &env, what).rate(rtl.p);
             assert!(
                 rate > 0.8,
@@ -249,37 +388,190 @@ fn throughput_of_the_wide_configuration() {
     }
 }
 
-/// 128^3 frames (head phantom and bubbles) at P = 4 on the throughput configuration: every view,
+/// 128^3 frames (head phantom and bubbles) at P = 4 on the throughput configuration: five views,
 /// composite and MIP alternately, random memories; then 45 degrees with the DDR-like memory.
 #[test]
 #[ignore = "sim-full: 128^3 frames, about 20 s each"]
 fn frames_128_p4() {
     let s = seed(0xacce7);
-    let rtl = AccelRtl::widest(4).expect("a P = 4 build of cube5_accel");
-    let frames: Vec<(View, Render)> = VIEWS
-        .iter()
+    let frames: Vec<(View, Render)> = some_views()
+        .into_iter()
         .enumerate()
-        .map(|(n, &v)| (v, [Composite, Mip][n % 2]))
+        .map(|(n, v)| (v, [Composite, Mip][n % 2]))
         .collect();
-    let mut c = Case::new(rtl, head_phantom(128, 12).unwrap(), s);
+    let mut c = Case::new(rtl(4, 128), head_phantom(128, 12).unwrap(), s);
     for next in [Some(bubbles_phantom(128, 12).unwrap()), None] {
         c.random(&frames);
-        c.frame(VIEWS[2], Composite, &ddr(100, 12), ", DDR-like 12 B/cycle");
+        c.frame(
+            view("45 xz"),
+            Composite,
+            &ddr(100, 12),
+            ", DDR-like 12 B/cycle",
+        );
         if let Some(v) = next {
             c = c.with(v);
         }
     }
 }
 
-/// P = 8 at 128^3 (head, 45 degrees and an oblique view, composite and MIP) and one 256^3 head
-/// frame at 45 degrees with the DDR-like memory.
+/// The 14 acceptance views (`cube5_tb::frame::VIEWS`) on the 128^3 head at `p` pipelines, each
+/// under its own random memory: composite (shaded) and MIP at every view (`both`), or the two
+/// alternately.
+fn views_14_at_128(p: usize, both: bool, s: u64) {
+    let mut c = Case::new(rtl(p, 128), head_phantom(128, 12).unwrap(), s);
+    let frames: Vec<(View, Render)> = VIEWS
+        .iter()
+        .enumerate()
+        .flat_map(|(n, &v)| {
+            let first = [Composite, Mip][n % 2];
+            let other = [Mip, Composite][n % 2];
+            std::iter::once((v, first)).chain(both.then_some((v, other)))
+        })
+        .collect();
+    c.random(&frames);
+}
+
 #[test]
-#[ignore = "sim-full: P = 8 and 256^3 frames, minutes each"]
-fn frames_p8_and_256() {
+#[ignore = "sim-full: 14 frames of 128^3 at P = 1, about 2.2 M cycles each"]
+fn views_14_128_p1() {
+    views_14_at_128(1, false, seed(0xacce12));
+}
+
+#[test]
+#[ignore = "sim-full: 28 frames of 128^3 at P = 4"]
+fn views_14_128_p4() {
+    views_14_at_128(4, true, seed(0xacce13));
+}
+
+#[test]
+#[ignore = "sim-full: 28 frames of 128^3 at P = 8"]
+fn views_14_128_p8() {
+    views_14_at_128(8, true, seed(0xacce14));
+}
+
+/// 256^3 head frames at P = 4 and 8: 45 degrees composite with the DDR-like memory, an oblique
+/// view (DX < 0, reversed sweep) in MIP under a random memory.
+#[test]
+#[ignore = "sim-full: 256^3 frames, minutes each"]
+fn frames_256_p4_p8() {
     let s = seed(0xacce8);
-    let rtl = AccelRtl::widest(8).expect("a P = 8 build of cube5_accel");
-    let mut c = Case::new(rtl, head_phantom(128, 12).unwrap(), s);
-    c.random(&[(VIEWS[2], Composite), (VIEWS[3], Mip)]);
-    let mut c = c.with(head_phantom(256, 12).unwrap());
-    c.frame(VIEWS[2], Composite, &ddr(100, 12), ", DDR-like 12 B/cycle");
+    let head = head_phantom(256, 12).unwrap();
+    for p in [4, 8] {
+        let mut c = Case::new(rtl(p, 256), head.clone(), s);
+        c.frame(
+            view("45 xz"),
+            Composite,
+            &ddr(100, 12),
+            ", DDR-like 12 B/cycle",
+        );
+        c.random(&[(view("oblique z"), Mip)]);
+    }
+}
+
+/// The non-cubic 160 x 128 x 96 volume of the acceptance list (no edge a power of two but 128)
+/// at P = 4 and 8 (the MaxDim 256 builds).
+#[test]
+#[ignore = "sim-full: 160 x 128 x 96 frames on the MaxDim 256 configurations"]
+fn non_cubic_160x128x96_p4_p8() {
+    for p in [4, 8] {
+        non_cubic(p, [160, 128, 96], seed(0xacce15));
+    }
+}
+
+/// A gate-level smoke run: every `gate` configuration of the top (its Yosys netlist; `full`, so
+/// built by `make sim-full` only), the head phantom at its largest size, composite at 45 degrees
+/// and MIP at an oblique view, bit-exact, under random memories.
+#[test]
+#[ignore = "sim-full: the gate-level netlist is on a `full` line (minutes of build)"]
+fn gate_level_smoke() {
+    let s = seed(0xacce16);
+    let gates = gate_variants_of(TOP);
+    assert!(!gates.is_empty(), "no gate-level build of {TOP}");
+    for g in gates {
+        let rtl = must(AccelRtl::from_variant(g));
+        let n = 1 << rtl.frame.max_dim_log2;
+        let bits = rtl.frame.cfg.trilin.voxel_w;
+        let mut c = Case::new(rtl, head_phantom(n, bits).unwrap(), s);
+        c.random(&[(view("45 xz"), Composite), (view("oblique z"), Mip)]);
+    }
+}
+
+/// The lowest placed Fmax (MHz) among the units inside the accelerator, from the generated ECP5
+/// table of docs/measurements.md (`make synth`, nextpnr-ecp5 routed; the top itself is not
+/// placed): the bound the benchmark's frames per second use, and the unit that sets it.
+fn placed_fmax_bound() -> (f64, String) {
+    const UNITS: &[&str] = &[
+        "cube5_frame",
+        "cube5_section_buf",
+        "cube5_vol_fetch",
+        "cube5_axi_rd",
+        "cube5_axi_wr",
+        "cube5_axil",
+        "cube5_accel_ctrl",
+    ];
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/measurements.md");
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let table = text
+        .split("<!-- BEGIN generated")
+        .nth(1)
+        .and_then(|t| t.split("<!-- END generated").next())
+        .expect("the generated ECP5 table in docs/measurements.md");
+    table
+        .lines()
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            let fmax: f64 = cells.get(cells.len().checked_sub(2)?)?.parse().ok()?;
+            UNITS
+                .contains(&cells.get(1)?)
+                .then(|| (fmax, format!("{} {}", cells[1], cells[2])))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .expect("a placed Fmax of the accelerator's units")
+}
+
+/// The benchmark (`make bench-accel`; docs/accel.md, *Measured*): whole frames of the head
+/// phantom, start to interrupt (read-out and the image's writes included), at P = 1, 2, 4, 8 on
+/// the MaxDim 256 configurations (8^3 blocks, 32-anchor sections, a 128-bit bus, 16 bursts in
+/// flight) with the DDR-like memory (latency 100..120 cycles, 12 bytes per cycle shared by reads
+/// and writes): samples per clock per pipeline, and frames per second at the lowest placed Fmax
+/// of the accelerator's units. Every image bit-exact. Prints a Markdown table (also written to
+/// target/bench-accel.md). Cycle counts are exact whatever the machine's load.
+#[test]
+#[ignore = "sim-full: the benchmark, 128^3 and 256^3 frames at P = 1, 2, 4, 8 (tens of minutes)"]
+fn benchmark_table() {
+    let s = seed(0xacce17);
+    let (fmax, unit) = placed_fmax_bound();
+    let env = ddr(100, 12);
+    let mut table = format!(
+        "| P | configuration | volume | view | cycles | samples | samples/clock/pipeline | frames/s at {fmax} MHz |\n|--:|---|---|---|--:|--:|--:|--:|\n"
+    );
+    let heads = [128, 256].map(|n| head_phantom(n, 12).unwrap());
+    // The fastest first: P = 1 at 256^3 alone is 17 M cycles.
+    for p in [8, 4, 2, 1] {
+        let rtl = rtl(p, 256);
+        let mut c = Case::new(rtl, heads[0].clone(), s);
+        for (head, views) in heads.iter().zip([&["+z", "45 xz"][..], &["45 xz"][..]]) {
+            c = c.with(head.clone());
+            for &v in views {
+                let run = c.frame(view(v), Composite, &env, ", DDR-like 12 B/cycle");
+                let n = head.dims[0];
+                table += &format!(
+                    "| {p} | `{}` | {n}^3 head | {v} | {} | {} | {:.3} | {:.1} |\n",
+                    rtl.variant.config,
+                    run.cycles,
+                    run.samples,
+                    run.rate(p),
+                    fmax * 1e6 / run.cycles as f64
+                );
+            }
+        }
+    }
+    table += &format!(
+        "\nFmax bound: {fmax} MHz, the lowest placed Fmax among the accelerator's units ({unit}, docs/measurements.md); the top itself is not placed.\n"
+    );
+    eprintln!("\n{table}");
+    let out = concat!(env!("CARGO_MANIFEST_DIR"), "/../target/bench-accel.md");
+    if let Err(e) = std::fs::write(out, &table) {
+        eprintln!("{out}: {e} (the table is printed above)");
+    }
 }

@@ -409,10 +409,10 @@ fn random_regs(rng: &mut ChaCha8Rng, cfg: &AccelCtrlConfig) -> CtrlRegs {
         0
     };
     let mode = if rng.random_bool(0.03) {
-        rng.random_range(2..4)
+        rng.random_range(5..8)
     } else {
-        rng.random_range(0..2)
-    } | rng.random_range(0..2) << 2;
+        rng.random_range(0..5)
+    } | rng.random_range(0..4) << 3;
     let align = |rng: &mut ChaCha8Rng, a: u64| -> u64 {
         let v: u64 = rng.random::<u64>() >> rng.random_range(0..64);
         if rng.random_bool(0.05) {
@@ -497,7 +497,7 @@ fn directed_extremes_faces_directions_and_section_counts() {
             (dims([16, 16 + p / 2, 16]), CODE_DIMS),
             (dims([16, 0, 16]), CODE_DIMS),
             (dims([16, 2 * md, 16]), CODE_DIMS),
-            (CtrlRegs { mode: 2, ..ok }, CODE_RENDER),
+            (CtrlRegs { mode: 5, ..ok }, CODE_RENDER),
             (
                 CtrlRegs {
                     dx: (1 << 16) + 1,

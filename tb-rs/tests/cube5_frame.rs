@@ -34,57 +34,6 @@ fn narrow(n: usize) -> FrameRtl {
 // Volumes and views
 // -------------------------------------------------------------------------------------------------
 
-/// A non-cubic volume: two overlapping soft ellipsoids, some noise, and an empty corner (so the
-/// block LUT has empty blocks to skip).
-fn blob_volume(dims: [usize; 3], bits: u32, seed: u64) -> Volume {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let max = f64::from((1u32 << bits) - 1);
-    let [nx, ny, nz] = dims;
-    let c = [nx as f64 * 0.55, ny as f64 * 0.45, nz as f64 * 0.5];
-    let mut data = Vec::with_capacity(nx * ny * nz);
-    for z in 0..nz {
-        for y in 0..ny {
-            for x in 0..nx {
-                let p = [x as f64, y as f64, z as f64];
-                let d1 = ((p[0] - c[0]) / (nx as f64 * 0.35)).powi(2)
-                    + ((p[1] - c[1]) / (ny as f64 * 0.3)).powi(2)
-                    + ((p[2] - c[2]) / (nz as f64 * 0.4)).powi(2);
-                let d2 = ((p[0] - c[0] * 0.6) / (nx as f64 * 0.15)).powi(2)
-                    + ((p[1] - c[1] * 1.4) / (ny as f64 * 0.2)).powi(2)
-                    + ((p[2] - c[2]) / (nz as f64 * 0.25)).powi(2);
-                let mut v = 0.45 * (1.0 - d1).max(0.0) + 0.6 * (1.0 - d2).max(0.0);
-                if x < nx / 4 && y < ny / 4 {
-                    v = 0.0;
-                } else if v > 0.0 {
-                    v += rng.random_range(0.0..0.08);
-                }
-                data.push((v.min(1.0) * max).round() as u16);
-            }
-        }
-    }
-    Volume::new(dims, [1.0; 3], bits, data).unwrap()
-}
-
-/// Views: the six faces, exactly 45 degrees and 45 +- 1e-3, the space diagonal, obliques.
-fn views() -> Vec<(&'static str, [f64; 3])> {
-    vec![
-        ("+z", [0.0, 0.0, 1.0]),
-        ("-z", [0.0, 0.0, -1.0]),
-        ("+x", [1.0, 0.0, 0.0]),
-        ("-x", [-1.0, 0.0, 0.0]),
-        ("+y", [0.0, 1.0, 0.0]),
-        ("-y", [0.0, -1.0, 0.0]),
-        ("45 xz", [1.0, 0.0, 1.0]),
-        ("45+1e-3 xz", [1.0 + 1e-3, 0.0, 1.0]),
-        ("45-1e-3 xz", [1.0 - 1e-3, 0.0, 1.0]),
-        ("45 -x-y", [-1.0, -1.0, 0.0]),
-        ("diagonal", [1.0, 1.0, 1.0]),
-        OBLIQUE_Z,
-        ("oblique y", [0.6, -1.0, 0.3]),
-        ("oblique x", [0.9, 0.45, -0.2]),
-    ]
-}
-
 /// The test volumes of the acceptance list: 16^3, 32^3, 64^3 head phantoms and a 48 x 32 x 40 blob.
 fn volumes(s: u64) -> Vec<(&'static str, Volume)> {
     vec![
@@ -145,9 +94,6 @@ fn loaded(rtl: FrameRtl, vol: &Volume, s: u64) -> (FrameBench, Rc<Volume>) {
     (bench(rtl, vol, &lut, s), seen)
 }
 
-/// The oblique view most single-frame tests render.
-const OBLIQUE_Z: (&str, [f64; 3]) = ("oblique z", [-0.37, 0.81, -1.0]);
-
 /// A P = 4 bench loaded with the `n`^3 head phantom, and its oblique composite frame (early
 /// termination `et`).
 fn oblique_head_p4(n: usize, et: bool, s: u64) -> (FrameRtl, FrameBench, Expected) {
@@ -173,7 +119,6 @@ fn frames_bit_exact(render: Render, plan: &[(FrameRtl, usize, Option<&[usize]>)]
     let t0 = Instant::now();
     let mut rng = ChaCha8Rng::seed_from_u64(seed_base);
     let traffic = [Traffic::full_speed(), Traffic::random(&mut rng, 0.0, 0.25)];
-    let all_views = views();
     let all = volumes(seed_base);
     let mut samples = 0;
     for (vi, (vname, vol)) in all.iter().enumerate() {
@@ -184,7 +129,7 @@ fn frames_bit_exact(render: Render, plan: &[(FrameRtl, usize, Option<&[usize]>)]
         let lut = BlockLut::from_volume(vol, runs[0].0.block as usize, 0).unwrap();
         let seen = seen_of(vol, &lut);
         let t = Instant::now();
-        let expected: Vec<Expected> = all_views
+        let expected: Vec<Expected> = VIEWS
             .iter()
             .map(|v| expect(&runs[0].0, &seen, *v, render, false))
             .collect();
@@ -558,7 +503,7 @@ fn narrow_configurations_s1_s4() {
             let mut rng = ChaCha8Rng::seed_from_u64(s);
             let traffic = Traffic::random(&mut rng, 0.0, 0.3);
             let mut n = 0;
-            for v in views() {
+            for &v in VIEWS {
                 let e = expect(&rtl, &seen, v, render, false);
                 if !accepted(&e.params, rtl.p) {
                     continue; // refused by the rule; see smallest_volumes_*
@@ -597,7 +542,7 @@ fn frames_without_gradient_and_shader_mip_bit_exact_composite_refused() {
             let mut rng = ChaCha8Rng::seed_from_u64(s);
             let traffic = [Traffic::full_speed(), Traffic::random(&mut rng, 0.0, 0.3)];
             let mut rendered = Vec::new();
-            for v in views() {
+            for &v in VIEWS {
                 let e = expect(&rtl, &seen, v, Render::Mip, false);
                 if !accepted(&e.params, rtl.p) {
                     continue;
@@ -642,12 +587,12 @@ fn gate_level_netlist_smoke() {
     let traffic = Traffic::random(&mut rng, 0.0, 0.3);
     for render in [Render::Mip, Render::Composite] {
         for &i in SOME_VIEWS {
-            let e = expect(&rtl, &seen, views()[i], render, false);
+            let e = expect(&rtl, &seen, VIEWS[i], render, false);
             must(bench.check(&e, &traffic, s));
         }
     }
     // A reset in mid-sweep, then a whole frame.
-    let e = expect(&rtl, &seen, views()[11], Render::Composite, false);
+    let e = expect(&rtl, &seen, VIEWS[11], Render::Composite, false);
     must(bench.load(&e));
     let d = bench
         .dut
@@ -707,11 +652,11 @@ fn test_side_fold_agrees_with_the_model_base_plane() {
         (Render::Composite, FrameMode::Composite),
     ] {
         for (v, et) in [
-            (views()[6], false),
-            (views()[11], false),
-            (views()[13], false),
-            (views()[6], true),
-            (views()[13], true),
+            (VIEWS[6], false),
+            (VIEWS[11], false),
+            (VIEWS[13], false),
+            (VIEWS[6], true),
+            (VIEWS[13], true),
         ] {
             let setup = FrameSetup::new(vol.dims, vol.spacing, v.1.into(), 1).unwrap();
             let p = setup.params;
@@ -758,7 +703,7 @@ fn empty_slice_skipping_cuts_cycles_without_changing_a_pixel() {
     for rtl in [p(1), p(4)] {
         let (mut bench, seen) = loaded(rtl, &vol, s);
         let (mut plain, mut skipping) = (0u64, 0u64);
-        for (i, v) in views().into_iter().enumerate() {
+        for (i, &v) in VIEWS.iter().enumerate() {
             for render in [Render::Mip, Render::Composite] {
                 let e = expect(&rtl, &seen, v, render, false);
                 bench.skip_empty = false;

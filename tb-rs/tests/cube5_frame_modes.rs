@@ -10,7 +10,6 @@
 mod support;
 
 use cube5_model::phantom::{bubbles_phantom, head_phantom};
-use cube5_model::transfer::{TfPoint, TransferFunction};
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
 use cube5_tb::frame::*;
@@ -62,19 +61,6 @@ const VIEWS: [(&str, [f64; 3]); 3] = [
     ("oblique reversed", [-0.6, 0.35, -1.0]),
     ("-x", [-1.0, 0.2, 0.1]),
 ];
-
-/// A transfer function with opaque tissue (first-opaque needs samples that reach the threshold).
-fn dense_tf() -> TransferFunction {
-    let p = |density, rgba| TfPoint { density, rgba };
-    TransferFunction {
-        points: vec![
-            p(0.0, [0.0; 4]),
-            p(0.1, [0.9, 0.7, 0.6, 0.0]),
-            p(0.4, [0.9, 0.6, 0.5, 0.55]),
-            p(1.0, [1.0, 1.0, 1.0, 0.95]),
-        ],
-    }
-}
 
 /// Renders `render` with `look` at every view on `rtl` for each volume; returns the frames'
 /// models' images (for the callers' checks of what the frames exercised).

@@ -14,7 +14,7 @@ pub const CODE_NONE: u32 = 0;
 pub const CODE_AXIS_K: u32 = 1;
 /// a dimension outside `P ..= MaxDim` or not a multiple of `P`
 pub const CODE_DIMS: u32 = 2;
-/// `render` >= 2
+/// `render` >= 5 (the frame's `Render` encodings are 0 to 4)
 pub const CODE_RENDER: u32 = 3;
 /// `|DX|` or `|DY|` above `2^16`
 pub const CODE_STEP: u32 = 4;
@@ -95,8 +95,8 @@ pub const REG_DX_DX: Field = Field::new(0, 18);
 pub const REG_DY: u32 = 7;
 /// Field `dy` of `Dy`.
 pub const REG_DY_DY: Field = Field::new(0, 18);
-/// `Mode` (RW): as cube5_frame's Mode: `render` 0 `Mip`, 1 `Composite`; `tf2d`. Fields: render
-/// [2:0], tf2d [3].
+/// `Mode` (RW): as cube5_frame's Mode: `render` 0 `Mip`, 1 `Composite`, 2 `Minip`, 3 `Xray`, 4
+/// `FirstOpaque`; `tf2d` the shader's 2-D classification. Fields: render [2:0], tf2d [3].
 pub const REG_MODE: u32 = 8;
 /// Field `render` of `Mode`.
 pub const REG_MODE_RENDER: Field = Field::new(0, 3);

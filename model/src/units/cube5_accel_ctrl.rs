@@ -119,10 +119,17 @@ impl AccelCtrlConfig {
         3 + 3 * (self.m() + 1) + self.m()
     }
 
-    /// Bits of the frame's section command.
-    pub fn frame_w(&self) -> u32 {
+    /// Widths of the frame registers' fields at the head of the frame's section command: Dims,
+    /// View, Dx, Dy, Mode (render and tf2d), Skip.
+    fn frame_reg_widths(&self) -> [u32; 6] {
         let m1 = self.m() + 1;
-        3 * m1 + 3 + 2 * (STEP_W + 2) + 3 + 2 * m1 + self.m() + m1 + 2
+        [3 * m1, 3, STEP_W + 2, STEP_W + 2, 4, 2 * m1]
+    }
+
+    /// Bits of the frame's section command: the frame registers, `sec_a0`, `sec_ns`,
+    /// `sec_first`, `sec_last`.
+    pub fn frame_w(&self) -> u32 {
+        self.frame_reg_widths().iter().sum::<u32>() + self.m() + (self.m() + 1) + 2
     }
 
     /// Bits of the writer's row command (docs/numerics/axi_wr.md).
@@ -162,7 +169,7 @@ impl AccelCtrlConfig {
         {
             return Err(CODE_DIMS);
         }
-        if render >= 2 {
+        if render >= 5 {
             return Err(CODE_RENDER);
         }
         if dx.unsigned_abs() > 1 << STEP_W || dy.unsigned_abs() > 1 << STEP_W {
@@ -276,7 +283,7 @@ impl AccelCtrlConfig {
             .put(mask(r.view, 3), 3)
             .put(REG_DX_DX.get(u64::from(r.dx)), STEP_W + 2)
             .put(mask(r.dy, STEP_W + 2), STEP_W + 2)
-            .put(mask(r.mode, 3), 3)
+            .put(mask(r.mode, 4), 4)
             .put(mask(r.skip, 2 * m1), 2 * m1)
             .put(u64::from(sec.a0), self.m())
             .put(u64::from(sec.ns), m1)
@@ -505,7 +512,7 @@ impl AccelCtrlConfig {
     pub fn frame_section_fields(&self, bits: &[u32]) -> (u32, u32, bool, bool) {
         let m1 = self.m() + 1;
         let mut r = BitReader::new(bits);
-        for w in [3 * m1, 3, STEP_W + 2, STEP_W + 2, 3, 2 * m1] {
+        for w in self.frame_reg_widths() {
             r.get(w);
         }
         let a0 = r.get(self.m()) as u32;
@@ -601,8 +608,10 @@ mod tests {
         assert_eq!(c.plan(&regs([40, 128, 24], 2, 0)), Err(CODE_DIMS));
         assert_eq!(c.plan(&regs([40, 0, 24], 2, 0)), Err(CODE_DIMS));
         let mut r = regs([40, 32, 24], 2, 0);
-        r.mode = 2;
+        r.mode = 5;
         assert_eq!(c.plan(&r), Err(CODE_RENDER));
+        r.mode = 4 | 1 << 3;
+        assert!(c.plan(&r).is_ok(), "first-opaque with the 2-D table");
         assert_eq!(
             c.plan(&regs([40, 32, 24], 2, (1 << 16) + 1)),
             Err(CODE_STEP)
