@@ -444,11 +444,11 @@ module cube5_section_buf #(
   logic [31:0]           ev;                       // an edge voxel's word before the group split
   logic [Q-1:0]          l_main;
   logic [3*Q-1:0]        l_edge;                   // lane q, edge column c at q 3 + c
-  logic [Q*BAW-1:0]      l_maddr;
-  logic [Q*EAW-1:0]      l_eaddr;
+  logic [G*BAW-1:0]      l_maddr;                  // per group, at its lane 0's slice
+  logic [G*EAW-1:0]      l_eaddr;                  // per group (its lanes share the word)
   logic [Q*GPW-1:0]      l_ebank;
   logic [G*PW-1:0]       w1rot;
-  logic [G-1:0]          w1grp;                    // the group's bank group (its g)
+  logic                  w1swap;                   // group 0's bank group g (1: the groups swap)
   always_comb begin
     ns_s   = $signed(CiW'(w1ns_q));
     ns1_s  = $signed(CiW'(w1ns1_q));
@@ -469,27 +469,27 @@ module cube5_section_buf #(
           l_edge[(g * P + l) * 3 +: 3] = {(l == Lane1) && c_ns2, (l == 0) && c_ns,
                                           (l == P - 1) && c_mp};
         end
-        l_maddr[(g * P + l) * BAW +: BAW] = BAW'((((((32'(w1half_q) << BW) | 32'(lk_l)) << M)
-                                                 | 32'(w1j_q[g])) << LSQ)
-                                                 | (32'(w1ci_q[g][CiW-2:0]) >> LQ));
+        if (l == 0) begin
+          l_maddr[g * BAW +: BAW] = BAW'((((((32'(w1half_q) << BW) | 32'(lk_l)) << M)
+                                          | 32'(w1j_q[g])) << LSQ)
+                                          | (32'(w1ci_q[g][CiW-2:0]) >> LQ));
+        end
         // Edge word v = (h MaxDim + j) (B / P) + lk / P; with two groups its parity picks the
         // bank group and the word is v / 2.
         ev = (((32'(w1half_q) << M) | 32'(w1j_q[g])) << LBPP) | (32'(lk_l) >> LP);
-        l_eaddr[(g * P + l) * EAW +: EAW] = EAW'(ev >> LG);
+        l_eaddr[g * EAW +: EAW] = EAW'(ev >> LG);
         l_ebank[(g * P + l) * GPW +: GPW] = GPW'((32'(lk_l) & (P - 1))
                                                  | (((G == 2) ? (ev & 1) : 0) << LP));
       end
       w1rot[g * PW +: PW] = PW'((32'(w1ci_q[g][CiW-2:0]) + 32'(w1j_q[g]) + 32'(w1lk_q[g]))
                                 & (P - 1));
-      // g = the group's word parity (g itself) xor bit 0 of ci / P, but the parity alone when
-      // the lanes run along i and B >= 2P (then the two agree).
-      if (G == 1) begin
-        w1grp[g] = 1'b0;
-      end else if (BPP >= 2 && !w1axx_q) begin
-        w1grp[g] = 1'(g);
-      end else begin
-        w1grp[g] = 1'(g) ^ 1'((32'(w1ci_q[g][CiW-2:0]) >> LP) & 1);
-      end
+    end
+    // A group's g: its word parity (the group's index) xor bit 0 of ci / P, but the parity alone
+    // when the lanes run along i and B >= 2P (then the two agree). The other group has the other g.
+    if (G == 1 || (BPP >= 2 && !w1axx_q)) begin
+      w1swap = 1'b0;
+    end else begin
+      w1swap = 1'((32'(w1ci_q[0][CiW-2:0]) >> LP) & 1);
     end
   end
 
@@ -501,11 +501,11 @@ module cube5_section_buf #(
   logic                wb_q, wbclose_q, wbhalf_q;
   logic [Q-1:0]        wbmain_q;
   logic [3*Q-1:0]      wbedge_q;
-  logic [Q*BAW-1:0]    wbmaddr_q;
-  logic [Q*EAW-1:0]    wbeaddr_q;
+  logic [G*BAW-1:0]    wbmaddr_q;
+  logic [G*EAW-1:0]    wbeaddr_q;
+  logic                wbaxx_q;
   logic [Q*GPW-1:0]    wbebank_q;
   logic [G*PW-1:0]     wbrot_q;
-  logic [G-1:0]        wbgrp_q;
   logic [Q*VoxelW-1:0] wblanes_q;
 
   always_ff @(posedge clk_i) begin
@@ -519,14 +519,23 @@ module cube5_section_buf #(
   end
   always_ff @(posedge clk_i) begin
     wbhalf_q  <= w1half_q;
-    wbmain_q  <= l_main;
-    wbedge_q  <= l_edge;
-    wbmaddr_q <= l_maddr;
-    wbeaddr_q <= l_eaddr;
-    wbebank_q <= l_ebank;
-    wbrot_q   <= w1rot;
-    wbgrp_q   <= w1grp;
-    wblanes_q <= w1lanes_q;
+    wbaxx_q   <= w1axx_q;
+    // Slot s holds the group whose g is s (with two groups their g differ): a swap when group 0
+    // has g = 1, so that the banks below take from a fixed slot (loops over constant indices).
+    for (int unsigned s = 0; s < G; s++) begin
+      for (int unsigned g = 0; g < G; g++) begin
+        if ((g == s) != w1swap) begin
+          wbmain_q[s * P +: P]                     <= l_main[g * P +: P];
+          wbedge_q[s * 3 * P +: 3 * P]             <= l_edge[g * 3 * P +: 3 * P];
+          wbmaddr_q[s * BAW +: BAW]                <= l_maddr[g * BAW +: BAW];
+          wbeaddr_q[s * EAW +: EAW]                <= l_eaddr[g * EAW +: EAW];
+          wbebank_q[s * P * GPW +: P * GPW]        <= l_ebank[g * P * GPW +: P * GPW];
+          wbrot_q[s * PW +: PW]                    <= w1rot[g * PW +: PW];
+          wblanes_q[s * P * VoxelW +: P * VoxelW]  <= w1lanes_q[g * P * VoxelW +: P * VoxelW];
+        end
+      end
+    end
+
   end
 
   // ==============================================================================================
@@ -542,34 +551,42 @@ module cube5_section_buf #(
   logic                      w2close_q, w2half_q;
 
   always_comb begin
-    // Bank gg P + b takes lane (b - rot) mod P of the group whose g is gg (loops over constant
-    // indices: no index arithmetic).
+    // Bank s P + b takes lane (b - rot) mod P of slot s (loops over constant indices: no index
+    // arithmetic).
     w2we_d   = '0;
     w2addr_d = '0;
     w2data_d = '0;
-    for (int unsigned gg = 0; gg < G; gg++) begin
-      for (int unsigned g = 0; g < G; g++) begin
-        for (int unsigned b = 0; b < P; b++) begin
-          for (int unsigned l = 0; l < P; l++) begin
-            if (wbgrp_q[g] == 1'(gg) && ((l + 32'(wbrot_q[g * PW +: PW])) & (P - 1)) == b) begin
-              w2we_d[gg * P + b] = wb_q && wbmain_q[g * P + l];
-              w2addr_d[(gg * P + b) * BAW +: BAW]       = wbmaddr_q[(g * P + l) * BAW +: BAW];
-              w2data_d[(gg * P + b) * VoxelW +: VoxelW] = wblanes_q[(g * P + l) * VoxelW +: VoxelW];
-            end
+    for (int unsigned s = 0; s < G; s++) begin
+      for (int unsigned b = 0; b < P; b++) begin
+        for (int unsigned l = 0; l < P; l++) begin
+          if (((l + 32'(wbrot_q[s * PW +: PW])) & (P - 1)) == b) begin
+            w2we_d[s * P + b] = wb_q && wbmain_q[s * P + l];
+            // The lanes of a group share its word but for slice axis x, where lane l's slice
+            // is lane 0's (a multiple of P) plus l: a field of the word, set without an adder.
+            w2addr_d[(s * P + b) * BAW +: BAW]       = wbmaddr_q[s * BAW +: BAW]
+                | (wbaxx_q ? BAW'(l << (LSQ + M)) : BAW'(0));
+            w2data_d[(s * P + b) * VoxelW +: VoxelW] = wblanes_q[(s * P + l) * VoxelW +: VoxelW];
           end
         end
       end
     end
+    // Edge bank e = b + P ee of column c: from each slot only one lane can reach it, lane b
+    // with slice axis x (lane l's slice is lk0 + l, lk0 a multiple of P), else the column's lane
+    // (P - 1 for lo, 0 for hi0, 1 mod P for hi1).
     for (int unsigned c = 0; c < 3; c++) begin
       for (int unsigned e = 0; e < NBank; e++) begin
         e2we_d[c * NBank + e] = 1'b0;
         e2addr_d[(c * NBank + e) * EAW +: EAW]       = wbeaddr_q[0 +: EAW];
         e2data_d[(c * NBank + e) * VoxelW +: VoxelW] = wblanes_q[0 +: VoxelW];
-        for (int unsigned q = 0; q < Q; q++) begin
-          if (wb_q && wbedge_q[q * 3 + c] && wbebank_q[q * GPW +: GPW] == GPW'(e)) begin
-            e2we_d[c * NBank + e] = 1'b1;
-            e2addr_d[(c * NBank + e) * EAW +: EAW]       = wbeaddr_q[q * EAW +: EAW];
-            e2data_d[(c * NBank + e) * VoxelW +: VoxelW] = wblanes_q[q * VoxelW +: VoxelW];
+        for (int unsigned s = 0; s < G; s++) begin
+          for (int unsigned l = 0; l < P; l++) begin
+            if (((wbaxx_q && l == e % P) || (!wbaxx_q && l == ((c == 0) ? P - 1 : ((c == 1) ? 0 : Lane1))))
+                && wb_q && wbedge_q[(s * P + l) * 3 + c]
+                && wbebank_q[(s * P + l) * GPW +: GPW] == GPW'(e)) begin
+              e2we_d[c * NBank + e] = 1'b1;
+              e2addr_d[(c * NBank + e) * EAW +: EAW]       = wbeaddr_q[s * EAW +: EAW];
+              e2data_d[(c * NBank + e) * VoxelW +: VoxelW] = wblanes_q[(s * P + l) * VoxelW +: VoxelW];
+            end
           end
         end
       end
