@@ -617,6 +617,35 @@ mod tests {
     use super::*;
     use crate::phantom::head_phantom;
 
+    /// `(P, B, S, G)` of the model's checks: one and two P-groups per item, `B = P` and `B > P`.
+    const SHAPES: &[(u32, u32, u32, u32)] = &[
+        (1, 2, 4, 1),
+        (2, 4, 8, 1),
+        (4, 4, 16, 1),
+        (8, 8, 8, 1),
+        (4, 8, 16, 1),
+        (1, 2, 4, 2),
+        (2, 2, 4, 2),
+        (2, 4, 8, 2),
+        (4, 4, 8, 2),
+        (4, 8, 16, 2),
+    ];
+
+    /// A configuration of 12-bit voxels: `(P, B, S, G)` and the largest edge.
+    fn config(
+        (p, block_dim, section, item_groups): (u32, u32, u32, u32),
+        max_dim: u32,
+    ) -> SectionBufConfig {
+        SectionBufConfig {
+            p,
+            voxel_w: 12,
+            max_dim,
+            block_dim,
+            section,
+            item_groups,
+        }
+    }
+
     /// DRAM -> fetch model -> section buffer model equals the beams read from the volume, for
     /// every axis both ways, every section of the face, P = 1 .. 8, with empty blocks.
     #[test]
@@ -634,26 +663,8 @@ mod tests {
             d
         })
         .unwrap();
-        for (p, b, s, g) in [
-            (1u32, 2u32, 4u32, 1u32),
-            (2, 4, 8, 1),
-            (4, 4, 16, 1),
-            (8, 8, 8, 1),
-            (4, 8, 16, 1),
-            (1, 2, 4, 2),
-            (2, 2, 4, 2),
-            (2, 4, 8, 2),
-            (4, 4, 8, 2),
-            (4, 8, 16, 2),
-        ] {
-            let c = SectionBufConfig {
-                p,
-                voxel_w: 12,
-                max_dim: 32,
-                block_dim: b,
-                section: s,
-                item_groups: g,
-            };
+        for &(p, b, s, g) in SHAPES {
+            let c = config((p, b, s, g), 32);
             let lut = BlockLut::from_volume(&vol, b as usize, 0).unwrap();
             assert!(lut.entries.iter().any(|e| e.empty));
             for axis_k in 0..3 {
@@ -688,24 +699,8 @@ mod tests {
     #[test]
     fn the_banks_are_conflict_free() {
         use std::collections::HashSet;
-        for (p, b, s, g) in [
-            (1u32, 2u32, 4u32, 1u32),
-            (4, 4, 16, 1),
-            (1, 2, 4, 2),
-            (2, 2, 4, 2),
-            (2, 4, 8, 2),
-            (4, 4, 8, 2),
-            (4, 8, 16, 2),
-            (2, 16, 32, 2),
-        ] {
-            let c = SectionBufConfig {
-                p,
-                voxel_w: 12,
-                max_dim: 64,
-                block_dim: b,
-                section: s,
-                item_groups: g,
-            };
+        for &(p, b, s, g) in SHAPES.iter().chain(&[(2, 16, 32, 2)]) {
+            let c = config((p, b, s, g), 64);
             let q = c.item_p();
             let nj = 2 * b;
             for axis_k in 0..3u32 {
