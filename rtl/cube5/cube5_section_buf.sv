@@ -764,20 +764,53 @@ module cube5_section_buf #(
     );
   end
 
-  for (genvar e = 0; e < 3 * NBank; e++) begin : gen_edge
-    cube5_section_buf_ram #(                    // reads and writes are in different halves
-      .Depth(EdgeDepth),
-      .Width(VoxelW),
-      .AddrW(EAW)
-    ) u_edge (
-      .clk_i  (clk_i),
-      .we_i   (e2we_q[e]),
-      .waddr_i(e2addr_q[e * EAW +: EAW]),
-      .wdata_i(e2data_q[e * VoxelW +: VoxelW]),
-      .re_i   (issue),
-      .raddr_i(r_eaddr),
-      .rdata_o(edge_rd[e * VoxelW +: VoxelW])
-    );
+  if (G == 1) begin : gen_edges
+    for (genvar e = 0; e < 3 * NBank; e++) begin : gen_edge
+      cube5_section_buf_ram #(                  // reads and writes are in different halves
+        .Depth(EdgeDepth),
+        .Width(VoxelW),
+        .AddrW(EAW)
+      ) u_edge (
+        .clk_i  (clk_i),
+        .we_i   (e2we_q[e]),
+        .waddr_i(e2addr_q[e * EAW +: EAW]),
+        .wdata_i(e2data_q[e * VoxelW +: VoxelW]),
+        .re_i   (issue),
+        .raddr_i(r_eaddr),
+        .rdata_o(edge_rd[e * VoxelW +: VoxelW])
+      );
+    end
+  end else begin : gen_edges
+    // The group banks b and b + P of an edge column share a memory, one half each: an item that
+    // writes both writes them at one word (docs/numerics/section_buf.md, "Storage").
+    for (genvar c = 0; c < 3; c++) begin : gen_col
+      for (genvar b = 0; b < P; b++) begin : gen_edge
+        localparam int unsigned E0 = c * NBank + b;
+        localparam int unsigned E1 = c * NBank + P + b;
+        logic [2*VoxelW-1:0] rd;
+        cube5_section_buf_eram #(               // reads and writes are in different halves
+          .Depth(EdgeDepth),
+          .Width(VoxelW),
+          .PartW((VoxelW > 9) ? 18 : 9),
+          .AddrW(EAW)
+        ) u_edge (
+          .clk_i  (clk_i),
+          .we_i   ({e2we_q[E1], e2we_q[E0]}),
+          .waddr_i(e2we_q[E0] ? e2addr_q[E0 * EAW +: EAW] : e2addr_q[E1 * EAW +: EAW]),
+          .wdata_i({e2data_q[E1 * VoxelW +: VoxelW], e2data_q[E0 * VoxelW +: VoxelW]}),
+          .re_i   (issue),
+          .raddr_i(r_eaddr),
+          .rdata_o(rd)
+        );
+        assign edge_rd[E0 * VoxelW +: VoxelW] = rd[0 +: VoxelW];
+        assign edge_rd[E1 * VoxelW +: VoxelW] = rd[VoxelW +: VoxelW];
+`ifndef SYNTHESIS
+        a_edge_one_word: assert property (@(posedge clk_i) disable iff (!rst_ni)
+            e2we_q[E0] && e2we_q[E1] |-> e2addr_q[E0 * EAW +: EAW] == e2addr_q[E1 * EAW +: EAW])
+          else $error("cube5_section_buf: an item wrote an edge memory's halves at two words");
+`endif
+      end
+    end
   end
 
   // ==============================================================================================
