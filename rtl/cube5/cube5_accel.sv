@@ -123,15 +123,19 @@ module cube5_accel #(
   localparam int unsigned M        = $clog2(MaxDim);
   localparam int unsigned DimW     = M + 1;
   localparam int unsigned NbW      = $clog2(MaxDim / BlockDim);
-  localparam int unsigned WordW    = cube5_vol_fetch_pkg::word_w(P, BlockDim);
+  // The fetch's items: two P-groups (the section buffer's ItemGroups = 2, its writer then keeps
+  // up with the overlap columns) where a bus beat holds them and the fetch allows it, else one.
+  localparam int unsigned SbG      = (DataW >= 32 * P && P <= 4) ? 2 : 1;
+  localparam int unsigned Q        = SbG * P;             // voxels per fetch item
+  localparam int unsigned WordW    = cube5_vol_fetch_pkg::word_w(Q, BlockDim);
   localparam int unsigned PixelBytes = 4;
   localparam int unsigned ItemW    = 8 * PixelBytes;
   localparam int unsigned LenW     = 16;
   localparam int unsigned FeCmdW   = cube5_vol_fetch_pkg::cmd_w(AddrW, MaxDim, BlockDim);
-  localparam int unsigned FeOutW   = cube5_vol_fetch_pkg::out_w(P, VoxelW, MaxDim, BlockDim);
+  localparam int unsigned FeOutW   = cube5_vol_fetch_pkg::out_w(Q, VoxelW, MaxDim, BlockDim);
   localparam int unsigned SweepW   = AddrW + 5 * NbW + 7;
   localparam int unsigned LutW     = 6 * NbW + 2;
-  localparam int unsigned SbInW    = cube5_section_buf_pkg::in_w(P, VoxelW, MaxDim, BlockDim);
+  localparam int unsigned SbInW    = cube5_section_buf_pkg::in_w(Q, VoxelW, MaxDim, BlockDim);
   localparam int unsigned SbOutW   = cube5_section_buf_pkg::out_w(P, VoxelW);
   localparam int unsigned SbCmdW   = 4 * M + 6;
   localparam int unsigned FrInW    = cube5_frame_pkg::in_w(1, P, VoxelW, M);
@@ -146,7 +150,7 @@ module cube5_accel #(
   localparam int unsigned CfgDataW = cube5_frame_pkg::cfg_data_w(M, VoxelW, BlkW, ShDataW, AccW);
   localparam int unsigned ChanW    = AccW + 1;
   // Fields of the streams (LSB first; docs/numerics/vol_fetch.md, section_buf.md).
-  localparam int unsigned FeLastBit = P * VoxelW + 3 * NbW + WordW + 1;
+  localparam int unsigned FeLastBit = Q * VoxelW + 3 * NbW + WordW + 1;
   localparam int unsigned SbLastBit = (P + 3) * VoxelW + 3;
   // Fields of the control core's frame command (docs/numerics/accel_ctrl.md).
   localparam int unsigned FcDims   = 0;
@@ -292,7 +296,7 @@ module cube5_accel #(
   assign fc_ready    = fe_in_ready && !blk_pend_q;
 
   cube5_vol_fetch #(
-    .AddrW(AddrW), .DataW(DataW), .P(P), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim),
+    .AddrW(AddrW), .DataW(DataW), .P(Q), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim),
     .MaxBurst(MaxBurst), .Outstanding(Outstanding), .IdW(IdW)
   ) u_fetch (
     .clk_i, .rst_ni,
@@ -328,7 +332,8 @@ module cube5_accel #(
   end
 
   cube5_section_buf #(
-    .P(P), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim), .Section(Section)
+    .P(P), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim), .Section(Section),
+    .ItemGroups(SbG)
   ) u_sbuf (
     .clk_i, .rst_ni,
     .in_valid_i(sb_in_valid), .in_ready_o(sb_in_ready), .in_data_i(sb_in_data),

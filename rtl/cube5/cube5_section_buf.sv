@@ -4,7 +4,9 @@
 // the frame's i axis in the frame's order (slice, row, beat), with the edge voxels A0 - 1,
 // A0 + ns, A0 + ns + 1 beside each row's first and last beam. Two halves: slab t + 1 is written
 // while slab t is read. P banks with voxel (ci, j, lk) in bank (ci + j + lk) mod P: an item
-// writes every bank at most once, a beam reads every bank once (conflict-free, [37]).
+// writes every bank at most once, a beam reads every bank once (conflict-free, [37]). With
+// ItemGroups = 2 an item is two P-groups and the banks are 2P: a group bit g beside the skew
+// sends the two groups to different banks (docs/numerics/section_buf.md, "Storage").
 //
 //   in ─► accept: (i, j, k) of lane 0 ─► w1 ─► per lane: column, address ─► wb
 //         present flags (a word per block row)      ─► per bank: rotate by (ci + j + lk) mod P ─► w2
@@ -21,7 +23,9 @@ module cube5_section_buf #(
   /// Block edge B: a power of two, max(2, P) <= B <= 16, B < MaxDim.
   parameter int unsigned BlockDim = 8,
   /// Section width S in anchors: a power of two, BlockDim <= S < MaxDim.
-  parameter int unsigned Section = 16
+  parameter int unsigned Section = 16,
+  /// P-groups per input item, G: 1, or 2 (P <= 4, Section >= 2 P): an item is G P voxels.
+  parameter int unsigned ItemGroups = 1
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -32,7 +36,7 @@ module cube5_section_buf #(
   output logic in_ready_o,
   /// op (1), then a fetch item {lanes, blk_x, blk_y, blk_z, word, skip, last, error, resp_err}
   /// or a section command {axis_k, reversed, ni, nj, nk, a0}, LSB first.
-  input  logic [cube5_section_buf_pkg::in_w(P, VoxelW, MaxDim, BlockDim)-1:0] in_data_i,
+  input  logic [cube5_section_buf_pkg::in_w(ItemGroups * P, VoxelW, MaxDim, BlockDim)-1:0] in_data_i,
 
   /// Beam valid.
   output logic out_valid_o,
@@ -50,19 +54,24 @@ module cube5_section_buf #(
   localparam int unsigned DimW      = M + 1;
   localparam int unsigned NbW       = cube5_vol_fetch_pkg::nb_w(MaxDim, BlockDim);
   localparam int unsigned NbCW      = NbW + 1;
-  localparam int unsigned WordW     = cube5_vol_fetch_pkg::word_w(P, BlockDim);
-  localparam int unsigned InW       = cube5_section_buf_pkg::in_w(P, VoxelW, MaxDim, BlockDim);
+  localparam int unsigned G         = ItemGroups;
+  localparam int unsigned Q         = G * P;                     // voxels per item
+  localparam int unsigned LG        = G - 1;                     // log2 G
+  localparam int unsigned WordW     = cube5_vol_fetch_pkg::word_w(Q, BlockDim);
+  localparam int unsigned InW       = cube5_section_buf_pkg::in_w(Q, VoxelW, MaxDim, BlockDim);
   localparam int unsigned OutW      = cube5_section_buf_pkg::out_w(P, VoxelW);
   localparam int unsigned BW        = $clog2(BlockDim);
   localparam int unsigned PW        = (P > 1) ? $clog2(P) : 1;   // a lane or bank number
+  localparam int unsigned NBank     = G * P;                     // banks (and banks per edge)
+  localparam int unsigned GPW       = (NBank > 1) ? $clog2(NBank) : 1;
   localparam int unsigned SW        = $clog2(Section);
-  localparam int unsigned Groups    = BlockDim * BlockDim * BlockDim / P;
+  localparam int unsigned Groups    = BlockDim * BlockDim * BlockDim / Q;   // items per block
   localparam int unsigned BPP       = BlockDim / P;              // P-groups per block row
   localparam int unsigned SP        = Section / P;               // beats per full row
   localparam int unsigned MW        = (SP > 1) ? $clog2(SP) : 1;
-  localparam int unsigned BankDepth = 2 * BlockDim * MaxDim * SP;
+  localparam int unsigned BankDepth = 2 * BlockDim * MaxDim * SP / G;
   localparam int unsigned BAW       = $clog2(BankDepth);
-  localparam int unsigned EdgeDepth = 2 * MaxDim * BPP;
+  localparam int unsigned EdgeDepth = 2 * MaxDim * BPP / G;
   localparam int unsigned EAW       = $clog2(EdgeDepth);
   localparam int unsigned NBR       = MaxDim / BlockDim;         // block rows of a slab
   localparam int unsigned CB        = Section / BlockDim + 2;    // block columns of a slab
@@ -71,6 +80,8 @@ module cube5_section_buf #(
   localparam int unsigned LP        = $clog2(P);
   localparam int unsigned LBPP      = $clog2(BPP);
   localparam int unsigned LSP       = $clog2(SP);
+  localparam int unsigned LSQ       = LSP - LG;                  // log2(S / Q)
+  localparam int unsigned LQ        = LP + LG;                   // log2 Q
   localparam int unsigned CiW       = M + 3;                     // signed column, -MaxDim..2 MaxDim
   localparam int unsigned KW        = BW + 1;                    // slices of a slab, 0..B
   localparam int unsigned FifoDepth = 8;
@@ -92,19 +103,22 @@ module cube5_section_buf #(
   if ((1 << SW) != Section || Section < BlockDim || Section >= MaxDim) begin : gen_bad_section
     $fatal(1, "cube5_section_buf: Section must be a power of two, BlockDim <= Section < MaxDim");
   end
+  if (G != 1 && (G != 2 || P > 4 || Section < 2 * P)) begin : gen_bad_groups
+    $fatal(1, "cube5_section_buf: ItemGroups must be 1, or 2 with P <= 4 and Section >= 2 P");
+  end
 
   // ==============================================================================================
   // Input fields
   // ==============================================================================================
 
-  localparam int unsigned ItBlk  = 1 + P * VoxelW;
+  localparam int unsigned ItBlk  = 1 + Q * VoxelW;
   localparam int unsigned ItWord = ItBlk + 3 * NbW;
   localparam int unsigned ItSkip = ItWord + WordW;
   localparam int unsigned CmdNi  = 4;
   localparam int unsigned CmdA0  = CmdNi + 3 * DimW;
 
   logic                op;
-  logic [P*VoxelW-1:0] it_lanes;
+  logic [Q*VoxelW-1:0] it_lanes;
   logic [NbW-1:0]      it_bx, it_by, it_bz;
   logic [WordW-1:0]    it_word;
   logic                it_skip, it_error;
@@ -113,7 +127,7 @@ module cube5_section_buf #(
   logic [DimW-1:0]     cm_ni, cm_nj, cm_nk;
   logic [M-1:0]        cm_a0;
   assign op       = in_data_i[0];
-  assign it_lanes = in_data_i[1 +: P * VoxelW];
+  assign it_lanes = in_data_i[1 +: Q * VoxelW];
   assign it_bx    = in_data_i[ItBlk +: NbW];
   assign it_by    = in_data_i[ItBlk + NbW +: NbW];
   assign it_bz    = in_data_i[ItBlk + 2 * NbW +: NbW];
@@ -178,21 +192,24 @@ module cube5_section_buf #(
     cm_sechi_cap = NbCW'(((DimW'(cm_a0) + DimW'(Section)) >> BW) + DimW'(1));
   end
 
-  // Lane 0 of an item in volume and frame coordinates.
-  logic [M-1:0]    x0, y0, z0, i0, j0, k0;
+  // Lane 0 of each P-group of an item (group word w G + g) in volume and frame coordinates.
+  logic [M-1:0]    x0, y0, z0;
+  logic [G*M-1:0]  i0, j0, k0;                 // group g at g M
   logic [NbW-1:0]  bi0, bj0;
   logic            axx0;                       // slice axis x: the lanes run along k
   logic [31:0]     w;
   always_comb begin
-    w  = 32'(it_word);
-    x0 = M'((32'(it_bx) << BW) | ((w & (BPP - 1)) << LP));
-    y0 = M'((32'(it_by) << BW) | ((w >> LBPP) & (BlockDim - 1)));
-    z0 = M'((32'(it_bz) << BW) | (w >> (LBPP + BW)));
-    // axis_k 0: (i, j, k) = (y, z, x); 1: (x, z, y); 2: (x, y, z). Two flags, so every field is
-    // one 2:1 multiplexer (k: two).
-    i0   = axx_q ? y0 : x0;
-    j0   = axz_q ? y0 : z0;
-    k0   = axx_q ? x0 : (axz_q ? z0 : y0);
+    for (int unsigned g = 0; g < G; g++) begin
+      w  = (32'(it_word) << LG) | g;
+      x0 = M'((32'(it_bx) << BW) | ((w & (BPP - 1)) << LP));
+      y0 = M'((32'(it_by) << BW) | ((w >> LBPP) & (BlockDim - 1)));
+      z0 = M'((32'(it_bz) << BW) | (w >> (LBPP + BW)));
+      // axis_k 0: (i, j, k) = (y, z, x); 1: (x, z, y); 2: (x, y, z). Two flags, so every field
+      // is one 2:1 multiplexer (k: two).
+      i0[g * M +: M] = axx_q ? y0 : x0;
+      j0[g * M +: M] = axz_q ? y0 : z0;
+      k0[g * M +: M] = axx_q ? x0 : (axz_q ? z0 : y0);
+    end
     bi0  = axx_q ? it_by : it_bx;
     bj0  = axz_q ? it_by : it_bz;
     axx0 = axx_q;
@@ -200,7 +217,7 @@ module cube5_section_buf #(
 
   // Only the slice inside the slab (k mod B) is stored; the slab is the writer's counter.
   logic unused_k;
-  assign unused_k = ^k0[M-1:BW];
+  assign unused_k = ^k0;
 
   logic item_close;                           // the item closes its slab
   assign item_close = (NbCW'(bj0) == nbj1_q) && (NbCW'(bi0) == sechi1_q)
@@ -297,6 +314,7 @@ module cube5_section_buf #(
   // ==============================================================================================
 
   logic [1:0]      de_err_q, de_last_q, de_rev_q, de_lo0_q, de_hi00_q, de_hi10_q;
+  logic [1:0]      de_axx_q, de_axz_q;        // the slice axis (the group bits, G = 2)
   // The reader's last beat, row and slice, minus one (its compares need no adder).
   logic [MW-1:0]   de_m1_q [2];
   logic [M-1:0]    de_nj1_q [2];
@@ -317,6 +335,8 @@ module cube5_section_buf #(
         de_err_q[h]  <= desc_err;
         de_last_q[h] <= tlast;
         de_rev_q[h]  <= rev_q;
+        de_axx_q[h]  <= axx_q;
+        de_axz_q[h]  <= axz_q;
         de_lo0_q[h]  <= (a0_q == '0);
         de_hi00_q[h] <= hi00_q;
         de_hi10_q[h] <= hi10_q;
@@ -378,15 +398,15 @@ module cube5_section_buf #(
   end
 
   // ==============================================================================================
-  // Write stage 1: the item's column, row and slice
+  // Write stage 1: each P-group's column, row and slice
   // ==============================================================================================
 
   logic                 w1_q, w1close_q, w1half_q, w1axx_q;
-  logic signed [CiW-1:0] w1ci_q;
-  logic [M-1:0]         w1j_q;
-  logic [BW-1:0]        w1lk_q;
+  logic signed [CiW-1:0] w1ci_q [G];
+  logic [M-1:0]         w1j_q [G];
+  logic [BW-1:0]        w1lk_q [G];
   logic [DimW-1:0]      w1ns_q, w1ns1_q;            // ns and ns + 1
-  logic [P*VoxelW-1:0]  w1lanes_q;
+  logic [Q*VoxelW-1:0]  w1lanes_q;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -400,55 +420,77 @@ module cube5_section_buf #(
   always_ff @(posedge clk_i) begin
     w1half_q  <= wh_q;
     w1axx_q   <= axx0;
-    w1ci_q    <= $signed(CiW'(i0)) - $signed(CiW'(a0_q));
-    w1j_q     <= j0;
-    w1lk_q    <= BW'(k0);
+    for (int unsigned g = 0; g < G; g++) begin
+      w1ci_q[g] <= $signed(CiW'(i0[g * M +: M])) - $signed(CiW'(a0_q));
+      w1j_q[g]  <= j0[g * M +: M];
+      w1lk_q[g] <= BW'(k0[g * M +: M]);
+    end
     w1ns_q    <= ns_q;
     w1ns1_q   <= ns_q + DimW'(1);
     w1lanes_q <= it_lanes;
   end
 
-  // Per lane: column, slice, which store it goes to, its address there. An item whose lanes run
-  // along i (slice axis y or z) starts at a column ci0 that is a multiple of P, and ns is a
+  // Per lane: column, slice, which store it goes to, its address there. A P-group whose lanes
+  // run along i (slice axis y or z) starts at a column ci0 that is a multiple of P, and ns is a
   // multiple of P (a0 a multiple of S, ni of P), so its lanes are all in 0..ns - 1 or all out,
-  // their main-bank word is ci0 / P, and edge column c goes to lane c mod P when
-  // ci0 = c - (c mod P). An item of slice axis x has one column for all lanes. So every compare
-  // is one of ci0 (no per-lane adder in front of the compares).
+  // their main-bank word is ci0 / Q, and edge column c goes to lane c mod P when
+  // ci0 = c - (c mod P). A group of slice axis x has one column for all lanes. So every compare
+  // is one of ci0 (no per-lane adder in front of the compares). Lane q = g P + l is lane l of
+  // group g.
   localparam int unsigned Lane1 = 1 % P;          // the lane of column ns + 1 (along i)
   logic signed [CiW-1:0] ns_s, ns1_s, ns2_s;
   logic                  c_main, c_m1, c_mp, c_ns, c_ns1, c_ns2;
   logic [BW-1:0]         lk_l;
-  logic [P-1:0]          l_main;
-  logic [3*P-1:0]        l_edge;                   // lane l, edge column c at l 3 + c
-  logic [P*BAW-1:0]      l_maddr;
-  logic [P*EAW-1:0]      l_eaddr;
-  logic [P*PW-1:0]       l_ebank;
-  logic [PW-1:0]         w1rot;
+  logic [31:0]           ev;                       // an edge voxel's word before the group split
+  logic [Q-1:0]          l_main;
+  logic [3*Q-1:0]        l_edge;                   // lane q, edge column c at q 3 + c
+  logic [G*BAW-1:0]      l_maddr;                  // per group, at its lane 0's slice
+  logic [G*EAW-1:0]      l_eaddr;                  // per group (its lanes share the word)
+  logic [Q*GPW-1:0]      l_ebank;
+  logic [G*PW-1:0]       w1rot;
+  logic                  w1swap;                   // group 0's bank group g (1: the groups swap)
   always_comb begin
     ns_s   = $signed(CiW'(w1ns_q));
     ns1_s  = $signed(CiW'(w1ns1_q));
     ns2_s  = (P == 1) ? ns1_s : ns_s;             // ns + 1 - (1 mod P)
-    c_main = !w1ci_q[CiW-1] && (w1ci_q < ns_s);
-    c_m1   = (w1ci_q == -$signed(CiW'(1)));
-    c_mp   = (w1ci_q == -$signed(CiW'(P)));
-    c_ns   = (w1ci_q == ns_s);
-    c_ns1  = (w1ci_q == ns1_s);
-    c_ns2  = (w1ci_q == ns2_s);
-    for (int unsigned l = 0; l < P; l++) begin
-      lk_l = w1axx_q ? w1lk_q + BW'(l) : w1lk_q;
-      l_main[l] = c_main;
-      if (w1axx_q) begin
-        l_edge[l * 3 +: 3] = {c_ns1, c_ns, c_m1};
-      end else begin
-        l_edge[l * 3 +: 3] = {(l == Lane1) && c_ns2, (l == 0) && c_ns, (l == P - 1) && c_mp};
+    for (int unsigned g = 0; g < G; g++) begin
+      c_main = !w1ci_q[g][CiW-1] && (w1ci_q[g] < ns_s);
+      c_m1   = (w1ci_q[g] == -$signed(CiW'(1)));
+      c_mp   = (w1ci_q[g] == -$signed(CiW'(P)));
+      c_ns   = (w1ci_q[g] == ns_s);
+      c_ns1  = (w1ci_q[g] == ns1_s);
+      c_ns2  = (w1ci_q[g] == ns2_s);
+      for (int unsigned l = 0; l < P; l++) begin
+        lk_l = w1axx_q ? w1lk_q[g] + BW'(l) : w1lk_q[g];
+        l_main[g * P + l] = c_main;
+        if (w1axx_q) begin
+          l_edge[(g * P + l) * 3 +: 3] = {c_ns1, c_ns, c_m1};
+        end else begin
+          l_edge[(g * P + l) * 3 +: 3] = {(l == Lane1) && c_ns2, (l == 0) && c_ns,
+                                          (l == P - 1) && c_mp};
+        end
+        if (l == 0) begin
+          l_maddr[g * BAW +: BAW] = BAW'((((((32'(w1half_q) << BW) | 32'(lk_l)) << M)
+                                          | 32'(w1j_q[g])) << LSQ)
+                                          | (32'(w1ci_q[g][CiW-2:0]) >> LQ));
+        end
+        // Edge word v = (h MaxDim + j) (B / P) + lk / P; with two groups its parity picks the
+        // bank group and the word is v / 2.
+        ev = (((32'(w1half_q) << M) | 32'(w1j_q[g])) << LBPP) | (32'(lk_l) >> LP);
+        l_eaddr[g * EAW +: EAW] = EAW'(ev >> LG);
+        l_ebank[(g * P + l) * GPW +: GPW] = GPW'((32'(lk_l) & (P - 1))
+                                                 | (((G == 2) ? (ev & 1) : 0) << LP));
       end
-      l_maddr[l * BAW +: BAW] = BAW'((((((32'(w1half_q) << BW) | 32'(lk_l)) << M)
-                                      | 32'(w1j_q)) << LSP) | (32'(w1ci_q[CiW-2:0]) >> LP));
-      l_eaddr[l * EAW +: EAW] = EAW'((((32'(w1half_q) << M) | 32'(w1j_q)) << LBPP)
-                                     | (32'(lk_l) >> LP));
-      l_ebank[l * PW +: PW]   = PW'(32'(lk_l) & (P - 1));
+      w1rot[g * PW +: PW] = PW'((32'(w1ci_q[g][CiW-2:0]) + 32'(w1j_q[g]) + 32'(w1lk_q[g]))
+                                & (P - 1));
     end
-    w1rot = PW'((32'(w1ci_q[CiW-2:0]) + 32'(w1j_q) + 32'(w1lk_q)) & (P - 1));
+    // A group's g: its word parity (the group's index) xor bit 0 of ci / P, but the parity alone
+    // when the lanes run along i and B >= 2P (then the two agree). The other group has the other g.
+    if (G == 1 || (BPP >= 2 && !w1axx_q)) begin
+      w1swap = 1'b0;
+    end else begin
+      w1swap = 1'((32'(w1ci_q[0][CiW-2:0]) >> LP) & 1);
+    end
   end
 
   // ==============================================================================================
@@ -457,13 +499,14 @@ module cube5_section_buf #(
   // ==============================================================================================
 
   logic                wb_q, wbclose_q, wbhalf_q;
-  logic [P-1:0]        wbmain_q;
-  logic [3*P-1:0]      wbedge_q;
-  logic [P*BAW-1:0]    wbmaddr_q;
-  logic [P*EAW-1:0]    wbeaddr_q;
-  logic [P*PW-1:0]     wbebank_q;
-  logic [PW-1:0]       wbrot_q;
-  logic [P*VoxelW-1:0] wblanes_q;
+  logic [Q-1:0]        wbmain_q;
+  logic [3*Q-1:0]      wbedge_q;
+  logic [G*BAW-1:0]    wbmaddr_q;
+  logic [G*EAW-1:0]    wbeaddr_q;
+  logic                wbaxx_q;
+  logic [Q*GPW-1:0]    wbebank_q;
+  logic [G*PW-1:0]     wbrot_q;
+  logic [Q*VoxelW-1:0] wblanes_q;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -476,51 +519,74 @@ module cube5_section_buf #(
   end
   always_ff @(posedge clk_i) begin
     wbhalf_q  <= w1half_q;
-    wbmain_q  <= l_main;
-    wbedge_q  <= l_edge;
-    wbmaddr_q <= l_maddr;
-    wbeaddr_q <= l_eaddr;
-    wbebank_q <= l_ebank;
-    wbrot_q   <= w1rot;
-    wblanes_q <= w1lanes_q;
+    wbaxx_q   <= w1axx_q;
+    // Slot s holds the group whose g is s (with two groups their g differ): a swap when group 0
+    // has g = 1, so that the banks below take from a fixed slot (loops over constant indices).
+    for (int unsigned s = 0; s < G; s++) begin
+      for (int unsigned g = 0; g < G; g++) begin
+        if ((g == s) != w1swap) begin
+          wbmain_q[s * P +: P]                     <= l_main[g * P +: P];
+          wbedge_q[s * 3 * P +: 3 * P]             <= l_edge[g * 3 * P +: 3 * P];
+          wbmaddr_q[s * BAW +: BAW]                <= l_maddr[g * BAW +: BAW];
+          wbeaddr_q[s * EAW +: EAW]                <= l_eaddr[g * EAW +: EAW];
+          wbebank_q[s * P * GPW +: P * GPW]        <= l_ebank[g * P * GPW +: P * GPW];
+          wbrot_q[s * PW +: PW]                    <= w1rot[g * PW +: PW];
+          wblanes_q[s * P * VoxelW +: P * VoxelW]  <= w1lanes_q[g * P * VoxelW +: P * VoxelW];
+        end
+      end
+    end
+
   end
 
   // ==============================================================================================
   // Write stage 2: per bank, the lane it takes (registered in front of the RAMs)
   // ==============================================================================================
 
-  logic [P-1:0]          w2we_q, w2we_d;
-  logic [P*BAW-1:0]      w2addr_q, w2addr_d;
-  logic [P*VoxelW-1:0]   w2data_q, w2data_d;
-  logic [3*P-1:0]        e2we_q, e2we_d;          // edge column c, bank e at c P + e
-  logic [3*P*EAW-1:0]    e2addr_q, e2addr_d;
-  logic [3*P*VoxelW-1:0] e2data_q, e2data_d;
-  logic                  w2close_q, w2half_q;
+  logic [NBank-1:0]          w2we_q, w2we_d;
+  logic [NBank*BAW-1:0]      w2addr_q, w2addr_d;
+  logic [NBank*VoxelW-1:0]   w2data_q, w2data_d;
+  logic [3*NBank-1:0]        e2we_q, e2we_d;      // edge column c, bank e at c G P + e
+  logic [3*NBank*EAW-1:0]    e2addr_q, e2addr_d;
+  logic [3*NBank*VoxelW-1:0] e2data_q, e2data_d;
+  logic                      w2close_q, w2half_q;
 
   always_comb begin
-    // Bank b takes lane (b - rot) mod P (loops over constant indices: no index arithmetic).
+    // Bank s P + b takes lane (b - rot) mod P of slot s (loops over constant indices: no index
+    // arithmetic).
     w2we_d   = '0;
     w2addr_d = '0;
     w2data_d = '0;
-    for (int unsigned b = 0; b < P; b++) begin
-      for (int unsigned l = 0; l < P; l++) begin
-        if (((l + 32'(wbrot_q)) & (P - 1)) == b) begin
-          w2we_d[b] = wb_q && wbmain_q[l];
-          w2addr_d[b * BAW +: BAW]       = wbmaddr_q[l * BAW +: BAW];
-          w2data_d[b * VoxelW +: VoxelW] = wblanes_q[l * VoxelW +: VoxelW];
+    for (int unsigned s = 0; s < G; s++) begin
+      for (int unsigned b = 0; b < P; b++) begin
+        for (int unsigned l = 0; l < P; l++) begin
+          if (((l + 32'(wbrot_q[s * PW +: PW])) & (P - 1)) == b) begin
+            w2we_d[s * P + b] = wb_q && wbmain_q[s * P + l];
+            // The lanes of a group share its word but for slice axis x, where lane l's slice
+            // is lane 0's (a multiple of P) plus l: a field of the word, set without an adder.
+            w2addr_d[(s * P + b) * BAW +: BAW]       = wbmaddr_q[s * BAW +: BAW]
+                | (wbaxx_q ? BAW'(l << (LSQ + M)) : BAW'(0));
+            w2data_d[(s * P + b) * VoxelW +: VoxelW] = wblanes_q[(s * P + l) * VoxelW +: VoxelW];
+          end
         end
       end
     end
+    // Edge bank e = b + P ee of column c: from each slot only one lane can reach it, lane b
+    // with slice axis x (lane l's slice is lk0 + l, lk0 a multiple of P), else the column's lane
+    // (P - 1 for lo, 0 for hi0, 1 mod P for hi1).
     for (int unsigned c = 0; c < 3; c++) begin
-      for (int unsigned e = 0; e < P; e++) begin
-        e2we_d[c * P + e] = 1'b0;
-        e2addr_d[(c * P + e) * EAW +: EAW]       = wbeaddr_q[0 +: EAW];
-        e2data_d[(c * P + e) * VoxelW +: VoxelW] = wblanes_q[0 +: VoxelW];
-        for (int unsigned l = 0; l < P; l++) begin
-          if (wb_q && wbedge_q[l * 3 + c] && wbebank_q[l * PW +: PW] == PW'(e)) begin
-            e2we_d[c * P + e] = 1'b1;
-            e2addr_d[(c * P + e) * EAW +: EAW]       = wbeaddr_q[l * EAW +: EAW];
-            e2data_d[(c * P + e) * VoxelW +: VoxelW] = wblanes_q[l * VoxelW +: VoxelW];
+      for (int unsigned e = 0; e < NBank; e++) begin
+        e2we_d[c * NBank + e] = 1'b0;
+        e2addr_d[(c * NBank + e) * EAW +: EAW]       = wbeaddr_q[0 +: EAW];
+        e2data_d[(c * NBank + e) * VoxelW +: VoxelW] = wblanes_q[0 +: VoxelW];
+        for (int unsigned s = 0; s < G; s++) begin
+          for (int unsigned l = 0; l < P; l++) begin
+            if (((wbaxx_q && l == e % P) || (!wbaxx_q && l == ((c == 0) ? P - 1 : ((c == 1) ? 0 : Lane1))))
+                && wb_q && wbedge_q[(s * P + l) * 3 + c]
+                && wbebank_q[(s * P + l) * GPW +: GPW] == GPW'(e)) begin
+              e2we_d[c * NBank + e] = 1'b1;
+              e2addr_d[(c * NBank + e) * EAW +: EAW]       = wbeaddr_q[s * EAW +: EAW];
+              e2data_d[(c * NBank + e) * VoxelW +: VoxelW] = wblanes_q[(s * P + l) * VoxelW +: VoxelW];
+            end
           end
         end
       end
@@ -639,15 +705,38 @@ module cube5_section_buf #(
   // Read addresses, the rotation back, and the present flags of the beam and the row's edges.
   logic [BAW-1:0] r_addr;
   logic [EAW-1:0] r_eaddr;
-  logic [PW-1:0]  r_rot, r_ebank;
+  logic [PW-1:0]  r_rot;
+  logic [GPW-1:0] r_ebank;
+  logic [P-1:0]   r_grp;                          // lane l's bank group
+  logic [31:0]    r_ev;
+  logic           r_c, r_axx, r_axz;
   logic [CB-1:0]  r_pres;
   logic [CBW-1:0] r_col;
   always_comb begin
-    r_addr  = BAW'((((((32'(rh_q) << BW) | 32'(r_lk)) << M) | 32'(rj_q)) << LSP)
-                   | (32'(rm_q) & (SP - 1)));
-    r_eaddr = EAW'((((32'(rh_q) << M) | 32'(rj_q)) << LBPP) | (32'(r_lk) >> LP));
+    r_addr  = BAW'((((((32'(rh_q) << BW) | 32'(r_lk)) << M) | 32'(rj_q)) << LSQ)
+                   | ((32'(rm_q) & (SP - 1)) >> LG));
+    r_ev    = (((32'(rh_q) << M) | 32'(rj_q)) << LBPP) | (32'(r_lk) >> LP);
+    r_eaddr = EAW'(r_ev >> LG);
     r_rot   = PW'((32'(rj_q) + 32'(r_lk)) & (P - 1));
-    r_ebank = PW'(32'(r_lk) & (P - 1));
+    r_ebank = GPW'((32'(r_lk) & (P - 1)) | (((G == 2) ? (r_ev & 1) : 0) << LP));
+    // Lane l (column ci = P m + l): g = the P-group word's parity pi xor c = bit 0 of m, or pi
+    // alone when the lanes run along i and B >= 2P (docs/numerics/section_buf.md, "Storage").
+    // pi: slice axis x: (lk / P) mod 2 (B >= 2P) or l mod 2 (B = P); axis y (B = P): lk mod 2;
+    // axis z (B = P): j mod 2; along i with B >= 2P: c.
+    r_c   = rm_q[0];
+    r_axx = de_axx_q[rh_q];
+    r_axz = de_axz_q[rh_q];
+    for (int unsigned l = 0; l < P; l++) begin
+      if (G == 1) begin
+        r_grp[l] = 1'b0;
+      end else if (BPP >= 2) begin
+        r_grp[l] = r_axx ? (r_c ^ 1'((32'(r_lk) >> LP) & 1)) : r_c;
+      end else if (r_axx) begin
+        r_grp[l] = r_c ^ 1'(l & 1);
+      end else begin
+        r_grp[l] = r_c ^ (r_axz ? rj_q[0] : r_lk[0]);
+      end
+    end
     r_pres  = pres_mem[{rh_q, rj_q[M-1:BW]}];
     r_col   = CBW'(((32'(rm_q) << LP) >> BW) + 1);
   end
@@ -656,10 +745,10 @@ module cube5_section_buf #(
   // The banks
   // ==============================================================================================
 
-  logic [P*VoxelW-1:0]   bank_rd;
-  logic [3*P*VoxelW-1:0] edge_rd;
+  logic [NBank*VoxelW-1:0]   bank_rd;
+  logic [3*NBank*VoxelW-1:0] edge_rd;
 
-  for (genvar b = 0; b < P; b++) begin : gen_bank
+  for (genvar b = 0; b < NBank; b++) begin : gen_bank
     cube5_section_buf_ram #(                    // reads and writes are in different halves
       .Depth(BankDepth),
       .Width(VoxelW),
@@ -675,20 +764,53 @@ module cube5_section_buf #(
     );
   end
 
-  for (genvar e = 0; e < 3 * P; e++) begin : gen_edge
-    cube5_section_buf_ram #(                    // reads and writes are in different halves
-      .Depth(EdgeDepth),
-      .Width(VoxelW),
-      .AddrW(EAW)
-    ) u_edge (
-      .clk_i  (clk_i),
-      .we_i   (e2we_q[e]),
-      .waddr_i(e2addr_q[e * EAW +: EAW]),
-      .wdata_i(e2data_q[e * VoxelW +: VoxelW]),
-      .re_i   (issue),
-      .raddr_i(r_eaddr),
-      .rdata_o(edge_rd[e * VoxelW +: VoxelW])
-    );
+  if (G == 1) begin : gen_edges
+    for (genvar e = 0; e < 3 * NBank; e++) begin : gen_edge
+      cube5_section_buf_ram #(                  // reads and writes are in different halves
+        .Depth(EdgeDepth),
+        .Width(VoxelW),
+        .AddrW(EAW)
+      ) u_edge (
+        .clk_i  (clk_i),
+        .we_i   (e2we_q[e]),
+        .waddr_i(e2addr_q[e * EAW +: EAW]),
+        .wdata_i(e2data_q[e * VoxelW +: VoxelW]),
+        .re_i   (issue),
+        .raddr_i(r_eaddr),
+        .rdata_o(edge_rd[e * VoxelW +: VoxelW])
+      );
+    end
+  end else begin : gen_edges
+    // The group banks b and b + P of an edge column share a memory, one half each: an item that
+    // writes both writes them at one word (docs/numerics/section_buf.md, "Storage").
+    for (genvar c = 0; c < 3; c++) begin : gen_col
+      for (genvar b = 0; b < P; b++) begin : gen_edge
+        localparam int unsigned E0 = c * NBank + b;
+        localparam int unsigned E1 = c * NBank + P + b;
+        logic [2*VoxelW-1:0] rd;
+        cube5_section_buf_eram #(               // reads and writes are in different halves
+          .Depth(EdgeDepth),
+          .Width(VoxelW),
+          .PartW((VoxelW > 9) ? 18 : 9),
+          .AddrW(EAW)
+        ) u_edge (
+          .clk_i  (clk_i),
+          .we_i   ({e2we_q[E1], e2we_q[E0]}),
+          .waddr_i(e2we_q[E0] ? e2addr_q[E0 * EAW +: EAW] : e2addr_q[E1 * EAW +: EAW]),
+          .wdata_i({e2data_q[E1 * VoxelW +: VoxelW], e2data_q[E0 * VoxelW +: VoxelW]}),
+          .re_i   (issue),
+          .raddr_i(r_eaddr),
+          .rdata_o(rd)
+        );
+        assign edge_rd[E0 * VoxelW +: VoxelW] = rd[0 +: VoxelW];
+        assign edge_rd[E1 * VoxelW +: VoxelW] = rd[VoxelW +: VoxelW];
+`ifndef SYNTHESIS
+        a_edge_one_word: assert property (@(posedge clk_i) disable iff (!rst_ni)
+            e2we_q[E0] && e2we_q[E1] |-> e2addr_q[E0 * EAW +: EAW] == e2addr_q[E1 * EAW +: EAW])
+          else $error("cube5_section_buf: an item wrote an edge memory's halves at two words");
+`endif
+      end
+    end
   end
 
   // ==============================================================================================
@@ -697,7 +819,9 @@ module cube5_section_buf #(
 
   // Stage d: the banks' (unregistered) outputs; stage d2: them registered (the block RAMs'
   // clock-to-output and the routing from them is a cycle of its own), then rotation and masks.
-  logic [PW-1:0] drot_q, debank_q, drot_q2, debank_q2;
+  logic [PW-1:0]  drot_q, drot_q2;
+  logic [GPW-1:0] debank_q, debank_q2;
+  logic [P-1:0]   dgrp_q, dgrp_q2;
   logic          dlane_q2, dlo_q2, dhi0_q2, dhi1_q2;
   // Stage d also holds the beam's present-flag word and which of its flags each voxel reads:
   // the flag selection is stage d's logic (not the issue cycle's, behind the LUT-RAM read).
@@ -712,8 +836,8 @@ module cube5_section_buf #(
     d_hi1_ok  = dhi1_ok_q && dpres_q[dc1_q];
   end
   logic [4:0]    dflags_q, dflags_q2;               // row_first, row_last, slice_last, last, error
-  logic [P*VoxelW-1:0]   bank_q2;
-  logic [3*P*VoxelW-1:0] edge_q2;
+  logic [NBank*VoxelW-1:0]   bank_q2;
+  logic [3*NBank*VoxelW-1:0] edge_q2;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -727,6 +851,7 @@ module cube5_section_buf #(
   always_ff @(posedge clk_i) begin
     drot_q   <= r_rot;
     debank_q <= r_ebank;
+    dgrp_q   <= r_grp;
     dpres_q    <= r_pres;
     dcol_q     <= r_col;
     dc0_q      <= de_c0_q[rh_q];
@@ -737,6 +862,7 @@ module cube5_section_buf #(
     dhi1_ok_q  <= !r_err && m_last && !de_hi10_q[rh_q];
     drot_q2   <= drot_q;
     debank_q2 <= debank_q;
+    dgrp_q2   <= dgrp_q;
     dlane_q2  <= d_lane_ok;
     dlo_q2    <= d_lo_ok;
     dhi0_q2   <= d_hi0_ok;
@@ -751,26 +877,29 @@ module cube5_section_buf #(
                  !r_err && (rm_q == '0)};
   end
 
-  // At P = 1 the rotation is the identity.
+  // At P = 1 the rotation is the identity; with one group there is no group bit.
   logic unused_rot;
-  assign unused_rot = ^drot_q2;
+  assign unused_rot = ^{drot_q2, dgrp_q2};
 
   logic [OutW-1:0] beam;
   always_comb begin
-    // Lane l from bank (l + rot) mod P; edges from bank lk mod P (constant-index loops).
+    // Lane l from bank (l + rot) mod P + P g_l; edges from bank lk mod P + P e (constant-index
+    // loops).
     beam = '0;
     for (int unsigned l = 0; l < P; l++) begin
-      for (int unsigned b = 0; b < P; b++) begin
-        if (dlane_q2 && ((l + 32'(drot_q2)) & (P - 1)) == b) begin
-          beam[l * VoxelW +: VoxelW] = bank_q2[b * VoxelW +: VoxelW];
+      for (int unsigned gg = 0; gg < G; gg++) begin
+        for (int unsigned b = 0; b < P; b++) begin
+          if (dlane_q2 && dgrp_q2[l] == 1'(gg) && ((l + 32'(drot_q2)) & (P - 1)) == b) begin
+            beam[l * VoxelW +: VoxelW] = bank_q2[(gg * P + b) * VoxelW +: VoxelW];
+          end
         end
       end
     end
-    for (int unsigned e = 0; e < P; e++) begin
+    for (int unsigned e = 0; e < NBank; e++) begin
       if (32'(debank_q2) == e) begin
         if (dlo_q2)  beam[P * VoxelW +: VoxelW]       = edge_q2[e * VoxelW +: VoxelW];
-        if (dhi0_q2) beam[(P + 1) * VoxelW +: VoxelW] = edge_q2[(P + e) * VoxelW +: VoxelW];
-        if (dhi1_q2) beam[(P + 2) * VoxelW +: VoxelW] = edge_q2[(2 * P + e) * VoxelW +: VoxelW];
+        if (dhi0_q2) beam[(P + 1) * VoxelW +: VoxelW] = edge_q2[(NBank + e) * VoxelW +: VoxelW];
+        if (dhi1_q2) beam[(P + 2) * VoxelW +: VoxelW] = edge_q2[(2 * NBank + e) * VoxelW +: VoxelW];
       end
     end
     beam[(P + 3) * VoxelW +: 5]      = dflags_q2;

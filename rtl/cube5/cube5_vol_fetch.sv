@@ -20,7 +20,7 @@ module cube5_vol_fetch #(
   parameter int unsigned VoxelW = 12,
   /// Largest volume edge (a power of two).
   parameter int unsigned MaxDim = 64,
-  /// Block edge B: a power of two, max(2, P) <= B <= 16, B < MaxDim.
+  /// Block edge B: a power of two, max(2, P / 2) <= B <= 16, B < MaxDim.
   parameter int unsigned BlockDim = 8,
   /// The reader's longest burst in beats.
   parameter int unsigned MaxBurst = 16,
@@ -114,9 +114,9 @@ module cube5_vol_fetch #(
   if (MaxDim < 8 || MaxDim > 1024 || (1 << $clog2(MaxDim)) != MaxDim) begin : gen_bad_max_dim
     $fatal(1, "cube5_vol_fetch: MaxDim must be a power of two in 8..1024");
   end
-  if ((1 << $clog2(BlockDim)) != BlockDim || BlockDim < 2 || BlockDim < P || BlockDim > 16
+  if ((1 << $clog2(BlockDim)) != BlockDim || BlockDim < 2 || 2 * BlockDim < P || BlockDim > 16
       || BlockDim >= MaxDim) begin : gen_bad_block
-    $fatal(1, "cube5_vol_fetch: BlockDim must be a power of two, max(2, P) <= B <= 16, B < MaxDim");
+    $fatal(1, "cube5_vol_fetch: BlockDim must be a power of two, max(2, P / 2) <= B <= 16, B < MaxDim");
   end
   if ((1 << $clog2(DataW)) != DataW || DataW < 16 * P || DataW > 16 * BlockDim * BlockDim * BlockDim)
   begin : gen_bad_data_w

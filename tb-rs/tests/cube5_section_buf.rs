@@ -79,7 +79,7 @@ fn random_inputs(
                 input.push(SbufIn::Section(bad));
                 want.push(section_beams(&cfg, &vol, &lut, &bad).unwrap()[0].clone());
             }
-            1 => input.push(SbufIn::Item(FetchItem::stray(cfg.p))),
+            1 => input.push(SbufIn::Item(FetchItem::stray(cfg.item_p()))),
             _ => {}
         }
         let (i, w) = section(cfg, &vol, &lut, cmd);
@@ -467,7 +467,8 @@ fn directed_extremes() {
 }
 
 /// Beams per clock at full speed, and the stalls at slab turns: with every block present the
-/// writer sets the pace (`ns / (ns + 2B)`-ish beams per clock, docs/numerics/section_buf.md);
+/// writer sets the pace with one P-group per item (`ns / (ns + 2B)`-ish beams per clock,
+/// docs/numerics/section_buf.md), the reader with two;
 /// with every block empty the reader does, one beam per clock. Asserts that no slab turn costs
 /// the reader a cycle when the next half is full, and prints the figures.
 #[test]
@@ -545,10 +546,14 @@ fn throughput_and_slab_turns() {
                 // waits, inside a slab or at a turn, once the first slab is in.
                 assert_eq!(turn_gaps + other_gaps, 0, "{variant}: one beam per clock");
             } else {
-                // The writer is the bottleneck: the run takes the items at one per clock, plus
-                // the last slab's beams, plus the pipeline (a few cycles per section).
+                // One P-group per item: the writer is the bottleneck, the run takes the items at
+                // one per clock, plus the last slab's beams, plus the pipeline (a few cycles per
+                // section). Two: the writer keeps up with the reader (2 ns / (ns + 2B) beams'
+                // worth per clock), which then waits only for the first slab.
                 let sections = u64::from(fd[0].div_ceil(cfg.section));
-                let bound = input.len() as u64 + per_slab + 8 * sections;
+                let slabs = (edge as u64).div_ceil(u64::from(cfg.block_dim));
+                let items = input.len() as u64;
+                let bound = (items + per_slab).max(n + items / slabs) + 8 * sections;
                 assert!(
                     d.stats.cycles <= bound,
                     "{variant}: {} cycles > {bound}: the writer waited for the reader",

@@ -27,7 +27,9 @@ fn dram_to_beams_through_both_rtl_units() {
     let mut pairs = 0;
     for (fv, fcfg) in configs::<VolFetchConfig>() {
         for (sv, scfg) in configs::<SectionBufConfig>() {
-            if (fcfg.p, fcfg.block_dim, fcfg.voxel_w) != (scfg.p, scfg.block_dim, scfg.voxel_w) {
+            if (fcfg.p, fcfg.block_dim, fcfg.voxel_w)
+                != (scfg.item_p(), scfg.block_dim, scfg.voxel_w)
+            {
                 continue;
             }
             pairs += 1;

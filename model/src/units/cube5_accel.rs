@@ -56,11 +56,22 @@ const PASSED_DEFAULTS: &[(&str, i64)] = &[
     ("ZW", 12),
 ];
 
+/// P-groups per fetch item (the section buffer's `ItemGroups`) at `P` pipelines and a `DataW`-bit
+/// bus: 2 where a beat holds two (and `P <= 4`), else 1.
+pub fn item_groups(p: i64, data_w: i64) -> u32 {
+    if data_w >= 32 * p && p <= 4 {
+        2
+    } else {
+        1
+    }
+}
+
 /// One configuration of `cube5_accel`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AccelConfig {
     /// The frame inside (`Source = 1`): its image is the top's.
     pub frame: FrameConfig,
+    /// The volume fetch inside: its `P` is the item's voxels, `item_groups(P, DataW)` P-groups.
     pub fetch: VolFetchConfig,
     /// Anchors per section (`Section`).
     pub section: u32,
@@ -101,9 +112,18 @@ impl UnitConfig for AccelConfig {
                 ModelError::Config(format!("cube5_accel: {n} = {} is out of range", get(n)))
             })
         };
+        // The fetch's items are the section buffer's: two P-groups where a bus beat holds them
+        // (`ItemGroups` = 2, docs/numerics/section_buf.md), else one.
+        let mut fetch_params = pick(FETCH_PARAMS);
+        let groups = item_groups(get("P"), get("DataW"));
+        for (n, v) in &mut fetch_params {
+            if *n == "P" {
+                *v *= i64::from(groups);
+            }
+        }
         let c = Self {
             frame: FrameConfig::from_params(&fp)?,
-            fetch: VolFetchConfig::from_params(&pick(FETCH_PARAMS))?,
+            fetch: VolFetchConfig::from_params(&fetch_params)?,
             section: own("Section")?,
             wr_outstanding: own("WrOutstanding")?,
             id_w: own("IdW")?,

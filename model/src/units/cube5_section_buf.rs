@@ -28,6 +28,8 @@ pub struct SectionBufConfig {
     pub block_dim: u32,
     /// Section width `S` in anchors.
     pub section: u32,
+    /// P-groups per input item, `G` (1 or 2): an item is `Q = G P` voxels.
+    pub item_groups: u32,
 }
 
 impl SectionBufConfig {
@@ -38,10 +40,12 @@ impl SectionBufConfig {
         max_dim: 64,
         block_dim: 8,
         section: 16,
+        item_groups: 1,
     };
 
-    /// P, VoxelW, MaxDim and BlockDim have the ranges of `cube5_vol_fetch`, whose items the unit
-    /// takes (checked by its configuration); Section is the unit's own.
+    /// VoxelW, MaxDim and BlockDim have the ranges of `cube5_vol_fetch`, whose items (of `Q`
+    /// voxels) the unit takes (checked by its configuration); P (with `B >= P`), Section and
+    /// ItemGroups are the unit's own.
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("cube5_section_buf: {what}")));
         if let Err(e) = self.fetch().validate() {
@@ -53,18 +57,36 @@ impl SectionBufConfig {
                 "Section {s} is not a power of two with BlockDim <= S < MaxDim"
             ));
         }
+        if !(1..=2).contains(&self.item_groups) || (self.item_groups == 2 && s < 2 * self.p) {
+            return bad(format!(
+                "ItemGroups {} is not 1, or 2 with Section >= 2 P",
+                self.item_groups
+            ));
+        }
+        if self.block_dim < self.p.max(2) {
+            return bad(format!(
+                "BlockDim {b} is not at least max(2, P = {})",
+                self.p
+            ));
+        }
         Ok(())
     }
 
-    /// A `cube5_vol_fetch` whose items feed this unit: the same P, voxel width, largest edge and
-    /// block edge, a bus of `2P` bytes (the sweep's demand) and the fetch's other defaults.
+    /// Voxels per input item, `Q = G P` (the fetch's P).
+    pub fn item_p(&self) -> u32 {
+        self.item_groups * self.p
+    }
+
+    /// A `cube5_vol_fetch` whose items feed this unit: P = `Q`, the same voxel width, largest
+    /// edge and block edge, a bus of `2Q` bytes (one item per beat) and the fetch's other
+    /// defaults.
     pub fn fetch(&self) -> VolFetchConfig {
         VolFetchConfig {
-            p: self.p,
+            p: self.item_p(),
             voxel_w: self.voxel_w,
             max_dim: self.max_dim,
             block_dim: self.block_dim,
-            data_w: 16 * self.p,
+            data_w: 16 * self.item_p(),
             ..VolFetchConfig::DEFAULT
         }
     }
@@ -97,19 +119,19 @@ impl SectionBufConfig {
         (self.max_dim / self.block_dim).trailing_zeros()
     }
 
-    /// Items per present block, `B^3 / P`.
+    /// Items per present block, `B^3 / Q`.
     pub fn groups(&self) -> u32 {
-        self.block_dim.pow(3) / self.p
+        self.block_dim.pow(3) / self.item_p()
     }
 
-    /// `WordW = max(1, log2(B^3 / P))`.
+    /// `WordW = max(1, log2(B^3 / Q))`.
     pub fn word_w(&self) -> u32 {
         self.groups().trailing_zeros().max(1)
     }
 
     /// Bits of a fetch item (the payload of op 0).
     pub fn item_w(&self) -> u32 {
-        self.p * self.voxel_w + 3 * self.nb_w() + self.word_w() + 4
+        self.item_p() * self.voxel_w + 3 * self.nb_w() + self.word_w() + 4
     }
 
     /// Bits of a section command (the payload of op 1).
@@ -117,14 +139,14 @@ impl SectionBufConfig {
         3 + 3 * (self.m() + 1) + self.m()
     }
 
-    /// Words of one bank, `2 B MaxDim S / P`.
+    /// Words of one bank (`G P` of them), `2 B MaxDim S / Q`.
     pub fn bank_depth(&self) -> u32 {
-        2 * self.block_dim * self.max_dim * self.section / self.p
+        2 * self.block_dim * self.max_dim * self.section / self.item_p()
     }
 
-    /// Words of one edge bank, `2 MaxDim B / P`.
+    /// Words of one edge bank (`3 G P` of them), `2 MaxDim B / Q`.
     pub fn edge_depth(&self) -> u32 {
-        2 * self.max_dim * self.block_dim / self.p
+        2 * self.max_dim * self.block_dim / self.item_p()
     }
 
     /// The fetch sweep that feeds `cmd` (docs/numerics/section_buf.md, "Protocol").
@@ -146,6 +168,43 @@ impl SectionBufConfig {
         }
         .with_anchor_section(b, cmd.a0, self.section)
     }
+}
+
+/// Where voxel `(ci, j, lk)` of half `h` of a section swept along `axis_k` is stored
+/// (docs/numerics/section_buf.md, *Storage and the skew*): `(bank, word)` among the `G P` banks.
+/// `ci` is the column inside the section (`0 .. S`).
+pub fn bank_of(c: &SectionBufConfig, axis_k: u32, h: u32, ci: u32, j: u32, lk: u32) -> (u32, u32) {
+    let (p, b, s) = (c.p, c.block_dim, c.section);
+    let r = (ci + j + lk) % p;
+    let g = if c.item_groups == 1 {
+        0
+    } else {
+        // The P-group word's parity (x div P when B >= 2P, y when B = P) and bit 0 of ci div P.
+        let [x, y] = match axis_k {
+            0 => [lk, ci],
+            1 => [ci, lk],
+            _ => [ci, j],
+        };
+        let pi = if b >= 2 * p { (x / p) % 2 } else { y % 2 };
+        let cbit = (ci / p) % 2;
+        if axis_k != 0 && b >= 2 * p {
+            pi
+        } else {
+            pi ^ cbit
+        }
+    };
+    let q = c.item_p();
+    let word = ((h * b + lk) * c.max_dim + j) * (s / q) + ci / q;
+    (r + p * g, word)
+}
+
+/// Where edge voxel `(j, lk)` of half `h` is stored in each edge memory: `(bank, word)` among its
+/// `G P` banks (docs/numerics/section_buf.md, *Storage and the skew*).
+pub fn edge_bank_of(c: &SectionBufConfig, h: u32, j: u32, lk: u32) -> (u32, u32) {
+    let p = c.p;
+    let v = (h * c.max_dim + j) * (c.block_dim / p) + lk / p;
+    let e = if c.item_groups == 1 { 0 } else { v % 2 };
+    (lk % p + p * e, v / c.item_groups)
 }
 
 /// The sizes `(ni, nj, nk)` in frame axes of a volume of `dims` swept along `axis_k` (0..=2).
@@ -427,7 +486,7 @@ impl SectionBuf {
             return;
         }
         for (l, &v) in it.lanes.iter().enumerate() {
-            let w = it.word * c.p + l as u32;
+            let w = it.word * c.item_p() + l as u32;
             let local = [w % b, (w / b) % b, w / (b * b)];
             let pos: [u32; 3] = std::array::from_fn(|a| it.blk[a] * b + local[a]);
             let ci = i64::from(pos[ai]) - i64::from(g.cmd.a0);
@@ -550,12 +609,42 @@ crate::unit_config!(SectionBufConfig, "cube5_section_buf", DEFAULT, {
     "MaxDim" => max_dim,
     "BlockDim" => block_dim,
     "Section" => section,
+    "ItemGroups" => item_groups,
 });
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::phantom::head_phantom;
+
+    /// `(P, B, S, G)` of the model's checks: one and two P-groups per item, `B = P` and `B > P`.
+    const SHAPES: &[(u32, u32, u32, u32)] = &[
+        (1, 2, 4, 1),
+        (2, 4, 8, 1),
+        (4, 4, 16, 1),
+        (8, 8, 8, 1),
+        (4, 8, 16, 1),
+        (1, 2, 4, 2),
+        (2, 2, 4, 2),
+        (2, 4, 8, 2),
+        (4, 4, 8, 2),
+        (4, 8, 16, 2),
+    ];
+
+    /// A configuration of 12-bit voxels: `(P, B, S, G)` and the largest edge.
+    fn config(
+        (p, block_dim, section, item_groups): (u32, u32, u32, u32),
+        max_dim: u32,
+    ) -> SectionBufConfig {
+        SectionBufConfig {
+            p,
+            voxel_w: 12,
+            max_dim,
+            block_dim,
+            section,
+            item_groups,
+        }
+    }
 
     /// DRAM -> fetch model -> section buffer model equals the beams read from the volume, for
     /// every axis both ways, every section of the face, P = 1 .. 8, with empty blocks.
@@ -574,20 +663,8 @@ mod tests {
             d
         })
         .unwrap();
-        for (p, b, s) in [
-            (1u32, 2u32, 4u32),
-            (2, 4, 8),
-            (4, 4, 16),
-            (8, 8, 8),
-            (4, 8, 16),
-        ] {
-            let c = SectionBufConfig {
-                p,
-                voxel_w: 12,
-                max_dim: 32,
-                block_dim: b,
-                section: s,
-            };
+        for &(p, b, s, g) in SHAPES {
+            let c = config((p, b, s, g), 32);
             let lut = BlockLut::from_volume(&vol, b as usize, 0).unwrap();
             assert!(lut.entries.iter().any(|e| e.empty));
             for axis_k in 0..3 {
@@ -605,12 +682,81 @@ mod tests {
                         let got = unit.run(&c.section_inputs(&vol, &lut, &cmd).unwrap());
                         let want = section_beams(&c, &vol, &lut, &cmd).unwrap();
                         assert_eq!(got.len(), want.len());
-                        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
-                            assert_eq!(g, w, "P {p} B {b} S {s} {cmd:?}: beam {k}");
+                        for (k, (gb, w)) in got.iter().zip(&want).enumerate() {
+                            assert_eq!(gb, w, "P {p} B {b} S {s} G {g} {cmd:?}: beam {k}");
                         }
                         total += got.len() as u32;
                     }
                     assert_eq!(total, dims.iter().product::<u32>() / p);
+                }
+            }
+        }
+    }
+
+    /// The skew of *Storage and the skew*: every item writes each bank (and each edge bank) at
+    /// most once, every beam reads each bank at most once at one word, and no two voxels share a
+    /// bank word, for every axis and both item widths.
+    #[test]
+    fn the_banks_are_conflict_free() {
+        use std::collections::HashSet;
+        for &(p, b, s, g) in SHAPES.iter().chain(&[(2, 16, 32, 2)]) {
+            let c = config((p, b, s, g), 64);
+            let q = c.item_p();
+            let nj = 2 * b;
+            for axis_k in 0..3u32 {
+                let mut seen = HashSet::new();
+                for h in 0..2 {
+                    for lk in 0..b {
+                        for j in 0..nj {
+                            for ci in 0..s {
+                                let (bank, word) = bank_of(&c, axis_k, h, ci, j, lk);
+                                assert!(bank < g * p && word < c.bank_depth());
+                                assert!(seen.insert((bank, word)), "{c:?} axis {axis_k}");
+                            }
+                            for m in 0..s / p {
+                                let at: Vec<_> = (0..p)
+                                    .map(|l| bank_of(&c, axis_k, h, m * p + l, j, lk))
+                                    .collect();
+                                assert!(at.iter().all(|a| a.1 == at[0].1));
+                                let banks: HashSet<_> = at.iter().map(|a| a.0).collect();
+                                assert_eq!(banks.len(), p as usize);
+                            }
+                        }
+                    }
+                }
+                // Items: the Q voxels of local indices u Q .. u Q + Q - 1 of a block at the
+                // section's columns (frame coordinates by the axis), main and edge banks.
+                let mut eseen = HashSet::new();
+                for h in 0..2 {
+                    for j in 0..nj {
+                        for lk in 0..b {
+                            let (bank, word) = edge_bank_of(&c, h, j, lk);
+                            assert!(bank < g * p && word < c.edge_depth());
+                            assert!(eseen.insert((bank, word)));
+                        }
+                    }
+                }
+                for bi in 0..s / b + 2 {
+                    for u in 0..b * b * b / q {
+                        let mut main = HashSet::new();
+                        let mut edge = HashSet::new();
+                        for l in 0..q {
+                            let w = u * q + l;
+                            let local = [w % b, (w / b) % b, w / (b * b)];
+                            let (i, jj, k) = match axis_k {
+                                0 => (local[1], local[2], local[0]),
+                                1 => (local[0], local[2], local[1]),
+                                _ => (local[0], local[1], local[2]),
+                            };
+                            let ci = (bi * b + i) as i64 - b as i64;
+                            if (0..s as i64).contains(&ci) {
+                                assert!(main.insert(bank_of(&c, axis_k, 0, ci as u32, jj, k).0));
+                            } else if [-1, s as i64, s as i64 + 1].contains(&ci) {
+                                let bank = edge_bank_of(&c, 0, jj, k).0;
+                                assert!(edge.insert((ci, bank)), "{c:?} axis {axis_k}");
+                            }
+                        }
+                    }
                 }
             }
         }
@@ -631,6 +777,7 @@ mod tests {
             max_dim: 32,
             block_dim: 4,
             section: 8,
+            item_groups: 1,
         };
         let lut = BlockLut::from_volume(&vol, 4, 0).unwrap();
         let cmd = |a0| SectionCmd {

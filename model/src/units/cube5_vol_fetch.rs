@@ -70,9 +70,9 @@ impl VolFetchConfig {
             ));
         }
         let b = self.block_dim;
-        if !b.is_power_of_two() || b < self.p.max(2) || b > 16 || b >= self.max_dim {
+        if !b.is_power_of_two() || b < (self.p / 2).max(2) || b > 16 || b >= self.max_dim {
             return bad(format!(
-                "BlockDim {b} is not a power of two with max(2, P) <= B <= 16 and B < MaxDim"
+                "BlockDim {b} is not a power of two with max(2, P / 2) <= B <= 16 and B < MaxDim"
             ));
         }
         if !self.data_w.is_power_of_two()
@@ -988,7 +988,12 @@ mod tests {
     fn bad_parameters_are_refused() {
         for bad in [
             VolFetchConfig { p: 3, ..C },
-            VolFetchConfig { block_dim: 2, ..C },
+            VolFetchConfig {
+                p: 8,
+                block_dim: 2,
+                data_w: 128,
+                ..C
+            },
             VolFetchConfig { data_w: 32, ..C },
             VolFetchConfig {
                 block_dim: 64,
