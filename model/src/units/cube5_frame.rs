@@ -28,6 +28,7 @@ pub use fast::{
     render_base_plane_stats as render_base_plane_stats_fast, render_sweep, SweepStats, SweepVolume,
 };
 pub mod sections;
+pub mod window;
 
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;
