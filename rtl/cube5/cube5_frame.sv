@@ -62,7 +62,11 @@ module cube5_frame #(
   /// Pixels per output item: 1, or P (DepthTest = 0 only): the read-out takes the P banks' words
   /// at one address, P consecutive pixels of a row per cycle, H ceil(W / P) items in all
   /// (docs/frame-rtl.md, "The read-out").
-  parameter int unsigned OutLanes   = 1
+  parameter int unsigned OutLanes   = 1,
+  /// Source = 1: the widest section the frame takes (sec_ns <= MaxSection, else refused), a
+  /// multiple of P in 2 P ..= MaxDim; the slice FIFOs hold MaxSection MaxDim / P beats instead of
+  /// MaxDim^2 / P (docs/frame-rtl.md, "Fed by a beat stream"). Source = 0: MaxDim.
+  parameter int unsigned MaxSection = MaxDim
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -161,6 +165,10 @@ module cube5_frame #(
   end
   if (OutLanes != 1 && (OutLanes != P || DepthTest != 0)) begin : gen_bad_out_lanes
     $fatal(1, "cube5_frame: OutLanes must be 1, or P without the depth test");
+  end
+  if (MaxSection > MaxDim || MaxSection < 2 * P || MaxSection % P != 0
+      || (Source == 0 && MaxSection != MaxDim)) begin : gen_bad_max_section
+    $fatal(1, "cube5_frame: MaxSection must be a multiple of P in 2 P ..= MaxDim (MaxDim when Source = 0)");
   end
   if (DepthTest > 1) begin : gen_bad_depth_test
     $fatal(1, "cube5_frame: DepthTest must be 0 or 1");
@@ -359,7 +367,7 @@ module cube5_frame #(
     // The section: P-aligned, inside the face (Source = 0: the face itself).
     sec_end   = {1'b0, DimW'(sa0)} + {1'b0, sns};
     sec_ok_d  = ((sa0 & M'(P - 1)) == '0) && ((sns & DimW'(P - 1)) == '0)
-                && (sec_end <= {1'b0, ni_q});
+                && (sec_end <= {1'b0, ni_q}) && (sns <= DimW'(MaxSection));
   end
 
   always_ff @(posedge clk_i) begin
@@ -755,6 +763,7 @@ module cube5_frame #(
     .DimW    (DimW),
     .TW      (TW),
     .DW      (DW),
+    .MaxRow  (MaxSection),
     .Edges   (Source)
   ) u_interp (
     .clk_i        (clk_i),
