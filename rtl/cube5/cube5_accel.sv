@@ -420,7 +420,8 @@ module cube5_accel #(
     .P(P), .MaxDim(MaxDim), .VoxelW(VoxelW), .WeightW(WeightW), .FracW(FracW),
     .BlockDim(BlockDim), .ClassIdxW(ClassIdxW), .MagIdxW(MagIdxW), .MagShift(MagShift),
     .ColorW(ColorW), .AlphaW(AlphaW), .RmLog2(RmLog2), .RmFracW(RmFracW), .DiffW(DiffW),
-    .SpecW(SpecW), .ExtraW(ExtraW), .AccW(AccW), .ZW(ZW), .Shade(1), .Source(1)
+    .SpecW(SpecW), .ExtraW(ExtraW), .AccW(AccW), .ZW(ZW), .Shade(1), .Source(1),
+    .MaxSection(Section)
   ) u_frame (
     .clk_i, .rst_ni,
     .in_valid_i(fr_in_valid), .in_ready_o(fr_in_ready), .in_data_i(fr_in_data),

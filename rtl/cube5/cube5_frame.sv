@@ -58,7 +58,15 @@ module cube5_frame #(
   /// geometry"): 1 keeps a per-pixel RGBA-Z table (configuration region 5) beside the compositing
   /// buffer, every ray starts from its pixel's Z and colour, and the read-out flushes the geometry
   /// colour under each ray through one more cube5_compos (mode Flush). 0: none of it.
-  parameter int unsigned DepthTest  = 0
+  parameter int unsigned DepthTest  = 0,
+  /// Pixels per output item: 1, or P (DepthTest = 0 only): the read-out takes the P banks' words
+  /// at one address, P consecutive pixels of a row per cycle, H ceil(W / P) items in all
+  /// (docs/frame-rtl.md, "The read-out").
+  parameter int unsigned OutLanes   = 1,
+  /// Source = 1: the widest section the frame takes (sec_ns <= MaxSection, else refused), a
+  /// multiple of P in 2 P ..= MaxDim; the slice FIFOs hold MaxSection MaxDim / P beats instead of
+  /// MaxDim^2 / P (docs/frame-rtl.md, "Fed by a beat stream"). Source = 0: MaxDim.
+  parameter int unsigned MaxSection = MaxDim
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -76,8 +84,9 @@ module cube5_frame #(
   output logic out_valid_o,
   /// Consumer takes the item.
   input  logic out_ready_i,
-  /// coxel (compos packing), error (1), beats read (32), sweep cycles (32); LSB first.
-  output logic [cube5_frame_pkg::out_w(AccW, ZW, ColorW)-1:0] out_data_o,
+  /// OutLanes coxels (compos packing; lane k is pixel R + k of the item's row, lanes past the
+  /// row's end carry the empty coxel), error (1), beats read (32), sweep cycles (32); LSB first.
+  output logic [cube5_frame_pkg::out_lanes_w(OutLanes, AccW, ZW, ColorW)-1:0] out_data_o,
 
   /// Configuration write (frame registers, voxels, block LUT, shader and compositing tables).
   input  logic cfg_valid_i,
@@ -153,6 +162,13 @@ module cube5_frame #(
   end
   if (Source > 1) begin : gen_bad_source
     $fatal(1, "cube5_frame: Source must be 0 (the skewed memory) or 1 (a beat stream)");
+  end
+  if (OutLanes != 1 && (OutLanes != P || DepthTest != 0)) begin : gen_bad_out_lanes
+    $fatal(1, "cube5_frame: OutLanes must be 1, or P without the depth test");
+  end
+  if (MaxSection > MaxDim || MaxSection < 2 * P || MaxSection % P != 0
+      || (Source == 0 && MaxSection != MaxDim)) begin : gen_bad_max_section
+    $fatal(1, "cube5_frame: MaxSection must be a multiple of P in 2 P ..= MaxDim (MaxDim when Source = 0)");
   end
   if (DepthTest > 1) begin : gen_bad_depth_test
     $fatal(1, "cube5_frame: DepthTest must be 0 or 1");
@@ -351,7 +367,7 @@ module cube5_frame #(
     // The section: P-aligned, inside the face (Source = 0: the face itself).
     sec_end   = {1'b0, DimW'(sa0)} + {1'b0, sns};
     sec_ok_d  = ((sa0 & M'(P - 1)) == '0) && ((sns & DimW'(P - 1)) == '0)
-                && (sec_end <= {1'b0, ni_q});
+                && (sec_end <= {1'b0, ni_q}) && (sns <= DimW'(MaxSection));
   end
 
   always_ff @(posedge clk_i) begin
@@ -412,9 +428,13 @@ module cube5_frame #(
     end
   end
 
-  // W * H, needed only by the read-out: multiplied from the registers during the sweep.
+  // The read-out's items, H ceil(W / OutLanes) (W H at one lane), needed only by the read-out:
+  // multiplied from the registers during the sweep.
+  localparam int unsigned LogLanes = $clog2(OutLanes);
   logic [PixW-1:0] pixels_d;
-  assign pixels_d = PixW'(w_q) * PixW'(h_q);
+  logic [DimW:0]   w_items;
+  assign w_items  = (w_q + (DimW+1)'(OutLanes - 1)) >> LogLanes;
+  assign pixels_d = PixW'(w_items) * PixW'(h_q);
 
   always_ff @(posedge clk_i) begin
     if (state_q == StSweep) pixels_q <= pixels_d;
@@ -743,6 +763,7 @@ module cube5_frame #(
     .DimW    (DimW),
     .TW      (TW),
     .DW      (DW),
+    .MaxRow  (MaxSection),
     .Edges   (Source)
   ) u_interp (
     .clk_i        (clk_i),
@@ -853,7 +874,8 @@ module cube5_frame #(
   logic [P*StoreW-1:0] upd_cox, upd_res;
   logic [P*RgbaW-1:0] upd_pay;
   logic [DimW-1:0]    upd_depth;
-  logic [StoreW-1:0]  cb_out_cox, empty_cox;
+  logic [OutLanes*StoreW-1:0] cb_out_cox;
+  logic [StoreW-1:0]  empty_cox;
   logic [P*CbGeoPW-1:0] cb_upd_geo;
   logic [CbGeoPW-1:0] cb_out_geo;
   logic               cb_out_ready;
@@ -874,7 +896,8 @@ module cube5_frame #(
     .TW     (TW),
     .DW     (DW),
     .GeoW   (CbGeoW),
-    .GeoPW  (CbGeoPW)
+    .GeoPW  (CbGeoPW),
+    .OutLanes (OutLanes)
   ) u_cbuf (
     .clk_i        (clk_i),
     .rst_ni       (cb_rst_n),
@@ -981,9 +1004,13 @@ module cube5_frame #(
   // ---------------------------------------------------------------------------
   // The read-out's coxel: as the buffer holds it, or (DepthTest) after a Flush item through one
   // more compositing unit, which puts the geometry colour under the ray (compos.md, rule 2).
-  logic              ro_valid;
-  logic [CoxelW-1:0] ro_cox, cb_full;
-  assign cb_full = full_coxel(cb_out_cox, out_geo);
+  logic                       ro_valid;
+  logic [OutLanes*CoxelW-1:0] ro_cox, cb_full;
+  always_comb begin
+    for (int unsigned k = 0; k < OutLanes; k++) begin
+      cb_full[k*CoxelW +: CoxelW] = full_coxel(cb_out_cox[k*StoreW +: StoreW], out_geo);
+    end
+  end
   if (DepthTest != 0) begin : gen_flush
     logic            fl_ready;
     logic [CInW-1:0] fl_in;
@@ -1017,7 +1044,9 @@ module cube5_frame #(
   logic error_item;
   assign error_item  = (state_q == StError);
   assign out_valid_o = error_item || (state_q == StReadout && ro_valid);
-  assign out_data_o  = {cycles_q, reads_q, error_item, error_item ? CoxelW'(0) : ro_cox};
+  logic [OutLanes*CoxelW-1:0] out_cox;
+  assign out_cox     = error_item ? '0 : ro_cox;
+  assign out_data_o  = {cycles_q, reads_q, error_item, out_cox};
 
   logic unused_top;
   assign unused_top = ^{co_ready, co_valid, co_out, cfg_data_i, cfg_off, unused_in};

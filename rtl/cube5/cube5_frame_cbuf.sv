@@ -15,7 +15,8 @@
 // (the compositing units, outside); their results are written back at the addresses kept in a FIFO.
 // A coxel is read again only in the next slice, at least nbs - nbr - 1 beats later; the frame refuses
 // volumes where that is not longer than the update loop (docs/frame-rtl.md). The read-out streams the
-// W x H coxels (q outer, r inner) and clears each word's valid bit behind it; after reset the buffer
+// W x H coxels (q outer, r inner; OutLanes = P: P pixels of a row per cycle, one word of every bank)
+// and clears each word's valid bit behind it; after reset the buffer
 // clears every valid bit once (clear_busy_o) before the first frame.
 //
 // GeoW > 0 (the frame's DepthTest = 1; docs/numerics/frame.md, "Opaque geometry"): beside each
@@ -36,7 +37,10 @@ module cube5_frame_cbuf #(
   /// Geometry table word width (Z and three colours), 0: no table.
   parameter int unsigned GeoW   = 0,
   /// Port width of the geometry words: GeoW, or 1 when there is no table.
-  parameter int unsigned GeoPW  = 1
+  parameter int unsigned GeoPW  = 1,
+  /// Pixels per read-out item: 1, or P (the P banks' words at one address, one row's P
+  /// consecutive pixels R = P c .. P c + P - 1 per cycle; GeoW = 0 only).
+  parameter int unsigned OutLanes = 1
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -86,8 +90,10 @@ module cube5_frame_cbuf #(
   input  logic [DimW:0] h_i,
   output logic out_valid_o,
   input  logic out_ready_i,
-  /// The pixel's coxel (empty_cox_i when no sample reached it).
-  output logic [CoxW-1:0] out_cox_o,
+  /// The pixel's coxel (empty_cox_i when no sample reached it); OutLanes = P: the coxels of
+  /// pixels R .. R + P - 1 of one row, lane k at [k*CoxW +: CoxW] (lanes at R + k >= W read the
+  /// empty coxel: no sample reaches them).
+  output logic [OutLanes*CoxW-1:0] out_cox_o,
   /// The pixel's geometry word (GeoW > 0; else 0).
   output logic [GeoPW-1:0] out_geo_o,
   /// The read-out has issued its last read.
@@ -115,6 +121,9 @@ module cube5_frame_cbuf #(
   end
   if (P < 1 || (1 << LogP) != P || P > MaxDim) begin : gen_bad_p
     $fatal(1, "cube5_frame_cbuf: P must be a power of two, at most MaxDim");
+  end
+  if (OutLanes != 1 && (OutLanes != P || GeoW != 0)) begin : gen_bad_lanes
+    $fatal(1, "cube5_frame_cbuf: OutLanes must be 1, or P without a geometry table");
   end
 
   // ---------------------------------------------------------------------------
@@ -253,7 +262,8 @@ module cube5_frame_cbuf #(
   );
 
   // ---------------------------------------------------------------------------
-  // Read-out: q outer, r inner; one read per cycle while the output FIFO has room
+  // Read-out: q outer, r inner; one read per cycle while the output FIFO has room (OutLanes = P:
+  // r steps by P, every bank reads the word {q, r div P})
   // ---------------------------------------------------------------------------
   logic             ro_busy_q, ro_busy_d;
   logic [DimW:0]    ro_r_q, ro_r_d, ro_q_q, ro_q_d;
@@ -281,8 +291,8 @@ module cube5_frame_cbuf #(
       ro_r_d    = '0;
       ro_q_d    = '0;
     end else if (ro_issue) begin
-      if (ro_r_q + (DimW+1)'(1) < w_i) begin
-        ro_r_d = ro_r_q + (DimW+1)'(1);
+      if (ro_r_q + (DimW+1)'(OutLanes) < w_i) begin
+        ro_r_d = ro_r_q + (DimW+1)'(OutLanes);
       end else begin
         ro_r_d = '0;
         ro_q_d = ro_q_q + (DimW+1)'(1);
@@ -337,7 +347,7 @@ module cube5_frame_cbuf #(
       if (clr_busy_q) begin
         we = 1'b1;
       end else if (ro_issue) begin
-        we = (ro_bank == LaneW'(j));
+        we = (OutLanes > 1) || (ro_bank == LaneW'(j));
         wa = ro_addr;
       end else if (upd_valid_i) begin
         we = 1'b1;
@@ -417,12 +427,23 @@ module cube5_frame_cbuf #(
   // ---------------------------------------------------------------------------
   // Output FIFO of the read-out
   // ---------------------------------------------------------------------------
-  logic [WordW-1:0] ro_word;
-  logic [CoxW-1:0]  ro_cox;
-  logic             out_empty, unused_out_full;
+  logic [OutLanes*CoxW-1:0] ro_cox;
+  logic                     out_empty, unused_out_full;
 
-  assign ro_word = rd_word[ro_bank_q*WordW +: WordW];
-  assign ro_cox  = ro_word[CoxW] ? ro_word[CoxW-1:0] : empty_cox_i;
+  if (OutLanes == 1) begin : gen_ro_one
+    logic [WordW-1:0] ro_word;
+    assign ro_word = rd_word[ro_bank_q*WordW +: WordW];
+    assign ro_cox  = ro_word[CoxW] ? ro_word[CoxW-1:0] : empty_cox_i;
+  end else begin : gen_ro_lanes
+    // Bank k holds pixel R + k (R a multiple of P).
+    logic unused_ro_bank;
+    assign unused_ro_bank = ^ro_bank_q;
+    always_comb begin
+      for (int unsigned k = 0; k < OutLanes; k++) begin
+        ro_cox[k*CoxW +: CoxW] = rd_word[k*WordW + CoxW] ? rd_word[k*WordW +: CoxW] : empty_cox_i;
+      end
+    end
+  end
 
   if (GeoW > 0) begin : gen_out_geo
     // The read-out word's geometry travels with its coxel.
@@ -444,7 +465,7 @@ module cube5_frame_cbuf #(
     );
   end else begin : gen_out
     cube5_frame_fifo #(
-      .Width (CoxW),
+      .Width (OutLanes * CoxW),
       .Depth (OutDepth)
     ) u_out (
       .clk_i   (clk_i),

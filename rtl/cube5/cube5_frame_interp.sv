@@ -19,6 +19,8 @@
 module cube5_frame_interp #(
   parameter int unsigned P       = 4,
   parameter int unsigned MaxDim  = 64,
+  /// Longest row in anchors (cube5_frame_vwin): MaxDim, or the widest section.
+  parameter int unsigned MaxRow  = MaxDim,
   parameter int unsigned VoxelW  = 12,
   parameter int unsigned WeightW = 8,
   parameter int unsigned FracW   = 4,
@@ -88,6 +90,7 @@ module cube5_frame_interp #(
     .P      (P),
     .VoxelW (VoxelW),
     .MaxDim (MaxDim),
+    .MaxRow (MaxRow),
     .Extra  (3 * Edges)
   ) u_vwin (
     .clk_i       (clk_i),

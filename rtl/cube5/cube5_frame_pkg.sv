@@ -146,6 +146,13 @@ package cube5_frame_pkg;
     out_w = coxel_w(acc_w, z_w, color_w) + 1 + 2 * CntW;
   endfunction
 
+  /// Bits of one output item of a frame with OutLanes coxels per item: the coxels (lane 0 lowest),
+  /// error, beats read, sweep cycles (out_w is the one-lane case).
+  function automatic int unsigned out_lanes_w(int unsigned lanes, int unsigned acc_w,
+                                              int unsigned z_w, int unsigned color_w);
+    out_lanes_w = lanes * coxel_w(acc_w, z_w, color_w) + 1 + 2 * CntW;
+  endfunction
+
   /// Source = 1: bits of a command's payload: op (2), sec_a0 (m), sec_ns (m + 1), sec_first,
   /// sec_last.
   function automatic int unsigned sec_cmd_w(int unsigned max_dim_log2);

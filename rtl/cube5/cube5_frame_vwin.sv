@@ -19,6 +19,9 @@ module cube5_frame_vwin #(
   parameter int unsigned VoxelW = 12,
   /// Largest volume edge.
   parameter int unsigned MaxDim = 64,
+  /// Longest row in anchors: MaxDim, or a sectioned frame's widest section (the slice FIFOs hold
+  /// MaxRow MaxDim / P beats; slice_len_i stays below that).
+  parameter int unsigned MaxRow = MaxDim,
   /// Voxels carried beside the P lanes of each beat (3: a sectioned frame's edge voxels lo, hi0,
   /// hi1; 0: none). They travel through every delay line with their beat.
   parameter int unsigned Extra  = 0
@@ -42,6 +45,18 @@ module cube5_frame_vwin #(
 );
 
   localparam int unsigned BeatW = (P + Extra) * VoxelW;
+  localparam int unsigned SliceDepth = MaxRow * MaxDim / P;
+  localparam int unsigned SliceLenW  = $clog2(SliceDepth + 1);
+
+  if (MaxRow < 2 * P || MaxRow > MaxDim) begin : gen_bad_max_row
+    $fatal(1, "cube5_frame_vwin: MaxRow must be 2 P ..= MaxDim");
+  end
+
+  // The slice FIFOs' length (explicitly sized: Yosys ignores a narrowing cast on a port).
+  logic [SliceLenW-1:0] slice_len;
+  logic                 unused_slice_len;
+  assign slice_len        = slice_len_i[SliceLenW-1:0];
+  assign unused_slice_len = ^slice_len_i;
 
   // Per level L at [L*BeatW +: BeatW] (flat vectors: these are registers, not RAMs).
   logic [3*BeatW-1:0] lvl;        // hi_cur of each level
@@ -55,13 +70,13 @@ module cube5_frame_vwin #(
   for (genvar l = 1; l < 3; l++) begin : gen_slice_fifo
     cube5_frame_delay #(
       .Width (BeatW),
-      .Depth (MaxDim * MaxDim / P)
+      .Depth (SliceDepth)
     ) u_slice (
       .clk_i   (clk_i),
       .rst_ni  (rst_ni),
       .clear_i (clear_i),
       .en_i    (en_i),
-      .len_i   (slice_len_i),
+      .len_i   (slice_len),
       .d_i     (lvl[(l-1)*BeatW +: BeatW]),
       .q_o     (lvl[l*BeatW +: BeatW])
     );

@@ -9,7 +9,7 @@
 //! pixels are compared with the model's image.
 
 use crate::error::{Mismatch, TbError};
-use crate::rtl::{RtlStream, Traffic};
+use crate::rtl::{RtlStream, Taken, Traffic};
 use crate::variants::{variants_of, Variant};
 use cube5_model::bits::{BitReader, BitWriter};
 use cube5_model::error::ModelError;
@@ -138,10 +138,13 @@ pub use cube5_model::units::cube5_frame::FrameMode as Render;
 /// A `render` code the frame refuses (the field's top code; the modes take 0..=4).
 pub const RENDER_REFUSED: u32 = (1 << REG_MODE_RENDER.width) - 1;
 
-/// One output item: a base-plane coxel and the frame's status.
+/// One output item: a base-plane coxel and the frame's status. With `OutLanes = P` an item holds
+/// P pixels of a row: `coxel` is the first, `rest` the others (the drivers expand an item into
+/// its pixels with [`pixels_of`], each with an empty `rest`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameOut {
     pub coxel: Coxel,
+    pub rest: Vec<Coxel>,
     pub error: bool,
     /// Memory beats the sweep read from the modules.
     pub reads: u32,
@@ -362,7 +365,7 @@ impl StreamCodec for FrameRtl {
     }
 
     fn out_width(&self) -> u32 {
-        self.compos.coxel_w() + 1 + 64
+        self.out_lanes as u32 * self.compos.coxel_w() + 1 + 64
     }
 
     fn pack_in(&self, op: &u32) -> Vec<u32> {
@@ -373,8 +376,13 @@ impl StreamCodec for FrameRtl {
 
     fn unpack_out(&self, words: &[u32]) -> FrameOut {
         let mut r = BitReader::new(words);
+        let coxel = cube5_compos::get_coxel(&mut r, &self.compos);
+        let rest = (1..self.out_lanes)
+            .map(|_| cube5_compos::get_coxel(&mut r, &self.compos))
+            .collect();
         FrameOut {
-            coxel: cube5_compos::get_coxel(&mut r, &self.compos),
+            coxel,
+            rest,
             error: r.get_bool(),
             reads: r.get(32) as u32,
             cycles: r.get(32) as u32,
@@ -920,13 +928,14 @@ impl FrameBench {
     /// Drives the render command until the W H pixels of `e`'s base plane are out (or a cycle
     /// limit far beyond the frame's budget passes).
     pub fn render(&mut self, e: &Expected, traffic: &Traffic) -> Result<Rendered, TbError> {
-        let n = (e.w * e.h) as u64;
+        let n = items_for(e.w, e.h, self.rtl.out_lanes);
         let start = self.dut.cycle();
         let limit = 40 * (e.params.samples() as u64 + n) + 100_000;
         let driven = self.dut.drive(&[OP_RENDER], traffic, n, limit)?;
+        let (pixels, taken_at) = pixels_of(&driven.outputs, e.w, self.rtl.out_lanes);
         Ok(Rendered {
-            pixels: driven.outputs.iter().map(|t| t.value.clone()).collect(),
-            taken_at: driven.outputs.iter().map(|t| t.cycle).collect(),
+            pixels,
+            taken_at,
             cycles: self.dut.cycle() - start,
             protocol_errors: driven.stats.protocol_errors,
             limit,
@@ -1020,6 +1029,37 @@ impl FrameBench {
             accesses,
         })
     }
+}
+
+/// Output items of a `w`-pixel-wide image, `lanes` pixels per item (a row's last item keeps only
+/// the pixels up to its end): one `FrameOut` per pixel, each with the cycle its item was taken.
+pub fn pixels_of(items: &[Taken<FrameOut>], w: usize, lanes: usize) -> (Vec<FrameOut>, Vec<u64>) {
+    let (mut pixels, mut taken_at) = (Vec::new(), Vec::new());
+    let per_row = w.div_ceil(lanes.max(1)).max(1);
+    for (n, t) in items.iter().enumerate() {
+        let keep = if t.value.error {
+            1
+        } else {
+            lanes.min(w - (n % per_row) * lanes)
+        };
+        for c in std::iter::once(t.value.coxel)
+            .chain(t.value.rest.iter().copied())
+            .take(keep)
+        {
+            pixels.push(FrameOut {
+                coxel: c,
+                rest: Vec::new(),
+                ..t.value.clone()
+            });
+            taken_at.push(t.cycle);
+        }
+    }
+    (pixels, taken_at)
+}
+
+/// Output items of a `w x h` image with `lanes` pixels per item.
+pub fn items_for(w: usize, h: usize, lanes: usize) -> u64 {
+    (w.div_ceil(lanes.max(1)) * h) as u64
 }
 
 /// The RTL's output of one render command.

@@ -6,7 +6,9 @@
 //! (`render_base_plane`, what [`Expected`] holds): sections must change no bit.
 
 use crate::error::{Mismatch, TbError};
-use crate::frame::{ray_trail, Expected, FrameOut, FrameRtl, Render, Rendered, REG_MODE};
+use crate::frame::{
+    items_for, pixels_of, ray_trail, Expected, FrameOut, FrameRtl, Render, Rendered, REG_MODE,
+};
 use crate::rtl::{RtlStream, Traffic};
 use crate::variants::variants_of;
 use cube5_model::bits::BitWriter;
@@ -225,13 +227,14 @@ impl StreamBench {
         items: &[StreamIn],
         traffic: &Traffic,
     ) -> Result<Rendered, TbError> {
-        let n = (e.w * e.h) as u64;
+        let n = items_for(e.w, e.h, self.rtl.out_lanes);
         let start = self.dut.cycle();
         let limit = 60 * (items.len() as u64 + n) + 200_000;
         let driven = self.dut.drive(items, traffic, n, limit)?;
+        let (pixels, taken_at) = pixels_of(&driven.outputs, e.w, self.rtl.out_lanes);
         Ok(Rendered {
-            pixels: driven.outputs.iter().map(|t| t.value.clone()).collect(),
-            taken_at: driven.outputs.iter().map(|t| t.cycle).collect(),
+            pixels,
+            taken_at,
             cycles: self.dut.cycle() - start,
             protocol_errors: driven.stats.protocol_errors,
             limit,

@@ -203,11 +203,21 @@ fn budget(
             3 + (nbs * e.params.nk) as u64 + (nbs + 2 * nbr + 2) as u64 + pipeline
         })
         .sum();
-    let n = (e.w * e.h) as u64;
+    // The read-out: one item per clock, OutLanes pixels of a row each.
+    let n = cube5_tb::frame::items_for(e.w, e.h, rtl.out_lanes);
     assert_eq!(
         got.taken_at[got.taken_at.len() - 1] - got.taken_at[0] + 1,
         n,
-        "one pixel per clock"
+        "one item of {} pixels per clock",
+        rtl.out_lanes
+    );
+    eprintln!(
+        "{} S = {w}: read-out {n} cycles for {} x {} pixels ({} per item; {} at one per clock)",
+        rtl.variant,
+        e.w,
+        e.h,
+        rtl.out_lanes,
+        e.w * e.h
     );
     (u64::from(sweep), ideal, beats)
 }

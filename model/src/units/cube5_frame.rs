@@ -28,6 +28,7 @@ pub use fast::{
     render_base_plane_stats as render_base_plane_stats_fast, render_sweep, SweepStats, SweepVolume,
 };
 pub mod sections;
+pub mod window;
 
 /// Fraction bits of the per-slice ray steps `DX`, `DY` (`S(2.StepW)`).
 pub const STEP_W: u32 = 16;
@@ -85,6 +86,9 @@ pub struct FrameConfig {
     /// ray starts from, and the read-out's flush of the geometry colour under each ray
     /// (docs/numerics/frame.md, "Opaque geometry").
     pub depth_test: bool,
+    /// Pixels per output item of the read-out (`OutLanes`): 1, or `p` (P consecutive pixels of a
+    /// row per item and per clock, `H ceil(W / P)` items; docs/frame-rtl.md, "The read-out").
+    pub out_lanes: usize,
 }
 
 impl FrameConfig {
@@ -101,6 +105,7 @@ impl FrameConfig {
         shade: true,
         stream: false,
         depth_test: false,
+        out_lanes: 1,
     };
 
     /// The largest volume edge (`MaxDim`).
@@ -122,6 +127,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         let mut shade = u32::from(d.shade);
         let mut source = u32::from(d.stream);
         let mut depth_test = u32::from(d.depth_test);
+        let mut out_lanes = d.out_lanes as u32;
         crate::unit::set_params(
             Self::TOP,
             params,
@@ -148,8 +154,14 @@ impl crate::unit::UnitConfig for FrameConfig {
                 ("Shade", &mut shade),
                 ("Source", &mut source),
                 ("DepthTest", &mut depth_test),
+                ("OutLanes", &mut out_lanes),
             ],
         )?;
+        if out_lanes != 1 && (out_lanes != p || depth_test != 0) {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: OutLanes = {out_lanes} must be 1, or P = {p} without the depth test"
+            )));
+        }
         if depth_test > 1 {
             return Err(ModelError::Config(format!(
                 "cube5_frame: DepthTest = {depth_test} must be 0 or 1"
@@ -189,6 +201,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             shade: shade == 1,
             stream: source == 1,
             depth_test: depth_test == 1,
+            out_lanes: out_lanes as usize,
         })
     }
 
@@ -218,6 +231,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             ("Shade", i64::from(self.shade)),
             ("Source", i64::from(self.stream)),
             ("DepthTest", i64::from(self.depth_test)),
+            ("OutLanes", self.out_lanes as i64),
         ]
     }
 }

@@ -177,6 +177,30 @@ impl SectionVoxels {
     ) -> [u32; 7] {
         neighbourhood_from(c, a, b, |t, a, b| self.sample(params, c, t, a, b, trilin))
     }
+
+    /// The shaded sample at anchor `(a, b)` of slice `c` (an anchor of this section) that the
+    /// compositing unit takes: gradient and shader, or the classification alone (`Shade = 0`).
+    pub fn shaded(
+        &self,
+        params: &FrameParams,
+        units: &FrameUnits,
+        c: &SliceConst,
+        a: usize,
+        b: usize,
+    ) -> crate::units::cube5_compos::Sample {
+        let s = c.s;
+        if units.shade {
+            let mode = ShaderMode {
+                tf2d: false,
+                unlit: units.mode == super::FrameMode::Mip,
+            };
+            let nb = self.neighbourhood(params, c, a, b, &units.trilin);
+            shade_n6(&units.gradient, &units.shader, &nb, mode, s as u32)
+        } else {
+            let centre = self.sample(params, c, s as i64, a as i64, b as i64, &units.trilin);
+            super::classify_only(&units.shader, centre, s as u32)
+        }
+    }
 }
 
 /// The base plane rendered section by section in `order`, each section from its own beats
@@ -192,24 +216,13 @@ pub fn render_sections(
 ) -> Result<BasePlane> {
     let (w, h) = params.base_plane_size();
     let mut coxels = vec![Coxel::empty(&units.compos.config()); w * h];
-    let mode = ShaderMode {
-        tf2d: false,
-        unlit: units.mode == super::FrameMode::Mip,
-    };
     for &sec in order {
         let data = SectionVoxels::from_beats(params, sec, &section_beats(params, vol, sec, p))?;
         for s in 0..params.nk {
             let c = params.slice(s);
             for b in 0..params.nj {
                 for a in sec.a0..sec.a0 + sec.ns {
-                    let smp = if units.shade {
-                        let nb = data.neighbourhood(params, &c, a, b, &units.trilin);
-                        shade_n6(&units.gradient, &units.shader, &nb, mode, s as u32)
-                    } else {
-                        let centre =
-                            data.sample(params, &c, s as i64, a as i64, b as i64, &units.trilin);
-                        super::classify_only(&units.shader, centre, s as u32)
-                    };
+                    let smp = data.shaded(params, units, &c, a, b);
                     let (r, q) = params.pixel_of(&c, a, b);
                     coxels[q * w + r] = units.compos.step(&coxels[q * w + r], &smp);
                 }
@@ -223,6 +236,21 @@ pub fn render_sections(
     })
 }
 
+/// Views of the section and window tests: the six faces (DX = 0), 45 degrees both ways, obliques
+/// with DX > 0 and DX < 0.
+#[cfg(test)]
+pub(super) fn test_views() -> Vec<[f64; 3]> {
+    let mut v: Vec<[f64; 3]> = crate::camera::FACE_DIRECTIONS.to_vec();
+    v.extend([
+        [1.0, 0.0, 1.0],
+        [-1.0, -1.0, 1.0],
+        [0.37, 0.81, -1.0],
+        [-0.6, 0.3, 1.0],
+        [0.9, -1.0, 0.2],
+    ]);
+    v
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -232,18 +260,7 @@ mod tests {
     };
     use glam::DVec3;
 
-    /// Views: the six faces (DX = 0), 45 degrees both ways, obliques with DX > 0 and DX < 0.
-    fn views() -> Vec<[f64; 3]> {
-        let mut v: Vec<[f64; 3]> = crate::camera::FACE_DIRECTIONS.to_vec();
-        v.extend([
-            [1.0, 0.0, 1.0],
-            [-1.0, -1.0, 1.0],
-            [0.37, 0.81, -1.0],
-            [-0.6, 0.3, 1.0],
-            [0.9, -1.0, 0.2],
-        ]);
-        v
-    }
+    use super::test_views as views;
 
     fn units(setup: &FrameSetup, mode: FrameMode) -> FrameUnits {
         let tf = TransferFunction::head_default();
