@@ -906,6 +906,7 @@ module cube5_frame #(
     .start_i      (start),
     .nbr_i        (nbr),
     .nj_i         (nj_q),
+    .far_x_i      (!edge_hi_on),
     .s_first_i    (s_first_q),
     .s_last_i     (s_last_q),
     .tx0_i        (tx0_q),

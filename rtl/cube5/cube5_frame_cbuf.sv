@@ -54,6 +54,9 @@ module cube5_frame_cbuf #(
   input  logic start_i,
   input  logic [DimW-1:0] nbr_i,
   input  logic [DimW-1:0] nj_i,
+  /// The section's last anchor is the face's (a = ni - 1): only there does a sample past the
+  /// x far face exist (1 for a whole-face sweep).
+  input  logic            far_x_i,
   /// The sweep's first and last slice, T_x and T_y of the first (cube5_frame_pos).
   input  logic [DimW-1:0] s_first_i,
   input  logic [DimW-1:0] s_last_i,
@@ -216,7 +219,8 @@ module cube5_frame_cbuf #(
   always_comb begin
     for (int unsigned l = 0; l < P; l++) begin
       past[l] = ((ty[StepW-1:0] != '0) && (pos_b == nj_i - DimW'(1)))
-                || ((tx[StepW-1:0] != '0) && (pos_m == nbr_i - DimW'(1)) && (l == P - 1));
+                || ((tx[StepW-1:0] != '0) && far_x_i && (pos_m == nbr_i - DimW'(1))
+                    && (l == P - 1));
     end
   end
 

@@ -303,15 +303,11 @@ fn newer_modes_through_the_registers() {
     modes_bit_exact(&newer_modes(), s);
 }
 
-/// MinIP (`Mode.render` 2) through the registers, as `newer_modes_through_the_registers`. Fails
-/// today in the frame fed by sections (`Source = 1`, never co-simulated in MinIP before): a ray
-/// the model's samples reach reads untouched (A all ones) when the view has `fx(s) != 0` and the
-/// face has two sections or more (faces and 45 degrees pass; obliques pass on 32^3 in one 32-anchor
-/// section and fail on 64^3 in two). cube5_frame_cbuf's `past` (a sample past a far face, which
-/// MinIP leaves out) compares the beat with `nbr`, the *section's* beats per row, so it drops the
-/// last anchor of every section, not only the face's (docs/accel.md, *Modes*).
+/// MinIP (`Mode.render` 2) through the registers, as `newer_modes_through_the_registers`. The
+/// obliques cross section boundaries (64^3: two sections), where the frame leaves out a sample
+/// past the x far face only in the section that holds the face's last anchor (cube5_frame_cbuf's
+/// `far_x_i`); before that fix every section's last anchor was taken for the face's.
 #[test]
-#[ignore = "sim-full: fails in cube5_frame (Source = 1): MinIP's past-a-far-face test at every section's last anchor"]
 fn minip_through_the_registers() {
     modes_bit_exact(&[(Render::Minip, Look::default())], seed(0xacce18));
 }
