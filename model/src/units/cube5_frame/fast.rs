@@ -357,6 +357,11 @@ struct SliceWork<'a> {
     shift: u32,
     /// Per block of this slice: the largest corrected alpha its samples can have.
     amax: &'a [u64],
+    /// Per block row of this slice, `live_words` words: bit `c` set when block column `c` can
+    /// change a coxel that is not terminated (its largest alpha is above 0, or a zero alpha is
+    /// not every coxel's identity). The band visits only these blocks.
+    live: &'a [u64],
+    live_words: usize,
     /// Samples of corrected alpha 0 are the identity of every coxel.
     zero_ok: bool,
     /// Base-plane column of anchor 0 and row of anchor row 0.
@@ -426,33 +431,66 @@ impl SliceWork<'_> {
         (n_rows, w): (usize, usize),
         band: &mut BandRows,
     ) -> SweepStats {
-        let (ni, nbi) = (self.sv.ni, self.sv.nbi);
+        let (ni, nbi, nw) = (self.sv.ni, self.sv.nbi, self.live_words);
         let mut st = SweepStats::default();
         band.b0 = b0 as isize;
         band.done.fill(0);
         for db in 0..n_rows {
             let b = b0 + db;
             st.samples += ni as u64;
-            let amax = &self.amax[(b / BLOCK) * nbi..(b / BLOCK + 1) * nbi];
+            let bj = b / BLOCK;
+            let amax = &self.amax[bj * nbi..(bj + 1) * nbi];
+            let live = &self.live[bj * nw..(bj + 1) * nw];
             let row_at = at + db * w + self.r0;
-            for (c, &am) in amax.iter().enumerate() {
-                let a0 = c * BLOCK;
-                let len = BLOCK.min(ni - a0);
-                let lane = row_at + a0;
-                let k = if len == BLOCK {
-                    self.block::<BLOCK, LIT>(band, rays, (b, c), a0, lane, am)
-                } else {
-                    // The last block of a row narrower than a block: lane by lane.
-                    let mut k = SweepStats::default();
-                    for n in 0..len {
-                        k = k.add(self.block::<1, LIT>(band, rays, (b, c), a0 + n, lane + n, am));
+            // The blocks of the row that are not transparent, in order (the others leave every
+            // coxel they meet unchanged: `zero_alpha_is_identity`).
+            let mut visited = 0;
+            for (wi, &word) in live.iter().enumerate() {
+                let mut bits = word;
+                while bits != 0 {
+                    let c = wi * 64 + bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let am = amax[c];
+                    let a0 = c * BLOCK;
+                    let len = BLOCK.min(ni - a0);
+                    visited += len;
+                    let lane = row_at + a0;
+                    if len == BLOCK {
+                        self.block::<BLOCK, LIT>(band, rays, (b, c), a0, lane, am, &mut st);
+                    } else {
+                        // The last block of a row narrower than a block: lane by lane.
+                        for n in 0..len {
+                            self.block::<1, LIT>(band, rays, (b, c), a0 + n, lane + n, am, &mut st);
+                        }
                     }
-                    k
-                };
-                st = st.add(k);
+                }
             }
+            st.in_skipped_blocks += (ni - visited) as u64;
         }
         st
+    }
+
+    /// Asks the memory for the voxel rows anchor rows `b0 .. b1` of this slice read (rows `b0 ..=
+    /// b1` of its plane, and of the neighbour planes when `LIT`), ahead of their use.
+    #[inline(always)]
+    fn prefetch<const LIT: bool>(&self, b0: usize, b1: usize) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let pi = self.sv.ni + 1;
+            let nj = self.sv.nj;
+            let ks = [Some(self.k), self.k_after];
+            for k in ks.iter().take(if LIT { 2 } else { 1 }).flatten() {
+                for b in b0..=b1.min(nj) {
+                    let row = self.sv.row(*k, b);
+                    for at in (0..pi).step_by(32) {
+                        // SAFETY: `_mm_prefetch` only hints the cache; the address is inside
+                        // `row`.
+                        unsafe { _mm_prefetch::<_MM_HINT_T0>(row[at..].as_ptr().cast()) };
+                    }
+                }
+            }
+        }
     }
 
     /// Anchors `a0 .. a0 + N` of anchor row `b` (in block column `c`) against lanes `lane ..` of
@@ -468,17 +506,17 @@ impl SliceWork<'_> {
         a0: usize,
         lane: usize,
         am: u64,
-    ) -> SweepStats {
+        st: &mut SweepStats,
+    ) {
         let units = self.units;
         let rules = &self.rules;
         let (ni, nj) = (self.sv.ni, self.sv.nj);
-        let mut st = SweepStats::default();
         // Samples that cannot change a coxel they meet: `leaves_unchanged` holds for their
         // largest alpha, so for every smaller one (rules 1-4 do not read the alpha; rule 5 keeps
         // alpha 0 under `FrontToBack`, anything up to the coxel's under `Max`).
         if (am == 0 && self.zero_ok) || rules.all_unchanged::<N>(rays, lane, am) {
             st.in_skipped_blocks += N as u64;
-            return st;
+            return;
         }
         self.ensure(band, b as isize, c);
         let r = (b as isize - band.b0 + 1) as usize;
@@ -535,7 +573,6 @@ impl SliceWork<'_> {
         st.shaded += k.shaded;
         st.without_effect += k.without_effect;
         st.after_termination += k.after_termination;
-        st
     }
 }
 
@@ -553,11 +590,21 @@ fn sweep_band<const LIT: bool>(
     let n_rows = rows.len() / w;
     let init = rows[0];
     let mut rays = RayLanes::new(rows.len());
-    for work in slices {
+    // Anchor rows `b` with `q <= b + q0 < q + n_rows`, within `0 .. nj`.
+    let rows_of = |work: &SliceWork| {
         let nj = work.sv.nj;
-        // Anchor rows `b` with `q <= b + q0 < q + n_rows`, within `0 .. nj`.
         let b0 = q.saturating_sub(work.q0);
         let b1 = (q + n_rows).saturating_sub(work.q0).min(nj);
+        (b0, b1)
+    };
+    for (n, work) in slices.iter().enumerate() {
+        if let Some(next) = slices.get(n + 1) {
+            let (b0, b1) = rows_of(next);
+            if b0 < b1 {
+                next.prefetch::<LIT>(b0, b1);
+            }
+        }
+        let (b0, b1) = rows_of(work);
         if b0 >= b1 {
             continue;
         }
@@ -747,10 +794,23 @@ pub fn render_sweep(
             *m = range_max.max(idx_of(lo), idx_of(hi));
         }
     });
+    // Per swept slice, per block row: the blocks a band visits (bit `c` of word `c / 64`).
+    let live_words = sv.nbi.div_ceil(64);
+    let nl = sv.nbj * live_words;
+    let mut live = vec![0u64; swept.len() * nl];
+    for (live, amax) in live.chunks_exact_mut(nl).zip(amax.chunks_exact(nb)) {
+        for (bj, row) in amax.chunks_exact(sv.nbi).enumerate() {
+            for (c, &am) in row.iter().enumerate() {
+                if am != 0 || !zero_ok {
+                    live[bj * live_words + c / 64] |= 1 << (c % 64);
+                }
+            }
+        }
+    }
     let slices: Option<Vec<SliceWork>> = swept
         .clone()
-        .zip(amax.chunks_exact(nb))
-        .map(|(s, amax)| {
+        .zip(amax.chunks_exact(nb).zip(live.chunks_exact(nl)))
+        .map(|(s, (amax, live))| {
             let c = params.slice(s);
             Some(SliceWork {
                 units,
@@ -761,6 +821,8 @@ pub fn render_sweep(
                 colour_code: &colour_code,
                 shift,
                 amax,
+                live,
+                live_words,
                 zero_ok,
                 r0: (max_sx - c.shift_x) as usize,
                 q0: (max_sy - c.shift_y) as usize,
