@@ -346,9 +346,9 @@ struct SliceWork<'a> {
     /// The corrected alpha of each class index (the compositing unit's `corrected` of the class
     /// entry's alpha): a sample's effect is known before its gradient.
     corrected: &'a [u32],
-    /// The colours of the shaded sample of each class index, coded for the compositing unit,
-    /// when the gradient does not matter.
-    flat: Option<&'a [[u32; 3]]>,
+    /// The corrected alpha and the colours of the shaded sample of each class index, coded for
+    /// the compositing unit, when the gradient does not matter (one entry a sample reads).
+    flat: Option<&'a [[u32; 4]]>,
     /// The compositing unit's rules of this slice, on lanes.
     rules: LaneRules,
     /// `Compos::code` of each colour code (a channel's code on the coxel's scale).
@@ -524,16 +524,26 @@ impl SliceWork<'_> {
             .try_into()
             .expect("N anchors");
         let shift = self.shift;
-        let idx: [usize; N] = std::array::from_fn(|n| (centre[n] >> shift) as usize);
-        let sa: [u32; N] = std::array::from_fn(|n| self.corrected[idx[n]]);
+        // A class index is below the table's length (`SampleW - shift = ClassIdxW` bits); the
+        // minimum says so to the compiler, which then checks no bound per lane.
+        let last = self.corrected.len() - 1;
+        let idx: [usize; N] = std::array::from_fn(|n| ((centre[n] >> shift) as usize).min(last));
+        let mut sa = [0u32; N];
         let mut sc = [[0u32; N]; 3];
         if let Some(flat) = self.flat {
+            let flat = &flat[..=last];
             for n in 0..N {
                 let e = flat[idx[n]];
+                sa[n] = e[0];
                 for ch in 0..3 {
-                    sc[ch][n] = e[ch];
+                    sc[ch][n] = e[ch + 1];
                 }
             }
+        } else {
+            let corrected = &self.corrected[..=last];
+            sa = std::array::from_fn(|n| corrected[idx[n]]);
+        }
+        if self.flat.is_some() {
         } else if LIT {
             // The samples that change their coxel go through gradient and shader.
             let changes = rules.changes::<N>(rays, lane, &sa);
@@ -723,16 +733,17 @@ pub fn render_sweep(
     let lit = gradient_matters(&units.shader, smode);
     // Without the gradient, a sample's way through the shader and the compositing unit's coding
     // is a function of its class index: the units' own outputs, once per index.
-    let flat: Option<Vec<[u32; 3]>> = (!lit).then(|| {
+    let flat: Option<Vec<[u32; 4]>> = (!lit).then(|| {
         (0..corrected.len())
             .map(|idx| {
                 let e = units.shader.shade(&class_in((idx as u32) << shift, smode));
-                lanes::colours(&units.compos.code(&Sample {
+                let [r, g, b] = lanes::colours(&units.compos.code(&Sample {
                     rgb: [e.r, e.g, e.b],
                     alpha: e.a,
                     depth: 0,
                     mode: cmode,
-                }))
+                }));
+                [corrected[idx] as u32, r, g, b]
             })
             .collect()
     });
