@@ -456,11 +456,18 @@ impl SliceWork<'_> {
                     visited += len;
                     let lane = row_at + a0;
                     if len == BLOCK {
-                        self.block::<BLOCK, LIT>(band, rays, (b, c), a0, lane, am, &mut st);
+                        self.block::<BLOCK, LIT>(band, rays, (b, c), (a0, lane), am, &mut st);
                     } else {
                         // The last block of a row narrower than a block: lane by lane.
                         for n in 0..len {
-                            self.block::<1, LIT>(band, rays, (b, c), a0 + n, lane + n, am, &mut st);
+                            self.block::<1, LIT>(
+                                band,
+                                rays,
+                                (b, c),
+                                (a0 + n, lane + n),
+                                am,
+                                &mut st,
+                            );
                         }
                     }
                 }
@@ -503,8 +510,7 @@ impl SliceWork<'_> {
         band: &mut BandRows,
         rays: &mut RayLanes,
         (b, c): (usize, usize),
-        a0: usize,
-        lane: usize,
+        (a0, lane): (usize, usize),
         am: u64,
         st: &mut SweepStats,
     ) {
@@ -543,8 +549,7 @@ impl SliceWork<'_> {
             let corrected = &self.corrected[..=last];
             sa = std::array::from_fn(|n| corrected[idx[n]]);
         }
-        if self.flat.is_some() {
-        } else if LIT {
+        if LIT && self.flat.is_none() {
             // The samples that change their coxel go through gradient and shader.
             let changes = rules.changes::<N>(rays, lane, &sa);
             if changes.iter().any(|&x| x) {
