@@ -1095,6 +1095,80 @@ mod tests {
         assert!(st.in_skipped_blocks > 0 && st.shaded > 0, "{st:?}");
     }
 
+    /// Random transfer functions (transparent bands of random width between random colours and
+    /// alphas, some opaque enough to end rays) over a volume with empty blocks and empty margins,
+    /// from faces (both sweep directions), 45 degrees and random views: MIP, composite lit and
+    /// unlit, with and without early termination at random thresholds. A block skipped, a row of
+    /// blocks left out or a ray ended that the reference would change shows as a coxel that
+    /// differs.
+    #[test]
+    fn random_transfer_functions_equal_the_reference() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 5);
+        let cfg = FrameConfig::DEFAULT;
+        // The head inside a larger box: empty blocks around it, and a bright cube with a hole in
+        // one corner (blocks opaque next to blocks empty).
+        let mut vol = window(
+            &head_phantom(24, 12).unwrap(),
+            [-4, -2, -6],
+            [32, 28, 36],
+            [1.0; 3],
+        );
+        for z in 26..34 {
+            for y in 2..10 {
+                for x in 22..30 {
+                    if (x + y + z) % 5 != 0 {
+                        let at = (z * 28 + y) * 32 + x;
+                        vol.data[at] = 3000 + ((x * 37 + y * 11) % 900) as u16;
+                    }
+                }
+            }
+        }
+        let p = |density, rgba| crate::transfer::TfPoint { density, rgba };
+        let vs = views(3, &mut rng);
+        let mut total = SweepStats::default();
+        for n in 0..6 {
+            let mut densities: Vec<f64> = (0..rng.random_range(2..7))
+                .map(|_| rng.random_range(0.02..0.98))
+                .collect();
+            densities.sort_by(f64::total_cmp);
+            let mut points = vec![p(0.0, [0.0; 4])];
+            for d in densities {
+                let alpha = match rng.random_range(0..3) {
+                    0 => 0.0,
+                    1 => rng.random_range(0.0..0.2),
+                    _ => rng.random_range(0.5..1.0),
+                };
+                let [r, g, b] = std::array::from_fn(|_| rng.random_range(0.0..1.0));
+                points.push(p(d, [r, g, b, alpha]));
+            }
+            points.push(p(1.0, [1.0, 1.0, 1.0, rng.random_range(0.0..1.0)]));
+            let tf = TransferFunction { points };
+            for (m, v) in vs.iter().enumerate() {
+                let pipes = [1, 4][(n + m) % 2];
+                let et = [None, Some(rng.random_range(0.3..1.0))][(n + m) % 2];
+                for lit in [true, false] {
+                    let view = (*v, pipes, FrameMode::Composite);
+                    total = total.add(check_one_lit("random TF", &vol, &cfg, &tf, et, view, lit));
+                }
+                total = total.add(check_one(
+                    "random TF",
+                    &vol,
+                    &cfg,
+                    &tf,
+                    None,
+                    (*v, pipes, FrameMode::Mip),
+                ));
+            }
+        }
+        assert!(
+            total.in_skipped_blocks > 0
+                && total.shaded > 0
+                && total.without_effect > 0
+                && total.after_termination > 0,
+            "{total:?}"
+        );
+    }
+
     /// The block skipping's premise: `Compos::leaves_unchanged_corrected` is monotone in the
     /// alpha (true for alpha `a` implies true for every smaller one) under the frame's modes.
     #[test]
