@@ -990,6 +990,26 @@ mod tests {
         st
     }
 
+    /// [`check_one_lit`] composite lit and unlit at each termination of `ets`, then MIP, from
+    /// view `v` at `p` pipelines; returns the summed stats.
+    fn check_modes(
+        what: &str,
+        vol: &Volume,
+        cfg: &FrameConfig,
+        tf: &TransferFunction,
+        ets: &[Option<f64>],
+        (v, p): ([f64; 3], usize),
+    ) -> SweepStats {
+        let mut total = SweepStats::default();
+        for &et in ets {
+            for lit in [true, false] {
+                let view = (v, p, FrameMode::Composite);
+                total = total.add(check_one_lit(what, vol, cfg, tf, et, view, lit));
+            }
+        }
+        total.add(check_one(what, vol, cfg, tf, None, (v, p, FrameMode::Mip)))
+    }
+
     /// [`check_one`] from every view, P = 1, 4, 8 in turn, MIP and composite; returns the summed
     /// stats (to check that the skips were exercised).
     fn check_equal(
@@ -1146,18 +1166,8 @@ mod tests {
             for (m, v) in vs.iter().enumerate() {
                 let pipes = [1, 4][(n + m) % 2];
                 let et = [None, Some(rng.random_range(0.3..1.0))][(n + m) % 2];
-                for lit in [true, false] {
-                    let view = (*v, pipes, FrameMode::Composite);
-                    total = total.add(check_one_lit("random TF", &vol, &cfg, &tf, et, view, lit));
-                }
-                total = total.add(check_one(
-                    "random TF",
-                    &vol,
-                    &cfg,
-                    &tf,
-                    None,
-                    (*v, pipes, FrameMode::Mip),
-                ));
+                let st = check_modes("random TF", &vol, &cfg, &tf, &[et], (*v, pipes));
+                total = total.add(st);
             }
         }
         assert!(
@@ -1383,21 +1393,9 @@ mod tests {
         let cfg = FrameConfig::DEFAULT;
         let mut total = SweepStats::default();
         for (n, v) in vs.iter().enumerate() {
-            let p = [1, 4][n % 2];
-            for et in [None, Some(ET_DEFAULT)] {
-                let view = (*v, p, FrameMode::Composite);
-                for lit in [true, false] {
-                    total = total.add(check_one_lit("MRI-like", &mri, &cfg, &tf, et, view, lit));
-                }
-            }
-            total = total.add(check_one(
-                "MRI-like",
-                &mri,
-                &cfg,
-                &tf,
-                None,
-                (*v, p, FrameMode::Mip),
-            ));
+            let ets = [None, Some(ET_DEFAULT)];
+            let st = check_modes("MRI-like", &mri, &cfg, &tf, &ets, (*v, [1, 4][n % 2]));
+            total = total.add(st);
         }
         assert!(
             total.shaded > 0 && total.without_effect > 0 && total.in_skipped_blocks > 0,
