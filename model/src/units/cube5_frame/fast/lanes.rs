@@ -69,6 +69,11 @@ pub(super) struct LaneRules {
     /// The slice's depth fails the depth test (`depth >= Znone`, every frame coxel's `z`):
     /// rule 4 leaves every coxel unchanged.
     past: bool,
+    /// `rnd`'s halves `2^(AccW - 1)` and `2^(Q - 1)`, and `!past` as a lane factor (made once a
+    /// slice rather than once a block).
+    half_f: u64,
+    half_q: u64,
+    open: u32,
 }
 
 impl LaneRules {
@@ -90,6 +95,9 @@ impl LaneRules {
             chan_max: cfg.chan_max() as u32,
             et: compos.regs().et_threshold.min(u64::from(u32::MAX)) as u32,
             past: depth >= cfg.z_none(),
+            half_f: 1 << (cfg.acc_w - 1),
+            half_q: 1 << (cfg.q() - 1),
+            open: u32::from(depth < cfg.z_none()),
         })
     }
 
@@ -103,10 +111,17 @@ impl LaneRules {
         let mut keep = 1u32;
         match self.mode {
             ComposMode::FrontToBack => {
-                let zero = u32::from(self.past || am == 0);
-                let et = self.et;
-                for i in 0..N {
-                    keep &= u32::from(term[i] != 0) | (u32::from(a[i] < et) & zero);
+                if self.past || am == 0 {
+                    // Rule 5 adds nothing: only rule 3 can change a coxel below the threshold.
+                    let et = self.et;
+                    for i in 0..N {
+                        keep &= u32::from(term[i] != 0) | u32::from(a[i] < et);
+                    }
+                } else {
+                    // A sample above alpha 0 changes every coxel that is not terminated.
+                    for &t in term {
+                        keep &= u32::from(t != 0);
+                    }
                 }
             }
             _ => {
@@ -161,9 +176,9 @@ impl LaneRules {
             ComposMode::FrontToBack => {
                 let (f, q) = (self.f, self.q);
                 let (et, one, chan_max) = (self.et, self.one, self.chan_max);
-                let (half_f, half_q) = (1u64 << (f - 1), 1u64 << (q - 1));
+                let (half_f, half_q) = (self.half_f, self.half_q);
                 // Rule 4 (past the depth) gives every lane the weight 0.
-                let open = u32::from(!self.past);
+                let open = self.open;
                 for i in 0..N {
                     let (a_in, t) = (a[i], term[i]);
                     // Rule 1 (terminated) and rule 3 (at the threshold): no weight. Rule 5
