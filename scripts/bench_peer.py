@@ -24,7 +24,6 @@ import re
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -492,24 +491,25 @@ def main() -> int:
         f"{args.cube5_frames}); VTK: best of {args.frames} frames after {args.warmup} warm-up")
 
     rows = []
-    with tempfile.TemporaryDirectory(prefix="bench-peer-") as tmp:
-        for name, mode, shading in cases:
-            for px in pixels:
-                scene = Path(tmp) / f"{mode}-{int(shading)}-{px}.toml"
-                scene.write_text(scene_toml(raw, args.size, args.bits, mode, shading, px))
-                for t in threads:
-                    stem = f"{name.replace(' ', '-')}-{px}-t{t}"
-                    vtk_png, c5_png = out / f"{stem}-vtk.png", out / f"{stem}-cube5.png"
-                    vt = render_vtk(v, img, max_value, mode, shading, px, t,
-                                    args.warmup, args.frames, vtk_png, tf_points)
-                    ct = run_cube5(cube5, scene, c5_png, t, args.cube5_frames, repeat)
-                    diff = side_by_side(v, vtk_png, c5_png, out / f"{stem}.png")
-                    row = (name, f"{px}x{px}", t, vt, ct)
-                    rows.append(row)
-                    say(f"{name}, {px}^2, {t} thread(s): VTK {vt.best_ms:.1f} ms "
-                        f"(median {vt.median_ms:.1f}, mapper {vt.mapper_ms:.1f}), "
-                        f"cube5 {ct.ms:.1f} ms, ratio {ratio(vt.best_ms, ct.ms)}; images differ by "
-                        f"{diff:.1f}/255 on average")
+    for name, mode, shading in cases:
+        for px in pixels:
+            # Kept beside the images, so that `cube5 render SCENE --repeat N` can time a case
+            # alone: OUT/composite-0-256.toml (mode, shading 0/1, pixels).
+            scene = out / f"{mode}-{int(shading)}-{px}.toml"
+            scene.write_text(scene_toml(raw, args.size, args.bits, mode, shading, px))
+            for t in threads:
+                stem = f"{name.replace(' ', '-')}-{px}-t{t}"
+                vtk_png, c5_png = out / f"{stem}-vtk.png", out / f"{stem}-cube5.png"
+                vt = render_vtk(v, img, max_value, mode, shading, px, t,
+                                args.warmup, args.frames, vtk_png, tf_points)
+                ct = run_cube5(cube5, scene, c5_png, t, args.cube5_frames, repeat)
+                diff = side_by_side(v, vtk_png, c5_png, out / f"{stem}.png")
+                row = (name, f"{px}x{px}", t, vt, ct)
+                rows.append(row)
+                say(f"{name}, {px}^2, {t} thread(s): VTK {vt.best_ms:.1f} ms "
+                    f"(median {vt.median_ms:.1f}, mapper {vt.mapper_ms:.1f}), "
+                    f"cube5 {ct.ms:.1f} ms, ratio {ratio(vt.best_ms, ct.ms)}; images differ by "
+                    f"{diff:.1f}/255 on average")
 
     say("")
     say(f"load average (1 min) at the start {load_start}, at the end {load_average()}")

@@ -346,9 +346,9 @@ struct SliceWork<'a> {
     /// The corrected alpha of each class index (the compositing unit's `corrected` of the class
     /// entry's alpha): a sample's effect is known before its gradient.
     corrected: &'a [u32],
-    /// The colours of the shaded sample of each class index, coded for the compositing unit,
-    /// when the gradient does not matter.
-    flat: Option<&'a [[u32; 3]]>,
+    /// The corrected alpha and the colours of the shaded sample of each class index, coded for
+    /// the compositing unit, when the gradient does not matter (one entry a sample reads).
+    flat: Option<&'a [[u32; 4]]>,
     /// The compositing unit's rules of this slice, on lanes.
     rules: LaneRules,
     /// `Compos::code` of each colour code (a channel's code on the coxel's scale).
@@ -357,6 +357,11 @@ struct SliceWork<'a> {
     shift: u32,
     /// Per block of this slice: the largest corrected alpha its samples can have.
     amax: &'a [u64],
+    /// Per block row of this slice, `live_words` words: bit `c` set when block column `c` can
+    /// change a coxel that is not terminated (its largest alpha is above 0, or a zero alpha is
+    /// not every coxel's identity). The band visits only these blocks.
+    live: &'a [u64],
+    live_words: usize,
     /// Samples of corrected alpha 0 are the identity of every coxel.
     zero_ok: bool,
     /// Base-plane column of anchor 0 and row of anchor row 0.
@@ -426,33 +431,73 @@ impl SliceWork<'_> {
         (n_rows, w): (usize, usize),
         band: &mut BandRows,
     ) -> SweepStats {
-        let (ni, nbi) = (self.sv.ni, self.sv.nbi);
+        let (ni, nbi, nw) = (self.sv.ni, self.sv.nbi, self.live_words);
         let mut st = SweepStats::default();
         band.b0 = b0 as isize;
         band.done.fill(0);
         for db in 0..n_rows {
             let b = b0 + db;
             st.samples += ni as u64;
-            let amax = &self.amax[(b / BLOCK) * nbi..(b / BLOCK + 1) * nbi];
+            let bj = b / BLOCK;
+            let amax = &self.amax[bj * nbi..(bj + 1) * nbi];
+            let live = &self.live[bj * nw..(bj + 1) * nw];
             let row_at = at + db * w + self.r0;
-            for (c, &am) in amax.iter().enumerate() {
-                let a0 = c * BLOCK;
-                let len = BLOCK.min(ni - a0);
-                let lane = row_at + a0;
-                let k = if len == BLOCK {
-                    self.block::<BLOCK, LIT>(band, rays, (b, c), a0, lane, am)
-                } else {
-                    // The last block of a row narrower than a block: lane by lane.
-                    let mut k = SweepStats::default();
-                    for n in 0..len {
-                        k = k.add(self.block::<1, LIT>(band, rays, (b, c), a0 + n, lane + n, am));
+            // The blocks of the row that are not transparent, in order (the others leave every
+            // coxel they meet unchanged: `zero_alpha_is_identity`).
+            let mut visited = 0;
+            for (wi, &word) in live.iter().enumerate() {
+                let mut bits = word;
+                while bits != 0 {
+                    let c = wi * 64 + bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let am = amax[c];
+                    let a0 = c * BLOCK;
+                    let len = BLOCK.min(ni - a0);
+                    visited += len;
+                    let lane = row_at + a0;
+                    if len == BLOCK {
+                        self.block::<BLOCK, LIT>(band, rays, (b, c), (a0, lane), am, &mut st);
+                    } else {
+                        // The last block of a row narrower than a block: lane by lane.
+                        for n in 0..len {
+                            self.block::<1, LIT>(
+                                band,
+                                rays,
+                                (b, c),
+                                (a0 + n, lane + n),
+                                am,
+                                &mut st,
+                            );
+                        }
                     }
-                    k
-                };
-                st = st.add(k);
+                }
             }
+            st.in_skipped_blocks += (ni - visited) as u64;
         }
         st
+    }
+
+    /// Asks the memory for the voxel rows anchor rows `b0 .. b1` of this slice read (rows `b0 ..=
+    /// b1` of its plane, and of the neighbour planes when `LIT`), ahead of their use.
+    #[inline(always)]
+    fn prefetch<const LIT: bool>(&self, b0: usize, b1: usize) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let pi = self.sv.ni + 1;
+            let nj = self.sv.nj;
+            let ks = [Some(self.k), self.k_after];
+            for k in ks.iter().take(if LIT { 2 } else { 1 }).flatten() {
+                for b in b0..=b1.min(nj) {
+                    let row = self.sv.row(*k, b);
+                    for at in (0..pi).step_by(32) {
+                        // SAFETY: `_mm_prefetch` only hints the cache; the address is inside
+                        // `row`.
+                        unsafe { _mm_prefetch::<_MM_HINT_T0>(row[at..].as_ptr().cast()) };
+                    }
+                }
+            }
+        }
     }
 
     /// Anchors `a0 .. a0 + N` of anchor row `b` (in block column `c`) against lanes `lane ..` of
@@ -465,20 +510,19 @@ impl SliceWork<'_> {
         band: &mut BandRows,
         rays: &mut RayLanes,
         (b, c): (usize, usize),
-        a0: usize,
-        lane: usize,
+        (a0, lane): (usize, usize),
         am: u64,
-    ) -> SweepStats {
+        st: &mut SweepStats,
+    ) {
         let units = self.units;
         let rules = &self.rules;
         let (ni, nj) = (self.sv.ni, self.sv.nj);
-        let mut st = SweepStats::default();
         // Samples that cannot change a coxel they meet: `leaves_unchanged` holds for their
         // largest alpha, so for every smaller one (rules 1-4 do not read the alpha; rule 5 keeps
         // alpha 0 under `FrontToBack`, anything up to the coxel's under `Max`).
         if (am == 0 && self.zero_ok) || rules.all_unchanged::<N>(rays, lane, am) {
             st.in_skipped_blocks += N as u64;
-            return st;
+            return;
         }
         self.ensure(band, b as isize, c);
         let r = (b as isize - band.b0 + 1) as usize;
@@ -486,17 +530,26 @@ impl SliceWork<'_> {
             .try_into()
             .expect("N anchors");
         let shift = self.shift;
-        let idx: [usize; N] = std::array::from_fn(|n| (centre[n] >> shift) as usize);
-        let sa: [u32; N] = std::array::from_fn(|n| self.corrected[idx[n]]);
+        // A class index is below the table's length (`SampleW - shift = ClassIdxW` bits); the
+        // minimum says so to the compiler, which then checks no bound per lane.
+        let last = self.corrected.len() - 1;
+        let idx: [usize; N] = std::array::from_fn(|n| ((centre[n] >> shift) as usize).min(last));
+        let mut sa = [0u32; N];
         let mut sc = [[0u32; N]; 3];
         if let Some(flat) = self.flat {
+            let flat = &flat[..=last];
             for n in 0..N {
                 let e = flat[idx[n]];
+                sa[n] = e[0];
                 for ch in 0..3 {
-                    sc[ch][n] = e[ch];
+                    sc[ch][n] = e[ch + 1];
                 }
             }
-        } else if LIT {
+        } else {
+            let corrected = &self.corrected[..=last];
+            sa = std::array::from_fn(|n| corrected[idx[n]]);
+        }
+        if LIT && self.flat.is_none() {
             // The samples that change their coxel go through gradient and shader.
             let changes = rules.changes::<N>(rays, lane, &sa);
             if changes.iter().any(|&x| x) {
@@ -535,7 +588,6 @@ impl SliceWork<'_> {
         st.shaded += k.shaded;
         st.without_effect += k.without_effect;
         st.after_termination += k.after_termination;
-        st
     }
 }
 
@@ -553,11 +605,21 @@ fn sweep_band<const LIT: bool>(
     let n_rows = rows.len() / w;
     let init = rows[0];
     let mut rays = RayLanes::new(rows.len());
-    for work in slices {
+    // Anchor rows `b` with `q <= b + q0 < q + n_rows`, within `0 .. nj`.
+    let rows_of = |work: &SliceWork| {
         let nj = work.sv.nj;
-        // Anchor rows `b` with `q <= b + q0 < q + n_rows`, within `0 .. nj`.
         let b0 = q.saturating_sub(work.q0);
         let b1 = (q + n_rows).saturating_sub(work.q0).min(nj);
+        (b0, b1)
+    };
+    for (n, work) in slices.iter().enumerate() {
+        if let Some(next) = slices.get(n + 1) {
+            let (b0, b1) = rows_of(next);
+            if b0 < b1 {
+                next.prefetch::<LIT>(b0, b1);
+            }
+        }
+        let (b0, b1) = rows_of(work);
         if b0 >= b1 {
             continue;
         }
@@ -676,16 +738,17 @@ pub fn render_sweep(
     let lit = gradient_matters(&units.shader, smode);
     // Without the gradient, a sample's way through the shader and the compositing unit's coding
     // is a function of its class index: the units' own outputs, once per index.
-    let flat: Option<Vec<[u32; 3]>> = (!lit).then(|| {
+    let flat: Option<Vec<[u32; 4]>> = (!lit).then(|| {
         (0..corrected.len())
             .map(|idx| {
                 let e = units.shader.shade(&class_in((idx as u32) << shift, smode));
-                lanes::colours(&units.compos.code(&Sample {
+                let [r, g, b] = lanes::colours(&units.compos.code(&Sample {
                     rgb: [e.r, e.g, e.b],
                     alpha: e.a,
                     depth: 0,
                     mode: cmode,
-                }))
+                }));
+                [corrected[idx] as u32, r, g, b]
             })
             .collect()
     });
@@ -747,10 +810,23 @@ pub fn render_sweep(
             *m = range_max.max(idx_of(lo), idx_of(hi));
         }
     });
+    // Per swept slice, per block row: the blocks a band visits (bit `c` of word `c / 64`).
+    let live_words = sv.nbi.div_ceil(64);
+    let nl = sv.nbj * live_words;
+    let mut live = vec![0u64; swept.len() * nl];
+    for (live, amax) in live.chunks_exact_mut(nl).zip(amax.chunks_exact(nb)) {
+        for (bj, row) in amax.chunks_exact(sv.nbi).enumerate() {
+            for (c, &am) in row.iter().enumerate() {
+                if am != 0 || !zero_ok {
+                    live[bj * live_words + c / 64] |= 1 << (c % 64);
+                }
+            }
+        }
+    }
     let slices: Option<Vec<SliceWork>> = swept
         .clone()
-        .zip(amax.chunks_exact(nb))
-        .map(|(s, amax)| {
+        .zip(amax.chunks_exact(nb).zip(live.chunks_exact(nl)))
+        .map(|(s, (amax, live))| {
             let c = params.slice(s);
             Some(SliceWork {
                 units,
@@ -761,6 +837,8 @@ pub fn render_sweep(
                 colour_code: &colour_code,
                 shift,
                 amax,
+                live,
+                live_words,
                 zero_ok,
                 r0: (max_sx - c.shift_x) as usize,
                 q0: (max_sy - c.shift_y) as usize,
@@ -912,6 +990,26 @@ mod tests {
         st
     }
 
+    /// [`check_one_lit`] composite lit and unlit at each termination of `ets`, then MIP, from
+    /// view `v` at `p` pipelines; returns the summed stats.
+    fn check_modes(
+        what: &str,
+        vol: &Volume,
+        cfg: &FrameConfig,
+        tf: &TransferFunction,
+        ets: &[Option<f64>],
+        (v, p): ([f64; 3], usize),
+    ) -> SweepStats {
+        let mut total = SweepStats::default();
+        for &et in ets {
+            for lit in [true, false] {
+                let view = (v, p, FrameMode::Composite);
+                total = total.add(check_one_lit(what, vol, cfg, tf, et, view, lit));
+            }
+        }
+        total.add(check_one(what, vol, cfg, tf, None, (v, p, FrameMode::Mip)))
+    }
+
     /// [`check_one`] from every view, P = 1, 4, 8 in turn, MIP and composite; returns the summed
     /// stats (to check that the skips were exercised).
     fn check_equal(
@@ -1015,6 +1113,70 @@ mod tests {
             ));
         }
         assert!(st.in_skipped_blocks > 0 && st.shaded > 0, "{st:?}");
+    }
+
+    /// Random transfer functions (transparent bands of random width between random colours and
+    /// alphas, some opaque enough to end rays) over a volume with empty blocks and empty margins,
+    /// from faces (both sweep directions), 45 degrees and random views: MIP, composite lit and
+    /// unlit, with and without early termination at random thresholds. A block skipped, a row of
+    /// blocks left out or a ray ended that the reference would change shows as a coxel that
+    /// differs.
+    #[test]
+    fn random_transfer_functions_equal_the_reference() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 5);
+        let cfg = FrameConfig::DEFAULT;
+        // The head inside a larger box: empty blocks around it, and a bright cube with a hole in
+        // one corner (blocks opaque next to blocks empty).
+        let mut vol = window(
+            &head_phantom(24, 12).unwrap(),
+            [-4, -2, -6],
+            [32, 28, 36],
+            [1.0; 3],
+        );
+        for z in 26..34 {
+            for y in 2..10 {
+                for x in 22..30 {
+                    if (x + y + z) % 5 != 0 {
+                        let at = (z * 28 + y) * 32 + x;
+                        vol.data[at] = 3000 + ((x * 37 + y * 11) % 900) as u16;
+                    }
+                }
+            }
+        }
+        let p = |density, rgba| crate::transfer::TfPoint { density, rgba };
+        let vs = views(3, &mut rng);
+        let mut total = SweepStats::default();
+        for n in 0..6 {
+            let mut densities: Vec<f64> = (0..rng.random_range(2..7))
+                .map(|_| rng.random_range(0.02..0.98))
+                .collect();
+            densities.sort_by(f64::total_cmp);
+            let mut points = vec![p(0.0, [0.0; 4])];
+            for d in densities {
+                let alpha = match rng.random_range(0..3) {
+                    0 => 0.0,
+                    1 => rng.random_range(0.0..0.2),
+                    _ => rng.random_range(0.5..1.0),
+                };
+                let [r, g, b] = std::array::from_fn(|_| rng.random_range(0.0..1.0));
+                points.push(p(d, [r, g, b, alpha]));
+            }
+            points.push(p(1.0, [1.0, 1.0, 1.0, rng.random_range(0.0..1.0)]));
+            let tf = TransferFunction { points };
+            for (m, v) in vs.iter().enumerate() {
+                let pipes = [1, 4][(n + m) % 2];
+                let et = [None, Some(rng.random_range(0.3..1.0))][(n + m) % 2];
+                let st = check_modes("random TF", &vol, &cfg, &tf, &[et], (*v, pipes));
+                total = total.add(st);
+            }
+        }
+        assert!(
+            total.in_skipped_blocks > 0
+                && total.shaded > 0
+                && total.without_effect > 0
+                && total.after_termination > 0,
+            "{total:?}"
+        );
     }
 
     /// The block skipping's premise: `Compos::leaves_unchanged_corrected` is monotone in the
@@ -1231,21 +1393,9 @@ mod tests {
         let cfg = FrameConfig::DEFAULT;
         let mut total = SweepStats::default();
         for (n, v) in vs.iter().enumerate() {
-            let p = [1, 4][n % 2];
-            for et in [None, Some(ET_DEFAULT)] {
-                let view = (*v, p, FrameMode::Composite);
-                for lit in [true, false] {
-                    total = total.add(check_one_lit("MRI-like", &mri, &cfg, &tf, et, view, lit));
-                }
-            }
-            total = total.add(check_one(
-                "MRI-like",
-                &mri,
-                &cfg,
-                &tf,
-                None,
-                (*v, p, FrameMode::Mip),
-            ));
+            let ets = [None, Some(ET_DEFAULT)];
+            let st = check_modes("MRI-like", &mri, &cfg, &tf, &ets, (*v, [1, 4][n % 2]));
+            total = total.add(st);
         }
         assert!(
             total.shaded > 0 && total.without_effect > 0 && total.in_skipped_blocks > 0,

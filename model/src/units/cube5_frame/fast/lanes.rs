@@ -11,7 +11,7 @@
 //! a corrected alpha `<= 2^Q` on the `2^AccW` scale). The products (`t a`, `w c`) are taken in 64
 //! bits, as `Compos::step_coded` takes them.
 
-use crate::units::cube5_compos::{rnd, CodedSample, Compos, ComposMode, Coxel};
+use crate::units::cube5_compos::{CodedSample, Compos, ComposMode, Coxel};
 
 /// The coxels of a band: lane `n` is coxel `n` (row-major, the band's rows).
 pub(super) struct RayLanes {
@@ -69,6 +69,11 @@ pub(super) struct LaneRules {
     /// The slice's depth fails the depth test (`depth >= Znone`, every frame coxel's `z`):
     /// rule 4 leaves every coxel unchanged.
     past: bool,
+    /// `rnd`'s halves `2^(AccW - 1)` and `2^(Q - 1)`, and `!past` as a lane factor (made once a
+    /// slice rather than once a block).
+    half_f: u64,
+    half_q: u64,
+    open: u32,
 }
 
 impl LaneRules {
@@ -76,7 +81,10 @@ impl LaneRules {
     /// depth `depth` against frame coxels (`z = Znone`).
     pub fn new(compos: &Compos, mode: ComposMode, depth: u32) -> Option<Self> {
         let cfg = compos.config();
-        if !matches!(mode, ComposMode::FrontToBack | ComposMode::Max) || cfg.acc_w > 29 {
+        if !matches!(mode, ComposMode::FrontToBack | ComposMode::Max)
+            || cfg.acc_w > 29
+            || cfg.q() == 0
+        {
             return None;
         }
         Some(Self {
@@ -87,6 +95,9 @@ impl LaneRules {
             chan_max: cfg.chan_max() as u32,
             et: compos.regs().et_threshold.min(u64::from(u32::MAX)) as u32,
             past: depth >= cfg.z_none(),
+            half_f: 1 << (cfg.acc_w - 1),
+            half_q: 1 << (cfg.q() - 1),
+            open: u32::from(depth < cfg.z_none()),
         })
     }
 
@@ -96,12 +107,21 @@ impl LaneRules {
     pub fn all_unchanged<const N: usize>(&self, st: &RayLanes, at: usize, am: u64) -> bool {
         let a: &[u32; N] = st.a[at..at + N].try_into().expect("N lanes");
         let term: &[u32; N] = st.term[at..at + N].try_into().expect("N lanes");
-        let mut keep = 0u32;
+        // Per lane 1 when the coxel is kept; their AND, branch-free so that it compiles to lanes.
+        let mut keep = 1u32;
         match self.mode {
             ComposMode::FrontToBack => {
-                let zero = self.past || am == 0;
-                for i in 0..N {
-                    keep += u32::from(term[i] != 0) | (u32::from(a[i] < self.et) & u32::from(zero));
+                if self.past || am == 0 {
+                    // Rule 5 adds nothing: only rule 3 can change a coxel below the threshold.
+                    let et = self.et;
+                    for i in 0..N {
+                        keep &= u32::from(term[i] != 0) | u32::from(a[i] < et);
+                    }
+                } else {
+                    // A sample above alpha 0 changes every coxel that is not terminated.
+                    for &t in term {
+                        keep &= u32::from(t != 0);
+                    }
                 }
             }
             _ => {
@@ -111,11 +131,11 @@ impl LaneRules {
                 // `am <= 2^Q`, so on the coxel's scale it is at most `2^AccW`.
                 let aw = (am << (self.f - self.q)) as u32;
                 for i in 0..N {
-                    keep += u32::from(term[i] != 0) | u32::from(aw <= a[i]);
+                    keep &= u32::from(term[i] != 0) | u32::from(aw <= a[i]);
                 }
             }
         }
-        keep == N as u32
+        keep != 0
     }
 
     /// Which lanes `at .. at + N` a sample of corrected alpha `sa[n]` would change (rule 5
@@ -155,22 +175,26 @@ impl LaneRules {
         match self.mode {
             ComposMode::FrontToBack => {
                 let (f, q) = (self.f, self.q);
-                let (et, one, chan_max) = (self.et, self.one, u64::from(self.chan_max));
+                let (et, one, chan_max) = (self.et, self.one, self.chan_max);
+                let (half_f, half_q) = (self.half_f, self.half_q);
                 // Rule 4 (past the depth) gives every lane the weight 0.
-                let open = u64::from(!self.past);
+                let open = self.open;
                 for i in 0..N {
                     let (a_in, t) = (a[i], term[i]);
                     // Rule 1 (terminated) and rule 3 (at the threshold): no weight. Rule 5
                     // otherwise; a zero alpha gives a zero weight, which adds 0 to channels
-                    // already saturated.
+                    // already saturated. Only the products need 64 bits: the weight `w` is at
+                    // most `2^AccW`, a colour's term at most `2^AccW`, so a channel's sum stays
+                    // below `2^(AccW + 2) <= 2^31` before the saturation.
                     let live = t == 0 && a_in < et;
-                    let wt = u64::from(live) * open * u64::from(one - a_in.min(one));
-                    let w = rnd(wt * u64::from(sa[i]), q);
+                    let wt = (u32::from(live) & open) * (one - a_in.min(one));
+                    // `rnd(x, s)` with `s >= 1` (`Q >= 1`, `AccW >= 1`).
+                    let w = ((u64::from(wt) * u64::from(sa[i]) + half_q) >> q) as u32;
                     for ch in 0..3 {
-                        c[ch][i] = (u64::from(c[ch][i]) + rnd(w * u64::from(sc[ch][i]), f))
-                            .min(chan_max) as u32;
+                        let add = ((u64::from(w) * u64::from(sc[ch][i]) + half_f) >> f) as u32;
+                        c[ch][i] = (c[ch][i] + add).min(chan_max);
                     }
-                    let a_out = a_in + w as u32;
+                    let a_out = a_in + w;
                     a[i] = a_out;
                     term[i] = t | u32::from(a_out >= et);
                     let none = live && (self.past || sa[i] == 0);
