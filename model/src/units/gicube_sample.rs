@@ -3,8 +3,9 @@
 //! `docs/numerics/gicube_sample.md`: the tri-linear sample of the eight corner voxels
 //! (`cube5_trilin`), its classification (`cube5_shader`, unlit), the irradiance of a lit rendering
 //! ray (a second `cube5_trilin` and the multiply), and one front-to-back compositing step onto the
-//! packet's colour and opacity (`cube5_compos`, with its opacity LUT and termination threshold).
-//! A pure function of the item.
+//! packet's colour and opacity (`cube5_compos`, with its opacity LUT and termination threshold),
+//! optionally jittered ([`Jitter`]: the random, log and power LUTs of [353], [380]). A pure
+//! function of the item.
 //!
 //! `gicube_processor::Processor` takes every sample through [`Sampler::sample`], so this is the
 //! one description of the sample. The RTL is `rtl/gicube/gicube_sample.sv` (step 4 of the build
@@ -361,6 +362,7 @@ impl Sampler {
     /// `rgb = min(1, e I)`, the opacity correction `1 - (1 - a)^(dr / 256)` and the front-to-back
     /// step `A' = A + (1 - A) a'`, `C' = C + (1 - A) a' rgb` in reals, the packet read as `raw /
     /// 4096`; termination compares the input opacity with the threshold (the compositor's rule).
+    /// With jitter the step is `r dr` with the datapath's factor `r` of the item's position bits.
     /// Returns red, green, blue, opacity on the packet's scale (`4096 = 1.0`), unsaturated.
     pub fn reference(&self, it: &SampleIn) -> [f64; 4] {
         let e = self.classified(it);
@@ -493,7 +495,7 @@ impl Sampler {
         if let Some(j) = &self.jitter {
             let word = |v: u32| {
                 let mut w = BitWriter::new();
-                w.put(u64::from(v), 32);
+                w.put(u64::from(v), CFG_DATA_W);
                 w.finish(CFG_DATA_W)
             };
             writes.extend((0u32..).zip(&j.log).map(|(a, &l)| (CFG_LOG + a, word(l))));
@@ -780,6 +782,21 @@ mod tests {
                 .all(|(a, d)| *a < 1 << 12 && d.len() == 2));
             assert!(w[entries..].iter().all(|(a, _)| a & CFG_REGION_COMPOS != 0));
         }
+        // With jitter the three tables follow, each address written once.
+        let rtl = SampleRtlConfig {
+            voxel_w: 8,
+            jitter: 1,
+        };
+        assert_eq!(rtl.latency(), 23);
+        let class = random_class_lut(&mut rng, 8).unwrap();
+        let w = Sampler::new(rtl.sample_config(200, None), class)
+            .unwrap()
+            .config_writes();
+        assert_eq!(w.len(), 4096 + 4096 + 3 + 4096 + 1024 + 256);
+        let mut addrs: Vec<u32> = w.iter().map(|(a, _)| *a).collect();
+        addrs.sort_unstable();
+        addrs.dedup();
+        assert_eq!(addrs.len(), w.len(), "no address written twice");
         assert!(SampleRtlConfig {
             voxel_w: 3,
             jitter: 0
