@@ -369,48 +369,42 @@ module gicube_sample #(
     assign idx_rd = idx_mem[rp_q];
 
     // The tables: one write port (configuration), one synchronous read port each (block RAM).
-    logic [JitW-1:0] jit_mem [2**JitIdxW];
-    logic [LogW-1:0] log_mem [2**AlphaW];
-    logic [ExpW-1:0] exp_mem [2**ExpIdxW];
+    // The random and log LUTs are read with the shade stage: J[idx], L[alpha].
     logic            cfg_log, cfg_exp, cfg_jit;
+    logic [LogW-1:0] log_q;
+    logic [JitW-1:0] jit_q;
 
     assign cfg_log = cfg_valid_i && cfg_addr_i[CfgAW-1:AlphaW] == 2'b01;
     assign cfg_exp = cfg_valid_i && cfg_addr_i[CfgAW-1:ExpIdxW] == 4'b1110;
     assign cfg_jit = cfg_valid_i && cfg_addr_i[CfgAW-1:JitIdxW] == 6'b111100;
 
-    always_ff @(posedge clk_i) begin
-      if (cfg_log) begin
-        log_mem[cfg_addr_i[AlphaW-1:0]] <= cfg_data_i[LogW-1:0];
-      end
-    end
+    cube5_shader_ram #(
+      .Depth (2**JitIdxW),
+      .Width (JitW),
+      .AddrW (JitIdxW)
+    ) u_jit_lut (
+      .clk_i   (clk_i),
+      .we_i    (cfg_jit),
+      .waddr_i (cfg_addr_i[JitIdxW-1:0]),
+      .wdata_i (cfg_data_i[JitW-1:0]),
+      .re_i    (shd_en),
+      .raddr_i (idx_rd),
+      .rdata_o (jit_q)
+    );
 
-    always_ff @(posedge clk_i) begin
-      if (cfg_exp) begin
-        exp_mem[cfg_addr_i[ExpIdxW-1:0]] <= cfg_data_i[ExpW-1:0];
-      end
-    end
-
-    always_ff @(posedge clk_i) begin
-      if (cfg_jit) begin
-        jit_mem[cfg_addr_i[JitIdxW-1:0]] <= cfg_data_i[JitW-1:0];
-      end
-    end
-
-    // Read with the shade stage: L[alpha], J[idx].
-    logic [LogW-1:0] log_q;
-    logic [JitW-1:0] jit_q;
-
-    always_ff @(posedge clk_i) begin
-      if (shd_en) begin
-        log_q <= log_mem[sh_rgba[3*ColorW +: AlphaW]];
-      end
-    end
-
-    always_ff @(posedge clk_i) begin
-      if (shd_en) begin
-        jit_q <= jit_mem[idx_rd];
-      end
-    end
+    cube5_shader_ram #(
+      .Depth (2**AlphaW),
+      .Width (LogW),
+      .AddrW (AlphaW)
+    ) u_log_lut (
+      .clk_i   (clk_i),
+      .we_i    (cfg_log),
+      .waddr_i (cfg_addr_i[AlphaW-1:0]),
+      .wdata_i (cfg_data_i[LogW-1:0]),
+      .re_i    (shd_en),
+      .raddr_i (sh_rgba[3*ColorW +: AlphaW]),
+      .rdata_o (log_q)
+    );
 
     // p = rnd(L (2^7 + J), 8), U(4.12); below 2^16 for every L < 2^16 - 1.
     localparam int unsigned PW = LogW + JitW + 1;
@@ -435,11 +429,19 @@ module gicube_sample #(
 
     assign en_j = shd_ready[ShdStages-1];
 
-    always_ff @(posedge clk_i) begin
-      if (en_j) begin
-        exp_q <= exp_mem[p[LogW-1:ExpShift]];
-      end
-    end
+    cube5_shader_ram #(
+      .Depth (2**ExpIdxW),
+      .Width (ExpW),
+      .AddrW (ExpIdxW)
+    ) u_exp_lut (
+      .clk_i   (clk_i),
+      .we_i    (cfg_exp),
+      .waddr_i (cfg_addr_i[ExpIdxW-1:0]),
+      .wdata_i (cfg_data_i[ExpW-1:0]),
+      .re_i    (en_j),
+      .raddr_i (p[LogW-1:ExpShift]),
+      .rdata_o (exp_q)
+    );
 
     always_ff @(posedge clk_i) begin
       if (en_j) begin
