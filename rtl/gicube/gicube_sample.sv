@@ -17,7 +17,10 @@
 // compositor. Latency 22, one item per clock when the output is never stalled.
 module gicube_sample #(
   /// Bits per voxel, 4..16.
-  parameter int unsigned VoxelW = 8
+  parameter int unsigned VoxelW = 8,
+  /// 1: the jitter stage (random, log and power LUTs, [353], [380]) before the compositor, whose
+  /// LUT is then bypassed; 0: the compositor's opacity table corrects for the fixed step.
+  parameter int unsigned Jitter = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -98,6 +101,9 @@ module gicube_sample #(
   if (VoxelW < 4 || VoxelW > 16) begin : gen_bad_voxel_w
     $fatal(1, "gicube_sample: VoxelW must be 4..16");
   end
+  if (Jitter > 1) begin : gen_bad_jitter
+    $fatal(1, "gicube_sample: Jitter must be 0 or 1");
+  end
   if (LightingBit != InW - 1) begin : gen_bad_packing
     $fatal(1, "gicube_sample: input packing and gicube_sample_pkg::in_w disagree");
   end
@@ -115,7 +121,9 @@ module gicube_sample #(
   always_comb begin
     cfg_class   = cfg_valid_i && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionClass
                   && cfg_addr_i[CfgAW-2:ClassIdxW] == '0;
-    cfg_compos  = cfg_valid_i && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionCompos;
+    // The jitter tables' addresses above the compositor's registers are not its words.
+    cfg_compos  = cfg_valid_i && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionCompos
+                  && !(Jitter != 0 && cfg_addr_i[CfgAW-2] && cfg_addr_i[CfgAW-3]);
     // Region 0 (classification) of the shader's map at the entry's index.
     sh_cfg_addr = {cube5_shader_pkg::RegionClass, (ShCfgAW-2)'(cfg_addr_i[ClassIdxW-1:0])};
     sh_cfg_data = ShCfgDW'(cfg_data_i);
@@ -260,6 +268,10 @@ module gicube_sample #(
   // ---------------------------------------------------------------------------
   localparam int unsigned ProdW = ColorW + IrrW;
 
+  // The shade stage, and with jitter the power-LUT stage after it.
+  localparam int unsigned ShdStages = 1 + Jitter;
+
+  logic [ShdStages-1:0]      shd_ready;
   logic                      shd_en, shd_valid, cx_in_ready;
   logic                      rd_lighting, rd_irr_en;
   logic [3*ProdW-1:0]        prod_d, prod_q;
@@ -267,15 +279,17 @@ module gicube_sample #(
   logic [AlphaW-1:0]         alpha_q;
 
   cube5_valid_chain #(
-    .Stages (1)
+    .Stages (ShdStages)
   ) u_shd_valid (
     .clk_i       (clk_i),
     .rst_ni      (rst_ni),
     .in_valid_i  (sh_out_valid),
     .out_ready_i (cx_in_ready),
-    .ready_o     (shd_en),
+    .ready_o     (shd_ready),
     .out_valid_o (shd_valid)
   );
+
+  assign shd_en = shd_ready[0];
 
   assign sh_out_ready = shd_en;
   assign pop          = sh_out_valid && shd_en;
@@ -318,6 +332,151 @@ module gicube_sample #(
   end
 
   // ---------------------------------------------------------------------------
+  // K (first half), with Jitter = 1: the jittered alpha code (contract, "Jitter and the power
+  // LUT"). The random LUT's index is the mangled position bits (the weights) of the item, kept
+  // in a FIFO beside the side FIFO; the random and log LUTs are read with the shade stage, the
+  // power LUT with the next, and its two entries interpolated into the compositor's input.
+  // ---------------------------------------------------------------------------
+  logic [4*ChanW-1:0]  cx_pkt;
+  logic [3*ColorW-1:0] cx_rgb;
+  logic [AlphaW-1:0]   cx_alpha;
+
+  if (Jitter != 0) begin : gen_jitter
+    localparam int unsigned JitIdxW  = gicube_sample_pkg::JitIdxW;
+    localparam int unsigned JitW     = gicube_sample_pkg::JitW;
+    localparam int unsigned LogW     = gicube_sample_pkg::LogW;
+    localparam int unsigned ExpIdxW  = gicube_sample_pkg::ExpIdxW;
+    localparam int unsigned ExpShift = LogW - ExpIdxW;
+    localparam int unsigned ExpDiffW = gicube_sample_pkg::ExpDiffW;
+    localparam int unsigned ExpW     = AlphaW + ExpDiffW;
+
+    // The mangled position bits: wx ^ rotl8(wy, 3) ^ rotl8(wz, 5).
+    logic [WeightW-1:0] wx, wy, wz, idx_wr;
+    assign wx     = in_data_i[WeightsLsb +: WeightW];
+    assign wy     = in_data_i[WeightsLsb + WeightW +: WeightW];
+    assign wz     = in_data_i[WeightsLsb + 2*WeightW +: WeightW];
+    assign idx_wr = wx ^ {wy[4:0], wy[7:5]} ^ {wz[2:0], wz[7:3]};
+
+    logic [JitIdxW-1:0] idx_mem [FifoDepth];
+    logic [JitIdxW-1:0] idx_rd;
+
+    always_ff @(posedge clk_i) begin
+      if (in_fire) begin
+        idx_mem[side_wp_q] <= idx_wr;
+      end
+    end
+
+    assign idx_rd = idx_mem[rp_q];
+
+    // The tables: one write port (configuration), one synchronous read port each (block RAM).
+    // The random and log LUTs are read with the shade stage: J[idx], L[alpha].
+    logic            cfg_log, cfg_exp, cfg_jit;
+    logic [LogW-1:0] log_q;
+    logic [JitW-1:0] jit_q;
+
+    assign cfg_log = cfg_valid_i && cfg_addr_i[CfgAW-1:AlphaW] == 2'b01;
+    assign cfg_exp = cfg_valid_i && cfg_addr_i[CfgAW-1:ExpIdxW] == 4'b1110;
+    assign cfg_jit = cfg_valid_i && cfg_addr_i[CfgAW-1:JitIdxW] == 6'b111100;
+
+    cube5_shader_ram #(
+      .Depth (2**JitIdxW),
+      .Width (JitW),
+      .AddrW (JitIdxW)
+    ) u_jit_lut (
+      .clk_i   (clk_i),
+      .we_i    (cfg_jit),
+      .waddr_i (cfg_addr_i[JitIdxW-1:0]),
+      .wdata_i (cfg_data_i[JitW-1:0]),
+      .re_i    (shd_en),
+      .raddr_i (idx_rd),
+      .rdata_o (jit_q)
+    );
+
+    cube5_shader_ram #(
+      .Depth (2**AlphaW),
+      .Width (LogW),
+      .AddrW (AlphaW)
+    ) u_log_lut (
+      .clk_i   (clk_i),
+      .we_i    (cfg_log),
+      .waddr_i (cfg_addr_i[AlphaW-1:0]),
+      .wdata_i (cfg_data_i[LogW-1:0]),
+      .re_i    (shd_en),
+      .raddr_i (sh_rgba[3*ColorW +: AlphaW]),
+      .rdata_o (log_q)
+    );
+
+    // p = rnd(L (2^7 + J), 8), U(4.12); below 2^16 for every L < 2^16 - 1.
+    localparam int unsigned PW = LogW + JitW + 1;
+    logic [PW-1:0]   prod_p;
+    logic [LogW-1:0] p;
+    logic            opaque;
+
+    always_comb begin
+      prod_p = PW'(log_q) * PW'({1'b1, jit_q}) + PW'(1 << JitW);
+      p      = prod_p[JitW+1 +: LogW];
+      opaque = log_q == '1;
+    end
+
+    // The power-LUT stage: E, D at p >> 6, the fraction, the opaque flag, the sample's colour and
+    // the packet move on with it.
+    logic                en_j;
+    logic [ExpW-1:0]     exp_q;
+    logic [ExpShift-1:0] frac_q;
+    logic                opaque_q;
+    logic [3*ColorW-1:0] rgb_q;
+    logic [4*ChanW-1:0]  pkt_j_q;
+
+    assign en_j = shd_ready[ShdStages-1];
+
+    cube5_shader_ram #(
+      .Depth (2**ExpIdxW),
+      .Width (ExpW),
+      .AddrW (ExpIdxW)
+    ) u_exp_lut (
+      .clk_i   (clk_i),
+      .we_i    (cfg_exp),
+      .waddr_i (cfg_addr_i[ExpIdxW-1:0]),
+      .wdata_i (cfg_data_i[ExpW-1:0]),
+      .re_i    (en_j),
+      .raddr_i (p[LogW-1:ExpShift]),
+      .rdata_o (exp_q)
+    );
+
+    always_ff @(posedge clk_i) begin
+      if (en_j) begin
+        frac_q   <= p[ExpShift-1:0];
+        opaque_q <= opaque;
+        rgb_q    <= shd_rgb;
+        pkt_j_q  <= pkt_q;
+      end
+    end
+
+    // a_j = E + rnd(D f, 6), or 4095 for an opaque sample.
+    localparam int unsigned IpW = ExpDiffW + ExpShift;
+    logic [IpW-1:0] interp;
+
+    always_comb begin
+      interp   = IpW'(exp_q[AlphaW +: ExpDiffW]) * IpW'(frac_q) + IpW'(1 << (ExpShift - 1));
+      cx_alpha = opaque_q ? {AlphaW{1'b1}}
+                          : exp_q[AlphaW-1:0] + AlphaW'(interp >> ExpShift);
+      cx_rgb   = rgb_q;
+      cx_pkt   = pkt_j_q;
+    end
+
+    // The alpha code the shade stage registered is read through the log LUT instead; the
+    // product's bits below the rounding are dropped.
+    logic unused_jitter;
+    assign unused_jitter = ^{alpha_q, prod_p[JitW:0]};
+  end else begin : gen_no_jitter
+    always_comb begin
+      cx_alpha = alpha_q;
+      cx_rgb   = shd_rgb;
+      cx_pkt   = pkt_q;
+    end
+  end
+
+  // ---------------------------------------------------------------------------
   // K: compositing. Coxel (R, G, B, A = the packet's channels, U(1.12); Z = 1; no geometry; not
   // terminated), sample (rgb, alpha, depth 0, front to back).
   // ---------------------------------------------------------------------------
@@ -327,11 +486,11 @@ module gicube_sample #(
   always_comb begin
     cx_in = '0;
     for (int c = 0; c < 4; c++) begin
-      cx_in[c*CxChanW +: CxChanW] = CxChanW'(pkt_q[c*ChanW +: ChanW]);
+      cx_in[c*CxChanW +: CxChanW] = CxChanW'(cx_pkt[c*ChanW +: ChanW]);
     end
     cx_in[4*CxChanW +: ZW]                      = ZW'(1);
-    cx_in[CoxelW +: 3*ColorW]                   = shd_rgb;
-    cx_in[CoxelW + 3*ColorW +: AlphaW]          = alpha_q;
+    cx_in[CoxelW +: 3*ColorW]                   = cx_rgb;
+    cx_in[CoxelW + 3*ColorW +: AlphaW]          = cx_alpha;
     cx_in[CoxelW + 3*ColorW + AlphaW + ZW +: 3] = cube5_compos_pkg::ModeFrontToBack;
   end
 

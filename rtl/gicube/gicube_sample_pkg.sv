@@ -29,6 +29,14 @@ package gicube_sample_pkg;
     in_w = 8 * voxel_w + 3 * WeightW + 1 + 8 * IrrW + 3 * ChanW + ChanW + 1;
   endfunction
 
+  /// Jitter (Jitter = 1; contract "Jitter and the power LUT"): random LUT index and entry bits
+  /// (r = (2^7 + J) / 2^8), log LUT entry bits (U(4.12)), power LUT index and difference bits.
+  localparam int unsigned JitIdxW  = 8;
+  localparam int unsigned JitW     = 7;
+  localparam int unsigned LogW     = 16;
+  localparam int unsigned ExpIdxW  = 10;
+  localparam int unsigned ExpDiffW = 7;
+
   /// Bits of one output item: colour, opacity, terminated.
   localparam int unsigned OutW = 3 * ChanW + ChanW + 1;
 

@@ -268,6 +268,37 @@ fn a_model_with_another_step_is_caught() {
     assert!(err.item < 200, "{variant}: caught at item {}", err.item);
 }
 
+/// The scoreboard bites on the jitter: a jitter configuration's RTL with its tables loaded
+/// against a model whose random LUT entries are all another value (a model without the jitter's
+/// factor, `r` constant) is caught.
+#[test]
+fn a_model_with_another_jitter_is_caught() {
+    let mut ran = 0;
+    for (variant, cfg) in configs::<SampleRtlConfig>() {
+        if cfg.jitter == 0 {
+            continue;
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(seed(1652));
+        let class = random_class_lut(&mut rng, cfg.voxel_w).unwrap();
+        let rtl = Sampler::new(cfg.sample_config(300, None), class.clone()).unwrap();
+        // The same datapath without jitter at the mean factor's step (3/4 of 400 = 300).
+        let plain = SampleRtlConfig { jitter: 0, ..cfg };
+        let mut other = Sampler::new(plain.sample_config(400, None), class).unwrap();
+        let mut check = check_for(
+            &rtl,
+            StreamCheck::new(seed(1653), 5_000).with_traffic(0.1, 0.1),
+        );
+        check.waveform_on_mismatch = false;
+        let err = expect_mismatch(
+            check_stream(variant, cfg, &mut other, &mut random_item(cfg), &check),
+            "a constant factor misses the jitter",
+        );
+        assert!(err.item < 200, "{variant}: caught at item {}", err.item);
+        ran += 1;
+    }
+    assert!(ran > 0, "a jitter configuration");
+}
+
 /// Tables survive a reset: loaded once, a reset in the first batch, the rest still matches (the
 /// long runs above reset too; this one resets before most items).
 #[test]
@@ -319,7 +350,8 @@ fn processor_gi_frame_sample_traffic_replays_on_the_rtl() {
     );
     let mut ran = 0;
     for (variant, cfg) in configs::<SampleRtlConfig>() {
-        if cfg.voxel_w != vol.bits {
+        // The processor's traffic is unjittered (ProcessorConfig::jitter off).
+        if cfg.voxel_w != vol.bits || cfg.jitter != 0 {
             continue;
         }
         let check = check_for(

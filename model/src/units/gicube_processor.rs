@@ -22,7 +22,7 @@ use crate::units::cube5_shader::ClassLut;
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_queue_front::{Chooser, FrontTraffic, QueueFront};
-use crate::units::gicube_sample::{SampleConfig, SampleIn, Sampler};
+use crate::units::gicube_sample::{jitter_index, Jitter, SampleConfig, SampleIn, Sampler};
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_step::{StepConfig, Stepper};
 use crate::volume::Volume;
@@ -82,6 +82,9 @@ pub struct ProcessorConfig {
     pub et_threshold: Option<u32>,
     /// Space leaping over empty blocks ([357]).
     pub space_leap: bool,
+    /// Jitter ([353], [380], `gicube_sample`): each sample's opacity for a step `r dr`, `r` in
+    /// `[1/2, 1)` from the random LUT at the position's fraction bits (the advance stays `dr`).
+    pub jitter: bool,
     pub order: QueueOrder,
     pub host_order: HostOrder,
 }
@@ -96,6 +99,7 @@ impl ProcessorConfig {
         step: 256,
         et_threshold: Some(CHAN_MAX + 1 - 16),
         space_leap: true,
+        jitter: false,
         order: QueueOrder::Sorter,
         host_order: HostOrder::RowMajor,
     };
@@ -463,6 +467,7 @@ impl Processor {
                 voxel_w: vol.bits,
                 step: cfg.step,
                 et_threshold: cfg.et_threshold,
+                jitter: cfg.jitter,
             },
             class,
         )?;
@@ -930,6 +935,7 @@ impl Processor {
         let n = f64::from(self.side);
         let max = f64::from(self.vol.max_value());
         let thr = self.cfg.et_threshold.map(|t| f64::from(t) / 4096.0);
+        let jit = self.cfg.jitter.then(|| Jitter::new(self.cfg.step));
         for r in &rays {
             let (mut c, mut a) = ([0.0f64; 3], 0.0f64);
             for k in 0.. {
@@ -938,7 +944,14 @@ impl Processor {
                     break;
                 }
                 let rgba = tf.lookup(self.vol.sample_f64(p.to_array()) / max);
-                let w = (1.0 - a) * corrected_alpha(rgba[3], dr);
+                // Jitter: the factor at the position's 8 fraction bits, as the packet has them.
+                let r_j = jit.as_ref().map_or(1.0, |j| {
+                    j.factor(jitter_index(
+                        p.to_array()
+                            .map(|x| (x.fract() * f64::from(1u32 << POS_FRAC_W)) as u32),
+                    ))
+                });
+                let w = (1.0 - a) * corrected_alpha(rgba[3], r_j * dr);
                 let light = irr.map_or(1.0, |f| field_f64(f, self.vol.dims, p));
                 for i in 0..3 {
                     c[i] += w * (rgba[i] * light).min(1.0);

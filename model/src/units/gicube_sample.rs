@@ -3,8 +3,9 @@
 //! `docs/numerics/gicube_sample.md`: the tri-linear sample of the eight corner voxels
 //! (`cube5_trilin`), its classification (`cube5_shader`, unlit), the irradiance of a lit rendering
 //! ray (a second `cube5_trilin` and the multiply), and one front-to-back compositing step onto the
-//! packet's colour and opacity (`cube5_compos`, with its opacity LUT and termination threshold).
-//! A pure function of the item.
+//! packet's colour and opacity (`cube5_compos`, with its opacity LUT and termination threshold),
+//! optionally jittered ([`Jitter`]: the random, log and power LUTs of [353], [380]). A pure
+//! function of the item.
 //!
 //! `gicube_processor::Processor` takes every sample through [`Sampler::sample`], so this is the
 //! one description of the sample. The RTL is `rtl/gicube/gicube_sample.sv` (step 4 of the build
@@ -42,6 +43,9 @@ pub struct SampleConfig {
     pub step: u32,
     /// Early ray termination threshold on the opacity, `U(0.12)` scale, 1..=4096; `None`: off.
     pub et_threshold: Option<u32>,
+    /// Jitter ([353], [380]): each sample's opacity is corrected for a step `r dr`, `r` in
+    /// `[1/2, 1)` from the random LUT at the mangled position bits ([`Jitter`]); off: `r = 1`.
+    pub jitter: bool,
 }
 
 /// One sample: the cell's eight voxels and weights, the packet's colour and opacity.
@@ -80,6 +84,7 @@ pub struct Sampler {
     irr_trilin: Trilin,
     shader: Shader,
     compos: Compos,
+    jitter: Option<Jitter>,
 }
 
 fn unlit() -> ShaderMode {
@@ -113,6 +118,120 @@ pub fn compos_config() -> ComposConfig {
     }
 }
 
+/// Jitter ([353], [380]; contract *Jitter and the power LUT*): index bits of the random LUT.
+pub const JIT_IDX_W: u32 = 8;
+/// Bits of a random LUT entry `J`: the factor is `r = (2^7 + J) / 2^8`, in `[1/2, 1)`.
+pub const JIT_W: u32 = 7;
+/// Bits of a log LUT entry, `U(4.12)`: `-ln(1 - alpha) dr / 256`.
+pub const LOG_W: u32 = 16;
+/// Fraction bits of the log LUT entry and of the product `p`.
+pub const LOG_FRAC_W: u32 = 12;
+/// The log LUT's "infinite" entry (alpha code 4095: opaque at any step).
+pub const LOG_OPAQUE: u32 = (1 << LOG_W) - 1;
+/// Index bits of the power (exp) LUT: `p >> EXP_SHIFT`.
+pub const EXP_IDX_W: u32 = 10;
+/// Bits of `p` below the power LUT's index, the interpolation fraction.
+pub const EXP_SHIFT: u32 = LOG_W - EXP_IDX_W;
+/// Bits of a power LUT entry's code `E` (an alpha code, `/ 4095`) and of its difference `D`.
+pub const EXP_CODE_W: u32 = 12;
+pub const EXP_DIFF_W: u32 = 7;
+/// The largest alpha code.
+const ALPHA_MAX: u32 = 4095;
+/// Largest error of [`Jitter::alpha`] against `4095 (1 - (1 - a/4095)^(r dr/256))`, in alpha
+/// codes (contract, *Jitter and the power LUT*: the log entry's and the product's rounding, 1 code
+/// together; the power entries' rounding and interpolation, 1.13; an entry capped at 16, 1.4).
+pub const JITTER_ALPHA_BOUND: f64 = 2.6;
+
+/// The mangled position bits that index the random LUT: the sample position's fraction bits
+/// (the weights), `wx ^ rotl8(wy, 3) ^ rotl8(wz, 5)`.
+pub fn jitter_index(weights: [u32; 3]) -> usize {
+    let rotl8 = |x: u32, k: u32| ((x << k) | (x >> (8 - k))) & 0xFF;
+    ((weights[0] & 0xFF) ^ rotl8(weights[1] & 0xFF, 3) ^ rotl8(weights[2] & 0xFF, 5)) as usize
+}
+
+/// The random LUT's contents (fixed; the one source of the RTL's table, loaded through the
+/// configuration port): entry `i` is the top `JIT_W` bits of SplitMix64's output for `i`.
+pub fn jitter_table() -> Vec<u32> {
+    (0..1u64 << JIT_IDX_W)
+        .map(|i| {
+            let mut z = i.wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^= z >> 31;
+            (z >> (64 - JIT_W)) as u32
+        })
+        .collect()
+}
+
+/// The log LUT for sample distance `step` (`U(4.8)`): entry `a` is `min(LOG_OPAQUE - 1,
+/// rnd(-ln(1 - a / 4095) step / 256 * 2^12))`, and `LOG_OPAQUE` at `a = 4095`.
+pub fn log_table(step: u32) -> Vec<u32> {
+    let ratio = f64::from(step) / f64::from(1u32 << POS_FRAC_W);
+    (0..=ALPHA_MAX)
+        .map(|a| {
+            if a == ALPHA_MAX {
+                return LOG_OPAQUE;
+            }
+            let l = -(-f64::from(a) / f64::from(ALPHA_MAX)).ln_1p() * ratio;
+            ((l * f64::from(1u32 << LOG_FRAC_W) + 0.5).floor()).min(f64::from(LOG_OPAQUE - 1))
+                as u32
+        })
+        .collect()
+}
+
+/// The power LUT (fixed): entry `i` is `(E_i, E_(i+1) - E_i)` with `E_i = rnd(4095 (1 -
+/// exp(-i 2^(EXP_SHIFT - 12))))`, the alpha code of `1 - exp(-p)` at the entry's `p`.
+pub fn exp_table() -> Vec<(u32, u32)> {
+    let e = |i: u32| {
+        let p = f64::from(i << EXP_SHIFT) / f64::from(1u32 << LOG_FRAC_W);
+        (-(-p).exp_m1() * f64::from(ALPHA_MAX) + 0.5).floor() as u32
+    };
+    (0..1u32 << EXP_IDX_W)
+        .map(|i| (e(i), e(i + 1) - e(i)))
+        .collect()
+}
+
+/// The jitter tables of one sample distance: random, log and power LUTs.
+#[derive(Debug, Clone)]
+pub struct Jitter {
+    jit: Vec<u32>,
+    log: Vec<u32>,
+    exp: Vec<(u32, u32)>,
+}
+
+impl Jitter {
+    pub fn new(step: u32) -> Self {
+        Self {
+            jit: jitter_table(),
+            log: log_table(step),
+            exp: exp_table(),
+        }
+    }
+
+    /// The factor `r = (2^7 + J) / 2^8` of random LUT entry `idx`.
+    pub fn factor(&self, idx: usize) -> f64 {
+        f64::from((1 << JIT_W) + self.jit[idx]) / f64::from(1u32 << (JIT_W + 1))
+    }
+
+    /// The alpha code of `1 - (1 - a / 4095)^(r dr / 256)`: `L = log[a]` (opaque stays 4095),
+    /// `p = rnd(L (2^7 + J), 8)`, `E, D = exp[p >> 6]`, `E + rnd(D (p & 63), 6)`.
+    pub fn alpha(&self, a: u32, idx: usize) -> u32 {
+        let l = self.log[a as usize];
+        if l == LOG_OPAQUE {
+            return ALPHA_MAX;
+        }
+        let p = rnd(
+            u64::from(l) * u64::from((1 << JIT_W) + self.jit[idx]),
+            JIT_W + 1,
+        ) as u32;
+        let (e, d) = self.exp[(p >> EXP_SHIFT) as usize];
+        e + rnd(
+            u64::from(d) * u64::from(p & ((1 << EXP_SHIFT) - 1)),
+            EXP_SHIFT,
+        ) as u32
+    }
+}
+
 impl Sampler {
     /// The datapath for `cfg` with the classification table `class` (built for
     /// [`shader_config`]`(cfg.voxel_w)`).
@@ -123,19 +242,23 @@ impl Sampler {
         let shader = Shader::new(scfg, ShaderTables { class, rmap })?;
         let ccfg = compos_config();
         let lut = OpacityLut::new(f64::from(cfg.step) / f64::from(1u32 << POS_FRAC_W), &ccfg)?;
-        let regs = match cfg.et_threshold {
+        let mut regs = match cfg.et_threshold {
             Some(t) => ComposRegs {
                 et_threshold: u64::from(t),
                 ..ComposRegs::defaults(&ccfg)
             },
             None => ComposRegs::without_termination(&ccfg),
         };
+        // With jitter the alpha code the compositor sees is already corrected: it reads it as
+        // `U(code, 12, 12)` (its LUT bypass).
+        regs.lut_bypass = cfg.jitter;
         Ok(Self {
             cfg,
             trilin,
             irr_trilin: Trilin::new(TrilinConfig::new(16, POS_FRAC_W, 0)?)?,
             shader,
             compos: Compos::new(ccfg, lut, regs)?,
+            jitter: cfg.jitter.then(|| Jitter::new(cfg.step)),
         })
     }
 
@@ -205,11 +328,15 @@ impl Sampler {
             geo: [0; 3],
             terminated: false,
         };
+        let alpha = match &self.jitter {
+            Some(j) => j.alpha(e.a, jitter_index(it.weights)),
+            None => e.a,
+        };
         let out = self.compos.step(
             &coxel,
             &Sample {
                 rgb,
-                alpha: e.a,
+                alpha,
                 depth: 0,
                 mode: ComposMode::FrontToBack,
             },
@@ -235,6 +362,7 @@ impl Sampler {
     /// `rgb = min(1, e I)`, the opacity correction `1 - (1 - a)^(dr / 256)` and the front-to-back
     /// step `A' = A + (1 - A) a'`, `C' = C + (1 - A) a' rgb` in reals, the packet read as `raw /
     /// 4096`; termination compares the input opacity with the threshold (the compositor's rule).
+    /// With jitter the step is `r dr` with the datapath's factor `r` of the item's position bits.
     /// Returns red, green, blue, opacity on the packet's scale (`4096 = 1.0`), unsaturated.
     pub fn reference(&self, it: &SampleIn) -> [f64; 4] {
         let e = self.classified(it);
@@ -267,9 +395,13 @@ impl Sampler {
                 (color_value(c, &ccfg) * irr.unwrap_or(1.0)).min(1.0)
             }
         });
+        let r = self
+            .jitter
+            .as_ref()
+            .map_or(1.0, |j| j.factor(jitter_index(it.weights)));
         let a = corrected_alpha(
             alpha_value(e.a, &ccfg),
-            f64::from(self.cfg.step) / f64::from(1u32 << POS_FRAC_W),
+            r * f64::from(self.cfg.step) / f64::from(1u32 << POS_FRAC_W),
         );
         let t = (1.0 - a_in).max(0.0);
         let color = if it.lighting {
@@ -325,6 +457,12 @@ pub fn trace_samples<R>(f: impl FnOnce() -> R) -> (R, SampleTrace) {
 pub const CFG_DATA_W: u32 = 36;
 /// The configuration address's region bit: set for a `cube5_compos` word.
 pub const CFG_REGION_COMPOS: u32 = 1 << 13;
+/// Jitter tables (`Jitter = 1`): the log LUT at `CFG_LOG + a` (region 0 above the classification
+/// index), the power LUT at `CFG_EXP + i` and the random LUT at `CFG_JIT + i` (the compositor's
+/// region above its registers: it ignores them).
+pub const CFG_LOG: u32 = 1 << 12;
+pub const CFG_EXP: u32 = CFG_REGION_COMPOS | 0x1800;
+pub const CFG_JIT: u32 = CFG_REGION_COMPOS | 0x1C00;
 
 impl Sampler {
     /// The writes that load this datapath's tables and registers into the RTL's configuration
@@ -354,6 +492,20 @@ impl Sampler {
                 .into_iter()
                 .map(|(addr, data)| (CFG_REGION_COMPOS | addr, data)),
         );
+        if let Some(j) = &self.jitter {
+            let word = |v: u32| {
+                let mut w = BitWriter::new();
+                w.put(u64::from(v), CFG_DATA_W);
+                w.finish(CFG_DATA_W)
+            };
+            writes.extend((0u32..).zip(&j.log).map(|(a, &l)| (CFG_LOG + a, word(l))));
+            writes.extend(
+                (0u32..)
+                    .zip(&j.exp)
+                    .map(|(i, &(e, d))| (CFG_EXP + i, word(e | d << EXP_CODE_W))),
+            );
+            writes.extend((0u32..).zip(&j.jit).map(|(i, &r)| (CFG_JIT + i, word(r))));
+        }
         writes
     }
 }
@@ -364,11 +516,16 @@ impl Sampler {
 pub struct SampleRtlConfig {
     /// Bits per voxel, 4..=16.
     pub voxel_w: u32,
+    /// 1: the jitter stage (random, log and power LUTs) before the compositor; 0: none.
+    pub jitter: u32,
 }
 
 impl SampleRtlConfig {
     /// The RTL's parameter default.
-    pub const DEFAULT: Self = Self { voxel_w: 8 };
+    pub const DEFAULT: Self = Self {
+        voxel_w: 8,
+        jitter: 0,
+    };
 
     pub fn validate(&self) -> Result<()> {
         if !(4..=16).contains(&self.voxel_w) {
@@ -377,13 +534,20 @@ impl SampleRtlConfig {
                 self.voxel_w
             )));
         }
+        if self.jitter > 1 {
+            return Err(ModelError::Config(format!(
+                "gicube_sample: Jitter {} is not 0 or 1",
+                self.jitter
+            )));
+        }
         Ok(())
     }
 
     /// Clocks from input to output: density trilin 3, shader 12 (its divider at the smallest
-    /// reflectance map), shade 1, compositor 6 (contract, *The RTL*).
+    /// reflectance map), shade 1, the jitter stage 1 (`Jitter = 1`), compositor 6 (contract,
+    /// *The RTL*).
     pub fn latency(&self) -> u64 {
-        22
+        22 + u64::from(self.jitter)
     }
 
     /// The model's configuration of this voxel width with a sample distance and threshold.
@@ -392,12 +556,14 @@ impl SampleRtlConfig {
             voxel_w: self.voxel_w,
             step,
             et_threshold,
+            jitter: self.jitter != 0,
         }
     }
 }
 
 crate::unit_config!(SampleRtlConfig, "gicube_sample", DEFAULT, {
     "VoxelW" => voxel_w,
+    "Jitter" => jitter,
 });
 
 /// Bits of one packet channel, `U(0.12)`.
@@ -518,6 +684,7 @@ mod tests {
             voxel_w: 8,
             step: 256,
             et_threshold: et,
+            jitter: false,
         };
         let tf = TransferFunction::head_default();
         let class = ClassLut::from_transfer(&shader_config(8), &tf).unwrap();
@@ -595,7 +762,7 @@ mod tests {
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         for voxel_w in [4, 8, 12, 16] {
-            let rtl = SampleRtlConfig { voxel_w };
+            let rtl = SampleRtlConfig { voxel_w, jitter: 0 };
             rtl.validate().unwrap();
             assert_eq!(rtl.in_width(), 8 * voxel_w + 202);
             assert_eq!(rtl.out_width(), 49);
@@ -615,7 +782,27 @@ mod tests {
                 .all(|(a, d)| *a < 1 << 12 && d.len() == 2));
             assert!(w[entries..].iter().all(|(a, _)| a & CFG_REGION_COMPOS != 0));
         }
-        assert!(SampleRtlConfig { voxel_w: 3 }.validate().is_err());
+        // With jitter the three tables follow, each address written once.
+        let rtl = SampleRtlConfig {
+            voxel_w: 8,
+            jitter: 1,
+        };
+        assert_eq!(rtl.latency(), 23);
+        let class = random_class_lut(&mut rng, 8).unwrap();
+        let w = Sampler::new(rtl.sample_config(200, None), class)
+            .unwrap()
+            .config_writes();
+        assert_eq!(w.len(), 4096 + 4096 + 3 + 4096 + 1024 + 256);
+        let mut addrs: Vec<u32> = w.iter().map(|(a, _)| *a).collect();
+        addrs.sort_unstable();
+        addrs.dedup();
+        assert_eq!(addrs.len(), w.len(), "no address written twice");
+        assert!(SampleRtlConfig {
+            voxel_w: 3,
+            jitter: 0
+        }
+        .validate()
+        .is_err());
     }
 
     #[test]
@@ -634,14 +821,15 @@ mod tests {
         assert!(empty.items.is_empty());
     }
 
-    #[test]
-    fn one_step_is_within_a_lsb_of_opacity_and_an_8_bit_colour_code_of_its_f64_reference() {
+    /// 3 x 20,000 random samples (`dr` 16, 200, 1024) within `extra` more than one opacity LSB
+    /// and half an 8-bit colour code (4096 / 510 = 8.03 LSB, plus 1.5) of the f64 reference.
+    fn one_step_against_f64(jitter: u32, seed: u64, extra: f64) {
         use rand::SeedableRng;
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let rtl = SampleRtlConfig { voxel_w: 8, jitter };
         for step in [16, 200, 1024] {
             let class = random_class_lut(&mut rng, 8).unwrap();
-            let s =
-                Sampler::new(SampleRtlConfig::DEFAULT.sample_config(step, None), class).unwrap();
+            let s = Sampler::new(rtl.sample_config(step, None), class).unwrap();
             for _ in 0..20_000 {
                 let it = random_sample_in(&mut rng, 8);
                 let o = s.sample(&it);
@@ -649,12 +837,83 @@ mod tests {
                 let got = [o.color[0], o.color[1], o.color[2], o.opacity].map(f64::from);
                 for ch in 0..4 {
                     if r[ch] < f64::from(CHAN_MAX) {
-                        // Half an 8-bit colour code is 4096 / 510 = 8.03 LSB.
-                        let bound = if ch < 3 { 4096.0 / 510.0 + 1.5 } else { 1.0 };
+                        let bound = extra + if ch < 3 { 4096.0 / 510.0 + 1.5 } else { 1.0 };
                         assert!((got[ch] - r[ch]).abs() <= bound, "{it:?}: {got:?} vs {r:?}");
                     }
                 }
             }
         }
+    }
+
+    #[test]
+    fn one_step_is_within_a_lsb_of_opacity_and_an_8_bit_colour_code_of_its_f64_reference() {
+        one_step_against_f64(0, 9, 0.0);
+    }
+
+    #[test]
+    fn the_jitter_tables_hold_what_the_contract_says() {
+        let jit = jitter_table();
+        assert_eq!(jit.len(), 1 << JIT_IDX_W);
+        assert!(jit.iter().all(|&j| j < 1 << JIT_W));
+        let mean = jit.iter().map(|&j| f64::from(j)).sum::<f64>() / jit.len() as f64;
+        assert!(
+            (mean - 63.5).abs() < 6.0,
+            "uniform over 0..128: mean {mean}"
+        );
+        for step in [16, 256, 1024] {
+            let log = log_table(step);
+            assert_eq!((log[0], log[4095]), (0, LOG_OPAQUE));
+            assert!(log.windows(2).all(|w| w[0] <= w[1]), "monotone");
+        }
+        let exp = exp_table();
+        assert_eq!(exp.len(), 1 << EXP_IDX_W);
+        assert_eq!(exp[0].0, 0);
+        assert!(exp
+            .iter()
+            .all(|&(e, d)| d < 1 << EXP_DIFF_W && e + d <= 4095));
+        // Every position byte pattern reaches the LUT.
+        let mut seen = [false; 256];
+        for w in 0..256 {
+            seen[jitter_index([w, 0, 0])] = true;
+        }
+        assert!(seen.iter().all(|&b| b));
+    }
+
+    #[test]
+    fn a_jittered_empty_cell_leaves_the_packet_unchanged_and_an_opaque_one_stays_opaque() {
+        let j = Jitter::new(1024);
+        for idx in 0..256 {
+            assert_eq!(j.alpha(0, idx), 0);
+            assert_eq!(j.alpha(4095, idx), 4095);
+        }
+        let mut cfg = SampleRtlConfig::DEFAULT.sample_config(256, None);
+        cfg.jitter = true;
+        let class =
+            ClassLut::from_transfer(&shader_config(8), &TransferFunction::head_default()).unwrap();
+        let s = Sampler::new(cfg, class).unwrap();
+        let it = item(0, 1000);
+        let o = s.sample(&it);
+        assert_eq!((o.color, o.opacity, o.terminated), (it.color, 1000, false));
+    }
+
+    #[test]
+    fn the_jittered_alpha_is_within_its_bound_of_f64() {
+        for step in [16, 100, 256, 1024] {
+            let j = Jitter::new(step);
+            let mut worst = 0.0f64;
+            for a in 0..=4095u32 {
+                for idx in (0..256).step_by(7) {
+                    let x = f64::from(a) / 4095.0;
+                    let want = corrected_alpha(x, j.factor(idx) * f64::from(step) / 256.0) * 4095.0;
+                    worst = worst.max((f64::from(j.alpha(a, idx)) - want).abs());
+                }
+            }
+            assert!(worst <= JITTER_ALPHA_BOUND, "step {step}: {worst} codes");
+        }
+    }
+
+    #[test]
+    fn one_jittered_step_is_within_its_bound_of_the_f64_reference() {
+        one_step_against_f64(1, 11, JITTER_ALPHA_BOUND);
     }
 }
