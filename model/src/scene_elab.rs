@@ -90,7 +90,7 @@ impl Elaboration {
     /// The parameters that set the configuration apart: `P` and `MaxDim` always, then every
     /// parameter whose value is not the RTL's default, in the frame's parameter order.
     pub fn params(&self) -> Vec<(&'static str, i64)> {
-        let dflt = FrameConfig::DEFAULT.to_params();
+        let dflt = self.config.rtl_defaults().to_params();
         self.config
             .to_params()
             .into_iter()
@@ -212,7 +212,7 @@ pub fn elaborate(scene: &Scene, dims: [usize; 3], pipelines: Option<usize>) -> R
         ("AlphaW", "quality.alpha_bits"),
         ("AccW", "quality.acc_bits"),
     ];
-    let dflt = FrameConfig::DEFAULT.to_params();
+    let dflt = config.rtl_defaults().to_params();
     let mine = config.to_params();
     for (name, field) in widths {
         if let Some((_, v)) = mine

@@ -107,6 +107,8 @@ impl UnitConfig for AccelConfig {
         let mut fp = pick(FRAME_PARAMS);
         fp.extend(pick(UNIT_WIDTH_PARAMS));
         fp.push(("Source", 1));
+        // The frame's slice FIFOs hold one section (cube5_accel.sv: `.MaxSection(Section)`).
+        fp.push(("MaxSection", get("Section")));
         let own = |n: &str| {
             u32::try_from(get(n)).map_err(|_| {
                 ModelError::Config(format!("cube5_accel: {n} = {} is out of range", get(n)))

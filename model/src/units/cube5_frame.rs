@@ -89,6 +89,9 @@ pub struct FrameConfig {
     /// Pixels per output item of the read-out (`OutLanes`): 1, or `p` (P consecutive pixels of a
     /// row per item and per clock, `H ceil(W / P)` items; docs/frame-rtl.md, "The read-out").
     pub out_lanes: usize,
+    /// The widest section a frame fed by beats takes (`MaxSection`; `None`: `MaxDim`, the RTL's
+    /// default): it sizes the slice FIFOs, `MaxSection MaxDim / P` beats (docs/frame-rtl.md).
+    pub max_section: Option<usize>,
 }
 
 impl FrameConfig {
@@ -106,11 +109,26 @@ impl FrameConfig {
         stream: false,
         depth_test: false,
         out_lanes: 1,
+        max_section: None,
     };
 
     /// The largest volume edge (`MaxDim`).
     pub fn max_dim(&self) -> usize {
         1 << self.max_dim_log2
+    }
+
+    /// The RTL's defaults at this configuration's `MaxDim` (a default that depends on it, as
+    /// `MaxSection`'s, follows it).
+    pub fn rtl_defaults(&self) -> Self {
+        Self {
+            max_dim_log2: self.max_dim_log2,
+            ..Self::DEFAULT
+        }
+    }
+
+    /// The widest section the frame takes (`MaxSection`): `MaxDim` unless set.
+    pub fn max_section(&self) -> usize {
+        self.max_section.unwrap_or_else(|| self.max_dim())
     }
 }
 
@@ -128,6 +146,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         let mut source = u32::from(d.stream);
         let mut depth_test = u32::from(d.depth_test);
         let mut out_lanes = d.out_lanes as u32;
+        let mut max_section = 0u32; // 0: not given, MaxDim
         crate::unit::set_params(
             Self::TOP,
             params,
@@ -155,8 +174,19 @@ impl crate::unit::UnitConfig for FrameConfig {
                 ("Source", &mut source),
                 ("DepthTest", &mut depth_test),
                 ("OutLanes", &mut out_lanes),
+                ("MaxSection", &mut max_section),
             ],
         )?;
+        if max_section != 0
+            && (max_section > max_dim
+                || max_section < 2 * p
+                || !max_section.is_multiple_of(p)
+                || (source == 0 && max_section != max_dim))
+        {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: MaxSection = {max_section} must be a multiple of P = {p} in 2 P ..= MaxDim = {max_dim} (MaxDim when Source = 0)"
+            )));
+        }
         if out_lanes != 1 && (out_lanes != p || depth_test != 0) {
             return Err(ModelError::Config(format!(
                 "cube5_frame: OutLanes = {out_lanes} must be 1, or P = {p} without the depth test"
@@ -202,6 +232,8 @@ impl crate::unit::UnitConfig for FrameConfig {
             stream: source == 1,
             depth_test: depth_test == 1,
             out_lanes: out_lanes as usize,
+            max_section: (max_section != 0 && max_section != max_dim)
+                .then_some(max_section as usize),
         })
     }
 
@@ -232,6 +264,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             ("Source", i64::from(self.stream)),
             ("DepthTest", i64::from(self.depth_test)),
             ("OutLanes", self.out_lanes as i64),
+            ("MaxSection", self.max_section() as i64),
         ]
     }
 }
