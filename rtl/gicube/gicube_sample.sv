@@ -104,6 +104,10 @@ module gicube_sample #(
   if (Jitter > 1) begin : gen_bad_jitter
     $fatal(1, "gicube_sample: Jitter must be 0 or 1");
   end
+  // The jitter's position mangling rotates 8-bit weights (contract, "Jitter and the power LUT").
+  if (Jitter != 0 && WeightW != 8) begin : gen_bad_jitter_weight_w
+    $fatal(1, "gicube_sample: Jitter = 1 needs gicube_sample_pkg::WeightW = 8");
+  end
   if (LightingBit != InW - 1) begin : gen_bad_packing
     $fatal(1, "gicube_sample: input packing and gicube_sample_pkg::in_w disagree");
   end
