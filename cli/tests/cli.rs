@@ -4,7 +4,7 @@
 mod support;
 
 use std::process::Output;
-use support::{cube5, scratch};
+use support::{cube5, render_ok, scratch};
 
 /// Asserts a refusal naming `needle` (one line, non-zero exit, no panic).
 fn assert_refused(out: &Output, needle: &str) {
@@ -43,17 +43,7 @@ fn renders_any_view_angle_from_a_scene_file() {
     let scene = scratch("view.toml");
     std::fs::write(&scene, "[volume]\nsize = 24\n[view]\nazimuth = -135.5\nelevation = 89.9\n[image]\nwidth = 16\nheight = 16\n").unwrap();
     let png = scratch("view.png");
-    let out = cube5(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    render_ok(&scene, &png);
     assert!(png.exists());
 }
 

@@ -242,17 +242,7 @@ fn prefilter_refusals_name_the_field() {
         )
         .unwrap();
         let png = dir.join(format!("{kernel}.png"));
-        let out = cube5(&[
-            "render",
-            toml.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        support::render_ok(&toml, &png);
         images.push(std::fs::read(&png).unwrap());
     }
     assert_ne!(

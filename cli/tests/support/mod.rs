@@ -1,7 +1,7 @@
 //! Helpers shared by the command-line tests.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Runs the `cube5` binary with `args`.
@@ -33,6 +33,22 @@ pub fn assert_refused(out: &Output, needles: &[&str]) {
     for n in needles {
         assert!(err.contains(n), "error should mention `{n}`: {err}");
     }
+}
+
+/// `cube5 render SCENE -o PNG`: must succeed; returns its output.
+pub fn render_ok(scene: &Path, png: &Path) -> Output {
+    let out = cube5(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
 
 /// Writes `scene` as NAME.toml in the scratch directory and renders it; returns the output and
