@@ -71,6 +71,19 @@ pub fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
     (out, png)
 }
 
+/// Renders `scene` as `render_scene` does: refused (as `assert_refused`) naming NAME.toml and every
+/// needle, and no PNG written.
+pub fn scene_refused(name: &str, scene: &str, needles: &[&str]) {
+    let (out, png) = render_scene(name, scene);
+    let file = format!("{name}.toml");
+    assert_refused(&out, &[&[file.as_str()], needles].concat());
+    assert!(
+        !png.exists(),
+        "{name}: a refused scene wrote {}",
+        png.display()
+    );
+}
+
 /// The example scene `scenes/NAME.toml` with each `(from, to)` replaced (each `from` must be in
 /// it, so a changed scene fails loudly), written to the scratch directory as TAG.toml.
 pub fn example_scene_with(name: &str, tag: &str, edits: &[(&str, &str)]) -> PathBuf {
