@@ -6,7 +6,7 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use support::{assert_refused, cube5, render_scene, scratch};
+use support::{assert_refused, cube5, render_scene, scratch, succeeded};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -32,13 +32,7 @@ fn render(scene: &Path, name: &str, extra: &[&str]) -> (String, image::RgbImage)
         "48",
     ];
     args.extend_from_slice(extra);
-    let out = cube5(&args);
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&cube5(&args), "render");
     (stdout, image::open(&png).unwrap().to_rgb8())
 }
 

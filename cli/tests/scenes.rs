@@ -5,7 +5,7 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use support::{cube5, render_scene, scene_refused, scratch};
+use support::{cube5, render_scene, scene_refused, scratch, succeeded};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -34,12 +34,7 @@ fn every_example_scene_renders() {
             "--height",
             "64",
         ]);
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stdout = succeeded(&out, &name);
         assert!(stdout.contains("; modelled: trilin"), "{name}: {stdout}");
         let img = image::open(&png).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), (64, 64));
@@ -205,12 +200,7 @@ fn rtl_target_cosimulates_the_frame() {
         "rtl",
         "[volume]\nsize = 16\n[render]\nmode = \"mip\"\n[run]\ntarget = \"both\"\n",
     );
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out, "rtl");
     assert!(
         stdout.contains("gradient (MIP is unlit; its frame has Shade = 0, no gradient unit)"),
         "{stdout}"
@@ -242,12 +232,7 @@ fn example_scene_is_the_rtl_frame(name: &str) {
     let scene = cube5_model::repo_root().join(format!("scenes/{name}.toml"));
     let png = scratch(&format!("cosim-{name}.png"));
     let out = cube5(&["render", s(&scene), "-o", s(&png), "--target", "both"]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{name}: {stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out, name);
     assert!(stdout.contains("plan: frame"), "{name}: {stdout}");
     assert!(stdout.contains("MATCH"), "{name}: {stdout}");
     let rtl = png
@@ -328,11 +313,7 @@ fn phantom_files_round_trip_through_render() {
                     "-o",
                     s(&file),
                 ]);
-                assert!(
-                    out.status.success(),
-                    "{}",
-                    String::from_utf8_lossy(&out.stderr)
-                );
+                succeeded(&out, "phantom");
                 format!("file = \"{}\"\n", s(&file))
             }
             _ => volume,
@@ -341,11 +322,7 @@ fn phantom_files_round_trip_through_render() {
             &format!("rt-{name}"),
             &format!("[volume]\n{volume}[transfer]\npreset = \"head\"\n"),
         );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        succeeded(&out, name);
         images.push(image::open(&png).unwrap().to_rgb8());
     }
     assert_eq!(images[0], images[1], "NIfTI");
@@ -357,12 +334,7 @@ fn tradeoff_tiny_sweep_end_to_end() {
     let dir = scratch("tradeoff");
     let _ = std::fs::remove_dir_all(&dir);
     let out = cube5(&["tradeoff", "--tiny", "--out", s(&dir)]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = succeeded(&out, "tradeoff");
     assert!(stdout.contains("cube3-paper 6.1"), "{stdout}");
     for f in [
         "tradeoff.md",

@@ -20,6 +20,19 @@ pub fn scratch(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+/// Asserts that `out` is a successful run (else panics with `what`, the exit status, stdout and
+/// stderr); returns its stdout.
+pub fn succeeded(out: &Output, what: &str) -> String {
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{what}: {}: {stdout}{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
 /// A refusal: non-zero exit, exactly one line on stderr containing every needle, no panic.
 pub fn assert_refused(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
@@ -43,11 +56,7 @@ pub fn render_ok(scene: &Path, png: &Path) -> Output {
         "-o",
         png.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeded(&out, &format!("render {}", scene.display()));
     out
 }
 
@@ -110,13 +119,7 @@ pub fn cosim_matches(scene: &std::path::Path, dir: &std::path::Path) -> String {
         "-o",
         dir.to_str().unwrap(),
     ]);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "{}: {stdout}{}",
-        scene.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out, &scene.display().to_string());
     assert!(stdout.contains("MATCH"), "{}: {stdout}", scene.display());
     stdout
 }
