@@ -4,7 +4,7 @@
 mod support;
 
 use std::process::Output;
-use support::{cube5, render_ok, scratch, succeeded};
+use support::{cube5, render_at, render_ok, scratch, succeeded};
 
 /// Asserts a refusal naming `needle` (one line, non-zero exit, no panic).
 fn assert_refused(out: &Output, needle: &str) {
@@ -170,21 +170,8 @@ fn render_view(name: &str, scene: &str, extra: &[&str]) -> (Output, Vec<u8>) {
     let toml = scratch(&format!("{name}.toml"));
     std::fs::write(&toml, format!("[volume]\nsize = 24\n{scene}")).unwrap();
     let png = scratch(&format!("{name}.png"));
-    let _ = std::fs::remove_file(&png);
-    let mut args = vec![
-        "render",
-        toml.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-        "--width",
-        "24",
-        "--height",
-        "24",
-    ];
-    args.extend_from_slice(extra);
-    let out = cube5(&args);
-    let bytes = std::fs::read(&png).unwrap_or_default();
-    (out, bytes)
+    let out = render_at(&toml, &png, 24, extra);
+    (out, std::fs::read(&png).unwrap_or_default())
 }
 
 /// `--azimuth` and `--elevation` apply over a scene's `view.direction` (they were silently ignored

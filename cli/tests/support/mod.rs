@@ -60,24 +60,31 @@ pub fn render_ok(scene: &Path, png: &Path) -> Output {
     out
 }
 
-/// Writes `scene` as NAME.toml in the scratch directory and renders it; returns the output and
-/// the PNG path (removed first).
+/// `cube5 render SCENE -o PNG` at `px` x `px` pixels with `extra` arguments, PNG removed first.
+pub fn render_at(scene: &Path, png: &Path, px: u32, extra: &[&str]) -> Output {
+    let _ = std::fs::remove_file(png);
+    let px = px.to_string();
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--width",
+        &px,
+        "--height",
+        &px,
+    ];
+    args.extend_from_slice(extra);
+    cube5(&args)
+}
+
+/// Writes `scene` as NAME.toml in the scratch directory and renders it at 16 x 16; returns the
+/// output and the PNG path (removed first).
 pub fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
     let toml = scratch(&format!("{name}.toml"));
     std::fs::write(&toml, scene).unwrap();
     let png = scratch(&format!("{name}.png"));
-    let _ = std::fs::remove_file(&png);
-    let out = cube5(&[
-        "render",
-        toml.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-        "--width",
-        "16",
-        "--height",
-        "16",
-    ]);
-    (out, png)
+    (render_at(&toml, &png, 16, &[]), png)
 }
 
 /// Renders `scene` as `render_scene` does: refused (as `assert_refused`) naming NAME.toml and every
