@@ -4,7 +4,7 @@
 mod support;
 
 use std::process::Output;
-use support::{cube5, scratch};
+use support::{cube5, render_at, render_ok, scratch, succeeded};
 
 /// Asserts a refusal naming `needle` (one line, non-zero exit, no panic).
 fn assert_refused(out: &Output, needle: &str) {
@@ -24,12 +24,7 @@ fn renders_the_default_scene_to_png() {
         "--height",
         "40",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = succeeded(&out, "render");
     assert!(
         stdout.contains(&format!("wrote {}", png.display())),
         "{stdout}"
@@ -43,17 +38,7 @@ fn renders_any_view_angle_from_a_scene_file() {
     let scene = scratch("view.toml");
     std::fs::write(&scene, "[volume]\nsize = 24\n[view]\nazimuth = -135.5\nelevation = 89.9\n[image]\nwidth = 16\nheight = 16\n").unwrap();
     let png = scratch("view.png");
-    let out = cube5(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    render_ok(&scene, &png);
     assert!(png.exists());
 }
 
@@ -135,12 +120,7 @@ fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
             "-o",
             dir.to_str().unwrap(),
         ]);
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "{stdout}{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stdout = succeeded(&out, p);
         assert!(stdout.contains("MATCH"), "{stdout}");
         assert!(stdout.contains("samples/clock/pipeline"), "{stdout}");
         for f in ["model.png", "rtl.png"] {
@@ -190,30 +170,8 @@ fn render_view(name: &str, scene: &str, extra: &[&str]) -> (Output, Vec<u8>) {
     let toml = scratch(&format!("{name}.toml"));
     std::fs::write(&toml, format!("[volume]\nsize = 24\n{scene}")).unwrap();
     let png = scratch(&format!("{name}.png"));
-    let _ = std::fs::remove_file(&png);
-    let mut args = vec![
-        "render",
-        toml.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-        "--width",
-        "24",
-        "--height",
-        "24",
-    ];
-    args.extend_from_slice(extra);
-    let out = cube5(&args);
-    let bytes = std::fs::read(&png).unwrap_or_default();
-    (out, bytes)
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
+    let out = render_at(&toml, &png, 24, extra);
+    (out, std::fs::read(&png).unwrap_or_default())
 }
 
 /// `--azimuth` and `--elevation` apply over a scene's `view.direction` (they were silently ignored
@@ -222,12 +180,12 @@ fn ok(out: &Output) -> String {
 fn command_line_angles_apply_over_a_scene_direction() {
     let dir = "[view]\ndirection = [0.0, -1.0, -1.0]\n";
     let (out, with_dir) = render_view("dir", dir, &[]);
-    ok(&out);
+    succeeded(&out, "render");
     let (out, both) = render_view("dir-both", dir, &["--azimuth", "10", "--elevation", "30"]);
-    let stdout = ok(&out);
+    let stdout = succeeded(&out, "render");
     assert!(stdout.contains("view azimuth 10 elevation 30"), "{stdout}");
     let (out, orbit) = render_view("orbit", "[view]\nazimuth = 10\nelevation = 30\n", &[]);
-    ok(&out);
+    succeeded(&out, "render");
     assert_eq!(
         both, orbit,
         "--azimuth/--elevation must give the orbit's image"
@@ -235,7 +193,7 @@ fn command_line_angles_apply_over_a_scene_direction() {
     assert_ne!(both, with_dir, "the angles were ignored");
     // Only the azimuth: the elevation is the direction's (45 degrees).
     let (out, az) = render_view("dir-az", dir, &["--azimuth", "10"]);
-    let stdout = ok(&out);
+    let stdout = succeeded(&out, "render");
     let elevation = stdout
         .split("view azimuth 10 elevation ")
         .nth(1)
@@ -248,7 +206,7 @@ fn command_line_angles_apply_over_a_scene_direction() {
         &format!("[view]\nazimuth = 10\nelevation = {elevation}\n"),
         &[],
     );
-    ok(&out);
+    succeeded(&out, "render");
     assert_eq!(az, orbit);
 }
 
@@ -257,22 +215,22 @@ fn command_line_angles_apply_over_a_scene_direction() {
 #[test]
 fn command_line_roll_and_up() {
     let (out, plain) = render_view("plain", "", &[]);
-    ok(&out);
+    succeeded(&out, "render");
     let (out, rolled) = render_view("rolled", "", &["--roll", "-30"]);
-    let stdout = ok(&out);
+    let stdout = succeeded(&out, "render");
     assert!(stdout.contains("roll -30"), "{stdout}");
     let (out, scene_rolled) = render_view("scene-rolled", "[view]\nroll = -30\n", &[]);
-    ok(&out);
+    succeeded(&out, "render");
     assert_eq!(rolled, scene_rolled);
     assert_ne!(rolled, plain);
     let top = "[view]\ndirection = [0, 0, -1]\n";
     let (out, up) = render_view("up", top, &["--up", "-1,0,0"]);
-    ok(&out);
+    succeeded(&out, "render");
     let (out, scene_up) = render_view("scene-up", &format!("{top}up = [-1, 0, 0]\n"), &[]);
-    ok(&out);
+    succeeded(&out, "render");
     assert_eq!(up, scene_up);
     let (out, default_up) = render_view("default-up", top, &[]);
-    ok(&out);
+    succeeded(&out, "render");
     assert_ne!(up, default_up);
     let (out, png) = render_view("up-parallel", top, &["--up", "0,0,1"]);
     assert_refused(&out, "view.up");
@@ -291,14 +249,14 @@ fn command_line_roll_and_up() {
 fn perspective_scenes_name_their_scheme() {
     let persp = "[view]\nprojection = \"perspective\"\nfov = 40\n[run]\nrenderer = \"reference\"\n";
     let (out, exact) = render_view("persp", persp, &[]);
-    let stdout = ok(&out);
+    let stdout = succeeded(&out, "render");
     assert!(
         stdout.contains("plan: f64 reference renderer")
             && stdout.contains("perspective (exact rays from the eye"),
         "{stdout}"
     );
     let (out, slabs) = render_view("persp-slabs", persp, &["--slabs", "4", "--compare"]);
-    let stdout = ok(&out);
+    let stdout = succeeded(&out, "render");
     assert!(
         stdout.contains("plan: what-if slab perspective (not the hardware: 4 equal slabs")
             && stdout.contains("error against the f64 reference: PSNR"),
@@ -310,7 +268,7 @@ fn perspective_scenes_name_their_scheme() {
         "[view]\nprojection = \"perspective\"\nfov = 40\nslabs = 4\n[run]\nrenderer = \"slabs\"\n",
         &[],
     );
-    ok(&out);
+    succeeded(&out, "render");
     assert_eq!(slabs, scene_slabs);
     let (out, _) = render_view("slabs-parallel", "", &["--slabs", "4"]);
     assert_refused(&out, "run.renderer");
@@ -326,7 +284,7 @@ fn perspective_scenes_name_their_scheme() {
 fn er_perspective_renders_and_names_its_counts() {
     let persp = "[view]\nprojection = \"perspective\"\nfov = 90\n[run]\nrenderer = \"reference\"\n";
     let (out, flag) = render_view("er-flag", persp, &["--er", "--compare"]);
-    let stdout = ok(&out);
+    let stdout = succeeded(&out, "render");
     assert!(
         stdout.contains("plan: ER-perspective model")
             && stdout.contains("against the bound N^2 = ")
@@ -337,14 +295,14 @@ fn er_perspective_renders_and_names_its_counts() {
     );
     let er = "[view]\nprojection = \"perspective\"\nfov = 90\n[run]\nrenderer = \"er\"\n";
     let (out, scene_er) = render_view("er-scene", er, &[]);
-    ok(&out);
+    succeeded(&out, "render");
     assert_eq!(flag, scene_er);
     let (out, centre) = render_view(
         "er-centre",
         "[view]\nprojection = \"perspective\"\nfov = 90\ner_merge = \"centre\"\n[run]\nrenderer = \"er\"\n",
         &[],
     );
-    ok(&out);
+    succeeded(&out, "render");
     assert_ne!(flag, centre, "two regions: the merge shows");
     for (name, text, field) in [
         ("er-parallel", "[run]\nrenderer = \"er\"\n", "run.renderer"),

@@ -3,7 +3,7 @@
 
 mod support;
 
-use support::{assert_refused, cube5, scratch};
+use support::{assert_refused, cube5, scratch, succeeded};
 
 fn scene_path(name: &str) -> String {
     cube5_model::repo_root()
@@ -13,14 +13,7 @@ fn scene_path(name: &str) -> String {
 }
 
 fn stdout_of(args: &[&str]) -> String {
-    let out = cube5(args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "{args:?}: {stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
+    succeeded(&cube5(args), &format!("{args:?}"))
 }
 
 /// The MIP example scene leaves gradient and shader out and says why; the composite one keeps

@@ -6,7 +6,7 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use support::{assert_refused, cube5, render_scene, scratch};
+use support::{assert_refused, cube5, render_at, render_scene, scratch, succeeded};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -20,25 +20,7 @@ fn example() -> PathBuf {
 /// output and the image.
 fn render(scene: &Path, name: &str, extra: &[&str]) -> (String, image::RgbImage) {
     let png = scratch(name);
-    let _ = std::fs::remove_file(&png);
-    let mut args = vec![
-        "render",
-        s(scene),
-        "-o",
-        s(&png),
-        "--width",
-        "48",
-        "--height",
-        "48",
-    ];
-    args.extend_from_slice(extra);
-    let out = cube5(&args);
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&render_at(scene, &png, 48, extra), "render");
     (stdout, image::open(&png).unwrap().to_rgb8())
 }
 

@@ -12,7 +12,7 @@
 
 mod support;
 
-use support::{assert_refused, cube5, scratch};
+use support::{assert_refused, cube5, scratch, succeeded};
 
 /// One scene and what its co-simulation must show.
 struct Wanted {
@@ -93,12 +93,7 @@ fn cosim_builds_what_the_scene_needs(w: &Wanted) {
     let dir = scratch(&format!("builds-{name}"));
     let _ = std::fs::remove_dir_all(&dir);
     let out = cube5(&["cosim", &scene, "-o", dir.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{name}: {stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out, name);
     let has = |needle: &str| {
         assert!(
             stdout.contains(needle),
@@ -166,12 +161,7 @@ fn cosim_builds_what_the_scene_needs(w: &Wanted) {
     let png = scratch(&format!("builds-{name}.png"));
     let _ = std::fs::remove_file(&png);
     let render = cube5(&["render", &scene, "-o", png.to_str().unwrap()]);
-    let rstdout = String::from_utf8_lossy(&render.stdout);
-    assert!(
-        render.status.success(),
-        "{name}: {rstdout}{}",
-        String::from_utf8_lossy(&render.stderr)
-    );
+    let rstdout = succeeded(&render, name);
     assert!(rstdout.contains("plan: frame"), "{name}: {rstdout}");
     if w.prefilter.is_some() {
         assert!(
@@ -242,17 +232,7 @@ fn prefilter_refusals_name_the_field() {
         )
         .unwrap();
         let png = dir.join(format!("{kernel}.png"));
-        let out = cube5(&[
-            "render",
-            toml.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        support::render_ok(&toml, &png);
         images.push(std::fs::read(&png).unwrap());
     }
     assert_ne!(

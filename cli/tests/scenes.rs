@@ -5,7 +5,7 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use support::{assert_refused, cube5, render_scene, scratch};
+use support::{cube5, render_scene, scene_refused, scratch, succeeded};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -34,12 +34,7 @@ fn every_example_scene_renders() {
             "--height",
             "64",
         ]);
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stdout = succeeded(&out, &name);
         assert!(stdout.contains("; modelled: trilin"), "{name}: {stdout}");
         let img = image::open(&png).unwrap().to_rgb8();
         assert_eq!(img.dimensions(), (64, 64));
@@ -61,12 +56,11 @@ fn every_example_scene_renders() {
 
 #[test]
 fn missing_volume_file() {
-    let (out, png) = render_scene("missing-volume", "[volume]\nfile = \"no/such.nrrd\"\n");
-    assert_refused(
-        &out,
-        &["missing-volume.toml", "volume.file", "no/such.nrrd"],
+    scene_refused(
+        "missing-volume",
+        "[volume]\nfile = \"no/such.nrrd\"\n",
+        &["volume.file", "no/such.nrrd"],
     );
-    assert!(!png.exists());
 }
 
 #[test]
@@ -74,46 +68,34 @@ fn unreadable_volume_file() {
     // A directory where a file should be (root can read any file, so permissions cannot show it).
     let dir = scratch("a-directory.nii");
     std::fs::create_dir_all(&dir).unwrap();
-    let (out, png) = render_scene("unreadable", &format!("[volume]\nfile = \"{}\"\n", s(&dir)));
-    assert_refused(&out, &["unreadable.toml", "volume.file", "a-directory.nii"]);
-    assert!(!png.exists());
+    scene_refused(
+        "unreadable",
+        &format!("[volume]\nfile = \"{}\"\n", s(&dir)),
+        &["volume.file", "a-directory.nii"],
+    );
 }
 
 #[test]
 fn raw_size_must_equal_dims_times_type() {
     let raw = scratch("short.raw");
     std::fs::write(&raw, vec![7u8; 1000]).unwrap();
-    let (out, png) = render_scene(
+    scene_refused(
         "raw-size",
         &format!(
             "[volume]\nfile = \"{}\"\ndims = [10, 10, 6]\ntype = \"u16\"\n",
             s(&raw)
         ),
+        &["volume.file", "short.raw", "file size", "1000 bytes"],
     );
-    assert_refused(
-        &out,
-        &[
-            "raw-size.toml",
-            "volume.file",
-            "short.raw",
-            "file size",
-            "1000 bytes",
-        ],
-    );
-    assert!(!png.exists());
 }
 
 #[test]
 fn dims_beyond_the_configured_rtl() {
-    let (out, png) = render_scene(
+    scene_refused(
         "rtl-limit",
         "[volume]\nsize = 600\n[run]\ntarget = \"rtl\"\n",
+        &["volume.size", "configured RTL", "128"],
     );
-    assert_refused(
-        &out,
-        &["rtl-limit.toml", "volume.size", "configured RTL", "128"],
-    );
-    assert!(!png.exists());
     // A file whose header says more than the model takes at all.
     let big = scratch("big.nrrd");
     std::fs::write(
@@ -121,52 +103,51 @@ fn dims_beyond_the_configured_rtl() {
         "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2000 4 4\nencoding: raw\n\n",
     )
     .unwrap();
-    let (out, png) = render_scene("too-big", &format!("[volume]\nfile = \"{}\"\n", s(&big)));
-    assert_refused(&out, &["too-big.toml", "volume.file", "big.nrrd", "sizes"]);
-    assert!(!png.exists());
+    scene_refused(
+        "too-big",
+        &format!("[volume]\nfile = \"{}\"\n", s(&big)),
+        &["volume.file", "big.nrrd", "sizes"],
+    );
 }
 
 #[test]
 fn nan_or_zero_view_vector() {
-    let (out, png) = render_scene("nan-view", "[view]\ndirection = [nan, 0.0, 1.0]\n");
-    assert_refused(&out, &["nan-view.toml", "view.direction"]);
-    assert!(!png.exists());
-    let (out, png) = render_scene("zero-view", "[view]\ndirection = [0, 0, 0]\n");
-    assert_refused(&out, &["zero-view.toml", "view.direction", "zero"]);
-    assert!(!png.exists());
+    scene_refused(
+        "nan-view",
+        "[view]\ndirection = [nan, 0.0, 1.0]\n",
+        &["view.direction"],
+    );
+    scene_refused(
+        "zero-view",
+        "[view]\ndirection = [0, 0, 0]\n",
+        &["view.direction", "zero"],
+    );
 }
 
 #[test]
 fn empty_or_constant_volume() {
     let empty = scratch("empty.nrrd");
     std::fs::write(&empty, b"").unwrap();
-    let (out, png) = render_scene("empty", &format!("[volume]\nfile = \"{}\"\n", s(&empty)));
-    assert_refused(&out, &["empty.toml", "volume.file", "empty.nrrd", "magic"]);
-    assert!(!png.exists());
+    scene_refused(
+        "empty",
+        &format!("[volume]\nfile = \"{}\"\n", s(&empty)),
+        &["volume.file", "empty.nrrd", "magic"],
+    );
     let flat = scratch("flat.raw");
     std::fs::write(&flat, vec![0u8; 8 * 8 * 8]).unwrap();
-    let (out, png) = render_scene(
+    scene_refused(
         "constant",
         &format!(
             "[volume]\nfile = \"{}\"\ndims = [8, 8, 8]\ntype = \"u8\"\n",
             s(&flat)
         ),
+        &["volume", "every voxel is 0"],
     );
-    assert_refused(&out, &["constant.toml", "volume", "every voxel is 0"]);
-    assert!(!png.exists());
 }
 
 #[test]
 fn unsorted_transfer_function_points() {
-    let (out, png) = render_scene(
-        "unsorted",
-        "[transfer]\npoints = [\n  { density = 0.0, rgba = [0, 0, 0, 0] },\n  { density = 0.6, rgba = [1, 1, 1, 0.5] },\n  { density = 0.4, rgba = [1, 1, 1, 1] },\n]\n",
-    );
-    assert_refused(
-        &out,
-        &["unsorted.toml", "transfer.points[2].density", "sorted"],
-    );
-    assert!(!png.exists());
+    scene_refused("unsorted", "[transfer]\npoints = [\n  { density = 0.0, rgba = [0, 0, 0, 0] },\n  { density = 0.6, rgba = [1, 1, 1, 0.5] },\n  { density = 0.4, rgba = [1, 1, 1, 1] },\n]\n", &["transfer.points[2].density", "sorted"]);
 }
 
 #[test]
@@ -177,25 +158,40 @@ fn malformed_headers_name_the_field() {
         "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: bzip2\n\n",
     )
     .unwrap();
-    let (out, _) = render_scene("bad-nrrd", &format!("[volume]\nfile = \"{}\"\n", s(&bad)));
-    assert_refused(&out, &["bad-nrrd.toml", "bad-header.nrrd", "encoding"]);
+    scene_refused(
+        "bad-nrrd",
+        &format!("[volume]\nfile = \"{}\"\n", s(&bad)),
+        &["bad-header.nrrd", "encoding"],
+    );
     let nii = scratch("bad.nii");
     let mut h = vec![0u8; 352];
     h[0..4].copy_from_slice(&348i32.to_le_bytes());
     h[344..348].copy_from_slice(b"n+1\0");
     std::fs::write(&nii, &h).unwrap();
-    let (out, _) = render_scene("bad-nifti", &format!("[volume]\nfile = \"{}\"\n", s(&nii)));
-    assert_refused(&out, &["bad-nifti.toml", "bad.nii", "dim[0]"]);
+    scene_refused(
+        "bad-nifti",
+        &format!("[volume]\nfile = \"{}\"\n", s(&nii)),
+        &["bad.nii", "dim[0]"],
+    );
 }
 
 #[test]
 fn bad_knobs_and_combinations() {
-    let (out, _) = render_scene("knob", "[quality]\nweight_bits = 20\n");
-    assert_refused(&out, &["knob.toml", "quality.weight_bits"]);
-    let (out, _) = render_scene("persp", "[view]\nprojection = \"perspective\"\n");
-    assert_refused(&out, &["persp.toml", "view.projection", "reference"]);
-    let (out, _) = render_scene("both", "[volume]\nphantom = \"head\"\nfile = \"x.nrrd\"\n");
-    assert_refused(&out, &["both.toml", "volume", "not both"]);
+    scene_refused(
+        "knob",
+        "[quality]\nweight_bits = 20\n",
+        &["quality.weight_bits"],
+    );
+    scene_refused(
+        "persp",
+        "[view]\nprojection = \"perspective\"\n",
+        &["view.projection", "reference"],
+    );
+    scene_refused(
+        "both",
+        "[volume]\nphantom = \"head\"\nfile = \"x.nrrd\"\n",
+        &["volume", "not both"],
+    );
 }
 
 #[test]
@@ -204,12 +200,7 @@ fn rtl_target_cosimulates_the_frame() {
         "rtl",
         "[volume]\nsize = 16\n[render]\nmode = \"mip\"\n[run]\ntarget = \"both\"\n",
     );
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out, "rtl");
     assert!(
         stdout.contains("gradient (MIP is unlit; its frame has Shade = 0, no gradient unit)"),
         "{stdout}"
@@ -241,12 +232,7 @@ fn example_scene_is_the_rtl_frame(name: &str) {
     let scene = cube5_model::repo_root().join(format!("scenes/{name}.toml"));
     let png = scratch(&format!("cosim-{name}.png"));
     let out = cube5(&["render", s(&scene), "-o", s(&png), "--target", "both"]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{name}: {stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out, name);
     assert!(stdout.contains("plan: frame"), "{name}: {stdout}");
     assert!(stdout.contains("MATCH"), "{name}: {stdout}");
     let rtl = png
@@ -327,11 +313,7 @@ fn phantom_files_round_trip_through_render() {
                     "-o",
                     s(&file),
                 ]);
-                assert!(
-                    out.status.success(),
-                    "{}",
-                    String::from_utf8_lossy(&out.stderr)
-                );
+                succeeded(&out, "phantom");
                 format!("file = \"{}\"\n", s(&file))
             }
             _ => volume,
@@ -340,11 +322,7 @@ fn phantom_files_round_trip_through_render() {
             &format!("rt-{name}"),
             &format!("[volume]\n{volume}[transfer]\npreset = \"head\"\n"),
         );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        succeeded(&out, name);
         images.push(image::open(&png).unwrap().to_rgb8());
     }
     assert_eq!(images[0], images[1], "NIfTI");
@@ -356,12 +334,7 @@ fn tradeoff_tiny_sweep_end_to_end() {
     let dir = scratch("tradeoff");
     let _ = std::fs::remove_dir_all(&dir);
     let out = cube5(&["tradeoff", "--tiny", "--out", s(&dir)]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = succeeded(&out, "tradeoff");
     assert!(stdout.contains("cube3-paper 6.1"), "{stdout}");
     for f in [
         "tradeoff.md",

@@ -1147,6 +1147,16 @@ pub struct PlanEntry {
     pub detail: String,
 }
 
+impl PlanEntry {
+    pub fn new(unit: Unit, needed: bool, detail: String) -> Self {
+        Self {
+            unit,
+            needed,
+            detail,
+        }
+    }
+}
+
 /// What a scene needs modelled (and, later, built and simulated on the RTL side).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
@@ -1174,13 +1184,7 @@ impl Plan {
         let setup = SliceSetup::new(vol, dir)?;
         let ratio = setup.ratio / f64::from(q.samples_per_slice);
         let mut entries = Vec::new();
-        let mut add = |unit, needed, detail: String| {
-            entries.push(PlanEntry {
-                unit,
-                needed,
-                detail,
-            })
-        };
+        let mut add = |unit, needed, detail| entries.push(PlanEntry::new(unit, needed, detail));
         let mname = mode.name().to_uppercase();
         let vb = q.voxel_width(vol.bits);
         let offset = setup.offset(q.interpolation, q.weight_bits);
@@ -1575,10 +1579,11 @@ pub fn empty_block_fraction(vol: &Volume, tf: &TransferFunction) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn err(text: &str) -> String {
+    /// The one-line error of parsing `text` (the tests of scene_gi.rs use it too).
+    pub(crate) fn err(text: &str) -> String {
         Scene::parse(text, "s.toml").unwrap_err().to_string()
     }
 

@@ -441,13 +441,7 @@ pub fn plan(scene: &Scene, vol: &Volume) -> Result<Plan> {
         Err(_) => 0.0,
     };
     let mut entries = Vec::new();
-    let mut add = |unit, needed, detail: String| {
-        entries.push(PlanEntry {
-            unit,
-            needed,
-            detail,
-        })
-    };
+    let mut add = |unit, needed, detail| entries.push(PlanEntry::new(unit, needed, detail));
     add(
         Unit::Trilin,
         true,
@@ -562,10 +556,7 @@ pub fn plan(scene: &Scene, vol: &Volume) -> Result<Plan> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn err(text: &str) -> String {
-        Scene::parse(text, "s.toml").unwrap_err().to_string()
-    }
+    use crate::scene::tests::err;
 
     #[test]
     fn an_empty_gi_table_is_the_default_section() {

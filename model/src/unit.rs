@@ -1,7 +1,8 @@
 //! The interface every streaming unit stands behind, model and RTL alike, so one test drives
 //! either and a scoreboard compares them in order.
 
-use std::fmt::Debug;
+use std::fmt::{Debug, Display};
+use std::ops::RangeInclusive;
 
 /// A streaming unit: items in, items out, one output per input, in order.
 ///
@@ -104,4 +105,22 @@ macro_rules! unit_config {
             }
         }
     };
+}
+
+/// A unit parameter's range check, as every unit's `validate` words it: `Err("{name} {v} outside
+/// {lo}..={hi}")` (for the unit's own `bad`, which names the unit) unless `v` lies in `range`.
+pub fn param_in<T: PartialOrd + Display>(
+    name: &str,
+    v: T,
+    range: RangeInclusive<T>,
+) -> std::result::Result<(), String> {
+    if range.contains(&v) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{name} {v} outside {}..={}",
+            range.start(),
+            range.end()
+        ))
+    }
 }

@@ -50,15 +50,7 @@ module cube5_pwarp #(
   localparam int unsigned TexW    = 3 * ColorW;
   localparam int unsigned MetaW   = 2 * O + 1;
 
-  if (ColorW < 4 || ColorW > 12) begin : gen_bad_color_w
-    $fatal(1, "cube5_pwarp: ColorW must be 4..12");
-  end
-  if (WeightW < 4 || WeightW > 12) begin : gen_bad_weight_w
-    $fatal(1, "cube5_pwarp: WeightW must be 4..12");
-  end
-  if (MaxBase < 4 || MaxBase > 1024 || (1 << B) != MaxBase) begin : gen_bad_max_base
-    $fatal(1, "cube5_pwarp: MaxBase must be a power of two in 4..1024");
-  end
+  // ColorW, WeightW and MaxBase are checked by cube5_warp_sample.
   if (MaxOut < 4 || MaxOut > 2048 || (1 << O) != MaxOut) begin : gen_bad_max_out
     $fatal(1, "cube5_pwarp: MaxOut must be a power of two in 4..2048 (U0, V0, N fit a payload)");
   end
@@ -137,27 +129,6 @@ module cube5_pwarp #(
     end
   end
 
-  // Texel position: raster order over BaseW, y held at MaxBase once it gets there.
-  logic [B:0] tx_q, tx_d, ty_q, ty_d;
-  logic       tex_we;
-  assign tex_we = is_texel && !tx_q[B] && !ty_q[B];
-
-  always_comb begin
-    tx_d = tx_q;
-    ty_d = ty_q;
-    if (is_write || is_line) begin
-      tx_d = '0;
-      ty_d = '0;
-    end else if (is_texel) begin
-      if ((tx_q + (B+1)'(1)) >= base_w_q) begin
-        tx_d = '0;
-        ty_d = ty_q[B] ? ty_q : ty_q + (B+1)'(1);
-      end else begin
-        tx_d = tx_q + (B+1)'(1);
-      end
-    end
-  end
-
   // ---------------------------------------------------------------------------------------------
   // Issue: the line's samples, exact coordinate steps, the write template's row steps
   // ---------------------------------------------------------------------------------------------
@@ -215,22 +186,21 @@ module cube5_pwarp #(
     .MaxBase(MaxBase),
     .MetaW  (MetaW)
   ) u_sample (
-    .clk_i   (clk_i),
-    .rst_ni  (rst_ni),
-    .adv_i   (adv),
-    .issue_i (issue),
-    .x_i     (xcur_q),
-    .y_i     (ycur_q),
-    .base_w_i(base_w_q),
-    .base_h_i(base_h_q),
-    .meta_i  (meta_in),
-    .we_i    (tex_we),
-    .wx_i    (tx_q[B-1:0]),
-    .wy_i    (ty_q[B-1:0]),
-    .wdata_i (payload[TexW-1:0]),
-    .valid_o (out_valid),
-    .rgb_o   (rgb),
-    .meta_o  (meta)
+    .clk_i         (clk_i),
+    .rst_ni        (rst_ni),
+    .adv_i         (adv),
+    .issue_i       (issue),
+    .x_i           (xcur_q),
+    .y_i           (ycur_q),
+    .base_w_i      (base_w_q),
+    .base_h_i      (base_h_q),
+    .meta_i        (meta_in),
+    .tex_i         (is_texel),
+    .tex_restart_i (is_write || is_line),
+    .wdata_i       (payload[TexW-1:0]),
+    .valid_o       (out_valid),
+    .rgb_o         (rgb),
+    .meta_o        (meta)
   );
 
   // ---------------------------------------------------------------------------------------------
@@ -251,8 +221,6 @@ module cube5_pwarp #(
       xsr_q    <= '0;
       ysr_q    <= '0;
       phr_q    <= '0;
-      tx_q     <= '0;
-      ty_q     <= '0;
     end else begin
       busy_q   <= busy_d;
       cnt_q    <= cnt_d;
@@ -266,8 +234,6 @@ module cube5_pwarp #(
       xsr_q    <= xsr_d;
       ysr_q    <= ysr_d;
       phr_q    <= phr_d;
-      tx_q     <= tx_d;
-      ty_q     <= ty_d;
     end
   end
 

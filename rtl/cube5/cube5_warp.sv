@@ -45,15 +45,7 @@ module cube5_warp #(
   localparam int unsigned O       = $clog2(MaxOut);
   localparam int unsigned TexW    = 3 * ColorW;
 
-  if (ColorW < 4 || ColorW > 12) begin : gen_bad_color_w
-    $fatal(1, "cube5_warp: ColorW must be 4..12");
-  end
-  if (WeightW < 4 || WeightW > 12) begin : gen_bad_weight_w
-    $fatal(1, "cube5_warp: WeightW must be 4..12");
-  end
-  if (MaxBase < 4 || MaxBase > 1024 || (1 << B) != MaxBase) begin : gen_bad_max_base
-    $fatal(1, "cube5_warp: MaxBase must be a power of two in 4..1024");
-  end
+  // ColorW, WeightW and MaxBase are checked by cube5_warp_sample.
   if (MaxOut < 4 || MaxOut > 4096 || (1 << O) != MaxOut) begin : gen_bad_max_out
     $fatal(1, "cube5_warp: MaxOut must be a power of two in 4..4096");
   end
@@ -106,27 +98,6 @@ module cube5_warp #(
       if (addr == AddrW'(cube5_warp_pkg::RegYPx))   ypx_d    = payload[CoordW-1:0];
       if (addr == AddrW'(cube5_warp_pkg::RegXPy))   xpy_d    = payload[CoordW-1:0];
       if (addr == AddrW'(cube5_warp_pkg::RegYPy))   ypy_d    = payload[CoordW-1:0];
-    end
-  end
-
-  // Texel position: raster order over BaseW, y held at MaxBase once it gets there.
-  logic [B:0] tx_q, tx_d, ty_q, ty_d;
-  logic       tex_we;
-  assign tex_we = is_texel && !tx_q[B] && !ty_q[B];
-
-  always_comb begin
-    tx_d = tx_q;
-    ty_d = ty_q;
-    if (is_write || is_go) begin
-      tx_d = '0;
-      ty_d = '0;
-    end else if (is_texel) begin
-      if ((tx_q + (B+1)'(1)) >= base_w_q) begin
-        tx_d = '0;
-        ty_d = ty_q[B] ? ty_q : ty_q + (B+1)'(1);
-      end else begin
-        tx_d = tx_q + (B+1)'(1);
-      end
     end
   end
 
@@ -194,22 +165,21 @@ module cube5_warp #(
     .MaxBase(MaxBase),
     .MetaW  (2)
   ) u_sample (
-    .clk_i   (clk_i),
-    .rst_ni  (rst_ni),
-    .adv_i   (adv),
-    .issue_i (issue),
-    .x_i     (xcur_q),
-    .y_i     (ycur_q),
-    .base_w_i(base_w_q),
-    .base_h_i(base_h_q),
-    .meta_i  (meta_in),
-    .we_i    (tex_we),
-    .wx_i    (tx_q[B-1:0]),
-    .wy_i    (ty_q[B-1:0]),
-    .wdata_i (payload[TexW-1:0]),
-    .valid_o (out_valid),
-    .rgb_o   (rgb),
-    .meta_o  (meta)
+    .clk_i         (clk_i),
+    .rst_ni        (rst_ni),
+    .adv_i         (adv),
+    .issue_i       (issue),
+    .x_i           (xcur_q),
+    .y_i           (ycur_q),
+    .base_w_i      (base_w_q),
+    .base_h_i      (base_h_q),
+    .meta_i        (meta_in),
+    .tex_i         (is_texel),
+    .tex_restart_i (is_write || is_go),
+    .wdata_i       (payload[TexW-1:0]),
+    .valid_o       (out_valid),
+    .rgb_o         (rgb),
+    .meta_o        (meta)
   );
 
   // ---------------------------------------------------------------------------------------------
@@ -229,8 +199,6 @@ module cube5_warp #(
       ypx_q    <= '0;
       xpy_q    <= '0;
       ypy_q    <= '0;
-      tx_q     <= '0;
-      ty_q     <= '0;
     end else begin
       busy_q   <= busy_d;
       base_w_q <= base_w_d;
@@ -243,8 +211,6 @@ module cube5_warp #(
       ypx_q    <= ypx_d;
       xpy_q    <= xpy_d;
       ypy_q    <= ypy_d;
-      tx_q     <= tx_d;
-      ty_q     <= ty_d;
     end
   end
 

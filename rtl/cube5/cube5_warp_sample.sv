@@ -19,7 +19,7 @@ module cube5_warp_sample #(
   parameter int unsigned MetaW   = 2
 ) (
   input  logic clk_i,
-  /// Synchronous, active low: the stage valids to 0.
+  /// Synchronous, active low: the stage valids and the texel position to 0.
   input  logic rst_ni,
 
   /// The pipeline moves this clock.
@@ -35,10 +35,11 @@ module cube5_warp_sample #(
   /// Carried with the position to the output.
   input  logic [MetaW-1:0]                      meta_i,
 
-  /// Texel write: codes R, G, B (ColorW each, LSB first) at (wx_i, wy_i).
-  input  logic                                  we_i,
-  input  logic [$clog2(MaxBase)-1:0]            wx_i,
-  input  logic [$clog2(MaxBase)-1:0]            wy_i,
+  /// Texel items: `tex_i` stores codes R, G, B (ColorW each, LSB first) at the texel position
+  /// (raster order over base_w_i; y held at MaxBase once it gets there, and nothing stored) and
+  /// advances it; `tex_restart_i` puts the position back to (0, 0).
+  input  logic                                  tex_i,
+  input  logic                                  tex_restart_i,
   input  logic [3*ColorW-1:0]                   wdata_i,
 
   /// S5 holds a pixel.
@@ -118,14 +119,48 @@ module cube5_warp_sample #(
   end
 
   // ---------------------------------------------------------------------------------------------
+  // Texel position: raster order over BaseW, y held at MaxBase once it gets there
+  // ---------------------------------------------------------------------------------------------
+
+  logic [B:0] tx_q, tx_d, ty_q, ty_d;
+  logic       tex_we;
+  assign tex_we = tex_i && !tx_q[B] && !ty_q[B];
+
+  always_comb begin
+    tx_d = tx_q;
+    ty_d = ty_q;
+    if (tex_restart_i) begin
+      tx_d = '0;
+      ty_d = '0;
+    end else if (tex_i) begin
+      if ((tx_q + (B+1)'(1)) >= base_w_i) begin
+        tx_d = '0;
+        ty_d = ty_q[B] ? ty_q : ty_q + (B+1)'(1);
+      end else begin
+        tx_d = tx_q + (B+1)'(1);
+      end
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      tx_q <= '0;
+      ty_q <= '0;
+    end else begin
+      tx_q <= tx_d;
+      ty_q <= ty_d;
+    end
+  end
+
+  // ---------------------------------------------------------------------------------------------
   // The four banks (block RAM, registered output = S1's texels)
   // ---------------------------------------------------------------------------------------------
 
   logic [BankAW-1:0] waddr;
   logic [1:0]        wbank;
   logic [4*TexW-1:0] rdata;       // bank k at [k*TexW +: TexW]
-  assign waddr = {wy_i[B-1:1], wx_i[B-1:1]};
-  assign wbank = {wy_i[0], wx_i[0]};
+  assign waddr = {ty_q[B-1:1], tx_q[B-1:1]};
+  assign wbank = {ty_q[0], tx_q[0]};
 
   for (genvar k = 0; k < 4; k++) begin : gen_bank
     cube5_shader_ram #(
@@ -134,7 +169,7 @@ module cube5_warp_sample #(
       .AddrW(BankAW)
     ) u_bank (
       .clk_i  (clk_i),
-      .we_i   (we_i && (wbank == 2'(k))),
+      .we_i   (tex_we && (wbank == 2'(k))),
       .waddr_i(waddr),
       .wdata_i(wdata_i),
       .re_i   (adv_i),

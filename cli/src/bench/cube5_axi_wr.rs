@@ -101,7 +101,6 @@ fn run_one(
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     println!(
         "Bytes written per clock ({n_items} items or more per run in commands of 256 beats; items"
     );

@@ -57,7 +57,6 @@ fn items(cfg: &ComposConfig, n: usize, seed: u64) -> Vec<ComposIn> {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     speed_table(
         |cfg: ComposConfig| {
             let model = Compos::new(cfg, OpacityLut::new(0.5, &cfg)?, ComposRegs::defaults(&cfg))?;

@@ -122,7 +122,6 @@ pub fn run(n_items: usize) -> Result<()> {
         .filter(|r| volumes.iter().any(|vol| holds(r, vol)))
         .map(|r| r.variant.config)
         .collect();
-    println!("## {TOP}\n");
     println!(
         "One composite frame (head phantom, 12-bit voxels, view (-0.37, 0.81, -1), all blocks \
          present) per row, on every configuration that holds the volume ({}). Cycles from the \

@@ -66,7 +66,6 @@ fn ramp_items(cfg: &GradientConfig, n: usize, seed: u64) -> Vec<GradientIn> {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     speed_table(
         |cfg: GradientConfig| {
             let items = gradient_items(&cfg, n_items, 1, None);

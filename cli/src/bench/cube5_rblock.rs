@@ -182,7 +182,6 @@ fn cache_experiment() -> Result<()> {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     speed(n_items)?;
     exactness(n_items)?;
     cache_experiment()

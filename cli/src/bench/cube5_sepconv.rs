@@ -24,7 +24,6 @@ fn sepconv_items(cfg: &SepconvConfig, n: usize, seed: u64) -> Vec<SepconvIn> {
 pub fn run(n_items: usize) -> Result<()> {
     // A Gaussian of sigma = 1: w = exp(1 / (2 sigma^2)).
     let w_real = 0.5f64.exp();
-    println!("## {TOP}\n");
     speed_table(
         |cfg: SepconvConfig| {
             let gold = Sepconv::new(cfg, cfg.weight_from_f64(w_real))?;

@@ -66,7 +66,6 @@ fn grey_tables(cfg: &ShaderConfig, phong: &Phong) -> Result<ShaderTables> {
 
 pub fn run(n_items: usize) -> Result<()> {
     let phong = Phong::two_lights();
-    println!("## {TOP}\n");
     speed_table(
         |cfg: ShaderConfig| {
             let tables = ShaderTables {

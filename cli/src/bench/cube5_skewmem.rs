@@ -166,7 +166,6 @@ fn threshold_tradeoff() -> Result<()> {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     speed(n_items)?;
     exactness(n_items)?;
     threshold_tradeoff()

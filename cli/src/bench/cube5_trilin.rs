@@ -22,7 +22,6 @@ fn trilin_items(cfg: &TrilinConfig, n: usize, seed: u64) -> Vec<TrilinIn> {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     speed_table(
         |cfg: TrilinConfig| Ok((Trilin::new(cfg)?, trilin_items(&cfg, n_items, 1), vec![])),
         Compare::No,

@@ -31,7 +31,6 @@ fn rotation(side: usize, out: u32, deg: f64, zoom: f64) -> Affine {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     println!("One frame per configuration: a random base plane of min(MaxBase, 128)^2 texels loaded, then");
     println!("warped (rotated 30 degrees, zoom 1.3) onto an image of about `--items` pixels (at most MaxOut^2),");
     println!("at full speed; the RTL's pixels are compared with the model's.\n");

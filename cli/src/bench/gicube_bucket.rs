@@ -15,7 +15,6 @@ use rand_chacha::ChaCha8Rng;
 pub const TOP: &str = BucketConfig::TOP;
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     println!("One item is `Lanes` positions (2 = the two rays per cycle of [370]).\n");
     speed_table(
         |cfg: BucketConfig| {

@@ -13,7 +13,6 @@ use rand_chacha::ChaCha8Rng;
 pub const TOP: &str = PacketLoopConfig::TOP;
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     println!("The round-trip fixture (unpack into the SV struct, repack, per-field probe).\n");
     speed_table(
         |cfg: PacketLoopConfig| {

@@ -81,7 +81,6 @@ fn ring_items(
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     println!("One item is one pop and one push at most (random fill / drain / mixed traffic).\n");
     speed_table(
         |cfg: RayQueuesConfig| {

@@ -15,7 +15,6 @@ use rand_chacha::ChaCha8Rng;
 pub const TOP: &str = SampleRtlConfig::TOP;
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     println!(
         "One item is one sample of one ray (a fifth lighting rays, half of the rendering rays lit"
     );

@@ -54,7 +54,6 @@ fn errors(cfg: &ScatterConfig, n: usize) -> Result<[Vec<f64>; 4]> {
 
 pub fn run(n_items: usize) -> Result<()> {
     let variants = variants_of(TOP);
-    println!("## {TOP}\n");
     speed_table(
         |cfg: ScatterConfig| {
             let model = Scatter::new(cfg)?;

@@ -24,7 +24,6 @@ fn verified() -> Result<Vec<SorterConfig>> {
 }
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     println!(
         "Random update traffic (phases of mixed updates, bursts, draining, ties, maxima, clears);"
     );

@@ -12,7 +12,6 @@ use rand_chacha::ChaCha8Rng;
 pub const TOP: &str = StepConfig::TOP;
 
 pub fn run(n_items: usize) -> Result<()> {
-    println!("## {TOP}\n");
     println!("One item is one ray (half of them leaping); one ray per clock, leaping or not.\n");
     speed_table(
         |cfg: StepConfig| {

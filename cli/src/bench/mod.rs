@@ -162,6 +162,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     }
     for bench in BENCHES {
         if chosen.is_empty() || chosen.contains(&bench.top) {
+            println!("## {}\n", bench.top);
             (bench.run)(args.items)?;
         }
     }

@@ -1,7 +1,7 @@
 //! Helpers shared by the command-line tests.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// Runs the `cube5` binary with `args`.
@@ -20,6 +20,19 @@ pub fn scratch(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+/// Asserts that `out` is a successful run (else panics with `what`, the exit status, stdout and
+/// stderr); returns its stdout.
+pub fn succeeded(out: &Output, what: &str) -> String {
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{what}: {}: {stdout}{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
 /// A refusal: non-zero exit, exactly one line on stderr containing every needle, no panic.
 pub fn assert_refused(out: &Output, needles: &[&str]) {
     let err = String::from_utf8_lossy(&out.stderr);
@@ -35,24 +48,56 @@ pub fn assert_refused(out: &Output, needles: &[&str]) {
     }
 }
 
-/// Writes `scene` as NAME.toml in the scratch directory and renders it; returns the output and
-/// the PNG path (removed first).
+/// `cube5 render SCENE -o PNG`: must succeed; returns its output.
+pub fn render_ok(scene: &Path, png: &Path) -> Output {
+    let out = cube5(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    succeeded(&out, &format!("render {}", scene.display()));
+    out
+}
+
+/// `cube5 render SCENE -o PNG` at `px` x `px` pixels with `extra` arguments, PNG removed first.
+pub fn render_at(scene: &Path, png: &Path, px: u32, extra: &[&str]) -> Output {
+    let _ = std::fs::remove_file(png);
+    let px = px.to_string();
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--width",
+        &px,
+        "--height",
+        &px,
+    ];
+    args.extend_from_slice(extra);
+    cube5(&args)
+}
+
+/// Writes `scene` as NAME.toml in the scratch directory and renders it at 16 x 16; returns the
+/// output and the PNG path (removed first).
 pub fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
     let toml = scratch(&format!("{name}.toml"));
     std::fs::write(&toml, scene).unwrap();
     let png = scratch(&format!("{name}.png"));
-    let _ = std::fs::remove_file(&png);
-    let out = cube5(&[
-        "render",
-        toml.to_str().unwrap(),
-        "-o",
-        png.to_str().unwrap(),
-        "--width",
-        "16",
-        "--height",
-        "16",
-    ]);
-    (out, png)
+    (render_at(&toml, &png, 16, &[]), png)
+}
+
+/// Renders `scene` as `render_scene` does: refused (as `assert_refused`) naming NAME.toml and every
+/// needle, and no PNG written.
+pub fn scene_refused(name: &str, scene: &str, needles: &[&str]) {
+    let (out, png) = render_scene(name, scene);
+    let file = format!("{name}.toml");
+    assert_refused(&out, &[&[file.as_str()], needles].concat());
+    assert!(
+        !png.exists(),
+        "{name}: a refused scene wrote {}",
+        png.display()
+    );
 }
 
 /// The example scene `scenes/NAME.toml` with each `(from, to)` replaced (each `from` must be in
@@ -81,13 +126,7 @@ pub fn cosim_matches(scene: &std::path::Path, dir: &std::path::Path) -> String {
         "-o",
         dir.to_str().unwrap(),
     ]);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "{}: {stdout}{}",
-        scene.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out, &scene.display().to_string());
     assert!(stdout.contains("MATCH"), "{}: {stdout}", scene.display());
     stdout
 }

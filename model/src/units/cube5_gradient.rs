@@ -5,7 +5,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::StreamCodec;
+use crate::unit::{param_in, StreamCodec};
 
 /// `rnd_s(x, s)`: round half up (toward +infinity) of `x / 2^s` for signed `x`.
 pub fn round_half_up_signed(x: i64, s: u32) -> i64 {
@@ -70,15 +70,9 @@ impl GradientConfig {
 
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("gradient: {what}")));
-        if !(4..=16).contains(&self.voxel_w) {
-            return bad(format!("VoxelW {} outside 4..=16", self.voxel_w));
-        }
-        if self.frac_w > 8 {
-            return bad(format!("FracW {} outside 0..=8", self.frac_w));
-        }
-        if !(2..=12).contains(&self.weight_w) {
-            return bad(format!("WeightW {} outside 2..=12", self.weight_w));
-        }
+        param_in("VoxelW", self.voxel_w, 4..=16).or_else(bad)?;
+        param_in("FracW", self.frac_w, 0..=8).or_else(bad)?;
+        param_in("WeightW", self.weight_w, 2..=12).or_else(bad)?;
         Ok(())
     }
 

@@ -4,7 +4,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::StreamCodec;
+use crate::unit::{param_in, StreamCodec};
 use crate::units::cube5_gradient::{round_half_up_signed, sign_extend};
 // =================================================================================================
 // cube5_sepconv
@@ -49,12 +49,8 @@ impl SepconvConfig {
 
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("sepconv: {what}")));
-        if !(4..=32).contains(&self.tap_w) {
-            return bad(format!("TapW {} outside 4..=32", self.tap_w));
-        }
-        if self.weight_frac_w > 8 {
-            return bad(format!("WeightFracW {} outside 0..=8", self.weight_frac_w));
-        }
+        param_in("TapW", self.tap_w, 4..=32).or_else(bad)?;
+        param_in("WeightFracW", self.weight_frac_w, 0..=8).or_else(bad)?;
         if self.out_shift > self.weight_frac_w + 4 {
             return bad(format!(
                 "OutShift {} outside 0..=WeightFracW+4 ({})",

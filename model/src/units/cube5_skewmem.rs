@@ -10,7 +10,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::{param_in, StreamCodec, StreamUnit};
 use crate::volume::Volume;
 
 /// Parameters of one `cube5_skewmem` configuration (the RTL parameters of the same names).
@@ -82,12 +82,8 @@ impl SkewConfig {
         if !matches!(self.p, 1 | 2 | 4 | 8 | 16) {
             return bad(format!("P {} is not 1, 2, 4, 8 or 16", self.p));
         }
-        if !(4..=16).contains(&self.voxel_w) {
-            return bad(format!("VoxelW {} outside 4..=16", self.voxel_w));
-        }
-        if !(2..=10).contains(&self.max_dim_log2) {
-            return bad(format!("MaxDimLog2 {} outside 2..=10", self.max_dim_log2));
-        }
+        param_in("VoxelW", self.voxel_w, 4..=16).or_else(bad)?;
+        param_in("MaxDimLog2", self.max_dim_log2, 2..=10).or_else(bad)?;
         if !self.block.is_power_of_two() || !(2..=64).contains(&self.block) {
             return bad(format!(
                 "block edge B {} is not a power of two in 2..=64",
@@ -107,12 +103,8 @@ impl SkewConfig {
                 self.max_dim()
             ));
         }
-        if !(1..=8).contains(&self.read_latency) {
-            return bad(format!("ReadLatency {} outside 1..=8", self.read_latency));
-        }
-        if !(8..=32).contains(&self.cnt_w) {
-            return bad(format!("CntW {} outside 8..=32", self.cnt_w));
-        }
+        param_in("ReadLatency", self.read_latency, 1..=8).or_else(bad)?;
+        param_in("CntW", self.cnt_w, 8..=32).or_else(bad)?;
         Ok(())
     }
 

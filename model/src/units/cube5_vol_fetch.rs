@@ -11,7 +11,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::StreamCodec;
+use crate::unit::{param_in, StreamCodec};
 use crate::units::cube5_axi_rd::{AxiMemImage, AxiRdCmd, AxiRdConfig, RESP_OKAY};
 use crate::units::cube5_frame::{FrameParams, FrameSetup};
 use crate::units::cube5_skewmem::{BlockEntry, BlockLut};
@@ -60,9 +60,7 @@ impl VolFetchConfig {
         if ![1, 2, 4, 8].contains(&self.p) {
             return bad(format!("P {} is not 1, 2, 4 or 8", self.p));
         }
-        if !(4..=16).contains(&self.voxel_w) {
-            return bad(format!("VoxelW {} outside 4..=16", self.voxel_w));
-        }
+        param_in("VoxelW", self.voxel_w, 4..=16).or_else(bad)?;
         if !self.max_dim.is_power_of_two() || !(8..=1024).contains(&self.max_dim) {
             return bad(format!(
                 "MaxDim {} is not a power of two in 8..=1024",

@@ -13,7 +13,7 @@ use crate::regs::cube5_warp::{
     REG_YPY, UNORM_W,
 };
 use crate::render::ImageF64;
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::{param_in, StreamCodec, StreamUnit};
 use crate::units::cube5_compos::ComposConfig;
 use crate::units::cube5_frame::{BasePlane, FrameParams};
 use glam::DVec3;
@@ -43,12 +43,8 @@ impl WarpConfig {
 
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("cube5_warp: {what}")));
-        if !(4..=12).contains(&self.color_w) {
-            return bad(format!("ColorW {} outside 4..=12", self.color_w));
-        }
-        if !(4..=12).contains(&self.weight_w) {
-            return bad(format!("WeightW {} outside 4..=12", self.weight_w));
-        }
+        param_in("ColorW", self.color_w, 4..=12).or_else(bad)?;
+        param_in("WeightW", self.weight_w, 4..=12).or_else(bad)?;
         if !self.max_base.is_power_of_two() || !(4..=1024).contains(&self.max_base) {
             return bad(format!(
                 "MaxBase {} is not a power of two in 4..=1024",

@@ -3,7 +3,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::StreamCodec;
+use crate::unit::{param_in, StreamCodec};
 use crate::units::gicube_packet_loop::{POS_FRAC_W, POS_W};
 
 /// How blocks are distributed among processors ([348]); the `Dist` parameter.
@@ -66,21 +66,15 @@ impl BucketConfig {
 
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("bucket: {what}")));
-        if !(1..=8).contains(&self.block_log2) {
-            return bad(format!("BlockLog2 {} outside 1..=8", self.block_log2));
-        }
-        if !(1..=64).contains(&self.vol_blocks) {
-            return bad(format!("VolBlocks {} outside 1..=64", self.vol_blocks));
-        }
+        param_in("BlockLog2", self.block_log2, 1..=8).or_else(bad)?;
+        param_in("VolBlocks", self.vol_blocks, 1..=64).or_else(bad)?;
         if self.vol_side() > 1 << (POS_W - POS_FRAC_W) {
             return bad(format!(
                 "volume side {} exceeds the 4096 voxels a U(12.8) position reaches",
                 self.vol_side()
             ));
         }
-        if self.proc_log2 > 4 {
-            return bad(format!("ProcLog2 {} outside 0..=4", self.proc_log2));
-        }
+        param_in("ProcLog2", self.proc_log2, 0..=4).or_else(bad)?;
         if !self.vol_blocks.is_multiple_of(self.procs()) {
             return bad(format!(
                 "VolBlocks {} is not a multiple of the {} processors",
@@ -88,9 +82,7 @@ impl BucketConfig {
                 self.procs()
             ));
         }
-        if !(1..=4).contains(&self.lanes) {
-            return bad(format!("Lanes {} outside 1..=4", self.lanes));
-        }
+        param_in("Lanes", self.lanes, 1..=4).or_else(bad)?;
         Ok(())
     }
 

@@ -13,7 +13,7 @@ use rand::Rng;
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::{param_in, StreamCodec, StreamUnit};
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_packet_loop::{flag, RayPacket, LAYOUT, PACKET_BITS, POS_W};
 use crate::units::gicube_ray_queues::{get_ray, put_ray, Ray, RayQueues};
@@ -340,9 +340,7 @@ impl QueueFrontConfig {
 
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(ModelError::Config(format!("gicube_queue_front: {m}")));
-        if !(1..=8).contains(&self.block_log2) {
-            return bad(format!("BlockLog2 {} outside 1..=8", self.block_log2));
-        }
+        param_in("BlockLog2", self.block_log2, 1..=8).or_else(bad)?;
         if !(1..=6).contains(&self.vol_blocks) {
             return bad(format!(
                 "VolBlocks {} outside 1..=6 (VolBlocks^3 <= 256 queues)",
@@ -352,9 +350,7 @@ impl QueueFrontConfig {
         if self.vol_blocks << self.block_log2 > 4096 {
             return bad("the volume side VolBlocks << BlockLog2 exceeds 4096".into());
         }
-        if !(1..=4096).contains(&self.queue_len) {
-            return bad(format!("QueueLen {} outside 1..=4096", self.queue_len));
-        }
+        param_in("QueueLen", self.queue_len, 1..=4096).or_else(bad)?;
         if !(2..=64).contains(&self.ranks) || self.ranks > self.queues() {
             return bad(format!(
                 "Ranks {} outside 2..=min(64, {} queues)",

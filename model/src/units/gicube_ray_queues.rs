@@ -16,7 +16,7 @@ use rand::Rng;
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::{param_in, StreamCodec, StreamUnit};
 
 /// Largest `DataW`: one 32-byte ray packet ([349], [391]).
 pub const MAX_DATA_W: u32 = 256;
@@ -150,12 +150,8 @@ impl RayQueuesConfig {
 
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(ModelError::Config(format!("gicube_ray_queues: {m}")));
-        if !(1..=8).contains(&self.queue_w) {
-            return bad(format!("QueueW {} outside 1..=8", self.queue_w));
-        }
-        if !(1..=4096).contains(&self.queue_len) {
-            return bad(format!("QueueLen {} outside 1..=4096", self.queue_len));
-        }
+        param_in("QueueW", self.queue_w, 1..=8).or_else(bad)?;
+        param_in("QueueLen", self.queue_len, 1..=4096).or_else(bad)?;
         if !(1..=MAX_DATA_W).contains(&self.data_w) {
             return bad(format!("DataW {} outside 1..={MAX_DATA_W}", self.data_w));
         }

@@ -7,7 +7,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::{param_in, StreamCodec, StreamUnit};
 use rand::Rng;
 
 /// One `gicube_sorter` configuration (the RTL parameters of the same names).
@@ -50,12 +50,8 @@ impl SorterConfig {
 
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("sorter: {what}")));
-        if !(1..=8).contains(&self.queue_w) {
-            return bad(format!("QueueW {} outside 1..=8", self.queue_w));
-        }
-        if !(2..=64).contains(&self.ranks) {
-            return bad(format!("Ranks {} outside 2..=64", self.ranks));
-        }
+        param_in("QueueW", self.queue_w, 1..=8).or_else(bad)?;
+        param_in("Ranks", self.ranks, 2..=64).or_else(bad)?;
         if self.ranks > self.queues() {
             return bad(format!(
                 "Ranks {} exceeds the {} queues (a queue is listed at most once)",
@@ -63,9 +59,7 @@ impl SorterConfig {
                 self.queues()
             ));
         }
-        if !(2..=24).contains(&self.imp_w) {
-            return bad(format!("ImpW {} outside 2..=24", self.imp_w));
-        }
+        param_in("ImpW", self.imp_w, 2..=24).or_else(bad)?;
         if !(1..=self.imp_max()).contains(&self.queue_len) {
             return bad(format!(
                 "QueueLen {} outside 1..={} (ImpW {} cannot count a full queue)",

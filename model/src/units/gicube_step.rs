@@ -9,7 +9,7 @@
 
 use crate::bits::{BitReader, BitWriter};
 use crate::error::{ModelError, Result};
-use crate::unit::StreamCodec;
+use crate::unit::{param_in, StreamCodec};
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_packet_loop::{DIR_FRAC_W, POS_FRAC_W, POS_W};
 
@@ -38,21 +38,15 @@ impl StepConfig {
 
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(ModelError::Config(format!("gicube_step: {what}")));
-        if !(2..=8).contains(&self.block_log2) {
-            return bad(format!("BlockLog2 {} outside 2..=8", self.block_log2));
-        }
-        if !(1..=64).contains(&self.vol_blocks) {
-            return bad(format!("VolBlocks {} outside 1..=64", self.vol_blocks));
-        }
+        param_in("BlockLog2", self.block_log2, 2..=8).or_else(bad)?;
+        param_in("VolBlocks", self.vol_blocks, 1..=64).or_else(bad)?;
         if self.vol_blocks << self.block_log2 > 1 << (POS_W - POS_FRAC_W) {
             return bad(format!(
                 "the domain side {} exceeds 4096 voxels",
                 self.vol_blocks << self.block_log2
             ));
         }
-        if !(16..=1024).contains(&self.step) {
-            return bad(format!("Step {} outside 16..=1024", self.step));
-        }
+        param_in("Step", self.step, 16..=1024).or_else(bad)?;
         Ok(())
     }
 
