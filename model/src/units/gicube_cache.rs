@@ -31,7 +31,7 @@ pub struct CacheConfig {
     pub max_dim: u32,
     /// Bits of a voxel word (8, 16 or 32).
     pub word_w: u32,
-    /// AXI4 data bus bits (a power of two, 32..=256, at least `WordW`).
+    /// AXI4 data bus bits (a power of two, 32..=256, at least `2 WordW`).
     pub data_w: u32,
     /// Voxels of a cache line (a power of two).
     pub line_vox: u32,
@@ -67,9 +67,10 @@ impl CacheConfig {
         if ![8, 16, 32].contains(&self.word_w) {
             return bad(format!("WordW {} is not 8, 16 or 32", self.word_w));
         }
-        if !(32..=256).contains(&self.data_w) || !pow2(self.data_w) || self.data_w < self.word_w {
+        if !(32..=256).contains(&self.data_w) || !pow2(self.data_w) || self.data_w < 2 * self.word_w
+        {
             return bad(format!(
-                "DataW {} is not a power of two in 32..=256 at least WordW",
+                "DataW {} is not a power of two in 32..=256 at least 2 WordW",
                 self.data_w
             ));
         }
