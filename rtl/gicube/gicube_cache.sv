@@ -156,6 +156,12 @@ module gicube_cache #(
     bank_index = idx;
   endfunction
 
+  // The set of a line: its low SetW bits XOR the next SetW (the tag's low bits), so that the
+  // rows of neighbouring z planes, Sets lines apart, fall into different sets.
+  function automatic logic [SetW-1:0] set_of_line(input logic [LineW-1:0] l);
+    set_of_line = SetW'(l ^ (l >> SetW));
+  endfunction
+
   // The lowest set bit of an eight-bit mask, as a bank number (0 for an empty mask).
   function automatic logic [2:0] lowest(input logic [7:0] m);
     logic [2:0] p;
@@ -204,6 +210,7 @@ module gicube_cache #(
   logic [8*SetW-1:0]  set_of;
   logic [8*TagW-1:0]  tag_of;
   logic [8*VLog-1:0]  wsel_of;   // word within the beat
+  logic [8*WordW-1:0] bank_word; // each bank's word of the request (after a read)
   logic [8*LineW-1:0] line_of;
   logic [7:0]         hit;
   logic               all_hit;
@@ -225,27 +232,28 @@ module gicube_cache #(
     logic [IdxW-1:0] idx_rd, idx_req;
     assign idx_rd  = bank_index(rd_xyz, p);
     assign idx_req = bank_index(req_q, p);
-    assign tag_raddr[p*SetW +: SetW]     = idx_rd[LineLog +: SetW];
-    assign dat_raddr[p*DAddrW +: DAddrW] = {idx_rd[LineLog +: SetW], idx_rd[VLog +: BplW]};
+    assign tag_raddr[p*SetW +: SetW]     = set_of_line(idx_rd[IdxW-1:LineLog]);
+    assign dat_raddr[p*DAddrW +: DAddrW] = {set_of_line(idx_rd[IdxW-1:LineLog]),
+                                            idx_rd[VLog +: BplW]};
     assign line_of[p*LineW +: LineW]     = idx_req[IdxW-1:LineLog];
-    assign set_of[p*SetW +: SetW]        = idx_req[LineLog +: SetW];
+    assign set_of[p*SetW +: SetW]        = set_of_line(idx_req[IdxW-1:LineLog]);
     if (LineW > SetW) begin : gen_tag
       assign tag_of[p*TagW +: TagW] = idx_req[IdxW-1:LineLog+SetW];
     end else begin : gen_no_tag
       assign tag_of[p*TagW +: TagW] = '0;
     end
     assign wsel_of[p*VLog +: VLog] = idx_req[0 +: VLog];
+    // The bank's word of this request: selected within the beat before the corner crossbar.
+    logic [DataW-1:0] beat_word;
+    assign beat_word = dat_rdata[p*DataW +: DataW];
+    assign bank_word[p*WordW +: WordW] = beat_word[wsel_of[p*VLog +: VLog]*WordW +: WordW];
     logic [Sets-1:0] valid_bank;
     assign valid_bank = valid_q[p*Sets +: Sets];
     assign hit[p] = valid_bank[set_of[p*SetW +: SetW]]
         && (tag_rdata[p*TagW +: TagW] == tag_of[p*TagW +: TagW]);
     // The read address takes the set and the beat; the word within the beat is the request's.
     logic unused_rd;
-    if (LineLog + SetW < IdxW) begin : gen_unused_hi
-      assign unused_rd = ^{idx_rd[VLog-1:0], idx_rd[IdxW-1:LineLog+SetW], idx_req[LineLog-1:VLog]};
-    end else begin : gen_unused_lo
-      assign unused_rd = ^{idx_rd[VLog-1:0], idx_req[LineLog-1:VLog]};
-    end
+    assign unused_rd = ^{idx_rd[VLog-1:0], idx_req[LineLog-1:VLog]};
   end
 
   assign all_hit = &hit;
@@ -264,9 +272,13 @@ module gicube_cache #(
   assign fill_p    = lowest(fill_q);
   assign cmd_valid = busy_q && state_q == StMiss && issue_q != '0;
   always_comb begin
-    logic [LAddrW-1:0] a;
-    a = {issue_p, line_of[(issue_p)*LineW +: LineW], ZeroW'(0)};
-    cmd_data = {LenW'(Bpl), AddrW'(a)};
+    logic [LineW-1:0] line_sel;
+    // Constant indices: a variable index times LineW (not a power of two) is a multiplier.
+    line_sel = '0;
+    for (int unsigned p = 0; p < 8; p++) begin
+      if (issue_p == 3'(p)) line_sel = line_of[p*LineW +: LineW];
+    end
+    cmd_data = {LenW'(Bpl), AddrW'({issue_p, line_sel, ZeroW'(0)})};
   end
 
   // ==============================================================================================
@@ -277,7 +289,6 @@ module gicube_cache #(
     logic [3:0]       n_hit, n_miss;
     logic [7:0]       m;
     logic [2:0]       cp;
-    logic [DataW-1:0] w;
     busy_d      = busy_q;
     state_d     = state_q;
     replay_d    = replay_q;
@@ -300,14 +311,12 @@ module gicube_cache #(
     // Leaving: the voxels (corner c from bank c ^ parity), the mask, the counts, the stall.
     m  = '0;
     cp = '0;
-    w  = '0;
     if (leave) begin
       m = replay_q ? hitm_q : 8'hff;
       if (!replay_q) hits_d = hits_q + CountW'(8);
       for (int unsigned c = 0; c < 8; c++) begin
         cp = 3'(c) ^ {req_q[2*CoordW], req_q[CoordW], req_q[0]};
-        w  = dat_rdata[(cp)*DataW +: DataW];
-        out_data_d[c*WordW +: WordW] = w[(wsel_of[(cp)*VLog +: VLog])*WordW +: WordW];
+        out_data_d[c*WordW +: WordW] = bank_word[cp*WordW +: WordW];
       end
       out_data_d[8*WordW +: 8 + 2*CountW + StallW] = {stall_q, misses_d, hits_d, m};
       out_valid_d = 1'b1;

@@ -275,7 +275,7 @@ fn directed_reqs(cfg: CacheConfig) -> Vec<CacheReq> {
     let t = CacheTraffic::new(cfg);
     let m = cfg.max_dim;
     let a = CacheReq { x: 2, y: 4, z: 6 };
-    let b = t.conflicting(a);
+    let b = t.conflicting(a).expect("a cell of the same sets");
     let mut r = vec![a; 40];
     for _ in 0..20 {
         r.push(a);

@@ -199,6 +199,21 @@ impl CacheConfig {
             * u64::from(self.word_w / 8)
     }
 
+    /// The line, set and tag of the corner in bank `p` of the cell at `base` (contract, *Tags*):
+    /// per axis the corner `a` or `a + 1` of bank `p`'s parity, wrapped, halved; the line's low
+    /// bits folded with its tag's for the set.
+    pub fn slot(&self, p: u32, base: [u32; 3]) -> (u64, usize, u64) {
+        let mask = self.max_dim - 1;
+        let b: [u32; 3] = std::array::from_fn(|a| {
+            let pa = (p >> a) & 1;
+            ((base[a] + ((base[a] & 1) ^ pa)) & mask) >> 1
+        });
+        let line = self.bank_index(b) >> self.line_vox.trailing_zeros();
+        let tag = line >> self.set_w();
+        let set = ((line ^ tag) & u64::from(self.sets - 1)) as usize;
+        (line, set, tag)
+    }
+
     /// The memory image of a volume of `M^3` words (x fastest), at byte address 0.
     pub fn image(&self, words: &[u32]) -> Result<AxiMemImage> {
         let m = self.max_dim as usize;
@@ -331,13 +346,7 @@ impl VolumeCache {
         let mut hit = 0u8;
         let mut bursts = Vec::new();
         for p in 0..8u32 {
-            let b: [u32; 3] = std::array::from_fn(|a| {
-                let pa = (p >> a) & 1;
-                ((base[a] + ((base[a] & 1) ^ pa)) & mask) >> 1
-            });
-            let line = cfg.bank_index(b) >> cfg.line_vox.trailing_zeros();
-            let set = (line & u64::from(cfg.sets - 1)) as usize;
-            let tag = line >> cfg.set_w();
+            let (line, set, tag) = cfg.slot(p, base);
             let slot = &mut self.tags[8 * set + p as usize];
             if *slot == Some(tag) {
                 hit |= 1 << p;
@@ -472,20 +481,24 @@ impl CacheTraffic {
         }
     }
 
-    /// A cell in the same set of every bank as `r` but another line (another tag), if the bank
-    /// holds more lines than sets: `r` moved by `Sets LineVox` bank voxels (2 per voxel in x).
-    pub fn conflicting(&self, r: CacheReq) -> CacheReq {
+    /// A cell whose corners fall in the same set as `r`'s in every bank, with other tags: the
+    /// first of `r` moved by `(0, 2 dy, 2 dz)` (parities kept) that does so, if any.
+    pub fn conflicting(&self, r: CacheReq) -> Option<CacheReq> {
         let cfg = self.cfg;
-        let h = u64::from(cfg.half());
-        let stride = u64::from(cfg.sets) * u64::from(cfg.line_vox);
-        let mut i = cfg.bank_index([r.x, r.y, r.z].map(|a| a >> 1)) + stride;
-        i %= cfg.bank_voxels();
-        let b = [i % h, (i / h) % h, i / (h * h)].map(|a| a as u32);
-        CacheReq {
-            x: (2 * b[0]) | (r.x & 1),
-            y: (2 * b[1]) | (r.y & 1),
-            z: (2 * b[2]) | (r.z & 1),
-        }
+        let m = cfg.max_dim;
+        let base = [r.x, r.y, r.z].map(|a| a & (m - 1));
+        let slots: Vec<_> = (0..8).map(|p| cfg.slot(p, base)).collect();
+        (1..cfg.half())
+            .flat_map(|dz| (0..cfg.half()).map(move |dy| (dy, dz)))
+            .map(|(dy, dz)| [base[0], (base[1] + 2 * dy) % m, (base[2] + 2 * dz) % m])
+            .find(|c| {
+                (0..8).all(|p| {
+                    let (_, set, tag) = cfg.slot(p, *c);
+                    let (_, s0, t0) = slots[p as usize];
+                    set == s0 && tag != t0
+                })
+            })
+            .map(|[x, y, z]| CacheReq { x, y, z })
     }
 
     pub fn next_item(&mut self, rng: &mut impl Rng) -> CacheReq {
@@ -496,7 +509,7 @@ impl CacheTraffic {
             let c = self.random_cell(rng);
             self.pos = [c.x, c.y, c.z].map(|a| i64::from(a) << 8);
             self.step = std::array::from_fn(|_| rng.random_range(-256..=256));
-            self.other = self.conflicting(c);
+            self.other = self.conflicting(c).unwrap_or(c);
         }
         self.left -= 1;
         match self.kind {
@@ -647,13 +660,33 @@ mod tests {
     }
 
     #[test]
+    fn the_set_folds_the_tag_so_a_set_and_a_tag_name_one_line() {
+        let cfg = SMALL;
+        let mut seen = std::collections::HashSet::new();
+        let h = cfg.half();
+        for bz in 0..h {
+            for by in 0..h {
+                for bx in (0..h).step_by(cfg.line_vox as usize) {
+                    let (line, set, tag) = cfg.slot(0, [2 * bx, 2 * by, 2 * bz]);
+                    assert!(seen.insert((set, tag)), "line {line}");
+                    assert_eq!(set as u64, (line ^ tag) % u64::from(cfg.sets));
+                }
+            }
+        }
+        // Lines `Sets` apart (rows two apart here) meet in other sets: the tag's low bits differ.
+        let (l0, s0, _) = cfg.slot(0, [0, 0, 0]);
+        let (l1, s1, _) = cfg.slot(0, [0, 4, 0]);
+        assert_eq!(l1 - l0, u64::from(cfg.sets));
+        assert_eq!((s0, s1), (0, 1));
+    }
+
+    #[test]
     fn two_cells_of_one_set_evict_each_other() {
         let cfg = SMALL;
         let mut c = VolumeCache::new(cfg, &ramp(cfg)).unwrap();
         let t = CacheTraffic::new(cfg);
         let a = CacheReq { x: 2, y: 4, z: 6 };
-        let b = t.conflicting(a);
-        assert_ne!(a, b);
+        let b = t.conflicting(a).unwrap();
         for _ in 0..4 {
             assert_eq!(c.request(&a).out.hit, 0);
             assert_eq!(c.request(&b).out.hit, 0);
