@@ -84,31 +84,24 @@ fn random_case(cfg: CacheConfig, s: u64, n: usize) -> Case {
     let words = random_words(cfg, &mut rng);
     let reqs = CacheTraffic::new(cfg).items(&mut rng, n);
     let img = cfg.image(&words).unwrap();
-    let bw = axi::random_bandwidth(&mut rng, cfg.data_w / 4);
-    let gaps = (rng.random_range(0..400), rng.random_range(0..400));
-    let setup = mem_setup(cfg, &img, (10, 190), gaps, bw, rng.random());
-    let stall = rng.random_range(0.0..0.6);
-    let traffic = Traffic::random(&mut rng, 0.3, stall);
+    let bus = (cfg.data_w / 8, cfg.addr_w);
+    let (setup, traffic) = axi::random_conditions(&mut rng, bus, &img, cfg.data_w / 4);
     Case {
         words,
         reqs,
-        setup,
+        setup: AxiMemSetup {
+            declared_outstanding: cfg.outstanding,
+            ..setup
+        },
         traffic,
         reset: None,
     }
 }
 
-fn check(
-    variant: &'static Variant,
-    cfg: CacheConfig,
-    seed: u64,
-    case: &Case,
-) -> Result<Report, TbError> {
-    with_waves(variant, seed, |trace| run(variant, cfg, seed, case, trace))
-}
-
+/// Runs `case` on `variant` (again with a waveform on a mismatch); a failure panics.
 fn must(variant: &'static Variant, cfg: CacheConfig, seed: u64, case: &Case) -> Report {
-    axi::must_pass(variant, seed, check(variant, cfg, seed, case), |r| {
+    let result = with_waves(variant, seed, |trace| run(variant, cfg, seed, case, trace));
+    axi::must_pass(variant, seed, result, |r| {
         format!(
             "{} requests, hit rate {:.4}, {} missed requests, {} stall cycles, {} cycles",
             r.items,
