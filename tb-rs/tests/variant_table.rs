@@ -15,6 +15,7 @@ use cube5_model::units::cube5_axil::AxilConfig;
 use cube5_model::units::cube5_er::ErConfig;
 use cube5_model::units::cube5_pwarp::PwarpConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
+use cube5_model::units::gicube_cache::CacheConfig;
 use cube5_model::units::gicube_queue_front::QueueFrontConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_model::units::gicube_sample::SampleRtlConfig;
@@ -82,6 +83,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == QueueFrontConfig::TOP => agree::<QueueFrontConfig>(v),
         t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
         t if t == StepConfig::TOP => agree::<StepConfig>(v),
+        t if t == CacheConfig::TOP => agree::<CacheConfig>(v),
         t if t == SampleRtlConfig::TOP => agree::<SampleRtlConfig>(v),
         t if t == ErConfig::TOP => agree::<ErConfig>(v),
         t if t == AccelConfig::TOP => agree::<AccelConfig>(v),

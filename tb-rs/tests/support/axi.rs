@@ -202,3 +202,19 @@ pub fn err_flag_matches<C: StreamCodec>(
         &format!("err_o differs (sticky: {some} != OKAY since reset)"),
     ))
 }
+
+/// A random subordinate and stream traffic, as the AXI tests' random cases draw them: latency
+/// 10..200, AR and R gaps up to 40 %, a bandwidth limit of up to `twice / 2` bytes per cycle on
+/// half the seeds, idle 30 % and back-pressure up to 60 %.
+pub fn random_conditions(
+    rng: &mut ChaCha8Rng,
+    bus: (u32, u32),
+    mem: &AxiMemImage,
+    twice: u32,
+) -> (AxiMemSetup, cube5_tb::rtl::Traffic) {
+    let bw = random_bandwidth(rng, twice);
+    let gaps = (rng.random_range(0..400), rng.random_range(0..400));
+    let setup = super::axi_mem_setup(bus, mem, (10, 190), gaps, bw, rng.random());
+    let stall = rng.random_range(0.0..0.6);
+    (setup, cube5_tb::rtl::Traffic::random(rng, 0.3, stall))
+}

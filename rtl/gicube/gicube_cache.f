@@ -1,0 +1,4 @@
+// gicube_cache: the block RAM it reuses, the burst reader (with its splitter), then the unit.
+rtl/cube5/cube5_shader_ram.sv
+-f rtl/cube5/cube5_axi_rd.f
+rtl/gicube/gicube_cache.sv
