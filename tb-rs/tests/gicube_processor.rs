@@ -393,9 +393,12 @@ fn large_frames_equal_the_model_with_every_count() {
         ] {
             let (got, want) = exact_frame(variant, rtl, px, proj, seed(1950));
             eprintln!(
-                "{variant} {proj:?}: {} rays, {} samples, {} processor cycles, {} clocks: {:.3} samples/clock",
+                "{variant} {proj:?}: {} rays, {} in, {} overflowed, {} samples, {} leaps, {} processor cycles, {} clocks: {:.3} samples/clock",
                 want.counts.rays_made,
+                want.counts.rays_in,
+                want.counts.rays_overflowed,
                 want.counts.samples,
+                want.counts.leaps,
                 want.counts.cycles,
                 got.clocks,
                 want.counts.samples as f64 / got.clocks as f64
