@@ -297,7 +297,7 @@ module gicube_processor #(
   logic [NW-1:0]    x0, y0, z0;
   logic [2:0]       par;
   logic [7:0]       outside;
-  logic [BankAW-1:0] raddr [8];
+  logic [8*BankAW-1:0] raddr;
 
   assign x0  = o_pop_ray[StartLsb + PosFracW +: NW];
   assign y0  = o_pop_ray[StartLsb + PosW + PosFracW +: NW];
@@ -319,10 +319,10 @@ module gicube_processor #(
     assign zi = {1'b0, z0} + {{NW{1'b0}}, zc};
     assign outside[b] = (xi == (NW+1)'(Side)) || (yi == (NW+1)'(Side))
                         || (zi == (NW+1)'(Side));
-    assign raddr[b] = {zi[HW:1], yi[HW:1], xi[HW:1]};
+    assign raddr[b * BankAW +: BankAW] = {zi[HW:1], yi[HW:1], xi[HW:1]};
   end
 
-  logic [VoxelW-1:0] bank_q [8];
+  logic [8*VoxelW-1:0] bank_q;
   for (genvar b = 0; b < 8; b++) begin : gen_bank
     cube5_shader_ram #(
       .Depth (1 << BankAW),
@@ -334,8 +334,8 @@ module gicube_processor #(
       .waddr_i ({cfg_z[HW:1], cfg_y[HW:1], cfg_x[HW:1]}),
       .wdata_i (cfg_data_i[VoxelW-1:0]),
       .re_i    (dispatch),
-      .raddr_i (raddr[b]),
-      .rdata_o (bank_q[b])
+      .raddr_i (raddr[b * BankAW +: BankAW]),
+      .rdata_o (bank_q[b * VoxelW +: VoxelW])
     );
   end
 
@@ -368,8 +368,13 @@ module gicube_processor #(
   // Corner c = x + 2y + 4z is in bank c ^ parity; a corner at N (past the domain) reads 0.
   logic [8*VoxelW-1:0] voxels;
   always_comb begin
+    voxels = '0;
     for (int c = 0; c < 8; c++) begin
-      voxels[c * VoxelW +: VoxelW] = f_out_q[3'(c) ^ f_par_q] ? '0 : bank_q[3'(c) ^ f_par_q];
+      for (int b = 0; b < 8; b++) begin
+        if ((3'(c) ^ f_par_q) == 3'(b) && !f_out_q[b]) begin
+          voxels[c * VoxelW +: VoxelW] = bank_q[b * VoxelW +: VoxelW];
+        end
+      end
     end
   end
 

@@ -322,7 +322,8 @@ fn idle_host_and_stalled_output_keep_the_image() {
     }
 }
 
-/// A reset in the middle of a frame drops the rays in the processor; the tables, flags and
+/// A reset in the middle of a frame (after three clocks per processor cycle of the whole frame: a
+/// cycle takes at least five) drops the rays in the processor; the tables, flags and
 /// volume survive it, and the next frame is exact, counts and all.
 #[test]
 fn mid_frame_reset_then_an_exact_frame() {
@@ -342,7 +343,7 @@ fn mid_frame_reset_then_an_exact_frame() {
                 stall: 0.2,
             },
             &mut rng,
-            Some(3_000),
+            Some(3 * want.counts.cycles),
         );
         assert!(
             part.outputs > 0 && (part.last.rays_finished as u64) < want.counts.rays_made,
@@ -404,5 +405,20 @@ fn large_frames_equal_the_model_with_every_count() {
                 want.counts.samples as f64 / got.clocks as f64
             );
         }
+    }
+}
+
+/// The gate-level netlist (Yosys) of the tiny configuration renders an exact frame, counts and
+/// all.
+#[test]
+#[ignore = "sim-full: the gate-level netlist is a `full` build (minutes of Yosys and Verilator)"]
+fn gate_level_netlist_renders_an_exact_frame() {
+    for (variant, rtl) in support::gate_configs::<ProcessorRtlConfig>() {
+        let px = 2 * rtl.side();
+        let (got, want) = exact_frame(variant, rtl, px, Projection::Parallel, seed(1960));
+        eprintln!(
+            "{variant}: {} rays, {} overflowed, {} samples in {} clocks",
+            want.counts.rays_made, want.counts.rays_overflowed, want.counts.samples, got.clocks
+        );
     }
 }
