@@ -323,6 +323,54 @@ fn bad_input_is_refused_with_one_line() {
     msg(p.render(&cam, Projection::Parallel).unwrap_err());
 }
 
+/// The ring latency (contract, *The ring*) changes the counts, never a pixel: latencies 0, 1, 3
+/// and 16 on the head at 32^3 with short queues (overflow), every ray finished once, each frame
+/// its own cycle count; and a latency above the RTL's 16 is refused.
+#[test]
+fn ring_latency_changes_counts_not_pixels() {
+    let tf = TransferFunction::head_default();
+    let vol = head_phantom(32, 12).unwrap();
+    let cam = camera(&vol, 32);
+    let frames: Vec<ProcessorFrame> = [0, 1, 3, 16]
+        .into_iter()
+        .map(|ring_latency| {
+            let cfg = ProcessorConfig {
+                queue_len: 8,
+                ring_latency,
+                ..cfg_for(32)
+            };
+            let f = Processor::new(cfg, &vol, &tf)
+                .unwrap()
+                .render(&cam, Projection::Parallel)
+                .unwrap();
+            check_conservation(&f);
+            f
+        })
+        .collect();
+    for f in &frames[1..] {
+        assert_eq!(
+            f.rgb, frames[0].rgb,
+            "the image does not depend on the ring"
+        );
+        assert_eq!(
+            (f.counts.samples, f.counts.leaps),
+            (frames[0].counts.samples, frames[0].counts.leaps)
+        );
+        assert!(f.counts.rays_overflowed > 0, "{:?}", f.counts);
+    }
+    let cycles: std::collections::BTreeSet<u64> = frames.iter().map(|f| f.counts.cycles).collect();
+    assert_eq!(
+        cycles.len(),
+        frames.len(),
+        "each latency its own cycle count"
+    );
+    let bad = ProcessorConfig {
+        ring_latency: 17,
+        ..cfg_for(32)
+    };
+    assert!(Processor::new(bad, &vol, &tf).is_err());
+}
+
 mod gi {
     use super::*;
     use cube5_model::units::gicube_processor::{

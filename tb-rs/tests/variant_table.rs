@@ -16,6 +16,7 @@ use cube5_model::units::cube5_er::ErConfig;
 use cube5_model::units::cube5_pwarp::PwarpConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
 use cube5_model::units::gicube_cache::CacheConfig;
+use cube5_model::units::gicube_processor::ProcessorRtlConfig;
 use cube5_model::units::gicube_queue_front::QueueFrontConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
 use cube5_model::units::gicube_sample::SampleRtlConfig;
@@ -81,6 +82,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == AccelCtrlConfig::TOP => agree::<AccelCtrlConfig>(v),
         t if t == RayQueuesConfig::TOP => agree::<RayQueuesConfig>(v),
         t if t == QueueFrontConfig::TOP => agree::<QueueFrontConfig>(v),
+        t if t == ProcessorRtlConfig::TOP => agree::<ProcessorRtlConfig>(v),
         t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
         t if t == StepConfig::TOP => agree::<StepConfig>(v),
         t if t == CacheConfig::TOP => agree::<CacheConfig>(v),

@@ -37,6 +37,9 @@ pub const DEPOSIT_SHIFT: u32 = 12 + 12 + POS_FRAC_W + 3 * POS_FRAC_W - IRR_FRAC_
 /// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
 pub use crate::units::gicube_queue_front::SORTER_SLOTS;
 
+/// Largest ring latency, processor cycles (the RTL's `RingLat`: 1..=16).
+pub const MAX_RING_LATENCY: u32 = 16;
+
 /// How the processor picks the next active queue.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum QueueOrder {
@@ -87,6 +90,10 @@ pub struct ProcessorConfig {
     pub jitter: bool,
     pub order: QueueOrder,
     pub host_order: HostOrder,
+    /// Ring latency `L` in processor cycles (contract, *The ring*): the ray popped in cycle `t`
+    /// is re-queued (or finishes) in cycle `t + L`; 0: in its own cycle (the pipeline inside the
+    /// cycle). The RTL `gicube_processor` sets it from its `RingLat` (1..=16).
+    pub ring_latency: u32,
 }
 
 impl ProcessorConfig {
@@ -102,6 +109,7 @@ impl ProcessorConfig {
         jitter: false,
         order: QueueOrder::Sorter,
         host_order: HostOrder::RowMajor,
+        ring_latency: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
@@ -125,6 +133,12 @@ impl ProcessorConfig {
             if !(1..=CHAN_MAX + 1).contains(&t) {
                 return bad(format!("et_threshold {t} outside 1..=4096"));
             }
+        }
+        if self.ring_latency > MAX_RING_LATENCY {
+            return bad(format!(
+                "ring_latency {} outside 0..={MAX_RING_LATENCY}",
+                self.ring_latency
+            ));
         }
         Ok(())
     }
@@ -505,6 +519,11 @@ impl Processor {
         self.cfg
     }
 
+    /// The loaded volume.
+    pub fn volume(&self) -> &Volume {
+        &self.vol
+    }
+
     /// Number of queues (blocks).
     pub fn queues(&self) -> u32 {
         self.blocks * self.blocks * self.blocks
@@ -828,9 +847,13 @@ impl Processor {
         let lives = packets_lives;
         let per_path =
             2 * u64::from(self.side) * 256 / u64::from(self.cfg.step) + u64::from(nq) + 64;
-        let bound = 64 + 8 * rays as u64 * lives * per_path;
+        let lat = self.cfg.ring_latency as usize;
+        let bound = 64 + 8 * rays as u64 * lives * per_path * (1 + lat as u64);
+        // The ring (contract, *The ring*): `ring_latency` slots, each the outcome of one cycle's
+        // popped ray (or none), oldest first.
+        let mut ring: VecDeque<Option<Outcome>> = (0..lat).map(|_| None).collect();
 
-        while !feed.is_empty() || front.total() > 0 {
+        while !feed.is_empty() || front.total() > 0 || ring.iter().any(Option::is_some) {
             let held = u64::from(front.total());
             counts.cycles += 1;
             if counts.cycles > bound {
@@ -853,13 +876,20 @@ impl Processor {
             let c = front.cycle(
                 true,
                 |popped| {
-                    let Some((q, ray)) = popped else {
-                        return Ok(None);
+                    // The popped ray's cycle (sample or leap, advance) enters the ring; the
+                    // outcome leaving it now is the one that entered `ring_latency` cycles ago.
+                    let entered = match popped {
+                        Some((q, ray)) => {
+                            let irr = irr.as_deref_mut().map(|v| v.as_mut_slice());
+                            Some(self.advance(ray, q, &mut counts, &mut cache, irr))
+                        }
+                        None => None,
                     };
-                    let irr = irr.as_deref_mut().map(|v| v.as_mut_slice());
-                    match self.advance(ray, q, &mut counts, &mut cache, irr) {
-                        Outcome::Next(ray) => Ok(Some(ray)),
-                        Outcome::Done(ray) => {
+                    ring.push_back(entered);
+                    match ring.pop_front().flatten() {
+                        None => Ok(None),
+                        Some(Outcome::Next(ray)) => Ok(Some(ray)),
+                        Some(Outcome::Done(ray)) => {
                             counts.rays_finished += 1;
                             let i = (u32::from(ray.v) * w + u32::from(ray.u)) as usize;
                             if done[i] {
@@ -1307,4 +1337,237 @@ pub fn shadow_scene(n: usize) -> Result<(Volume, TransferFunction, GiLight)> {
         mode: GiMode::LowAlbedo,
     };
     Ok((vol, tf, light))
+}
+
+/// The RTL top `gicube_processor`'s parameters (contract, *The RTL*): the front end's, the voxel
+/// width, the sample distance and the ring latency. Every parameter is a field of the model
+/// ([`ProcessorRtlConfig::processor_config`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ProcessorRtlConfig {
+    /// Block side `n = 2^block_log2` voxels, 2..=8.
+    pub block_log2: u32,
+    /// Blocks a side `B`, 1..=6; `N = B n <= 64` voxels a side (the on-chip volume).
+    pub vol_blocks: u32,
+    /// Rays per queue, 1..=4096.
+    pub queue_len: u32,
+    /// Sorter ranks, 2..=64 and at most the queues.
+    pub ranks: u32,
+    /// Bits per voxel, 4..=16.
+    pub voxel_w: u32,
+    /// Sample distance `dr`, `U(4.8)` voxels, 16..=1024.
+    pub step: u32,
+    /// Ring latency, processor cycles, 1..=16 (the model's `ring_latency`).
+    pub ring_lat: u32,
+}
+
+/// Region of a configuration address (its top two bits): `gicube_sample`'s tables, the empty
+/// flags, the volume.
+pub const CFG_REGION_SAMPLE: u32 = 0;
+pub const CFG_REGION_EMPTY: u32 = 1;
+pub const CFG_REGION_VOXEL: u32 = 2;
+/// Address bits of `gicube_sample`'s configuration port.
+const SAMPLE_CFG_ADDR_W: u32 = 14;
+/// Bits of a configuration word (`gicube_sample`'s).
+const CFG_WORD_W: u32 = 36;
+/// Bits of each count in an output item.
+pub const COUNT_W: u32 = 32;
+
+impl ProcessorRtlConfig {
+    /// The RTL's parameter defaults.
+    pub const DEFAULT: Self = Self {
+        block_log2: 2,
+        vol_blocks: 4,
+        queue_len: 16,
+        ranks: 8,
+        voxel_w: 8,
+        step: 256,
+        ring_lat: 8,
+    };
+
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(ModelError::Config(format!("gicube_processor: {m}")));
+        if !(2..=8).contains(&self.block_log2) {
+            return bad(format!("BlockLog2 {} outside 2..=8", self.block_log2));
+        }
+        if !(1..=6).contains(&self.vol_blocks) || self.side() > 64 {
+            return bad(format!(
+                "VolBlocks {} outside 1..=6 or N = {} above 64",
+                self.vol_blocks,
+                self.side()
+            ));
+        }
+        if !(1..=4096).contains(&self.queue_len) {
+            return bad(format!("QueueLen {} outside 1..=4096", self.queue_len));
+        }
+        if !(2..=64).contains(&self.ranks) || self.ranks > 1 << self.queue_w() {
+            return bad(format!(
+                "Ranks {} outside 2..=64 or above the {} queues",
+                self.ranks,
+                1u32 << self.queue_w()
+            ));
+        }
+        if !(4..=16).contains(&self.voxel_w) {
+            return bad(format!("VoxelW {} outside 4..=16", self.voxel_w));
+        }
+        if !(16..=1024).contains(&self.step) {
+            return bad(format!("Step {} outside 16..=1024", self.step));
+        }
+        if !(1..=MAX_RING_LATENCY).contains(&self.ring_lat) {
+            return bad(format!(
+                "RingLat {} outside 1..={MAX_RING_LATENCY}",
+                self.ring_lat
+            ));
+        }
+        Ok(())
+    }
+
+    /// `N = B n`, voxels a side.
+    pub fn side(&self) -> u32 {
+        self.vol_blocks << self.block_log2
+    }
+
+    /// `QueueW = max(1, clog2(B^3))`.
+    pub fn queue_w(&self) -> u32 {
+        (self.vol_blocks.pow(3))
+            .next_power_of_two()
+            .trailing_zeros()
+            .max(1)
+    }
+
+    /// Bits of a voxel coordinate in a configuration address, `clog2(N)`.
+    fn coord_w(&self) -> u32 {
+        self.side().next_power_of_two().trailing_zeros()
+    }
+
+    /// Configuration address bits: two region bits over the wider of `gicube_sample`'s address
+    /// and a voxel's index.
+    pub fn cfg_addr_w(&self) -> u32 {
+        2 + (3 * self.coord_w()).max(SAMPLE_CFG_ADDR_W)
+    }
+
+    /// The model's configuration that this RTL renders exactly (frames and counts): the RTL's
+    /// front end, step and ring latency, the model's defaults otherwise (termination at
+    /// `1 - 2^-8`, space leaping, the sorter, no jitter).
+    pub fn processor_config(&self) -> ProcessorConfig {
+        ProcessorConfig {
+            block_log2: self.block_log2,
+            queue_len: self.queue_len,
+            ranks: self.ranks,
+            step: self.step,
+            ring_latency: self.ring_lat,
+            ..ProcessorConfig::DEFAULT
+        }
+    }
+}
+
+crate::unit_config!(ProcessorRtlConfig, "gicube_processor", DEFAULT, {
+    "BlockLog2" => block_log2,
+    "VolBlocks" => vol_blocks,
+    "QueueLen" => queue_len,
+    "Ranks" => ranks,
+    "VoxelW" => voxel_w,
+    "Step" => step,
+    "RingLat" => ring_lat,
+});
+
+/// One output item of the RTL: a finished or an overflowed ray, and the counts after it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ProcessorOut {
+    /// Finished (exited or terminated); else returned to the host with `OVERFLOW` set.
+    pub done: bool,
+    /// The packet's bits.
+    pub ray: [u32; crate::units::gicube_packet_loop::PACKET_WORDS],
+    pub rays_in: u32,
+    pub rays_finished: u32,
+    pub rays_overflowed: u32,
+    pub samples: u32,
+    pub leaps: u32,
+    /// Processor cycles in which the host offered a ray or a ray was in the processor.
+    pub cycles: u32,
+}
+
+impl crate::unit::StreamCodec for ProcessorRtlConfig {
+    /// A host ray's bits.
+    type In = [u32; crate::units::gicube_packet_loop::PACKET_WORDS];
+    type Out = ProcessorOut;
+
+    fn in_width(&self) -> u32 {
+        256
+    }
+
+    fn out_width(&self) -> u32 {
+        1 + 256 + 6 * COUNT_W
+    }
+
+    fn pack_in(&self, item: &Self::In) -> Vec<u32> {
+        item.to_vec()
+    }
+
+    fn unpack_out(&self, words: &[u32]) -> ProcessorOut {
+        let mut r = crate::bits::BitReader::new(words);
+        let done = r.get_bool();
+        let ray = std::array::from_fn(|_| r.get(32) as u32);
+        let mut c = || r.get(COUNT_W) as u32;
+        ProcessorOut {
+            done,
+            ray,
+            rays_in: c(),
+            rays_finished: c(),
+            rays_overflowed: c(),
+            samples: c(),
+            leaps: c(),
+            cycles: c(),
+        }
+    }
+}
+
+impl Processor {
+    /// The writes that load this processor's tables, empty flags and volume into the RTL
+    /// `rtl` (contract, *The RTL*): `gicube_sample`'s tables (region 0), every queue's empty flag
+    /// (region 1: the flags when leaping is on, else 0), every voxel of `[0, N)^3` (region 2: 0
+    /// outside the volume). Refused: another voxel width, step or block size, a volume wider than
+    /// `N`.
+    pub fn rtl_config_writes(&self, rtl: &ProcessorRtlConfig) -> Result<Vec<(u32, Vec<u32>)>> {
+        rtl.validate()?;
+        let n = rtl.side();
+        if self.vol.bits != rtl.voxel_w
+            || self.cfg.step != rtl.step
+            || self.cfg.block_log2 != rtl.block_log2
+            || self.blocks != rtl.vol_blocks
+        {
+            return Err(ModelError::Config(format!(
+                "gicube_processor: a {}-bit volume of {} blocks of 2^{} at step {} does not fit {rtl:?}",
+                self.vol.bits, self.blocks, self.cfg.block_log2, self.cfg.step
+            )));
+        }
+        let top = rtl.cfg_addr_w() - 2;
+        let region = |r: u32, a: u32| (r << top) | a;
+        let word = |v: u32| {
+            let mut w = crate::bits::BitWriter::new();
+            w.put(u64::from(v), CFG_WORD_W);
+            w.finish(CFG_WORD_W)
+        };
+        let mut writes: Vec<(u32, Vec<u32>)> = self
+            .sampler
+            .config_writes()
+            .into_iter()
+            .map(|(a, d)| (region(CFG_REGION_SAMPLE, a), d))
+            .collect();
+        debug_assert!(writes.iter().all(|(a, _)| *a < 1 << SAMPLE_CFG_ADDR_W));
+        for q in 0..1u32 << rtl.queue_w() {
+            let e = self.cfg.space_leap && self.empty.get(q as usize).copied().unwrap_or(false);
+            writes.push((region(CFG_REGION_EMPTY, q), word(u32::from(e))));
+        }
+        let cw = rtl.coord_w();
+        for z in 0..n {
+            for y in 0..n {
+                for x in 0..n {
+                    let v = self.vol.get(i64::from(x), i64::from(y), i64::from(z));
+                    let a = x | y << cw | z << (2 * cw);
+                    writes.push((region(CFG_REGION_VOXEL, a), word(v)));
+                }
+            }
+        }
+        Ok(writes)
+    }
 }

@@ -1,0 +1,511 @@
+// gicube_processor: the GI-Cube block processor for direct volume rendering (patent [347]-[357],
+// [369]-[374]; docs/gicube-rtl.md step 6; contract docs/numerics/gicube_processor.md, "The ring"
+// and "The RTL"). The verified units, unchanged, in the circular ray pipeline:
+//
+//   host rays ─► gicube_queue_front (arbiter, bucketing, ray queues, sorter) ─► popped ray
+//        ▲             ▲ ring ray                    │ overflowed ray           │
+//        │             │                             ▼                          ▼
+//        └──── out ◄───┼──── finished ◄── merge ◄── out FIFO           volume banks (8-way, x&1,
+//                      │                    ▲                          y&1, z&1), empty LUT
+//                      └────────────────────┤                                   │
+//                     side FIFO (ray, leap) ┤◄──────────────────────────────────┤
+//                     gicube_sample ─► FIFO ┤◄──────────────── 8 voxels, weights┤
+//                     gicube_step   ─► FIFO ┘◄──────────────── start, dir, leap ┘
+//
+// One processor cycle is one item of the front end. The cycle's popped ray (or a bubble) enters
+// the ring; the ring's ray of cycle t is the outcome of the ray popped in cycle t - RingLat (the
+// ring latency, the model's `ring_latency`): the cycle waits until that outcome is back, so the
+// order of processor cycles, and with it every count, is the model's whatever the clock timing.
+// A cycle also waits until the previous cycle's outputs (finished and overflowed rays) have
+// left, so that the host has seen an overflowed ray before the next offer (the model appends it
+// to the host's list at the end of its cycle).
+//
+// The volume sits on chip until gicube_cache (step 5) replaces it behind AXI4: eight block RAMs
+// by (x&1, y&1, z&1), loaded through the configuration port; the eight corners of a cell are one
+// read of each bank.
+module gicube_processor #(
+  /// Block side n = 2^BlockLog2 voxels, 2..8.
+  parameter int unsigned BlockLog2 = 2,
+  /// Blocks a side B, 1..6 (B^3 <= 256 queues); N = B n voxels a side, 4..64 here.
+  parameter int unsigned VolBlocks = 4,
+  /// Rays per queue, 1..4096.
+  parameter int unsigned QueueLen  = 16,
+  /// Sorter ranks, 2..64 and <= 2^QueueW.
+  parameter int unsigned Ranks     = 8,
+  /// Bits per voxel, 4..16.
+  parameter int unsigned VoxelW    = 8,
+  /// Sample distance dr, U(4.8) voxels, 16..1024.
+  parameter int unsigned Step      = 256,
+  /// Ring latency in processor cycles, 1..16.
+  parameter int unsigned RingLat   = 8
+) (
+  input  logic clk_i,
+  input  logic rst_ni,
+
+  /// Host ray valid (held until taken: an offer that the cycle does not take stays).
+  input  logic in_valid_i,
+  /// The host ray is taken this clock.
+  output logic in_ready_o,
+  /// The host's ray packet (256 bits).
+  input  logic [gicube_pkg::PacketW-1:0] in_data_i,
+
+  /// Output item valid.
+  output logic out_valid_o,
+  /// Consumer takes the output item this clock.
+  input  logic out_ready_i,
+  /// done (1: finished, 0: overflowed), ray (256), then the counts after it: rays_in,
+  /// rays_finished, rays_overflowed, samples, leaps, cycles (32 each); LSB first.
+  output logic [1+gicube_pkg::PacketW+6*32-1:0] out_data_o,
+
+  /// Configuration write this clock (tables, empty flags, volume; they survive reset).
+  input  logic cfg_valid_i,
+  /// Region (top 2 bits): 0 gicube_sample's address (low 14 bits), 1 the empty flag of queue
+  /// (low bits), 2 voxel x + N' y + N'^2 z (N' = 2^clog2(N)).
+  input  logic [2+((3*$clog2(VolBlocks<<BlockLog2) > gicube_sample_pkg::CfgAddrW)
+                   ? 3*$clog2(VolBlocks<<BlockLog2) : gicube_sample_pkg::CfgAddrW)-1:0] cfg_addr_i,
+  /// gicube_sample's data; the empty flag in bit 0; the voxel in bits VoxelW-1:0.
+  input  logic [gicube_sample_pkg::CfgDataW-1:0] cfg_data_i
+);
+
+  localparam int unsigned PacketW  = gicube_pkg::PacketW;
+  localparam int unsigned PosW     = gicube_pkg::PosW;
+  localparam int unsigned PosFracW = gicube_pkg::PosFracW;
+  localparam int unsigned StartLsb = gicube_pkg::PacketStartLsb;
+  localparam int unsigned DirLsb   = StartLsb + 3 * PosW;            // 84
+  localparam int unsigned ColLsb   = DirLsb + 3 * 16;                // 132: red, green, blue, opacity
+  localparam int unsigned TypeLsb  = 224;
+  localparam int unsigned TermBit  = gicube_pkg::PacketFlagsLsb + gicube_pkg::FlagTerminated;
+  localparam int unsigned QueueW   = gicube_pkg::bucket_queue_w(VolBlocks, 0);
+  localparam int unsigned Queues   = 1 << QueueW;
+  localparam int unsigned LenW     = gicube_pkg::rq_len_w(QueueLen);
+  localparam int unsigned TotW     = gicube_pkg::rq_tot_w(QueueW, QueueLen);
+  localparam int unsigned FeInW    = 3 + 2 * PacketW;
+  localparam int unsigned FeOutW   = 7 + 3 * QueueW + LenW + TotW + 2 * PacketW;
+  localparam int unsigned Side     = VolBlocks << BlockLog2;         // N
+  localparam int unsigned NW       = $clog2(Side);                   // bits of a voxel coordinate
+  localparam int unsigned HW       = NW - 1;                         // bits of a bank coordinate
+  localparam int unsigned BankAW   = 3 * HW;
+  // 2 region bits over the wider of gicube_sample's address and a voxel's index.
+  localparam int unsigned CfgAW    = 2 + ((3 * NW > gicube_sample_pkg::CfgAddrW)
+                                          ? 3 * NW : gicube_sample_pkg::CfgAddrW);
+  localparam int unsigned SmInW    = gicube_sample_pkg::in_w(VoxelW);
+  localparam int unsigned SmOutW   = gicube_sample_pkg::OutW;        // colour, opacity, terminated
+  localparam int unsigned StInW    = 3 * PosW + 3 * 16 + QueueW + 1;
+  localparam int unsigned KW       = BlockLog2 + 9;
+  localparam int unsigned StOutW   = KW + 1 + 3 * PosW + QueueW;
+  localparam int unsigned TvW      = 1 + 3 * PosW;                   // exit, next
+  localparam int unsigned SideW    = 2 + PacketW;                    // ray, leap, packet
+  localparam int unsigned FifoD    = (RingLat < 2) ? 2 : (1 << $clog2(RingLat));
+  localparam int unsigned LeadW    = $clog2(RingLat + 1);
+  localparam int unsigned CntW     = 32;
+  localparam int unsigned OutW     = 1 + PacketW + 6 * CntW;
+
+  if (BlockLog2 < 2 || BlockLog2 > 8) begin : gen_bad_block_log2
+    $fatal(1, "gicube_processor: BlockLog2 must be 2..8");
+  end
+  if (VolBlocks < 1 || VolBlocks > 6 || Side > 64) begin : gen_bad_vol_blocks
+    $fatal(1, "gicube_processor: VolBlocks must be 1..6 with N = VolBlocks 2^BlockLog2 <= 64");
+  end
+  if (RingLat < 1 || RingLat > 16) begin : gen_bad_ring_lat
+    $fatal(1, "gicube_processor: RingLat must be 1..16");
+  end
+
+  // ---------------------------------------------------------------------------
+  // Configuration: the empty flags and the volume banks (gicube_sample takes region 0)
+  // ---------------------------------------------------------------------------
+  logic [1:0]        cfg_region;
+  logic              cfg_sample, cfg_empty, cfg_voxel;
+  logic [NW-1:0]     cfg_x, cfg_y, cfg_z;
+  logic [Queues-1:0] empty_q;
+
+  assign cfg_region = cfg_addr_i[CfgAW-1 -: 2];
+  assign cfg_sample = cfg_valid_i && (cfg_region == 2'd0);
+  assign cfg_empty  = cfg_valid_i && (cfg_region == 2'd1);
+  assign cfg_voxel  = cfg_valid_i && (cfg_region == 2'd2);
+  assign cfg_x      = cfg_addr_i[0 +: NW];
+  assign cfg_y      = cfg_addr_i[NW +: NW];
+  assign cfg_z      = cfg_addr_i[2 * NW +: NW];
+
+  // The block LUT of empty flags [357] (datapath state: no reset, written by the host).
+  always_ff @(posedge clk_i) begin
+    if (cfg_empty) begin
+      empty_q[cfg_addr_i[0 +: QueueW]] <= cfg_data_i[0];
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // The processor cycle: issue (the front end's item) and dispatch (its output item)
+  // ---------------------------------------------------------------------------
+  logic               waiting_q;            // an item is in the front end
+  logic [LeadW-1:0]   lead_q;               // ring slots still owed their initial bubble
+  logic               fe_in_valid, fe_in_ready, fe_out_valid, fe_out_ready;
+  logic [FeInW-1:0]   fe_in;
+  logic [FeOutW-1:0]  fe_out;
+
+  // The front end's output item.
+  logic               o_act_v, o_popped, o_ring_ovf, o_host_taken;
+  logic [QueueW-1:0]  o_act_q;
+  logic [TotW-1:0]    o_total;
+  logic [PacketW-1:0] o_pop_ray, o_ovf_ray;
+
+  assign o_act_v      = fe_out[0];
+  assign o_act_q      = fe_out[1 +: QueueW];
+  assign o_popped     = fe_out[1 + QueueW];
+  assign o_ring_ovf   = fe_out[4 + QueueW];
+  assign o_host_taken = fe_out[5 + QueueW];
+  assign o_total      = fe_out[7 + 3 * QueueW + LenW +: TotW];
+  assign o_pop_ray    = fe_out[7 + 3 * QueueW + LenW + TotW +: PacketW];
+  assign o_ovf_ray    = fe_out[7 + 3 * QueueW + LenW + TotW + PacketW +: PacketW];
+
+  // The ring's head: the record of the cycle RingLat ago (side FIFO), and its results.
+  logic               sd_empty, sd_full, sm_empty, sm_full, tv_empty, tv_full;
+  logic [SideW-1:0]   sd_head;
+  logic [SmOutW-1:0]  sm_head;
+  logic [TvW-1:0]     tv_head;
+  logic               h_ray, h_leap, h_term, h_done;
+  logic [PacketW-1:0] h_pkt, h_out;
+  logic               head_ready, issue, dispatch;
+  logic [4:0]         ring_rays_q;  // rays in the ring (popped, outcome not yet taken), <= RingLat
+  logic               held_q;       // the queues hold rays (the last cycle's total)
+  logic               busy;
+
+  // The host offers or a ray is in the processor: the condition of the model's frame loop.
+  assign busy = in_valid_i || held_q || (ring_rays_q != '0);
+
+  assign h_ray  = sd_head[0];
+  assign h_leap = sd_head[1];
+  assign h_pkt  = sd_head[2 +: PacketW];
+
+  // The outcome (contract, "One pipeline cycle on one ray"): a sample's colour and opacity unless
+  // the ray leapt; terminated, or out of the volume: finished; else advanced to `next`.
+  always_comb begin
+    h_out  = h_pkt;
+    h_term = !h_leap && sm_head[SmOutW-1];
+    if (!h_leap) begin
+      h_out[ColLsb +: 48] = sm_head[0 +: 48];
+    end
+    h_done = h_term || tv_head[0];
+    if (h_term) begin
+      h_out[TermBit] = 1'b1;
+    end else if (!tv_head[0]) begin
+      h_out[StartLsb +: 3 * PosW] = tv_head[1 +: 3 * PosW];
+    end
+  end
+
+  // Output FIFO (finished at issue, overflowed at dispatch); a cycle issues when it is empty.
+  logic            of_empty, of_full, of_push_fin, of_push_ovf, of_push, of_pop;
+  logic [OutW-1:0] of_d, of_q;
+
+  assign head_ready = (lead_q != '0) || (!sd_empty && (!h_ray || (!sm_empty && !tv_empty)));
+  // A cycle is issued only while the host offers or a ray is in the processor (the model's frame
+  // loop): idle cycles would step the sorter (its Noops move its scan), which the model's frame
+  // does not see.
+  assign issue      = !waiting_q && fe_in_ready && of_empty && head_ready && busy;
+  assign dispatch   = waiting_q && fe_out_valid;
+
+  // The front end's item: take, ring, host, ring ray, host ray.
+  logic ring_v;
+  assign ring_v       = (lead_q == '0) && h_ray && !h_done;
+  assign fe_in_valid  = issue;
+  assign fe_in        = {in_data_i, h_out, in_valid_i, ring_v, 1'b1};
+  assign fe_out_ready = dispatch;
+
+  // The host's ray is taken in the dispatch clock of the cycle that took it (it was offered, and
+  // held, since the issue).
+  assign in_ready_o = dispatch && o_host_taken;
+
+  logic rec_leap;
+  assign rec_leap = empty_q[o_act_q] && (o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeRendering);
+
+  // Counts.
+  logic [CntW-1:0] c_in_q, c_fin_q, c_ovf_q, c_smp_q, c_leap_q, c_cyc_q;
+  logic [CntW-1:0] c_in_d, c_fin_d, c_ovf_d, c_smp_d, c_leap_d, c_cyc_d;
+
+  always_comb begin
+    c_in_d   = c_in_q   + CntW'(dispatch && o_host_taken);
+    c_ovf_d  = c_ovf_q  + CntW'(dispatch && o_ring_ovf);
+    c_smp_d  = c_smp_q  + CntW'(dispatch && o_popped && !rec_leap);
+    c_leap_d = c_leap_q + CntW'(dispatch && o_popped && rec_leap);
+    c_fin_d  = c_fin_q  + CntW'(issue && (lead_q == '0) && h_ray && h_done);
+    c_cyc_d  = c_cyc_q  + CntW'(issue);
+  end
+
+  assign of_push_fin = issue && (lead_q == '0) && h_ray && h_done;
+  assign of_push_ovf = dispatch && o_ring_ovf;
+  assign of_push     = of_push_fin || of_push_ovf;
+  assign of_d        = {c_cyc_d, c_leap_d, c_smp_d, c_ovf_d, c_fin_d, c_in_d,
+                        of_push_fin ? h_out : o_ovf_ray, of_push_fin};
+  assign of_pop      = out_valid_o && out_ready_i;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      waiting_q   <= 1'b0;
+      lead_q      <= LeadW'(RingLat);
+      ring_rays_q <= '0;
+      held_q      <= 1'b0;
+      c_in_q      <= '0;
+      c_fin_q     <= '0;
+      c_ovf_q     <= '0;
+      c_smp_q     <= '0;
+      c_leap_q    <= '0;
+      c_cyc_q     <= '0;
+    end else begin
+      if (issue) begin
+        waiting_q <= 1'b1;
+      end else if (dispatch) begin
+        waiting_q <= 1'b0;
+      end
+      if (issue && lead_q != '0) begin
+        lead_q <= lead_q - LeadW'(1);
+      end
+      if (dispatch) begin
+        held_q <= (o_total != '0);
+      end
+      if (dispatch && o_popped) begin
+        ring_rays_q <= ring_rays_q + 5'd1;
+      end else if (issue && lead_q == '0 && h_ray) begin
+        ring_rays_q <= ring_rays_q - 5'd1;
+      end
+      c_in_q   <= c_in_d;
+      c_fin_q  <= c_fin_d;
+      c_ovf_q  <= c_ovf_d;
+      c_smp_q  <= c_smp_d;
+      c_leap_q <= c_leap_d;
+      c_cyc_q  <= c_cyc_d;
+    end
+  end
+
+  gicube_queue_front #(
+    .BlockLog2 (BlockLog2),
+    .VolBlocks (VolBlocks),
+    .QueueLen  (QueueLen),
+    .Ranks     (Ranks)
+  ) u_front (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (fe_in_valid),
+    .in_ready_o  (fe_in_ready),
+    .in_data_i   (fe_in),
+    .out_valid_o (fe_out_valid),
+    .out_ready_i (fe_out_ready),
+    .out_data_o  (fe_out)
+  );
+
+  // ---------------------------------------------------------------------------
+  // Fetch: the cell's eight corners, one from each bank, read in the dispatch clock
+  // ---------------------------------------------------------------------------
+  logic [NW-1:0]    x0, y0, z0;
+  logic [2:0]       par;
+  logic [7:0]       outside;
+  logic [8*BankAW-1:0] raddr;
+
+  assign x0  = o_pop_ray[StartLsb + PosFracW +: NW];
+  assign y0  = o_pop_ray[StartLsb + PosW + PosFracW +: NW];
+  assign z0  = o_pop_ray[StartLsb + 2 * PosW + PosFracW +: NW];
+  assign par = {z0[0], y0[0], x0[0]};
+
+  // Bank (px, py, pz) holds the corner whose coordinates have that parity: x0 + (px ^ x0&1).
+  for (genvar b = 0; b < 8; b++) begin : gen_addr
+    localparam logic [2:0] Bank = 3'(b);
+    logic [NW:0] xi, yi, zi;
+    logic        xc;
+    assign xc = Bank[0] ^ x0[0];
+    assign xi = {1'b0, x0} + {{NW{1'b0}}, xc};
+    logic        yc;
+    assign yc = Bank[1] ^ y0[0];
+    assign yi = {1'b0, y0} + {{NW{1'b0}}, yc};
+    logic        zc;
+    assign zc = Bank[2] ^ z0[0];
+    assign zi = {1'b0, z0} + {{NW{1'b0}}, zc};
+    assign outside[b] = (xi == (NW+1)'(Side)) || (yi == (NW+1)'(Side))
+                        || (zi == (NW+1)'(Side));
+    assign raddr[b * BankAW +: BankAW] = {zi[HW:1], yi[HW:1], xi[HW:1]};
+  end
+
+  logic [8*VoxelW-1:0] bank_q;
+  for (genvar b = 0; b < 8; b++) begin : gen_bank
+    cube5_shader_ram #(
+      .Depth (1 << BankAW),
+      .Width (VoxelW),
+      .AddrW (BankAW)
+    ) u_bank (
+      .clk_i   (clk_i),
+      .we_i    (cfg_voxel && ({cfg_z[0], cfg_y[0], cfg_x[0]} == 3'(b))),
+      .waddr_i ({cfg_z[HW:1], cfg_y[HW:1], cfg_x[HW:1]}),
+      .wdata_i (cfg_data_i[VoxelW-1:0]),
+      .re_i    (dispatch),
+      .raddr_i (raddr[b * BankAW +: BankAW]),
+      .rdata_o (bank_q[b * VoxelW +: VoxelW])
+    );
+  end
+
+  // The record of the dispatched cycle, one clock later (with the banks' data).
+  logic               f_v_q, f_ray_q, f_leap_q;
+  logic [2:0]         f_par_q;
+  logic [7:0]         f_out_q;
+  logic [QueueW-1:0]  f_q_q;
+  logic [PacketW-1:0] f_pkt_q;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      f_v_q <= 1'b0;
+    end else begin
+      f_v_q <= dispatch;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (dispatch) begin
+      f_ray_q  <= o_popped;
+      f_leap_q <= rec_leap;
+      f_par_q  <= par;
+      f_out_q  <= outside;
+      f_q_q    <= o_act_q;
+      f_pkt_q  <= o_pop_ray;
+    end
+  end
+
+  // Corner c = x + 2y + 4z is in bank c ^ parity; a corner at N (past the domain) reads 0.
+  logic [8*VoxelW-1:0] voxels;
+  always_comb begin
+    voxels = '0;
+    for (int c = 0; c < 8; c++) begin
+      for (int b = 0; b < 8; b++) begin
+        if ((3'(c) ^ f_par_q) == 3'(b) && !f_out_q[b]) begin
+          voxels[c * VoxelW +: VoxelW] = bank_q[b * VoxelW +: VoxelW];
+        end
+      end
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // The ring: the sample and the step side by side, never stalled, each into a FIFO
+  // ---------------------------------------------------------------------------
+  logic              go;
+  logic [SmInW-1:0]  sm_in;
+  logic [StInW-1:0]  st_in;
+  logic              sm_in_ready, sm_out_valid, st_in_ready, st_out_valid;
+  logic [SmOutW-1:0] sm_out;
+  logic [StOutW-1:0] st_out;
+
+  assign go    = f_v_q && f_ray_q;
+  // voxels, weights (the start's fraction bits), no irradiance, colour and opacity, lighting.
+  assign sm_in = {f_pkt_q[TypeLsb +: 2] == gicube_pkg::RayTypeLighting, f_pkt_q[ColLsb +: 48],
+                  {8 * gicube_sample_pkg::IrrW{1'b0}}, 1'b0,
+                  f_pkt_q[StartLsb + 2 * PosW +: PosFracW], f_pkt_q[StartLsb + PosW +: PosFracW],
+                  f_pkt_q[StartLsb +: PosFracW], voxels};
+  // start, dir, queue, leap.
+  assign st_in = {f_leap_q, f_q_q, f_pkt_q[DirLsb +: 48], f_pkt_q[StartLsb +: 3 * PosW]};
+
+  gicube_sample #(
+    .VoxelW (VoxelW),
+    .Jitter (0)
+  ) u_sample (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (go),
+    .in_ready_o  (sm_in_ready),
+    .in_data_i   (sm_in),
+    .out_valid_o (sm_out_valid),
+    .out_ready_i (1'b1),
+    .out_data_o  (sm_out),
+    .cfg_valid_i (cfg_sample),
+    .cfg_addr_i  (cfg_addr_i[gicube_sample_pkg::CfgAddrW-1:0]),
+    .cfg_data_i  (cfg_data_i)
+  );
+
+  gicube_step #(
+    .BlockLog2 (BlockLog2),
+    .VolBlocks (VolBlocks),
+    .Step      (Step)
+  ) u_step (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (go),
+    .in_ready_o  (st_in_ready),
+    .in_data_i   (st_in),
+    .out_valid_o (st_out_valid),
+    .out_ready_i (1'b1),
+    .out_data_o  (st_out)
+  );
+
+  logic pop_head;
+  assign pop_head = issue && (lead_q == '0);
+
+  cube5_frame_fifo #(.Width(SideW), .Depth(FifoD)) u_side_fifo (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .clear_i (1'b0),
+    .push_i  (f_v_q),
+    .d_i     ({f_pkt_q, f_leap_q, f_ray_q}),
+    .pop_i   (pop_head),
+    .q_o     (sd_head),
+    .empty_o (sd_empty),
+    .full_o  (sd_full)
+  );
+
+  cube5_frame_fifo #(.Width(SmOutW), .Depth(FifoD)) u_sample_fifo (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .clear_i (1'b0),
+    .push_i  (sm_out_valid),
+    .d_i     (sm_out),
+    .pop_i   (pop_head && h_ray),
+    .q_o     (sm_head),
+    .empty_o (sm_empty),
+    .full_o  (sm_full)
+  );
+
+  cube5_frame_fifo #(.Width(TvW), .Depth(FifoD)) u_step_fifo (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .clear_i (1'b0),
+    .push_i  (st_out_valid),
+    .d_i     (st_out[KW +: TvW]),
+    .pop_i   (pop_head && h_ray),
+    .q_o     (tv_head),
+    .empty_o (tv_empty),
+    .full_o  (tv_full)
+  );
+
+  cube5_frame_fifo #(.Width(OutW), .Depth(2)) u_out_fifo (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .clear_i (1'b0),
+    .push_i  (of_push),
+    .d_i     (of_d),
+    .pop_i   (of_pop),
+    .q_o     (of_q),
+    .empty_o (of_empty),
+    .full_o  (of_full)
+  );
+
+  assign out_valid_o = !of_empty;
+  assign out_data_o  = of_q;
+
+  // The step's k and queue are not used (the front end re-buckets the ray); the FIFOs' full
+  // flags are covered by the assertions below (a record per cycle, RingLat cycles at most).
+  logic unused;
+  assign unused = ^{st_out[0 +: KW], st_out[KW + TvW +: QueueW], sd_full, sm_full, tv_full,
+                    of_full, sm_in_ready, st_in_ready, o_act_v, fe_out};
+
+`ifndef SYNTHESIS
+  // A stalled output holds its item (STYLE.md rule 3).
+  OutputHoldsWhileStalled: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      out_valid_o && !out_ready_i |=> out_valid_o && $stable(out_data_o))
+    else $error("gicube_processor: output changed while stalled");
+  // The units are never stalled: they take every ray of the ring.
+  UnitsTakeEveryRay: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      go |-> sm_in_ready && st_in_ready)
+    else $error("gicube_processor: a ring unit refused a ray");
+  // The ring holds RingLat records at most, so its FIFOs never overflow.
+  RingFifosNeverOverflow: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      !(f_v_q && sd_full) && !(sm_out_valid && sm_full) && !(st_out_valid && tv_full))
+    else $error("gicube_processor: a ring FIFO overflowed");
+  // The host's ray taken at dispatch was offered at the issue and held.
+  HostHeldUntilTaken: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      in_ready_o |-> in_valid_i)
+    else $error("gicube_processor: host ray taken while not offered");
+`endif
+
+endmodule
