@@ -17,7 +17,7 @@
 //! otherwise, when the shaded colour depends on the gradient, the in-plane neighbours come from
 //! the band's plane rows, `B = S'(s-1)` and `A = S'(s+1)` are interpolated on demand with slice
 //! `s`'s weights (a row of the block's anchors at a time), and the sample goes through the `N6`
-//! differences, `Shader::shade_lit_by_float_division` (the bits of [`super::shade_n6`]) and
+//! differences, `Shader::shade_lit_lanes` (the bits of [`super::shade_n6`], a row at a time) and
 //! `Compos::step`, the unit models' own functions; when it does not (MIP, or a
 //! uniform reflectance map), the shaded entry of its class index is the shader's own output for
 //! that index. Leading and trailing slices whose voxels are all 0 are left out when a zero sample
@@ -351,8 +351,6 @@ struct SliceWork<'a> {
     flat: Option<&'a [[u32; 4]]>,
     /// The compositing unit's rules of this slice, on lanes.
     rules: LaneRules,
-    /// `Compos::code` of each colour code (a channel's code on the coxel's scale).
-    colour_code: &'a [u32],
     /// `SampleW - ClassIdxW`: a sample's class index is `sample >> shift`.
     shift: u32,
     /// Per block of this slice: the largest corrected alpha its samples can have.
@@ -551,8 +549,7 @@ impl SliceWork<'_> {
         }
         if LIT && self.flat.is_none() {
             // The samples that change their coxel go through gradient and shader.
-            let changes = rules.changes::<N>(rays, lane, &sa);
-            if changes.iter().any(|&x| x) {
+            if rules.any_changes::<N>(rays, lane, &sa) {
                 if c > 0 {
                     self.ensure(band, b as isize, c - 1);
                 }
@@ -565,23 +562,35 @@ impl SliceWork<'_> {
                 let (mut before, mut after) = ([0u32; N], [0u32; N]);
                 self.other_row(self.k_before, a0, b, &mut before);
                 self.other_row(self.k_after, a0, b, &mut after);
-                let at = |rr: usize, aa: usize| band.rows[rr * ni + aa] as i32;
-                for n in (0..N).filter(|&n| changes[n]) {
-                    let a = a0 + n;
-                    let xm = if a > 0 { at(r, a - 1) } else { 0 };
-                    let xp = if a + 1 < ni { at(r, a + 1) } else { 0 };
-                    let ym = if b > 0 { at(r - 1, a) } else { 0 };
-                    let yp = if b + 1 < nj { at(r + 1, a) } else { 0 };
-                    // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
-                    // (`n6_components`, `shader_in`): the differences themselves. The magnitude
-                    // is not computed: the frame never classifies in 2-D.
-                    let grad = [xp - xm, yp - ym, after[n] as i32 - before[n] as i32];
-                    let e = units.shader.shade_lit_by_float_division(centre[n], grad);
-                    // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
-                    for (ch, v) in [e.r, e.g, e.b].into_iter().enumerate() {
-                        sc[ch][n] = self.colour_code[v as usize];
-                    }
-                }
+                // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
+                // (`n6_components`, `shader_in`): the differences themselves, 0 read past the
+                // faces. The magnitude is not computed: the frame never classifies in 2-D. Every
+                // lane is shaded; a sample that changes nothing has its colours not read.
+                let row = |rr: usize| &band.rows[rr * ni..(rr + 1) * ni];
+                let (mid, zeros) = (row(r), [0u32; N]);
+                let left = if a0 > 0 { mid[a0 - 1] } else { 0 };
+                let right = if a0 + N < ni { mid[a0 + N] } else { 0 };
+                let xm = |n: usize| if n == 0 { left } else { centre[n - 1] };
+                let xp = |n: usize| if n + 1 == N { right } else { centre[n + 1] };
+                let up = if b > 0 {
+                    &row(r - 1)[a0..a0 + N]
+                } else {
+                    &zeros
+                };
+                let down = if b + 1 < nj {
+                    &row(r + 1)[a0..a0 + N]
+                } else {
+                    &zeros
+                };
+                let diff = |p: u32, m: u32| p as i32 - m as i32;
+                let grad: [[i32; N]; 3] = [
+                    std::array::from_fn(|n| diff(xp(n), xm(n))),
+                    std::array::from_fn(|n| diff(down[n], up[n])),
+                    std::array::from_fn(|n| diff(after[n], before[n])),
+                ];
+                let rgb = units.shader.shade_lit_lanes(&centre, &grad);
+                // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
+                sc = rules.colour_codes(&rgb);
             }
         }
         let k = rules.step::<N>(rays, lane, &sa, &sc);
@@ -752,20 +761,6 @@ pub fn render_sweep(
             })
             .collect()
     });
-    // The compositing unit's code of each colour code, from `Compos::code` (it codes each
-    // channel alone).
-    let colours = units.compos.config().color_max().max(scfg.color_max());
-    let colour_code: Vec<u32> = (0..=colours)
-        .map(|c| {
-            let coded = units.compos.code(&Sample {
-                rgb: [c; 3],
-                alpha: 0,
-                depth: 0,
-                mode: cmode,
-            });
-            lanes::colours(&coded)[0]
-        })
-        .collect();
     // The corrected alphas in lanes (`<= 2^Q`).
     let corrected32: Vec<u32> = corrected.iter().map(|&a| a as u32).collect();
     let zero_ok = zero_alpha_is_identity(&units.compos, &init, cmode);
@@ -823,18 +818,21 @@ pub fn render_sweep(
             }
         }
     }
+    // The lanes code the shader's colours as the compositing unit's (`LaneRules::colour_codes`):
+    // one `ColorW` for both, as every frame configuration has it.
+    let same_colours = scfg.color_w == units.compos.config().color_w;
     let slices: Option<Vec<SliceWork>> = swept
         .clone()
         .zip(amax.chunks_exact(nb).zip(live.chunks_exact(nl)))
         .map(|(s, (amax, live))| {
             let c = params.slice(s);
+            same_colours.then_some(())?;
             Some(SliceWork {
                 units,
                 sv,
                 corrected: &corrected32,
                 flat: flat.as_deref(),
                 rules: LaneRules::new(&units.compos, cmode, s as u32)?,
-                colour_code: &colour_code,
                 shift,
                 amax,
                 live,
