@@ -600,16 +600,24 @@ impl SliceWork<'_> {
     }
 }
 
-/// Base-plane rows `q ..` (`rows`, `w` coxels each) through every swept slice in order: the
-/// anchor rows of each slice that feed them, as one band.
-#[inline(always)]
-fn sweep_band<const LIT: bool>(
-    slices: &[SliceWork],
+/// One band of the base plane: rows `q ..` (`rows`, `w` coxels each), and the plane rows that its
+/// anchor rows read.
+struct Band<'a> {
     q: usize,
-    rows: &mut [Coxel],
+    rows: &'a mut [Coxel],
     w: usize,
-    band: &mut BandRows,
-) -> SweepStats {
+    plane: BandRows,
+}
+
+/// A band through every swept slice in order: the anchor rows of each slice that feed it.
+#[inline(always)]
+fn sweep_band<const LIT: bool>(slices: &[SliceWork], band: Band) -> SweepStats {
+    let Band {
+        q,
+        rows,
+        w,
+        plane: mut band,
+    } = band;
     let mut st = SweepStats::default();
     let n_rows = rows.len() / w;
     let init = rows[0];
@@ -633,7 +641,7 @@ fn sweep_band<const LIT: bool>(
             continue;
         }
         let at = b0 + work.q0 - q;
-        st = st.add(work.band::<LIT>(b0, &mut rays, at * w, (b1 - b0, w), band));
+        st = st.add(work.band::<LIT>(b0, &mut rays, at * w, (b1 - b0, w), &mut band));
     }
     rays.write(&init, rows);
     st
@@ -647,39 +655,24 @@ fn sweep_band<const LIT: bool>(
 /// The CPU must have AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn sweep_band_avx2<const LIT: bool>(
-    slices: &[SliceWork],
-    q: usize,
-    rows: &mut [Coxel],
-    w: usize,
-    band: &mut BandRows,
-) -> SweepStats {
-    sweep_band::<LIT>(slices, q, rows, w, band)
+unsafe fn sweep_band_avx2<const LIT: bool>(slices: &[SliceWork], band: Band) -> SweepStats {
+    sweep_band::<LIT>(slices, band)
 }
 
 /// [`sweep_band`], in AVX2 where the CPU has it.
-fn sweep_band_dispatch<const LIT: bool>(
-    slices: &[SliceWork],
-    q: usize,
-    rows: &mut [Coxel],
-    w: usize,
-    band: &mut BandRows,
-) -> SweepStats {
+fn sweep_band_dispatch<const LIT: bool>(slices: &[SliceWork], band: Band) -> SweepStats {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (detected just above), `sweep_band_avx2`'s one requirement.
-        return unsafe { sweep_band_avx2::<LIT>(slices, q, rows, w, band) };
+        return unsafe { sweep_band_avx2::<LIT>(slices, band) };
     }
-    sweep_band::<LIT>(slices, q, rows, w, band)
+    sweep_band::<LIT>(slices, band)
 }
 
-/// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md): the
-/// fast path, equal to [`render_base_plane_reference`] coxel for coxel.
-pub fn render_base_plane(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
-    render_base_plane_stats(params, vol, units).0
-}
-
-/// [`render_base_plane`] with the counts of what its sweep computed and skipped.
+/// The base-plane image of a frame and the counts of what its sweep computed and skipped,
+/// bit-exact with `cube5_frame` (docs/numerics/frame.md): the fast path, equal to
+/// [`render_base_plane_reference`] coxel for coxel (`super::render_base_plane_stats` of a frame
+/// the fast path covers).
 pub fn render_base_plane_stats(
     params: &FrameParams,
     vol: &Volume,
@@ -862,12 +855,16 @@ pub fn render_sweep(
         .par_chunks_mut(BAND * w)
         .enumerate()
         .map(|(n, rows)| {
-            let mut band = BandRows::new(ni);
-            let q = n * BAND;
+            let band = Band {
+                q: n * BAND,
+                rows,
+                w,
+                plane: BandRows::new(ni),
+            };
             if lit {
-                sweep_band_dispatch::<true>(&slices, q, rows, w, &mut band)
+                sweep_band_dispatch::<true>(&slices, band)
             } else {
-                sweep_band_dispatch::<false>(&slices, q, rows, w, &mut band)
+                sweep_band_dispatch::<false>(&slices, band)
             }
         })
         .reduce(SweepStats::default, SweepStats::add);
@@ -895,8 +892,21 @@ mod tests {
     use glam::DVec3;
     use rand::{Rng, SeedableRng};
 
+    /// The compositing unit's registers with early termination at the default threshold, off,
+    /// and at threshold 0 (a sample ends every ray it meets).
+    pub(super) fn thresholds(cfg: &crate::units::cube5_compos::ComposConfig) -> [ComposRegs; 3] {
+        [
+            ComposRegs::defaults(cfg),
+            ComposRegs::without_termination(cfg),
+            ComposRegs {
+                et_threshold: 0,
+                ..ComposRegs::defaults(cfg)
+            },
+        ]
+    }
+
     /// The seed of the random views: `CUBE5_SEED` or a fixed default, printed on failure.
-    fn seed() -> u64 {
+    pub(super) fn seed() -> u64 {
         std::env::var("CUBE5_SEED")
             .ok()
             .and_then(|s| s.parse().ok())
@@ -1185,14 +1195,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 3);
         let cfg = ComposConfig::DEFAULT;
         let one = cfg.one();
-        for regs in [
-            ComposRegs::defaults(&cfg),
-            ComposRegs::without_termination(&cfg),
-            ComposRegs {
-                et_threshold: 0,
-                ..ComposRegs::defaults(&cfg)
-            },
-        ] {
+        for regs in thresholds(&cfg) {
             let c = Compos::new(cfg, OpacityLut::new(1.0, &cfg).unwrap(), regs).unwrap();
             for _ in 0..50_000 {
                 let coxel = Coxel {
@@ -1415,6 +1418,6 @@ mod tests {
         )
         .unwrap();
         let want = render_base_plane_reference(&setup.params, &vol, &units);
-        assert!(render_base_plane(&setup.params, &vol, &units) == want);
+        assert!(super::super::render_base_plane(&setup.params, &vol, &units) == want);
     }
 }

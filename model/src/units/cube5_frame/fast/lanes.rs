@@ -282,16 +282,10 @@ pub(super) fn colours(s: &CodedSample) -> [u32; 3] {
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::{seed, thresholds};
     use super::*;
     use crate::units::cube5_compos::{ComposConfig, ComposRegs, OpacityLut, Sample};
     use rand::{Rng, SeedableRng};
-
-    fn seed() -> u64 {
-        std::env::var("CUBE5_SEED")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(1313)
-    }
 
     /// The lanes' colour codes are `Compos::code`'s, every colour of the narrow, default and wide
     /// widths and of `ColorW` 12 on `AccW` 12 (rounded) and 28 (shifted).
@@ -337,14 +331,7 @@ mod tests {
             ComposConfig::new(12, 12, 6, 28, 16).unwrap(),
         ] {
             let one = cfg.one();
-            for regs in [
-                ComposRegs::defaults(&cfg),
-                ComposRegs::without_termination(&cfg),
-                ComposRegs {
-                    et_threshold: 0,
-                    ..ComposRegs::defaults(&cfg)
-                },
-            ] {
+            for regs in thresholds(&cfg) {
                 let ratio = rng.random_range(0.3..3.0);
                 let c = Compos::new(cfg, OpacityLut::new(ratio, &cfg).unwrap(), regs).unwrap();
                 let init = Coxel::empty(&cfg);
