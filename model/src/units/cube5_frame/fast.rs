@@ -64,6 +64,7 @@ impl SweepStats {
         self.without_effect += o.without_effect;
         self.after_termination += o.after_termination;
         self.in_skipped_blocks += o.in_skipped_blocks;
+        self.rays_terminated += o.rays_terminated;
         self
     }
 }
@@ -644,6 +645,7 @@ fn sweep_band<const LIT: bool>(slices: &[SliceWork], band: Band) -> SweepStats {
         st = st.add(work.band::<LIT>(b0, &mut rays, at * w, (b1 - b0, w), &mut band));
     }
     rays.write(&init, rows);
+    st.rays_terminated = rays.term.iter().filter(|&&t| t != 0).count() as u64;
     st
 }
 
@@ -869,7 +871,6 @@ pub fn render_sweep(
         })
         .reduce(SweepStats::default, SweepStats::add);
     stats = stats.add(part);
-    stats.rays_terminated = coxels.iter().filter(|c| c.terminated).count() as u64;
     (
         BasePlane {
             width: w,
@@ -1038,7 +1039,6 @@ mod tests {
                 let st = check_one(what, vol, cfg, tf, early_termination, (*v, p, mode));
                 total = total.add(st);
                 total.slices_skipped.0 += st.slices_skipped.0 + st.slices_skipped.1;
-                total.rays_terminated += st.rays_terminated;
             }
         }
         total
@@ -1095,7 +1095,6 @@ mod tests {
                         (*v, p, FrameMode::Composite),
                     );
                     st = st.add(one);
-                    st.rays_terminated += one.rays_terminated;
                 }
             }
             assert!(
