@@ -24,7 +24,6 @@ use rayon::prelude::*;
 
 mod fast;
 pub use fast::{
-    render_base_plane as render_base_plane_fast,
     render_base_plane_stats as render_base_plane_stats_fast, render_sweep, SweepStats, SweepVolume,
 };
 pub mod sections;

@@ -605,6 +605,14 @@ fn major_axis(g: [i64; 3]) -> Option<(usize, bool, usize, usize)> {
     Some((axis, g[axis] < 0, (axis + 1) % 3, (axis + 2) % 3))
 }
 
+/// `floor(x)` of `0 <= x < 2^32`, in operations the compiler takes in vector lanes (Rust's `as`
+/// conversion saturates, which it does lane by lane): `floor(x) + 2^52` is exact in f64 (its unit
+/// in the last place is 1), and the low 32 bits of its representation are `floor(x)`.
+#[inline(always)]
+fn floor_to_u32(x: f64) -> u32 {
+    (x.floor() + (1u64 << 52) as f64).to_bits() as u32
+}
+
 /// `rnd(x, s)`: round half up of `x / 2^s`.
 #[inline]
 fn rnd(x: u64, s: u32) -> u64 {
@@ -784,73 +792,136 @@ impl Shader {
         }
     }
 
-    /// [`Shader::intensity`], the same bits, with each face coordinate's quotient
-    /// `floor(n / d)` (`n = num 2^(p+1) + m`, `d = 2m`) taken as the floor of the f64 quotient,
-    /// which costs a fraction of a u64 division (the frame's sweep divides twice per shaded
-    /// sample). Exact: `n <= 2^(GradW + RmLog2 + RmFracW + 1) <= 2^42` and `d` are exact in f64;
-    /// the division is correctly rounded, so an integer quotient comes out exact, and an inexact
-    /// one lies at least `1/d >= 2^-GradW` below the next integer while its rounding error is at
-    /// most `(n/d) 2^-53 <= 2^(RmLog2 + RmFracW - 53)`: the floor never moves up.
+    /// [`Shader::shade`] of `N` lit items without 2-D classification at once (item `n`: sample
+    /// `sample[n]`, gradient `(grad[0][n], grad[1][n], grad[2][n])`), their colours `[r, g, b]`
+    /// as lanes; alpha is the class entry's (illumination keeps it). The same bits as `shade`,
+    /// written without a data-dependent branch, in 32-bit lanes where the widths allow, so that
+    /// the compiler takes the lanes together (the frame's sweep shades a row of anchors at once).
+    ///
+    /// Why each step is `shade`'s:
+    /// - The major axis, its sign and the minor axes are `major_axis`'s, the ties as there.
+    /// - A face coordinate's quotient `floor(n / d)` (`n = num 2^(p+1) + m`, `d = 2m`) is the
+    ///   floor of the f64 quotient: `num <= 2m < 2^GradW <= 2^26` and `2^(p+1) <= 2^15` are exact
+    ///   in f64, so is their product and `n < 2^42`; the division is correctly rounded, so an
+    ///   integer quotient comes out exact, and an inexact one lies at least `1/d >= 2^-GradW`
+    ///   below the next integer while its rounding error is at most `(n/d) 2^-53 <= 2^(p+1-53)`:
+    ///   truncating it never moves up. The quotient is at most `2^(p+1) <= 2^15`.
+    /// - `q = top` gives the last cell and the weight `2^RmFracW`: `top >> RmFracW` is one past the
+    ///   last cell and `top & (2^RmFracW - 1)` is 0, so subtracting and adding the flag gives both.
+    /// - The zero gradient (`m = 0`) divides by 1 instead (the lane's quotient is not used) and
+    ///   reads the zero-gradient texel at all four corners: the weights sum to `2^(2 RmFracW)`,
+    ///   so the rounded sum is that texel.
+    /// - The bilinear sums fit 32 bits: the four weights sum to `2^(2 RmFracW) <= 2^16` and a
+    ///   texel field is below `2^12`.
+    /// - Illumination (`lit`) in 64 bits: `c d 2^SpecW` and `sp 2^(ColorW + DiffW - 1)` reach
+    ///   `2^36`; the rounding shift `DiffW - 1 + SpecW` is at least 2.
     #[inline(always)]
-    pub fn intensity_by_float_division(&self, grad: [i32; 3]) -> Texel {
+    pub fn shade_lit_lanes<const N: usize>(
+        &self,
+        sample: &[u32; N],
+        grad: &[[i32; N]; 3],
+    ) -> [[u32; N]; 3] {
         let c = &self.cfg;
-        let g = grad.map(i64::from);
-        let Some((axis, negative, u, v)) = major_axis(g) else {
-            return self.tables.rmap.zero;
-        };
-        let m = g[axis].unsigned_abs();
-        let p = c.rm_log2 + c.rm_frac_w - 1;
-        let top = 1u64 << (c.rm_log2 + c.rm_frac_w);
-        // Through i64: the conversions between i64 and f64 are single instructions, those of u64
-        // are not (below 2^53 all are exact).
-        let d = (2 * m) as i64 as f64;
-        let cell_weight = |minor: usize| {
-            let num = (g[minor] + m as i64) as u64; // in [0, 2m]
-            let n = (num << (p + 1)) + m;
-            debug_assert!(n < 1 << 53);
-            // Truncation is the floor: the quotient is >= 0.
-            let q = (n as i64 as f64 / d) as i64 as u64;
-            if q == top {
-                ((1usize << c.rm_log2) - 1, 1u64 << c.rm_frac_w)
-            } else {
-                ((q >> c.rm_frac_w) as usize, q & ((1 << c.rm_frac_w) - 1))
-            }
-        };
-        let ((i0, eu), (j0, ev)) = (cell_weight(u), cell_weight(v));
-        let face = 2 * axis + usize::from(negative);
-        let f = c.rm_frac_w;
-        let one = 1u64 << f;
         let rm = &self.tables.rmap;
-        let t = [
-            rm.texel(face, i0, j0),
-            rm.texel(face, i0 + 1, j0),
-            rm.texel(face, i0, j0 + 1),
-            rm.texel(face, i0 + 1, j0 + 1),
-        ];
-        let w = [
-            (one - eu) * (one - ev),
-            eu * (one - ev),
-            (one - eu) * ev,
-            eu * ev,
-        ];
-        let (mut dsum, mut spsum) = (0u64, 0u64);
-        for (t, w) in t.iter().zip(w) {
-            dsum += u64::from(t.d) * w;
-            spsum += u64::from(t.sp) * w;
+        let f = c.rm_frac_w;
+        let p1 = c.rm_log2 + f;
+        let scale = f64::from(1u32 << p1);
+        let frac_mask = (1u32 << f) - 1;
+        let side = rm.side as u32;
+        // Per lane: the texel of the cell's corner `(i0, j0)`, the weights `eu`, `ev`, and whether
+        // the gradient is zero.
+        let mut at = [0u32; N];
+        let mut eu = [0u32; N];
+        let mut ev = [0u32; N];
+        let mut zero = [false; N];
+        for n in 0..N {
+            let g = [grad[0][n], grad[1][n], grad[2][n]];
+            let a = g.map(i32::unsigned_abs);
+            let x_major = a[0] >= a[1] && a[0] >= a[2];
+            let y_major = !x_major && a[1] >= a[2];
+            let (axis, major, gu, gv) = if x_major {
+                (0, g[0], g[1], g[2])
+            } else if y_major {
+                (1, g[1], g[2], g[0])
+            } else {
+                (2, g[2], g[0], g[1])
+            };
+            let m = major.unsigned_abs();
+            zero[n] = m == 0;
+            let d = f64::from(2 * m.max(1));
+            // `num = g_minor + m` in `[0, 2m]`; the cell and the weight of its quotient.
+            let cell_weight = |minor: i32| {
+                let num = f64::from(minor + m as i32);
+                let q = floor_to_u32((num * scale + f64::from(m as i32)) / d);
+                let is_top = u32::from(q == 1 << p1);
+                ((q >> f) - is_top, (q & frac_mask) + (is_top << f))
+            };
+            let ((i0, wu), (j0, wv)) = (cell_weight(gu), cell_weight(gv));
+            let face = 2 * axis + u32::from(major < 0);
+            at[n] = (face * side + j0) * side + i0;
+            (eu[n], ev[n]) = (wu, wv);
         }
-        Texel {
-            d: rnd(dsum, 2 * f) as u32,
-            sp: rnd(spsum, 2 * f) as u32,
+        // The four texels of each lane's cell and its class entry's colours, gathered (loads,
+        // lane by lane), then the arithmetic on whole lanes.
+        let s = side as usize;
+        let corner = [0, 1, s, s + 1];
+        let mut td = [[0u32; N]; 4];
+        let mut tsp = [[0u32; N]; 4];
+        let mut colour = [[0u32; N]; 3];
+        let class = &self.tables.class.entries;
+        let shift = c.sample_w() - c.class_idx_w;
+        for n in 0..N {
+            for (k, off) in corner.iter().enumerate() {
+                let t = if zero[n] {
+                    rm.zero
+                } else {
+                    rm.texels[at[n] as usize + off]
+                };
+                (td[k][n], tsp[k][n]) = (t.d, t.sp);
+            }
+            let e = class[(sample[n] >> shift) as usize];
+            [colour[0][n], colour[1][n], colour[2][n]] = [e.r, e.g, e.b];
         }
-    }
-
-    /// [`Shader::shade`] of a lit item without 2-D classification, its intensity by
-    /// [`Shader::intensity_by_float_division`] (the same bits).
-    #[inline(always)]
-    pub fn shade_lit_by_float_division(&self, sample: u32, grad: [i32; 3]) -> Rgba {
-        let c = &self.cfg;
-        let e = self.tables.class.entries[(sample >> (c.sample_w() - c.class_idx_w)) as usize];
-        self.lit(e, self.intensity_by_float_division(grad))
+        let one = 1u32 << f;
+        let half = 1u32 << (2 * f - 1);
+        let (mut d, mut sp) = ([0u32; N], [0u32; N]);
+        for n in 0..N {
+            let (eu, ev) = (eu[n], ev[n]);
+            let w = [
+                (one - eu) * (one - ev),
+                eu * (one - ev),
+                (one - eu) * ev,
+                eu * ev,
+            ];
+            let (mut dsum, mut spsum) = (0u32, 0u32);
+            for k in 0..4 {
+                dsum += td[k][n] * w[k];
+                spsum += tsp[k][n] * w[k];
+            }
+            (d[n], sp[n]) = ((dsum + half) >> (2 * f), (spsum + half) >> (2 * f));
+        }
+        let (cw, dw, sw) = (c.color_w, c.diff_w, c.spec_w);
+        let (lit_half, lit_shift) = (1u64 << (dw + sw - 2), dw - 1 + sw);
+        let mut rgb = [[0u32; N]; 3];
+        if cw + dw + sw < 32 {
+            // `c d 2^SpecW + sp 2^(ColorW + DiffW - 1) < 2^(ColorW + DiffW + SpecW + 1)`: 32 bits.
+            for ch in 0..3 {
+                for n in 0..N {
+                    let sum = ((colour[ch][n] * d[n]) << sw) + (sp[n] << (cw + dw - 1));
+                    rgb[ch][n] = ((sum + lit_half as u32) >> lit_shift).min(c.color_max());
+                }
+            }
+        } else {
+            for ch in 0..3 {
+                for n in 0..N {
+                    let specular = u64::from(sp[n]) << (cw + dw - 1);
+                    let sum = (u64::from(colour[ch][n] * d[n]) << sw) + specular;
+                    let out = ((sum + lit_half) >> lit_shift).min(u64::from(c.color_max()));
+                    rgb[ch][n] = out as u32;
+                }
+            }
+        }
+        rgb
     }
 
     /// The classified entry `e` lit by the intensities `t`: `c d + sp` per channel, rounded and
@@ -1121,12 +1192,13 @@ mod tests {
         assert_eq!(s.class_index(&item(0xabcd, cfg.mag_max(), true)), 0xabf);
     }
 
-    /// `shade_lit_by_float_division` (the frame's sweep) is `shade` of a lit item bit for bit:
-    /// random tables, gradients over the full range, small ones, near-ties and the extremes, at
-    /// the narrow, default and widest widths (`VoxelW` 16, `FracW` 8, `RmLog2` 7, `RmFracW` 8:
-    /// the largest dividends).
+    /// `shade_lit_lanes` (the frame's sweep) is `shade` of a lit item bit for bit, eight lanes at
+    /// once and one: random tables, gradients over the full range, small ones, near-ties and the
+    /// extremes (every combination of the smallest, -1, 0, 1 and the largest component), at the
+    /// narrow, default and widest widths (`VoxelW` 16, `FracW` 8, `RmLog2` 7, `RmFracW` 8: the
+    /// largest dividends), and the widest texels and colours (`DiffW`, `SpecW`, `ColorW` 12).
     #[test]
-    fn shading_by_float_division_is_shade() {
+    fn shading_in_lanes_is_shade() {
         let widest = ShaderConfig {
             voxel_w: 16,
             frac_w: 8,
@@ -1136,8 +1208,38 @@ mod tests {
             ..ShaderConfig::DEFAULT
         };
         let mut rng = ChaCha8Rng::seed_from_u64(21);
-        for cfg in [ShaderConfig::NARROW, ShaderConfig::DEFAULT, widest] {
-            let s = Shader::new(cfg, ShaderTables::random(&cfg, &mut rng).unwrap()).unwrap();
+        let widest_texels = ShaderConfig {
+            color_w: 12,
+            diff_w: 12,
+            spec_w: 12,
+            ..widest
+        };
+        for cfg in [
+            ShaderConfig::NARROW,
+            ShaderConfig::DEFAULT,
+            widest,
+            widest_texels,
+        ] {
+            // Random tables, and every entry and texel at its largest (the widest sums).
+            let (c, t) = (
+                cfg.color_max(),
+                Texel {
+                    d: cfg.diff_max(),
+                    sp: cfg.spec_max(),
+                },
+            );
+            let full = ShaderTables {
+                class: ClassLut::from_fn(&cfg, |_| Rgba {
+                    r: c,
+                    g: c,
+                    b: c,
+                    a: cfg.alpha_max(),
+                })
+                .unwrap(),
+                rmap: ReflectanceMap::from_fn(&cfg, |_, _, _| t, t).unwrap(),
+            };
+            let shaders = [ShaderTables::random(&cfg, &mut rng).unwrap(), full]
+                .map(|tables| Shader::new(cfg, tables).unwrap());
             let lit = ShaderMode {
                 tf2d: false,
                 unlit: false,
@@ -1167,24 +1269,28 @@ mod tests {
                 }
                 grads.push(g);
             }
-            for g in grads {
-                let sample = rng.random_range(0..=cfg.sample_max());
-                let item = ShaderIn {
-                    sample,
-                    grad: g,
-                    mag: 0,
-                    mode: lit,
-                };
-                assert_eq!(
-                    s.intensity_by_float_division(g),
-                    s.intensity(g),
-                    "{cfg:?} {g:?}"
-                );
-                assert_eq!(
-                    s.shade_lit_by_float_division(sample, g),
-                    s.shade(&item),
-                    "{cfg:?} {g:?}"
-                );
+            const N: usize = 8;
+            for lanes in grads.chunks(N) {
+                let g: [[i32; 3]; N] = std::array::from_fn(|n| lanes[n % lanes.len()]);
+                let sample: [u32; N] =
+                    std::array::from_fn(|_| rng.random_range(0..=cfg.sample_max()));
+                let grad: [[i32; N]; 3] = std::array::from_fn(|k| g.map(|g| g[k]));
+                for s in &shaders {
+                    let got = s.shade_lit_lanes(&sample, &grad);
+                    for n in 0..N {
+                        let want = s.shade(&ShaderIn {
+                            sample: sample[n],
+                            grad: g[n],
+                            mag: 0,
+                            mode: lit,
+                        });
+                        let one = s.shade_lit_lanes(&[sample[n]], &grad.map(|c| [c[n]]));
+                        for (ch, w) in [want.r, want.g, want.b].into_iter().enumerate() {
+                            assert_eq!(got[ch][n], w, "{cfg:?} {:?} lane {n}", g[n]);
+                            assert_eq!(one[ch][0], w, "{cfg:?} {:?}", g[n]);
+                        }
+                    }
+                }
             }
         }
     }

@@ -17,7 +17,7 @@
 //! otherwise, when the shaded colour depends on the gradient, the in-plane neighbours come from
 //! the band's plane rows, `B = S'(s-1)` and `A = S'(s+1)` are interpolated on demand with slice
 //! `s`'s weights (a row of the block's anchors at a time), and the sample goes through the `N6`
-//! differences, `Shader::shade_lit_by_float_division` (the bits of [`super::shade_n6`]) and
+//! differences, `Shader::shade_lit_lanes` (the bits of [`super::shade_n6`], a row at a time) and
 //! `Compos::step`, the unit models' own functions; when it does not (MIP, or a
 //! uniform reflectance map), the shaded entry of its class index is the shader's own output for
 //! that index. Leading and trailing slices whose voxels are all 0 are left out when a zero sample
@@ -64,6 +64,7 @@ impl SweepStats {
         self.without_effect += o.without_effect;
         self.after_termination += o.after_termination;
         self.in_skipped_blocks += o.in_skipped_blocks;
+        self.rays_terminated += o.rays_terminated;
         self
     }
 }
@@ -351,8 +352,6 @@ struct SliceWork<'a> {
     flat: Option<&'a [[u32; 4]]>,
     /// The compositing unit's rules of this slice, on lanes.
     rules: LaneRules,
-    /// `Compos::code` of each colour code (a channel's code on the coxel's scale).
-    colour_code: &'a [u32],
     /// `SampleW - ClassIdxW`: a sample's class index is `sample >> shift`.
     shift: u32,
     /// Per block of this slice: the largest corrected alpha its samples can have.
@@ -551,8 +550,7 @@ impl SliceWork<'_> {
         }
         if LIT && self.flat.is_none() {
             // The samples that change their coxel go through gradient and shader.
-            let changes = rules.changes::<N>(rays, lane, &sa);
-            if changes.iter().any(|&x| x) {
+            if rules.any_changes::<N>(rays, lane, &sa) {
                 if c > 0 {
                     self.ensure(band, b as isize, c - 1);
                 }
@@ -565,23 +563,35 @@ impl SliceWork<'_> {
                 let (mut before, mut after) = ([0u32; N], [0u32; N]);
                 self.other_row(self.k_before, a0, b, &mut before);
                 self.other_row(self.k_after, a0, b, &mut after);
-                let at = |rr: usize, aa: usize| band.rows[rr * ni + aa] as i32;
-                for n in (0..N).filter(|&n| changes[n]) {
-                    let a = a0 + n;
-                    let xm = if a > 0 { at(r, a - 1) } else { 0 };
-                    let xp = if a + 1 < ni { at(r, a + 1) } else { 0 };
-                    let ym = if b > 0 { at(r - 1, a) } else { 0 };
-                    let yp = if b + 1 < nj { at(r + 1, a) } else { 0 };
-                    // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
-                    // (`n6_components`, `shader_in`): the differences themselves. The magnitude
-                    // is not computed: the frame never classifies in 2-D.
-                    let grad = [xp - xm, yp - ym, after[n] as i32 - before[n] as i32];
-                    let e = units.shader.shade_lit_by_float_division(centre[n], grad);
-                    // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
-                    for (ch, v) in [e.r, e.g, e.b].into_iter().enumerate() {
-                        sc[ch][n] = self.colour_code[v as usize];
-                    }
-                }
+                // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
+                // (`n6_components`, `shader_in`): the differences themselves, 0 read past the
+                // faces. The magnitude is not computed: the frame never classifies in 2-D. Every
+                // lane is shaded; a sample that changes nothing has its colours not read.
+                let row = |rr: usize| &band.rows[rr * ni..(rr + 1) * ni];
+                let (mid, zeros) = (row(r), [0u32; N]);
+                let left = if a0 > 0 { mid[a0 - 1] } else { 0 };
+                let right = if a0 + N < ni { mid[a0 + N] } else { 0 };
+                let xm = |n: usize| if n == 0 { left } else { centre[n - 1] };
+                let xp = |n: usize| if n + 1 == N { right } else { centre[n + 1] };
+                let up = if b > 0 {
+                    &row(r - 1)[a0..a0 + N]
+                } else {
+                    &zeros
+                };
+                let down = if b + 1 < nj {
+                    &row(r + 1)[a0..a0 + N]
+                } else {
+                    &zeros
+                };
+                let diff = |p: u32, m: u32| p as i32 - m as i32;
+                let grad: [[i32; N]; 3] = [
+                    std::array::from_fn(|n| diff(xp(n), xm(n))),
+                    std::array::from_fn(|n| diff(down[n], up[n])),
+                    std::array::from_fn(|n| diff(after[n], before[n])),
+                ];
+                let rgb = units.shader.shade_lit_lanes(&centre, &grad);
+                // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
+                sc = rules.colour_codes(&rgb);
             }
         }
         let k = rules.step::<N>(rays, lane, &sa, &sc);
@@ -591,16 +601,24 @@ impl SliceWork<'_> {
     }
 }
 
-/// Base-plane rows `q ..` (`rows`, `w` coxels each) through every swept slice in order: the
-/// anchor rows of each slice that feed them, as one band.
-#[inline(always)]
-fn sweep_band<const LIT: bool>(
-    slices: &[SliceWork],
+/// One band of the base plane: rows `q ..` (`rows`, `w` coxels each), and the plane rows that its
+/// anchor rows read.
+struct Band<'a> {
     q: usize,
-    rows: &mut [Coxel],
+    rows: &'a mut [Coxel],
     w: usize,
-    band: &mut BandRows,
-) -> SweepStats {
+    plane: BandRows,
+}
+
+/// A band through every swept slice in order: the anchor rows of each slice that feed it.
+#[inline(always)]
+fn sweep_band<const LIT: bool>(slices: &[SliceWork], band: Band) -> SweepStats {
+    let Band {
+        q,
+        rows,
+        w,
+        plane: mut band,
+    } = band;
     let mut st = SweepStats::default();
     let n_rows = rows.len() / w;
     let init = rows[0];
@@ -624,9 +642,10 @@ fn sweep_band<const LIT: bool>(
             continue;
         }
         let at = b0 + work.q0 - q;
-        st = st.add(work.band::<LIT>(b0, &mut rays, at * w, (b1 - b0, w), band));
+        st = st.add(work.band::<LIT>(b0, &mut rays, at * w, (b1 - b0, w), &mut band));
     }
     rays.write(&init, rows);
+    st.rays_terminated = rays.term.iter().filter(|&&t| t != 0).count() as u64;
     st
 }
 
@@ -638,39 +657,24 @@ fn sweep_band<const LIT: bool>(
 /// The CPU must have AVX2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn sweep_band_avx2<const LIT: bool>(
-    slices: &[SliceWork],
-    q: usize,
-    rows: &mut [Coxel],
-    w: usize,
-    band: &mut BandRows,
-) -> SweepStats {
-    sweep_band::<LIT>(slices, q, rows, w, band)
+unsafe fn sweep_band_avx2<const LIT: bool>(slices: &[SliceWork], band: Band) -> SweepStats {
+    sweep_band::<LIT>(slices, band)
 }
 
 /// [`sweep_band`], in AVX2 where the CPU has it.
-fn sweep_band_dispatch<const LIT: bool>(
-    slices: &[SliceWork],
-    q: usize,
-    rows: &mut [Coxel],
-    w: usize,
-    band: &mut BandRows,
-) -> SweepStats {
+fn sweep_band_dispatch<const LIT: bool>(slices: &[SliceWork], band: Band) -> SweepStats {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (detected just above), `sweep_band_avx2`'s one requirement.
-        return unsafe { sweep_band_avx2::<LIT>(slices, q, rows, w, band) };
+        return unsafe { sweep_band_avx2::<LIT>(slices, band) };
     }
-    sweep_band::<LIT>(slices, q, rows, w, band)
+    sweep_band::<LIT>(slices, band)
 }
 
-/// The base-plane image of a frame, bit-exact with `cube5_frame` (docs/numerics/frame.md): the
-/// fast path, equal to [`render_base_plane_reference`] coxel for coxel.
-pub fn render_base_plane(params: &FrameParams, vol: &Volume, units: &FrameUnits) -> BasePlane {
-    render_base_plane_stats(params, vol, units).0
-}
-
-/// [`render_base_plane`] with the counts of what its sweep computed and skipped.
+/// The base-plane image of a frame and the counts of what its sweep computed and skipped,
+/// bit-exact with `cube5_frame` (docs/numerics/frame.md): the fast path, equal to
+/// [`render_base_plane_reference`] coxel for coxel (`super::render_base_plane_stats` of a frame
+/// the fast path covers).
 pub fn render_base_plane_stats(
     params: &FrameParams,
     vol: &Volume,
@@ -752,20 +756,6 @@ pub fn render_sweep(
             })
             .collect()
     });
-    // The compositing unit's code of each colour code, from `Compos::code` (it codes each
-    // channel alone).
-    let colours = units.compos.config().color_max().max(scfg.color_max());
-    let colour_code: Vec<u32> = (0..=colours)
-        .map(|c| {
-            let coded = units.compos.code(&Sample {
-                rgb: [c; 3],
-                alpha: 0,
-                depth: 0,
-                mode: cmode,
-            });
-            lanes::colours(&coded)[0]
-        })
-        .collect();
     // The corrected alphas in lanes (`<= 2^Q`).
     let corrected32: Vec<u32> = corrected.iter().map(|&a| a as u32).collect();
     let zero_ok = zero_alpha_is_identity(&units.compos, &init, cmode);
@@ -823,18 +813,21 @@ pub fn render_sweep(
             }
         }
     }
+    // The lanes code the shader's colours as the compositing unit's (`LaneRules::colour_codes`):
+    // one `ColorW` for both, as every frame configuration has it.
+    let same_colours = scfg.color_w == units.compos.config().color_w;
     let slices: Option<Vec<SliceWork>> = swept
         .clone()
         .zip(amax.chunks_exact(nb).zip(live.chunks_exact(nl)))
         .map(|(s, (amax, live))| {
             let c = params.slice(s);
+            same_colours.then_some(())?;
             Some(SliceWork {
                 units,
                 sv,
                 corrected: &corrected32,
                 flat: flat.as_deref(),
                 rules: LaneRules::new(&units.compos, cmode, s as u32)?,
-                colour_code: &colour_code,
                 shift,
                 amax,
                 live,
@@ -864,17 +857,20 @@ pub fn render_sweep(
         .par_chunks_mut(BAND * w)
         .enumerate()
         .map(|(n, rows)| {
-            let mut band = BandRows::new(ni);
-            let q = n * BAND;
+            let band = Band {
+                q: n * BAND,
+                rows,
+                w,
+                plane: BandRows::new(ni),
+            };
             if lit {
-                sweep_band_dispatch::<true>(&slices, q, rows, w, &mut band)
+                sweep_band_dispatch::<true>(&slices, band)
             } else {
-                sweep_band_dispatch::<false>(&slices, q, rows, w, &mut band)
+                sweep_band_dispatch::<false>(&slices, band)
             }
         })
         .reduce(SweepStats::default, SweepStats::add);
     stats = stats.add(part);
-    stats.rays_terminated = coxels.iter().filter(|c| c.terminated).count() as u64;
     (
         BasePlane {
             width: w,
@@ -897,8 +893,21 @@ mod tests {
     use glam::DVec3;
     use rand::{Rng, SeedableRng};
 
+    /// The compositing unit's registers with early termination at the default threshold, off,
+    /// and at threshold 0 (a sample ends every ray it meets).
+    pub(super) fn thresholds(cfg: &crate::units::cube5_compos::ComposConfig) -> [ComposRegs; 3] {
+        [
+            ComposRegs::defaults(cfg),
+            ComposRegs::without_termination(cfg),
+            ComposRegs {
+                et_threshold: 0,
+                ..ComposRegs::defaults(cfg)
+            },
+        ]
+    }
+
     /// The seed of the random views: `CUBE5_SEED` or a fixed default, printed on failure.
-    fn seed() -> u64 {
+    pub(super) fn seed() -> u64 {
         std::env::var("CUBE5_SEED")
             .ok()
             .and_then(|s| s.parse().ok())
@@ -1030,7 +1039,6 @@ mod tests {
                 let st = check_one(what, vol, cfg, tf, early_termination, (*v, p, mode));
                 total = total.add(st);
                 total.slices_skipped.0 += st.slices_skipped.0 + st.slices_skipped.1;
-                total.rays_terminated += st.rays_terminated;
             }
         }
         total
@@ -1087,7 +1095,6 @@ mod tests {
                         (*v, p, FrameMode::Composite),
                     );
                     st = st.add(one);
-                    st.rays_terminated += one.rays_terminated;
                 }
             }
             assert!(
@@ -1187,14 +1194,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 3);
         let cfg = ComposConfig::DEFAULT;
         let one = cfg.one();
-        for regs in [
-            ComposRegs::defaults(&cfg),
-            ComposRegs::without_termination(&cfg),
-            ComposRegs {
-                et_threshold: 0,
-                ..ComposRegs::defaults(&cfg)
-            },
-        ] {
+        for regs in thresholds(&cfg) {
             let c = Compos::new(cfg, OpacityLut::new(1.0, &cfg).unwrap(), regs).unwrap();
             for _ in 0..50_000 {
                 let coxel = Coxel {
@@ -1417,6 +1417,6 @@ mod tests {
         )
         .unwrap();
         let want = render_base_plane_reference(&setup.params, &vol, &units);
-        assert!(render_base_plane(&setup.params, &vol, &units) == want);
+        assert!(super::super::render_base_plane(&setup.params, &vol, &units) == want);
     }
 }

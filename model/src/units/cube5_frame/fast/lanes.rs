@@ -69,6 +69,8 @@ pub(super) struct LaneRules {
     /// The slice's depth fails the depth test (`depth >= Znone`, every frame coxel's `z`):
     /// rule 4 leaves every coxel unchanged.
     past: bool,
+    /// `ColorW` (a colour code's width).
+    cw: u32,
     /// `rnd`'s halves `2^(AccW - 1)` and `2^(Q - 1)`, and `!past` as a lane factor (made once a
     /// slice rather than once a block).
     half_f: u64,
@@ -93,12 +95,39 @@ impl LaneRules {
             q: cfg.q(),
             one: cfg.one() as u32,
             chan_max: cfg.chan_max() as u32,
+            cw: cfg.color_w,
             et: compos.regs().et_threshold.min(u64::from(u32::MAX)) as u32,
             past: depth >= cfg.z_none(),
             half_f: 1 << (cfg.acc_w - 1),
             half_q: 1 << (cfg.q() - 1),
             open: u32::from(depth < cfg.z_none()),
         })
+    }
+
+    /// `Compos::code`'s colour codes (`c_w`, `unit_code(c, ColorW, AccW)` of each channel) of
+    /// colours `c[ch][n] <= 2^ColorW - 1`, in 32-bit lanes: `expand_double(c, ColorW) <=
+    /// 2^(2 ColorW) <= 2^24` (`ColorW <= 12`), and the code is at most `2^AccW <= 2^28`.
+    #[inline(always)]
+    pub fn colour_codes<const N: usize>(&self, c: &[[u32; N]; 3]) -> [[u32; N]; 3] {
+        let (w, f) = (self.cw, self.f);
+        let expand = |c: u32| c * ((1 << w) + 1) + (c >> (w - 1));
+        let mut out = [[0u32; N]; 3];
+        // One loop per case, so that each is straight-line code over the lanes.
+        if f >= 2 * w {
+            for ch in 0..3 {
+                for n in 0..N {
+                    out[ch][n] = expand(c[ch][n]) << (f - 2 * w);
+                }
+            }
+        } else {
+            let (k, half) = (2 * w - f, 1 << (2 * w - f - 1));
+            for ch in 0..3 {
+                for n in 0..N {
+                    out[ch][n] = (expand(c[ch][n]) + half) >> k;
+                }
+            }
+        }
+        out
     }
 
     /// Whether `Compos::leaves_unchanged_corrected` holds at corrected alpha `am` for every coxel
@@ -138,19 +167,32 @@ impl LaneRules {
         keep != 0
     }
 
-    /// Which lanes `at .. at + N` a sample of corrected alpha `sa[n]` would change (rule 5
-    /// writes the coxel, or rule 3 terminates it): `!Compos::leaves_unchanged_corrected`, and the
-    /// ray not terminated. These are the samples the sweep shades.
+    /// Whether a sample of corrected alpha `sa[n]` would change any of lanes `at .. at + N` (rule
+    /// 5 writes the coxel, or rule 3 terminates it): `!Compos::leaves_unchanged_corrected` for
+    /// some lane whose ray is not terminated. The sweep shades a row only then.
     #[inline(always)]
-    pub fn changes<const N: usize>(&self, st: &RayLanes, at: usize, sa: &[u32; N]) -> [bool; N] {
+    pub fn any_changes<const N: usize>(&self, st: &RayLanes, at: usize, sa: &[u32; N]) -> bool {
         let a: &[u32; N] = st.a[at..at + N].try_into().expect("N lanes");
         let term: &[u32; N] = st.term[at..at + N].try_into().expect("N lanes");
-        std::array::from_fn(|i| match self.mode {
+        // Per lane 1 when the sample changes the coxel; their OR, branch-free (lanes).
+        let mut any = 0u32;
+        let open = |i: usize| u32::from(term[i] == 0);
+        let before = 1 - u32::from(self.past);
+        match self.mode {
             ComposMode::FrontToBack => {
-                term[i] == 0 && !(a[i] < self.et && (self.past || sa[i] == 0))
+                let et = self.et;
+                for i in 0..N {
+                    any |= open(i) & (u32::from(a[i] >= et) | (before & u32::from(sa[i] != 0)));
+                }
             }
-            _ => term[i] == 0 && !self.past && (sa[i] << (self.f - self.q)) > a[i],
-        })
+            _ => {
+                let sh = self.f - self.q;
+                for i in 0..N {
+                    any |= open(i) & before & u32::from((sa[i] << sh) > a[i]);
+                }
+            }
+        }
+        any != 0
     }
 
     /// `Compos::step_coded` of the samples `sa[n]` (corrected alpha) and `sc[ch][n]` (colour
@@ -240,15 +282,39 @@ pub(super) fn colours(s: &CodedSample) -> [u32; 3] {
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::{seed, thresholds};
     use super::*;
     use crate::units::cube5_compos::{ComposConfig, ComposRegs, OpacityLut, Sample};
     use rand::{Rng, SeedableRng};
 
-    fn seed() -> u64 {
-        std::env::var("CUBE5_SEED")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(1313)
+    /// The lanes' colour codes are `Compos::code`'s, every colour of the narrow, default and wide
+    /// widths and of `ColorW` 12 on `AccW` 12 (rounded) and 28 (shifted).
+    #[test]
+    fn colour_codes_are_the_compositing_units() {
+        for cfg in [
+            ComposConfig::NARROW,
+            ComposConfig::DEFAULT,
+            ComposConfig::WIDE,
+            ComposConfig::new(12, 12, 0, 12, 16).unwrap(),
+            ComposConfig::new(12, 12, 6, 28, 16).unwrap(),
+        ] {
+            let regs = ComposRegs::defaults(&cfg);
+            let c = Compos::new(cfg, OpacityLut::new(1.0, &cfg).unwrap(), regs).unwrap();
+            let rules = LaneRules::new(&c, ComposMode::FrontToBack, 0).unwrap();
+            for v in 0..=cfg.color_max() {
+                let want = colours(&c.code(&Sample {
+                    rgb: [v; 3],
+                    alpha: 0,
+                    depth: 0,
+                    mode: ComposMode::FrontToBack,
+                }));
+                assert_eq!(
+                    rules.colour_codes(&[[v]; 3]),
+                    want.map(|x| [x]),
+                    "{cfg:?} {v}"
+                );
+            }
+        }
     }
 
     /// The lanes' rules equal `Compos::step_coded` and `Compos::leaves_unchanged_corrected` on
@@ -265,14 +331,7 @@ mod tests {
             ComposConfig::new(12, 12, 6, 28, 16).unwrap(),
         ] {
             let one = cfg.one();
-            for regs in [
-                ComposRegs::defaults(&cfg),
-                ComposRegs::without_termination(&cfg),
-                ComposRegs {
-                    et_threshold: 0,
-                    ..ComposRegs::defaults(&cfg)
-                },
-            ] {
+            for regs in thresholds(&cfg) {
                 let ratio = rng.random_range(0.3..3.0);
                 let c = Compos::new(cfg, OpacityLut::new(ratio, &cfg).unwrap(), regs).unwrap();
                 let init = Coxel::empty(&cfg);
@@ -348,8 +407,8 @@ mod tests {
                             let want = c.leaves_unchanged_corrected(x, am, depth, mode);
                             assert_eq!(rules.all_unchanged::<1>(&st, i, am), want, "{mode:?}");
                         }
-                        let ch = rules.changes::<N>(&st, 0, &sa);
                         let mut want = RowCounts::default();
+                        let mut any = false;
                         for (i, (x, s)) in coxels.iter().zip(&samples).enumerate() {
                             let unchanged = c.leaves_unchanged_corrected(x, s.a, depth, mode);
                             if x.terminated {
@@ -359,8 +418,15 @@ mod tests {
                             } else {
                                 want.shaded += 1;
                             }
-                            assert_eq!(ch[i], !x.terminated && !unchanged, "{mode:?} {x:?} {s:?}");
+                            let changes = !x.terminated && !unchanged;
+                            assert_eq!(
+                                rules.any_changes::<1>(&st, i, &[sa[i]]),
+                                changes,
+                                "{mode:?} {x:?} {s:?}"
+                            );
+                            any |= changes;
                         }
+                        assert_eq!(rules.any_changes::<N>(&st, 0, &sa), any, "{mode:?}");
                         // Eight lanes at once, and one at a time.
                         let mut one_by_one = RayLanes::new(n);
                         for (d, s) in one_by_one.c.iter_mut().zip(&st.c) {
