@@ -73,11 +73,7 @@ module cube5_frame #(
   /// stream (a later section samples them) or the final stream (the image's pixels), parked ones
   /// come back on the restore streams; no read-out (the output stream carries error items only).
   /// 0: the whole base plane in the buffer, the read-out after the last section.
-  parameter int unsigned Window     = 0,
-  /// Window = 1: depth of the descriptor, park and final FIFOs, and of the restore FIFO (restores
-  /// requested ahead of the sweep), powers of two.
-  parameter int unsigned WinDepth   = 32,
-  parameter int unsigned RsDepth    = 2 * MaxDim
+  parameter int unsigned Window     = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -927,8 +923,13 @@ module cube5_frame #(
   logic [P-1:0]       win_enter, win_restore;
   logic [StoreW-1:0]  win_rs_cox;
   logic [P*StoreW-1:0] win_wb_cox;
-  // The window's words per bank row: MaxSection / P rounded up to a power of two.
-  localparam int unsigned WinCols = 1 << $clog2(MaxSection / P);
+  // The window's words per bank row: MaxSection / P rounded up to a power of two. Its
+  // descriptor, park and final FIFOs (more than the beats from admission to write-back: no stall
+  // while the streams keep up) and its restore FIFO (restores requested ahead: more than a slice's
+  // nj).
+  localparam int unsigned WinCols  = 1 << $clog2(MaxSection / P);
+  localparam int unsigned WinDepth = 32;
+  localparam int unsigned RsDepth  = 2 * MaxDim;
 
   cube5_frame_cbuf #(
     .P      (P),

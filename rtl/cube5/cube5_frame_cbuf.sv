@@ -270,23 +270,41 @@ module cube5_frame_cbuf #(
 
   // Write-back addresses wait for the update units' results.
   logic [P*AddrW-1:0] wb_addr;
-  logic [LaneW-1:0]   wb_rot;
+  logic [LaneW-1:0]   wb_rot;     // Window = 1: the beat's rotation, for the results in lane order
   logic               unused_wb_empty, unused_wb_full;
 
-  cube5_frame_fifo #(
-    .Width (P * AddrW + LaneW),
-    .Depth (8)
-  ) u_wb_addr (
-    .clk_i   (clk_i),
-    .rst_ni  (rst_ni),
-    .clear_i (start_i),
-    .push_i  (in_valid_i),
-    .d_i     ({rot, sw_addr}),
-    .pop_i   (upd_valid_i),
-    .q_o     ({wb_rot, wb_addr}),
-    .empty_o (unused_wb_empty),
-    .full_o  (unused_wb_full)
-  );
+  if (Window != 0) begin : gen_wb_rot
+    cube5_frame_fifo #(
+      .Width (P * AddrW + LaneW),
+      .Depth (8)
+    ) u_wb_addr (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (start_i),
+      .push_i  (in_valid_i),
+      .d_i     ({rot, sw_addr}),
+      .pop_i   (upd_valid_i),
+      .q_o     ({wb_rot, wb_addr}),
+      .empty_o (unused_wb_empty),
+      .full_o  (unused_wb_full)
+    );
+  end else begin : gen_wb
+    cube5_frame_fifo #(
+      .Width (P * AddrW),
+      .Depth (8)
+    ) u_wb_addr (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (start_i),
+      .push_i  (in_valid_i),
+      .d_i     (sw_addr),
+      .pop_i   (upd_valid_i),
+      .q_o     (wb_addr),
+      .empty_o (unused_wb_empty),
+      .full_o  (unused_wb_full)
+    );
+    assign wb_rot = '0;
+  end
 
   // ---------------------------------------------------------------------------
   // Read-out: q outer, r inner; one read per cycle while the output FIFO has room (OutLanes = P:

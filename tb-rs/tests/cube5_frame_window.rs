@@ -32,9 +32,9 @@ fn must<T>(r: Result<T, TbError>) -> T {
 
 /// The builds with the compositing window, `p` pipelines.
 fn window(p: usize) -> FrameRtl {
-    FrameRtl::streams()
+    FrameRtl::windows()
         .into_iter()
-        .find(|r| r.window && r.p == p)
+        .find(|r| r.p == p)
         .unwrap_or_else(|| panic!("no cube5_frame variant with Window = 1 and P = {p}"))
 }
 
@@ -298,7 +298,7 @@ fn window_throughput_against_the_whole_plane() {
     let rtl = window(4);
     let whole = FrameRtl::streams()
         .into_iter()
-        .filter(|r| !r.window && r.p == 4 && r.default_widths())
+        .filter(|r| r.p == 4 && r.default_widths())
         .min_by_key(|r| r.max_dim_log2)
         .expect("a Window = 0 stream frame at P = 4");
     let vol = Rc::new(head_phantom(32, 12).unwrap());
