@@ -243,7 +243,33 @@ fn window_frames_bit_exact_p4() {
             must(run(&mut bench, &c, &traffic, win, s));
         }
     }
+    // MinIP: its initial coxel (A all ones) for the fresh pixels, and the samples past the x far
+    // face left out in the section that holds the face's last anchor only.
+    let c = case(&rtl, &vol, VIEWS[4], Render::Minip, 8);
+    must(run(&mut bench, &c, &traffic, dram(&mut rng, true), s));
     assert!(parked > 0, "no frame parked a coxel");
+}
+
+/// Every view, sections of 8 and 16, MIP, composite and MinIP, at P = 4 (and P = 1 on 16^3).
+#[test]
+#[ignore = "sim-full: every view, width and mode through the window, a minute"]
+fn window_frames_every_view_and_mode() {
+    let s = seed(15);
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    for (p, n, widths) in [(4, 32, &[8, 16][..]), (1, 16, &[4, 8, 16][..])] {
+        let rtl = window(p);
+        let vol = Rc::new(head_phantom(n, 12).unwrap());
+        let mut bench = must(StreamBench::new(rtl, s as u32));
+        let traffic = Traffic::random(&mut rng, 0.2, 0.2);
+        for &view in VIEWS {
+            for render in [Render::Mip, Render::Composite, Render::Minip] {
+                for &width in widths {
+                    let c = case(&rtl, &vol, view, render, width);
+                    must(run(&mut bench, &c, &traffic, dram(&mut rng, true), s));
+                }
+            }
+        }
+    }
 }
 
 /// P = 1, 16^3: sections of 4 (many boundaries), 8 and 16.

@@ -93,7 +93,7 @@ pub fn render_window(
 ) -> Result<(BasePlane, WindowTraffic)> {
     let (w, h) = params.base_plane_size();
     let nk = params.nk;
-    let empty = Coxel::empty(&units.compos.config());
+    let empty = units.initial_coxel();
     // The last step (section n, slice s: n nk + s) that takes a sample into each pixel.
     let mut last = vec![None::<usize>; w * h];
     for (n, sec) in order.iter().enumerate() {
@@ -238,7 +238,7 @@ mod tests {
         for v in super::super::sections::test_views() {
             let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), 4).unwrap();
             let params = setup.params;
-            for mode in [FrameMode::Mip, FrameMode::Composite] {
+            for mode in [FrameMode::Mip, FrameMode::Composite, FrameMode::Minip] {
                 let u = units(&setup, mode);
                 let want = render_base_plane(&params, &vol, &u);
                 for s in [4, 8, 16, params.ni] {
