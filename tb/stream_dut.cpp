@@ -38,6 +38,8 @@ bool StreamDut::trace_window(rust::Str path, uint64_t from_cycle, uint64_t to_cy
 
 AxiHost* StreamDut::axi() const { return dynamic_cast<AxiHost*>(core_.get()); }
 
+WinHost* StreamDut::win() const { return dynamic_cast<WinHost*>(core_.get()); }
+
 bool StreamDut::axi_setup(const AxiMemSetup& s) {
   AxiHost* h = axi();
   if (!h) return false;
@@ -133,7 +135,7 @@ AxiWrCounters StreamDut::axi_wr_counters() const {
 }
 
 bool StreamDut::win_setup(const WinSetup& s) {
-  WinHost* h = dynamic_cast<WinHost*>(core_.get());
+  WinHost* h = win();
   if (!h) return false;
   WinConfig c;
   c.seed = s.seed;
@@ -149,7 +151,7 @@ bool StreamDut::win_setup(const WinSetup& s) {
 }
 
 uint32_t StreamDut::win_take(rust::Vec<uint32_t>& out) {
-  WinHost* h = dynamic_cast<WinHost*>(core_.get());
+  WinHost* h = win();
   if (!h) return 0;
   std::vector<uint32_t> rec;
   const uint32_t words = h->win_take(rec);
@@ -159,7 +161,7 @@ uint32_t StreamDut::win_take(rust::Vec<uint32_t>& out) {
 }
 
 uint64_t StreamDut::win_errors() const {
-  WinHost* h = dynamic_cast<WinHost*>(core_.get());
+  WinHost* h = win();
   return h ? h->win_errors() : 0;
 }
 

@@ -14,6 +14,7 @@ struct AxiCounters;
 struct AxiWrCounters;
 struct WinSetup;
 class AxiHost;
+class WinHost;
 
 class StreamDut {
  public:
@@ -45,6 +46,7 @@ class StreamDut {
 
  private:
   AxiHost* axi() const;
+  WinHost* win() const;
 
   std::unique_ptr<DutCore> core_;
 };
