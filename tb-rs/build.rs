@@ -254,6 +254,8 @@ fn main() {
         "axi_wr_shim.h",
         "accel_ctrl_shim.h",
         "accel_shim.h",
+        "win_host.h",
+        "win_shim.h",
         "stream_dut.h",
         "stream_dut.cpp",
     ] {
@@ -673,20 +675,26 @@ enum Shim {
     Axil,
     AccelCtrl,
     Accel,
+    Win,
 }
 
 impl Shim {
     /// In `Shim as usize` order.
-    const ALL: [Shim; 6] = [
+    const ALL: [Shim; 7] = [
         Shim::Stream,
         Shim::Axi,
         Shim::AxiWr,
         Shim::Axil,
         Shim::AccelCtrl,
         Shim::Accel,
+        Shim::Win,
     ];
 
     fn of(v: &Variant) -> Shim {
+        // cube5_frame with the compositing window: its window streams played as DRAM.
+        if v.params.iter().any(|(k, x)| k == "Window" && *x != 0) {
+            return Shim::Win;
+        }
         let own = format!("{}.sv", v.top);
         let text = v
             .files
@@ -717,6 +725,7 @@ impl Shim {
             Shim::Axil => "axil_shim.h",
             Shim::AccelCtrl => "accel_ctrl_shim.h",
             Shim::Accel => "accel_shim.h",
+            Shim::Win => "win_shim.h",
         }
     }
 
@@ -728,6 +737,7 @@ impl Shim {
             Shim::Axil => "AxilShim",
             Shim::AccelCtrl => "AccelCtrlShim",
             Shim::Accel => "AccelShim",
+            Shim::Win => "WinShim",
         }
     }
 
@@ -753,6 +763,7 @@ impl Shim {
                 "axil_mgr.h",
                 "accel_shim.h",
             ],
+            Shim::Win => &["clocked_top.h", "win_host.h", "win_shim.h"],
         }
     }
 }

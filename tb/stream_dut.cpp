@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "axi_mem.h"
+#include "win_host.h"
 
 #include "cube5-tb/src/ffi.rs.h"
 
@@ -36,6 +37,8 @@ bool StreamDut::trace_window(rust::Str path, uint64_t from_cycle, uint64_t to_cy
 }
 
 AxiHost* StreamDut::axi() const { return dynamic_cast<AxiHost*>(core_.get()); }
+
+WinHost* StreamDut::win() const { return dynamic_cast<WinHost*>(core_.get()); }
 
 bool StreamDut::axi_setup(const AxiMemSetup& s) {
   AxiHost* h = axi();
@@ -129,6 +132,37 @@ AxiWrCounters StreamDut::axi_wr_counters() const {
   return AxiWrCounters{s.aw_accepted, s.w_beats,           s.w_bytes,
                        s.b_responses, s.w_dropped_at_reset, s.bready_low,
                        h->axi_mem().write.in_flight()};
+}
+
+bool StreamDut::win_setup(const WinSetup& s) {
+  WinHost* h = win();
+  if (!h) return false;
+  WinConfig c;
+  c.seed = s.seed;
+  c.park_stall = s.park_stall;
+  c.fin_stall = s.fin_stall;
+  c.rq_stall = s.rq_stall;
+  c.rs_idle = s.rs_idle;
+  c.lat_fixed = s.lat_fixed;
+  c.lat_random = s.lat_random;
+  c.expect_final = s.expect_final;
+  h->win_setup(c);
+  return true;
+}
+
+uint32_t StreamDut::win_take(rust::Vec<uint32_t>& out) {
+  WinHost* h = win();
+  if (!h) return 0;
+  std::vector<uint32_t> rec;
+  const uint32_t words = h->win_take(rec);
+  out.reserve(out.size() + rec.size());
+  for (uint32_t w : rec) out.push_back(w);
+  return words;
+}
+
+uint64_t StreamDut::win_errors() const {
+  WinHost* h = win();
+  return h ? h->win_errors() : 0;
 }
 
 uint64_t StreamDut::cycle() const { return core_->cycle(); }

@@ -12,7 +12,9 @@ struct RunResult;
 struct AxiMemSetup;
 struct AxiCounters;
 struct AxiWrCounters;
+struct WinSetup;
 class AxiHost;
+class WinHost;
 
 class StreamDut {
  public:
@@ -35,11 +37,16 @@ class StreamDut {
   bool axi_take_aw(rust::Vec<uint64_t>& out);
   bool axi_image(rust::Vec<uint8_t>& out) const;
   AxiWrCounters axi_wr_counters() const;
+  // The window streams of cube5_frame Window = 1 (tb/win_shim.h); false/0 otherwise.
+  bool win_setup(const WinSetup& setup);
+  uint32_t win_take(rust::Vec<uint32_t>& out);
+  uint64_t win_errors() const;
   uint32_t in_bits() const;
   uint32_t out_bits() const;
 
  private:
   AxiHost* axi() const;
+  WinHost* win() const;
 
   std::unique_ptr<DutCore> core_;
 };

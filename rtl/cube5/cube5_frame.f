@@ -15,4 +15,5 @@ rtl/cube5/cube5_frame_swin.sv
 rtl/cube5/cube5_frame_shade.sv
 rtl/cube5/cube5_frame_class.sv
 rtl/cube5/cube5_frame_cbuf.sv
+rtl/cube5/cube5_frame_win.sv
 rtl/cube5/cube5_frame.sv

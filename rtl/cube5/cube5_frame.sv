@@ -66,7 +66,14 @@ module cube5_frame #(
   /// Source = 1: the widest section the frame takes (sec_ns <= MaxSection, else refused), a
   /// multiple of P in 2 P ..= MaxDim; the slice FIFOs hold MaxSection MaxDim / P beats instead of
   /// MaxDim^2 / P (docs/frame-rtl.md, "Fed by a beat stream"). Source = 0: MaxDim.
-  parameter int unsigned MaxSection = MaxDim
+  parameter int unsigned MaxSection = MaxDim,
+  /// 1 (Source = 1 only): the compositing window (docs/numerics/compos_window.md, *RTL*): the
+  /// buffer keeps the coxels of the section's active rays only ((MaxDim x WinCols) words per bank,
+  /// WinCols = MaxSection / P rounded up to a power of two); pixels leaving it go out on the park
+  /// stream (a later section samples them) or the final stream (the image's pixels), parked ones
+  /// come back on the restore streams; no read-out (the output stream carries error items only).
+  /// 0: the whole base plane in the buffer, the read-out after the last section.
+  parameter int unsigned Window     = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -95,7 +102,28 @@ module cube5_frame #(
                   cube5_shader_pkg::cfg_addr_w(ClassIdxW, RmLog2), AlphaW)-1:0] cfg_addr_i,
   input  logic [cube5_frame_pkg::cfg_data_w(
                   $clog2(MaxDim), VoxelW, cube5_skewmem_pkg::blk_w($clog2(MaxDim), BlockDim),
-                  cube5_shader_pkg::cfg_data_w(ColorW, AlphaW, DiffW, SpecW), AccW)-1:0] cfg_data_i
+                  cube5_shader_pkg::cfg_data_w(ColorW, AlphaW, DiffW, SpecW), AccW)-1:0] cfg_data_i,
+
+  /// Window = 1 (else idle: valid low, ready high): parked coxels, key {Q, R} (R low, DimW bits
+  /// each) and the stored coxel {terminated, A, B, G, R}.
+  output logic park_valid_o,
+  input  logic park_ready_i,
+  output logic [2*($clog2(MaxDim)+1)-1:0] park_key_o,
+  output logic [4*(AccW+1):0] park_cox_o,
+  /// Final pixels: key {Q, R} of lane 0, the lanes that are final (lane k is pixel (R + k, Q)),
+  /// the lanes' stored coxels.
+  output logic fin_valid_o,
+  input  logic fin_ready_i,
+  output logic [2*($clog2(MaxDim)+1)-1:0] fin_key_o,
+  output logic [P-1:0] fin_mask_o,
+  output logic [P*(4*(AccW+1)+1)-1:0] fin_cox_o,
+  /// Restore requests {Q, R}, and the restored coxels, in request order.
+  output logic rq_valid_o,
+  input  logic rq_ready_i,
+  output logic [2*($clog2(MaxDim)+1)-1:0] rq_key_o,
+  input  logic rs_valid_i,
+  output logic rs_ready_o,
+  input  logic [4*(AccW+1):0] rs_cox_i
 );
 
   // ---------------------------------------------------------------------------
@@ -169,6 +197,10 @@ module cube5_frame #(
   if (MaxSection > MaxDim || MaxSection < 2 * P || MaxSection % P != 0
       || (Source == 0 && MaxSection != MaxDim)) begin : gen_bad_max_section
     $fatal(1, "cube5_frame: MaxSection must be a multiple of P in 2 P ..= MaxDim (MaxDim when Source = 0)");
+  end
+  if (Window > 1 || (Window != 0 && (Source != 1 || DepthTest != 0 || OutLanes != 1)))
+  begin : gen_bad_window
+    $fatal(1, "cube5_frame: Window = 1 needs Source = 1, no depth test and OutLanes = 1");
   end
   if (DepthTest > 1) begin : gen_bad_depth_test
     $fatal(1, "cube5_frame: DepthTest must be 0 or 1");
@@ -451,18 +483,19 @@ module cube5_frame #(
   logic [PixW-1:0] sent_q, sent_d;
   logic [CntW-1:0] reads_q, reads_d, cycles_q, cycles_d;
   logic            mem_beat, mem_read, flush_beat, upd_done;
+  logic            win_ok;     // Window = 1: the window can take the next beat's sample beat
 
   // Commands while idle; beats (Source = 1) while the sweep still needs them, or while idle (a
   // stray beat after a reset: taken and dropped).
   assign cmd_ready  = (state_q == StIdle) && !cbuf_clear_busy;
-  assign beat_ready = (state_q == StIdle) || (state_q == StSweep && recvd_q != total_q);
+  assign beat_ready = (state_q == StIdle) || (state_q == StSweep && recvd_q != total_q && win_ok);
   assign in_ready_o = in_is_cmd ? cmd_ready : beat_ready;
   assign in_fire    = in_valid_i && in_ready_o;
   assign cmd_fire   = in_fire && in_is_cmd;
   assign out_fire   = out_valid_o && out_ready_i;
   assign start      = (state_q == StSetup3) && frame_ok;
   assign sweep_done = (state_q == StSweep) && (written_q == total_q);
-  assign ro_start   = sweep_done && slast;
+  assign ro_start   = sweep_done && slast && Window == 0;
   assign ro_last    = (state_q == StReadout) && out_fire && (sent_q == pixels_q - PixW'(1));
 
   // The section's fields (configuration-like: kept until the next command).
@@ -483,7 +516,7 @@ module cube5_frame #(
   always_comb begin
     dirty_d = dirty_q;
     wipe_d  = 1'b0;
-    if (start && Source != 0) dirty_d = 1'b1;
+    if (start && Source != 0 && Window == 0) dirty_d = 1'b1;
     if (ro_last) dirty_d = 1'b0;
     if (cmd_fire && Source != 0 && cmd_first && dirty_q
         && cmd_op == cube5_frame_pkg::OpRender) begin
@@ -512,7 +545,7 @@ module cube5_frame #(
       StSetup1: if (!wipe_q && !cbuf_clear_busy) state_d = StSetup2;
       StSetup2: state_d = StSetup3;
       StSetup3: state_d = frame_ok ? StSweep : StError;
-      StSweep:   if (sweep_done) state_d = slast ? StReadout : StIdle;
+      StSweep:   if (sweep_done) state_d = (slast && Window == 0) ? StReadout : StIdle;
       StReadout: if (ro_last) state_d = StIdle;
       StError:   if (out_fire) state_d = StIdle;
       default:   state_d = StIdle;
@@ -730,7 +763,8 @@ module cube5_frame #(
   end
 
   // After the last memory beat: nbs + 2 nbr + 2 beats of zeros flush the windows.
-  assign flush_beat  = (state_q == StSweep) && (recvd_q == total_q) && (flushed_q != flush_q);
+  assign flush_beat  = (state_q == StSweep) && (recvd_q == total_q) && (flushed_q != flush_q)
+                       && win_ok;
 
   logic                beat_valid;
   logic [XBeatW-1:0]   beat;
@@ -886,6 +920,16 @@ module cube5_frame #(
   assign cb_rst_n  = rst_ni && !wipe_q;
   logic [P-1:0]       co_ready, co_valid;
   logic [P*CoxelW-1:0] co_out;
+  logic [P-1:0]       win_enter, win_restore;
+  logic [StoreW-1:0]  win_rs_cox;
+  logic [P*StoreW-1:0] win_wb_cox;
+  // The window's words per bank row: MaxSection / P rounded up to a power of two. Its
+  // descriptor, park and final FIFOs (more than the beats from admission to write-back: no stall
+  // while the streams keep up) and its restore FIFO (restores requested ahead: more than a slice's
+  // nj).
+  localparam int unsigned WinCols  = 1 << $clog2(MaxSection / P);
+  localparam int unsigned WinDepth = 32;
+  localparam int unsigned RsDepth  = 2 * MaxDim;
 
   cube5_frame_cbuf #(
     .P      (P),
@@ -897,7 +941,9 @@ module cube5_frame #(
     .DW     (DW),
     .GeoW   (CbGeoW),
     .GeoPW  (CbGeoPW),
-    .OutLanes (OutLanes)
+    .OutLanes (OutLanes),
+    .Window   (Window),
+    .WinCols  (WinCols)
   ) u_cbuf (
     .clk_i        (clk_i),
     .rst_ni       (cb_rst_n),
@@ -936,9 +982,82 @@ module cube5_frame #(
     .geo_we_i     (cfg_geo),
     .geo_r_i      (cfg_off[0 +: DimW]),
     .geo_q_i      (cfg_off[DimW +: DimW]),
-    .geo_data_i   (cfg_data_i[CbGeoPW-1:0])
+    .geo_data_i   (cfg_data_i[CbGeoPW-1:0]),
+    .win_enter_i  (win_enter),
+    .win_restore_i (win_restore),
+    .win_rs_cox_i (win_rs_cox),
+    .wb_cox_o     (win_wb_cox)
   );
   assign unused_ro_busy = ro_busy;
+
+  // The compositing window's control (Window = 1), or nothing.
+  if (Window != 0) begin : gen_window
+    cube5_frame_win #(
+      .P       (P),
+      .DimW    (DimW),
+      .TW      (TW),
+      .DW      (DW),
+      .CoxW    (StoreW),
+      .TrigW   (LagW + 1),
+      .Depth   (WinDepth),
+      .RsDepth (RsDepth)
+    ) u_win (
+      .clk_i        (clk_i),
+      .rst_ni       (rst_ni),
+      .start_i      (start),
+      .nbr_i        (nbr),
+      .nj_i         (nj_q),
+      .nk_i         (nk_q),
+      .lo_edge_i    (!edge_lo_on),
+      .hi_edge_i    (!edge_hi_on),
+      .dx_i         (dx_q),
+      .dy_i         (dy_q),
+      .max_sx_i     (cb_max_sx),
+      .max_sy_i     (max_sy_q),
+      .trig_i       (flush_q),
+      .adm_ok_o     (win_ok),
+      .adm_i        (beat_valid),
+      .rd_i         (rgba_valid),
+      .rd_enter_o   (win_enter),
+      .rd_restore_o (win_restore),
+      .rd_rs_cox_o  (win_rs_cox),
+      .wb_i         (co_valid[0]),
+      .wb_cox_i     (win_wb_cox),
+      .park_valid_o (park_valid_o),
+      .park_ready_i (park_ready_i),
+      .park_key_o   (park_key_o),
+      .park_cox_o   (park_cox_o),
+      .fin_valid_o  (fin_valid_o),
+      .fin_ready_i  (fin_ready_i),
+      .fin_key_o    (fin_key_o),
+      .fin_mask_o   (fin_mask_o),
+      .fin_cox_o    (fin_cox_o),
+      .rq_valid_o   (rq_valid_o),
+      .rq_ready_i   (rq_ready_i),
+      .rq_key_o     (rq_key_o),
+      .rs_valid_i   (rs_valid_i),
+      .rs_ready_o   (rs_ready_o),
+      .rs_cox_i     (rs_cox_i)
+    );
+  end else begin : gen_no_window
+    assign win_ok       = 1'b1;
+    assign win_enter    = '0;
+    assign win_restore  = '0;
+    assign win_rs_cox   = '0;
+    assign park_valid_o = 1'b0;
+    assign park_key_o   = '0;
+    assign park_cox_o   = '0;
+    assign fin_valid_o  = 1'b0;
+    assign fin_key_o    = '0;
+    assign fin_mask_o   = '0;
+    assign fin_cox_o    = '0;
+    assign rq_valid_o   = 1'b0;
+    assign rq_key_o     = '0;
+    assign rs_ready_o   = 1'b1;
+    logic unused_win_in;
+    assign unused_win_in = ^{park_ready_i, fin_ready_i, rq_ready_i, rs_valid_i, rs_cox_i,
+                             win_wb_cox};
+  end
 
   // "No geometry" depth, all ones (written out: Yosys 0.23 reads a '1 localparam as 1).
   localparam logic [ZW-1:0] ZNone = {ZW{1'b1}};

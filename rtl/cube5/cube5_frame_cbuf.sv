@@ -40,7 +40,13 @@ module cube5_frame_cbuf #(
   parameter int unsigned GeoPW  = 1,
   /// Pixels per read-out item: 1, or P (the P banks' words at one address, one row's P
   /// consecutive pixels R = P c .. P c + P - 1 per cycle; GeoW = 0 only).
-  parameter int unsigned OutLanes = 1
+  parameter int unsigned OutLanes = 1,
+  /// 1: the compositing window (cube5_frame Window = 1; docs/numerics/compos_window.md): words
+  /// {Q mod MaxDim, (R div P) mod WinCols}, the coxel of an entering pixel from win_*_i instead
+  /// of the word, the results also out in lane order (wb_cox_o); no read-out.
+  parameter int unsigned Window   = 0,
+  /// Window = 1: words per bank row, a power of two >= the widest section / P.
+  parameter int unsigned WinCols  = 2
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -106,7 +112,15 @@ module cube5_frame_cbuf #(
   input  logic geo_we_i,
   input  logic [DimW-1:0] geo_r_i,
   input  logic [DimW-1:0] geo_q_i,
-  input  logic [GeoPW-1:0] geo_data_i
+  input  logic [GeoPW-1:0] geo_data_i,
+
+  /// Window = 1, with in_valid_i: lane l's pixel enters the window (its coxel is empty_cox_i, or
+  /// win_rs_cox_i where win_restore_i), lane order.
+  input  logic [P-1:0] win_enter_i,
+  input  logic [P-1:0] win_restore_i,
+  input  logic [CoxW-1:0] win_rs_cox_i,
+  /// With upd_valid_i: the results in lane order (lane l at [l*CoxW +: CoxW]).
+  output logic [P*CoxW-1:0] wb_cox_o
 );
 
   localparam int unsigned StepW = cube5_frame_pkg::StepW;
@@ -114,7 +128,8 @@ module cube5_frame_cbuf #(
   localparam int unsigned LaneW = cube5_frame_pkg::lane_w(P);
   localparam int unsigned QW    = DimW;                // Q <= 2 MaxDim - 2
   localparam int unsigned ColW  = DimW - LogP;         // R div P < 2 MaxDim / P
-  localparam int unsigned AddrW = QW + ColW;
+  localparam int unsigned WinColW = $clog2(WinCols);
+  localparam int unsigned AddrW = (Window != 0) ? (QW - 1 + WinColW) : (QW + ColW);
   localparam int unsigned Depth = 1 << AddrW;
   localparam int unsigned WordW = CoxW + 1;            // valid bit on top
   localparam int unsigned OutDepth = 4;
@@ -124,6 +139,10 @@ module cube5_frame_cbuf #(
   end
   if (P < 1 || (1 << LogP) != P || P > MaxDim) begin : gen_bad_p
     $fatal(1, "cube5_frame_cbuf: P must be a power of two, at most MaxDim");
+  end
+  if (Window > 1 || (Window != 0 && (GeoW != 0 || WinCols < 2
+      || (1 << WinColW) != WinCols))) begin : gen_bad_window
+    $fatal(1, "cube5_frame_cbuf: Window = 1 needs no geometry table and WinCols a power of two >= 2");
   end
   if (OutLanes != 1 && (OutLanes != P || GeoW != 0)) begin : gen_bad_lanes
     $fatal(1, "cube5_frame_cbuf: OutLanes must be 1, or P without a geometry table");
@@ -233,37 +252,59 @@ module cube5_frame_cbuf #(
         logic [LaneW-1:0] lane;
         col  = col_base + ((LaneW'(j) < rot) ? DimW'(1) : DimW'(0));
         lane = LaneW'(j) - rot;
-        sw_addr[j*AddrW +: AddrW] = {q_row[QW-1:0], col[ColW-1:0]};
+        // The word {Q, R div P}, or in the window {Q mod MaxDim, (R div P) mod WinCols}.
+        sw_addr[j*AddrW +: AddrW] = (Window != 0) ? AddrW'({q_row[QW-2:0], col[WinColW-1:0]})
+                                                  : AddrW'({q_row[QW-1:0], col[ColW-1:0]});
         pay_rot[j*PayW +: PayW]   = in_pay_i[lane*PayW +: PayW];
         past_rot[j]               = past[lane];
-        unused_col ^= ^col[DimW-1:ColW];
+        unused_col ^= ^col;
       end
     end
   end else begin : gen_single
-    assign sw_addr    = {q_row[QW-1:0], col_base[ColW-1:0]};
+    assign sw_addr    = (Window != 0) ? AddrW'({q_row[QW-2:0], col_base[WinColW-1:0]})
+                                      : AddrW'({q_row[QW-1:0], col_base[ColW-1:0]});
     assign pay_rot    = in_pay_i;
     assign past_rot   = past;
-    assign unused_col = ^rot;
+    assign unused_col = ^{rot, col_base, q_row};
   end
 
   // Write-back addresses wait for the update units' results.
   logic [P*AddrW-1:0] wb_addr;
+  logic [LaneW-1:0]   wb_rot;     // Window = 1: the beat's rotation, for the results in lane order
   logic               unused_wb_empty, unused_wb_full;
 
-  cube5_frame_fifo #(
-    .Width (P * AddrW),
-    .Depth (8)
-  ) u_wb_addr (
-    .clk_i   (clk_i),
-    .rst_ni  (rst_ni),
-    .clear_i (start_i),
-    .push_i  (in_valid_i),
-    .d_i     (sw_addr),
-    .pop_i   (upd_valid_i),
-    .q_o     (wb_addr),
-    .empty_o (unused_wb_empty),
-    .full_o  (unused_wb_full)
-  );
+  if (Window != 0) begin : gen_wb_rot
+    cube5_frame_fifo #(
+      .Width (P * AddrW + LaneW),
+      .Depth (8)
+    ) u_wb_addr (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (start_i),
+      .push_i  (in_valid_i),
+      .d_i     ({rot, sw_addr}),
+      .pop_i   (upd_valid_i),
+      .q_o     ({wb_rot, wb_addr}),
+      .empty_o (unused_wb_empty),
+      .full_o  (unused_wb_full)
+    );
+  end else begin : gen_wb
+    cube5_frame_fifo #(
+      .Width (P * AddrW),
+      .Depth (8)
+    ) u_wb_addr (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (start_i),
+      .push_i  (in_valid_i),
+      .d_i     (sw_addr),
+      .pop_i   (upd_valid_i),
+      .q_o     (wb_addr),
+      .empty_o (unused_wb_empty),
+      .full_o  (unused_wb_full)
+    );
+    assign wb_rot = '0;
+  end
 
   // ---------------------------------------------------------------------------
   // Read-out: q outer, r inner; one read per cycle while the output FIFO has room (OutLanes = P:
@@ -278,7 +319,7 @@ module cube5_frame_cbuf #(
   logic             ro_rd_q;                   // a read-out word arrives this cycle
 
   assign ro_issue = ro_busy_q && (ro_cred_q < 3'(OutDepth));
-  assign ro_addr  = {ro_q_q[QW-1:0], ColW'(ro_r_q >> LogP)};
+  assign ro_addr  = AddrW'({ro_q_q[QW-1:0], ColW'(ro_r_q >> LogP)});
   if (P > 1) begin : gen_ro_bank
     assign ro_bank = ro_r_q[LogP-1:0];
   end else begin : gen_ro_bank1
@@ -408,18 +449,48 @@ module cube5_frame_cbuf #(
     end
   end
 
-  always_ff @(posedge clk_i) begin
-    if (in_valid_i) begin
-      pay_q   <= pay_rot;
-      depth_q <= pos_s;
-      past_q  <= past_rot;
+  // Window = 1: bank j's pixel enters (lane (j - rot) mod P's flags), its restored coxel.
+  logic [P-1:0]    ent_rot, rst_rot, ent_q, rst_q;
+  logic [CoxW-1:0] rs_cox_q;
+  always_comb begin
+    for (int unsigned j = 0; j < P; j++) begin
+      logic [LaneW-1:0] lane;
+      lane       = LaneW'(j) - rot;
+      ent_rot[j] = (Window != 0) && win_enter_i[lane];
+      rst_rot[j] = (Window != 0) && win_restore_i[lane];
     end
   end
 
-  // A word whose valid bit is clear is the empty coxel (the frame's, by render mode).
+  always_ff @(posedge clk_i) begin
+    if (in_valid_i) begin
+      pay_q    <= pay_rot;
+      depth_q  <= pos_s;
+      past_q   <= past_rot;
+      ent_q    <= ent_rot;
+      rst_q    <= rst_rot;
+      rs_cox_q <= win_rs_cox_i;
+    end
+  end
+
+  // A word whose valid bit is clear is the empty coxel (the frame's, by render mode); in the
+  // window an entering pixel's coxel is the empty or the restored one, whatever the word holds.
   always_comb begin
     for (int unsigned j = 0; j < P; j++) begin
-      upd_cox_o[j*CoxW +: CoxW] = rd_word[j*WordW + CoxW] ? rd_word[j*WordW +: CoxW] : empty_cox_i;
+      if (ent_q[j]) begin
+        upd_cox_o[j*CoxW +: CoxW] = rst_q[j] ? rs_cox_q : empty_cox_i;
+      end else begin
+        upd_cox_o[j*CoxW +: CoxW] = rd_word[j*WordW + CoxW] ? rd_word[j*WordW +: CoxW]
+                                                            : empty_cox_i;
+      end
+    end
+  end
+
+  // The results in lane order: lane l's pixel is in bank (l + rot) mod P.
+  always_comb begin
+    for (int unsigned l = 0; l < P; l++) begin
+      logic [LaneW-1:0] bank;
+      bank = LaneW'(l) + wb_rot;
+      wb_cox_o[l*CoxW +: CoxW] = upd_cox_i[bank*CoxW +: CoxW];
     end
   end
   assign upd_geo_o   = geo_word;

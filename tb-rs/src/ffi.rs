@@ -61,6 +61,19 @@ pub mod bridge {
         err_flag: bool,
     }
 
+    /// The compositing window's streams as DRAM (mirrors `WinConfig` in tb/win_host.h).
+    #[derive(Debug, Clone, Copy, Default)]
+    struct WinSetup {
+        seed: u64,
+        park_stall: u32,
+        fin_stall: u32,
+        rq_stall: u32,
+        rs_idle: u32,
+        lat_fixed: u32,
+        lat_random: u32,
+        expect_final: u64,
+    }
+
     unsafe extern "C++" {
         include!("stream_dut.h");
 
@@ -104,6 +117,11 @@ pub mod bridge {
         fn axi_take_aw(self: Pin<&mut StreamDut>, out: &mut Vec<u64>) -> bool;
         fn axi_image(self: &StreamDut, out: &mut Vec<u8>) -> bool;
         fn axi_wr_counters(self: &StreamDut) -> AxiWrCounters;
+        /// cube5_frame with Window = 1 (tb/win_shim.h): its DRAM's traffic; false otherwise.
+        fn win_setup(self: Pin<&mut StreamDut>, setup: &WinSetup) -> bool;
+        /// The window records since the last call; the words per record (0: no window).
+        fn win_take(self: Pin<&mut StreamDut>, out: &mut Vec<u32>) -> u32;
+        fn win_errors(self: &StreamDut) -> u64;
         fn in_bits(self: &StreamDut) -> u32;
         fn out_bits(self: &StreamDut) -> u32;
     }

@@ -18,13 +18,22 @@ use cube5_model::units::cube5_frame::sections::{section_beats, section_order, Se
 use cube5_model::units::cube5_section_buf::Beam;
 
 impl FrameRtl {
-    /// The configurations fed by a beat stream (`Source = 1`), in `.variants` order.
+    /// The configurations fed by a beat stream (`Source = 1`) with the whole base plane and its
+    /// read-out (`Window = 0`), in `.variants` order.
     pub fn streams() -> Vec<FrameRtl> {
+        Self::beat_fed().filter(|r| !r.window).collect()
+    }
+
+    /// The configurations with the compositing window (`Window = 1`; tests/cube5_frame_window.rs).
+    pub fn windows() -> Vec<FrameRtl> {
+        Self::beat_fed().filter(|r| r.window).collect()
+    }
+
+    fn beat_fed() -> impl Iterator<Item = FrameRtl> {
         variants_of(crate::frame::TOP)
             .into_iter()
             .map(|v| FrameRtl::from_variant(v).unwrap_or_else(|e| panic!("{e}")))
             .filter(|r| r.stream)
-            .collect()
     }
 }
 

@@ -3,7 +3,7 @@
 use crate::error::TbError;
 pub use crate::ffi::bridge::AxiWrCounters;
 use crate::ffi::bridge::{self, RunResult, StreamDut};
-pub use crate::ffi::bridge::{AxiCounters, AxiMemSetup};
+pub use crate::ffi::bridge::{AxiCounters, AxiMemSetup, WinSetup};
 use crate::variants::{Variant, VARIANTS};
 use cube5_model::bits::words_for;
 use cube5_model::unit::UnitConfig;
@@ -248,6 +248,30 @@ impl<C: StreamCodec> RtlStream<C> {
     /// The subordinate's write-port counters.
     pub fn axi_wr_counters(&self) -> AxiWrCounters {
         self.dut.axi_wr_counters()
+    }
+
+    /// Sets up the DRAM that a `cube5_frame` with `Window = 1` parks in (tb/win_shim.h).
+    pub fn win_setup(&mut self, setup: &WinSetup) -> Result<(), TbError> {
+        if self.dut.pin_mut().win_setup(setup) {
+            Ok(())
+        } else {
+            Err(TbError::setup(
+                self.variant.name,
+                "this build has no window streams",
+            ))
+        }
+    }
+
+    /// The window streams' records since the last call (tb/win_host.h), and words per record.
+    pub fn win_take(&mut self) -> (Vec<u32>, usize) {
+        let mut raw = Vec::new();
+        let words = self.dut.pin_mut().win_take(&mut raw);
+        (raw, words as usize)
+    }
+
+    /// Restore requests for pixels never parked, and stalled window outputs that changed.
+    pub fn win_errors(&self) -> u64 {
+        self.dut.win_errors()
     }
 
     fn no_axi(&self) -> TbError {

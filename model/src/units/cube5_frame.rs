@@ -91,6 +91,10 @@ pub struct FrameConfig {
     /// The widest section a frame fed by beats takes (`MaxSection`; `None`: `MaxDim`, the RTL's
     /// default): it sizes the slice FIFOs, `MaxSection MaxDim / P` beats (docs/frame-rtl.md).
     pub max_section: Option<usize>,
+    /// The compositing window (`Window = 1`, with a beat stream only): the buffer keeps the active
+    /// rays' coxels, the rest leave on the park and final streams and come back on the restore
+    /// streams (docs/numerics/compos_window.md; the model: `window::render_window`).
+    pub window: bool,
 }
 
 impl FrameConfig {
@@ -109,6 +113,7 @@ impl FrameConfig {
         depth_test: false,
         out_lanes: 1,
         max_section: None,
+        window: false,
     };
 
     /// The largest volume edge (`MaxDim`).
@@ -146,6 +151,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         let mut depth_test = u32::from(d.depth_test);
         let mut out_lanes = d.out_lanes as u32;
         let mut max_section = 0u32; // 0: not given, MaxDim
+        let mut window = 0u32;
         crate::unit::set_params(
             Self::TOP,
             params,
@@ -174,8 +180,14 @@ impl crate::unit::UnitConfig for FrameConfig {
                 ("DepthTest", &mut depth_test),
                 ("OutLanes", &mut out_lanes),
                 ("MaxSection", &mut max_section),
+                ("Window", &mut window),
             ],
         )?;
+        if window > 1 || (window == 1 && (source != 1 || depth_test != 0 || out_lanes != 1)) {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: Window = {window} must be 0, or 1 with Source = 1, no depth test and OutLanes = 1"
+            )));
+        }
         if max_section != 0
             && (max_section > max_dim
                 || max_section < 2 * p
@@ -233,6 +245,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             out_lanes: out_lanes as usize,
             max_section: (max_section != 0 && max_section != max_dim)
                 .then_some(max_section as usize),
+            window: window == 1,
         })
     }
 
@@ -264,6 +277,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             ("DepthTest", i64::from(self.depth_test)),
             ("OutLanes", self.out_lanes as i64),
             ("MaxSection", self.max_section() as i64),
+            ("Window", i64::from(self.window)),
         ]
     }
 }

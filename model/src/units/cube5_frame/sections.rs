@@ -14,9 +14,7 @@ use super::{
     SliceConst,
 };
 use crate::error::{ModelError, Result};
-use crate::units::cube5_compos::Coxel;
 use crate::units::cube5_section_buf::Beam;
-use crate::units::cube5_shader::ShaderMode;
 use crate::units::cube5_trilin::Trilin;
 use crate::volume::Volume;
 
@@ -189,16 +187,30 @@ impl SectionVoxels {
         b: usize,
     ) -> crate::units::cube5_compos::Sample {
         let s = c.s;
+        // As `FrameUnits::shaded_sample`: every mode (MinIP's depth past a far face, the unlit
+        // modes, the 2-D table), from the section's own voxels.
+        let mode = units.mode.compos_mode();
+        let depth = units
+            .mode
+            .sample_depth(params, c, (a, b), &units.compos.config());
         if units.shade {
-            let mode = ShaderMode {
-                tf2d: false,
-                unlit: units.mode == super::FrameMode::Mip,
-            };
             let nb = self.neighbourhood(params, c, a, b, &units.trilin);
-            shade_n6(&units.gradient, &units.shader, &nb, mode, s as u32)
+            crate::units::cube5_compos::Sample {
+                mode,
+                ..shade_n6(
+                    &units.gradient,
+                    &units.shader,
+                    &nb,
+                    units.shader_mode(),
+                    depth,
+                )
+            }
         } else {
             let centre = self.sample(params, c, s as i64, a as i64, b as i64, &units.trilin);
-            super::classify_only(&units.shader, centre, s as u32)
+            crate::units::cube5_compos::Sample {
+                mode,
+                ..super::classify_only(&units.shader, centre, depth)
+            }
         }
     }
 }
@@ -215,7 +227,7 @@ pub fn render_sections(
     p: usize,
 ) -> Result<BasePlane> {
     let (w, h) = params.base_plane_size();
-    let mut coxels = vec![Coxel::empty(&units.compos.config()); w * h];
+    let mut coxels = vec![units.initial_coxel(); w * h];
     for &sec in order {
         let data = SectionVoxels::from_beats(params, sec, &section_beats(params, vol, sec, p))?;
         for s in 0..params.nk {

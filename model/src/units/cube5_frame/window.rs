@@ -17,7 +17,7 @@ use crate::units::cube5_compos::Coxel;
 use crate::volume::Volume;
 
 /// What moved between the window and DRAM in one frame, in coxels (pixels).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct WindowTraffic {
     /// Partial coxels written to DRAM on leaving the window (a later sample will need them).
     pub parked: u64,
@@ -40,6 +40,26 @@ pub struct WindowTraffic {
     /// Pixels still in the window when the last section's sweep ends: the only ones whose
     /// read-out cannot overlap the sweep (at most `ns nj`).
     pub left_at_end: u64,
+    /// The three streams of the window, in the order the RTL (`cube5_frame` `Window = 1`)
+    /// emits them (docs/numerics/compos_window.md, *Order of the streams*).
+    pub streams: WindowStreams,
+}
+
+/// A pixel `(R, Q)` and its coxel, as it leaves the window.
+pub type PixelCoxel = (usize, usize, Coxel);
+
+/// What crosses the window's edge, in order: within a step the pixels in row-major order of
+/// their base-plane position (`Q` outer, `R` inner), the steps in sweep order. The leaving
+/// pixels of a step follow the step's samples (their last write-back), the restores of a step
+/// are requested before it (its first samples take them).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct WindowStreams {
+    /// Parked coxels (partial: a later step samples the pixel again).
+    pub parked: Vec<PixelCoxel>,
+    /// Final pixels (no later sample), the image's pixels but the untouched ones.
+    pub finals: Vec<PixelCoxel>,
+    /// Restore requests `(R, Q)`: the coxel parked for that pixel comes back, in this order.
+    pub restores: Vec<(usize, usize)>,
 }
 
 /// The active pixels of section `sec` at slice `s`: columns, rows.
@@ -73,7 +93,7 @@ pub fn render_window(
 ) -> Result<(BasePlane, WindowTraffic)> {
     let (w, h) = params.base_plane_size();
     let nk = params.nk;
-    let empty = Coxel::empty(&units.compos.config());
+    let empty = units.initial_coxel();
     // The last step (section n, slice s: n nk + s) that takes a sample into each pixel.
     let mut last = vec![None::<usize>; w * h];
     for (n, sec) in order.iter().enumerate() {
@@ -100,16 +120,24 @@ pub fn render_window(
                  image: &mut [Option<Coxel>],
                  t: &mut WindowTraffic| {
         let c = chip[i].take();
+        let (r, q) = (i % w, i / w);
         if last[i] == Some(step) {
+            if let Some(x) = c {
+                t.streams.finals.push((r, q, x));
+            }
             image[i] = c;
             t.final_out += 1;
         } else {
+            if let Some(x) = c {
+                t.streams.parked.push((r, q, x));
+            }
             dram[i] = c;
             t.parked += 1;
         }
     };
     for (n, sec) in order.iter().enumerate() {
         let data = SectionVoxels::from_beats(params, *sec, &section_beats(params, vol, *sec, p))?;
+        let mut prev: Vec<usize> = Vec::new();
         for s in 0..nk {
             let now = active_pixels(params, w, sec, s);
             for &i in &now {
@@ -118,17 +146,15 @@ pub fn render_window(
             let entering = now.iter().filter(|&&i| chip[i].is_none()).count();
             t.max_window = t.max_window.max(on.len() + entering);
             if s > 0 {
+                // The previous step's pixels in row-major order: those not active now leave.
                 let before = on.len();
-                let mut kept = Vec::with_capacity(on.len());
-                for &i in &on {
-                    if now_mark[i] {
-                        kept.push(i);
-                    } else {
+                for &i in &prev {
+                    if !now_mark[i] {
                         leave(i, n * nk + s - 1, &mut chip, &mut dram, &mut image, &mut t);
                     }
                 }
-                t.max_moves = t.max_moves.max(before - kept.len());
-                on = kept;
+                on.retain(|&i| now_mark[i]);
+                t.max_moves = t.max_moves.max(before - on.len());
             }
             for &i in &now {
                 now_mark[i] = false;
@@ -136,6 +162,7 @@ pub fn render_window(
                     chip[i] = Some(match dram[i].take() {
                         Some(c) => {
                             t.restored += 1;
+                            t.streams.restores.push((i % w, i / w));
                             c
                         }
                         None => {
@@ -146,6 +173,7 @@ pub fn render_window(
                     on.push(i);
                 }
             }
+            prev = now;
             let c = params.slice(s);
             for b in 0..params.nj {
                 for a in sec.a0..sec.a0 + sec.ns {
@@ -163,7 +191,8 @@ pub fn render_window(
         }
         // The section's end: every coxel leaves the window.
         t.left_at_end = on.len() as u64;
-        for i in std::mem::take(&mut on) {
+        on.clear();
+        for i in std::mem::take(&mut prev) {
             leave(i, n * nk + nk - 1, &mut chip, &mut dram, &mut image, &mut t);
         }
         t.final_after.push(t.final_out);
@@ -209,7 +238,7 @@ mod tests {
         for v in super::super::sections::test_views() {
             let setup = FrameSetup::new(vol.dims, vol.spacing, DVec3::from(v), 4).unwrap();
             let params = setup.params;
-            for mode in [FrameMode::Mip, FrameMode::Composite] {
+            for mode in [FrameMode::Mip, FrameMode::Composite, FrameMode::Minip] {
                 let u = units(&setup, mode);
                 let want = render_base_plane(&params, &vol, &u);
                 for s in [4, 8, 16, params.ni] {
@@ -220,6 +249,13 @@ mod tests {
                         "{mode:?} view {v:?} S = {s}: the image changed"
                     );
                     assert_eq!(t.parked, t.restored, "view {v:?} S = {s}");
+                    let st = &t.streams;
+                    assert_eq!(st.parked.len() as u64, t.parked);
+                    assert_eq!(st.finals.len() as u64, t.final_out);
+                    // Restores come back in the order they were parked (a FIFO in DRAM would do).
+                    let parked: Vec<(usize, usize)> =
+                        st.parked.iter().map(|&(r, q, _)| (r, q)).collect();
+                    assert_eq!(parked, st.restores, "view {v:?} S = {s}: restore order");
                     assert_eq!(
                         t.final_out + t.untouched,
                         (want.width * want.height) as u64,
