@@ -240,9 +240,7 @@ fn soft_reset_mid_frame_drains_then_an_exact_frame() {
             must(c.bench.start(&e, &c.vol, &c.lut, &env, mem_seed));
             let at = c.rng.random_range(1..span);
             must(c.bench.idle(at));
-            let mut host = AccelHost::new(&mut c.bench, 0);
-            host.soft_reset().unwrap();
-            drop(host);
+            AccelHost::new(&mut c.bench, 0).soft_reset().unwrap();
             must(c.bench.wait_irq(200_000));
             let mut host = AccelHost::new(&mut c.bench, 0);
             let ended = host.wait_done(1);
