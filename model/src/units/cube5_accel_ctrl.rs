@@ -575,6 +575,16 @@ mod tests {
             ..o
         };
         assert_eq!(o.code(), CODE_STEP);
+        // A soft reset reports Aborted before the frame's and the writer's errors (docs,
+        // "Soft reset": after the strobe they are not awaited).
+        let o = Outcome {
+            aborted: true,
+            frame_error: true,
+            write_error: true,
+            ..Outcome::default()
+        };
+        assert_eq!(o.code(), CODE_ABORTED);
+        assert_eq!(o.status(), CODE_ABORTED << 4 | 0x4);
     }
 
     fn regs(dims: [u32; 3], view: u32, dx: i32) -> CtrlRegs {
