@@ -10,7 +10,9 @@
 //             w1.. the payload, LSB first;
 //     kind 1: the frame's done driven in this cycle, flag = error;
 //     kind 2: a writer completion driven in this cycle, flag = resp;
-//     kind 3: a table-port write, w1 = index | table << 16, w2 = data.
+//     kind 3: a table-port write, w1 = index | table << 16, w2 = data;
+//     kind 4: `drained_i` driven in this cycle (the answer to `flush_o` after a random delay: the
+//             data path's units reset, so pending completions and the frame's done are dropped).
 // `stall` back-pressures B and R (as AxilShim) and each command port at its own offset; `idle` is
 // unused. write_config sets the environment's knobs (kKnob*). With no items, run() runs
 // `max_cycles` cycles (the host idle).
@@ -37,9 +39,10 @@ class AccelCtrlShim final : public AxilTopBase<V> {
   /// Knobs (write_config address): the longest extra delay of a completion after its command and
   /// of the frame's done after its last section; the error flag the frame's done carries; the
   /// row (from 1, counted from the frame's first section command; 0 none) whose completion answers
-  /// SLVERR; the bit of the frame command that is `sec_last`.
+  /// SLVERR; the bit of the frame command that is `sec_last`; the longest extra delay of
+  /// `drained_i` after `flush_o` rises.
   static constexpr uint32_t kKnobCplDelay = 0, kKnobDoneDelay = 1, kKnobFrameErr = 2,
-                            kKnobErrRow = 3, kKnobLastBit = 4;
+                            kKnobErrRow = 3, kKnobLastBit = 4, kKnobDrainDelay = 5;
 
   AccelCtrlShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     idle_inputs();
@@ -47,7 +50,7 @@ class AccelCtrlShim final : public AxilTopBase<V> {
   }
 
   bool write_config(uint32_t addr, const uint32_t* words, uint32_t n) override {
-    if (n < 1 || addr > kKnobLastBit) return false;
+    if (n < 1 || addr > kKnobDrainDelay) return false;
     knob_[addr] = words[0];
     return true;
   }
@@ -55,6 +58,7 @@ class AccelCtrlShim final : public AxilTopBase<V> {
   void reset(uint32_t cycles) override {
     cpl_.clear();
     done_at_ = kNever;
+    drain_at_ = kNever;
     for (auto& h : held_) h.valid = false;
     this->reset_with_mgr(cycles, [this] { idle_inputs(); }, [] {});
   }
@@ -79,6 +83,8 @@ class AccelCtrlShim final : public AxilTopBase<V> {
       const bool cpl = !cpl_.empty() && cpl_.front().due <= cycle_;
       top_->wr_cpl_valid_i = cpl;
       top_->wr_cpl_resp_i = cpl ? cpl_.front().resp : 0;
+      const bool drained = drain_at_ <= cycle_;
+      top_->drained_i = drained;
       top_->eval();
       const SubOut s = axil_sub(*top_);
       tmp_.clear();
@@ -113,6 +119,15 @@ class AccelCtrlShim final : public AxilTopBase<V> {
         const uint64_t due = cycle_ + 1 + rand(2) % (knob_[kKnobCplDelay] + 1);
         const uint64_t prev = cpl_.empty() ? 0 : cpl_.back().due + 1;
         cpl_.push_back(Cpl{due > prev ? due : prev, rows_ == knob_[kKnobErrRow] ? 2u : 0u});
+      }
+      if (drained) {
+        record(out, 4, 0, 0, nullptr);
+        drain_at_ = kNever;
+        done_at_ = kNever;
+        cpl_.clear();
+        for (auto& h : held_) h.valid = false;
+      } else if (top_->flush_o && drain_at_ == kNever) {
+        drain_at_ = cycle_ + 1 + rand(3) % (knob_[kKnobDrainDelay] + 1);
       }
       if (top_->table_valid_o) {
         uint32_t w[2] = {static_cast<uint32_t>(top_->table_index_o) | static_cast<uint32_t>(top_->table_id_o) << 16,
@@ -200,13 +215,15 @@ class AccelCtrlShim final : public AxilTopBase<V> {
     top_->frame_done_error_i = 0;
     top_->wr_cpl_valid_i = 0;
     top_->wr_cpl_resp_i = 0;
+    top_->drained_i = 0;
   }
 
   std::vector<uint32_t> tmp_;
   std::deque<Cpl> cpl_;
   uint64_t done_at_ = kNever;
+  uint64_t drain_at_ = kNever;
   uint32_t rows_ = 0;
-  uint32_t knob_[kKnobLastBit + 1] = {0, 0, 0, 0, 0};
+  uint32_t knob_[kKnobDrainDelay + 1] = {0, 0, 0, 0, 0, 0};
   Held held_[4];
   uint64_t port_errors_ = 0, first_port_error_ = 0;
 };

@@ -168,6 +168,14 @@ impl<B: RegBus> AccelHost<B> {
         self.write(REG_IMG_BASE_HI, (image >> 32) as u32)
     }
 
+    /// The image's row pitch in bytes (`ImgPitch`): row `r` starts at the image base + `r pitch`.
+    /// 0 asks for the smallest legal pitch (a row of `W` pixels rounded up to `P`); otherwise a
+    /// multiple of the row alignment (32 bytes serves every build) and at least the row's bytes,
+    /// else the frame is refused with `Status.code` `Pitch`.
+    pub fn set_pitch(&mut self, pitch: u32) -> Result<(), HostError<B::Error>> {
+        self.write(crate::regs::cube5_accel::REG_IMG_PITCH, pitch)
+    }
+
     /// Loads `words` into entries `first ..` of `table` (a `Table` encoding) through the window:
     /// one TableAddr write, then one TableData write per word (the core steps the index).
     pub fn load_table(
@@ -384,6 +392,11 @@ mod tests {
         assert_eq!(h.read_frame().unwrap(), f);
         h.set_bases(0x1_2345_6780, 0x8000_0000).unwrap();
         assert_eq!(h.read(REG_VOL_BASE_HI).unwrap(), 1);
+        h.set_pitch(2048).unwrap();
+        assert_eq!(
+            h.read(crate::regs::cube5_accel::REG_IMG_PITCH).unwrap(),
+            2048
+        );
         h.load_table(TABLE_CLASS, 10, &[1, 2, 3]).unwrap();
         assert_eq!(h.bus().table_log, vec![(1, 10, 1), (1, 11, 2), (1, 12, 3)]);
         assert!(h.load_table(9, 0, &[1]).is_err());

@@ -15,10 +15,12 @@
 // input streams: the fetch's input (a pending Block-table write, else the sweep), the buffer's
 // input (a section command, then the fetch's items up to the sweep's last), and the frame's input
 // (the frame registers through the configuration port on a frame's first section, the section
-// command, then the buffer's beams up to the section's last). The frame's read-out becomes one
-// 32-bit pixel per coxel, R, G, B, A each `min(2^ColorW - 1, (c (2^ColorW - 1) + 2^(AccW - 1))
-// >> AccW)` (docs/numerics/warp.md, "Base-plane codes", applied to all four channels), R in the
-// lowest byte. The frame's done goes to the core with the first read-out item of a frame (once the
+// command, then the buffer's beams up to the section's last). The frame's read-out (P pixels of a
+// row per item, OutLanes = P) becomes 32-bit pixels, R, G, B, A each `min(2^ColorW - 1,
+// (c (2^ColorW - 1) + 2^(AccW - 1)) >> AccW)` (docs/numerics/warp.md, "Base-plane codes", applied
+// to all four channels), R in the lowest byte; P pixels per writer item where a bus beat holds
+// them, else one beat's worth per item (each read-out item then takes 32 P / DataW writer items).
+// Rows are written whole items at ImgBase + r ImgPitch (the core's row commands). The frame's done goes to the core with the first read-out item of a frame (once the
 // last section's beams are in); the core ends the frame when every row's write has completed as
 // well. After an error item of the frame (a section it refused) the writer is fed zero pixels.
 module cube5_accel #(
@@ -129,7 +131,14 @@ module cube5_accel #(
   localparam int unsigned Q        = SbG * P;             // voxels per fetch item
   localparam int unsigned WordW    = cube5_vol_fetch_pkg::word_w(Q, BlockDim);
   localparam int unsigned PixelBytes = 4;
-  localparam int unsigned ItemW    = 8 * PixelBytes;
+  localparam int unsigned PixW     = 8 * PixelBytes;
+  // The image writer's item: the read-out's P pixels, or a bus beat where that is narrower
+  // (Pieces writer items per read-out item, L pixels each).
+  localparam int unsigned FrPixW   = P * PixW;
+  localparam int unsigned ItemW    = (FrPixW <= DataW) ? FrPixW : DataW;
+  localparam int unsigned Pieces   = FrPixW / ItemW;
+  localparam int unsigned PcW      = (Pieces > 1) ? $clog2(Pieces) : 1;
+  localparam int unsigned LogL     = $clog2(ItemW / PixW);
   localparam int unsigned LenW     = 16;
   localparam int unsigned FeCmdW   = cube5_vol_fetch_pkg::cmd_w(AddrW, MaxDim, BlockDim);
   localparam int unsigned FeOutW   = cube5_vol_fetch_pkg::out_w(Q, VoxelW, MaxDim, BlockDim);
@@ -139,7 +148,8 @@ module cube5_accel #(
   localparam int unsigned SbOutW   = cube5_section_buf_pkg::out_w(P, VoxelW);
   localparam int unsigned SbCmdW   = 4 * M + 6;
   localparam int unsigned FrInW    = cube5_frame_pkg::in_w(1, P, VoxelW, M);
-  localparam int unsigned FrOutW   = cube5_frame_pkg::out_w(AccW, ZW, ColorW);
+  localparam int unsigned FrOutW   = cube5_frame_pkg::out_lanes_w(P, AccW, ZW, ColorW);
+  localparam int unsigned CoxelW   = cube5_frame_pkg::coxel_w(AccW, ZW, ColorW);
   localparam int unsigned FrSecW   = cube5_frame_pkg::sec_cmd_w(M);
   localparam int unsigned FrCmdW   = 7 * M + 51;
   localparam int unsigned BlkW     = cube5_skewmem_pkg::blk_w(M, BlockDim);
@@ -183,6 +193,11 @@ module cube5_accel #(
   // ---------------------------------------------------------------------------
   // The control core
   // ---------------------------------------------------------------------------
+  logic              flush;        // the core's soft reset: drain the data path
+  logic              drain_q;      // the AXI4 port is quiet: the units are reset this cycle
+  logic              unit_rst_n;   // the units' reset: rst_ni, or the drain's one cycle
+  assign unit_rst_n = rst_ni && !drain_q;
+
   logic              fc_valid, fc_ready;   // fetch sweep
   logic [SweepW-1:0] fc_data;
   logic              sc_valid, sc_ready;   // buffer section
@@ -214,6 +229,7 @@ module cube5_accel #(
     .wr_cmd_valid_o(wc_valid), .wr_cmd_ready_i(wc_ready), .wr_cmd_data_o(wc_data),
     .frame_done_valid_i(done_valid), .frame_done_error_i(done_error),
     .wr_cpl_valid_i(cpl_valid), .wr_cpl_resp_i(cpl_data[1:0]),
+    .flush_o(flush), .drained_i(drain_q),
     .table_valid_o(tbl_valid), .table_id_o(tbl_id), .table_index_o(tbl_index),
     .table_data_o(tbl_data)
   );
@@ -285,6 +301,8 @@ module cube5_accel #(
   // ---------------------------------------------------------------------------
   // The fetch: a pending LUT write first, else the core's sweep.
   // ---------------------------------------------------------------------------
+  logic              fe_arvalid, fe_arready;   // the fetch's AR handshake, before the drain's gate
+  logic              wr_awvalid, wr_awready, wr_wvalid, wr_wready;  // the writer's AW and W
   logic              fe_in_valid;
   logic [FeCmdW-1:0] fe_in_data;
   logic              fe_out_valid, fe_out_ready;
@@ -299,12 +317,12 @@ module cube5_accel #(
     .AddrW(AddrW), .DataW(DataW), .P(Q), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim),
     .MaxBurst(MaxBurst), .Outstanding(Outstanding), .IdW(IdW)
   ) u_fetch (
-    .clk_i, .rst_ni,
+    .clk_i, .rst_ni(unit_rst_n),
     .in_valid_i(fe_in_valid), .in_ready_o(fe_in_ready), .in_data_i(fe_in_data),
     .out_valid_o(fe_out_valid), .out_ready_i(fe_out_ready), .out_data_o(fe_out_data),
     .err_o(fe_err),
     .m_axi_araddr_o, .m_axi_arlen_o, .m_axi_arsize_o, .m_axi_arburst_o, .m_axi_arid_o,
-    .m_axi_arvalid_o, .m_axi_arready_i, .m_axi_rdata_i, .m_axi_rresp_i, .m_axi_rlast_i,
+    .m_axi_arvalid_o(fe_arvalid), .m_axi_arready_i(fe_arready), .m_axi_rdata_i, .m_axi_rresp_i, .m_axi_rlast_i,
     .m_axi_rid_i, .m_axi_rvalid_i, .m_axi_rready_o
   );
 
@@ -324,7 +342,7 @@ module cube5_accel #(
   assign sc_ready     = !sb_items_q && sb_in_ready;
 
   always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
+    if (!unit_rst_n) begin
       sb_items_q <= 1'b0;
     end else if (sb_in_valid && sb_in_ready) begin
       sb_items_q <= sb_items_q ? !fe_out_data[FeLastBit] : 1'b1;
@@ -335,7 +353,7 @@ module cube5_accel #(
     .P(P), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim), .Section(Section),
     .ItemGroups(SbG)
   ) u_sbuf (
-    .clk_i, .rst_ni,
+    .clk_i, .rst_ni(unit_rst_n),
     .in_valid_i(sb_in_valid), .in_ready_o(sb_in_ready), .in_data_i(sb_in_data),
     .out_valid_o(sb_out_valid), .out_ready_i(sb_out_ready), .out_data_o(sb_out_data)
   );
@@ -386,7 +404,7 @@ module cube5_accel #(
   assign rc_ready     = fr_q == FrCmd && fr_in_ready;
 
   always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
+    if (!unit_rst_n) begin
       fr_q      <= FrIdle;
       reg_q     <= 3'd0;
       readout_q <= 1'b0;
@@ -421,9 +439,9 @@ module cube5_accel #(
     .BlockDim(BlockDim), .ClassIdxW(ClassIdxW), .MagIdxW(MagIdxW), .MagShift(MagShift),
     .ColorW(ColorW), .AlphaW(AlphaW), .RmLog2(RmLog2), .RmFracW(RmFracW), .DiffW(DiffW),
     .SpecW(SpecW), .ExtraW(ExtraW), .AccW(AccW), .ZW(ZW), .Shade(1), .Source(1),
-    .MaxSection(Section)
+    .OutLanes(P), .MaxSection(Section)
   ) u_frame (
-    .clk_i, .rst_ni,
+    .clk_i, .rst_ni(unit_rst_n),
     .in_valid_i(fr_in_valid), .in_ready_o(fr_in_ready), .in_data_i(fr_in_data),
     .out_valid_o(fr_out_valid), .out_ready_i(fr_out_ready), .out_data_o(fr_out_data),
     .cfg_valid_i(cfg_valid), .cfg_addr_i(cfg_addr), .cfg_data_i(cfg_data)
@@ -442,7 +460,7 @@ module cube5_accel #(
   assign done_error = done_pend_q ? done_err_q : fr_error;
 
   always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
+    if (!unit_rst_n) begin
       cur_last_q  <= 1'b0;
       last_in_q   <= 1'b0;
       done_pend_q <= 1'b0;
@@ -465,47 +483,70 @@ module cube5_accel #(
   end
 
   // ---------------------------------------------------------------------------
-  // Coxels to pixels: four codes, one register stage.
+  // Coxels to pixels: four codes per lane, one register stage; then the register's P pixels to
+  // the writer as Pieces items (one when they fit a bus beat).
   // ---------------------------------------------------------------------------
-  logic             pix_valid_q;
-  logic [ItemW-1:0] pix_q, pix_d;
-  logic             wr_dat_ready;
+  logic              pix_valid_q;
+  logic [FrPixW-1:0] pix_q, pix_d;
+  logic              wr_dat_ready;
+  logic [PcW-1:0]    piece_q;       // the writer item of pix_q that goes next
+  logic              last_piece;
+  logic [ItemW-1:0]  pix_piece;
 
-  for (genvar c = 0; c < 4; c++) begin : gen_code
-    logic [ChanW-1:0]          chan;
-    logic [ChanW+ColorW:0]     scaled;
-    logic [ChanW+ColorW-AccW:0] code;
-    assign chan   = fr_out_data[c*ChanW +: ChanW];
-    assign scaled = ((ChanW+ColorW+1)'(chan) << ColorW) - (ChanW+ColorW+1)'(chan)
-                    + ((ChanW+ColorW+1)'(1) << (AccW - 1));
-    assign code   = scaled[ChanW+ColorW:AccW];
-    assign pix_d[8*c +: 8] = 8'(code > (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1)
-                                ? (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1) : code);
-    logic unused_low;
-    assign unused_low = ^scaled[AccW-1:0];
+  for (genvar k = 0; k < P; k++) begin : gen_lane
+    for (genvar c = 0; c < 4; c++) begin : gen_code
+      logic [ChanW-1:0]          chan;
+      logic [ChanW+ColorW:0]     scaled;
+      logic [ChanW+ColorW-AccW:0] code;
+      assign chan   = fr_out_data[k*CoxelW + c*ChanW +: ChanW];
+      assign scaled = ((ChanW+ColorW+1)'(chan) << ColorW) - (ChanW+ColorW+1)'(chan)
+                      + ((ChanW+ColorW+1)'(1) << (AccW - 1));
+      assign code   = scaled[ChanW+ColorW:AccW];
+      assign pix_d[k*PixW + 8*c +: 8] = 8'(code > (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1)
+                                           ? (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1) : code);
+      logic unused_low;
+      assign unused_low = ^scaled[AccW-1:0];
+    end
+  end
+
+  if (Pieces > 1) begin : gen_pieces
+    assign last_piece = piece_q == PcW'(Pieces - 1);
+    always_comb begin
+      pix_piece = pix_q[ItemW-1:0];
+      for (int unsigned n = 1; n < Pieces; n++) begin
+        if (piece_q == PcW'(n)) pix_piece = pix_q[n*ItemW +: ItemW];
+      end
+    end
+  end else begin : gen_one_piece
+    assign last_piece = 1'b1;
+    assign pix_piece  = pix_q;
   end
 
   // After an error item of the frame (a section it refused) the frame's output is dropped and
   // the writer gets zero pixels for every pixel of the rows the core has commanded, so that the
   // frame ends (with IrqStatus.error, code Frame) instead of waiting for pixels that never come;
-  // the next frame's first section ends it. `owed_q`: pixels commanded minus pixels handed over.
+  // the next frame's first section ends it. `owed_q`: writer items commanded minus handed over.
   localparam int unsigned OwedW = 2 * DimW + 3;
   logic                    flush_q;
   logic signed [OwedW-1:0] owed_q;
   logic                    wr_dat_valid;
   logic [ItemW-1:0]        wr_dat;
 
-  assign fr_error     = fr_out_data[cube5_frame_pkg::coxel_w(AccW, ZW, ColorW)];
-  assign fr_out_ready = flush_q || !pix_valid_q || wr_dat_ready;
+  logic [LenW-1:0]         wc_items;  // a row command's writer items
+  assign wc_items     = wc_data[AddrW +: LenW] >> LogL;
+  assign fr_error     = fr_out_data[P*CoxelW];
+  assign fr_out_ready = flush_q || !pix_valid_q || (wr_dat_ready && last_piece);
   assign wr_dat_valid = flush_q ? owed_q > 0 : pix_valid_q;
-  assign wr_dat       = flush_q ? '0 : pix_q;
+  assign wr_dat       = flush_q ? '0 : pix_piece;
 
   always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
+    if (!unit_rst_n) begin
       pix_valid_q <= 1'b0;
+      piece_q     <= '0;
       flush_q     <= 1'b0;
       owed_q      <= '0;
     end else begin
+      if (!flush_q && pix_valid_q && wr_dat_ready) piece_q <= last_piece ? '0 : piece_q + PcW'(1);
       if (fr_out_ready) begin
         pix_valid_q <= fr_out_valid && !flush_q && !fr_error;
         if (fr_out_valid) pix_q <= pix_d;
@@ -513,37 +554,96 @@ module cube5_accel #(
       if (fr_out_valid && fr_out_ready && fr_error) begin
         flush_q     <= 1'b1;
         pix_valid_q <= 1'b0;
+        piece_q     <= '0;
       end
       if (fr_q == FrCmd && rc_valid && fr_in_ready && rc_data[FcFirst]) flush_q <= 1'b0;
-      owed_q <= owed_q + ((wc_valid && wc_ready) ? OwedW'(wc_data[AddrW +: LenW]) : '0)
+      owed_q <= owed_q + ((wc_valid && wc_ready) ? OwedW'(wc_items) : '0)
                        - OwedW'(wr_dat_valid && wr_dat_ready);
     end
   end
 
   // ---------------------------------------------------------------------------
-  // The image writer.
+  // The image writer: the core's row commands {addr, pixels} in writer items.
   // ---------------------------------------------------------------------------
   logic wr_err;
+  logic [AddrW+LenW-1:0] wr_cmd;
+  assign wr_cmd = {wc_items, wc_data[AddrW-1:0]};
 
   cube5_axi_wr #(
     .AddrW(AddrW), .DataW(DataW), .ItemW(ItemW), .LenW(LenW), .MaxBurst(MaxBurst),
     .Outstanding(WrOutstanding), .IdW(IdW)
   ) u_wr (
-    .clk_i, .rst_ni,
-    .in_valid_i(wc_valid), .in_ready_o(wc_ready), .in_data_i(wc_data),
+    .clk_i, .rst_ni(unit_rst_n),
+    .in_valid_i(wc_valid), .in_ready_o(wc_ready), .in_data_i(wr_cmd),
     .dat_valid_i(wr_dat_valid), .dat_ready_o(wr_dat_ready), .dat_data_i(wr_dat),
     .out_valid_o(cpl_valid), .out_ready_i(1'b1), .out_data_o(cpl_data),
     .err_o(wr_err),
     .m_axi_awaddr_o, .m_axi_awlen_o, .m_axi_awsize_o, .m_axi_awburst_o, .m_axi_awid_o,
-    .m_axi_awvalid_o, .m_axi_awready_i, .m_axi_wdata_o, .m_axi_wstrb_o, .m_axi_wlast_o,
-    .m_axi_wvalid_o, .m_axi_wready_i, .m_axi_bresp_i, .m_axi_bid_i, .m_axi_bvalid_i,
+    .m_axi_awvalid_o(wr_awvalid), .m_axi_awready_i(wr_awready), .m_axi_wdata_o, .m_axi_wstrb_o,
+    .m_axi_wlast_o, .m_axi_wvalid_o(wr_wvalid), .m_axi_wready_i(wr_wready), .m_axi_bresp_i, .m_axi_bid_i, .m_axi_bvalid_i,
     .m_axi_bready_o
   );
 
   assign err_o = fe_err || wr_err;
 
+  // ---------------------------------------------------------------------------
+  // Soft reset (docs/accel.md, "Soft reset"): on the core's flush the AXI4 port stops starting
+  // transactions: AR (and AW) is blocked from the first cycle no address is being offered, so no
+  // valid is dropped; W passes only the beats of write bursts whose AW was accepted (a burst's
+  // AWVALID never comes after its first WVALID in cube5_axi_wr). The port is quiet once no read
+  // or write burst is outstanding and every accepted burst's W beats are out: then the units and
+  // the sequencers are reset for one cycle (drain_q), which is the core's drained_i.
+  // ---------------------------------------------------------------------------
+  localparam int unsigned RdOutW = $clog2(Outstanding) + 2;
+  localparam int unsigned WrOutW = $clog2(WrOutstanding) + 2;
+  localparam int unsigned WOwedW = $clog2((WrOutstanding + 2) * MaxBurst) + 3;
+  logic                     ar_block_q, aw_block_q, w_open, quiet;
+  logic [RdOutW-1:0]        rd_out_q;   // read bursts accepted, last beat not yet in
+  logic [WrOutW-1:0]        wr_out_q;   // write bursts accepted, B not yet in
+  logic signed [WOwedW-1:0] w_owed_q;   // beats of accepted write bursts not yet sent
+
+  assign m_axi_arvalid_o = fe_arvalid && !ar_block_q;
+  assign fe_arready      = m_axi_arready_i && !ar_block_q;
+  assign m_axi_awvalid_o = wr_awvalid && !aw_block_q;
+  assign wr_awready      = m_axi_awready_i && !aw_block_q;
+  assign w_open          = !aw_block_q || w_owed_q > 0;
+  assign m_axi_wvalid_o  = wr_wvalid && w_open;
+  assign wr_wready       = m_axi_wready_i && w_open;
+  assign quiet = ar_block_q && aw_block_q && rd_out_q == '0 && wr_out_q == '0 && w_owed_q == '0;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      drain_q    <= 1'b0;
+      ar_block_q <= 1'b0;
+      aw_block_q <= 1'b0;
+      rd_out_q   <= '0;
+      wr_out_q   <= '0;
+      w_owed_q   <= '0;
+    end else begin
+      drain_q <= flush && quiet && !drain_q;
+      if (drain_q) begin
+        ar_block_q <= 1'b0;
+        aw_block_q <= 1'b0;
+      end else if (flush) begin
+        if (!m_axi_arvalid_o || m_axi_arready_i) ar_block_q <= 1'b1;
+        if (!m_axi_awvalid_o || m_axi_awready_i) aw_block_q <= 1'b1;
+      end
+      rd_out_q <= rd_out_q + RdOutW'(m_axi_arvalid_o && m_axi_arready_i)
+                           - RdOutW'(m_axi_rvalid_i && m_axi_rready_o && m_axi_rlast_i);
+      wr_out_q <= wr_out_q + WrOutW'(m_axi_awvalid_o && m_axi_awready_i)
+                           - WrOutW'(m_axi_bvalid_i && m_axi_bready_o);
+      w_owed_q <= w_owed_q + ((m_axi_awvalid_o && m_axi_awready_i)
+                              ? WOwedW'(m_axi_awlen_o) + WOwedW'(1) : '0)
+                           - WOwedW'(m_axi_wvalid_o && m_axi_wready_i);
+    end
+  end
+
   // The rest of the frame's output item (counters) and of the completion (its count).
   logic unused;
-  assign unused = ^{fr_out_data[FrOutW-1:4*ChanW], cpl_data[17:2]};
+  logic [P-1:0] unused_cox;
+  for (genvar k = 0; k < P; k++) begin : gen_unused_cox
+    assign unused_cox[k] = ^fr_out_data[k*CoxelW + 4*ChanW +: CoxelW - 4*ChanW];
+  end
+  assign unused = ^{fr_out_data[FrOutW-1:P*CoxelW+1], unused_cox, cpl_data[17:2]};
 
 endmodule

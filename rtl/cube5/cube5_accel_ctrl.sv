@@ -7,7 +7,9 @@
 // right to left when DX < 0), one command on each of the fetch, section-buffer and frame ports
 // (each port independent, its own back-pressure); once the frame port has its last section, one
 // row command per base-plane row on the writer port; then wait for the frame's done and every
-// row's completion and set IrqStatus.done (or .error). The table window's TableData writes become
+// row's completion and set IrqStatus.done (or .error). Ctrl.soft_reset while busy: no new
+// command, flush_o until the data path reports drained_i (its AXI4 transactions finished, its
+// units reset), then the frame ends with code Aborted. The table window's TableData writes become
 // writes on the table port, the index stepping after each.
 module cube5_accel_ctrl #(
   /// Pipelines: voxels per beam (1, 2, 4, 8).
@@ -22,7 +24,8 @@ module cube5_accel_ctrl #(
   parameter int unsigned AddrW = 32,
   /// Data width of the AXI4 read port: the volume base must be a multiple of DataW / 8.
   parameter int unsigned DataW = 64,
-  /// Bytes per base-plane pixel (the writer's item).
+  /// Bytes per base-plane pixel (the unit of the writer's `len`). Image rows start at multiples
+  /// of the row alignment min(P PixelBytes, DataW / 8) bytes (the image writer's item).
   parameter int unsigned PixelBytes = 4,
   /// Bits of the writer's `len` field.
   parameter int unsigned LenW = 16
@@ -73,6 +76,12 @@ module cube5_accel_ctrl #(
   /// The writer completed a row (cube5_axi_wr's completion, `resp`).
   input  logic        wr_cpl_valid_i,
   input  logic [1:0]  wr_cpl_resp_i,
+  // ---- soft reset: drain the data path ----
+  /// After Ctrl.soft_reset: the data path is to stop its AXI4 transactions and reset its units.
+  output logic        flush_o,
+  /// The data path is quiet and its units reset in this cycle: the frame ends (Aborted); every
+  /// command still offered is withdrawn.
+  input  logic        drained_i,
   // ---- table port (one write per TableData write) ----
   output logic        table_valid_o,
   output logic [3:0]  table_id_o,
@@ -94,6 +103,7 @@ module cube5_accel_ctrl #(
   localparam int unsigned RegVolBaseHi = cube5_accel_regs_pkg::RegVolBaseHi;
   localparam int unsigned RegImgBaseLo = cube5_accel_regs_pkg::RegImgBaseLo;
   localparam int unsigned RegImgBaseHi = cube5_accel_regs_pkg::RegImgBaseHi;
+  localparam int unsigned RegImgPitch = cube5_accel_regs_pkg::RegImgPitch;
   localparam int unsigned RegCycleLo = cube5_accel_regs_pkg::RegCycleLo;
   localparam int unsigned RegCycleHi = cube5_accel_regs_pkg::RegCycleHi;
   localparam int unsigned RegSampleLo = cube5_accel_regs_pkg::RegSampleLo;
@@ -112,7 +122,9 @@ module cube5_accel_ctrl #(
   localparam int unsigned Words = AxilWords;
   localparam int unsigned StepW = 16;
   localparam int unsigned VolMask = DataW / 8 - 1;
-  localparam int unsigned ImgMask = PixelBytes - 1;
+  /// Row alignment: the image writer's item, P pixels or a bus beat if that is narrower.
+  localparam int unsigned RowAlign = (P * PixelBytes < DataW / 8) ? P * PixelBytes : DataW / 8;
+  localparam int unsigned ImgMask = RowAlign - 1;
   /// Rows of the base plane fit M + 1 bits (H < 2 MaxDim); counters get one more.
   localparam int unsigned RowW = M + 2;
 
@@ -130,7 +142,7 @@ module cube5_accel_ctrl #(
       $fatal(1, "cube5_accel_ctrl: DataW = %0d is not a power of two in 16 P .. 16 B^3", DataW);
     if ((PixelBytes & (PixelBytes - 1)) != 0 || PixelBytes < 1 || PixelBytes > 128)
       $fatal(1, "cube5_accel_ctrl: PixelBytes = %0d is not a power of two up to 128", PixelBytes);
-    if (LenW < M + 1 || LenW > 32) $fatal(1, "cube5_accel_ctrl: LenW = %0d outside m + 1 .. 32", LenW);
+    if (LenW < M + 2 || LenW > 32) $fatal(1, "cube5_accel_ctrl: LenW = %0d outside m + 2 .. 32", LenW);
   end
 `endif
 
@@ -205,6 +217,7 @@ module cube5_accel_ctrl #(
   logic [17:0]      dx_q, dy_q;
   logic [3:0]       mode_q;           // Mode: render (3), tf2d (1)
   logic [AddrW-1:0] vbase_q, ibase_q;
+  logic [31:0]      pitch_q;
   logic [63:0]      vbase_w, ibase_w;
 
   assign vbase_w = {word(reg_q, RegVolBaseHi), word(reg_q, RegVolBaseLo)};
@@ -224,6 +237,7 @@ module cube5_accel_ctrl #(
       back_q  <= reg_q[RegSkip*32 + 1*M1 +: M1];
       vbase_q <= vbase_w[AddrW-1:0];
       ibase_q <= ibase_w[AddrW-1:0];
+      pitch_q <= word(reg_q, RegImgPitch);
     end
   end
 
@@ -311,19 +325,29 @@ module cube5_accel_ctrl #(
   logic [3:0]         code_a_q;
 
   // Stage 2 (the Check cycle, t0 + 3): the rules that need the products, the base plane, samples.
+  // A row as written: W rounded up to P pixels (the frame's read-out items), its bytes (the
+  // pitch when ImgPitch is 0; a multiple of the row alignment, which divides P PixelBytes).
+  localparam int unsigned RowBW = M + LogPix + 2;
+  logic [M+1:0]     wpad;
+  logic [RowBW-1:0] row_bytes;
   always_comb begin
     wpix = ni_q + M1'(abs_shift(sx_q));
+    wpad = ((M+2)'(wpix) + (M+2)'(P - 1)) >> LogP << LogP;
+    row_bytes = RowBW'(wpad) << LogPix;
     hpix = nj_q + M1'(abs_shift(sy_q));
     samples = (3*M+3)'(ninj_q) * (3*M+3)'(swept_q);
     if (code_a_q != cube5_accel_regs_pkg::CodeNone) code = code_a_q;
     else if (ni_q < M1'(2 * P) || (ni_nj1_q >> LogP) < (2*M+2)'(9)) code = cube5_accel_regs_pkg::CodeSmall;
     else if ((vbase_q & AddrW'(VolMask)) != '0) code = cube5_accel_regs_pkg::CodeVolAlign;
     else if ((ibase_q & AddrW'(ImgMask)) != '0) code = cube5_accel_regs_pkg::CodeImgAlign;
+    else if (pitch_q != '0 && ((pitch_q & 32'(ImgMask)) != '0 || pitch_q < 32'(row_bytes)))
+      code = cube5_accel_regs_pkg::CodePitch;
     else code = cube5_accel_regs_pkg::CodeNone;
   end
 
   // Stage 2's results.
-  logic [M:0]       w_q, h_q;
+  logic [M:0]       h_q;
+  logic [M+1:0]     w_q;           // pixels per row command: W rounded up to P
   logic [AddrW-1:0] row_step_q;
 
   // ---------------------------------------------------------------------------------------------
@@ -350,6 +374,7 @@ module cube5_accel_ctrl #(
   assign wr_fire    = wr_cmd_valid_o & wr_cmd_ready_i;
 
   assign run = state_q == StRun;
+  assign flush_o = run && abort_q;
   // A port offers its next command while the frame runs; after an abort only the one it holds.
   assign fetch_cmd_valid_o = run && fidx_q < nsec_q && (!abort_q || fhold_q);
   assign sbuf_cmd_valid_o  = run && sidx_q < nsec_q && (!abort_q || shold_q);
@@ -376,6 +401,7 @@ module cube5_accel_ctrl #(
     set_done = 1'b0;
     set_err  = 1'b0;
     finish   = 1'b0;
+    if (abort_stb && state_q != StIdle) abort_d = 1'b1;
     if (run) begin
       if (frame_done_valid_i) begin
         fdone_d = 1'b1;
@@ -385,10 +411,8 @@ module cube5_accel_ctrl #(
         cpl_d  = cpl_q + RowW'(1);
         werr_d = werr_q | (wr_cpl_resp_i != 2'b00);
       end
-      if (abort_stb) abort_d = 1'b1;
       if (abort_q) begin
-        finish = !fetch_cmd_valid_o && !sbuf_cmd_valid_o && !frame_cmd_valid_o && !wr_cmd_valid_o
-                 && cpl_q == row_q;
+        finish = drained_i;
       end else begin
         finish = fidx_q == nsec_q && sidx_q == nsec_q && gidx_q == nsec_q
                  && row_q == RowW'(h_q) && cpl_q == RowW'(h_q) && fdone_q;
@@ -403,6 +427,7 @@ module cube5_accel_ctrl #(
           done_d  = 1'b0;
           err_d   = 1'b0;
           code_d  = cube5_accel_regs_pkg::CodeNone;
+          abort_d = 1'b0;
         end
       end
       StAxes:  state_d = StSetup;
@@ -417,7 +442,6 @@ module cube5_accel_ctrl #(
         fdone_d = 1'b0;
         ferr_d  = 1'b0;
         werr_d  = 1'b0;
-        abort_d = 1'b0;
         if (code != cube5_accel_regs_pkg::CodeNone) begin
           state_d = StIdle;
           set_err = 1'b1;
@@ -523,9 +547,9 @@ module cube5_accel_ctrl #(
       ni_nj1_q <= ni_nj1;
     end
     if (state_q == StCheck) begin
-      w_q        <= wpix;
+      w_q        <= wpad;
       h_q        <= hpix;
-      row_step_q <= AddrW'(wpix) << LogPix;
+      row_step_q <= (pitch_q != '0) ? AddrW'(pitch_q) : AddrW'(row_bytes);
     end
     waddr_q <= waddr_d;
   end
@@ -589,18 +613,18 @@ module cube5_accel_ctrl #(
   assign unused = ^{reg_q, rd_stb, wr_stb, nk_q, vbase_w, ibase_w, sec_lo_w, a0_end, tx, ty, ninj, s_a0};
 
 `ifndef SYNTHESIS
-  // A stalled command holds its valid and payload.
+  // A stalled command holds its valid and payload (until the drain of a soft reset ends).
   assert property (@(posedge clk_i) disable iff (!rst_ni)
-      fetch_cmd_valid_o && !fetch_cmd_ready_i |=> fetch_cmd_valid_o && $stable(fetch_cmd_data_o))
+      fetch_cmd_valid_o && !fetch_cmd_ready_i && !(flush_o && drained_i) |=> fetch_cmd_valid_o && $stable(fetch_cmd_data_o))
     else $error("cube5_accel_ctrl: fetch command changed while stalled");
   assert property (@(posedge clk_i) disable iff (!rst_ni)
-      sbuf_cmd_valid_o && !sbuf_cmd_ready_i |=> sbuf_cmd_valid_o && $stable(sbuf_cmd_data_o))
+      sbuf_cmd_valid_o && !sbuf_cmd_ready_i && !(flush_o && drained_i) |=> sbuf_cmd_valid_o && $stable(sbuf_cmd_data_o))
     else $error("cube5_accel_ctrl: section-buffer command changed while stalled");
   assert property (@(posedge clk_i) disable iff (!rst_ni)
-      frame_cmd_valid_o && !frame_cmd_ready_i |=> frame_cmd_valid_o && $stable(frame_cmd_data_o))
+      frame_cmd_valid_o && !frame_cmd_ready_i && !(flush_o && drained_i) |=> frame_cmd_valid_o && $stable(frame_cmd_data_o))
     else $error("cube5_accel_ctrl: frame command changed while stalled");
   assert property (@(posedge clk_i) disable iff (!rst_ni)
-      wr_cmd_valid_o && !wr_cmd_ready_i |=> wr_cmd_valid_o && $stable(wr_cmd_data_o))
+      wr_cmd_valid_o && !wr_cmd_ready_i && !(flush_o && drained_i) |=> wr_cmd_valid_o && $stable(wr_cmd_data_o))
     else $error("cube5_accel_ctrl: write command changed while stalled");
 `endif
 

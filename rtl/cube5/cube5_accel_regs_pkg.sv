@@ -20,7 +20,8 @@ package cube5_accel_regs_pkg;
   localparam logic [3:0] CodeSmall    = 4'd6;
   // the volume base is not a multiple of the read bus's bytes
   localparam logic [3:0] CodeVolAlign = 4'd7;
-  // the image base is not a multiple of the pixel's bytes
+  // the image base is not a multiple of the row alignment `min(P PixelBytes, DataW / 8)` bytes (32
+  // bytes serve every build)
   localparam logic [3:0] CodeImgAlign = 4'd8;
   // the frame reported an error
   localparam logic [3:0] CodeFrame    = 4'd9;
@@ -28,6 +29,9 @@ package cube5_accel_regs_pkg;
   localparam logic [3:0] CodeWrite    = 4'd10;
   // `Ctrl.soft_reset` abandoned the frame
   localparam logic [3:0] CodeAborted  = 4'd11;
+  // ImgPitch is not 0 and either not a multiple of the row alignment or below a row's `W
+  // PixelBytes` bytes
+  localparam logic [3:0] CodePitch    = 4'd12;
 
   /// The `table` field of TableAddr: which on-chip table the table-load window writes.
   // block LUT of the volume (one bit per block: non-empty)
@@ -54,6 +58,7 @@ package cube5_accel_regs_pkg;
   localparam int unsigned RegVolBaseHi = 11;  // RW
   localparam int unsigned RegImgBaseLo = 12;  // RW
   localparam int unsigned RegImgBaseHi = 13;  // RW
+  localparam int unsigned RegImgPitch  = 14;  // RW
   localparam int unsigned RegCycleLo   = 16;  // RO
   localparam int unsigned RegCycleHi   = 17;  // RO
   localparam int unsigned RegSampleLo  = 18;  // RO
@@ -76,6 +81,7 @@ package cube5_accel_regs_pkg;
   localparam logic [31:0] RegVolBaseHiReset = 32'h0;
   localparam logic [31:0] RegImgBaseLoReset = 32'h0;
   localparam logic [31:0] RegImgBaseHiReset = 32'h0;
+  localparam logic [31:0] RegImgPitchReset = 32'h0;
   localparam logic [31:0] RegTableAddrReset = 32'h0;
   localparam logic [31:0] RegTableDataReset = 32'h0;
 
@@ -126,21 +132,21 @@ package cube5_accel_regs_pkg;
   /// highest offset first.
   localparam int unsigned AxilWords = 23;
   // a register is at the offset
-  localparam logic [22:0] AxilMapped = 23'b11111110011111111111111;
+  localparam logic [22:0] AxilMapped = 23'b11111110111111111111111;
   // the block keeps its value (RW, WO, W1C)
-  localparam logic [22:0] AxilStored = 23'b01100000011111111111101;
+  localparam logic [22:0] AxilStored = 23'b01100000111111111111101;
   // a read answers OKAY (RW, RO, W1C)
-  localparam logic [22:0] AxilReadable = 23'b10111110011111111111110;
+  localparam logic [22:0] AxilReadable = 23'b10111110111111111111110;
   // a read returns `ro_i` (RO)
   localparam logic [22:0] AxilRo = 23'b10011110000000000000010;
   // writing 1 clears a bit, `w1c_set_i` sets it (W1C)
   localparam logic [22:0] AxilW1c = 23'b00000000000000000000100;
   // reset sets the register to its AxilReset word
-  localparam logic [22:0] AxilHasReset = 23'b01100000011111111111101;
+  localparam logic [22:0] AxilHasReset = 23'b01100000111111111111101;
   // the bits a register keeps (its fields; all where a field's place depends on parameters)
   localparam logic [735:0] AxilMask = {
       32'h000fffff, 32'hffffffff, 32'h000fffff, 32'hffffffff, 32'hffffffff, 32'hffffffff,
-      32'hffffffff, 32'h00000000, 32'h00000000, 32'hffffffff, 32'hffffffff, 32'hffffffff,
+      32'hffffffff, 32'h00000000, 32'hffffffff, 32'hffffffff, 32'hffffffff, 32'hffffffff,
       32'hffffffff, 32'hffffffff, 32'h0000000f, 32'h0003ffff, 32'h0003ffff, 32'h00000007,
       32'hffffffff, 32'h00000003, 32'h00000003, 32'h000000f7, 32'h00000003
   };

@@ -16,6 +16,7 @@ use crate::variants::{variants_of, Variant};
 use cube5_model::accel_host::{AccelHost, FrameRegs, HostError, RegBus};
 use cube5_model::regs::cube5_accel::{TABLE_BLOCK, TABLE_CLASS, TABLE_OPACITY, TABLE_REFLECT};
 use cube5_model::units::cube5_accel::AccelConfig;
+use cube5_model::units::cube5_accel_ctrl::AccelCtrlConfig;
 use cube5_model::units::cube5_axil::{AxilCodec, AxilRecordKind, AxilTxn, RESP_OKAY};
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::units::cube5_vol_fetch::{dram_image, FetchCmd, VolFetchConfig};
@@ -34,6 +35,8 @@ pub struct AccelRtl {
     /// The frame inside (`Source = 1`), with the accelerator's variant: the model's image.
     pub frame: FrameRtl,
     pub fetch: VolFetchConfig,
+    /// The control core inside: its plan places the image's rows.
+    pub ctrl: AccelCtrlConfig,
     pub p: usize,
     pub section: usize,
 }
@@ -52,6 +55,7 @@ impl AccelRtl {
                 cfg: ac.frame,
             },
             fetch: ac.fetch,
+            ctrl: ac.ctrl(),
             p: ac.frame.p,
             section: ac.section as usize,
         })
@@ -204,6 +208,8 @@ pub struct AccelBench {
     lut_loaded: Option<Vec<(u32, u32, Vec<u32>)>>,
     /// The memory's AR, R and AW counters when the frame started.
     at_start: (u64, u64, u64),
+    /// The `ImgPitch` register the next frames are started with (0: the smallest pitch).
+    pub pitch: u32,
 }
 
 /// The image's place in memory: right after the volume, 4 KB aligned.
@@ -232,6 +238,7 @@ impl AccelBench {
             loaded: None,
             lut_loaded: None,
             at_start: (0, 0, 0),
+            pitch: 0,
         })
     }
 
@@ -344,8 +351,9 @@ impl AccelBench {
             c.r_beats,
             self.dut.axi_wr_counters().aw_accepted,
         );
+        let pitch = self.pitch;
         let mut host = AccelHost::new(&mut *self, 0);
-        start_frame(&mut host, &rtl, e, lut, img_base).map_err(host_err)?;
+        start_frame(&mut host, &rtl, e, lut, img_base, pitch).map_err(host_err)?;
         self.flush(None)?;
         Ok(img_base)
     }
@@ -391,7 +399,7 @@ impl AccelBench {
         let mut img = dram_image(vol, lut, VOL_BASE).map_err(|x| TbError::setup(self.name(), x))?;
         let end = img.base + img.bytes.len() as u64;
         let img_base = end.div_ceil(4096) * 4096;
-        let img_bytes = e.w * e.h * PIXEL_BYTES;
+        let img_bytes = self.pitch_bytes(e) * e.h;
         img.bytes
             .resize((img_base - img.base) as usize + img_bytes + 64, 0xee);
         let setup = AxiMemSetup {
@@ -417,13 +425,35 @@ impl AccelBench {
         Ok(img_base)
     }
 
-    /// Every byte of the image in memory against the model's pixels.
+    /// The bytes from one image row to the next for the frame of `e` (`ImgPitch`, or the smallest
+    /// pitch when it is 0: the control core's rule).
+    pub fn pitch_bytes(&self, e: &Expected) -> usize {
+        self.rtl.ctrl.pitch(self.pitch, e.w as u32) as usize
+    }
+
+    /// Every byte of the image in memory against the model's pixels: pixel `(r, q)` at the image
+    /// base + `q` pitch + 4 `r`; nothing written outside the rows (each `W` rounded up to `P`
+    /// pixels: the padding's values are unspecified).
     pub fn compare(&self, e: &Expected, img_base: u64, seed: u64) -> Result<(), TbError> {
         let mem = self.dut.axi_image()?;
         let at = (img_base - VOL_BASE) as usize;
+        let pitch = self.pitch_bytes(e);
+        let row = self.rtl.ctrl.row_pixels(e.w as u32) as usize * PIXEL_BYTES;
+        for (q, line) in mem[at..at + pitch * e.h].chunks(pitch).enumerate() {
+            if line[row..].iter().any(|&b| b != 0xee) {
+                return Err(self.protocol(
+                    self.dut.cycle(),
+                    format!(
+                        "bytes written between rows {q} and {} (pitch {pitch})",
+                        q + 1
+                    ),
+                ));
+            }
+        }
         for (i, c) in e.want.iter().enumerate() {
             let want: Vec<u8> = c.rgba.iter().map(|&v| self.rtl.code(v)).collect();
-            let got = &mem[at + PIXEL_BYTES * i..at + PIXEL_BYTES * (i + 1)];
+            let o = at + pitch * (i / e.w) + PIXEL_BYTES * (i % e.w);
+            let got = &mem[o..o + PIXEL_BYTES];
             if got != want.as_slice() {
                 let (r, q) = (i % e.w, i / e.w);
                 return Err(TbError::from(Mismatch {
@@ -443,7 +473,7 @@ impl AccelBench {
             }
         }
         // Nothing written past the image.
-        let past = &mem[at + PIXEL_BYTES * e.want.len()..];
+        let past = &mem[at + pitch * e.h..];
         if past.iter().any(|&b| b != 0xee) {
             return Err(self.protocol(self.dut.cycle(), "bytes written past the image".into()));
         }
@@ -465,6 +495,7 @@ fn start_frame(
     e: &Expected,
     lut: &BlockLut,
     img_base: u64,
+    pitch: u32,
 ) -> Result<(), HostError<TbError>> {
     let lut_loads = rtl.block_loads(lut).map_err(HostError::Bus)?;
     if host.bus().lut_loaded.as_ref() != Some(&lut_loads) {
@@ -493,6 +524,7 @@ fn start_frame(
         skip: word(5),
     })?;
     host.set_bases(VOL_BASE, img_base)?;
+    host.set_pitch(pitch)?;
     host.enable_irq(true, true)?;
     host.start()
 }

@@ -10,7 +10,7 @@ mod support;
 
 use cube5_model::accel_host::{AccelHost, HostError};
 use cube5_model::phantom::{bubbles_phantom, head_phantom};
-use cube5_model::regs::cube5_accel::CODE_FRAME;
+use cube5_model::regs::cube5_accel::{CODE_ABORTED, CODE_FRAME};
 use cube5_model::units::cube5_skewmem::BlockLut;
 use cube5_model::volume::Volume;
 use cube5_tb::accel::{AccelBench, AccelRtl, FrameRun, MemEnv, TOP};
@@ -101,8 +101,16 @@ impl Case {
         self.frame_of(&e, env, what)
     }
 
-    /// The frame of `e` under `env`.
+    /// The frame of `e` under `env`; the image's rows packed (ImgPitch 0) or, one frame in
+    /// three, a random legal pitch up to 7 row alignments longer than a row.
     fn frame_of(&mut self, e: &Expected, env: &MemEnv, what: &str) -> FrameRun {
+        let ctrl = self.bench.rtl.ctrl;
+        let row = ctrl.row_pixels(e.w as u32) as u64 * ctrl.pixel_bytes as u64;
+        self.bench.pitch = if self.rng.random_bool(0.3) {
+            (row + ctrl.row_align() * self.rng.random_range(1..8)) as u32
+        } else {
+            0
+        };
         let mem_seed = self.rng.random();
         let img_base = must(self.bench.start(e, &self.vol, &self.lut, env, mem_seed));
         let run = must(self.bench.finish(e, img_base, mem_seed));
@@ -110,10 +118,11 @@ impl Case {
         let [nx, ny, nz] = self.vol.dims;
         let render = e.units.render;
         eprintln!(
-            "{}: {nx}x{ny}x{nz} {} {render:?}{}{what}: {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
+            "{}: {nx}x{ny}x{nz} {} {render:?}{}{what}, pitch {}: {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
             rtl.variant,
             e.view,
             if e.units.tf2d { " 2-D TF" } else { "" },
+            self.bench.pitch_bytes(e),
             run.cycles,
             run.samples,
             run.rate(rtl.p),
@@ -209,6 +218,67 @@ fn reset_mid_frame_then_an_exact_frame() {
         &env,
         " after a reset mid-frame",
     );
+}
+
+/// `Ctrl.soft_reset` at random points of frames under random memories (latency 10..200, gaps on
+/// every channel): the frame ends with IrqStatus.error and code Aborted (or done, when it had
+/// ended already), the Sample counter holds the plan's count, no AXI4 burst is left outstanding
+/// on either direction (the memory's checker saw every transaction complete), and the next frame,
+/// started without a reset or a table reload, is exact. On the 64^3 build (a 64-bit bus, the
+/// read-out in two writer items per P pixels) and on the narrow 16^3 one (many resets).
+#[test]
+fn soft_reset_mid_frame_drains_then_an_exact_frame() {
+    let s = seed(0xacce19);
+    for (n, bits, resets, span) in [(64, 12, 4, 140_000u64), (16, 8, 12, 9_000)] {
+        let mut c = Case::new(rtl(4, n), head_phantom(n, bits).unwrap(), s);
+        let views = some_views();
+        let mut aborted = 0;
+        for k in 0..resets {
+            let env = MemEnv::random(&mut c.rng);
+            let e = c.expect(views[k % views.len()], [Composite, Mip][k % 2]);
+            let mem_seed = c.rng.random();
+            must(c.bench.start(&e, &c.vol, &c.lut, &env, mem_seed));
+            let at = c.rng.random_range(1..span);
+            must(c.bench.idle(at));
+            AccelHost::new(&mut c.bench, 0).soft_reset().unwrap();
+            must(c.bench.wait_irq(200_000));
+            let mut host = AccelHost::new(&mut c.bench, 0);
+            let ended = host.wait_done(1);
+            let code = host.status_code().unwrap();
+            let counters = host.counters().unwrap();
+            match ended {
+                Err(HostError::Frame(_)) => {
+                    assert_eq!(code, CODE_ABORTED, "soft reset after {at} cycles");
+                    aborted += 1;
+                }
+                Ok(_) => eprintln!("the frame had ended before the soft reset ({at} cycles)"),
+                Err(other) => panic!("soft reset after {at} cycles: {other}"),
+            }
+            let [ni, nj, nk] = [e.params.ni, e.params.nj, e.params.nk];
+            assert_eq!(
+                counters.samples,
+                (ni * nj * nk) as u64,
+                "the plan's samples"
+            );
+            let (rd, wr) = (c.bench.dut.axi_counters(), c.bench.dut.axi_wr_counters());
+            assert_eq!(
+                (rd.in_flight, wr.in_flight),
+                (0, 0),
+                "read and write bursts outstanding after the soft reset at {at} cycles"
+            );
+            eprintln!(
+                "{}: soft reset {at} cycles into the frame, ended after {} cycles",
+                c.bench.rtl.variant, counters.cycles
+            );
+            c.frame(
+                views[(k + 1) % views.len()],
+                Composite,
+                &env,
+                " after a soft reset",
+            );
+        }
+        assert!(aborted > 0, "no frame was aborted");
+    }
 }
 
 /// A frame whose last section the frame refuses (36 anchors in sections of 16: the last has 4,

@@ -12,15 +12,15 @@ mod support;
 
 use cube5_model::accel_host::{AccelHost, FrameRegs, RegBus};
 use cube5_model::regs::cube5_accel::{
-    CODE_ABORTED, CODE_AXIS_K, CODE_DIMS, CODE_FRAME, CODE_IMG_ALIGN, CODE_NONE, CODE_RENDER,
-    CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_CTRL, REG_CYCLE_HI,
-    REG_CYCLE_LO, REG_DIMS, REG_DX, REG_DY, REG_IMG_BASE_HI, REG_IMG_BASE_LO, REG_IRQ_ENABLE,
-    REG_IRQ_STATUS, REG_MODE, REG_SAMPLE_HI, REG_SAMPLE_LO, REG_SKIP, REG_STATUS, REG_STATUS_BUSY,
-    REG_STATUS_CODE, REG_TABLE_ADDR, REG_TABLE_DATA, REG_TABLE_POS, REG_VIEW, REG_VOL_BASE_HI,
-    REG_VOL_BASE_LO, TABLE_CLASS,
+    CODE_ABORTED, CODE_AXIS_K, CODE_DIMS, CODE_FRAME, CODE_IMG_ALIGN, CODE_NONE, CODE_PITCH,
+    CODE_RENDER, CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_CTRL,
+    REG_CYCLE_HI, REG_CYCLE_LO, REG_DIMS, REG_DX, REG_DY, REG_IMG_BASE_HI, REG_IMG_BASE_LO,
+    REG_IMG_PITCH, REG_IRQ_ENABLE, REG_IRQ_STATUS, REG_MODE, REG_SAMPLE_HI, REG_SAMPLE_LO,
+    REG_SKIP, REG_STATUS, REG_STATUS_BUSY, REG_STATUS_CODE, REG_TABLE_ADDR, REG_TABLE_DATA,
+    REG_TABLE_POS, REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO, TABLE_CLASS,
 };
 use cube5_model::units::cube5_accel_ctrl::{
-    AccelCtrlCodec, AccelCtrlConfig, CtrlRecord, CtrlRegs, Outcome, Port, PORTS,
+    AccelCtrlCodec, AccelCtrlConfig, CtrlRecord, CtrlRegs, Outcome, PORTS,
 };
 use cube5_model::units::cube5_axil::{AxilRecordKind, AxilTxn, RESP_OKAY};
 use cube5_tb::rtl::{RtlStream, Taken, Traffic};
@@ -36,6 +36,7 @@ const KNOB_DONE_DELAY: u32 = 1;
 const KNOB_FRAME_ERR: u32 = 2;
 const KNOB_ERR_ROW: u32 = 3;
 const KNOB_LAST_BIT: u32 = 4;
+const KNOB_DRAIN_DELAY: u32 = 5;
 
 /// The environment of one frame: delays, injected errors, back-pressure, host delays.
 #[derive(Debug, Clone)]
@@ -205,6 +206,7 @@ impl Bench {
             (REG_VOL_BASE_HI, (r.vol_base >> 32) as u32),
             (REG_IMG_BASE_LO, r.img_base as u32),
             (REG_IMG_BASE_HI, (r.img_base >> 32) as u32),
+            (REG_IMG_PITCH, r.img_pitch),
             (REG_IRQ_ENABLE, 3),
         ]
         .iter()
@@ -372,6 +374,7 @@ fn regs_of(
         skip: 0,
         vol_base: 0x40 * u64::from(cfg.data_w / 8),
         img_base: 0x100 * u64::from(cfg.pixel_bytes),
+        img_pitch: 0,
     }
 }
 
@@ -434,7 +437,17 @@ fn random_regs(rng: &mut ChaCha8Rng, cfg: &AccelCtrlConfig) -> CtrlRegs {
         mode,
         skip,
         vol_base: align(rng, u64::from(cfg.data_w / 8)),
-        img_base: align(rng, u64::from(cfg.pixel_bytes)),
+        img_base: align(rng, cfg.row_align()),
+        // ImgPitch: mostly 0 (the smallest), else aligned (some below the row), rarely not.
+        img_pitch: match rng.random_range(0..10) {
+            0..=4 => 0,
+            5 => rng.random::<u32>() >> rng.random_range(0..32),
+            _ => {
+                rng.random_range(0..=(4 * cfg.max_dim * cfg.pixel_bytes) as u64 / cfg.row_align())
+                    as u32
+                    * cfg.row_align() as u32
+            }
+        },
     }
 }
 
@@ -445,7 +458,7 @@ fn random_register_programs_match_the_model_stream_by_stream() {
         let mut rng = ChaCha8Rng::seed_from_u64(s ^ u64::from(cfg.max_dim));
         let mut b = Bench::open(v, cfg, s);
         let n = if cfg.max_dim > 64 { 400 } else { 1500 };
-        let mut codes = [0u32; 12];
+        let mut codes = [0u32; 13];
         for _ in 0..n {
             let regs = random_regs(&mut rng, &cfg);
             let env = Env::random(&mut rng);
@@ -531,6 +544,25 @@ fn directed_extremes_faces_directions_and_section_counts() {
                 CODE_IMG_ALIGN,
             ));
         }
+        // ImgPitch: not a multiple of the row alignment, below the row (W = 16 pixels here).
+        let a = cfg.row_align() as u32;
+        let row = 16 * cfg.pixel_bytes;
+        if a > 1 {
+            cases.push((
+                CtrlRegs {
+                    img_pitch: row.next_multiple_of(a) + a / 2,
+                    ..ok
+                },
+                CODE_PITCH,
+            ));
+        }
+        cases.push((
+            CtrlRegs {
+                img_pitch: row - a,
+                ..ok
+            },
+            CODE_PITCH,
+        ));
         for (regs, want) in cases {
             let code = must(frame(&mut b, &regs, &Env::quiet()));
             assert_eq!(code, want, "{v}: {regs:x?}");
@@ -604,7 +636,7 @@ fn reset_mid_frame_then_the_next_frame_is_exact() {
 }
 
 #[test]
-fn soft_reset_abandons_the_frame_after_the_commands_in_flight() {
+fn soft_reset_ends_the_frame_when_the_data_path_has_drained() {
     let s = seed(0xacc4);
     for (v, cfg) in configs::<AccelCtrlConfig>() {
         let mut b = Bench::open(v, cfg, s);
@@ -618,6 +650,7 @@ fn soft_reset_abandons_the_frame_after_the_commands_in_flight() {
                 ..Env::quiet()
             };
             b.env(&env);
+            b.knob(KNOB_DRAIN_DELAY, rng.random_range(0..100));
             must(b.write_regs(&regs));
             b.recs.clear();
             let t0 = must(b.write(REG_CTRL, 1));
@@ -642,28 +675,34 @@ fn soft_reset_abandons_the_frame_after_the_commands_in_flight() {
             );
             if code == CODE_ABORTED {
                 aborted += 1;
-                // Every row issued was completed before the core idled.
-                let issued = b
+                // The frame ends in the cycle of drained_i (te): no command after it, the
+                // interrupt in te + 1, the cycle counter te - t0, the plan's samples.
+                let drained: Vec<u64> = b
                     .recs
                     .iter()
-                    .filter(|t| {
-                        matches!(
-                            &t.value,
-                            CtrlRecord::Cmd {
-                                port: Port::Write,
-                                ..
-                            }
-                        )
-                    })
-                    .count();
-                let done = b
+                    .filter(|t| matches!(&t.value, CtrlRecord::Drained))
+                    .map(|t| t.cycle)
+                    .collect();
+                assert_eq!(drained.len(), 1, "{v}: one drain per soft reset");
+                let te = drained[0];
+                let late = b
                     .recs
                     .iter()
-                    .filter(|t| matches!(&t.value, CtrlRecord::Completion { .. }))
-                    .count();
-                assert_eq!(issued, done, "{v}: rows issued and completed");
-                let irq = b.recs.iter().any(|t| matches!(&t.value, CtrlRecord::Axil(r) if r.kind == AxilRecordKind::Irq && r.irq));
-                assert!(irq, "{v}: no interrupt after the abort (start {t0})");
+                    .find(|t| t.cycle > te && matches!(&t.value, CtrlRecord::Cmd { .. }));
+                assert!(late.is_none(), "{v}: a command after the drain: {late:?}");
+                let rise = b.recs.iter().find_map(|t| match &t.value {
+                    CtrlRecord::Axil(r) if r.kind == AxilRecordKind::Irq && r.irq => {
+                        Some((t.cycle & !0xffff_ffff) | u64::from(r.at))
+                    }
+                    _ => None,
+                });
+                assert_eq!(rise, Some(te + 1), "{v}: the interrupt (start {t0})");
+                let (_, lo) = must(b.read(REG_CYCLE_LO));
+                let (_, hi) = must(b.read(REG_CYCLE_HI));
+                assert_eq!(u64::from(lo) | u64::from(hi) << 32, te - t0, "{v}: cycles");
+                let (_, s_lo) = must(b.read(REG_SAMPLE_LO));
+                let samples = cfg.plan(&regs).expect("accepted").samples;
+                assert_eq!(u64::from(s_lo), samples, "{v}: samples");
             }
             assert_prefixes(&mut b, &regs, v);
             // Let a late frame done pass, clear, and check the next frame is exact.

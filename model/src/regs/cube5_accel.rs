@@ -24,7 +24,8 @@ pub const CODE_SKIP: u32 = 5;
 pub const CODE_SMALL: u32 = 6;
 /// the volume base is not a multiple of the read bus's bytes
 pub const CODE_VOL_ALIGN: u32 = 7;
-/// the image base is not a multiple of the pixel's bytes
+/// the image base is not a multiple of the row alignment `min(P PixelBytes, DataW / 8)` bytes (32
+/// bytes serve every build)
 pub const CODE_IMG_ALIGN: u32 = 8;
 /// the frame reported an error
 pub const CODE_FRAME: u32 = 9;
@@ -32,6 +33,9 @@ pub const CODE_FRAME: u32 = 9;
 pub const CODE_WRITE: u32 = 10;
 /// `Ctrl.soft_reset` abandoned the frame
 pub const CODE_ABORTED: u32 = 11;
+/// ImgPitch is not 0 and either not a multiple of the row alignment or below a row's `W PixelBytes`
+/// bytes
+pub const CODE_PITCH: u32 = 12;
 
 // The `table` field of TableAddr: which on-chip table the table-load window writes.
 /// block LUT of the volume (one bit per block: non-empty)
@@ -115,6 +119,11 @@ pub const REG_VOL_BASE_HI: u32 = 11;
 pub const REG_IMG_BASE_LO: u32 = 12;
 /// `ImgBaseHi` (RW): image base address, bits 63:32. Fields: .
 pub const REG_IMG_BASE_HI: u32 = 13;
+/// `ImgPitch` (RW): bytes from one image row's first pixel to the next row's (row r at ImgBase + r
+/// ImgPitch; only a row's W pixels are written): a multiple of the row alignment `min(P PixelBytes,
+/// DataW / 8)` (32 serves every build) and at least `W PixelBytes`; 0: the smallest such pitch, `W
+/// PixelBytes` rounded up to the alignment. Fields: .
+pub const REG_IMG_PITCH: u32 = 14;
 /// `CycleLo` (RO): clock cycles of the last (or current) frame, bits 31:0; reading it latches
 /// CycleHi (the read strobe). Fields: .
 pub const REG_CYCLE_LO: u32 = 16;
@@ -146,7 +155,7 @@ pub const REG_TABLE_POS_INDEX: Field = Field::new(0, 16);
 pub const REG_TABLE_POS_TABLE: Field = Field::new(16, 4);
 
 /// Every register, by offset.
-pub const REGISTERS: [Register; 21] = [
+pub const REGISTERS: [Register; 22] = [
     Register::new("Ctrl", 0, Access::Wo, Some(0x0)),
     Register::new("Status", 1, Access::Ro, None),
     Register::new("IrqStatus", 2, Access::W1c, Some(0x0)),
@@ -161,6 +170,7 @@ pub const REGISTERS: [Register; 21] = [
     Register::new("VolBaseHi", 11, Access::Rw, Some(0x0)),
     Register::new("ImgBaseLo", 12, Access::Rw, Some(0x0)),
     Register::new("ImgBaseHi", 13, Access::Rw, Some(0x0)),
+    Register::new("ImgPitch", 14, Access::Rw, Some(0x0)),
     Register::new("CycleLo", 16, Access::Ro, None),
     Register::new("CycleHi", 17, Access::Ro, None),
     Register::new("SampleLo", 18, Access::Ro, None),
@@ -174,7 +184,7 @@ pub const REGISTERS: [Register; 21] = [
 /// every bit where a field's place depends on parameters, 0 where no register is.
 pub const AXIL_MASK: [u32; 23] = [
     0x00000003, 0x000000f7, 0x00000003, 0x00000003, 0xffffffff, 0x00000007, 0x0003ffff, 0x0003ffff,
-    0x0000000f, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x00000000, 0x00000000,
+    0x0000000f, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x00000000,
     0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x000fffff, 0xffffffff, 0x000fffff,
 ];
 

@@ -4,6 +4,7 @@
 //! `cube5_section_buf`); this module is the one place that maps the top's parameters onto them.
 
 use crate::unit::UnitConfig;
+use crate::units::cube5_accel_ctrl::AccelCtrlConfig;
 use crate::units::cube5_frame::{FrameConfig, UNIT_WIDTH_PARAMS};
 use crate::units::cube5_vol_fetch::VolFetchConfig;
 use crate::{ModelError, Result};
@@ -81,6 +82,26 @@ pub struct AccelConfig {
     pub id_w: u32,
 }
 
+/// Bytes per base-plane pixel in memory (the top's `PixelBytes`: R, G, B, A codes).
+pub const PIXEL_BYTES: u32 = 4;
+
+impl AccelConfig {
+    /// The control core inside (cube5_accel.sv: its parameters from the top's), whose plan gives
+    /// the image's rows in memory.
+    pub fn ctrl(&self) -> AccelCtrlConfig {
+        AccelCtrlConfig {
+            p: self.frame.p as u32,
+            max_dim: self.fetch.max_dim,
+            block_dim: self.fetch.block_dim,
+            section: self.section,
+            addr_w: self.fetch.addr_w,
+            data_w: self.fetch.data_w,
+            pixel_bytes: PIXEL_BYTES,
+            len_w: 16,
+        }
+    }
+}
+
 impl UnitConfig for AccelConfig {
     const TOP: &'static str = "cube5_accel";
 
@@ -107,8 +128,10 @@ impl UnitConfig for AccelConfig {
         let mut fp = pick(FRAME_PARAMS);
         fp.extend(pick(UNIT_WIDTH_PARAMS));
         fp.push(("Source", 1));
-        // The frame's slice FIFOs hold one section (cube5_accel.sv: `.MaxSection(Section)`).
+        // The frame's slice FIFOs hold one section (cube5_accel.sv: `.MaxSection(Section)`), and
+        // its read-out gives P pixels of a row per item (`.OutLanes(P)`).
         fp.push(("MaxSection", get("Section")));
+        fp.push(("OutLanes", get("P")));
         let own = |n: &str| {
             u32::try_from(get(n)).map_err(|_| {
                 ModelError::Config(format!("cube5_accel: {n} = {} is out of range", get(n)))

@@ -13,9 +13,10 @@
 use crate::bits::{words_for, BitReader, BitWriter};
 use crate::error::{ModelError, Result};
 use crate::regs::cube5_accel::{
-    CODE_ABORTED, CODE_AXIS_K, CODE_DIMS, CODE_FRAME, CODE_IMG_ALIGN, CODE_NONE, CODE_RENDER,
-    CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_DX_DX, REG_MODE_RENDER,
-    REG_STATUS_CODE, REG_STATUS_DONE, REG_STATUS_ERROR, REG_VIEW_AXIS_K, REG_VIEW_K_REVERSED,
+    CODE_ABORTED, CODE_AXIS_K, CODE_DIMS, CODE_FRAME, CODE_IMG_ALIGN, CODE_NONE, CODE_PITCH,
+    CODE_RENDER, CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_DX_DX,
+    REG_MODE_RENDER, REG_STATUS_CODE, REG_STATUS_DONE, REG_STATUS_ERROR, REG_VIEW_AXIS_K,
+    REG_VIEW_K_REVERSED,
 };
 use crate::unit::StreamCodec;
 use crate::units::cube5_axil::{AxilCodec, AxilRecord, AxilTxn};
@@ -41,7 +42,7 @@ pub struct AccelCtrlConfig {
     pub addr_w: u32,
     /// Data width of the AXI4 read port (the volume base must be a multiple of `DataW / 8`).
     pub data_w: u32,
-    /// Bytes per base-plane pixel (the writer's item).
+    /// Bytes per base-plane pixel (the unit of the writer's `len`).
     pub pixel_bytes: u32,
     /// Bits of the writer's `len` field.
     pub len_w: u32,
@@ -90,13 +91,35 @@ impl AccelCtrlConfig {
                 self.pixel_bytes
             ));
         }
-        if self.len_w < self.m() + 1 || self.len_w > 32 {
+        if self.len_w < self.m() + 2 || self.len_w > 32 {
             return bad(format!(
-                "LenW {} outside m + 1 ..= 32 (a row is below 2 MaxDim pixels)",
+                "LenW {} outside m + 2 ..= 32 (a row is up to 2 MaxDim pixels)",
                 self.len_w
             ));
         }
         Ok(())
+    }
+
+    /// The row alignment in bytes: the image base and a nonzero `ImgPitch` are multiples of it
+    /// (the image writer's item: `P` pixels, or a bus beat where that is narrower).
+    pub fn row_align(&self) -> u64 {
+        u64::from((self.p * self.pixel_bytes).min(self.data_w / 8))
+    }
+
+    /// The pixels of a row as written for a base plane `w` pixels wide: `w` rounded up to `P`
+    /// (the frame's read-out items of `P` pixels; the padding's values are unspecified).
+    pub fn row_pixels(&self, w: u32) -> u32 {
+        w.next_multiple_of(self.p)
+    }
+
+    /// The bytes from one row's start to the next for a base plane `w` pixels wide: `ImgPitch`,
+    /// or when it is 0 the bytes of a row as written.
+    pub fn pitch(&self, img_pitch: u32, w: u32) -> u64 {
+        if img_pitch != 0 {
+            u64::from(img_pitch)
+        } else {
+            u64::from(self.row_pixels(w)) * u64::from(self.pixel_bytes)
+        }
     }
 
     /// `m = log2 MaxDim`.
@@ -188,7 +211,7 @@ impl AccelCtrlConfig {
         if !vol_base.is_multiple_of(u64::from(self.data_w / 8)) {
             return Err(CODE_VOL_ALIGN);
         }
-        if !img_base.is_multiple_of(u64::from(self.pixel_bytes)) {
+        if !img_base.is_multiple_of(self.row_align()) {
             return Err(CODE_IMG_ALIGN);
         }
         let params = FrameParams {
@@ -203,6 +226,12 @@ impl AccelCtrlConfig {
             dy,
         };
         let (w, h) = params.base_plane_size();
+        let row_bytes = u64::from(self.row_pixels(w as u32)) * u64::from(self.pixel_bytes);
+        let pitch = u64::from(regs.img_pitch);
+        if pitch != 0 && (!pitch.is_multiple_of(self.row_align()) || pitch < row_bytes) {
+            return Err(CODE_PITCH);
+        }
+        let pitch = self.pitch(regs.img_pitch, w as u32);
         let s = self.section;
         let nsec = ni.div_ceil(s);
         let blocks = dims.map(|n| n.div_ceil(self.block_dim));
@@ -229,8 +258,8 @@ impl AccelCtrlConfig {
         }
         let rows = (0..h as u64)
             .map(|r| RowCmd {
-                addr: (img_base + r * w as u64 * u64::from(self.pixel_bytes)) & self.addr_mask(),
-                len: w as u32,
+                addr: img_base.wrapping_add(r.wrapping_mul(pitch)) & self.addr_mask(),
+                len: self.row_pixels(w as u32),
             })
             .collect();
         Ok(Plan {
@@ -383,6 +412,8 @@ pub struct CtrlRegs {
     pub skip: u32,
     pub vol_base: u64,
     pub img_base: u64,
+    /// `ImgPitch` (0: the smallest legal pitch).
+    pub img_pitch: u32,
 }
 
 /// One section of the plan, in issue order.
@@ -442,6 +473,8 @@ pub enum CtrlRecord {
     Completion { resp: u32 },
     /// A write on the table port.
     Table { table: u32, index: u32, data: u32 },
+    /// The shim drove `drained_i` (its answer to `flush_o`).
+    Drained,
 }
 
 /// Words of a record after its two cycle words.
@@ -480,6 +513,7 @@ impl StreamCodec for AccelCtrlCodec {
             },
             1 => CtrlRecord::FrameDone { error: flag != 0 },
             2 => CtrlRecord::Completion { resp: flag & 3 },
+            4 => CtrlRecord::Drained,
             _ => CtrlRecord::Table {
                 table: at(1) >> 16 & 0xf,
                 index: at(1) & 0xffff,
@@ -541,6 +575,16 @@ mod tests {
             ..o
         };
         assert_eq!(o.code(), CODE_STEP);
+        // A soft reset reports Aborted before the frame's and the writer's errors (docs,
+        // "Soft reset": after the strobe they are not awaited).
+        let o = Outcome {
+            aborted: true,
+            frame_error: true,
+            write_error: true,
+            ..Outcome::default()
+        };
+        assert_eq!(o.code(), CODE_ABORTED);
+        assert_eq!(o.status(), CODE_ABORTED << 4 | 0x4);
     }
 
     fn regs(dims: [u32; 3], view: u32, dx: i32) -> CtrlRegs {
@@ -554,6 +598,7 @@ mod tests {
             skip: 0,
             vol_base: 0x1000,
             img_base: 0x8000,
+            img_pitch: 0,
         }
     }
 
@@ -593,7 +638,20 @@ mod tests {
         let p = c.plan(&regs([40, 32, 24], 2, -1)).unwrap();
         assert_eq!(p.base_plane, (41, 32));
         assert_eq!(p.rows.len(), 32);
-        assert_eq!(p.rows[1].addr, 0x8000 + 41 * 4);
+        // W = 41 pixels: rows of 44 pixels (P = 4) 176 bytes apart, unless ImgPitch says
+        // otherwise (a multiple of the row alignment, a 64-bit beat here: P = 4 pixels are 16
+        // bytes, wider than the bus).
+        assert_eq!(c.row_align(), 8);
+        assert_eq!((p.rows[1].addr, p.rows[1].len), (0x8000 + 176, 44));
+        let mut r = regs([40, 32, 24], 2, -1);
+        r.img_pitch = 1024;
+        assert_eq!(c.plan(&r).unwrap().rows[2].addr, 0x8000 + 2048);
+        r.img_pitch = 1028;
+        assert_eq!(c.plan(&r), Err(CODE_PITCH), "not a multiple of 8");
+        r.img_pitch = 168;
+        assert_eq!(c.plan(&r), Err(CODE_PITCH), "below 44 pixels");
+        r.img_pitch = 176;
+        assert!(c.plan(&r).is_ok());
         // DX = 2^16: W = ni + nk - 1.
         let p = c.plan(&regs([40, 32, 24], 2, 1 << 16)).unwrap();
         assert_eq!(p.base_plane.0, 40 + 23);
@@ -630,8 +688,12 @@ mod tests {
         r.vol_base = 4;
         assert_eq!(c.plan(&r), Err(CODE_VOL_ALIGN));
         let mut r = regs([40, 32, 24], 2, 0);
-        r.img_base = 2;
-        assert_eq!(c.plan(&r), Err(CODE_IMG_ALIGN));
+        r.img_base = 4;
+        assert_eq!(
+            c.plan(&r),
+            Err(CODE_IMG_ALIGN),
+            "rows start at multiples of 8 bytes"
+        );
         // Address bits above AddrW are dropped before the checks.
         let mut r = regs([40, 32, 24], 2, 0);
         r.vol_base = 1 << 40;
