@@ -434,6 +434,14 @@ module cube5_accel #(
     end
   end
 
+  localparam int unsigned WinKeyW = 2 * ($clog2(MaxDim) + 1);
+  localparam int unsigned WinCoxW = 4 * (AccW + 1) + 1;
+  logic                 win_park_valid, win_fin_valid, win_rq_valid, win_rs_ready;
+  logic [WinKeyW-1:0]   win_park_key, win_fin_key, win_rq_key;
+  logic [WinCoxW-1:0]   win_park_cox;
+  logic [P-1:0]         win_fin_mask;
+  logic [P*WinCoxW-1:0] win_fin_cox;
+
   cube5_frame #(
     .P(P), .MaxDim(MaxDim), .VoxelW(VoxelW), .WeightW(WeightW), .FracW(FracW),
     .BlockDim(BlockDim), .ClassIdxW(ClassIdxW), .MagIdxW(MagIdxW), .MagShift(MagShift),
@@ -444,7 +452,14 @@ module cube5_accel #(
     .clk_i, .rst_ni(unit_rst_n),
     .in_valid_i(fr_in_valid), .in_ready_o(fr_in_ready), .in_data_i(fr_in_data),
     .out_valid_o(fr_out_valid), .out_ready_i(fr_out_ready), .out_data_o(fr_out_data),
-    .cfg_valid_i(cfg_valid), .cfg_addr_i(cfg_addr), .cfg_data_i(cfg_data)
+    .cfg_valid_i(cfg_valid), .cfg_addr_i(cfg_addr), .cfg_data_i(cfg_data),
+    // Window = 0: the compositing-window streams stay idle (docs/accel.md, *Next*, wires them).
+    .park_valid_o(win_park_valid), .park_ready_i(1'b1), .park_key_o(win_park_key),
+    .park_cox_o(win_park_cox),
+    .fin_valid_o(win_fin_valid), .fin_ready_i(1'b1), .fin_key_o(win_fin_key),
+    .fin_mask_o(win_fin_mask), .fin_cox_o(win_fin_cox),
+    .rq_valid_o(win_rq_valid), .rq_ready_i(1'b1), .rq_key_o(win_rq_key),
+    .rs_valid_i(1'b0), .rs_ready_o(win_rs_ready), .rs_cox_i('0)
   );
 
   // The frame's done: its first read-out item (or its error item), passed on once the beams of
@@ -644,6 +659,8 @@ module cube5_accel #(
   for (genvar k = 0; k < P; k++) begin : gen_unused_cox
     assign unused_cox[k] = ^fr_out_data[k*CoxelW + 4*ChanW +: CoxelW - 4*ChanW];
   end
-  assign unused = ^{fr_out_data[FrOutW-1:P*CoxelW+1], unused_cox, cpl_data[17:2]};
+  assign unused = ^{fr_out_data[FrOutW-1:P*CoxelW+1], unused_cox, cpl_data[17:2],
+                    win_park_valid, win_park_key, win_park_cox, win_fin_valid, win_fin_key,
+                    win_fin_mask, win_fin_cox, win_rq_valid, win_rq_key, win_rs_ready};
 
 endmodule
