@@ -7,7 +7,7 @@
 
 use crate::error::{Mismatch, TbError};
 use crate::frame::{
-    items_for, pixels_of, ray_trail, Expected, FrameOut, FrameRtl, Render, Rendered, REG_MODE,
+    drive_pixels, items_for, ray_trail, Expected, FrameOut, FrameRtl, Render, Rendered, REG_MODE,
 };
 use crate::rtl::{RtlStream, Traffic};
 use crate::variants::variants_of;
@@ -68,7 +68,7 @@ impl StreamFrame {
     }
 
     fn beat_w(&self) -> u32 {
-        (self.0.p as u32 + 3) * self.0.trilin.voxel_w + 5
+        Beam::width(self.0.p as u32, self.0.trilin.voxel_w)
     }
 }
 
@@ -96,14 +96,8 @@ impl StreamCodec for StreamFrame {
                 w.put(u64::from(c.last), 1);
             }
             StreamIn::Beat(b) => {
-                let vw = self.0.trilin.voxel_w;
                 w.put(u64::from(KIND_BEAT), 1);
-                for &v in b.lanes.iter().chain([&b.lo, &b.hi0, &b.hi1]) {
-                    w.put(u64::from(v), vw);
-                }
-                for f in [b.row_first, b.row_last, b.slice_last, b.last, b.error] {
-                    w.put(u64::from(f), 1);
-                }
+                b.pack(&mut w, self.0.trilin.voxel_w);
             }
         }
         while w.len() < self.in_width() {
@@ -237,17 +231,8 @@ impl StreamBench {
         traffic: &Traffic,
     ) -> Result<Rendered, TbError> {
         let n = items_for(e.w, e.h, self.rtl.out_lanes);
-        let start = self.dut.cycle();
         let limit = 60 * (items.len() as u64 + n) + 200_000;
-        let driven = self.dut.drive(items, traffic, n, limit)?;
-        let (pixels, taken_at) = pixels_of(&driven.outputs, e.w, self.rtl.out_lanes);
-        Ok(Rendered {
-            pixels,
-            taken_at,
-            cycles: self.dut.cycle() - start,
-            protocol_errors: driven.stats.protocol_errors,
-            limit,
-        })
+        drive_pixels(&mut self.dut, items, e, self.rtl.out_lanes, traffic, limit)
     }
 
     /// Loads `e`, renders it in sections of `width` and compares every pixel with the frame
