@@ -1017,20 +1017,8 @@ impl FrameBench {
                 )));
             }
         }
+        got.all_out(e, rtl.variant, seed, &ctx())?;
         let n = e.w * e.h;
-        if got.pixels.len() != n {
-            return Err(TbError::Deadlock {
-                variant: rtl.variant.name.to_string(),
-                seed,
-                cycle: got.cycles,
-                what: format!(
-                    "{} of {n} pixels within {} cycles (deadlock or lost pixel; {})",
-                    got.pixels.len(),
-                    got.limit,
-                    ctx()
-                ),
-            });
-        }
         Ok(FrameStats {
             cycles: got.cycles,
             sweep: got.pixels[0].cycles,
@@ -1106,6 +1094,32 @@ pub struct Rendered {
     pub cycles: u64,
     pub protocol_errors: u64,
     pub limit: u64,
+}
+
+impl Rendered {
+    /// All W H pixels of `e` came out, else a `Deadlock` (`ctx`: the frame, for the report).
+    pub fn all_out(
+        &self,
+        e: &Expected,
+        variant: &Variant,
+        seed: u64,
+        ctx: &str,
+    ) -> Result<(), TbError> {
+        let n = e.w * e.h;
+        if self.pixels.len() == n {
+            return Ok(());
+        }
+        Err(TbError::Deadlock {
+            variant: variant.name.to_string(),
+            seed,
+            cycle: self.cycles,
+            what: format!(
+                "{} of {n} pixels within {} cycles (deadlock or lost pixel; {ctx})",
+                self.pixels.len(),
+                self.limit
+            ),
+        })
+    }
 }
 
 impl FrameBench {

@@ -278,19 +278,7 @@ impl StreamBench {
         if got.protocol_errors > 0 {
             return fail(0, "a stalled output changed".into(), String::new());
         }
-        let n = e.w * e.h;
-        if got.pixels.len() != n {
-            return Err(TbError::Deadlock {
-                variant: rtl.variant.name.to_string(),
-                seed,
-                cycle: got.cycles,
-                what: format!(
-                    "{} of {n} pixels within {} cycles ({ctx})",
-                    got.pixels.len(),
-                    got.limit
-                ),
-            });
-        }
+        got.all_out(e, rtl.variant, seed, &ctx)?;
         for (i, px) in got.pixels.iter().enumerate() {
             let (r, q) = (i % e.w, i / e.w);
             if px.error {
