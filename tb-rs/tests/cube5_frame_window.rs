@@ -23,11 +23,7 @@ use cube5_tb::TbError;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::rc::Rc;
-use support::seed;
-
-fn must<T>(r: Result<T, TbError>) -> T {
-    r.unwrap_or_else(|e| panic!("{e}"))
-}
+use support::{must, seed};
 
 /// The builds with the compositing window, `p` pipelines.
 fn window(p: usize) -> FrameRtl {
