@@ -100,11 +100,7 @@ impl StreamCodec for StreamFrame {
                 b.pack(&mut w, self.0.trilin.voxel_w);
             }
         }
-        while w.len() < self.in_width() {
-            let pad = (self.in_width() - w.len()).min(64);
-            w.put(0, pad);
-        }
-        w.finish(self.in_width())
+        w.finish_padded(self.in_width())
     }
 
     fn unpack_out(&self, words: &[u32]) -> FrameOut {

@@ -617,11 +617,7 @@ impl StreamCodec for SectionBufConfig {
                 w.put(u64::from(cmd.a0), self.m());
             }
         }
-        while w.len() < self.in_width() {
-            let pad = (self.in_width() - w.len()).min(32);
-            w.put(0, pad);
-        }
-        w.finish(self.in_width())
+        w.finish_padded(self.in_width())
     }
 
     fn unpack_out(&self, words: &[u32]) -> Beam {
