@@ -754,12 +754,17 @@ impl Processor {
         Outcome::Next(ray)
     }
 
+    /// The host's packets of a frame, in its order.
+    fn frame_packets(&self, cam: &Camera, proj: Projection) -> Result<Vec<RayPacket>> {
+        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
+        rays.iter().map(Self::packet).collect()
+    }
+
     /// Renders a frame: the host makes the rays (`host_rays`), offers the head of its list in
     /// every cycle with a free sorter slot (accepted when its queue has room), and takes back
     /// finished and overflowed rays (appending the latter to its list) until every ray finished.
     pub fn render(&self, cam: &Camera, proj: Projection) -> Result<ProcessorFrame> {
-        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
-        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let packets = self.frame_packets(cam, proj)?;
         self.run(packets, cam.width, cam.height, None, None, None)
     }
 
@@ -770,8 +775,7 @@ impl Processor {
         cam: &Camera,
         proj: Projection,
     ) -> Result<(ProcessorFrame, Vec<QueueOp>)> {
-        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
-        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let packets = self.frame_packets(cam, proj)?;
         let mut trace = FrontTrace::default();
         let f = self.run(packets, cam.width, cam.height, None, Some(&mut trace), None)?;
         Ok((f, trace.0))
@@ -785,8 +789,7 @@ impl Processor {
         cam: &Camera,
         proj: Projection,
     ) -> Result<(ProcessorFrame, Vec<FrontTraffic<RayPacket>>)> {
-        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
-        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let packets = self.frame_packets(cam, proj)?;
         let mut trace = FrontTrace::default();
         let f = self.run(packets, cam.width, cam.height, None, Some(&mut trace), None)?;
         Ok((f, trace.1))
@@ -799,8 +802,7 @@ impl Processor {
         cam: &Camera,
         proj: Projection,
     ) -> Result<(ProcessorFrame, Vec<Burst>)> {
-        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
-        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let packets = self.frame_packets(cam, proj)?;
         let mut bursts = Vec::new();
         let f = self.run(
             packets,
