@@ -397,16 +397,23 @@ fn throughput_one_request_per_clock_while_hitting_and_the_cycle_identity() {
 }
 
 /// The sample requests of a processor frame: the rays its frame loop pops (`render_traced`'s
-/// queue steps replayed on plain FIFOs); a popped rendering ray of a block that is not empty
-/// samples the cell `start >> 8` (an empty block's ray leaps, [357]).
+/// queue steps replayed on plain FIFOs of `queue_len` rays: a push into a full one overflows to
+/// the host); a popped rendering ray of a block that is not empty samples the cell `start >> 8`
+/// (an empty block's ray leaps, [357]).
 fn processor_requests(proc: &Processor, ops: &[QueueOp]) -> Vec<CacheReq> {
     let leap = proc.config().space_leap;
+    let len = proc.config().queue_len as usize;
     let empty = proc.empty_flags();
     let mut queues: HashMap<u32, VecDeque<RayPacket>> = HashMap::new();
     let mut reqs = Vec::new();
     for op in ops {
         match op {
-            QueueOp::Push(q, ray) => queues.entry(*q).or_default().push_back(*ray),
+            QueueOp::Push(q, ray) => {
+                let fifo = queues.entry(*q).or_default();
+                if fifo.len() < len {
+                    fifo.push_back(*ray);
+                }
+            }
             QueueOp::Pop(q) => {
                 let Some(ray) = queues.get_mut(q).and_then(VecDeque::pop_front) else {
                     continue;
