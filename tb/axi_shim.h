@@ -123,7 +123,31 @@ class AxiShim final : public AxiTopBase<V> {
   AxiShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     top_->m_axi_arready_i = 0;
     top_->m_axi_rvalid_i = 0;
+    if constexpr (HasConfigPort<V>::value) top_->cfg_valid_i = 0;
     top_->eval();
+  }
+
+  /// One write on the optional configuration port (as StreamShim's), the AXI4 port idle: no
+  /// address taken, no beat offered in that clock.
+  bool write_config(uint32_t addr, const uint32_t* words, uint32_t n_words) override {
+    if constexpr (HasConfigPort<V>::value) {
+      top_->in_valid_i = 0;
+      top_->out_ready_i = 0;
+      top_->m_axi_arready_i = 0;
+      top_->m_axi_rvalid_i = 0;
+      top_->cfg_valid_i = 1;
+      top_->cfg_addr_i = addr;
+      write_port(top_->cfg_data_i, words, n_words);
+      this->tick();
+      top_->cfg_valid_i = 0;
+      top_->eval();
+      return true;
+    } else {
+      (void)addr;
+      (void)words;
+      (void)n_words;
+      return false;
+    }
   }
 
   /// Resets the top and the subordinate together: bursts in flight are dropped on both sides. A

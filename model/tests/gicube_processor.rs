@@ -5,8 +5,10 @@
 use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
+use cube5_model::units::gicube_cache::CacheConfig;
 use cube5_model::units::gicube_processor::{
-    host_rays, psnr, HostOrder, Processor, ProcessorConfig, ProcessorFrame, Projection, QueueOrder,
+    host_rays, psnr, HostOrder, Processor, ProcessorConfig, ProcessorCounts, ProcessorFrame,
+    Projection, QueueOrder,
 };
 use cube5_model::volume::Volume;
 use glam::DVec3;
@@ -152,9 +154,11 @@ fn image_does_not_depend_on_queue_order() {
             "{order:?} {host_order:?}: the image changed"
         );
         assert_eq!(f.counts.samples, base.counts.samples);
-        // The cache misses at most once per voxel of a block per activation ([351]).
-        let side = (1u64 << cfg.block_log2) + 1;
-        assert!(f.counts.cache_misses <= f.counts.activations * side.pow(3));
+        // Eight corner reads per sample through the volume cache, mostly hits.
+        assert_eq!(
+            f.counts.cache_hits + f.counts.cache_misses,
+            8 * f.counts.samples
+        );
         assert!(f.counts.cache_hit_rate() > 0.5, "{:?}", f.counts);
     }
     // The orders really differ (the test is not comparing one schedule with itself).
@@ -596,4 +600,72 @@ fn jittered_head_within_psnr_of_its_f64_reference() {
     );
     assert!(db >= 40.0, "PSNR {db:.2} dB below 40 dB");
     assert!(f.rgb != g.rgb, "the jitter changed the image");
+}
+
+/// The samples read through the volume cache (contract, *The volume cache*): another cache
+/// geometry changes the hit and miss counts, never a pixel or another count; one AXI4 burst per
+/// missed line; a cache whose `MaxDim` does not exceed the domain is refused.
+#[test]
+fn the_volume_cache_changes_its_counts_not_the_image() {
+    let vol = head_phantom(32, 12).unwrap();
+    let tf = TransferFunction::head_default();
+    let cam = camera(&vol, 48);
+    let proj = Projection::Parallel;
+    let base = Processor::new(cfg_for(32), &vol, &tf).unwrap();
+    let (want, bursts) = base.render_cache_traced(&cam, proj).unwrap();
+    assert_eq!(bursts.len() as u64, want.counts.cache_misses);
+    assert_eq!(
+        want.counts.cache_hits + want.counts.cache_misses,
+        8 * want.counts.samples
+    );
+    let small = CacheConfig {
+        max_dim: 64,
+        sets: 4,
+        line_vox: 8,
+        ..CacheConfig::DEFAULT
+    };
+    let p = Processor::new(
+        ProcessorConfig {
+            cache: Some(small),
+            ..cfg_for(32)
+        },
+        &vol,
+        &tf,
+    )
+    .unwrap();
+    let f = p.render(&cam, proj).unwrap();
+    assert_eq!(f.rgb, want.rgb);
+    let strip = |c: ProcessorCounts| ProcessorCounts {
+        cache_hits: 0,
+        cache_misses: 0,
+        ..c
+    };
+    assert_eq!(strip(f.counts), strip(want.counts));
+    assert!(
+        f.counts.cache_misses > want.counts.cache_misses,
+        "four sets of short lines miss more: {:?} vs {:?}",
+        f.counts,
+        want.counts
+    );
+    println!(
+        "32^3 parallel: hit rate {:.3} (default cache at M = 64), {:.3} (4 sets of 8 voxels)",
+        want.counts.cache_hit_rate(),
+        f.counts.cache_hit_rate()
+    );
+    for bad in [
+        CacheConfig {
+            max_dim: 32,
+            ..CacheConfig::DEFAULT
+        },
+        CacheConfig {
+            word_w: 8,
+            ..CacheConfig::DEFAULT
+        },
+    ] {
+        let cfg = ProcessorConfig {
+            cache: Some(bad),
+            ..cfg_for(32)
+        };
+        assert!(Processor::new(cfg, &vol, &tf).is_err(), "{bad:?}");
+    }
 }

@@ -1,6 +1,7 @@
 // gicube_processor: the reused units' filelists (packages first in each), then its own files.
 -f rtl/gicube/gicube_queue_front.f
 -f rtl/gicube/gicube_sample.f
+-f rtl/gicube/gicube_cache.f
 rtl/gicube/gicube_step_div.sv
 rtl/gicube/gicube_step.sv
 rtl/cube5/cube5_frame_fifo.sv

@@ -3,13 +3,13 @@
 // and "The RTL"). The verified units, unchanged, in the circular ray pipeline:
 //
 //   host rays ─► gicube_queue_front (arbiter, bucketing, ray queues, sorter) ─► popped ray
-//        ▲             ▲ ring ray                    │ overflowed ray           │
+//        ▲             ▲ ring ray                    │ overflowed ray           │ (empty LUT)
 //        │             │                             ▼                          ▼
-//        └──── out ◄───┼──── finished ◄── merge ◄── out FIFO           volume banks (8-way, x&1,
-//                      │                    ▲                          y&1, z&1), empty LUT
-//                      └────────────────────┤                                   │
+//        └──── out ◄───┼──── finished ◄── merge ◄── out FIFO      sampling: cell ─► gicube_cache
+//                      │                    ▲                     (weights, colour: cell FIFO)  │
+//                      └────────────────────┤                                   │   AXI4 AR/R ◄┘
 //                     side FIFO (ray, leap) ┤◄──────────────────────────────────┤
-//                     gicube_sample ─► FIFO ┤◄──────────────── 8 voxels, weights┤
+//                     gicube_sample ─► FIFO ┤◄──────── 8 voxels (cache), weights┘
 //                     gicube_step   ─► FIFO ┘◄──────────────── start, dir, leap ┘
 //
 // One processor cycle is one item of the front end. The cycle's popped ray (or a bubble) enters
@@ -20,9 +20,10 @@
 // left, so that the host has seen an overflowed ray before the next offer (the model appends it
 // to the host's list at the end of its cycle).
 //
-// The volume sits on chip until gicube_cache (step 5) replaces it behind AXI4: eight block RAMs
-// by (x&1, y&1, z&1), loaded through the configuration port; the eight corners of a cell are one
-// read of each bank.
+// The volume is in memory behind the AXI4 read port, read through gicube_cache (its bank-major
+// layout, padded to MaxDim > N): a sampling ray's cell goes to the cache at dispatch (which waits
+// while the cache holds a request for its fills), its eight voxels to gicube_sample. A cache
+// stall delays processor cycles (the issue waits for the ring's head), never reorders them.
 module gicube_processor #(
   /// Block side n = 2^BlockLog2 voxels, 2..8.
   parameter int unsigned BlockLog2 = 2,
@@ -37,7 +38,15 @@ module gicube_processor #(
   /// Sample distance dr, U(4.8) voxels, 16..1024.
   parameter int unsigned Step      = 256,
   /// Ring latency in processor cycles, 1..16.
-  parameter int unsigned RingLat   = 8
+  parameter int unsigned RingLat   = 8,
+  /// The volume cache's AXI4 data bus bits (gicube_cache's DataW).
+  parameter int unsigned DataW       = 64,
+  /// Voxels of a cache line (gicube_cache's LineVox).
+  parameter int unsigned LineVox     = 16,
+  /// Lines per cache bank (gicube_cache's Sets).
+  parameter int unsigned Sets        = 32,
+  /// Line reads in flight at most (gicube_cache's Outstanding).
+  parameter int unsigned Outstanding = 8
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -54,17 +63,50 @@ module gicube_processor #(
   /// Consumer takes the output item this clock.
   input  logic out_ready_i,
   /// done (1: finished, 0: overflowed), ray (256), then the counts after it: rays_in,
-  /// rays_finished, rays_overflowed, samples, leaps, cycles (32 each); LSB first.
-  output logic [1+gicube_pkg::PacketW+6*32-1:0] out_data_o,
+  /// rays_finished, rays_overflowed, samples, leaps, cycles, cache_hits, cache_misses (32
+  /// each); LSB first.
+  output logic [1+gicube_pkg::PacketW+8*32-1:0] out_data_o,
 
-  /// Configuration write this clock (tables, empty flags, volume; they survive reset).
+  /// Configuration write this clock (tables, empty flags; they survive reset).
   input  logic cfg_valid_i,
   /// Region (top 2 bits): 0 gicube_sample's address (low 14 bits), 1 the empty flag of queue
-  /// (low bits), 2 voxel x + N' y + N'^2 z (N' = 2^clog2(N)).
-  input  logic [2+((3*$clog2(VolBlocks<<BlockLog2) > gicube_sample_pkg::CfgAddrW)
-                   ? 3*$clog2(VolBlocks<<BlockLog2) : gicube_sample_pkg::CfgAddrW)-1:0] cfg_addr_i,
-  /// gicube_sample's data; the empty flag in bit 0; the voxel in bits VoxelW-1:0.
-  input  logic [gicube_sample_pkg::CfgDataW-1:0] cfg_data_i
+  /// (low bits).
+  input  logic [2+gicube_sample_pkg::CfgAddrW-1:0] cfg_addr_i,
+  /// gicube_sample's data; the empty flag in bit 0.
+  input  logic [gicube_sample_pkg::CfgDataW-1:0] cfg_data_i,
+
+  /// Sticky: some volume read since reset came back with RRESP != OKAY (gicube_cache's).
+  output logic err_o,
+
+  // AXI4 read address channel (the volume in memory; no write channels).
+  /// Burst start address.
+  output logic [31:0] m_axi_araddr_o,
+  /// Beats in the burst minus one.
+  output logic [7:0] m_axi_arlen_o,
+  /// log2 of the bytes per beat.
+  output logic [2:0] m_axi_arsize_o,
+  /// INCR.
+  output logic [1:0] m_axi_arburst_o,
+  /// Always 0.
+  output logic [3:0] m_axi_arid_o,
+  /// Address valid.
+  output logic m_axi_arvalid_o,
+  /// Subordinate takes the address.
+  input  logic m_axi_arready_i,
+
+  // AXI4 read data channel.
+  /// Read data.
+  input  logic [DataW-1:0] m_axi_rdata_i,
+  /// Read response.
+  input  logic [1:0] m_axi_rresp_i,
+  /// Last beat of the burst.
+  input  logic m_axi_rlast_i,
+  /// Read ID (one ID).
+  input  logic [3:0] m_axi_rid_i,
+  /// Read data valid.
+  input  logic m_axi_rvalid_i,
+  /// Read data ready.
+  output logic m_axi_rready_o
 );
 
   localparam int unsigned PacketW  = gicube_pkg::PacketW;
@@ -82,12 +124,14 @@ module gicube_processor #(
   localparam int unsigned FeInW    = 3 + 2 * PacketW;
   localparam int unsigned FeOutW   = 7 + 3 * QueueW + LenW + TotW + 2 * PacketW;
   localparam int unsigned Side     = VolBlocks << BlockLog2;         // N
-  localparam int unsigned NW       = $clog2(Side);                   // bits of a voxel coordinate
-  localparam int unsigned HW       = NW - 1;                         // bits of a bank coordinate
-  localparam int unsigned BankAW   = 3 * HW;
-  // 2 region bits over the wider of gicube_sample's address and a voxel's index.
-  localparam int unsigned CfgAW    = 2 + ((3 * NW > gicube_sample_pkg::CfgAddrW)
-                                          ? 3 * NW : gicube_sample_pkg::CfgAddrW);
+  // The cache: the volume padded to the smallest power of two above N, a voxel per word.
+  localparam int unsigned MaxDim   = 1 << $clog2(Side + 1);
+  localparam int unsigned MW       = $clog2(MaxDim);                 // bits of a cache coordinate
+  localparam int unsigned WordW    = (VoxelW <= 8) ? 8 : 16;
+  localparam int unsigned CaOutW   = 8 * WordW + 8 + 2 * 32 + 16;    // vox, hit, hits, misses, stall
+  localparam int unsigned CellW    = 1 + 48 + 3 * PosFracW;          // lighting, colour, weights
+  // 2 region bits over gicube_sample's address.
+  localparam int unsigned CfgAW    = 2 + gicube_sample_pkg::CfgAddrW;
   localparam int unsigned SmInW    = gicube_sample_pkg::in_w(VoxelW);
   localparam int unsigned SmOutW   = gicube_sample_pkg::OutW;        // colour, opacity, terminated
   localparam int unsigned StInW    = 3 * PosW + 3 * 16 + QueueW + 1;
@@ -98,7 +142,7 @@ module gicube_processor #(
   localparam int unsigned FifoD    = (RingLat < 2) ? 2 : (1 << $clog2(RingLat));
   localparam int unsigned LeadW    = $clog2(RingLat + 1);
   localparam int unsigned CntW     = 32;
-  localparam int unsigned OutW     = 1 + PacketW + 6 * CntW;
+  localparam int unsigned OutW     = 1 + PacketW + 8 * CntW;
 
   if (BlockLog2 < 2 || BlockLog2 > 8) begin : gen_bad_block_log2
     $fatal(1, "gicube_processor: BlockLog2 must be 2..8");
@@ -111,20 +155,15 @@ module gicube_processor #(
   end
 
   // ---------------------------------------------------------------------------
-  // Configuration: the empty flags and the volume banks (gicube_sample takes region 0)
+  // Configuration: the empty flags (gicube_sample takes region 0)
   // ---------------------------------------------------------------------------
   logic [1:0]        cfg_region;
-  logic              cfg_sample, cfg_empty, cfg_voxel;
-  logic [NW-1:0]     cfg_x, cfg_y, cfg_z;
+  logic              cfg_sample, cfg_empty;
   logic [Queues-1:0] empty_q;
 
   assign cfg_region = cfg_addr_i[CfgAW-1 -: 2];
   assign cfg_sample = cfg_valid_i && (cfg_region == 2'd0);
   assign cfg_empty  = cfg_valid_i && (cfg_region == 2'd1);
-  assign cfg_voxel  = cfg_valid_i && (cfg_region == 2'd2);
-  assign cfg_x      = cfg_addr_i[0 +: NW];
-  assign cfg_y      = cfg_addr_i[NW +: NW];
-  assign cfg_z      = cfg_addr_i[2 * NW +: NW];
 
   // The block LUT of empty flags [357] (datapath state: no reset, written by the host).
   always_ff @(posedge clk_i) begin
@@ -176,6 +215,10 @@ module gicube_processor #(
   assign h_leap = sd_head[1];
   assign h_pkt  = sd_head[2 +: PacketW];
 
+  // The popped ray leaps: its block is empty and it is a rendering ray.
+  logic rec_leap;
+  assign rec_leap = empty_q[o_act_q] && (o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeRendering);
+
   // The outcome (contract, "One pipeline cycle on one ray"): a sample's colour and opacity unless
   // the ray leapt; terminated, or out of the volume: finished; else advanced to `next`.
   always_comb begin
@@ -196,12 +239,18 @@ module gicube_processor #(
   logic            of_empty, of_full, of_push_fin, of_push_ovf, of_push, of_pop;
   logic [OutW-1:0] of_d, of_q;
 
-  assign head_ready = (lead_q != '0) || (!sd_empty && (!h_ray || (!sm_empty && !tv_empty)));
+  // A leap's slot needs its step only; a sample's, its sample too.
+  assign head_ready = (lead_q != '0)
+      || (!sd_empty && (!h_ray || (!tv_empty && (h_leap || !sm_empty))));
   // A cycle is issued only while the host offers or a ray is in the processor (the model's frame
   // loop): idle cycles would step the sorter (its Noops move its scan), which the model's frame
   // does not see.
   assign issue      = !waiting_q && fe_in_ready && of_empty && head_ready && busy;
-  assign dispatch   = waiting_q && fe_out_valid;
+  // A sampling ray's cell goes to the cache in the dispatch clock: the dispatch waits while the
+  // cache holds a request for its fills.
+  logic smp_req, ca_in_ready;
+  assign smp_req    = waiting_q && fe_out_valid && o_popped && !rec_leap;
+  assign dispatch   = waiting_q && fe_out_valid && (!smp_req || ca_in_ready);
 
   // The front end's item: take, ring, host, ring ray, host ray.
   logic ring_v;
@@ -214,12 +263,12 @@ module gicube_processor #(
   // held, since the issue).
   assign in_ready_o = dispatch && o_host_taken;
 
-  logic rec_leap;
-  assign rec_leap = empty_q[o_act_q] && (o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeRendering);
 
   // Counts.
-  logic [CntW-1:0] c_in_q, c_fin_q, c_ovf_q, c_smp_q, c_leap_q, c_cyc_q;
-  logic [CntW-1:0] c_in_d, c_fin_d, c_ovf_d, c_smp_d, c_leap_d, c_cyc_d;
+  logic [CntW-1:0] c_in_q, c_fin_q, c_ovf_q, c_smp_q, c_leap_q, c_cyc_q, c_hit_q, c_mis_q;
+  logic [CntW-1:0] c_in_d, c_fin_d, c_ovf_d, c_smp_d, c_leap_d, c_cyc_d, c_hit_d, c_mis_d;
+  logic              ca_out_valid;
+  logic [CaOutW-1:0] ca_out;
 
   always_comb begin
     c_in_d   = c_in_q   + CntW'(dispatch && o_host_taken);
@@ -228,12 +277,15 @@ module gicube_processor #(
     c_leap_d = c_leap_q + CntW'(dispatch && o_popped && rec_leap);
     c_fin_d  = c_fin_q  + CntW'(issue && (lead_q == '0) && h_ray && h_done);
     c_cyc_d  = c_cyc_q  + CntW'(issue);
+    // The cache's running counts, as its last output gave them.
+    c_hit_d  = ca_out_valid ? ca_out[8 * WordW + 8 +: CntW] : c_hit_q;
+    c_mis_d  = ca_out_valid ? ca_out[8 * WordW + 8 + CntW +: CntW] : c_mis_q;
   end
 
   assign of_push_fin = issue && (lead_q == '0) && h_ray && h_done;
   assign of_push_ovf = dispatch && o_ring_ovf;
   assign of_push     = of_push_fin || of_push_ovf;
-  assign of_d        = {c_cyc_d, c_leap_d, c_smp_d, c_ovf_d, c_fin_d, c_in_d,
+  assign of_d        = {c_mis_d, c_hit_d, c_cyc_d, c_leap_d, c_smp_d, c_ovf_d, c_fin_d, c_in_d,
                         of_push_fin ? h_out : o_ovf_ray, of_push_fin};
   assign of_pop      = out_valid_o && out_ready_i;
 
@@ -249,6 +301,8 @@ module gicube_processor #(
       c_smp_q     <= '0;
       c_leap_q    <= '0;
       c_cyc_q     <= '0;
+      c_hit_q     <= '0;
+      c_mis_q     <= '0;
     end else begin
       if (issue) begin
         waiting_q <= 1'b1;
@@ -272,6 +326,8 @@ module gicube_processor #(
       c_smp_q  <= c_smp_d;
       c_leap_q <= c_leap_d;
       c_cyc_q  <= c_cyc_d;
+      c_hit_q  <= c_hit_d;
+      c_mis_q  <= c_mis_d;
     end
   end
 
@@ -292,57 +348,79 @@ module gicube_processor #(
   );
 
   // ---------------------------------------------------------------------------
-  // Fetch: the cell's eight corners, one from each bank, read in the dispatch clock
+  // Fetch: the sampling ray's cell through the volume cache (the volume in memory)
   // ---------------------------------------------------------------------------
-  logic [NW-1:0]    x0, y0, z0;
-  logic [2:0]       par;
-  logic [7:0]       outside;
-  logic [8*BankAW-1:0] raddr;
+  logic               ca_in_valid;
+  logic [3*MW-1:0]    ca_in;
+  logic               cell_push, cell_empty, cell_full;
+  logic [CellW-1:0]   cell_d, cell_q;
 
-  assign x0  = o_pop_ray[StartLsb + PosFracW +: NW];
-  assign y0  = o_pop_ray[StartLsb + PosW + PosFracW +: NW];
-  assign z0  = o_pop_ray[StartLsb + 2 * PosW + PosFracW +: NW];
-  assign par = {z0[0], y0[0], x0[0]};
+  // The cell's lowest voxel: the start's integer part (below N < MaxDim).
+  assign ca_in_valid = smp_req;
+  assign ca_in       = {o_pop_ray[StartLsb + 2 * PosW + PosFracW +: MW],
+                        o_pop_ray[StartLsb + PosW + PosFracW +: MW],
+                        o_pop_ray[StartLsb + PosFracW +: MW]};
+  // What the sample needs beside the voxels: lighting, colour and opacity, the weights.
+  assign cell_push   = smp_req && ca_in_ready;
+  assign cell_d      = {o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeLighting,
+                        o_pop_ray[ColLsb +: 48],
+                        o_pop_ray[StartLsb + 2 * PosW +: PosFracW],
+                        o_pop_ray[StartLsb + PosW +: PosFracW], o_pop_ray[StartLsb +: PosFracW]};
 
-  // Bank (px, py, pz) holds the corner whose coordinates have that parity: x0 + (px ^ x0&1).
-  for (genvar b = 0; b < 8; b++) begin : gen_addr
-    localparam logic [2:0] Bank = 3'(b);
-    logic [NW:0] xi, yi, zi;
-    logic        xc;
-    assign xc = Bank[0] ^ x0[0];
-    assign xi = {1'b0, x0} + {{NW{1'b0}}, xc};
-    logic        yc;
-    assign yc = Bank[1] ^ y0[0];
-    assign yi = {1'b0, y0} + {{NW{1'b0}}, yc};
-    logic        zc;
-    assign zc = Bank[2] ^ z0[0];
-    assign zi = {1'b0, z0} + {{NW{1'b0}}, zc};
-    assign outside[b] = (xi == (NW+1)'(Side)) || (yi == (NW+1)'(Side))
-                        || (zi == (NW+1)'(Side));
-    assign raddr[b * BankAW +: BankAW] = {zi[HW:1], yi[HW:1], xi[HW:1]};
+  gicube_cache #(
+    .MaxDim      (MaxDim),
+    .WordW       (WordW),
+    .DataW       (DataW),
+    .LineVox     (LineVox),
+    .Sets        (Sets),
+    .Outstanding (Outstanding),
+    .AddrW       (32)
+  ) u_cache (
+    .clk_i           (clk_i),
+    .rst_ni          (rst_ni),
+    .in_valid_i      (ca_in_valid),
+    .in_ready_o      (ca_in_ready),
+    .in_data_i       (ca_in),
+    .out_valid_o     (ca_out_valid),
+    .out_ready_i     (1'b1),
+    .out_data_o      (ca_out),
+    .err_o           (err_o),
+    .m_axi_araddr_o  (m_axi_araddr_o),
+    .m_axi_arlen_o   (m_axi_arlen_o),
+    .m_axi_arsize_o  (m_axi_arsize_o),
+    .m_axi_arburst_o (m_axi_arburst_o),
+    .m_axi_arid_o    (m_axi_arid_o),
+    .m_axi_arvalid_o (m_axi_arvalid_o),
+    .m_axi_arready_i (m_axi_arready_i),
+    .m_axi_rdata_i   (m_axi_rdata_i),
+    .m_axi_rresp_i   (m_axi_rresp_i),
+    .m_axi_rlast_i   (m_axi_rlast_i),
+    .m_axi_rid_i     (m_axi_rid_i),
+    .m_axi_rvalid_i  (m_axi_rvalid_i),
+    .m_axi_rready_o  (m_axi_rready_o)
+  );
+
+  // The cache holds two requests at most (the one at its check, its output register).
+  cube5_frame_fifo #(.Width(CellW), .Depth(4)) u_cell_fifo (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .clear_i (1'b0),
+    .push_i  (cell_push),
+    .d_i     (cell_d),
+    .pop_i   (ca_out_valid),
+    .q_o     (cell_q),
+    .empty_o (cell_empty),
+    .full_o  (cell_full)
+  );
+
+  // Corner c's voxel: the low VoxelW bits of the cache's word c.
+  logic [8*VoxelW-1:0] voxels;
+  for (genvar c = 0; c < 8; c++) begin : gen_voxel
+    assign voxels[c * VoxelW +: VoxelW] = ca_out[c * WordW +: VoxelW];
   end
 
-  logic [8*VoxelW-1:0] bank_q;
-  for (genvar b = 0; b < 8; b++) begin : gen_bank
-    cube5_shader_ram #(
-      .Depth (1 << BankAW),
-      .Width (VoxelW),
-      .AddrW (BankAW)
-    ) u_bank (
-      .clk_i   (clk_i),
-      .we_i    (cfg_voxel && ({cfg_z[0], cfg_y[0], cfg_x[0]} == 3'(b))),
-      .waddr_i ({cfg_z[HW:1], cfg_y[HW:1], cfg_x[HW:1]}),
-      .wdata_i (cfg_data_i[VoxelW-1:0]),
-      .re_i    (dispatch),
-      .raddr_i (raddr[b * BankAW +: BankAW]),
-      .rdata_o (bank_q[b * VoxelW +: VoxelW])
-    );
-  end
-
-  // The record of the dispatched cycle, one clock later (with the banks' data).
+  // The record of the dispatched cycle, one clock later.
   logic               f_v_q, f_ray_q, f_leap_q;
-  logic [2:0]         f_par_q;
-  logic [7:0]         f_out_q;
   logic [QueueW-1:0]  f_q_q;
   logic [PacketW-1:0] f_pkt_q;
 
@@ -358,42 +436,26 @@ module gicube_processor #(
     if (dispatch) begin
       f_ray_q  <= o_popped;
       f_leap_q <= rec_leap;
-      f_par_q  <= par;
-      f_out_q  <= outside;
       f_q_q    <= o_act_q;
       f_pkt_q  <= o_pop_ray;
-    end
-  end
-
-  // Corner c = x + 2y + 4z is in bank c ^ parity; a corner at N (past the domain) reads 0.
-  logic [8*VoxelW-1:0] voxels;
-  always_comb begin
-    voxels = '0;
-    for (int c = 0; c < 8; c++) begin
-      for (int b = 0; b < 8; b++) begin
-        if ((3'(c) ^ f_par_q) == 3'(b) && !f_out_q[b]) begin
-          voxels[c * VoxelW +: VoxelW] = bank_q[b * VoxelW +: VoxelW];
-        end
-      end
     end
   end
 
   // ---------------------------------------------------------------------------
   // The ring: the sample and the step side by side, never stalled, each into a FIFO
   // ---------------------------------------------------------------------------
-  logic              go;
+  logic              go, go_sample;
   logic [SmInW-1:0]  sm_in;
   logic [StInW-1:0]  st_in;
   logic              sm_in_ready, sm_out_valid, st_in_ready, st_out_valid;
   logic [SmOutW-1:0] sm_out;
   logic [StOutW-1:0] st_out;
 
-  assign go    = f_v_q && f_ray_q;
+  assign go        = f_v_q && f_ray_q;
+  assign go_sample = ca_out_valid;
   // voxels, weights (the start's fraction bits), no irradiance, colour and opacity, lighting.
-  assign sm_in = {f_pkt_q[TypeLsb +: 2] == gicube_pkg::RayTypeLighting, f_pkt_q[ColLsb +: 48],
-                  {8 * gicube_sample_pkg::IrrW{1'b0}}, 1'b0,
-                  f_pkt_q[StartLsb + 2 * PosW +: PosFracW], f_pkt_q[StartLsb + PosW +: PosFracW],
-                  f_pkt_q[StartLsb +: PosFracW], voxels};
+  assign sm_in = {cell_q[CellW-1 -: 49], {8 * gicube_sample_pkg::IrrW{1'b0}}, 1'b0,
+                  cell_q[0 +: 3 * PosFracW], voxels};
   // start, dir, queue, leap.
   assign st_in = {f_leap_q, f_q_q, f_pkt_q[DirLsb +: 48], f_pkt_q[StartLsb +: 3 * PosW]};
 
@@ -403,7 +465,7 @@ module gicube_processor #(
   ) u_sample (
     .clk_i       (clk_i),
     .rst_ni      (rst_ni),
-    .in_valid_i  (go),
+    .in_valid_i  (go_sample),
     .in_ready_o  (sm_in_ready),
     .in_data_i   (sm_in),
     .out_valid_o (sm_out_valid),
@@ -450,7 +512,7 @@ module gicube_processor #(
     .clear_i (1'b0),
     .push_i  (sm_out_valid),
     .d_i     (sm_out),
-    .pop_i   (pop_head && h_ray),
+    .pop_i   (pop_head && h_ray && !h_leap),
     .q_o     (sm_head),
     .empty_o (sm_empty),
     .full_o  (sm_full)
@@ -487,7 +549,8 @@ module gicube_processor #(
   // flags are covered by the assertions below (a record per cycle, RingLat cycles at most).
   logic unused;
   assign unused = ^{st_out[0 +: KW], st_out[KW + TvW +: QueueW], sd_full, sm_full, tv_full,
-                    of_full, sm_in_ready, st_in_ready, o_act_v, fe_out};
+                    of_full, sm_in_ready, st_in_ready, o_act_v, fe_out, cell_full, cell_empty,
+                    ca_out};
 
 `ifndef SYNTHESIS
   // A stalled output holds its item (STYLE.md rule 3).
@@ -496,7 +559,7 @@ module gicube_processor #(
     else $error("gicube_processor: output changed while stalled");
   // The units are never stalled: they take every ray of the ring.
   UnitsTakeEveryRay: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      go |-> sm_in_ready && st_in_ready)
+      (go || go_sample) |-> (!go || st_in_ready) && (!go_sample || sm_in_ready))
     else $error("gicube_processor: a ring unit refused a ray");
   // The ring holds RingLat records at most, so its FIFOs never overflow.
   RingFifosNeverOverflow: assert property (@(posedge clk_i) disable iff (!rst_ni)
@@ -506,6 +569,10 @@ module gicube_processor #(
   HostHeldUntilTaken: assert property (@(posedge clk_i) disable iff (!rst_ni)
       in_ready_o |-> in_valid_i)
     else $error("gicube_processor: host ray taken while not offered");
+  // Every cache output has its cell's record, and the cell FIFO never overflows.
+  CellFifoMatchesCache: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      !(ca_out_valid && cell_empty) && !(cell_push && cell_full && !ca_out_valid))
+    else $error("gicube_processor: the cell FIFO is out of step with the cache");
 `endif
 
 endmodule

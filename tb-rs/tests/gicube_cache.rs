@@ -397,16 +397,23 @@ fn throughput_one_request_per_clock_while_hitting_and_the_cycle_identity() {
 }
 
 /// The sample requests of a processor frame: the rays its frame loop pops (`render_traced`'s
-/// queue steps replayed on plain FIFOs); a popped rendering ray of a block that is not empty
-/// samples the cell `start >> 8` (an empty block's ray leaps, [357]).
+/// queue steps replayed on plain FIFOs of `queue_len` rays: a push into a full one overflows to
+/// the host); a popped rendering ray of a block that is not empty samples the cell `start >> 8`
+/// (an empty block's ray leaps, [357]).
 fn processor_requests(proc: &Processor, ops: &[QueueOp]) -> Vec<CacheReq> {
     let leap = proc.config().space_leap;
+    let len = proc.config().queue_len as usize;
     let empty = proc.empty_flags();
     let mut queues: HashMap<u32, VecDeque<RayPacket>> = HashMap::new();
     let mut reqs = Vec::new();
     for op in ops {
         match op {
-            QueueOp::Push(q, ray) => queues.entry(*q).or_default().push_back(*ray),
+            QueueOp::Push(q, ray) => {
+                let fifo = queues.entry(*q).or_default();
+                if fifo.len() < len {
+                    fifo.push_back(*ray);
+                }
+            }
             QueueOp::Pop(q) => {
                 let Some(ray) = queues.get_mut(q).and_then(VecDeque::pop_front) else {
                     continue;
@@ -424,8 +431,9 @@ fn processor_requests(proc: &Processor, ops: &[QueueOp]) -> Vec<CacheReq> {
 
 /// The processor model's own sample traffic replayed on the RTL: the 32^3 head phantom (blocks of
 /// 8) rendered by `gicube_processor`, its samples' cells as requests over the volume padded to
-/// `MaxDim`, under random latency, gaps and back-pressure. Hit rates of this cache and of the
-/// processor's block count are printed (docs/measurements.md).
+/// `MaxDim`, under random latency, gaps and back-pressure. The hit rate is printed
+/// (docs/measurements.md); on the processor model's own cache configuration its hits and misses
+/// are the frame's.
 #[test]
 fn processor_frame_sample_traffic_replays_on_the_rtl() {
     let vol = head_phantom(32, 12).unwrap();
@@ -467,12 +475,19 @@ fn processor_frame_sample_traffic_replays_on_the_rtl() {
         };
         let r = must(variant, cfg, s, &case);
         eprintln!(
-            "{variant}: processor frame ({} samples): this cache's hit rate {:.4} ({} lines read), the block count's {:.4}",
+            "{variant}: processor frame ({} samples): this cache's hit rate {:.4} ({} lines read), the processor model's {:.4}",
             reqs.len(),
             r.hit_rate(),
             r.misses,
             frame.counts.cache_hit_rate()
         );
+        if proc.cache_config().unwrap() == Some(cfg) {
+            assert_eq!(
+                (r.hits, r.misses),
+                (frame.counts.cache_hits, frame.counts.cache_misses),
+                "{variant}: the processor model's cache counts are this replay's"
+            );
+        }
         ran += 1;
     }
     assert!(ran > 0, "a configuration holds the padded 32^3 volume");

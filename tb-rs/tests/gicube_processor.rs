@@ -1,8 +1,11 @@
 //! Co-simulation of gicube_processor (the GI-Cube block processor for direct volume rendering:
-//! the queue front end, the sample and the step units in the ring, the volume in eight on-chip
-//! banks) against the processor model `Processor::render` at the RTL's ring latency
-//! (docs/numerics/gicube_processor.md, *The ring*, *The RTL*): whole images, every pixel, and the
-//! counts (rays in, finished, overflowed, samples, leaps, processor cycles) of both.
+//! the queue front end, the volume cache, the sample and the step units in the ring, the volume
+//! in the test bench's AXI4 memory) against the processor model `Processor::render` at the RTL's
+//! ring latency and cache (docs/numerics/gicube_processor.md, *The ring*, *The volume cache*,
+//! *The RTL*): whole images, every pixel, the counts (rays in, finished, overflowed, samples,
+//! leaps, processor cycles, cache hits and misses) of both, and the AR bursts of the cache's
+//! misses, under the subordinate's seeded random latency, gaps and bandwidth limit, its protocol
+//! checker silent.
 //!
 //! The test bench is the host: it offers the head of its list of ray packets, holds it until the
 //! RTL takes it, and appends every overflowed ray that comes back to the end of its list.
@@ -12,16 +15,17 @@ mod support;
 use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
+use cube5_model::units::cube5_axi_rd::Burst;
 use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
 use cube5_model::units::gicube_processor::{
     host_rays, Processor, ProcessorFrame, ProcessorOut, ProcessorRtlConfig, Projection,
 };
-use cube5_tb::rtl::{RtlStream, Traffic};
+use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::VecDeque;
-use support::{configs, seed};
+use support::{axi, axi_mem_setup, compare_bursts, configs, seed};
 
 type Bits = [u32; PACKET_WORDS];
 
@@ -59,18 +63,45 @@ impl Scene {
         self.proc.volume()
     }
 
-    fn model(&self) -> ProcessorFrame {
-        self.proc.render(&self.cam, self.proj).unwrap()
+    /// The model's frame and the bursts of its cache's misses.
+    fn model(&self) -> (ProcessorFrame, Vec<Burst>) {
+        self.proc.render_cache_traced(&self.cam, self.proj).unwrap()
     }
 }
 
+/// How the memory answers: latency `fixed + U(0..random)` cycles, AR and R gaps (per mille), a
+/// bandwidth limit of `num / den` bytes per cycle (0: none).
+#[derive(Clone, Copy, Debug)]
+struct Memory {
+    lat: (u32, u32),
+    gaps: (u32, u32),
+    bw: (u32, u32),
+}
+
+/// Random conditions: latency 10-200, gaps of up to 30 %, a bandwidth limit on half the seeds.
+fn random_memory(rng: &mut ChaCha8Rng, rtl: &ProcessorRtlConfig) -> Memory {
+    Memory {
+        lat: (10, 190),
+        gaps: (rng.random_range(0..300), rng.random_range(0..300)),
+        bw: axi::random_bandwidth(rng, rtl.data_w / 8),
+    }
+}
+
+/// A DDR-like channel (docs/accel.md): latency 100-120 cycles, 12 bytes per cycle.
+const DDR_LIKE: Memory = Memory {
+    lat: (100, 20),
+    gaps: (0, 0),
+    bw: (12, 1),
+};
+
 /// What the RTL rendered: the pixels, the last output's counts, the clocks from the first offer
-/// to the last output.
+/// to the last output, the AR bursts.
 struct RtlFrame {
     rgb: Vec<[u16; 3]>,
     last: ProcessorOut,
     outputs: u64,
     clocks: u64,
+    ars: Vec<cube5_tb::rtl::ArHandshake>,
 }
 
 /// How the host and the consumer behave: the probability that the host, having a ray, does not
@@ -104,7 +135,7 @@ fn run_host(
     let (mut finished, mut outputs, mut clocks) = (0usize, 0u64, 0u64);
     let mut offering = false;
     let mut last = ProcessorOut::default();
-    let limit = 20_000 + 4_000 * rays.len() as u64;
+    let limit = 100_000 + 40_000 * rays.len() as u64;
     while finished < rays.len() && stop_after.is_none_or(|s| clocks < s) {
         assert!(clocks < limit, "{name}: no progress after {clocks} clocks");
         if !list.is_empty() && !offering {
@@ -118,6 +149,10 @@ fn run_host(
         let expect = u64::from(items.is_empty());
         let d = dut.drive(&items, &traffic, expect, 1).unwrap();
         clocks += 1;
+        assert_eq!(
+            d.stats.protocol_errors, 0,
+            "{name}: a stalled output changed at clock {clocks}"
+        );
         if d.stats.consumed == 1 {
             list.pop_front();
             offering = false;
@@ -143,22 +178,39 @@ fn run_host(
             }
         }
     }
+    let c = dut.axi_counters();
+    assert_eq!(
+        c.protocol_errors,
+        0,
+        "{name}: AXI checker: {}",
+        dut.axi_first_error()
+    );
     RtlFrame {
         rgb,
         last,
         outputs,
         clocks,
+        ars: dut.axi_take_ar().unwrap(),
     }
 }
 
-/// Opens `variant` and loads the scene's tables, empty flags and volume.
+/// Opens `variant` with the scene's volume in its subordinate's memory (answering as `mem`
+/// says) and loads the tables and empty flags.
 fn open(
     variant: &'static Variant,
     rtl: ProcessorRtlConfig,
     scene: &Scene,
+    mem: Memory,
     s: u64,
 ) -> RtlStream<ProcessorRtlConfig> {
+    let img = scene.proc.rtl_memory().unwrap().expect("the RTL's cache");
+    let setup = AxiMemSetup {
+        declared_outstanding: rtl.outstanding,
+        ..axi_mem_setup((rtl.data_w / 8, 32), &img, mem.lat, mem.gaps, mem.bw, s)
+    };
     let mut dut = RtlStream::new(variant, rtl, s as u32).unwrap();
+    dut.axi_setup(&setup).unwrap();
+    dut.axi_load(img.base, &img.bytes).unwrap();
     for (a, d) in scene.proc.rtl_config_writes(&rtl).unwrap() {
         dut.write_config(a, &d).unwrap();
     }
@@ -210,24 +262,79 @@ fn check_frame(name: &str, what: &str, got: &RtlFrame, want: &ProcessorFrame, ex
             (c.rays_in, c.rays_overflowed, c.cycles),
             "{name} {what}: rays in, overflowed and processor cycles equal the model's"
         );
+        assert_eq!(
+            (u64::from(l.cache_hits), u64::from(l.cache_misses)),
+            (c.cache_hits, c.cache_misses),
+            "{name} {what}: cache hits and misses equal the model's"
+        );
     }
 }
 
-/// One frame at full speed, every pixel and every count equal to the model's.
+/// The AR bursts of a frame from reset equal the model cache's, in order.
+fn check_bursts(
+    variant: &'static Variant,
+    rtl: &ProcessorRtlConfig,
+    got: &RtlFrame,
+    want: &[Burst],
+    s: u64,
+) {
+    let size = (rtl.data_w / 8).trailing_zeros();
+    let n = compare_bursts(&got.ars, "AR", want, size, variant, s, |k| {
+        format!("the frame's burst #{k}")
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(n, want.len(), "{variant}: every missed line read once");
+}
+
+/// One frame from reset with the host always offering and the output taken at random with
+/// probability `1 - stall`, the memory as `mem` (random when `None`): every pixel, every count
+/// and every AR burst equal to the model's.
 fn exact_frame(
     variant: &'static Variant,
     rtl: ProcessorRtlConfig,
     px: u32,
     proj: Projection,
+    mem: Option<Memory>,
     s: u64,
 ) -> (RtlFrame, ProcessorFrame) {
     let scene = Scene::new(&rtl, px, proj);
-    let want = scene.model();
-    let mut dut = open(variant, rtl, &scene, s);
+    let (want, bursts) = scene.model();
     let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let got = run_host(&mut dut, &scene.packets(), px, FULL_SPEED, &mut rng, None);
-    check_frame(variant.name, &format!("{proj:?}"), &got, &want, true);
+    let mem = mem.unwrap_or_else(|| random_memory(&mut rng, &rtl));
+    let mut dut = open(variant, rtl, &scene, mem, s);
+    let b = Behaviour {
+        idle: 0.0,
+        stall: if mem.lat.1 > 20 { 0.3 } else { 0.0 },
+    };
+    let got = run_host(&mut dut, &scene.packets(), px, b, &mut rng, None);
+    check_frame(
+        variant.name,
+        &format!("{proj:?} ({mem:?})"),
+        &got,
+        &want,
+        true,
+    );
+    check_bursts(variant, &rtl, &got, &bursts, s);
     (got, want)
+}
+
+/// A frame's line: rays, overflow, samples, clocks, samples per clock, hit rate.
+fn frame_line(variant: &'static Variant, what: &str, got: &RtlFrame, want: &ProcessorFrame) {
+    let c = &want.counts;
+    eprintln!(
+        "{variant} {what}: {} rays, {} in, {} overflowed, {} samples, {} leaps, {} processor cycles, {} clocks: {:.3} samples/clock, {:.2} clocks/cycle, cache hit rate {:.4} ({} lines read)",
+        c.rays_made,
+        c.rays_in,
+        c.rays_overflowed,
+        c.samples,
+        c.leaps,
+        c.cycles,
+        got.clocks,
+        c.samples as f64 / got.clocks as f64,
+        got.clocks as f64 / c.cycles as f64,
+        c.cache_hit_rate(),
+        got.ars.len()
+    );
 }
 
 fn ci_configs() -> Vec<(&'static Variant, ProcessorRtlConfig)> {
@@ -237,6 +344,9 @@ fn ci_configs() -> Vec<(&'static Variant, ProcessorRtlConfig)> {
         .collect()
 }
 
+/// Parallel and perspective frames under random memory latency (10-200), gaps, bandwidth limits
+/// and output back-pressure, then with a DDR-like memory at full speed (the figures of
+/// docs/measurements.md).
 #[test]
 fn parallel_and_perspective_frames_equal_the_model_with_every_count() {
     for (variant, rtl) in ci_configs() {
@@ -245,20 +355,15 @@ fn parallel_and_perspective_frames_equal_the_model_with_every_count() {
             Projection::Parallel,
             Projection::Perspective { fov_deg: 30.0 },
         ] {
-            let (got, want) = exact_frame(variant, rtl, px, proj, seed(1900));
-            let c = &want.counts;
-            eprintln!(
-                "{variant} {proj:?}: {} rays, {} in, {} overflowed, {} samples, {} leaps, {} processor cycles, {} clocks: {:.3} samples/clock, {:.2} clocks/cycle",
-                c.rays_made,
-                c.rays_in,
-                c.rays_overflowed,
-                c.samples,
-                c.leaps,
-                c.cycles,
-                got.clocks,
-                c.samples as f64 / got.clocks as f64,
-                got.clocks as f64 / c.cycles as f64
-            );
+            for (k, mem) in [None, Some(DDR_LIKE)].into_iter().enumerate() {
+                let (got, want) = exact_frame(variant, rtl, px, proj, mem, seed(1900 + k as u64));
+                let what = if mem.is_some() {
+                    "DDR-like"
+                } else {
+                    "random memory"
+                };
+                frame_line(variant, &format!("{proj:?}, {what}"), &got, &want);
+            }
         }
     }
 }
@@ -272,7 +377,7 @@ fn forced_overflow_loses_no_ray() {
         .min_by_key(|(_, c)| c.queue_len << c.queue_w())
         .unwrap();
     let px = 2 * rtl.side();
-    let (got, want) = exact_frame(variant, rtl, px, Projection::Parallel, seed(1910));
+    let (got, want) = exact_frame(variant, rtl, px, Projection::Parallel, None, seed(1910));
     assert!(
         got.last.rays_overflowed > 0 && want.counts.rays_overflowed > 0,
         "{variant}: the frame overflows ({:?})",
@@ -295,10 +400,11 @@ fn idle_host_and_stalled_output_keep_the_image() {
     for (variant, rtl) in ci_configs() {
         let px = rtl.side();
         let scene = Scene::new(&rtl, px, Projection::Perspective { fov_deg: 30.0 });
-        let want = scene.model();
+        let (want, _) = scene.model();
         let s = seed(1920);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let mut dut = open(variant, rtl, &scene, s);
+        let mem = random_memory(&mut rng, &rtl);
+        let mut dut = open(variant, rtl, &scene, mem, s);
         for (b, exact) in [
             (
                 Behaviour {
@@ -323,17 +429,19 @@ fn idle_host_and_stalled_output_keep_the_image() {
 }
 
 /// A reset in the middle of a frame (after three clocks per processor cycle of the whole frame: a
-/// cycle takes at least five) drops the rays in the processor; the tables, flags and
-/// volume survive it, and the next frame is exact, counts and all.
+/// cycle takes at least five) drops the rays in the processor and the cache's bursts in flight
+/// (the subordinate is reset with it); the tables, flags and memory survive it, and the next
+/// frame is exact, counts, cache and bursts and all.
 #[test]
 fn mid_frame_reset_then_an_exact_frame() {
     for (variant, rtl) in ci_configs() {
         let px = rtl.side();
         let scene = Scene::new(&rtl, px, Projection::Parallel);
-        let want = scene.model();
+        let (want, bursts) = scene.model();
         let s = seed(1930);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
-        let mut dut = open(variant, rtl, &scene, s);
+        let mem = random_memory(&mut rng, &rtl);
+        let mut dut = open(variant, rtl, &scene, mem, s);
         let part = run_host(
             &mut dut,
             &scene.packets(),
@@ -349,9 +457,14 @@ fn mid_frame_reset_then_an_exact_frame() {
             part.outputs > 0 && (part.last.rays_finished as u64) < want.counts.rays_made,
             "{variant}: the reset falls mid-frame"
         );
-        dut.reset();
+        let dropped = axi::reset_leaves_nothing_in_flight(&mut dut, variant, s, false).unwrap();
+        eprintln!(
+            "{variant}: reset after {} clocks, {} of {} rays finished, {} bursts in flight dropped",
+            part.clocks, part.last.rays_finished, want.counts.rays_made, dropped
+        );
         let got = run_host(&mut dut, &scene.packets(), px, FULL_SPEED, &mut rng, None);
         check_frame(variant.name, "after a reset", &got, &want, true);
+        check_bursts(variant, &rtl, &got, &bursts, s);
     }
 }
 
@@ -366,10 +479,11 @@ fn a_model_with_another_ring_latency_counts_other_cycles() {
         ring_lat: rtl.ring_lat + 1,
         ..rtl
     };
-    let want = Scene::new(&other, px, Projection::Parallel).model();
+    let (want, _) = Scene::new(&other, px, Projection::Parallel).model();
     let s = seed(1940);
     let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let mut dut = open(variant, rtl, &scene, s);
+    let mem = random_memory(&mut rng, &rtl);
+    let mut dut = open(variant, rtl, &scene, mem, s);
     let got = run_host(&mut dut, &scene.packets(), px, FULL_SPEED, &mut rng, None);
     check_frame(variant.name, "other latency: image", &got, &want, false);
     assert_ne!(
@@ -392,18 +506,15 @@ fn large_frames_equal_the_model_with_every_count() {
             Projection::Parallel,
             Projection::Perspective { fov_deg: 30.0 },
         ] {
-            let (got, want) = exact_frame(variant, rtl, px, proj, seed(1950));
-            eprintln!(
-                "{variant} {proj:?}: {} rays, {} in, {} overflowed, {} samples, {} leaps, {} processor cycles, {} clocks: {:.3} samples/clock",
-                want.counts.rays_made,
-                want.counts.rays_in,
-                want.counts.rays_overflowed,
-                want.counts.samples,
-                want.counts.leaps,
-                want.counts.cycles,
-                got.clocks,
-                want.counts.samples as f64 / got.clocks as f64
-            );
+            for (k, mem) in [None, Some(DDR_LIKE)].into_iter().enumerate() {
+                let (got, want) = exact_frame(variant, rtl, px, proj, mem, seed(1950 + k as u64));
+                let what = if mem.is_some() {
+                    "DDR-like"
+                } else {
+                    "random memory"
+                };
+                frame_line(variant, &format!("{proj:?}, {what}"), &got, &want);
+            }
         }
     }
 }
@@ -415,7 +526,7 @@ fn large_frames_equal_the_model_with_every_count() {
 fn gate_level_netlist_renders_an_exact_frame() {
     for (variant, rtl) in support::gate_configs::<ProcessorRtlConfig>() {
         let px = 2 * rtl.side();
-        let (got, want) = exact_frame(variant, rtl, px, Projection::Parallel, seed(1960));
+        let (got, want) = exact_frame(variant, rtl, px, Projection::Parallel, None, seed(1960));
         eprintln!(
             "{variant}: {} rays, {} overflowed, {} samples in {} clocks",
             want.counts.rays_made, want.counts.rays_overflowed, want.counts.samples, got.clocks

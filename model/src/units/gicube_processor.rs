@@ -17,9 +17,11 @@ use glam::DVec3;
 use crate::camera::Camera;
 use crate::error::{ModelError, Result};
 use crate::transfer::TransferFunction;
+use crate::units::cube5_axi_rd::{AxiMemImage, Burst};
 use crate::units::cube5_compos::{corrected_alpha, rnd};
 use crate::units::cube5_shader::ClassLut;
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
+use crate::units::gicube_cache::{CacheConfig, CacheReq, VolumeCache};
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_queue_front::{Chooser, FrontTraffic, QueueFront};
 use crate::units::gicube_sample::{jitter_index, Jitter, SampleConfig, SampleIn, Sampler};
@@ -39,6 +41,9 @@ pub use crate::units::gicube_queue_front::SORTER_SLOTS;
 
 /// Largest ring latency, processor cycles (the RTL's `RingLat`: 1..=16).
 pub const MAX_RING_LATENCY: u32 = 16;
+/// Largest `MaxDim` of the default volume cache (contract, *The volume cache*): a larger domain's
+/// padded copy (`M^3` words) is not made, and its samples are not counted.
+pub const MAX_DEFAULT_CACHE_DIM: u32 = 256;
 
 /// How the processor picks the next active queue.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -94,6 +99,10 @@ pub struct ProcessorConfig {
     /// is re-queued (or finishes) in cycle `t + L`; 0: in its own cycle (the pipeline inside the
     /// cycle). The RTL `gicube_processor` sets it from its `RingLat` (1..=16).
     pub ring_latency: u32,
+    /// The volume cache the samples read through (`gicube_cache`, contract *The volume cache*):
+    /// `None`, `CacheConfig::DEFAULT`'s lines and sets at the smallest `MaxDim > N` (at least
+    /// 16; none beyond [`MAX_DEFAULT_CACHE_DIM`]); `Some`, exactly this one (`MaxDim > N`).
+    pub cache: Option<CacheConfig>,
 }
 
 impl ProcessorConfig {
@@ -110,6 +119,7 @@ impl ProcessorConfig {
         order: QueueOrder::Sorter,
         host_order: HostOrder::RowMajor,
         ring_latency: 0,
+        cache: None,
     };
 
     pub fn validate(&self) -> Result<()> {
@@ -181,7 +191,8 @@ pub struct ProcessorCounts {
     /// High-albedo photons: interactions that scattered, and that absorbed the photon.
     pub scatterings: u64,
     pub absorbed: u64,
-    /// Voxel reads (eight per sample) found in the block cache, and not found (fetched).
+    /// Voxel reads (eight per sample) found in the volume cache, and not found (its lines read
+    /// from memory): the `hit` masks of `VolumeCache::request` (contract, *The volume cache*).
     pub cache_hits: u64,
     pub cache_misses: u64,
 }
@@ -383,44 +394,27 @@ pub fn interaction_draw(bits: u32) -> u16 {
     (jenkins_hash(bits ^ INTERACTION_KEY) >> 16).min(65520) as u16
 }
 
-/// The volume cache as counted here ([351]): it holds the `(n + 1)^3` voxels a block's samples
-/// read; a voxel read is a miss the first time after the block's queue became the cache's block,
-/// a hit after that; sampling a ray of another block empties it. (Counts only: no timing.)
-struct BlockCache {
-    block: Option<u32>,
-    /// `n + 1`.
-    side: i64,
-    loaded: Vec<bool>,
+/// The volume cache of one frame (contract, *The volume cache*): the samples' requests, in order,
+/// and the bursts of their misses when traced.
+#[derive(Debug, Clone)]
+struct FrameCache {
+    cache: VolumeCache,
+    bursts: Option<Vec<Burst>>,
 }
 
-impl BlockCache {
-    fn new(block_log2: u32) -> Self {
-        let side = (1usize << block_log2) + 1;
-        Self {
-            block: None,
-            side: side as i64,
-            loaded: vec![false; side * side * side],
+impl FrameCache {
+    /// The eight corner voxels of the cell at `base`, read through the cache; the corners found
+    /// and not found are counted.
+    fn read(&mut self, base: [i64; 3], counts: &mut ProcessorCounts) -> [u32; 8] {
+        let [x, y, z] = base.map(|a| a as u32);
+        let step = self.cache.request(&CacheReq { x, y, z });
+        let found = u64::from(step.out.hit.count_ones());
+        counts.cache_hits += found;
+        counts.cache_misses += 8 - found;
+        if let Some(b) = self.bursts.as_mut() {
+            b.extend(step.bursts);
         }
-    }
-
-    /// Counts the eight reads of the cell at `base` for a sample of block `q` at `origin`.
-    fn read(&mut self, q: u32, origin: [u32; 3], base: [i64; 3], counts: &mut ProcessorCounts) {
-        if self.block != Some(q) {
-            self.block = Some(q);
-            self.loaded.fill(false);
-        }
-        let side = self.side;
-        for c in 0..8 {
-            let v = corner(base, c);
-            let l: [i64; 3] = std::array::from_fn(|a| v[a] - i64::from(origin[a]));
-            let i = (l[0] + side * (l[1] + side * l[2])) as usize;
-            if self.loaded[i] {
-                counts.cache_hits += 1;
-            } else {
-                self.loaded[i] = true;
-                counts.cache_misses += 1;
-            }
-        }
+        step.out.vox
     }
 }
 
@@ -461,6 +455,8 @@ pub struct Processor {
     photon_albedo: Option<u32>,
     /// Step, leap, advance and re-bucketing (`gicube_step`).
     stepper: Stepper,
+    /// The volume cache after reset over the padded volume (`None`: samples read the volume).
+    cache: Option<VolumeCache>,
 }
 
 impl Processor {
@@ -508,6 +504,11 @@ impl Processor {
                 vol_blocks: blocks,
                 step: cfg.step,
             })?,
+            cache: None,
+        };
+        p.cache = match p.cache_config()? {
+            Some(c) => Some(VolumeCache::new(c, &p.padded_words(c.max_dim))?),
+            None => None,
         };
         p.empty = (0..blocks * blocks * blocks)
             .map(|q| p.block_is_empty(q))
@@ -517,6 +518,43 @@ impl Processor {
 
     pub fn config(&self) -> ProcessorConfig {
         self.cfg
+    }
+
+    /// The volume cache's configuration (contract, *The volume cache*): `cfg.cache`, or the
+    /// default at the smallest `MaxDim > N` of at least 16 (`None` beyond
+    /// [`MAX_DEFAULT_CACHE_DIM`]). Refused: a `MaxDim` not above `N`, a word narrower than a voxel.
+    pub fn cache_config(&self) -> Result<Option<CacheConfig>> {
+        let Some(c) = self.cfg.cache else {
+            let m = (self.side + 1).next_power_of_two().max(16);
+            return Ok((m <= MAX_DEFAULT_CACHE_DIM).then_some(CacheConfig {
+                max_dim: m,
+                ..CacheConfig::DEFAULT
+            }));
+        };
+        if c.max_dim <= self.side || c.word_w < self.vol.bits {
+            return Err(ModelError::Config(format!(
+                "gicube processor: a volume cache of MaxDim {} and WordW {} for a domain of {} voxels a side of {} bits (need MaxDim above the side, WordW at least the voxel)",
+                c.max_dim, c.word_w, self.side, self.vol.bits
+            )));
+        }
+        Ok(Some(c))
+    }
+
+    /// The volume padded with zeros to `m^3` words, x fastest (the cache's memory).
+    fn padded_words(&self, m: u32) -> Vec<u32> {
+        let m = i64::from(m);
+        (0..m * m * m)
+            .map(|i| self.vol.get(i % m, (i / m) % m, i / (m * m)))
+            .collect()
+    }
+
+    /// The memory image the RTL's AXI4 port reads (contract, *The RTL*): the padded volume in
+    /// the cache's bank-major layout at byte address 0 (`None`: no cache).
+    pub fn rtl_memory(&self) -> Result<Option<AxiMemImage>> {
+        match self.cache_config()? {
+            Some(c) => Ok(Some(c.image(&self.padded_words(c.max_dim))?)),
+            None => Ok(None),
+        }
     }
 
     /// The loaded volume.
@@ -589,14 +627,9 @@ impl Processor {
 
     /// The classified, composited sample at the ray's position (the pipeline's datapath). A
     /// lighting ray deposits into `irr` first; a rendering ray is lit by the loaded irradiance.
-    fn sample(&self, ray: &mut RayPacket, irr: Option<&mut [u16]>) -> bool {
+    fn sample(&self, ray: &mut RayPacket, voxels: [u32; 8], irr: Option<&mut [u16]>) -> bool {
         let p = ray.start;
         let base = p.map(|c| i64::from(c >> POS_FRAC_W));
-        let mut voxels = [0u32; 8];
-        for (c, v) in voxels.iter_mut().enumerate() {
-            let [x, y, z] = corner(base, c);
-            *v = self.vol.get(x, y, z);
-        }
         let mask = (1u32 << POS_FRAC_W) - 1;
         let weights = p.map(|c| c & mask);
         let lighting = ray.ray_type == RayType::Lighting;
@@ -661,7 +694,7 @@ impl Processor {
         mut ray: RayPacket,
         q: u32,
         counts: &mut ProcessorCounts,
-        cache: &mut BlockCache,
+        cache: Option<&mut FrameCache>,
         irr: Option<&mut [u16]>,
     ) -> Outcome {
         let leap =
@@ -670,11 +703,16 @@ impl Processor {
             counts.leaps += 1;
         } else {
             counts.samples += 1;
-            let n = 1u32 << self.cfg.block_log2;
-            let origin = self.bucket.block_of(0, q).map(|b| b * n);
+            // The cell's eight voxels, through the volume cache (contract, *The volume cache*).
             let base = ray.start.map(|c| i64::from(c >> POS_FRAC_W));
-            cache.read(q, origin, base, counts);
-            let terminated = self.sample(&mut ray, irr);
+            let voxels = match cache {
+                Some(cache) => cache.read(base, counts),
+                None => std::array::from_fn(|c| {
+                    let [x, y, z] = corner(base, c);
+                    self.vol.get(x, y, z)
+                }),
+            };
+            let terminated = self.sample(&mut ray, voxels, irr);
             if let Some(albedo) = self.photon_albedo {
                 // A photon interacts when its opacity reaches its interaction value [364].
                 if u32::from(ray.opacity) << 4 >= u32::from(ray.interaction) {
@@ -716,13 +754,18 @@ impl Processor {
         Outcome::Next(ray)
     }
 
+    /// The host's packets of a frame, in its order.
+    fn frame_packets(&self, cam: &Camera, proj: Projection) -> Result<Vec<RayPacket>> {
+        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
+        rays.iter().map(Self::packet).collect()
+    }
+
     /// Renders a frame: the host makes the rays (`host_rays`), offers the head of its list in
     /// every cycle with a free sorter slot (accepted when its queue has room), and takes back
     /// finished and overflowed rays (appending the latter to its list) until every ray finished.
     pub fn render(&self, cam: &Camera, proj: Projection) -> Result<ProcessorFrame> {
-        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
-        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
-        self.run(packets, cam.width, cam.height, None, None)
+        let packets = self.frame_packets(cam, proj)?;
+        self.run(packets, cam.width, cam.height, None, None, None)
     }
 
     /// `render`, and every step the frame loop made on its ray queues, in order: the frame's queue
@@ -732,10 +775,9 @@ impl Processor {
         cam: &Camera,
         proj: Projection,
     ) -> Result<(ProcessorFrame, Vec<QueueOp>)> {
-        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
-        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let packets = self.frame_packets(cam, proj)?;
         let mut trace = FrontTrace::default();
-        let f = self.run(packets, cam.width, cam.height, None, Some(&mut trace))?;
+        let f = self.run(packets, cam.width, cam.height, None, Some(&mut trace), None)?;
         Ok((f, trace.0))
     }
 
@@ -747,11 +789,30 @@ impl Processor {
         cam: &Camera,
         proj: Projection,
     ) -> Result<(ProcessorFrame, Vec<FrontTraffic<RayPacket>>)> {
-        let rays = host_rays(&self.vol, cam, proj, self.cfg.host_order)?;
-        let packets = rays.iter().map(Self::packet).collect::<Result<Vec<_>>>()?;
+        let packets = self.frame_packets(cam, proj)?;
         let mut trace = FrontTrace::default();
-        let f = self.run(packets, cam.width, cam.height, None, Some(&mut trace))?;
+        let f = self.run(packets, cam.width, cam.height, None, Some(&mut trace), None)?;
         Ok((f, trace.1))
+    }
+
+    /// `render`, and the AXI4 bursts of the volume cache's misses in order (contract, *The volume
+    /// cache*): the AR stream of the RTL's memory port (empty without a cache).
+    pub fn render_cache_traced(
+        &self,
+        cam: &Camera,
+        proj: Projection,
+    ) -> Result<(ProcessorFrame, Vec<Burst>)> {
+        let packets = self.frame_packets(cam, proj)?;
+        let mut bursts = Vec::new();
+        let f = self.run(
+            packets,
+            cam.width,
+            cam.height,
+            None,
+            None,
+            Some(&mut bursts),
+        )?;
+        Ok((f, bursts))
     }
 
     /// The lighting pass of volumetric GI ([358]-[363], low albedo, single scattering): lighting
@@ -776,7 +837,14 @@ impl Processor {
         };
         let mut field = vec![0u16; self.vol.len()];
         self.irradiance = None;
-        let f = self.run(packets, light.grid, light.grid, Some(&mut field), None);
+        let f = self.run(
+            packets,
+            light.grid,
+            light.grid,
+            Some(&mut field),
+            None,
+            None,
+        );
         self.photon_albedo = None;
         self.irradiance = Some(field);
         f
@@ -808,6 +876,7 @@ impl Processor {
         h: u32,
         mut irr: Option<&mut Vec<u16>>,
         trace: Option<&mut FrontTrace>,
+        bursts: Option<&mut Vec<Burst>>,
     ) -> Result<ProcessorFrame> {
         let rays = packets.len();
         let packets_lives = packets
@@ -839,7 +908,11 @@ impl Processor {
         };
         let mut rgb = vec![[0u16; 3]; (w * h) as usize];
         let mut done = vec![false; (w * h) as usize];
-        let mut cache = BlockCache::new(self.cfg.block_log2);
+        // The volume cache from reset (contract, *The volume cache*).
+        let mut cache = self.cache.as_ref().map(|c| FrameCache {
+            cache: c.clone(),
+            bursts: bursts.is_some().then(Vec::new),
+        });
         let mut last_active: Option<u32> = None;
         // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
         // Per ray and life: at most 2 N 256 / step samples along a path (sqrt 3 N < 2 N), plus
@@ -881,7 +954,7 @@ impl Processor {
                     let entered = match popped {
                         Some((q, ray)) => {
                             let irr = irr.as_deref_mut().map(|v| v.as_mut_slice());
-                            Some(self.advance(ray, q, &mut counts, &mut cache, irr))
+                            Some(self.advance(ray, q, &mut counts, cache.as_mut(), irr))
                         }
                         None => None,
                     };
@@ -929,6 +1002,9 @@ impl Processor {
         }
         if let Some(t) = trace {
             *t = front.take_trace();
+        }
+        if let (Some(b), Some(c)) = (bursts, cache) {
+            *b = c.bursts.unwrap_or_default();
         }
         Ok(ProcessorFrame {
             width: w,
@@ -1340,13 +1416,13 @@ pub fn shadow_scene(n: usize) -> Result<(Volume, TransferFunction, GiLight)> {
 }
 
 /// The RTL top `gicube_processor`'s parameters (contract, *The RTL*): the front end's, the voxel
-/// width, the sample distance and the ring latency. Every parameter is a field of the model
-/// ([`ProcessorRtlConfig::processor_config`]).
+/// width, the sample distance, the ring latency and the volume cache's. Every parameter is a
+/// field of the model ([`ProcessorRtlConfig::processor_config`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ProcessorRtlConfig {
     /// Block side `n = 2^block_log2` voxels, 2..=8.
     pub block_log2: u32,
-    /// Blocks a side `B`, 1..=6; `N = B n <= 64` voxels a side (the on-chip volume).
+    /// Blocks a side `B`, 1..=6; `N = B n <= 64` voxels a side.
     pub vol_blocks: u32,
     /// Rays per queue, 1..=4096.
     pub queue_len: u32,
@@ -1358,19 +1434,29 @@ pub struct ProcessorRtlConfig {
     pub step: u32,
     /// Ring latency, processor cycles, 1..=16 (the model's `ring_latency`).
     pub ring_lat: u32,
+    /// The volume cache's AXI4 data bus, line, sets and bursts in flight (`gicube_cache`'s
+    /// `DataW`, `LineVox`, `Sets`, `Outstanding`; the others derived: [`Self::cache_config`]).
+    pub data_w: u32,
+    pub line_vox: u32,
+    pub sets: u32,
+    pub outstanding: u32,
 }
 
 /// Region of a configuration address (its top two bits): `gicube_sample`'s tables, the empty
-/// flags, the volume.
+/// flags.
 pub const CFG_REGION_SAMPLE: u32 = 0;
 pub const CFG_REGION_EMPTY: u32 = 1;
-pub const CFG_REGION_VOXEL: u32 = 2;
 /// Address bits of `gicube_sample`'s configuration port.
 const SAMPLE_CFG_ADDR_W: u32 = 14;
 /// Bits of a configuration word (`gicube_sample`'s).
 const CFG_WORD_W: u32 = 36;
 /// Bits of each count in an output item.
 pub const COUNT_W: u32 = 32;
+/// Counts in an output item (rays in, finished, overflowed, samples, leaps, cycles, cache hits,
+/// cache misses).
+pub const OUT_COUNTS: u32 = 8;
+/// Byte address bits of the RTL's AXI4 port.
+pub const RTL_ADDR_W: u32 = 32;
 
 impl ProcessorRtlConfig {
     /// The RTL's parameter defaults.
@@ -1382,6 +1468,10 @@ impl ProcessorRtlConfig {
         voxel_w: 8,
         step: 256,
         ring_lat: 8,
+        data_w: 64,
+        line_vox: 16,
+        sets: 32,
+        outstanding: 8,
     };
 
     pub fn validate(&self) -> Result<()> {
@@ -1418,7 +1508,21 @@ impl ProcessorRtlConfig {
                 self.ring_lat
             ));
         }
-        Ok(())
+        self.cache_config().validate()
+    }
+
+    /// The volume cache (contract, *The RTL*): `MaxDim` the smallest power of two above `N` (at
+    /// least 4), `WordW` 8 for voxels of up to 8 bits, else 16, `AddrW = 32`, the rest the RTL's.
+    pub fn cache_config(&self) -> CacheConfig {
+        CacheConfig {
+            max_dim: (self.side() + 1).next_power_of_two().max(4),
+            word_w: if self.voxel_w <= 8 { 8 } else { 16 },
+            data_w: self.data_w,
+            line_vox: self.line_vox,
+            sets: self.sets,
+            outstanding: self.outstanding,
+            addr_w: RTL_ADDR_W,
+        }
     }
 
     /// `N = B n`, voxels a side.
@@ -1434,20 +1538,14 @@ impl ProcessorRtlConfig {
             .max(1)
     }
 
-    /// Bits of a voxel coordinate in a configuration address, `clog2(N)`.
-    fn coord_w(&self) -> u32 {
-        self.side().next_power_of_two().trailing_zeros()
-    }
-
-    /// Configuration address bits: two region bits over the wider of `gicube_sample`'s address
-    /// and a voxel's index.
+    /// Configuration address bits: two region bits over `gicube_sample`'s address.
     pub fn cfg_addr_w(&self) -> u32 {
-        2 + (3 * self.coord_w()).max(SAMPLE_CFG_ADDR_W)
+        2 + SAMPLE_CFG_ADDR_W
     }
 
     /// The model's configuration that this RTL renders exactly (frames and counts): the RTL's
-    /// front end, step and ring latency, the model's defaults otherwise (termination at
-    /// `1 - 2^-8`, space leaping, the sorter, no jitter).
+    /// front end, step, ring latency and volume cache, the model's defaults otherwise
+    /// (termination at `1 - 2^-8`, space leaping, the sorter, no jitter).
     pub fn processor_config(&self) -> ProcessorConfig {
         ProcessorConfig {
             block_log2: self.block_log2,
@@ -1455,6 +1553,7 @@ impl ProcessorRtlConfig {
             ranks: self.ranks,
             step: self.step,
             ring_latency: self.ring_lat,
+            cache: Some(self.cache_config()),
             ..ProcessorConfig::DEFAULT
         }
     }
@@ -1468,6 +1567,10 @@ crate::unit_config!(ProcessorRtlConfig, "gicube_processor", DEFAULT, {
     "VoxelW" => voxel_w,
     "Step" => step,
     "RingLat" => ring_lat,
+    "DataW" => data_w,
+    "LineVox" => line_vox,
+    "Sets" => sets,
+    "Outstanding" => outstanding,
 });
 
 /// One output item of the RTL: a finished or an overflowed ray, and the counts after it.
@@ -1484,6 +1587,9 @@ pub struct ProcessorOut {
     pub leaps: u32,
     /// Processor cycles in which the host offered a ray or a ray was in the processor.
     pub cycles: u32,
+    /// The volume cache's corner reads found and not found since reset.
+    pub cache_hits: u32,
+    pub cache_misses: u32,
 }
 
 impl crate::unit::StreamCodec for ProcessorRtlConfig {
@@ -1496,7 +1602,7 @@ impl crate::unit::StreamCodec for ProcessorRtlConfig {
     }
 
     fn out_width(&self) -> u32 {
-        1 + 256 + 6 * COUNT_W
+        1 + 256 + OUT_COUNTS * COUNT_W
     }
 
     fn pack_in(&self, item: &Self::In) -> Vec<u32> {
@@ -1517,23 +1623,24 @@ impl crate::unit::StreamCodec for ProcessorRtlConfig {
             samples: c(),
             leaps: c(),
             cycles: c(),
+            cache_hits: c(),
+            cache_misses: c(),
         }
     }
 }
 
 impl Processor {
-    /// The writes that load this processor's tables, empty flags and volume into the RTL
-    /// `rtl` (contract, *The RTL*): `gicube_sample`'s tables (region 0), every queue's empty flag
-    /// (region 1: the flags when leaping is on, else 0), every voxel of `[0, N)^3` (region 2: 0
-    /// outside the volume). Refused: another voxel width, step or block size, a volume wider than
-    /// `N`.
+    /// The writes that load this processor's tables and empty flags into the RTL `rtl`
+    /// (contract, *The RTL*): `gicube_sample`'s tables (region 0), every queue's empty flag
+    /// (region 1: the flags when leaping is on, else 0); the volume is in memory
+    /// ([`Processor::rtl_memory`]). Refused: another voxel width, step, block size or cache.
     pub fn rtl_config_writes(&self, rtl: &ProcessorRtlConfig) -> Result<Vec<(u32, Vec<u32>)>> {
         rtl.validate()?;
-        let n = rtl.side();
         if self.vol.bits != rtl.voxel_w
             || self.cfg.step != rtl.step
             || self.cfg.block_log2 != rtl.block_log2
             || self.blocks != rtl.vol_blocks
+            || self.cache_config()? != Some(rtl.cache_config())
         {
             return Err(ModelError::Config(format!(
                 "gicube_processor: a {}-bit volume of {} blocks of 2^{} at step {} does not fit {rtl:?}",
@@ -1557,16 +1664,6 @@ impl Processor {
         for q in 0..1u32 << rtl.queue_w() {
             let e = self.cfg.space_leap && self.empty.get(q as usize).copied().unwrap_or(false);
             writes.push((region(CFG_REGION_EMPTY, q), word(u32::from(e))));
-        }
-        let cw = rtl.coord_w();
-        for z in 0..n {
-            for y in 0..n {
-                for x in 0..n {
-                    let v = self.vol.get(i64::from(x), i64::from(y), i64::from(z));
-                    let a = x | y << cw | z << (2 * cw);
-                    writes.push((region(CFG_REGION_VOXEL, a), word(v)));
-                }
-            }
         }
         Ok(writes)
     }
