@@ -663,7 +663,9 @@ fn compile_variant(
     Ok(())
 }
 
-/// The C++ shim a top runs in (tb/*_shim.h), chosen by the ports its own file declares: an AXI4
+/// The C++ shim a top runs in (tb/*_shim.h), chosen by the ports its own file declares: AXI4
+/// read and write manager ports on a stream top (`m_axi_arvalid_o` and `m_axi_awvalid_o`: both
+/// sides of the subordinate in the clock loop), an AXI4
 /// write manager port (`m_axi_awvalid_o`, with the subordinate's write port in the clock loop),
 /// an AXI4 read manager port (`m_axi_arvalid_o`, the AXI memory subordinate), an AXI4-Lite
 /// subordinate port (`s_axil_awvalid_i`, an AXI4-Lite manager), or the plain streams.
@@ -676,11 +678,12 @@ enum Shim {
     AccelCtrl,
     Accel,
     Win,
+    AxiRw,
 }
 
 impl Shim {
     /// In `Shim as usize` order.
-    const ALL: [Shim; 7] = [
+    const ALL: [Shim; 8] = [
         Shim::Stream,
         Shim::Axi,
         Shim::AxiWr,
@@ -688,6 +691,7 @@ impl Shim {
         Shim::AccelCtrl,
         Shim::Accel,
         Shim::Win,
+        Shim::AxiRw,
     ];
 
     fn of(v: &Variant) -> Shim {
@@ -704,6 +708,8 @@ impl Shim {
             .unwrap_or_default();
         if text.contains("s_axil_awvalid_i") && text.contains("m_axi_arvalid_o") {
             Shim::Accel
+        } else if text.contains("m_axi_awvalid_o") && text.contains("m_axi_arvalid_o") {
+            Shim::AxiRw
         } else if text.contains("m_axi_awvalid_o") {
             Shim::AxiWr
         } else if text.contains("m_axi_arvalid_o") {
@@ -726,6 +732,7 @@ impl Shim {
             Shim::AccelCtrl => "accel_ctrl_shim.h",
             Shim::Accel => "accel_shim.h",
             Shim::Win => "win_shim.h",
+            Shim::AxiRw => "axi_rw_shim.h",
         }
     }
 
@@ -738,6 +745,7 @@ impl Shim {
             Shim::AccelCtrl => "AccelCtrlShim",
             Shim::Accel => "AccelShim",
             Shim::Win => "WinShim",
+            Shim::AxiRw => "AxiRwShim",
         }
     }
 
@@ -764,6 +772,13 @@ impl Shim {
                 "accel_shim.h",
             ],
             Shim::Win => &["clocked_top.h", "win_host.h", "win_shim.h"],
+            Shim::AxiRw => &[
+                "clocked_top.h",
+                "axi_mem.h",
+                "axi_ports.h",
+                "axi_shim.h",
+                "axi_rw_shim.h",
+            ],
         }
     }
 }
