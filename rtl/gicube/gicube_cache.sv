@@ -231,11 +231,9 @@ module gicube_cache #(
   // Request register and state
   // ==============================================================================================
 
-  typedef enum logic [1:0] {
+  typedef enum logic [0:0] {
     StCheck,  // the RAMs' outputs hold this request's tags and words
-    StMiss,   // issuing the miss queue and writing the fills
-    StWb,     // Splat: writing back the dirty lines this request evicts
-    StFlush   // Splat: writing back every dirty line
+    StMiss    // issuing the miss queue and writing the fills (Splat: or the phases below)
   } state_e;
 
   logic             in_fire;
@@ -258,6 +256,10 @@ module gicube_cache #(
   localparam int unsigned SlotW = 3 + SetW;                   // a (bank, set) of the flush walk
   localparam int unsigned PendW = SlotW + 2;                  // write-backs not yet answered
   logic              is_dep, is_flush;
+  // Splat's phases within StMiss (flags, so that the read-only state machine stays as it was):
+  // writing back the lines the request evicts (before its reads), and a flush's walk.
+  logic              wbst_q, wbst_d, flst_q, flst_d;
+  logic              in_wb, in_fl, in_miss;
   logic [8*Sets-1:0] dirty_q, dirty_d;   // per bank and set: the line holds deposits
   logic [7:0]        wb_q, wb_d;         // evicted dirty lines not yet written back
   logic [8*TagW-1:0] vtag_q, vtag_d;     // their tags (read at the check)
@@ -385,12 +387,15 @@ module gicube_cache #(
   assign leave      = busy_q && state_q == StCheck && !is_flush && all_hit && out_free;
   assign dep_we     = leave && is_dep;
   assign fl_done    = fl_idx_q[SlotW] && !eng_q && pend_q == '0;
-  assign fleave     = busy_q && state_q == StFlush && fl_done && out_free;
+  assign in_wb      = busy_q && state_q == StMiss && wbst_q;
+  assign in_fl      = busy_q && state_q == StMiss && flst_q;
+  assign in_miss    = busy_q && state_q == StMiss && !wbst_q && !flst_q;
+  assign fleave     = in_fl && fl_done && out_free;
   assign in_ready_o = !busy_q || (leave && !is_dep) || fleave;
-  assign reread     = busy_q && state_q == StMiss && issue_q == '0 && fill_q == '0;
+  assign reread     = in_miss && issue_q == '0 && fill_q == '0;
   assign rd_xyz     = reread ? req_q : in_data_i;
   assign ram_re     = {8{in_fire || reread}};
-  assign fl_rd      = busy_q && state_q == StFlush && !eng_q && !fl_tag_q && !fl_idx_q[SlotW]
+  assign fl_rd      = in_fl && !eng_q && !fl_tag_q && !fl_idx_q[SlotW]
                       && dirty_q[fl_idx_q[SlotW-1:0]];
 
   // ==============================================================================================
@@ -399,7 +404,7 @@ module gicube_cache #(
 
   assign issue_p   = lowest(issue_q);
   assign fill_p    = lowest(fill_q);
-  assign cmd_valid = busy_q && state_q == StMiss && issue_q != '0;
+  assign cmd_valid = in_miss && issue_q != '0;
   always_comb begin
     logic [LineW-1:0] line_sel;
     // Constant indices: a variable index times LineW (not a power of two) is a multiplier.
@@ -435,6 +440,8 @@ module gicube_cache #(
     vtag_d      = vtag_q;
     fl_idx_d    = fl_idx_q;
     fl_tag_d    = 1'b0;
+    wbst_d      = wbst_q;
+    flst_d      = flst_q;
     out_valid_d = out_valid_q && !out_ready_i;
     out_data_d  = out_data_q;
     tag_we      = '0;
@@ -468,10 +475,11 @@ module gicube_cache #(
 
     // A flush: its walk starts at the check; it leaves with no voxels and the counts.
     if (busy_q && state_q == StCheck && is_flush) begin
-      state_d  = StFlush;
+      state_d  = StMiss;
+      flst_d   = 1'b1;
       fl_idx_d = '0;
     end
-    if (busy_q && state_q == StFlush) begin
+    if (in_fl) begin
       if (stall_q != '1) stall_d = stall_q + StallW'(1);
       if (fl_rd) begin
         fl_tag_d = 1'b1;
@@ -484,6 +492,7 @@ module gicube_cache #(
         out_data_d  = {stall_q, misses_q, hits_q, 8'h00, (8*WordW)'(0)};
         out_valid_d = 1'b1;
         busy_d      = 1'b0;
+        flst_d      = 1'b0;
       end
     end
 
@@ -509,17 +518,17 @@ module gicube_cache #(
           end
         end
       end
-      if (wb_d != '0) state_d = StWb;
+      wbst_d   = wb_d != '0;
     end
 
     // The evicted dirty lines go to the engine in bank order; the reads wait for their B.
-    if (busy_q && state_q == StWb) begin
+    if (in_wb) begin
       if (stall_q != '1) stall_d = stall_q + StallW'(1);
       if (!eng_q && wb_q != '0) wb_d[lowest(wb_q)] = 1'b0;
-      if (!eng_q && wb_q == '0 && pend_q == '0) state_d = StMiss;
+      if (!eng_q && wb_q == '0 && pend_q == '0) wbst_d = 1'b0;
     end
 
-    if (busy_q && state_q == StMiss) begin
+    if (in_miss) begin
       if (stall_q != '1) stall_d = stall_q + StallW'(1);
       if (cmd_valid && cmd_ready) issue_d[issue_p] = 1'b0;
       if (beat_valid) begin
@@ -565,7 +574,7 @@ module gicube_cache #(
     start     = 1'b0;
     sp        = '0;
     // An evicted line (the lowest bank first) or the flush's slot whose tag was just read.
-    if (busy_q && state_q == StWb && !eng_q && wb_q != '0) begin
+    if (in_wb && !eng_q && wb_q != '0) begin
       start = 1'b1;
       sp    = lowest(wb_q);
       for (int unsigned p = 0; p < 8; p++) begin
@@ -635,13 +644,6 @@ module gicube_cache #(
       stall_q     <= '0;
       valid_q     <= '0;
       out_valid_q <= 1'b0;
-      dirty_q     <= '0;
-      wb_q        <= '0;
-      fl_idx_q    <= '0;
-      fl_tag_q    <= 1'b0;
-      pend_q      <= '0;
-      eng_q       <= 1'b0;
-      rd_pend_q   <= 1'b0;
     end else begin
       busy_q      <= busy_d;
       state_q     <= state_d;
@@ -654,13 +656,6 @@ module gicube_cache #(
       stall_q     <= stall_d;
       valid_q     <= valid_d;
       out_valid_q <= out_valid_d;
-      dirty_q     <= dirty_d;
-      wb_q        <= wb_d;
-      fl_idx_q    <= fl_idx_d;
-      fl_tag_q    <= fl_tag_d;
-      pend_q      <= pend_d;
-      eng_q       <= eng_d;
-      rd_pend_q   <= rd_pend_d;
     end
   end
 
@@ -668,13 +663,65 @@ module gicube_cache #(
     req_q      <= req_d;
     hitm_q     <= hitm_d;
     out_data_q <= out_data_d;
-    vtag_q     <= vtag_d;
-    eng_p_q    <= eng_p_d;
-    eng_set_q  <= eng_set_d;
-    eng_tag_q  <= eng_tag_d;
-    eng_cmd_q  <= eng_cmd_d;
-    eng_rd_q   <= eng_rd_d;
-    eng_tk_q   <= eng_tk_d;
+  end
+
+  // The splatting side's state exists only with Splat: without it, constants (nothing is dirty,
+  // the engine idle), so the read-only netlist is the one it was.
+  if (Splat != 0) begin : gen_splat_state
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni) begin
+        dirty_q   <= '0;
+        wbst_q    <= 1'b0;
+        flst_q    <= 1'b0;
+        wb_q      <= '0;
+        fl_idx_q  <= '0;
+        fl_tag_q  <= 1'b0;
+        pend_q    <= '0;
+        eng_q     <= 1'b0;
+        rd_pend_q <= 1'b0;
+      end else begin
+        dirty_q   <= dirty_d;
+        wbst_q    <= wbst_d;
+        flst_q    <= flst_d;
+        wb_q      <= wb_d;
+        fl_idx_q  <= fl_idx_d;
+        fl_tag_q  <= fl_tag_d;
+        pend_q    <= pend_d;
+        eng_q     <= eng_d;
+        rd_pend_q <= rd_pend_d;
+      end
+    end
+
+    always_ff @(posedge clk_i) begin
+      vtag_q    <= vtag_d;
+      eng_p_q   <= eng_p_d;
+      eng_set_q <= eng_set_d;
+      eng_tag_q <= eng_tag_d;
+      eng_cmd_q <= eng_cmd_d;
+      eng_rd_q  <= eng_rd_d;
+      eng_tk_q  <= eng_tk_d;
+    end
+  end else begin : gen_no_splat_state
+    logic unused_splat_state;
+    assign dirty_q   = '0;
+    assign wbst_q    = 1'b0;
+    assign flst_q    = 1'b0;
+    assign wb_q      = '0;
+    assign fl_idx_q  = '0;
+    assign fl_tag_q  = 1'b0;
+    assign pend_q    = '0;
+    assign eng_q     = 1'b0;
+    assign rd_pend_q = 1'b0;
+    assign vtag_q    = '0;
+    assign eng_p_q   = '0;
+    assign eng_set_q = '0;
+    assign eng_tag_q = '0;
+    assign eng_cmd_q = 1'b0;
+    assign eng_rd_q  = '0;
+    assign eng_tk_q  = '0;
+    assign unused_splat_state = ^{dirty_d, wbst_d, flst_d, wb_d, fl_idx_d, fl_tag_d, pend_d, eng_d, rd_pend_d,
+                                  vtag_d, eng_p_d, eng_set_d, eng_tag_d, eng_cmd_d, eng_rd_d,
+                                  eng_tk_d};
   end
 
   assign out_valid_o = out_valid_q;
