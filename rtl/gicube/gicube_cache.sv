@@ -489,7 +489,8 @@ module gicube_cache #(
       end
       if (fl_tag_q) fl_idx_d = fl_idx_q + (SlotW+1)'(1);
       if (fleave) begin
-        out_data_d  = {stall_q, misses_q, hits_q, 8'h00, (8*WordW)'(0)};
+        out_data_d  = '0;
+        out_data_d[8*WordW +: 8 + 2*CountW + StallW] = {stall_q, misses_q, hits_q, 8'h00};
         out_valid_d = 1'b1;
         busy_d      = 1'b0;
         flst_d      = 1'b0;
@@ -563,6 +564,7 @@ module gicube_cache #(
   always_comb begin
     logic             start;
     logic [2:0]       sp;
+    logic [SetW-1:0]  low;
     logic [LineW-1:0] line;
     eng_d     = eng_q;
     eng_p_d   = eng_p_q;
@@ -605,9 +607,13 @@ module gicube_cache #(
       if (rd_pend_q && wr_dat_ready) eng_tk_d = eng_tk_q + (BplW+1)'(1);
       if (eng_cmd_q && eng_tk_q == (BplW+1)'(Bpl)) eng_d = 1'b0;
     end
-    // The line held under the tag in the set: l mod Sets = set xor (tag mod Sets).
+    // The line held under the tag in the set: l mod Sets = set xor (tag mod Sets). (The low
+    // bits go through a variable of their width: Yosys 0.23 sized `set ^ SetW'(tag)` inside the
+    // concatenation as the tag's width, and the gate-level netlist wrote the wrong line.)
+    low = SetW'(eng_tag_q);
+    low = eng_set_q ^ low;
     if (LineW > SetW) begin
-      line = LineW'({eng_tag_q, eng_set_q ^ SetW'(eng_tag_q)});
+      line = LineW'({eng_tag_q, low});
     end else begin
       line = LineW'(eng_set_q);
     end
