@@ -10,9 +10,9 @@ mod support;
 use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
-use cube5_model::units::cube5_axi_rd::{AxiMemImage, Burst};
+use cube5_model::units::cube5_axi_rd::AxiMemImage;
 use cube5_model::units::gicube_cache::{
-    CacheConfig, CacheItem, CacheOut, CacheReq, CacheTraffic, SplatCodec, VolumeCache, HIT_LATENCY,
+    CacheConfig, CacheItem, CacheReq, CacheTraffic, SplatCodec, VolumeCache, HIT_LATENCY,
 };
 use cube5_model::units::gicube_packet_loop::{RayPacket, RayType, POS_FRAC_W};
 use cube5_model::units::gicube_processor::{Processor, ProcessorConfig, Projection, QueueOp};
@@ -27,15 +27,16 @@ use support::{
     with_waves,
 };
 
-/// One run: the volume's words (`M^3`, x fastest), the requests, how the subordinate behaves, the
-/// output traffic, and optionally a reset after `reset_at` cycles followed by `after` requests.
+/// One run: the volume's words (`M^3`, x fastest), the items (reads, and with `Splat` deposits
+/// and flushes), how the subordinate behaves, the output traffic, and optionally a reset after
+/// `reset_at` cycles followed by `after` items (over the memory the subordinate then holds).
 #[derive(Clone)]
 struct Case {
     words: Vec<u32>,
-    reqs: Vec<CacheReq>,
+    items: Vec<CacheItem>,
     setup: AxiMemSetup,
     traffic: Traffic,
-    reset: Option<(u64, Vec<CacheReq>)>,
+    reset: Option<(u64, Vec<CacheItem>)>,
 }
 
 /// What a passing run measured.
@@ -48,12 +49,21 @@ struct Report {
     stall: u64,
     cycles: u64,
     dropped_at_reset: u64,
+    deposits: u64,
+    reads: u64,
+    writes: u64,
+    saturated: u64,
 }
 
 impl Report {
     fn hit_rate(&self) -> f64 {
         self.hits as f64 / (self.hits + self.misses).max(1) as f64
     }
+}
+
+/// Read items.
+fn reads(reqs: &[CacheReq]) -> Vec<CacheItem> {
+    reqs.iter().map(|r| CacheItem::Read(*r)).collect()
 }
 
 /// The subordinate at latency `fixed + U(0..random)`, gaps, bandwidth, the unit's Outstanding as
@@ -82,13 +92,13 @@ fn random_words(cfg: CacheConfig, rng: &mut ChaCha8Rng) -> Vec<u32> {
 fn random_case(cfg: CacheConfig, s: u64, n: usize) -> Case {
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let words = random_words(cfg, &mut rng);
-    let reqs = CacheTraffic::new(cfg).items(&mut rng, n);
+    let items = reads(&CacheTraffic::new(cfg).items(&mut rng, n));
     let img = cfg.image(&words).unwrap();
     let bus = (cfg.data_w / 8, cfg.addr_w);
     let (setup, traffic) = axi::random_conditions(&mut rng, bus, &img, cfg.data_w / 4);
     Case {
         words,
-        reqs,
+        items,
         setup: AxiMemSetup {
             declared_outstanding: cfg.outstanding,
             ..setup
@@ -96,148 +106,6 @@ fn random_case(cfg: CacheConfig, s: u64, n: usize) -> Case {
         traffic,
         reset: None,
     }
-}
-
-/// Runs `case` on `variant` (again with a waveform on a mismatch); a failure panics.
-fn must(variant: &'static Variant, cfg: CacheConfig, seed: u64, case: &Case) -> Report {
-    let result = with_waves(variant, seed, |trace| run(variant, cfg, seed, case, trace));
-    axi::must_pass(variant, seed, result, |r| {
-        format!(
-            "{} requests, hit rate {:.4}, {} missed requests, {} stall cycles, {} cycles",
-            r.items,
-            r.hit_rate(),
-            r.missed_requests,
-            r.stall,
-            r.cycles
-        )
-    })
-}
-
-/// Drives `reqs` on `dut` (cut after `max_cycles` when a reset follows) and compares outputs and
-/// AR against `model` (stepped here). A missed request's `stall` is the RTL's (memory timing) once
-/// it is at least the fixed latency plus a line's beats; a hit's must be 0.
-#[allow(clippy::too_many_arguments)]
-fn drive_and_compare(
-    dut: &mut RtlStream<CacheConfig>,
-    (variant, cfg, seed): (&'static Variant, CacheConfig, u64),
-    model: &mut VolumeCache,
-    reqs: &[CacheReq],
-    setup: &AxiMemSetup,
-    traffic: &Traffic,
-    max_cycles: Option<u64>,
-    report: &mut Report,
-) -> Result<(), TbError> {
-    let (mut want, bursts): (Vec<CacheOut>, Vec<Burst>) = model.run_all(reqs);
-    let exact = max_cycles.is_none();
-    let limit = max_cycles.unwrap_or(100_000 + 20 * reqs.len() as u64 + 600 * bursts.len() as u64);
-    let driven = dut.drive(reqs, traffic, want.len() as u64, limit)?;
-    axi_protocol_clean(dut, &driven.stats, variant, seed)?;
-    let size = (cfg.data_w / 8).trailing_zeros();
-    let n_ars = compare_bursts(
-        &dut.axi_take_ar()?,
-        "AR",
-        &bursts,
-        size,
-        variant,
-        seed,
-        |k| format!("burst #{k}"),
-    )?;
-    // The memory's timing: a missed request's stall is the RTL's when plausible.
-    let least = setup.latency_fixed + cfg.bpl();
-    for (w, got) in want.iter_mut().zip(&driven.outputs) {
-        if w.hit != 0xff && got.value.stall >= least {
-            w.stall = got.value.stall;
-        }
-    }
-    compare_axi_outputs(
-        dut,
-        &driven,
-        &want,
-        (n_ars, bursts.len()),
-        exact,
-        limit,
-        (variant, seed),
-        "item",
-        |k| format!("request #{k} {:?}", reqs[k]),
-    )?;
-    if exact {
-        // The volume lies inside the subordinate's image: no beat may come back with an error.
-        axi::err_flag_matches(dut, (variant, seed), reqs.len(), false, "some fill's RRESP")?;
-    }
-    let outs = &want[..driven.outputs.len()];
-    let missed = outs.iter().filter(|o| o.hit != 0xff).count() as u64;
-    let stall: u64 = outs.iter().map(|o| u64::from(o.stall)).sum();
-    if exact && traffic.idle.is_empty() && traffic.stall.is_empty() {
-        // The contract's identity at full speed.
-        let n = reqs.len() as u64;
-        let expect = if n == 0 {
-            0
-        } else {
-            n + HIT_LATENCY + missed + stall
-        };
-        if driven.stats.cycles != expect {
-            return Err(axi::mismatch(
-                dut,
-                (variant, seed),
-                format!("{n} requests at full speed, {missed} with misses"),
-                format!("{} cycles", driven.stats.cycles),
-                format!("n + 2 + k + sum(stall) = {expect} cycles"),
-                "the cycle identity fails",
-            ));
-        }
-    }
-    if let Some(last) = outs.last() {
-        report.hits = u64::from(last.hits);
-        report.misses = u64::from(last.misses);
-    }
-    report.items += outs.len() as u64;
-    report.missed_requests += missed;
-    report.stall += stall;
-    report.cycles += driven.stats.cycles;
-    Ok(())
-}
-
-fn run(
-    variant: &'static Variant,
-    cfg: CacheConfig,
-    seed: u64,
-    case: &Case,
-    trace: Option<(PathBuf, (u64, u64))>,
-) -> Result<Report, TbError> {
-    let img = cfg
-        .image(&case.words)
-        .map_err(|e| TbError::setup(variant.name, e))?;
-    let mut model =
-        VolumeCache::new(cfg, &case.words).map_err(|e| TbError::setup(variant.name, e))?;
-    let mut dut = axi::open(variant, cfg, seed, (&case.setup, &img), &trace)?;
-    let mut report = Report::default();
-    let ctx = (variant, cfg, seed);
-    drive_and_compare(
-        &mut dut,
-        ctx,
-        &mut model,
-        &case.reqs,
-        &case.setup,
-        &case.traffic,
-        case.reset.as_ref().map(|r| r.0),
-        &mut report,
-    )?;
-    if let Some((_, after)) = &case.reset {
-        report.dropped_at_reset =
-            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, false)?;
-        model.clear();
-        drive_and_compare(
-            &mut dut,
-            ctx,
-            &mut model,
-            after,
-            &case.setup,
-            &case.traffic,
-            None,
-            &mut report,
-        )?;
-    }
-    Ok(report)
 }
 
 #[test]
@@ -259,7 +127,7 @@ fn a_million_random_requests_per_config() {
         let mut case = random_case(cfg, s, 20_000);
         if k == 2 {
             let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let after = CacheTraffic::new(cfg).items(&mut rng, 20_000);
+            let after = reads(&CacheTraffic::new(cfg).items(&mut rng, 20_000));
             case.reset = Some((rng.random_range(1000..100_000), after));
         }
         must(variant, cfg, s, &case).items
@@ -318,26 +186,43 @@ fn directed_extremes_all_hits_all_misses_one_set_and_the_far_faces() {
         let s = seed(300 + i as u64);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let words = random_words(cfg, &mut rng);
-        let img = cfg.image(&words).unwrap();
         let reqs = directed_reqs(cfg);
         // The model's view: the conflicting pair misses everywhere, the repeats hit everywhere.
         let (outs, _) = VolumeCache::new(cfg, &words).unwrap().run_all(&reqs);
         assert!(outs[1..40].iter().all(|o| o.hit == 0xff));
         assert!(outs[41..80].iter().all(|o| o.hit == 0));
-        for (lat, gaps, stall) in [((10, 0), (0, 0), 0.0), ((10, 190), (300, 300), 0.5)] {
-            let case = Case {
-                words: words.clone(),
-                reqs: reqs.clone(),
-                setup: mem_setup(cfg, &img, lat, gaps, (0, 1), s),
-                traffic: if stall == 0.0 {
-                    Traffic::full_speed()
-                } else {
-                    Traffic::random(&mut rng, 0.3, stall)
-                },
-                reset: None,
-            };
-            must(variant, cfg, s, &case);
-        }
+        directed_runs((variant, cfg, s), &mut rng, &words, &reads(&reqs));
+    }
+}
+
+/// `items` at full speed at a fixed latency, then under latency 10-200, gaps on every channel,
+/// idle and back-pressure (`rng` draws the traffic).
+fn directed_runs(
+    (variant, cfg, s): (&'static Variant, CacheConfig, u64),
+    rng: &mut ChaCha8Rng,
+    words: &[u32],
+    items: &[CacheItem],
+) {
+    let img = cfg.image(words).unwrap();
+    for (lat, gaps, stall) in [((10, 0), (0, 0), 0.0), ((10, 190), (300, 300), 0.5)] {
+        let setup = AxiMemSetup {
+            aw_gap_permille: gaps.0,
+            w_gap_permille: gaps.1,
+            b_gap_permille: gaps.0,
+            ..mem_setup(cfg, &img, lat, gaps, (0, 1), s)
+        };
+        let case = Case {
+            words: words.to_vec(),
+            items: items.to_vec(),
+            setup,
+            traffic: if stall == 0.0 {
+                Traffic::full_speed()
+            } else {
+                Traffic::random(rng, 0.3, stall)
+            },
+            reset: None,
+        };
+        must(variant, cfg, s, &case);
     }
 }
 
@@ -346,7 +231,7 @@ fn reset_in_mid_stream_forgets_the_tags_and_the_next_requests_are_exact() {
     axi::resets_land_with_bursts_in_flight(|variant, cfg: CacheConfig, s| {
         let mut case = random_case(cfg, s, 300);
         let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-        let after = CacheTraffic::new(cfg).items(&mut rng, 300);
+        let after = reads(&CacheTraffic::new(cfg).items(&mut rng, 300));
         case.reset = Some((rng.random_range(30..3000), after));
         let r = must(variant, cfg, s, &case);
         assert!(r.items > 0);
@@ -367,7 +252,7 @@ fn throughput_one_request_per_clock_while_hitting_and_the_cycle_identity() {
         let reqs = vec![CacheReq { x: 5, y: 6, z: 7 }; n as usize];
         let case = Case {
             words: words.clone(),
-            reqs,
+            items: reads(&reqs),
             setup: mem_setup(cfg, &img, (100, 0), (0, 0), (0, 1), 1),
             traffic: Traffic::full_speed(),
             reset: None,
@@ -380,7 +265,7 @@ fn throughput_one_request_per_clock_while_hitting_and_the_cycle_identity() {
             let reqs = CacheTraffic::new(cfg).items(&mut rng, 3000);
             let case = Case {
                 words: words.clone(),
-                reqs,
+                items: reads(&reqs),
                 setup: mem_setup(cfg, &img, (lat, 0), (0, 0), (0, 1), 2),
                 traffic: Traffic::full_speed(),
                 reset: None,
@@ -460,7 +345,7 @@ fn processor_frame_sample_traffic_replays_on_the_rtl() {
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let case = Case {
             words,
-            reqs: reqs.clone(),
+            items: reads(&reqs),
             setup: mem_setup(cfg, &img, (10, 190), (200, 200), (0, 1), s),
             traffic: Traffic::random(&mut rng, 0.2, 0.3),
             reset: None,
@@ -488,7 +373,7 @@ fn gate_level_netlist_smoke() {
             let mut case = random_case(cfg, s, 100);
             case.reset = Some((
                 rng.random_range(30..500),
-                CacheTraffic::new(cfg).items(rng, 100),
+                reads(&CacheTraffic::new(cfg).items(rng, 100)),
             ));
             must(variant, cfg, s, &case);
         },
@@ -506,13 +391,13 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_tag() {
     let setup = mem_setup(cfg, &img, (10, 0), (0, 0), (0, 1), 1);
     let reqs = CacheTraffic::new(cfg).items(&mut rng, 300);
     let fails = |model: &mut VolumeCache| {
-        let mut dut = axi::open(variant, cfg, 1, (&setup, &img), &None).unwrap();
+        let mut dut = axi::open(variant, SplatCodec(cfg), 1, (&setup, &img), &None).unwrap();
         let mut report = Report::default();
         drive_and_compare(
             &mut dut,
             (variant, cfg, 1),
             model,
-            &reqs,
+            &reads(&reqs),
             &setup,
             &Traffic::full_speed(),
             None,
@@ -536,7 +421,8 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_tag() {
 }
 
 // ================================================================================================
-// Splat = 1: deposits, write-back of dirty lines, flush (contract, "Splatting")
+// Splat = 1: deposits, write-back of dirty lines, flush (contract, "Splatting"); the run, the
+// comparisons and the report every test above uses (a read-only run is a run of read items)
 // ================================================================================================
 
 /// The configurations with the splatting side.
@@ -545,30 +431,6 @@ fn splat_configs() -> Vec<(&'static Variant, CacheConfig)> {
         .into_iter()
         .filter(|(_, c)| c.splat == 1)
         .collect()
-}
-
-/// One run of items; a reset after `reset_at` cycles is followed by `after`, over the memory the
-/// subordinate then holds.
-#[derive(Clone)]
-struct SplatCase {
-    words: Vec<u32>,
-    items: Vec<CacheItem>,
-    setup: AxiMemSetup,
-    traffic: Traffic,
-    reset: Option<(u64, Vec<CacheItem>)>,
-}
-
-/// What a passing splat run measured.
-#[derive(Debug, Default)]
-struct SplatReport {
-    items: u64,
-    deposits: u64,
-    reads: u64,
-    writes: u64,
-    saturated: u64,
-    stall: u64,
-    cycles: u64,
-    dropped_at_reset: u64,
 }
 
 /// Random energies of `IrrW` bits: mostly small, a tenth the maximum (saturation).
@@ -601,7 +463,7 @@ fn splat_items(cfg: CacheConfig, rng: &mut ChaCha8Rng, n: usize, dep: f64) -> Ve
     items
 }
 
-fn random_splat_case(cfg: CacheConfig, s: u64, n: usize) -> SplatCase {
+fn random_splat_case(cfg: CacheConfig, s: u64, n: usize) -> Case {
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let words = random_words(cfg, &mut rng);
     let dep = rng.random_range(0.1..0.6);
@@ -616,7 +478,7 @@ fn random_splat_case(cfg: CacheConfig, s: u64, n: usize) -> SplatCase {
         b_gap_permille: rng.random_range(0..400),
         ..setup
     };
-    SplatCase {
+    Case {
         words,
         items,
         setup,
@@ -650,7 +512,7 @@ fn memory_matches(
 /// Drives `items` and compares outputs, AR and AW against `model`; with a full run (no reset cut)
 /// the memory too (the items end with a flush) and, at full speed, the cycle identity.
 #[allow(clippy::too_many_arguments)]
-fn splat_drive_and_compare(
+fn drive_and_compare(
     dut: &mut RtlStream<SplatCodec>,
     (variant, cfg, seed): (&'static Variant, CacheConfig, u64),
     model: &mut VolumeCache,
@@ -658,7 +520,7 @@ fn splat_drive_and_compare(
     setup: &AxiMemSetup,
     traffic: &Traffic,
     max_cycles: Option<u64>,
-    report: &mut SplatReport,
+    report: &mut Report,
 ) -> Result<(), TbError> {
     let before: Vec<u32> = items
         .iter()
@@ -741,6 +603,15 @@ fn splat_drive_and_compare(
             ));
         }
     }
+    if let Some(last) = outs.last() {
+        report.hits = u64::from(last.hits);
+        report.misses = u64::from(last.misses);
+    }
+    report.missed_requests += outs
+        .iter()
+        .zip(items)
+        .filter(|(o, it)| o.hit != 0xff && **it != CacheItem::Flush)
+        .count() as u64;
     report.items += outs.len() as u64;
     report.deposits += before[..outs.len()]
         .iter()
@@ -762,22 +633,22 @@ fn splat_drive_and_compare(
     Ok(())
 }
 
-fn splat_run(
+fn run(
     variant: &'static Variant,
     cfg: CacheConfig,
     seed: u64,
-    case: &SplatCase,
+    case: &Case,
     trace: Option<(PathBuf, (u64, u64))>,
-) -> Result<SplatReport, TbError> {
+) -> Result<Report, TbError> {
     let img = cfg
         .image(&case.words)
         .map_err(|e| TbError::setup(variant.name, e))?;
     let mut model =
         VolumeCache::new(cfg, &case.words).map_err(|e| TbError::setup(variant.name, e))?;
     let mut dut = axi::open(variant, SplatCodec(cfg), seed, (&case.setup, &img), &trace)?;
-    let mut report = SplatReport::default();
+    let mut report = Report::default();
     let ctx = (variant, cfg, seed);
-    splat_drive_and_compare(
+    drive_and_compare(
         &mut dut,
         ctx,
         &mut model,
@@ -795,7 +666,7 @@ fn splat_run(
         // reset in part): the model starts again over it.
         let words = cfg.words_of(&dut.axi_image()?);
         model = VolumeCache::new(cfg, &words).map_err(|e| TbError::setup(variant.name, e))?;
-        splat_drive_and_compare(
+        drive_and_compare(
             &mut dut,
             ctx,
             &mut model,
@@ -809,19 +680,21 @@ fn splat_run(
     Ok(report)
 }
 
-fn splat_must(
-    variant: &'static Variant,
-    cfg: CacheConfig,
-    seed: u64,
-    case: &SplatCase,
-) -> SplatReport {
-    let result = with_waves(variant, seed, |trace| {
-        splat_run(variant, cfg, seed, case, trace)
-    });
+/// Runs `case` on `variant` (again with a waveform on a mismatch); a failure panics.
+fn must(variant: &'static Variant, cfg: CacheConfig, seed: u64, case: &Case) -> Report {
+    let result = with_waves(variant, seed, |trace| run(variant, cfg, seed, case, trace));
     axi::must_pass(variant, seed, result, |r| {
         format!(
-            "{} items ({} deposits, {} with a saturated corner), {} lines read, {} written back, {} cycles",
-            r.items, r.deposits, r.saturated, r.reads, r.writes, r.cycles
+            "{} items ({} deposits, {} with a saturated corner), hit rate {:.4}, {} missed, {} lines read, {} written back, {} stall cycles, {} cycles",
+            r.items,
+            r.deposits,
+            r.saturated,
+            r.hit_rate(),
+            r.missed_requests,
+            r.reads,
+            r.writes,
+            r.stall,
+            r.cycles
         )
     })
 }
@@ -831,7 +704,7 @@ fn splat_random_reads_deposits_and_flushes_leave_memory_as_the_model() {
     for (i, (variant, cfg)) in splat_configs().into_iter().enumerate() {
         for k in 0..3 {
             let s = seed(2100 + 10 * i as u64 + k);
-            let r = splat_must(variant, cfg, s, &random_splat_case(cfg, s, 1500));
+            let r = must(variant, cfg, s, &random_splat_case(cfg, s, 1500));
             assert!(r.writes > 20, "{variant}: write-backs (seed {s})");
             assert!(r.saturated > 0, "{variant}: saturation (seed {s})");
         }
@@ -854,7 +727,7 @@ fn splat_a_million_random_items_per_config() {
                 let after = splat_items(cfg, &mut rng, 20_000, 0.3);
                 case.reset = Some((rng.random_range(1000..100_000), after));
             }
-            items += splat_must(variant, cfg, s, &case).items;
+            items += must(variant, cfg, s, &case).items;
             k += 1;
         }
     }
@@ -913,7 +786,6 @@ fn splat_directed_saturation_one_voxel_many_deposits_evict_while_dirty() {
         let s = seed(2300 + i as u64);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let words = random_words(cfg, &mut rng);
-        let img = cfg.image(&words).unwrap();
         let items = splat_directed(cfg);
         // The model's view: the maximum saturates every corner's field and keeps the rest.
         let mut model = VolumeCache::new(cfg, &words).unwrap();
@@ -921,26 +793,7 @@ fn splat_directed_saturation_one_voxel_many_deposits_evict_while_dirty() {
         let top = (1u32 << cfg.irr_w()) - 1;
         assert!(outs[6].vox.iter().all(|v| v >> cfg.irr_shift() == top));
         assert!(!writes.is_empty());
-        for (lat, gaps, stall) in [((10, 0), (0, 0), 0.0), ((10, 190), (300, 300), 0.5)] {
-            let setup = AxiMemSetup {
-                aw_gap_permille: gaps.0,
-                w_gap_permille: gaps.1,
-                b_gap_permille: gaps.0,
-                ..mem_setup(cfg, &img, lat, gaps, (0, 1), s)
-            };
-            let case = SplatCase {
-                words: words.clone(),
-                items: items.clone(),
-                setup,
-                traffic: if stall == 0.0 {
-                    Traffic::full_speed()
-                } else {
-                    Traffic::random(&mut rng, 0.3, stall)
-                },
-                reset: None,
-            };
-            splat_must(variant, cfg, s, &case);
-        }
+        directed_runs((variant, cfg, s), &mut rng, &words, &items);
     }
 }
 
@@ -954,7 +807,7 @@ fn splat_reset_in_mid_stream_drops_the_dirty_lines_and_the_next_items_are_exact(
             let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
             let after = splat_items(cfg, &mut rng, 300, 0.4);
             case.reset = Some((rng.random_range(30..3000), after));
-            dropped += splat_must(variant, cfg, s, &case).dropped_at_reset;
+            dropped += must(variant, cfg, s, &case).dropped_at_reset;
         }
         assert!(
             dropped > 0,
@@ -975,27 +828,27 @@ fn splat_throughput_two_clocks_per_hitting_deposit_and_the_cycle_identity() {
         let r = CacheReq { x: 5, y: 6, z: 7 };
         let mut items = vec![CacheItem::Read(r)];
         items.extend((1..n).map(|k| CacheItem::Deposit(r, [(k % 5) as u32; 8])));
-        let case = SplatCase {
+        let case = Case {
             words: words.clone(),
             items,
             setup: mem_setup(cfg, &img, (100, 0), (0, 0), (0, 1), 1),
             traffic: Traffic::full_speed(),
             reset: None,
         };
-        let rep = splat_must(variant, cfg, 1, &case);
+        let rep = must(variant, cfg, 1, &case);
         // One miss, then n - 1 deposits that hit, two clocks each (the last one's bubble is
         // after the run): n + 2 + 1 + (n - 2) + stall.
         assert_eq!(rep.cycles, 2 * n + 1 + rep.stall, "{variant}: {rep:?}");
         for lat in [10u32, 100] {
             let items = splat_items(cfg, &mut rng, 3000, 0.3);
-            let case = SplatCase {
+            let case = Case {
                 words: words.clone(),
                 items,
                 setup: mem_setup(cfg, &img, (lat, 0), (0, 0), (0, 1), 2),
                 traffic: Traffic::full_speed(),
                 reset: None,
             };
-            let rep = splat_must(variant, cfg, 2, &case);
+            let rep = must(variant, cfg, 2, &case);
             eprintln!(
                 "{variant}: latency {lat}: {:.2} clocks per item ({} deposits, {} lines read, {} written back)",
                 rep.cycles as f64 / rep.items as f64,
@@ -1014,13 +867,13 @@ fn splat_gate_level_netlist_smoke() {
         .filter(|(_, c)| c.splat == 1)
     {
         let s = seed(2700);
-        splat_must(variant, cfg, s, &random_splat_case(cfg, s, 200));
+        must(variant, cfg, s, &random_splat_case(cfg, s, 200));
         let mut case = random_splat_case(cfg, s + 1, 150);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         case.reset = Some((
             rng.random_range(30..500),
             splat_items(cfg, &mut rng, 100, 0.4),
         ));
-        splat_must(variant, cfg, s + 1, &case);
+        must(variant, cfg, s + 1, &case);
     }
 }
