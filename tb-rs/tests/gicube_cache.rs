@@ -433,13 +433,14 @@ fn splat_configs() -> Vec<(&'static Variant, CacheConfig)> {
         .collect()
 }
 
-/// Random energies of `IrrW` bits: mostly small, a tenth the maximum (saturation).
+/// Random energies of `IrrW` bits: mostly under a 32nd of the range (so that most sums do not
+/// saturate), a tenth 0, a fiftieth the maximum (a sum that saturates).
 fn random_energies(cfg: CacheConfig, rng: &mut ChaCha8Rng) -> [u32; 8] {
     let top = (1u32 << cfg.irr_w()) - 1;
-    std::array::from_fn(|_| match rng.random_range(0..10) {
+    std::array::from_fn(|_| match rng.random_range(0..50) {
         0 => top,
-        1 => 0,
-        _ => rng.random_range(0..=top >> 3),
+        1..=5 => 0,
+        _ => rng.random_range(0..=top >> 5),
     })
 }
 
