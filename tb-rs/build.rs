@@ -248,6 +248,7 @@ fn main() {
         "clocked_top.h",
         "axi_mem.h",
         "axi_ports.h",
+        "out_watch.h",
         "axi_shim.h",
         "axil_mgr.h",
         "axil_shim.h",
@@ -754,11 +755,18 @@ impl Shim {
     fn stamp_headers(self) -> &'static [&'static str] {
         match self {
             Shim::Stream => &[],
-            Shim::Axi => &["clocked_top.h", "axi_mem.h", "axi_ports.h", "axi_shim.h"],
+            Shim::Axi => &[
+                "clocked_top.h",
+                "axi_mem.h",
+                "axi_ports.h",
+                "out_watch.h",
+                "axi_shim.h",
+            ],
             Shim::AxiWr => &[
                 "clocked_top.h",
                 "axi_mem.h",
                 "axi_ports.h",
+                "out_watch.h",
                 "axi_shim.h",
                 "axi_wr_shim.h",
             ],
@@ -771,11 +779,12 @@ impl Shim {
                 "axil_mgr.h",
                 "accel_shim.h",
             ],
-            Shim::Win => &["clocked_top.h", "win_host.h", "win_shim.h"],
+            Shim::Win => &["clocked_top.h", "win_host.h", "out_watch.h", "win_shim.h"],
             Shim::AxiRw => &[
                 "clocked_top.h",
                 "axi_mem.h",
                 "axi_ports.h",
+                "out_watch.h",
                 "axi_shim.h",
                 "axi_rw_shim.h",
             ],

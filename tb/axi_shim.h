@@ -7,6 +7,7 @@
 #include "axi_mem.h"
 #include "axi_ports.h"
 #include "clocked_top.h"
+#include "out_watch.h"
 #include "stream_shim.h"
 
 namespace cube5 {
@@ -57,7 +58,7 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
     top_->rst_ni = 1;
     top_->eval();
     if (const char* what = still_valid()) axi_violation(what);
-    has_stalled_ = false;
+    out_watch_.clear();
   }
 
   /// Records a protocol error of the manager found outside the subordinate's own checks.
@@ -90,7 +91,7 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
       ++next;
       ++st.consumed;
     }
-    watch_output(st, take, out, out_words);
+    out_watch_.watch(*top_, cycle_, take, st, out, out_words);
     this->tick();
     ++st.cycles;
     if (this->ctx_->gotFinish()) {
@@ -107,26 +108,7 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
     top_->eval();
   }
 
-  /// After eval: the output's stall rule, and the output taken this cycle (if `take`) appended to
-  /// `out` as DutCore::run describes.
-  void watch_output(RunStats& st, bool take, std::vector<uint32_t>& out, uint32_t out_words) {
-    if (has_stalled_ && (!top_->out_valid_o || !port_equal(top_->out_data_o, stalled_data_))) {
-      if (st.protocol_errors++ == 0) st.first_protocol_error_cycle = cycle_;
-    }
-    has_stalled_ = top_->out_valid_o && !take;
-    if (has_stalled_) stalled_data_ = top_->out_data_o;
-    if (top_->out_valid_o && take) {
-      const size_t at = out.size();
-      out.resize(at + 2 + out_words);
-      out[at] = static_cast<uint32_t>(cycle_);
-      out[at + 1] = static_cast<uint32_t>(cycle_ >> 32);
-      read_port(top_->out_data_o, out.data() + at + 2, out_words);
-      ++st.produced;
-    }
-  }
-
-  bool has_stalled_ = false;
-  std::remove_reference_t<decltype(V::out_data_o)> stalled_data_{};
+  OutWatch<V> out_watch_;
   AxiMem mem_;
 };
 

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "clocked_top.h"
+#include "out_watch.h"
 #include "stream_shim.h"
 #include "win_host.h"
 
@@ -50,7 +51,8 @@ class WinShim final : public ClockedTop<V>, public WinHost {
     top_->eval();
     dram_.clear();
     answers_.clear();
-    has_stalled_ = park_held_ = fin_held_ = rq_held_ = false;
+    out_watch_.clear();
+    park_held_ = fin_held_ = rq_held_ = false;
   }
 
   void win_setup(const WinConfig& c) override {
@@ -92,11 +94,7 @@ class WinShim final : public ClockedTop<V>, public WinHost {
       top_->eval();
 
       // The valid/ready rule on all four outputs.
-      if (has_stalled_ && (!top_->out_valid_o || !port_equal(top_->out_data_o, stalled_data_))) {
-        if (st.protocol_errors++ == 0) st.first_protocol_error_cycle = cycle_;
-      }
-      has_stalled_ = top_->out_valid_o && !take;
-      if (has_stalled_) stalled_data_ = top_->out_data_o;
+      out_watch_.watch(*top_, cycle_, take, st, out, out_words);
       held(park_held_, top_->park_valid_o, park_take, top_->park_key_o, park_key_, top_->park_cox_o,
            park_cox_);
       held(fin_held_, top_->fin_valid_o, fin_take, top_->fin_key_o, fin_key_, top_->fin_cox_o,
@@ -106,14 +104,6 @@ class WinShim final : public ClockedTop<V>, public WinHost {
       if (offer && top_->in_ready_o) {
         ++next;
         ++st.consumed;
-      }
-      if (top_->out_valid_o && take) {
-        const size_t at = out.size();
-        out.resize(at + 2 + out_words);
-        out[at] = static_cast<uint32_t>(cycle_);
-        out[at + 1] = static_cast<uint32_t>(cycle_ >> 32);
-        read_port(top_->out_data_o, out.data() + at + 2, out_words);
-        ++st.produced;
       }
       if (top_->park_valid_o && park_take) {
         uint32_t* r = record(kWinPark, top_->park_key_o, 0);
@@ -204,8 +194,8 @@ class WinShim final : public ClockedTop<V>, public WinHost {
   std::vector<uint32_t> records_;
   std::unordered_map<uint64_t, std::vector<uint32_t>> dram_;
   std::deque<Answer> answers_;
-  bool has_stalled_ = false, park_held_ = false, fin_held_ = false, rq_held_ = false;
-  std::remove_reference_t<decltype(V::out_data_o)> stalled_data_{};
+  OutWatch<V> out_watch_;
+  bool park_held_ = false, fin_held_ = false, rq_held_ = false;
   std::remove_reference_t<decltype(V::park_key_o)> park_key_{}, fin_key_{}, rq_key_{}, rq_key2_{};
   std::remove_reference_t<decltype(V::park_cox_o)> park_cox_{};
   std::remove_reference_t<decltype(V::fin_cox_o)> fin_cox_{};

@@ -4,7 +4,7 @@
 mod support;
 
 use std::process::Output;
-use support::{cube5, render_at, render_ok, scratch, succeeded};
+use support::{cube5, render_at, render_ok, scratch, scratch_file, succeeded};
 
 /// Asserts a refusal naming `needle` (one line, non-zero exit, no panic).
 fn assert_refused(out: &Output, needle: &str) {
@@ -35,8 +35,7 @@ fn renders_the_default_scene_to_png() {
 
 #[test]
 fn renders_any_view_angle_from_a_scene_file() {
-    let scene = scratch("view.toml");
-    std::fs::write(&scene, "[volume]\nsize = 24\n[view]\nazimuth = -135.5\nelevation = 89.9\n[image]\nwidth = 16\nheight = 16\n").unwrap();
+    let scene = scratch_file("view.toml", "[volume]\nsize = 24\n[view]\nazimuth = -135.5\nelevation = 89.9\n[image]\nwidth = 16\nheight = 16\n");
     let png = scratch("view.png");
     render_ok(&scene, &png);
     assert!(png.exists());
@@ -75,8 +74,7 @@ fn unknown_option() {
 
 #[test]
 fn malformed_scene_names_file_and_line() {
-    let scene = scratch("bad.toml");
-    std::fs::write(&scene, "[view]\nazimuth = 10\nelevation = [\n").unwrap();
+    let scene = scratch_file("bad.toml", "[view]\nazimuth = 10\nelevation = [\n");
     assert_refused(&cube5(&["render", scene.to_str().unwrap()]), "bad.toml:");
     std::fs::write(&scene, "[view]\nazimuth = nan\n").unwrap();
     assert_refused(&cube5(&["render", scene.to_str().unwrap()]), "view.azimuth");
@@ -103,12 +101,7 @@ fn output_must_be_png_in_an_existing_directory() {
 /// `make demo`), then the inputs it refuses.
 #[test]
 fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
-    let scene = scratch("cosim-small.toml");
-    std::fs::write(
-        &scene,
-        "[volume]\nphantom = \"sphere\"\nsize = 32\n[view]\nazimuth = 45.0\nelevation = 0.0\n[image]\nwidth = 64\nheight = 64\n",
-    )
-    .unwrap();
+    let scene = scratch_file("cosim-small.toml", "[volume]\nphantom = \"sphere\"\nsize = 32\n[view]\nazimuth = 45.0\nelevation = 0.0\n[image]\nwidth = 64\nheight = 64\n");
     for p in ["1", "8"] {
         let dir = scratch(&format!("cosim-p{p}"));
         let _ = std::fs::remove_dir_all(&dir);
@@ -129,8 +122,7 @@ fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
         }
     }
     let bad = |name: &str, text: &str, extra: &[&str], needle: &str| {
-        let f = scratch(name);
-        std::fs::write(&f, text).unwrap();
+        let f = scratch_file(name, text);
         let dir = scratch(&format!("{name}-out"));
         let _ = std::fs::remove_dir_all(&dir);
         let mut args = vec!["cosim", f.to_str().unwrap(), "-o", dir.to_str().unwrap()];
@@ -167,8 +159,10 @@ fn cosim_matches_and_refuses_what_the_frame_cannot_render() {
 
 /// Renders `scene` (written to NAME.toml) with `extra` arguments at 24 x 24; the PNG's bytes.
 fn render_view(name: &str, scene: &str, extra: &[&str]) -> (Output, Vec<u8>) {
-    let toml = scratch(&format!("{name}.toml"));
-    std::fs::write(&toml, format!("[volume]\nsize = 24\n{scene}")).unwrap();
+    let toml = scratch_file(
+        &format!("{name}.toml"),
+        format!("[volume]\nsize = 24\n{scene}"),
+    );
     let png = scratch(&format!("{name}.png"));
     let out = render_at(&toml, &png, 24, extra);
     (out, std::fs::read(&png).unwrap_or_default())

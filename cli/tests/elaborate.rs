@@ -3,7 +3,7 @@
 
 mod support;
 
-use support::{assert_refused, cube5, scratch, succeeded};
+use support::{assert_refused, cube5, scratch, scratch_file, succeeded};
 
 fn scene_path(name: &str) -> String {
     cube5_model::repo_root()
@@ -65,14 +65,18 @@ fn elaborate_refuses_naming_the_field() {
         &cube5(&["elaborate", &scene_path("head-mip"), "-p", "3"]),
         &["--pipelines", "P = 3"],
     );
-    let odd = scratch("elab-odd.toml");
-    std::fs::write(&odd, "[volume]\nsize = 20\n[run]\npipelines = 8\n").unwrap();
+    let odd = scratch_file(
+        "elab-odd.toml",
+        "[volume]\nsize = 20\n[run]\npipelines = 8\n",
+    );
     assert_refused(
         &cube5(&["elaborate", odd.to_str().unwrap()]),
         &["run.pipelines", "multiple of P = 8"],
     );
-    let bad = scratch("elab-p5.toml");
-    std::fs::write(&bad, "[volume]\nsize = 20\n[run]\npipelines = 5\n").unwrap();
+    let bad = scratch_file(
+        "elab-p5.toml",
+        "[volume]\nsize = 20\n[run]\npipelines = 5\n",
+    );
     assert_refused(
         &cube5(&["elaborate", bad.to_str().unwrap()]),
         &["run.pipelines"],
@@ -84,12 +88,7 @@ fn elaborate_refuses_naming_the_field() {
 #[cfg(feature = "rtl")]
 #[test]
 fn cosim_runs_a_mip_scene_on_the_frame_without_gradient_and_shader() {
-    let scene = scratch("elab-mip.toml");
-    std::fs::write(
-        &scene,
-        "[volume]\nphantom = \"head\"\nsize = 16\n[render]\nmode = \"mip\"\n[image]\nwidth = 32\nheight = 32\n",
-    )
-    .unwrap();
+    let scene = scratch_file("elab-mip.toml", "[volume]\nphantom = \"head\"\nsize = 16\n[render]\nmode = \"mip\"\n[image]\nwidth = 32\nheight = 32\n");
     let dir = scratch("elab-mip-out");
     let out = stdout_of(&[
         "cosim",

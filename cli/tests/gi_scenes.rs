@@ -6,7 +6,7 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use support::{assert_refused, cube5, render_at, render_scene, scratch, succeeded};
+use support::{assert_refused, cube5, render_at, render_scene, scratch, scratch_file, succeeded};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -73,8 +73,10 @@ fn gi_shadow_renders_on_the_processor_with_its_counts() {
     // lit image is darker where the sphere shadows the floor.
     let text = std::fs::read_to_string(example()).unwrap();
     assert!(text.contains("passes = 2"));
-    let unlit_scene = scratch("gi-shadow-unlit.toml");
-    std::fs::write(&unlit_scene, text.replace("passes = 2", "passes = 1")).unwrap();
+    let unlit_scene = scratch_file(
+        "gi-shadow-unlit.toml",
+        text.replace("passes = 2", "passes = 1"),
+    );
     let (stdout, unlit) = render(&unlit_scene, "gi-shadow-unlit.png", &["--compare"]);
     assert!(stdout.contains("rendering pass only"), "{stdout}");
     assert!(!stdout.contains("lighting pass: "), "{stdout}");
@@ -89,12 +91,10 @@ fn gi_shadow_renders_on_the_processor_with_its_counts() {
         "only {darker} pixels are clearly darker with the light's shadow than without"
     );
     // The shadow moves with the light.
-    let moved_scene = scratch("gi-shadow-moved.toml");
-    std::fs::write(
-        &moved_scene,
+    let moved_scene = scratch_file(
+        "gi-shadow-moved.toml",
         text.replace("light = [0.55, 0.25, -0.8]", "light = [-0.55, -0.25, -0.8]"),
-    )
-    .unwrap();
+    );
     let (_, moved) = render(&moved_scene, "gi-shadow-moved.png", &[]);
     assert!(moved != lit, "moving the light changes nothing");
 }

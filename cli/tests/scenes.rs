@@ -5,7 +5,7 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use support::{cube5, render_scene, scene_refused, scratch, succeeded};
+use support::{cube5, render_scene, scene_refused, scratch, scratch_file, succeeded};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -77,8 +77,7 @@ fn unreadable_volume_file() {
 
 #[test]
 fn raw_size_must_equal_dims_times_type() {
-    let raw = scratch("short.raw");
-    std::fs::write(&raw, vec![7u8; 1000]).unwrap();
+    let raw = scratch_file("short.raw", vec![7u8; 1000]);
     scene_refused(
         "raw-size",
         &format!(
@@ -97,12 +96,10 @@ fn dims_beyond_the_configured_rtl() {
         &["volume.size", "configured RTL", "128"],
     );
     // A file whose header says more than the model takes at all.
-    let big = scratch("big.nrrd");
-    std::fs::write(
-        &big,
+    let big = scratch_file(
+        "big.nrrd",
         "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2000 4 4\nencoding: raw\n\n",
-    )
-    .unwrap();
+    );
     scene_refused(
         "too-big",
         &format!("[volume]\nfile = \"{}\"\n", s(&big)),
@@ -126,15 +123,13 @@ fn nan_or_zero_view_vector() {
 
 #[test]
 fn empty_or_constant_volume() {
-    let empty = scratch("empty.nrrd");
-    std::fs::write(&empty, b"").unwrap();
+    let empty = scratch_file("empty.nrrd", b"");
     scene_refused(
         "empty",
         &format!("[volume]\nfile = \"{}\"\n", s(&empty)),
         &["volume.file", "empty.nrrd", "magic"],
     );
-    let flat = scratch("flat.raw");
-    std::fs::write(&flat, vec![0u8; 8 * 8 * 8]).unwrap();
+    let flat = scratch_file("flat.raw", vec![0u8; 8 * 8 * 8]);
     scene_refused(
         "constant",
         &format!(
@@ -152,12 +147,10 @@ fn unsorted_transfer_function_points() {
 
 #[test]
 fn malformed_headers_name_the_field() {
-    let bad = scratch("bad-header.nrrd");
-    std::fs::write(
-        &bad,
+    let bad = scratch_file(
+        "bad-header.nrrd",
         "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 4 4\nencoding: bzip2\n\n",
-    )
-    .unwrap();
+    );
     scene_refused(
         "bad-nrrd",
         &format!("[volume]\nfile = \"{}\"\n", s(&bad)),

@@ -60,6 +60,19 @@ impl BitWriter {
         self.words.resize(words_for(total_width), 0);
         self.words
     }
+
+    /// The words of an item narrower than its stream's `total_width` bits (a stream whose kinds
+    /// of item carry payloads of different widths, a configuration word with unused bits),
+    /// zero-padded to that width.
+    pub fn finish_padded(mut self, total_width: u32) -> Vec<u32> {
+        assert!(
+            self.len <= total_width,
+            "packed width {} exceeds the declared width {total_width}",
+            self.len
+        );
+        self.len = total_width;
+        self.finish(total_width)
+    }
 }
 
 /// Reads fields LSB first from 32-bit words.
@@ -108,6 +121,15 @@ pub fn words_for(width: u32) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_narrower_item_is_zero_padded_to_the_stream_width() {
+        let mut w = BitWriter::new();
+        w.put(0x3, 2);
+        assert_eq!(w.clone().finish_padded(70), vec![3, 0, 0]);
+        w.put(0x1, 1);
+        assert_eq!(w.finish_padded(3), vec![7]);
+    }
 
     #[test]
     fn round_trip_across_word_boundaries() {

@@ -709,28 +709,10 @@ impl Expected {
         render: Render,
         look: &Look,
     ) -> Result<Self, ModelError> {
-        // The set-up is that of P = 1: the image does not depend on P (only the set-up's check
-        // that the dimensions are multiples of P does).
-        let mut setup = FrameSetup::new(seen.dims, seen.spacing, dir.into(), 1)?;
-        if let Some(x) = look.xray_shift {
-            setup.xray_shift = x;
-        }
-        let params = setup.params;
+        let (params, fu) = Self::model_units(rtl, seen, dir, render, look)?;
+        let geometry = fu.geometry.clone();
         // The model's own base plane at the variant's widths
         // (cube5_model::units::cube5_frame::render_base_plane): what `cube5 render` computes.
-        let mut fu = FrameUnits::with_options(
-            &rtl.cfg,
-            render,
-            &setup,
-            &look.tf,
-            &look.phong,
-            &look.options(),
-        )?;
-        if rtl.depth_test {
-            let g = geometry::rasterize(&params, &look.geometry, &rtl.compos);
-            fu.set_geometry(&params, g)?;
-        }
-        let geometry = fu.geometry.clone();
         let bp = cube5_frame::render_base_plane(&params, seen, &fu);
         let units = Units {
             trilin: fu.trilin,
@@ -756,6 +738,37 @@ impl Expected {
 }
 
 impl Expected {
+    /// The frame's parameters and the model's units at the variant's widths for `seen` viewed
+    /// along `dir` with `look` (the geometry table rasterized when the variant has the depth test).
+    /// The set-up is that of P = 1: the image does not depend on P (only the set-up's check that
+    /// the dimensions are multiples of P does).
+    pub fn model_units(
+        rtl: &FrameRtl,
+        seen: &Volume,
+        dir: [f64; 3],
+        render: Render,
+        look: &Look,
+    ) -> Result<(FrameParams, FrameUnits), ModelError> {
+        let mut setup = FrameSetup::new(seen.dims, seen.spacing, dir.into(), 1)?;
+        if let Some(x) = look.xray_shift {
+            setup.xray_shift = x;
+        }
+        let params = setup.params;
+        let mut fu = FrameUnits::with_options(
+            &rtl.cfg,
+            render,
+            &setup,
+            &look.tf,
+            &look.phong,
+            &look.options(),
+        )?;
+        if rtl.depth_test {
+            let g = geometry::rasterize(&params, &look.geometry, &rtl.compos);
+            fu.set_geometry(&params, g)?;
+        }
+        Ok((params, fu))
+    }
+
     /// The model's frame of a scene, exactly what `cube5 render` computes for it
     /// (`cube5_model::scene_render::FrameJob`): the RTL is compared with that image.
     pub fn from_job(job: &FrameJob, run: FrameRun, view: &str) -> Self {
@@ -929,17 +942,15 @@ impl FrameBench {
     /// limit far beyond the frame's budget passes).
     pub fn render(&mut self, e: &Expected, traffic: &Traffic) -> Result<Rendered, TbError> {
         let n = items_for(e.w, e.h, self.rtl.out_lanes);
-        let start = self.dut.cycle();
         let limit = 40 * (e.params.samples() as u64 + n) + 100_000;
-        let driven = self.dut.drive(&[OP_RENDER], traffic, n, limit)?;
-        let (pixels, taken_at) = pixels_of(&driven.outputs, e.w, self.rtl.out_lanes);
-        Ok(Rendered {
-            pixels,
-            taken_at,
-            cycles: self.dut.cycle() - start,
-            protocol_errors: driven.stats.protocol_errors,
+        drive_pixels(
+            &mut self.dut,
+            &[OP_RENDER],
+            e,
+            self.rtl.out_lanes,
+            traffic,
             limit,
-        })
+        )
     }
 
     /// Compares a rendered frame with the model's: every pixel and channel, the error flag, and
@@ -1006,20 +1017,8 @@ impl FrameBench {
                 )));
             }
         }
+        got.all_out(e, rtl.variant, seed, &ctx())?;
         let n = e.w * e.h;
-        if got.pixels.len() != n {
-            return Err(TbError::Deadlock {
-                variant: rtl.variant.name.to_string(),
-                seed,
-                cycle: got.cycles,
-                what: format!(
-                    "{} of {n} pixels within {} cycles (deadlock or lost pixel; {})",
-                    got.pixels.len(),
-                    got.limit,
-                    ctx()
-                ),
-            });
-        }
         Ok(FrameStats {
             cycles: got.cycles,
             sweep: got.pixels[0].cycles,
@@ -1062,6 +1061,29 @@ pub fn items_for(w: usize, h: usize, lanes: usize) -> u64 {
     (w.div_ceil(lanes.max(1)) * h) as u64
 }
 
+/// Drives `items` on `dut` until the W H pixels of `e`'s base plane are out in items of `lanes`
+/// pixels (or `limit` cycles pass): the frame of the command stream (`FrameBench`) or of the
+/// section stream (`StreamBench`).
+pub(crate) fn drive_pixels<C: StreamCodec<Out = FrameOut>>(
+    dut: &mut RtlStream<C>,
+    items: &[C::In],
+    e: &Expected,
+    lanes: usize,
+    traffic: &Traffic,
+    limit: u64,
+) -> Result<Rendered, TbError> {
+    let start = dut.cycle();
+    let driven = dut.drive(items, traffic, items_for(e.w, e.h, lanes), limit)?;
+    let (pixels, taken_at) = pixels_of(&driven.outputs, e.w, lanes);
+    Ok(Rendered {
+        pixels,
+        taken_at,
+        cycles: dut.cycle() - start,
+        protocol_errors: driven.stats.protocol_errors,
+        limit,
+    })
+}
+
 /// The RTL's output of one render command.
 #[derive(Debug, Clone)]
 pub struct Rendered {
@@ -1072,6 +1094,32 @@ pub struct Rendered {
     pub cycles: u64,
     pub protocol_errors: u64,
     pub limit: u64,
+}
+
+impl Rendered {
+    /// All W H pixels of `e` came out, else a `Deadlock` (`ctx`: the frame, for the report).
+    pub fn all_out(
+        &self,
+        e: &Expected,
+        variant: &Variant,
+        seed: u64,
+        ctx: &str,
+    ) -> Result<(), TbError> {
+        let n = e.w * e.h;
+        if self.pixels.len() == n {
+            return Ok(());
+        }
+        Err(TbError::Deadlock {
+            variant: variant.name.to_string(),
+            seed,
+            cycle: self.cycles,
+            what: format!(
+                "{} of {n} pixels within {} cycles (deadlock or lost pixel; {ctx})",
+                self.pixels.len(),
+                self.limit
+            ),
+        })
+    }
 }
 
 impl FrameBench {

@@ -7,7 +7,7 @@
 
 use crate::error::{Mismatch, TbError};
 use crate::frame::{
-    items_for, pixels_of, ray_trail, Expected, FrameOut, FrameRtl, Render, Rendered, REG_MODE,
+    drive_pixels, items_for, ray_trail, Expected, FrameOut, FrameRtl, Render, Rendered, REG_MODE,
 };
 use crate::rtl::{RtlStream, Traffic};
 use crate::variants::variants_of;
@@ -68,7 +68,7 @@ impl StreamFrame {
     }
 
     fn beat_w(&self) -> u32 {
-        (self.0.p as u32 + 3) * self.0.trilin.voxel_w + 5
+        Beam::width(self.0.p as u32, self.0.trilin.voxel_w)
     }
 }
 
@@ -96,21 +96,11 @@ impl StreamCodec for StreamFrame {
                 w.put(u64::from(c.last), 1);
             }
             StreamIn::Beat(b) => {
-                let vw = self.0.trilin.voxel_w;
                 w.put(u64::from(KIND_BEAT), 1);
-                for &v in b.lanes.iter().chain([&b.lo, &b.hi0, &b.hi1]) {
-                    w.put(u64::from(v), vw);
-                }
-                for f in [b.row_first, b.row_last, b.slice_last, b.last, b.error] {
-                    w.put(u64::from(f), 1);
-                }
+                b.pack(&mut w, self.0.trilin.voxel_w);
             }
         }
-        while w.len() < self.in_width() {
-            let pad = (self.in_width() - w.len()).min(64);
-            w.put(0, pad);
-        }
-        w.finish(self.in_width())
+        w.finish_padded(self.in_width())
     }
 
     fn unpack_out(&self, words: &[u32]) -> FrameOut {
@@ -237,17 +227,8 @@ impl StreamBench {
         traffic: &Traffic,
     ) -> Result<Rendered, TbError> {
         let n = items_for(e.w, e.h, self.rtl.out_lanes);
-        let start = self.dut.cycle();
         let limit = 60 * (items.len() as u64 + n) + 200_000;
-        let driven = self.dut.drive(items, traffic, n, limit)?;
-        let (pixels, taken_at) = pixels_of(&driven.outputs, e.w, self.rtl.out_lanes);
-        Ok(Rendered {
-            pixels,
-            taken_at,
-            cycles: self.dut.cycle() - start,
-            protocol_errors: driven.stats.protocol_errors,
-            limit,
-        })
+        drive_pixels(&mut self.dut, items, e, self.rtl.out_lanes, traffic, limit)
     }
 
     /// Loads `e`, renders it in sections of `width` and compares every pixel with the frame
@@ -293,19 +274,7 @@ impl StreamBench {
         if got.protocol_errors > 0 {
             return fail(0, "a stalled output changed".into(), String::new());
         }
-        let n = e.w * e.h;
-        if got.pixels.len() != n {
-            return Err(TbError::Deadlock {
-                variant: rtl.variant.name.to_string(),
-                seed,
-                cycle: got.cycles,
-                what: format!(
-                    "{} of {n} pixels within {} cycles ({ctx})",
-                    got.pixels.len(),
-                    got.limit
-                ),
-            });
-        }
+        got.all_out(e, rtl.variant, seed, &ctx)?;
         for (i, px) in got.pixels.iter().enumerate() {
             let (r, q) = (i % e.w, i / e.w);
             if px.error {

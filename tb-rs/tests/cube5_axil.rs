@@ -12,14 +12,9 @@ use cube5_model::regs::cube5_accel::TABLE_CLASS;
 use cube5_model::regs::cube5_axil_regs::MAP_ACCEL;
 use cube5_model::units::cube5_axil::{AxilConfig, AxilTxn, BusWrite, RESP_OKAY, RESP_SLVERR};
 use cube5_tb::axil::{random_txn, stall_pattern, AxilBench, TxnMix};
-use cube5_tb::TbError;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use support::{configs, gate_configs, seed, MILLION};
-
-fn must<T>(r: Result<T, TbError>) -> T {
-    r.unwrap_or_else(|e| panic!("{e}"))
-}
+use support::{configs, gate_configs, must, seed, MILLION};
 
 /// `n` random transactions in batches, each batch under its own back-pressure; every
 /// `reset_every` batches the batch is cut short in mid-stream and the block reset.

@@ -18,7 +18,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::rc::Rc;
 use std::time::Instant;
-use support::seed;
+use support::{must, seed};
 
 /// The largest-memory configuration with `n` pipelines (default widths).
 fn p(n: usize) -> FrameRtl {
@@ -105,10 +105,6 @@ fn oblique_head_p4(n: usize, et: bool, s: u64) -> (FrameRtl, FrameBench, Expecte
         bench,
         expect(&rtl, &seen, OBLIQUE_Z, Render::Composite, et),
     )
-}
-
-fn must<T>(r: Result<T, cube5_tb::TbError>) -> T {
-    r.unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Renders views of the acceptance volumes in one rendering on the configurations of `plan`

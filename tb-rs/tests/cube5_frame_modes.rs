@@ -17,11 +17,7 @@ use cube5_tb::rtl::Traffic;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::rc::Rc;
-use support::seed;
-
-fn must<T>(r: Result<T, cube5_tb::TbError>) -> T {
-    r.unwrap_or_else(|e| panic!("{e}"))
-}
+use support::{must, seed};
 
 /// The default-width configuration with four pipelines, with (`shade`) or without gradient and
 /// shader.

@@ -13,15 +13,10 @@ use cube5_model::volume::Volume;
 use cube5_tb::frame::{Expected, FrameRtl, Look, Render, COMPOS_LATENCY, TRILIN_LATENCY};
 use cube5_tb::frame_stream::{items_of, StreamBench, StreamIn};
 use cube5_tb::rtl::Traffic;
-use cube5_tb::TbError;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::rc::Rc;
-use support::seed;
-
-fn must<T>(r: Result<T, TbError>) -> T {
-    r.unwrap_or_else(|e| panic!("{e}"))
-}
+use support::{must, seed};
 
 /// The stream configuration with `p` pipelines and the largest memory.
 fn stream(p: usize) -> FrameRtl {

@@ -14,7 +14,6 @@ use cube5_model::phantom::head_phantom;
 use cube5_model::units::cube5_compos::Coxel;
 use cube5_model::units::cube5_frame::sections::section_order;
 use cube5_model::units::cube5_frame::window::{render_window, WindowTraffic};
-use cube5_model::units::cube5_frame::{FrameSetup, FrameUnits};
 use cube5_model::volume::Volume;
 use cube5_tb::error::Mismatch;
 use cube5_tb::frame::{Expected, FrameRtl, Look, Render};
@@ -24,11 +23,7 @@ use cube5_tb::TbError;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::rc::Rc;
-use support::seed;
-
-fn must<T>(r: Result<T, TbError>) -> T {
-    r.unwrap_or_else(|e| panic!("{e}"))
-}
+use support::{must, seed};
 
 /// The builds with the compositing window, `p` pipelines.
 fn window(p: usize) -> FrameRtl {
@@ -81,16 +76,7 @@ fn case(
 ) -> Case {
     let look = Look::default();
     let e = Expected::new(rtl, vol, view.0, view.1, render, &look).unwrap();
-    let setup = FrameSetup::new(vol.dims, vol.spacing, view.1.into(), 1).unwrap();
-    let fu = FrameUnits::with_options(
-        &rtl.cfg,
-        render,
-        &setup,
-        &look.tf,
-        &look.phong,
-        &look.options(),
-    )
-    .unwrap();
+    let (_, fu) = Expected::model_units(rtl, vol, view.1, render, &look).unwrap();
     let order = section_order(&e.params, width, rtl.p).unwrap();
     let (bp, t) = render_window(&e.params, vol, &fu, &order, rtl.p).unwrap();
     assert!(

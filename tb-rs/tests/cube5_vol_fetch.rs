@@ -441,31 +441,7 @@ fn directed_extremes() {
             }
         }
         let ok = Sweep::whole(base, blocks);
-        let bbus = u64::from(cfg.data_w / 8);
-        for bad in [
-            Sweep { axis_k: 3, ..ok },
-            Sweep {
-                blocks: [0, 1, 1],
-                ..ok
-            },
-            Sweep {
-                blocks: [cfg.nb() + 1, 1, 1],
-                ..ok
-            },
-            Sweep {
-                sec_lo: 1,
-                sec_hi: 1,
-                ..ok
-            },
-            Sweep {
-                sec_hi: blocks[0] + 1,
-                ..ok
-            },
-            Sweep {
-                base: base + bbus / 2,
-                ..ok
-            },
-        ] {
+        for bad in cfg.refused_sweeps(ok) {
             cmds.push(FetchCmd::Sweep(bad));
             cmds.push(FetchCmd::Sweep(Sweep { sec_hi: 1, ..ok }));
         }

@@ -20,6 +20,13 @@ pub fn scratch(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+/// Writes `contents` to the scratch file `name` (as `scratch`); returns its path.
+pub fn scratch_file(name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
+    let f = scratch(name);
+    std::fs::write(&f, contents).unwrap();
+    f
+}
+
 /// Asserts that `out` is a successful run (else panics with `what`, the exit status, stdout and
 /// stderr); returns its stdout.
 pub fn succeeded(out: &Output, what: &str) -> String {
@@ -81,8 +88,7 @@ pub fn render_at(scene: &Path, png: &Path, px: u32, extra: &[&str]) -> Output {
 /// Writes `scene` as NAME.toml in the scratch directory and renders it at 16 x 16; returns the
 /// output and the PNG path (removed first).
 pub fn render_scene(name: &str, scene: &str) -> (Output, PathBuf) {
-    let toml = scratch(&format!("{name}.toml"));
-    std::fs::write(&toml, scene).unwrap();
+    let toml = scratch_file(&format!("{name}.toml"), scene);
     let png = scratch(&format!("{name}.png"));
     (render_at(&toml, &png, 16, &[]), png)
 }
@@ -112,9 +118,7 @@ pub fn example_scene_with(name: &str, tag: &str, edits: &[(&str, &str)]) -> Path
         );
         text = text.replace(from, to);
     }
-    let f = scratch(&format!("{tag}.toml"));
-    std::fs::write(&f, text).unwrap();
-    f
+    scratch_file(&format!("{tag}.toml"), text)
 }
 
 /// `cube5 cosim SCENE -o DIR` (DIR emptied first): must succeed and print MATCH; returns stdout.

@@ -96,7 +96,7 @@ impl AxiRdConfig {
     }
 
     /// Wraps `a` into the address space.
-    fn wrap(&self, a: u64) -> u64 {
+    pub(crate) fn wrap(&self, a: u64) -> u64 {
         self.address_space().map_or(a, |s| a & (s - 1))
     }
 

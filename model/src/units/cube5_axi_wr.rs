@@ -72,7 +72,7 @@ impl AxiWrConfig {
 
     /// Bytes per beat, `DataW / 8`.
     pub fn bytes(&self) -> u32 {
-        self.data_w / 8
+        self.bus().bytes()
     }
 
     /// Bytes per item, `ItemW / 8`.
@@ -80,9 +80,9 @@ impl AxiWrConfig {
         self.item_w / 8
     }
 
-    /// AWSIZE: log2 of the bytes per beat.
+    /// AWSIZE: log2 of the bytes per beat (ARSIZE's rule).
     pub fn size(&self) -> u32 {
-        self.bytes().trailing_zeros()
+        self.bus().size()
     }
 
     /// The address space, `2^AddrW` bytes (`None` for 64 bits).
@@ -91,7 +91,7 @@ impl AxiWrConfig {
     }
 
     fn wrap(&self, a: u64) -> u64 {
-        self.address_space().map_or(a, |s| a & (s - 1))
+        self.bus().wrap(a)
     }
 
     /// Whether a command is well formed: the address aligned to an item, inside the address

@@ -245,6 +245,47 @@ pub struct Beam {
 }
 
 impl Beam {
+    /// Bits of a beam of `p` lanes of `voxel_w` bits (the section buffer's output item and the
+    /// beat of a frame fed by a beat stream): lanes, lo, hi0, hi1 (`voxel_w` each), row_first,
+    /// row_last, slice_last, last, error, LSB first.
+    pub fn width(p: u32, voxel_w: u32) -> u32 {
+        (p + 3) * voxel_w + 5
+    }
+
+    /// Appends the beam's [`Beam::width`] bits to `w`.
+    pub fn pack(&self, w: &mut BitWriter, voxel_w: u32) {
+        for &v in self.lanes.iter().chain([&self.lo, &self.hi0, &self.hi1]) {
+            w.put(u64::from(v), voxel_w);
+        }
+        for f in [
+            self.row_first,
+            self.row_last,
+            self.slice_last,
+            self.last,
+            self.error,
+        ] {
+            w.put_bool(f);
+        }
+    }
+
+    /// Reads a beam of `p` lanes back from `r` (the inverse of [`Beam::pack`]).
+    pub fn unpack(r: &mut BitReader, p: u32, voxel_w: u32) -> Self {
+        let lanes = (0..p).map(|_| r.get(voxel_w) as u32).collect();
+        let mut v = || r.get(voxel_w) as u32;
+        let (lo, hi0, hi1) = (v(), v(), v());
+        Beam {
+            lanes,
+            lo,
+            hi0,
+            hi1,
+            row_first: r.get_bool(),
+            row_last: r.get_bool(),
+            slice_last: r.get_bool(),
+            last: r.get_bool(),
+            error: r.get_bool(),
+        }
+    }
+
     fn error(p: u32) -> Self {
         Self {
             lanes: vec![0; p as usize],
@@ -545,9 +586,9 @@ impl StreamCodec for SectionBufConfig {
         1 + self.item_w().max(self.cmd_w())
     }
 
-    /// lanes, lo, hi0, hi1 (VoxelW each), row_first, row_last, slice_last, last, error.
+    /// A beam ([`Beam::width`]).
     fn out_width(&self) -> u32 {
-        (self.p + 3) * self.voxel_w + 5
+        Beam::width(self.p, self.voxel_w)
     }
 
     fn pack_in(&self, input: &SbufIn) -> Vec<u32> {
@@ -576,29 +617,11 @@ impl StreamCodec for SectionBufConfig {
                 w.put(u64::from(cmd.a0), self.m());
             }
         }
-        while w.len() < self.in_width() {
-            let pad = (self.in_width() - w.len()).min(32);
-            w.put(0, pad);
-        }
-        w.finish(self.in_width())
+        w.finish_padded(self.in_width())
     }
 
     fn unpack_out(&self, words: &[u32]) -> Beam {
-        let mut r = BitReader::new(words);
-        let lanes = (0..self.p).map(|_| r.get(self.voxel_w) as u32).collect();
-        let mut v = || r.get(self.voxel_w) as u32;
-        let (lo, hi0, hi1) = (v(), v(), v());
-        Beam {
-            lanes,
-            lo,
-            hi0,
-            hi1,
-            row_first: r.get_bool(),
-            row_last: r.get_bool(),
-            slice_last: r.get_bool(),
-            last: r.get_bool(),
-            error: r.get_bool(),
-        }
+        Beam::unpack(&mut BitReader::new(words), self.p, self.voxel_w)
     }
 }
 

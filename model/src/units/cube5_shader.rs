@@ -518,12 +518,7 @@ impl ShaderTables {
     /// classification entries, texels, the zero-gradient entry.
     pub fn config_writes(&self, cfg: &ShaderConfig) -> Vec<(u32, Vec<u32>)> {
         let dw = cfg.cfg_data_w();
-        let word = |w: BitWriter| {
-            let mut w = w;
-            let pad = dw - w.len();
-            w.put(0, pad);
-            w.finish(dw)
-        };
+        let word = |w: BitWriter| w.finish_padded(dw);
         let mut out = Vec::with_capacity(cfg.class_entries() + cfg.rm_texels() + 1);
         for (idx, e) in self.class.entries.iter().enumerate() {
             out.push((cfg.class_addr(idx), word(e.pack(cfg))));

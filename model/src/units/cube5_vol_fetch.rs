@@ -102,6 +102,39 @@ impl VolFetchConfig {
         self.max_dim / self.block_dim
     }
 
+    /// One sweep for each rule of [`VolFetch::refusal`], each otherwise `ok` (a sweep the unit
+    /// takes): a reserved axis, a volume edge of 0 blocks and one of NB + 1, an empty section, a
+    /// section past the volume, a base off the bus. The model's tests and the co-simulation's
+    /// use the same list.
+    pub fn refused_sweeps(&self, ok: Sweep) -> [Sweep; 6] {
+        let (ai, _) = frame_axes(ok.axis_k);
+        let [_, by, bz] = ok.blocks;
+        [
+            Sweep { axis_k: 3, ..ok },
+            Sweep {
+                blocks: [0, by, bz],
+                ..ok
+            },
+            Sweep {
+                blocks: [self.nb() + 1, by, bz],
+                ..ok
+            },
+            Sweep {
+                sec_lo: 1,
+                sec_hi: 1,
+                ..ok
+            },
+            Sweep {
+                sec_hi: ok.blocks[ai] + 1,
+                ..ok
+            },
+            Sweep {
+                base: ok.base + u64::from(self.data_w / 16),
+                ..ok
+            },
+        ]
+    }
+
     /// `NbW = log2 NB`.
     pub fn nb_w(&self) -> u32 {
         self.nb().trailing_zeros()
@@ -564,11 +597,7 @@ impl StreamCodec for VolFetchConfig {
             }
         }
         // Zero padding up to the longer payload.
-        while w.len() < self.in_width() {
-            let pad = (self.in_width() - w.len()).min(32);
-            w.put(0, pad);
-        }
-        w.finish(self.in_width())
+        w.finish_padded(self.in_width())
     }
 
     fn unpack_out(&self, words: &[u32]) -> FetchItem {
@@ -914,24 +943,8 @@ mod tests {
         let c = VolFetchConfig { max_dim: 32, ..C };
         let mut unit = VolFetch::new(c).unwrap();
         let ok = Sweep::whole(0, [4, 4, 4]);
-        for bad in [
-            Sweep { axis_k: 3, ..ok },
-            Sweep {
-                blocks: [0, 4, 4],
-                ..ok
-            },
-            Sweep {
-                blocks: [5, 4, 4],
-                ..ok
-            },
-            Sweep {
-                sec_lo: 2,
-                sec_hi: 2,
-                ..ok
-            },
-            Sweep { sec_hi: 5, ..ok },
-            Sweep { base: 4, ..ok },
-        ] {
+        assert!(unit.refusal(&ok).is_none());
+        for bad in c.refused_sweeps(ok) {
             assert!(unit.refusal(&bad).is_some(), "{bad:?}");
             let run = unit
                 .run(&[FetchCmd::Sweep(bad)], &AxiMemImage::default())

@@ -27,6 +27,11 @@ pub fn seed(default: u64) -> u64 {
     seed_from_env(default)
 }
 
+/// The value of a run that must succeed; a failure panics with its report (seed, cycle, what).
+pub fn must<T>(r: Result<T, cube5_tb::TbError>) -> T {
+    r.unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// `n` items from `gen`, seeded with `seed`.
 pub fn random_items<T>(seed: u64, n: usize, mut gen: impl FnMut(&mut ChaCha8Rng) -> T) -> Vec<T> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
