@@ -664,7 +664,9 @@ fn compile_variant(
     Ok(())
 }
 
-/// The C++ shim a top runs in (tb/*_shim.h), chosen by the ports its own file declares: an AXI4
+/// The C++ shim a top runs in (tb/*_shim.h), chosen by the ports its own file declares: AXI4
+/// read and write manager ports on a stream top (`m_axi_arvalid_o` and `m_axi_awvalid_o`: both
+/// sides of the subordinate in the clock loop), an AXI4
 /// write manager port (`m_axi_awvalid_o`, with the subordinate's write port in the clock loop),
 /// an AXI4 read manager port (`m_axi_arvalid_o`, the AXI memory subordinate), an AXI4-Lite
 /// subordinate port (`s_axil_awvalid_i`, an AXI4-Lite manager), or the plain streams.
@@ -677,11 +679,12 @@ enum Shim {
     AccelCtrl,
     Accel,
     Win,
+    AxiRw,
 }
 
 impl Shim {
     /// In `Shim as usize` order.
-    const ALL: [Shim; 7] = [
+    const ALL: [Shim; 8] = [
         Shim::Stream,
         Shim::Axi,
         Shim::AxiWr,
@@ -689,6 +692,7 @@ impl Shim {
         Shim::AccelCtrl,
         Shim::Accel,
         Shim::Win,
+        Shim::AxiRw,
     ];
 
     fn of(v: &Variant) -> Shim {
@@ -703,15 +707,27 @@ impl Shim {
             .find(|f| f.file_name().is_some_and(|n| n.to_string_lossy() == own))
             .and_then(|f| fs::read_to_string(f).ok())
             .unwrap_or_default();
-        if text.contains("s_axil_awvalid_i") && text.contains("m_axi_arvalid_o") {
+        // A port of the top itself: a declaration line (`input` / `output`), not an instance's
+        // connection to a sub-unit's port of the same name.
+        let has = |port: &str| {
+            text.lines().any(|l| {
+                let l = l.trim_start();
+                (l.starts_with("input") || l.starts_with("output"))
+                    && l.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                        .any(|w| w == port)
+            })
+        };
+        if has("s_axil_awvalid_i") && has("m_axi_arvalid_o") {
             Shim::Accel
-        } else if text.contains("m_axi_awvalid_o") {
+        } else if has("m_axi_awvalid_o") && has("m_axi_arvalid_o") {
+            Shim::AxiRw
+        } else if has("m_axi_awvalid_o") {
             Shim::AxiWr
-        } else if text.contains("m_axi_arvalid_o") {
+        } else if has("m_axi_arvalid_o") {
             Shim::Axi
-        } else if text.contains("s_axil_awvalid_i") && text.contains("fetch_cmd_valid_o") {
+        } else if has("s_axil_awvalid_i") && has("fetch_cmd_valid_o") {
             Shim::AccelCtrl
-        } else if text.contains("s_axil_awvalid_i") {
+        } else if has("s_axil_awvalid_i") {
             Shim::Axil
         } else {
             Shim::Stream
@@ -727,6 +743,7 @@ impl Shim {
             Shim::AccelCtrl => "accel_ctrl_shim.h",
             Shim::Accel => "accel_shim.h",
             Shim::Win => "win_shim.h",
+            Shim::AxiRw => "axi_rw_shim.h",
         }
     }
 
@@ -739,6 +756,7 @@ impl Shim {
             Shim::AccelCtrl => "AccelCtrlShim",
             Shim::Accel => "AccelShim",
             Shim::Win => "WinShim",
+            Shim::AxiRw => "AxiRwShim",
         }
     }
 
@@ -772,6 +790,14 @@ impl Shim {
                 "accel_shim.h",
             ],
             Shim::Win => &["clocked_top.h", "win_host.h", "out_watch.h", "win_shim.h"],
+            Shim::AxiRw => &[
+                "clocked_top.h",
+                "axi_mem.h",
+                "axi_ports.h",
+                "out_watch.h",
+                "axi_shim.h",
+                "axi_rw_shim.h",
+            ],
         }
     }
 }

@@ -16,6 +16,14 @@
 // Blocking: the request at the tag check holds the unit until its fills are written, so the tags
 // change in request order and hit/miss is a function of the request sequence alone. One request
 // per clock while they hit, latency 2 (contract, "Cycles").
+//
+// Splat = 1 (part M's side of the cache, contract "Splatting"): an item is a read, a deposit (eight
+// corner energies added, saturating, into the irradiance fields of the cell's corners, the words'
+// top min(WordW, 16) bits, in the cached lines, which become dirty) or a flush. A miss whose set
+// holds a dirty line writes that line back first (one INCR burst through cube5_axi_wr, its beats
+// read from the bank's RAM), waits for the write-backs' B responses, then reads its lines; a
+// flush writes back every dirty line, bank by bank, set by set, and leaves when all are answered.
+// Splat = 0 ties the write channels off (AWVALID, WVALID low, BREADY high).
 module gicube_cache #(
   /// The volume's edge in memory, M: a power of two, 4..1024.
   parameter int unsigned MaxDim      = 64,
@@ -30,7 +38,9 @@ module gicube_cache #(
   /// Line reads in flight at most: a power of two, 2..8.
   parameter int unsigned Outstanding = 8,
   /// Byte address width of the AXI port (13..64; the volume's M^3 WordW/8 bytes sit at 0).
-  parameter int unsigned AddrW       = 32
+  parameter int unsigned AddrW       = 32,
+  /// 1: deposits, dirty lines, write-back and flush (contract, "Splatting"); 0: read-only.
+  parameter int unsigned Splat       = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -39,8 +49,9 @@ module gicube_cache #(
   input  logic in_valid_i,
   /// The unit takes a request this cycle.
   output logic in_ready_o,
-  /// x, y, z (log2 MaxDim bits each): the cell's lowest voxel, LSB first.
-  input  logic [3*$clog2(MaxDim)-1:0] in_data_i,
+  /// x, y, z (log2 MaxDim bits each): the cell's lowest voxel, LSB first; with Splat, then op
+  /// (2: 0 read, 1 deposit, 2 or 3 flush) and the energies e[0..8] (min(WordW, 16) bits each).
+  input  logic [3*$clog2(MaxDim)+(Splat != 0 ? 2 + 8 * ((WordW < 16) ? WordW : 16) : 0)-1:0] in_data_i,
 
   /// Output item valid.
   output logic out_valid_o,
@@ -50,7 +61,7 @@ module gicube_cache #(
   /// misses (32), stall (16), LSB first.
   output logic [8*WordW+8+32+32+16-1:0] out_data_o,
 
-  /// Sticky: some fill beat since reset came back with RRESP != OKAY.
+  /// Sticky: some fill beat since reset came back with RRESP != OKAY, or some write-back's BRESP.
   output logic err_o,
 
   // AXI4 read address channel.
@@ -81,7 +92,45 @@ module gicube_cache #(
   /// Read data valid.
   input  logic m_axi_rvalid_i,
   /// Read data ready (always 1 out of reset: cube5_axi_rd's credit rule).
-  output logic m_axi_rready_o
+  output logic m_axi_rready_o,
+
+  // AXI4 write address channel (the write-back of dirty lines; idle without Splat).
+  /// Burst start address (a line's).
+  output logic [AddrW-1:0] m_axi_awaddr_o,
+  /// Beats in the burst minus one.
+  output logic [7:0] m_axi_awlen_o,
+  /// log2 of the bytes per beat.
+  output logic [2:0] m_axi_awsize_o,
+  /// INCR.
+  output logic [1:0] m_axi_awburst_o,
+  /// Always 0.
+  output logic [3:0] m_axi_awid_o,
+  /// Address valid.
+  output logic m_axi_awvalid_o,
+  /// Subordinate takes the address.
+  input  logic m_axi_awready_i,
+
+  // AXI4 write data channel.
+  /// Write data.
+  output logic [DataW-1:0] m_axi_wdata_o,
+  /// Byte strobes (all set: whole lines).
+  output logic [DataW/8-1:0] m_axi_wstrb_o,
+  /// Last beat of the burst.
+  output logic m_axi_wlast_o,
+  /// Write data valid.
+  output logic m_axi_wvalid_o,
+  /// Subordinate takes the beat.
+  input  logic m_axi_wready_i,
+
+  // AXI4 write response channel.
+  /// Write response.
+  input  logic [1:0] m_axi_bresp_i,
+  /// Response ID (unused: one ID).
+  input  logic [3:0] m_axi_bid_i,
+  /// Response valid.
+  input  logic m_axi_bvalid_i,
+  /// Response ready.
+  output logic m_axi_bready_o
 );
 
   // ==============================================================================================
@@ -104,7 +153,10 @@ module gicube_cache #(
   localparam int unsigned LenW    = BplW + 1;
   localparam int unsigned CountW  = 32;
   localparam int unsigned StallW  = 16;
-  localparam int unsigned InW     = 3 * CoordW;
+  localparam int unsigned XyzW    = 3 * CoordW;
+  localparam int unsigned IrrW    = (WordW < 16) ? WordW : 16; // the irradiance field's bits
+  localparam int unsigned IrrSh   = WordW - IrrW;             // ... and its lowest bit
+  localparam int unsigned InW     = XyzW + (Splat != 0 ? 2 + 8 * IrrW : 0);
   localparam int unsigned OutW    = 8 * WordW + 8 + 2 * CountW + StallW;
   localparam int unsigned LAddrW  = 3 + IdxW + WbLog;         // bytes of the volume
   localparam int unsigned ZeroW   = LineLog + WbLog;          // a line's byte offset bits
@@ -134,6 +186,9 @@ module gicube_cache #(
   end
   if (AddrW < 13 || AddrW > 64 || AddrW < LAddrW) begin : gen_bad_addr_w
     $fatal(1, "gicube_cache: AddrW must be in 13..64 and hold the volume's bytes");
+  end
+  if (Splat > 1) begin : gen_bad_splat
+    $fatal(1, "gicube_cache: Splat must be 0 or 1");
   end
 
   // ==============================================================================================
@@ -178,7 +233,7 @@ module gicube_cache #(
 
   typedef enum logic [0:0] {
     StCheck,  // the RAMs' outputs hold this request's tags and words
-    StMiss    // issuing the miss queue and writing the fills
+    StMiss    // issuing the miss queue and writing the fills (Splat: or the phases below)
   } state_e;
 
   logic             in_fire;
@@ -196,6 +251,39 @@ module gicube_cache #(
   logic             out_valid_q, out_valid_d;
   logic [OutW-1:0]  out_data_q, out_data_d;
 
+  // Splat: the held item's kind, dirty lines, the evicted lines to write back, the flush's walk,
+  // and the write-back engine (one line at a time: its command, then its beats from the RAM).
+  localparam int unsigned SlotW = 3 + SetW;                   // a (bank, set) of the flush walk
+  localparam int unsigned PendW = SlotW + 2;                  // write-backs not yet answered
+  logic              is_dep, is_flush;
+  // Splat's phases within StMiss (flags, so that the read-only state machine stays as it was):
+  // writing back the lines the request evicts (before its reads), and a flush's walk.
+  logic              wbst_q, wbst_d, flst_q, flst_d;
+  logic              in_wb, in_fl, in_miss;
+  logic [8*Sets-1:0] dirty_q, dirty_d;   // per bank and set: the line holds deposits
+  logic [7:0]        wb_q, wb_d;         // evicted dirty lines not yet written back
+  logic [8*TagW-1:0] vtag_q, vtag_d;     // their tags (read at the check)
+  logic [SlotW:0]    fl_idx_q, fl_idx_d; // the flush's next slot, bank-major (8 Sets = done)
+  logic              fl_tag_q, fl_tag_d; // the slot's tag is being read
+  logic              fl_rd;              // read the tag of slot fl_idx
+  logic              fl_done, fleave;
+  logic [PendW-1:0]  pend_q, pend_d;     // write-back commands without their completion
+  logic              eng_q, eng_d;       // the engine holds a line
+  logic [2:0]        eng_p_q, eng_p_d;
+  logic [SetW-1:0]   eng_set_q, eng_set_d;
+  logic [TagW-1:0]   eng_tag_q, eng_tag_d;
+  logic              eng_cmd_q, eng_cmd_d; // its command was taken
+  logic [BplW:0]     eng_rd_q, eng_rd_d;   // beats read from the RAM
+  logic [BplW:0]     eng_tk_q, eng_tk_d;   // beats taken by cube5_axi_wr
+  logic              rd_pend_q, rd_pend_d; // the RAM's output register holds a beat not taken
+  logic              rd_go;                // read the engine's next beat
+  logic              wr_cmd_valid, wr_cmd_ready, wr_dat_ready, wr_done, wr_err;
+  logic [AddrW+LenW-1:0] wr_cmd_data;
+  logic [DataW-1:0]  wr_dat_data;
+  logic [8*WordW-1:0] dep_word;          // each bank's word after the deposit's addition
+  logic [8*DataW-1:0] dep_beat;          // ... in its beat
+  logic              dep_we;             // the deposit's words are written this cycle
+
   // RAM ports, per bank.
   logic [7:0]             ram_re;
   logic [InW-1:0]         rd_xyz;          // the request whose words the RAMs read
@@ -210,6 +298,7 @@ module gicube_cache #(
   logic [8*SetW-1:0]  set_of;
   logic [8*TagW-1:0]  tag_of;
   logic [8*VLog-1:0]  wsel_of;   // word within the beat
+  logic [8*BplW-1:0]  idx_req_beat; // beat within the line
   logic [8*WordW-1:0] bank_word; // each bank's word of the request (after a read)
   logic [8*LineW-1:0] line_of;
   logic [7:0]         hit;
@@ -227,14 +316,22 @@ module gicube_cache #(
 
   assign in_fire  = in_valid_i && in_ready_o;
   assign out_free = !out_valid_q || out_ready_i;
+  // The held item with its op and energies (zero without Splat).
+  logic [XyzW+2+8*IrrW-1:0] req_e;
+  assign req_e    = (XyzW+2+8*IrrW)'(req_q);
+  assign is_dep   = Splat != 0 && req_e[XyzW +: 2] == 2'd1;
+  assign is_flush = Splat != 0 && req_e[XyzW + 1];
 
   for (genvar p = 0; p < 8; p++) begin : gen_fields
     logic [IdxW-1:0] idx_rd, idx_req;
     assign idx_rd  = bank_index(rd_xyz, p);
     assign idx_req = bank_index(req_q, p);
-    assign tag_raddr[p*SetW +: SetW]     = set_of_line(idx_rd[IdxW-1:LineLog]);
-    assign dat_raddr[p*DAddrW +: DAddrW] = {set_of_line(idx_rd[IdxW-1:LineLog]),
-                                            idx_rd[VLog +: BplW]};
+    // The flush reads a slot's tag, the write-back engine its line's beats.
+    assign tag_raddr[p*SetW +: SetW]     = fl_rd ? fl_idx_q[SetW-1:0]
+                                                 : set_of_line(idx_rd[IdxW-1:LineLog]);
+    assign dat_raddr[p*DAddrW +: DAddrW] = rd_go ? {eng_set_q, eng_rd_q[BplW-1:0]}
+                                                 : {set_of_line(idx_rd[IdxW-1:LineLog]),
+                                                    idx_rd[VLog +: BplW]};
     assign line_of[p*LineW +: LineW]     = idx_req[IdxW-1:LineLog];
     assign set_of[p*SetW +: SetW]        = set_of_line(idx_req[IdxW-1:LineLog]);
     if (LineW > SetW) begin : gen_tag
@@ -243,6 +340,7 @@ module gicube_cache #(
       assign tag_of[p*TagW +: TagW] = '0;
     end
     assign wsel_of[p*VLog +: VLog] = idx_req[0 +: VLog];
+    assign idx_req_beat[p*BplW +: BplW] = idx_req[VLog +: BplW];
     // The bank's word of this request: selected within the beat before the corner crossbar.
     logic [DataW-1:0] beat_word;
     assign beat_word = dat_rdata[p*DataW +: DataW];
@@ -251,18 +349,54 @@ module gicube_cache #(
     assign valid_bank = valid_q[p*Sets +: Sets];
     assign hit[p] = valid_bank[set_of[p*SetW +: SetW]]
         && (tag_rdata[p*TagW +: TagW] == tag_of[p*TagW +: TagW]);
+    // A deposit adds the energy of its corner in this bank (corner p ^ parity) to the word's
+    // irradiance field, saturating, and writes the word back into its beat.
+    logic [2:0]      dep_c;
+    logic [IrrW:0]   dep_sum;
+    logic [IrrW-1:0] dep_e;
+    assign dep_c = 3'(p) ^ {req_q[2*CoordW], req_q[CoordW], req_q[0]};
+    always_comb begin
+      dep_e = '0;
+      for (int unsigned c = 0; c < 8; c++) begin
+        if (dep_c == 3'(c)) dep_e = req_e[XyzW + 2 + c*IrrW +: IrrW];
+      end
+    end
+    assign dep_sum = {1'b0, bank_word[p*WordW + IrrSh +: IrrW]} + {1'b0, dep_e};
+    if (IrrSh > 0) begin : gen_low
+      assign dep_word[p*WordW +: WordW] = {dep_sum[IrrW] ? {IrrW{1'b1}} : dep_sum[IrrW-1:0],
+                                           bank_word[p*WordW +: IrrSh]};
+    end else begin : gen_whole
+      assign dep_word[p*WordW +: WordW] = dep_sum[IrrW] ? {IrrW{1'b1}} : dep_sum[IrrW-1:0];
+    end
+    always_comb begin
+      dep_beat[p*DataW +: DataW] = beat_word;
+      for (int unsigned k = 0; k < PerBeat; k++) begin
+        if (wsel_of[p*VLog +: VLog] == VLog'(k)) dep_beat[p*DataW + k*WordW +: WordW]
+            = dep_word[p*WordW +: WordW];
+      end
+    end
     // The read address takes the set and the beat; the word within the beat is the request's.
     logic unused_rd;
     assign unused_rd = ^{idx_rd[VLog-1:0], idx_req[LineLog-1:VLog]};
   end
 
   assign all_hit = &hit;
-  // A check that hits everywhere (always, after the fills) leaves when the output has room.
-  assign leave      = busy_q && state_q == StCheck && all_hit && out_free;
-  assign in_ready_o = !busy_q || leave;
-  assign reread     = busy_q && state_q == StMiss && issue_q == '0 && fill_q == '0;
+  // A check that hits everywhere (always, after the fills) leaves when the output has room; a
+  // deposit writes its words as it leaves, so the next item is taken a cycle later (its read
+  // then sees them). A flush leaves when its walk is done and every write-back is answered.
+  assign leave      = busy_q && state_q == StCheck && !is_flush && all_hit && out_free;
+  assign dep_we     = leave && is_dep;
+  assign fl_done    = fl_idx_q[SlotW] && !eng_q && pend_q == '0;
+  assign in_wb      = busy_q && state_q == StMiss && wbst_q;
+  assign in_fl      = busy_q && state_q == StMiss && flst_q;
+  assign in_miss    = busy_q && state_q == StMiss && !wbst_q && !flst_q;
+  assign fleave     = in_fl && fl_done && out_free;
+  assign in_ready_o = !busy_q || (leave && !is_dep) || fleave;
+  assign reread     = in_miss && issue_q == '0 && fill_q == '0;
   assign rd_xyz     = reread ? req_q : in_data_i;
   assign ram_re     = {8{in_fire || reread}};
+  assign fl_rd      = in_fl && !eng_q && !fl_tag_q && !fl_idx_q[SlotW]
+                      && dirty_q[fl_idx_q[SlotW-1:0]];
 
   // ==============================================================================================
   // Miss queue (issue in ascending bank order) and fills
@@ -270,7 +404,7 @@ module gicube_cache #(
 
   assign issue_p   = lowest(issue_q);
   assign fill_p    = lowest(fill_q);
-  assign cmd_valid = busy_q && state_q == StMiss && issue_q != '0;
+  assign cmd_valid = in_miss && issue_q != '0;
   always_comb begin
     logic [LineW-1:0] line_sel;
     // Constant indices: a variable index times LineW (not a power of two) is a multiplier.
@@ -301,6 +435,13 @@ module gicube_cache #(
     misses_d    = misses_q;
     stall_d     = stall_q;
     valid_d     = valid_q;
+    dirty_d     = dirty_q;
+    wb_d        = wb_q;
+    vtag_d      = vtag_q;
+    fl_idx_d    = fl_idx_q;
+    fl_tag_d    = 1'b0;
+    wbst_d      = wbst_q;
+    flst_d      = flst_q;
     out_valid_d = out_valid_q && !out_ready_i;
     out_data_d  = out_data_q;
     tag_we      = '0;
@@ -316,16 +457,52 @@ module gicube_cache #(
       if (!replay_q) hits_d = hits_q + CountW'(8);
       for (int unsigned c = 0; c < 8; c++) begin
         cp = 3'(c) ^ {req_q[2*CoordW], req_q[CoordW], req_q[0]};
-        out_data_d[c*WordW +: WordW] = bank_word[cp*WordW +: WordW];
+        out_data_d[c*WordW +: WordW] = is_dep ? dep_word[cp*WordW +: WordW]
+                                              : bank_word[cp*WordW +: WordW];
       end
       out_data_d[8*WordW +: 8 + 2*CountW + StallW] = {stall_q, misses_d, hits_d, m};
       out_valid_d = 1'b1;
       busy_d = 1'b0;
+      // A deposit's eight lines are dirty now.
+      if (is_dep) begin
+        for (int unsigned p = 0; p < 8; p++) begin
+          for (int unsigned s = 0; s < Sets; s++) begin
+            if (set_of[p*SetW +: SetW] == SetW'(s)) dirty_d[p*Sets + s] = 1'b1;
+          end
+        end
+      end
     end
 
-    // The first check with misses: allocate (tags written, sets valid), queue the misses.
-    if (busy_q && state_q == StCheck && !all_hit) begin
+    // A flush: its walk starts at the check; it leaves with no voxels and the counts.
+    if (busy_q && state_q == StCheck && is_flush) begin
+      state_d  = StMiss;
+      flst_d   = 1'b1;
+      fl_idx_d = '0;
+    end
+    if (in_fl) begin
+      if (stall_q != '1) stall_d = stall_q + StallW'(1);
+      if (fl_rd) begin
+        fl_tag_d = 1'b1;
+        dirty_d[fl_idx_q[SlotW-1:0]] = 1'b0;
+      end else if (!eng_q && !fl_tag_q && !fl_idx_q[SlotW]) begin
+        fl_idx_d = fl_idx_q + (SlotW+1)'(1);  // a clean slot
+      end
+      if (fl_tag_q) fl_idx_d = fl_idx_q + (SlotW+1)'(1);
+      if (fleave) begin
+        out_data_d  = '0;
+        out_data_d[8*WordW +: 8 + 2*CountW + StallW] = {stall_q, misses_q, hits_q, 8'h00};
+        out_valid_d = 1'b1;
+        busy_d      = 1'b0;
+        flst_d      = 1'b0;
+      end
+    end
+
+    // The first check with misses: allocate (tags written, sets valid), queue the misses; the
+    // dirty lines they evict are written back first.
+    if (busy_q && state_q == StCheck && !is_flush && !all_hit) begin
       tag_we   = ~hit;
+      vtag_d   = tag_rdata;
+      wb_d     = '0;
       hitm_d   = hit;
       issue_d  = ~hit;
       fill_d   = ~hit;
@@ -335,12 +512,24 @@ module gicube_cache #(
       state_d  = StMiss;
       for (int unsigned p = 0; p < 8; p++) begin
         for (int unsigned s = 0; s < Sets; s++) begin
-          if (!hit[p] && set_of[p*SetW +: SetW] == SetW'(s)) valid_d[p*Sets + s] = 1'b1;
+          if (!hit[p] && set_of[p*SetW +: SetW] == SetW'(s)) begin
+            valid_d[p*Sets + s] = 1'b1;
+            wb_d[p]             = dirty_q[p*Sets + s];
+            dirty_d[p*Sets + s] = 1'b0;
+          end
         end
       end
+      wbst_d   = wb_d != '0;
     end
 
-    if (busy_q && state_q == StMiss) begin
+    // The evicted dirty lines go to the engine in bank order; the reads wait for their B.
+    if (in_wb) begin
+      if (stall_q != '1) stall_d = stall_q + StallW'(1);
+      if (!eng_q && wb_q != '0) wb_d[lowest(wb_q)] = 1'b0;
+      if (!eng_q && wb_q == '0 && pend_q == '0) wbst_d = 1'b0;
+    end
+
+    if (in_miss) begin
       if (stall_q != '1) stall_d = stall_q + StallW'(1);
       if (cmd_valid && cmd_ready) issue_d[issue_p] = 1'b0;
       if (beat_valid) begin
@@ -365,6 +554,87 @@ module gicube_cache #(
   always_comb begin
     dat_we = '0;
     if (beat_valid) dat_we[fill_p] = 1'b1;
+    if (dep_we) dat_we = '1;
+  end
+
+  // ==============================================================================================
+  // Splat: the write-back engine (one line: its command, its beats read from the bank's RAM)
+  // ==============================================================================================
+
+  always_comb begin
+    logic             start;
+    logic [2:0]       sp;
+    logic [SetW-1:0]  low;
+    logic [LineW-1:0] line;
+    eng_d     = eng_q;
+    eng_p_d   = eng_p_q;
+    eng_set_d = eng_set_q;
+    eng_tag_d = eng_tag_q;
+    eng_cmd_d = eng_cmd_q;
+    eng_rd_d  = eng_rd_q;
+    eng_tk_d  = eng_tk_q;
+    start     = 1'b0;
+    sp        = '0;
+    // An evicted line (the lowest bank first) or the flush's slot whose tag was just read.
+    if (in_wb && !eng_q && wb_q != '0) begin
+      start = 1'b1;
+      sp    = lowest(wb_q);
+      for (int unsigned p = 0; p < 8; p++) begin
+        if (sp == 3'(p)) begin
+          eng_set_d = set_of[p*SetW +: SetW];
+          eng_tag_d = vtag_q[p*TagW +: TagW];
+        end
+      end
+    end
+    if (fl_tag_q) begin
+      start     = 1'b1;
+      sp        = fl_idx_q[SlotW-1:SetW];
+      eng_set_d = fl_idx_q[SetW-1:0];
+      for (int unsigned p = 0; p < 8; p++) begin
+        if (sp == 3'(p)) eng_tag_d = tag_rdata[p*TagW +: TagW];
+      end
+    end
+    if (start) begin
+      eng_d     = 1'b1;
+      eng_p_d   = sp;
+      eng_cmd_d = 1'b0;
+      eng_rd_d  = '0;
+      eng_tk_d  = '0;
+    end
+    if (eng_q) begin
+      if (wr_cmd_valid && wr_cmd_ready) eng_cmd_d = 1'b1;
+      if (rd_go) eng_rd_d = eng_rd_q + (BplW+1)'(1);
+      if (rd_pend_q && wr_dat_ready) eng_tk_d = eng_tk_q + (BplW+1)'(1);
+      if (eng_cmd_q && eng_tk_q == (BplW+1)'(Bpl)) eng_d = 1'b0;
+    end
+    // The line held under the tag in the set: l mod Sets = set xor (tag mod Sets). (The low
+    // bits go through a variable of their width: Yosys 0.23 sized `set ^ SetW'(tag)` inside the
+    // concatenation as the tag's width, and the gate-level netlist wrote the wrong line.)
+    low = SetW'(eng_tag_q);
+    low = eng_set_q ^ low;
+    if (LineW > SetW) begin
+      line = LineW'({eng_tag_q, low});
+    end else begin
+      line = LineW'(eng_set_q);
+    end
+    wr_cmd_data = {LenW'(Bpl), AddrW'({eng_p_q, line, ZeroW'(0)})};
+  end
+
+  assign wr_cmd_valid = eng_q && !eng_cmd_q;
+  // A beat is read when the RAM's output register is free or being taken.
+  assign rd_go        = eng_q && eng_rd_q != (BplW+1)'(Bpl) && (!rd_pend_q || wr_dat_ready);
+  assign rd_pend_d    = rd_go || (rd_pend_q && !wr_dat_ready);
+  always_comb begin
+    wr_dat_data = '0;
+    for (int unsigned p = 0; p < 8; p++) begin
+      if (eng_p_q == 3'(p)) wr_dat_data = dat_rdata[p*DataW +: DataW];
+    end
+  end
+  // Commands taken minus completions.
+  always_comb begin
+    pend_d = pend_q;
+    if (wr_cmd_valid && wr_cmd_ready) pend_d = pend_d + PendW'(1);
+    if (wr_done) pend_d = pend_d - PendW'(1);
   end
 
   always_ff @(posedge clk_i) begin
@@ -401,6 +671,65 @@ module gicube_cache #(
     out_data_q <= out_data_d;
   end
 
+  // The splatting side's state exists only with Splat: without it, constants (nothing is dirty,
+  // the engine idle), so the read-only netlist is the one it was.
+  if (Splat != 0) begin : gen_splat_state
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni) begin
+        dirty_q   <= '0;
+        wbst_q    <= 1'b0;
+        flst_q    <= 1'b0;
+        wb_q      <= '0;
+        fl_idx_q  <= '0;
+        fl_tag_q  <= 1'b0;
+        pend_q    <= '0;
+        eng_q     <= 1'b0;
+        rd_pend_q <= 1'b0;
+      end else begin
+        dirty_q   <= dirty_d;
+        wbst_q    <= wbst_d;
+        flst_q    <= flst_d;
+        wb_q      <= wb_d;
+        fl_idx_q  <= fl_idx_d;
+        fl_tag_q  <= fl_tag_d;
+        pend_q    <= pend_d;
+        eng_q     <= eng_d;
+        rd_pend_q <= rd_pend_d;
+      end
+    end
+
+    always_ff @(posedge clk_i) begin
+      vtag_q    <= vtag_d;
+      eng_p_q   <= eng_p_d;
+      eng_set_q <= eng_set_d;
+      eng_tag_q <= eng_tag_d;
+      eng_cmd_q <= eng_cmd_d;
+      eng_rd_q  <= eng_rd_d;
+      eng_tk_q  <= eng_tk_d;
+    end
+  end else begin : gen_no_splat_state
+    logic unused_splat_state;
+    assign dirty_q   = '0;
+    assign wbst_q    = 1'b0;
+    assign flst_q    = 1'b0;
+    assign wb_q      = '0;
+    assign fl_idx_q  = '0;
+    assign fl_tag_q  = 1'b0;
+    assign pend_q    = '0;
+    assign eng_q     = 1'b0;
+    assign rd_pend_q = 1'b0;
+    assign vtag_q    = '0;
+    assign eng_p_q   = '0;
+    assign eng_set_q = '0;
+    assign eng_tag_q = '0;
+    assign eng_cmd_q = 1'b0;
+    assign eng_rd_q  = '0;
+    assign eng_tk_q  = '0;
+    assign unused_splat_state = ^{dirty_d, wbst_d, flst_d, wb_d, fl_idx_d, fl_tag_d, pend_d, eng_d, rd_pend_d,
+                                  vtag_d, eng_p_d, eng_set_d, eng_tag_d, eng_cmd_d, eng_rd_d,
+                                  eng_tk_d};
+  end
+
   assign out_valid_o = out_valid_q;
   assign out_data_o  = out_data_q;
 
@@ -418,7 +747,7 @@ module gicube_cache #(
       .we_i   (tag_we[p]),
       .waddr_i(set_of[p*SetW +: SetW]),
       .wdata_i(tag_of[p*TagW +: TagW]),
-      .re_i   (ram_re[p]),
+      .re_i   (ram_re[p] || fl_rd),
       .raddr_i(tag_raddr[p*SetW +: SetW]),
       .rdata_o(tag_rdata[p*TagW +: TagW])
     );
@@ -430,9 +759,9 @@ module gicube_cache #(
     ) u_words (
       .clk_i  (clk_i),
       .we_i   (dat_we[p]),
-      .waddr_i({set_of[p*SetW +: SetW], beat_q}),
-      .wdata_i(beat_data[DataW-1:0]),
-      .re_i   (ram_re[p]),
+      .waddr_i({set_of[p*SetW +: SetW], dep_we ? idx_req_beat[p*BplW +: BplW] : beat_q}),
+      .wdata_i(dep_we ? dep_beat[p*DataW +: DataW] : beat_data[DataW-1:0]),
+      .re_i   (ram_re[p] || (rd_go && eng_p_q == 3'(p))),
       .raddr_i(dat_raddr[p*DAddrW +: DAddrW]),
       .rdata_o(dat_rdata[p*DataW +: DataW])
     );
@@ -458,7 +787,7 @@ module gicube_cache #(
     .out_valid_o    (beat_valid),
     .out_ready_i    (1'b1),
     .out_data_o     (beat_data),
-    .err_o          (err_o),
+    .err_o          (rd_err),
     .m_axi_araddr_o (m_axi_araddr_o),
     .m_axi_arlen_o  (m_axi_arlen_o),
     .m_axi_arsize_o (m_axi_arsize_o),
@@ -476,6 +805,77 @@ module gicube_cache #(
 
   logic [1:0] unused_resp;
   assign unused_resp = beat_data[DataW+2:DataW+1];
+
+  // ==============================================================================================
+  // The write side (Splat): one INCR burst of Bpl beats per dirty line
+  // ==============================================================================================
+
+  if (Splat != 0) begin : gen_wr
+    logic [17:0] wr_out;
+    logic        unused_wr_out;
+    cube5_axi_wr #(
+      .AddrW      (AddrW),
+      .DataW      (DataW),
+      .ItemW      (DataW),
+      .LenW       (LenW),
+      .MaxBurst   (Bpl),
+      .Outstanding(Outstanding),
+      .IdW        (4)
+    ) u_wr (
+      .clk_i          (clk_i),
+      .rst_ni         (rst_ni),
+      .in_valid_i     (wr_cmd_valid),
+      .in_ready_o     (wr_cmd_ready),
+      .in_data_i      (wr_cmd_data),
+      .dat_valid_i    (rd_pend_q),
+      .dat_ready_o    (wr_dat_ready),
+      .dat_data_i     (wr_dat_data),
+      .out_valid_o    (wr_done),
+      .out_ready_i    (1'b1),
+      .out_data_o     (wr_out),
+      .err_o          (wr_err),
+      .m_axi_awaddr_o (m_axi_awaddr_o),
+      .m_axi_awlen_o  (m_axi_awlen_o),
+      .m_axi_awsize_o (m_axi_awsize_o),
+      .m_axi_awburst_o(m_axi_awburst_o),
+      .m_axi_awid_o   (m_axi_awid_o),
+      .m_axi_awvalid_o(m_axi_awvalid_o),
+      .m_axi_awready_i(m_axi_awready_i),
+      .m_axi_wdata_o  (m_axi_wdata_o),
+      .m_axi_wstrb_o  (m_axi_wstrb_o),
+      .m_axi_wlast_o  (m_axi_wlast_o),
+      .m_axi_wvalid_o (m_axi_wvalid_o),
+      .m_axi_wready_i (m_axi_wready_i),
+      .m_axi_bresp_i  (m_axi_bresp_i),
+      .m_axi_bid_i    (m_axi_bid_i),
+      .m_axi_bvalid_i (m_axi_bvalid_i),
+      .m_axi_bready_o (m_axi_bready_o)
+    );
+    assign unused_wr_out = ^wr_out;
+  end else begin : gen_no_wr
+    // Read-only: the write channels idle; nothing is ever dirty.
+    logic unused_wr;
+    assign wr_cmd_ready    = 1'b0;
+    assign wr_dat_ready    = 1'b0;
+    assign wr_done         = 1'b0;
+    assign wr_err          = 1'b0;
+    assign m_axi_awaddr_o  = '0;
+    assign m_axi_awlen_o   = '0;
+    assign m_axi_awsize_o  = '0;
+    assign m_axi_awburst_o = '0;
+    assign m_axi_awid_o    = '0;
+    assign m_axi_awvalid_o = 1'b0;
+    assign m_axi_wdata_o   = '0;
+    assign m_axi_wstrb_o   = '0;
+    assign m_axi_wlast_o   = 1'b0;
+    assign m_axi_wvalid_o  = 1'b0;
+    assign m_axi_bready_o  = 1'b1;
+    assign unused_wr = ^{m_axi_awready_i, m_axi_wready_i, m_axi_bresp_i, m_axi_bid_i,
+                         m_axi_bvalid_i, wr_cmd_data, wr_dat_data};
+  end
+
+  logic rd_err;
+  assign err_o = rd_err || wr_err;
 
 `ifndef SYNTHESIS
   // A stalled output holds its item (STYLE.md rule 3).

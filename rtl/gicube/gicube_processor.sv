@@ -367,6 +367,15 @@ module gicube_processor #(
                         o_pop_ray[StartLsb + 2 * PosW +: PosFracW],
                         o_pop_ray[StartLsb + PosW +: PosFracW], o_pop_ray[StartLsb +: PosFracW]};
 
+  logic [31:0]       ca_awaddr;
+  logic [7:0]        ca_awlen;
+  logic [2:0]        ca_awsize;
+  logic [1:0]        ca_awburst;
+  logic [3:0]        ca_awid;
+  logic [DataW-1:0]  ca_wdata;
+  logic [DataW/8-1:0] ca_wstrb;
+  logic              ca_awvalid, ca_wlast, ca_wvalid, ca_bready;
+
   gicube_cache #(
     .MaxDim      (MaxDim),
     .WordW       (WordW),
@@ -397,7 +406,25 @@ module gicube_processor #(
     .m_axi_rlast_i   (m_axi_rlast_i),
     .m_axi_rid_i     (m_axi_rid_i),
     .m_axi_rvalid_i  (m_axi_rvalid_i),
-    .m_axi_rready_o  (m_axi_rready_o)
+    .m_axi_rready_o  (m_axi_rready_o),
+    // Splat = 0: the cache writes nothing; its write channels are tied off until GI's splat
+    // joins the ring (docs/gicube-rtl.md, step 7).
+    .m_axi_awaddr_o  (ca_awaddr),
+    .m_axi_awlen_o   (ca_awlen),
+    .m_axi_awsize_o  (ca_awsize),
+    .m_axi_awburst_o (ca_awburst),
+    .m_axi_awid_o    (ca_awid),
+    .m_axi_awvalid_o (ca_awvalid),
+    .m_axi_awready_i (1'b0),
+    .m_axi_wdata_o   (ca_wdata),
+    .m_axi_wstrb_o   (ca_wstrb),
+    .m_axi_wlast_o   (ca_wlast),
+    .m_axi_wvalid_o  (ca_wvalid),
+    .m_axi_wready_i  (1'b0),
+    .m_axi_bresp_i   (2'b00),
+    .m_axi_bid_i     (4'd0),
+    .m_axi_bvalid_i  (1'b0),
+    .m_axi_bready_o  (ca_bready)
   );
 
   // The cache holds two requests at most (the one at its check, its output register).
@@ -550,7 +577,8 @@ module gicube_processor #(
   logic unused;
   assign unused = ^{st_out[0 +: KW], st_out[KW + TvW +: QueueW], sd_full, sm_full, tv_full,
                     of_full, sm_in_ready, st_in_ready, o_act_v, fe_out, cell_full, cell_empty,
-                    ca_out};
+                    ca_out, ca_awaddr, ca_awlen, ca_awsize, ca_awburst, ca_awid, ca_awvalid,
+                    ca_wdata, ca_wstrb, ca_wlast, ca_wvalid, ca_bready};
 
 `ifndef SYNTHESIS
   // A stalled output holds its item (STYLE.md rule 3).

@@ -23,6 +23,10 @@ pub const HIT_LATENCY: u64 = 2;
 pub const COUNT_W: u32 = 32;
 /// Bits of the output item's `stall` (saturating).
 pub const STALL_W: u32 = 16;
+/// Widest irradiance field: `U(2.14)` ([352]).
+pub const IRR_MAX_W: u32 = 16;
+/// Bits of an item's operation (`Splat = 1`): 0 read, 1 deposit, 2 or 3 flush.
+pub const OP_W: u32 = 2;
 
 /// One configuration of the RTL top `gicube_cache`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,6 +45,9 @@ pub struct CacheConfig {
     pub outstanding: u32,
     /// Byte address width (13..=64).
     pub addr_w: u32,
+    /// 1: the splatting side (deposits, dirty lines, write-back, flush; contract, *Splatting*);
+    /// 0: the read-only cache.
+    pub splat: u32,
 }
 
 impl CacheConfig {
@@ -53,6 +60,7 @@ impl CacheConfig {
         sets: 32,
         outstanding: 8,
         addr_w: 32,
+        splat: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
@@ -116,7 +124,30 @@ impl CacheConfig {
                 self.volume_bytes()
             ));
         }
+        if self.splat > 1 {
+            return bad(format!("Splat {} is not 0 or 1", self.splat));
+        }
         Ok(())
+    }
+
+    /// Bits of the irradiance field, the word's top `min(WordW, 16)` bits (contract,
+    /// *Splatting*).
+    pub fn irr_w(&self) -> u32 {
+        self.word_w.min(IRR_MAX_W)
+    }
+
+    /// The irradiance field's lowest bit in the word.
+    pub fn irr_shift(&self) -> u32 {
+        self.word_w - self.irr_w()
+    }
+
+    /// Bits of a request's operation and energies in the input item (0 without `Splat`).
+    fn splat_in_w(&self) -> u32 {
+        if self.splat == 1 {
+            OP_W + 8 * self.irr_w()
+        } else {
+            0
+        }
     }
 
     /// `m = log2 M`: bits of a coordinate.
@@ -240,6 +271,24 @@ impl CacheConfig {
     }
 }
 
+impl CacheConfig {
+    /// The volume's `M^3` words (x fastest) in a memory image's bytes at address 0 (the inverse of
+    /// [`CacheConfig::image`]); bytes missing read as 0.
+    pub fn words_of(&self, bytes: &[u8]) -> Vec<u32> {
+        let m = self.max_dim as usize;
+        let wb = (self.word_w / 8) as usize;
+        (0..m * m * m)
+            .map(|i| {
+                let v = [i % m, (i / m) % m, i / (m * m)].map(|a| a as u32);
+                let at = self.word_index(v) as usize * wb;
+                (0..wb).fold(0u32, |w, k| {
+                    w | u32::from(bytes.get(at + k).copied().unwrap_or(0)) << (8 * k)
+                })
+            })
+            .collect()
+    }
+}
+
 crate::unit_config!(CacheConfig, "gicube_cache", DEFAULT, {
     "MaxDim" => max_dim,
     "WordW" => word_w,
@@ -248,6 +297,7 @@ crate::unit_config!(CacheConfig, "gicube_cache", DEFAULT, {
     "Sets" => sets,
     "Outstanding" => outstanding,
     "AddrW" => addr_w,
+    "Splat" => splat,
 });
 
 /// One request: the cell whose lowest voxel is `(x, y, z)` (taken modulo `M`).
@@ -280,14 +330,37 @@ pub struct CacheStep {
     pub bursts: Vec<Burst>,
 }
 
-/// The golden model of `gicube_cache`: tags, valid bits and counts, stepped per request, over a
-/// read-only volume of `M^3` words.
+/// One item of a `Splat = 1` configuration (contract, *Splatting*): a read (as [`CacheReq`]), a
+/// deposit of eight corner energies (`IrrW` bits each, corner `c = cx + 2 cy + 4 cz`) into the
+/// cell's irradiance fields, or a flush of every dirty line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CacheItem {
+    Read(CacheReq),
+    Deposit(CacheReq, [u32; 8]),
+    Flush,
+}
+
+/// What one item did: its output, the lines it read (AR, in issue order) and the lines it wrote
+/// back (AW, in issue order).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ItemStep {
+    pub out: CacheOut,
+    pub reads: Vec<Burst>,
+    pub writes: Vec<Burst>,
+}
+
+/// The golden model of `gicube_cache`: tags, valid and dirty bits and counts, stepped per item,
+/// over a volume of `M^3` words: what the cache and memory hold together (`words`, which reads
+/// return) and what memory holds (`mem`: a dirty line's words differ until it is written back).
 #[derive(Debug, Clone)]
 pub struct VolumeCache {
     cfg: CacheConfig,
     words: Vec<u32>,
-    /// Per bank and set: the tag of the line held, `None` when invalid.
+    mem: Vec<u32>,
+    /// Per bank and set (`8 set + p`): the tag of the line held, `None` when invalid.
     tags: Vec<Option<u64>>,
+    /// Per bank and set: the line holds deposits not yet written back.
+    dirty: Vec<bool>,
     hits: u32,
     misses: u32,
 }
@@ -303,15 +376,14 @@ impl VolumeCache {
                 words.len()
             )));
         }
-        let mask = if cfg.word_w == 32 {
-            u32::MAX
-        } else {
-            (1 << cfg.word_w) - 1
-        };
+        let mask = word_mask(cfg.word_w);
+        let words: Vec<u32> = words.iter().map(|w| w & mask).collect();
         Ok(Self {
             cfg,
-            words: words.iter().map(|w| w & mask).collect(),
+            mem: words.clone(),
+            words,
             tags: vec![None; 8 * cfg.sets as usize],
+            dirty: vec![false; 8 * cfg.sets as usize],
             hits: 0,
             misses: 0,
         })
@@ -331,48 +403,33 @@ impl VolumeCache {
         self.misses
     }
 
-    /// The voxel word at `v` (coordinates `< M`).
-    pub fn voxel(&self, v: [u32; 3]) -> u32 {
+    fn at(&self, v: [u32; 3]) -> usize {
         let m = self.cfg.max_dim as usize;
-        self.words[v[0] as usize + m * (v[1] as usize + m * v[2] as usize)]
+        v[0] as usize + m * (v[1] as usize + m * v[2] as usize)
+    }
+
+    /// The voxel word at `v` (coordinates `< M`): what a read returns.
+    pub fn voxel(&self, v: [u32; 3]) -> u32 {
+        self.words[self.at(v)]
+    }
+
+    /// The words memory holds (`M^3`, x fastest): the volume with every written-back deposit.
+    pub fn memory_words(&self) -> &[u32] {
+        &self.mem
+    }
+
+    /// Lines holding deposits not yet written back.
+    pub fn dirty_lines(&self) -> usize {
+        self.dirty.iter().filter(|d| **d).count()
     }
 
     /// One request: the tag check of its eight banks (allocating the misses), its output and the
     /// bursts of its misses in ascending bank order.
     pub fn request(&mut self, req: &CacheReq) -> CacheStep {
-        let cfg = self.cfg;
-        let mask = cfg.max_dim - 1;
-        let base = [req.x, req.y, req.z].map(|a| a & mask);
-        let mut hit = 0u8;
-        let mut bursts = Vec::new();
-        for p in 0..8u32 {
-            let (line, set, tag) = cfg.slot(p, base);
-            let slot = &mut self.tags[8 * set + p as usize];
-            if *slot == Some(tag) {
-                hit |= 1 << p;
-                self.hits = self.hits.wrapping_add(1);
-            } else {
-                *slot = Some(tag);
-                self.misses = self.misses.wrapping_add(1);
-                bursts.push(Burst {
-                    addr: cfg.line_addr(p, line),
-                    beats: cfg.bpl(),
-                });
-            }
-        }
-        let vox = std::array::from_fn(|c| {
-            let v: [u32; 3] = std::array::from_fn(|a| (base[a] + ((c as u32 >> a) & 1)) & mask);
-            self.voxel(v)
-        });
+        let s = self.item(&CacheItem::Read(*req));
         CacheStep {
-            out: CacheOut {
-                vox,
-                hit,
-                hits: self.hits,
-                misses: self.misses,
-                stall: 0,
-            },
-            bursts,
+            out: s.out,
+            bursts: s.reads,
         }
     }
 
@@ -388,11 +445,147 @@ impl VolumeCache {
         (outs, bursts)
     }
 
-    /// Reset: every set invalid, the counts 0.
+    /// Every item of `items`: the outputs, all reads and all write-backs, in order.
+    pub fn run_items(&mut self, items: &[CacheItem]) -> (Vec<CacheOut>, Vec<Burst>, Vec<Burst>) {
+        let mut outs = Vec::with_capacity(items.len());
+        let (mut reads, mut writes) = (Vec::new(), Vec::new());
+        for it in items {
+            let s = self.item(it);
+            outs.push(s.out);
+            reads.extend(s.reads);
+            writes.extend(s.writes);
+        }
+        (outs, reads, writes)
+    }
+
+    /// Writes line `line` of bank `p` back: its words into memory, its burst.
+    fn write_back(&mut self, p: u32, line: u64) -> Burst {
+        let cfg = self.cfg;
+        let h = u64::from(cfg.half());
+        for k in 0..u64::from(cfg.line_vox) {
+            let i = line * u64::from(cfg.line_vox) + k;
+            let b = [i % h, (i / h) % h, i / (h * h)];
+            let v: [u32; 3] = std::array::from_fn(|a| (2 * b[a]) as u32 | ((p >> a) & 1));
+            let at = self.at(v);
+            self.mem[at] = self.words[at];
+        }
+        Burst {
+            addr: cfg.line_addr(p, line),
+            beats: cfg.bpl(),
+        }
+    }
+
+    /// The line that set `set` holds under `tag` (`l mod Sets = set xor (t mod Sets)`).
+    fn line_of(&self, set: usize, tag: u64) -> u64 {
+        let sets = u64::from(self.cfg.sets);
+        tag * sets + ((set as u64 ^ tag) & (sets - 1))
+    }
+
+    /// One item (contract, *Splatting*): a read or a deposit checks its eight banks in order,
+    /// writing back each dirty line it evicts and reading each line it misses; a deposit then adds
+    /// its energies into the corners' irradiance fields (saturating) and marks the eight lines
+    /// dirty; a flush writes back every dirty line, bank by bank, set by set.
+    pub fn item(&mut self, item: &CacheItem) -> ItemStep {
+        let cfg = self.cfg;
+        let (req, energies) = match *item {
+            CacheItem::Read(r) => (r, None),
+            CacheItem::Deposit(r, e) => (r, Some(e)),
+            CacheItem::Flush => {
+                let mut writes = Vec::new();
+                for p in 0..8u32 {
+                    for set in 0..cfg.sets as usize {
+                        let k = 8 * set + p as usize;
+                        if self.dirty[k] {
+                            let tag = self.tags[k].expect("a dirty line is valid");
+                            let line = self.line_of(set, tag);
+                            writes.push(self.write_back(p, line));
+                            self.dirty[k] = false;
+                        }
+                    }
+                }
+                return ItemStep {
+                    out: CacheOut {
+                        hits: self.hits,
+                        misses: self.misses,
+                        ..CacheOut::default()
+                    },
+                    reads: Vec::new(),
+                    writes,
+                };
+            }
+        };
+        let mask = cfg.max_dim - 1;
+        let base = [req.x, req.y, req.z].map(|a| a & mask);
+        let mut hit = 0u8;
+        let (mut reads, mut writes) = (Vec::new(), Vec::new());
+        for p in 0..8u32 {
+            let (line, set, tag) = cfg.slot(p, base);
+            let k = 8 * set + p as usize;
+            if self.tags[k] == Some(tag) {
+                hit |= 1 << p;
+                self.hits = self.hits.wrapping_add(1);
+            } else {
+                if self.dirty[k] {
+                    let victim = self.line_of(set, self.tags[k].expect("a dirty line is valid"));
+                    writes.push(self.write_back(p, victim));
+                    self.dirty[k] = false;
+                }
+                self.tags[k] = Some(tag);
+                self.misses = self.misses.wrapping_add(1);
+                reads.push(Burst {
+                    addr: cfg.line_addr(p, line),
+                    beats: cfg.bpl(),
+                });
+            }
+        }
+        let corner = |c: usize| -> [u32; 3] {
+            std::array::from_fn(|a| (base[a] + ((c as u32 >> a) & 1)) & mask)
+        };
+        if let Some(e) = energies {
+            let (w, shift) = (cfg.irr_w(), cfg.irr_shift());
+            let top = word_mask(w);
+            for (c, &ec) in e.iter().enumerate() {
+                let at = self.at(corner(c));
+                let word = self.words[at];
+                let sum = ((word >> shift) + (ec & top)).min(top);
+                self.words[at] = (word & word_mask(shift)) | sum << shift;
+            }
+            for p in 0..8u32 {
+                let (_, set, _) = cfg.slot(p, base);
+                self.dirty[8 * set + p as usize] = true;
+            }
+        }
+        let vox = std::array::from_fn(|c| self.voxel(corner(c)));
+        ItemStep {
+            out: CacheOut {
+                vox,
+                hit,
+                hits: self.hits,
+                misses: self.misses,
+                stall: 0,
+            },
+            reads,
+            writes,
+        }
+    }
+
+    /// Reset: every set invalid and clean (deposits not written back are lost: reads return
+    /// memory's words again), the counts 0.
     pub fn clear(&mut self) {
         self.tags.fill(None);
+        self.dirty.fill(false);
+        self.words.clone_from(&self.mem);
         self.hits = 0;
         self.misses = 0;
+    }
+}
+
+/// The low `w` bits (`w <= 32`).
+fn word_mask(w: u32) -> u32 {
+    if w >= 32 {
+        u32::MAX
+    } else {
+        (1 << w) - 1
     }
 }
 
@@ -413,9 +606,10 @@ impl StreamCodec for CacheConfig {
     type In = CacheReq;
     type Out = CacheOut;
 
-    /// x, y, z (`m` bits each), LSB first.
+    /// x, y, z (`m` bits each), LSB first; with `Splat`, then op (2) and eight energies (`IrrW`
+    /// each), zero for a read.
     fn in_width(&self) -> u32 {
-        3 * self.coord_w()
+        3 * self.coord_w() + self.splat_in_w()
     }
 
     /// vox[0..8] (`WordW` each), hit (8), hits (32), misses (32), stall (16), LSB first.
@@ -424,13 +618,7 @@ impl StreamCodec for CacheConfig {
     }
 
     fn pack_in(&self, r: &CacheReq) -> Vec<u32> {
-        let m = self.coord_w();
-        let mask = u64::from(self.max_dim - 1);
-        let mut w = BitWriter::new();
-        w.put(u64::from(r.x) & mask, m)
-            .put(u64::from(r.y) & mask, m)
-            .put(u64::from(r.z) & mask, m);
-        w.finish(self.in_width())
+        SplatCodec(*self).pack_in(&CacheItem::Read(*r))
     }
 
     fn unpack_out(&self, words: &[u32]) -> CacheOut {
@@ -443,6 +631,52 @@ impl StreamCodec for CacheConfig {
             misses: r.get(COUNT_W) as u32,
             stall: r.get(STALL_W) as u32,
         }
+    }
+}
+
+/// The codec of a `Splat = 1` configuration's items ([`CacheItem`]: reads, deposits, flushes);
+/// the output item is [`CacheOut`] as for a read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SplatCodec(pub CacheConfig);
+
+impl StreamCodec for SplatCodec {
+    type In = CacheItem;
+    type Out = CacheOut;
+
+    fn in_width(&self) -> u32 {
+        self.0.in_width()
+    }
+
+    fn out_width(&self) -> u32 {
+        self.0.out_width()
+    }
+
+    /// x, y, z (`m` bits each), then with `Splat` op (2: 0 read, 1 deposit, 2 flush) and the
+    /// energies `e[0..8]` (`IrrW` bits each, zero unless a deposit), LSB first.
+    fn pack_in(&self, item: &CacheItem) -> Vec<u32> {
+        let cfg = self.0;
+        let m = cfg.coord_w();
+        let mask = u64::from(cfg.max_dim - 1);
+        let (r, op, e) = match *item {
+            CacheItem::Read(r) => (r, 0, [0; 8]),
+            CacheItem::Deposit(r, e) => (r, 1, e),
+            CacheItem::Flush => (CacheReq::default(), 2, [0; 8]),
+        };
+        let mut w = BitWriter::new();
+        w.put(u64::from(r.x) & mask, m)
+            .put(u64::from(r.y) & mask, m)
+            .put(u64::from(r.z) & mask, m);
+        if cfg.splat == 1 {
+            w.put(op, OP_W);
+            for ec in e {
+                w.put(u64::from(ec & word_mask(cfg.irr_w())), cfg.irr_w());
+            }
+        }
+        w.finish(cfg.in_width())
+    }
+
+    fn unpack_out(&self, words: &[u32]) -> CacheOut {
+        self.0.unpack_out(words)
     }
 }
 
@@ -557,6 +791,7 @@ mod tests {
         sets: 4,
         outstanding: 2,
         addr_w: 16,
+        splat: 0,
     };
 
     fn ramp(cfg: CacheConfig) -> Vec<u32> {
@@ -746,6 +981,96 @@ mod tests {
         assert_eq!(
             cfg.pack_in(&CacheReq { x: 1, y: 2, z: 3 }),
             vec![1 | 2 << 4 | 3 << 8]
+        );
+    }
+
+    const SPLAT: CacheConfig = CacheConfig {
+        max_dim: 8,
+        word_w: 32,
+        data_w: 64,
+        line_vox: 4,
+        sets: 4,
+        outstanding: 2,
+        addr_w: 13,
+        splat: 1,
+    };
+
+    #[test]
+    fn a_deposit_adds_into_the_top_half_saturating_and_memory_changes_at_the_write_back() {
+        let cfg = SPLAT;
+        cfg.validate().unwrap();
+        assert_eq!((cfg.irr_w(), cfg.irr_shift()), (16, 16));
+        let words = ramp(cfg);
+        let mut c = VolumeCache::new(cfg, &words).unwrap();
+        let a = CacheReq { x: 2, y: 4, z: 6 };
+        let before = c.request(&a).out.vox;
+        let e = [1, 2, 3, 4, 5, 6, 7, 0xffff];
+        let s = c.item(&CacheItem::Deposit(a, e));
+        assert_eq!(s.out.hit, 0xff);
+        assert!(s.reads.is_empty() && s.writes.is_empty());
+        for k in 0..8 {
+            let f = ((before[k] >> 16) + e[k]).min(0xffff);
+            assert_eq!(s.out.vox[k], f << 16 | (before[k] & 0xffff), "corner {k}");
+        }
+        assert_eq!(c.dirty_lines(), 8);
+        // Memory is unchanged until the flush writes the eight lines back, bank by bank.
+        assert_eq!(c.memory_words(), &words[..]);
+        let f = c.item(&CacheItem::Flush);
+        assert_eq!(f.writes.len(), 8);
+        assert!(f.writes.windows(2).all(|w| w[0].addr < w[1].addr));
+        assert_eq!(f.out.vox, [0; 8]);
+        assert_eq!((f.out.hits, f.out.misses), (8, 8));
+        assert_eq!(c.dirty_lines(), 0);
+        let m = cfg.max_dim;
+        let at = |v: [u32; 3]| (v[0] + m * (v[1] + m * v[2])) as usize;
+        assert_eq!(c.memory_words()[at([2, 4, 6])], s.out.vox[0]);
+        assert_eq!(c.memory_words()[at([3, 5, 7])], s.out.vox[7]);
+        assert!(c.item(&CacheItem::Flush).writes.is_empty());
+    }
+
+    #[test]
+    fn an_evicted_dirty_line_is_written_back_before_the_reads_and_read_again_later() {
+        let cfg = SPLAT;
+        let words = ramp(cfg);
+        let mut c = VolumeCache::new(cfg, &words).unwrap();
+        let t = CacheTraffic::new(cfg);
+        let a = CacheReq { x: 2, y: 4, z: 6 };
+        let b = t.conflicting(a).unwrap();
+        let d = c.item(&CacheItem::Deposit(a, [9; 8])).out.vox;
+        let s = c.item(&CacheItem::Read(b));
+        assert_eq!(s.out.hit, 0);
+        assert_eq!(s.writes.len(), 8);
+        assert_eq!(s.reads.len(), 8);
+        // The victims are a's lines.
+        for (p, w) in s.writes.iter().enumerate() {
+            let (line, _, _) = cfg.slot(p as u32, [2, 4, 6]);
+            assert_eq!(w.addr, cfg.line_addr(p as u32, line));
+        }
+        assert_eq!(c.item(&CacheItem::Read(a)).out.vox, d);
+        // A reset loses what was not written back.
+        c.item(&CacheItem::Deposit(a, [1; 8]));
+        c.clear();
+        assert_eq!(c.item(&CacheItem::Read(a)).out.vox, d);
+    }
+
+    #[test]
+    fn the_splat_codec_packs_op_and_energies_and_a_read_leaves_them_zero() {
+        let cfg = CacheConfig { splat: 1, ..SMALL };
+        assert_eq!(cfg.in_width(), 12 + 2 + 8 * 16);
+        let r = CacheReq { x: 1, y: 2, z: 3 };
+        let words = SplatCodec(cfg).pack_in(&CacheItem::Deposit(r, [0xabcd; 8]));
+        assert_eq!(words[0] & 0xfff, 1 | 2 << 4 | 3 << 8);
+        assert_eq!(words[0] >> 12 & 3, 1);
+        assert_eq!(words[0] >> 14 & 0xffff, 0xabcd);
+        let read = cfg.pack_in(&r);
+        assert_eq!(read[0], 1 | 2 << 4 | 3 << 8);
+        assert!(read[1..].iter().all(|w| *w == 0));
+        assert_eq!(SplatCodec(cfg).pack_in(&CacheItem::Flush)[0], 2 << 12);
+        let img = cfg.image(&ramp(cfg)).unwrap();
+        let back = cfg.words_of(&img.bytes);
+        assert_eq!(
+            back,
+            ramp(cfg).iter().map(|w| w & 0xffff).collect::<Vec<_>>()
         );
     }
 }

@@ -1522,6 +1522,7 @@ impl ProcessorRtlConfig {
             sets: self.sets,
             outstanding: self.outstanding,
             addr_w: RTL_ADDR_W,
+            splat: 0,
         }
     }
 
