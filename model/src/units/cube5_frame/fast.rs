@@ -26,6 +26,7 @@
 use super::{render_base_plane_reference, BasePlane, FrameMode, FrameParams, FrameUnits, STEP_W};
 use crate::units::cube5_compos::{Compos, ComposMode, Coxel, Sample};
 use crate::units::cube5_shader::{Shader, ShaderIn, ShaderMode};
+use crate::units::cube5_trilin::InSlice;
 use crate::volume::Volume;
 use rayon::prelude::*;
 
@@ -369,6 +370,8 @@ struct SliceWork<'a> {
     k: usize,
     wx: u32,
     wy: u32,
+    /// The interpolation's weights of this slice (`wx`, `wy` set up once).
+    lerp: InSlice,
     /// Volume slices of `s - 1` and `s + 1` (none outside the sweep).
     k_before: Option<usize>,
     k_after: Option<usize>,
@@ -392,13 +395,11 @@ impl SliceWork<'_> {
         let top = self.sv.row(self.k, b as usize);
         let bot = self.sv.row(self.k, b as usize + 1);
         let out = &mut band.rows[r * ni + a0..r * ni + a1];
-        let trilin = &self.units.trilin;
         if a1 - a0 == BLOCK {
-            // A whole block: a row of constant length, which the compiler unrolls into lanes.
-            let mut o = [0u32; BLOCK];
-            trilin.row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, &mut o);
-            out.copy_from_slice(&o);
+            // A whole block: a row of constant length, in lanes.
+            out.copy_from_slice(&self.lerp.lanes::<BLOCK>(&top[a0..], &bot[a0..]));
         } else {
+            let trilin = &self.units.trilin;
             trilin.row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, out);
         }
     }
@@ -406,14 +407,12 @@ impl SliceWork<'_> {
     /// `S'(t)` at anchors `a0 .. a0 + out.len()` of row `b`: slice `k(t)`'s voxels, slice `s`'s
     /// weights (0 outside).
     #[inline(always)]
-    fn other_row(&self, k: Option<usize>, a0: usize, b: usize, out: &mut [u32]) {
+    fn other_row<const N: usize>(&self, k: Option<usize>, a0: usize, b: usize) -> [u32; N] {
         match k {
-            None => out.fill(0),
+            None => [0; N],
             Some(k) => {
                 let (top, bot) = (self.sv.row(k, b), self.sv.row(k, b + 1));
-                self.units
-                    .trilin
-                    .row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, out);
+                self.lerp.lanes::<N>(&top[a0..], &bot[a0..])
             }
         }
     }
@@ -559,11 +558,7 @@ impl SliceWork<'_> {
                 .expect("N anchors")
         } else {
             // Nothing else reads these anchors: interpolated straight from the voxel rows.
-            let mut o = [0u32; N];
-            self.units
-                .trilin
-                .row_in_slice(&top[a0..], &bot[a0..], self.wx, self.wy, &mut o);
-            o
+            self.lerp.lanes::<N>(&top[a0..], &bot[a0..])
         };
         let shift = self.shift;
         // A class index is below the table's length (`SampleW - shift = ClassIdxW` bits); the
@@ -610,9 +605,8 @@ impl SliceWork<'_> {
                 self.ensure(band, b as isize - 1, c);
                 self.ensure(band, b as isize + 1, c);
                 // `B = S'(s-1)` and `A = S'(s+1)` of the anchors, in lanes.
-                let (mut before, mut after) = ([0u32; N], [0u32; N]);
-                self.other_row(self.k_before, a0, b, &mut before);
-                self.other_row(self.k_after, a0, b, &mut after);
+                let before = self.other_row::<N>(self.k_before, a0, b);
+                let after = self.other_row::<N>(self.k_after, a0, b);
                 // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
                 // (`n6_components`, `shader_in`): the differences themselves, 0 read past the
                 // faces. The magnitude is not computed: the frame never classifies in 2-D. Every
@@ -932,6 +926,7 @@ pub fn render_sweep(
                 k: c.k,
                 wx: weight(c.frac_x),
                 wy: weight(c.frac_y),
+                lerp: units.trilin.in_slice(weight(c.frac_x), weight(c.frac_y)),
                 k_before: (s > 0).then(|| params.slice(s - 1).k),
                 k_after: (s + 1 < nk).then(|| params.slice(s + 1).k),
             })

@@ -265,18 +265,21 @@ impl LaneRules {
                 };
             }
             _ => {
-                let sh = self.f - self.q;
+                let (sh, open) = (self.f - self.q, self.open);
                 for i in 0..N {
                     let t = term[i];
                     let aw = sa[i] << sh;
-                    let wins = t == 0 && !self.past && aw > a[i];
+                    // Rule 5 of `Max`: the sample replaces the coxel when it is above it. As a
+                    // lane mask (`&` of flags, not `&&`, and selects by masks: no branch).
+                    let wins = u32::from(t == 0) & open & u32::from(aw > a[i]);
+                    let m = 0u32.wrapping_sub(wins);
                     for ch in 0..3 {
-                        c[ch][i] = if wins { sc[ch][i] } else { c[ch][i] };
+                        c[ch][i] = (sc[ch][i] & m) | (c[ch][i] & !m);
                     }
-                    a[i] = if wins { aw } else { a[i] };
+                    a[i] = (aw & m) | (a[i] & !m);
                     after += u32::from(t != 0);
-                    none_n += u32::from(t == 0 && !wins);
-                    shaded += u32::from(wins);
+                    none_n += u32::from(t == 0) & (wins ^ 1);
+                    shaded += wins;
                 }
             }
         }
@@ -319,7 +322,7 @@ impl LaneRules {
             // the products need more than 32 bits (or `rnd_mul32`'s split): the weight `w` is at
             // most `2^AccW`, a colour's term at most `2^AccW`, so a channel's sum stays below
             // `2^(AccW + 2) <= 2^31` before the saturation.
-            let live = t == 0 && a_in < et;
+            let live = (t == 0) & (a_in < et);
             let wt = (u32::from(live) & open) * (one - a_in.min(one));
             // `rnd(x, s)` with `s >= 1` (`Q >= 1`, `AccW >= 1`).
             let w = if NARROW {
@@ -338,10 +341,10 @@ impl LaneRules {
             let a_out = a_in + w;
             a[i] = a_out;
             term[i] = t | u32::from(a_out >= et);
-            let none = live && (self.past || sa[i] == 0);
+            let none = live & (self.past | (sa[i] == 0));
             after += u32::from(t != 0);
             none_n += u32::from(none);
-            shaded += u32::from(t == 0 && !none);
+            shaded += u32::from(t == 0) & u32::from(!none);
         }
         (shaded, none_n, after)
     }
