@@ -259,33 +259,35 @@ pub struct InSlice {
 
 impl InSlice {
     /// [`Trilin::row_in_slice`] of `N` anchors (`top`, `bot` at least `N + 1` voxels): the same
-    /// three rounded lerps, written as whole rows of lanes (corners, then the two x lerps, then
-    /// the y lerp) so that the compiler makes one vector operation of each.
+    /// three rounded lerps with the slice's weights made once.
     #[inline(always)]
     pub fn lanes<const N: usize>(&self, top: &[u16], bot: &[u16]) -> [u32; N] {
         let (t, b) = (&top[..N + 1], &bot[..N + 1]);
         let (w, f) = (self.w, self.f);
+        let mut out = [0u32; N];
         if self.narrow {
             let (ex, ey, fx, fy, half) = (self.ex, self.ey, self.fx, self.fy, self.half);
-            let t0: [u32; N] = std::array::from_fn(|i| u32::from(t[i]) << f);
-            let t1: [u32; N] = std::array::from_fn(|i| u32::from(t[i + 1]) << f);
-            let b0: [u32; N] = std::array::from_fn(|i| u32::from(b[i]) << f);
-            let b1: [u32; N] = std::array::from_fn(|i| u32::from(b[i + 1]) << f);
-            let p0: [u32; N] = std::array::from_fn(|i| (t0[i] * fx + t1[i] * ex + half) >> w);
-            let p1: [u32; N] = std::array::from_fn(|i| (b0[i] * fx + b1[i] * ex + half) >> w);
-            std::array::from_fn(|i| (p0[i] * fy + p1[i] * ey + half) >> w)
+            // An indexed loop of constant length, which the loop vectorizer makes whole vectors
+            // of (`array::from_fn` stayed a call per element).
+            let c = |v: u16| u32::from(v) << f;
+            for i in 0..N {
+                let p0 = (c(t[i]) * fx + c(t[i + 1]) * ex + half) >> w;
+                let p1 = (c(b[i]) * fx + c(b[i + 1]) * ex + half) >> w;
+                out[i] = (p0 * fy + p1 * ey + half) >> w;
+            }
         } else {
             let lerp = |a: u64, b: u64, e: u32| {
                 let e = u64::from(e);
                 round_half_up(a * ((1 << w) - e) + b * e, w)
             };
             let c = |v: u16| u64::from(v) << f;
-            std::array::from_fn(|i| {
+            for i in 0..N {
                 let p0 = lerp(c(t[i]), c(t[i + 1]), self.ex);
                 let p1 = lerp(c(b[i]), c(b[i + 1]), self.ex);
-                lerp(p0, p1, self.ey) as u32
-            })
+                out[i] = lerp(p0, p1, self.ey) as u32;
+            }
         }
+        out
     }
 }
 

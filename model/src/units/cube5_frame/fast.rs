@@ -649,8 +649,11 @@ impl SliceWork<'_> {
 /// anchor rows read.
 struct Band<'a> {
     q: usize,
-    rows: &'a mut [Coxel],
+    /// Not yet written: the band writes every coxel once, at its end.
+    rows: &'a mut [std::mem::MaybeUninit<Coxel>],
     w: usize,
+    /// Every frame coxel's start (`Coxel::empty`).
+    init: Coxel,
     plane: BandRows,
 }
 
@@ -661,11 +664,11 @@ fn sweep_band<const LIT: bool, const AVX2: bool>(slices: &[SliceWork], band: Ban
         q,
         rows,
         w,
+        init,
         plane: mut band,
     } = band;
     let mut st = SweepStats::default();
     let n_rows = rows.len() / w;
-    let init = rows[0];
     let mut rays = RayLanes::new(rows.len());
     // Anchor rows `b` with `q <= b + q0 < q + n_rows`, within `0 .. nj`.
     let rows_of = |work: &SliceWork| {
@@ -810,7 +813,6 @@ pub fn render_sweep(
     let (w, h) = params.base_plane_size();
     let ((_, max_sx), (_, max_sy)) = params.shift_range();
     let init = Coxel::empty(&units.compos.config());
-    let mut coxels = vec![init; w * h];
     let (smode, cmode) = modes(units.mode);
     let ww = units.trilin.config().weight_w;
     let weight = |f: u32| f >> (STEP_W - ww);
@@ -942,7 +944,10 @@ pub fn render_sweep(
     // bands share a coxel): one parallel split per frame, and a band's coxels stay in the
     // thread's cache across the slices. One copy of the band loop per mode and lighting, so that
     // the units' mode branches fold away.
-    let part = coxels
+    // The base plane is not filled first (8 MB a frame at 256^3, on one thread): each band writes
+    // its rows once, at its end.
+    let mut coxels: Vec<Coxel> = Vec::with_capacity(w * h);
+    let part = coxels.spare_capacity_mut()[..w * h]
         .par_chunks_mut(BAND * w)
         .enumerate()
         .map(|(n, rows)| {
@@ -950,6 +955,7 @@ pub fn render_sweep(
                 q: n * BAND,
                 rows,
                 w,
+                init,
                 plane: BandRows::new(ni),
             };
             if lit {
@@ -959,6 +965,9 @@ pub fn render_sweep(
             }
         })
         .reduce(SweepStats::default, SweepStats::add);
+    // SAFETY: the chunks cover the first `w h` elements of the capacity, and every band wrote
+    // each element of its chunk (`RayLanes::write` of the band's whole slice).
+    unsafe { coxels.set_len(w * h) };
     stats = stats.add(part);
     (
         BasePlane {

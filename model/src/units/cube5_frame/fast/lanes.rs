@@ -31,10 +31,11 @@ impl RayLanes {
         }
     }
 
-    /// The coxels, each `init` (the frame's `Coxel::empty`) with the lanes' `R, G, B, A` and flag.
-    pub fn write(&self, init: &Coxel, out: &mut [Coxel]) {
+    /// The coxels, each `init` (the frame's `Coxel::empty`) with the lanes' `R, G, B, A` and flag:
+    /// every one of `out` written.
+    pub fn write(&self, init: &Coxel, out: &mut [std::mem::MaybeUninit<Coxel>]) {
         for (n, x) in out.iter_mut().enumerate() {
-            *x = Coxel {
+            x.write(Coxel {
                 rgba: [
                     u64::from(self.c[0][n]),
                     u64::from(self.c[1][n]),
@@ -43,7 +44,7 @@ impl RayLanes {
                 ],
                 terminated: self.term[n] != 0,
                 ..*init
-            };
+            });
         }
     }
 }
@@ -557,8 +558,13 @@ mod tests {
                         }
                         assert_eq!(sum, want, "{mode:?}");
                         for lanes in [&st, &one_by_one] {
-                            let mut out = vec![init; n];
+                            let mut out = vec![std::mem::MaybeUninit::uninit(); n];
                             lanes.write(&init, &mut out);
+                            // SAFETY: `write` wrote every element.
+                            let out: Vec<Coxel> = out
+                                .into_iter()
+                                .map(|x| unsafe { x.assume_init() })
+                                .collect();
                             for (i, (x, s)) in coxels.iter().zip(&samples).enumerate() {
                                 assert_eq!(
                                     out[i],
