@@ -404,7 +404,7 @@ impl SliceWork<'_> {
         }
     }
 
-    /// `S'(t)` at anchors `a0 .. a0 + out.len()` of row `b`: slice `k(t)`'s voxels, slice `s`'s
+    /// `S'(t)` at anchors `a0 .. a0 + N` of row `b`: slice `k(t)`'s voxels, slice `s`'s
     /// weights (0 outside).
     #[inline(always)]
     fn other_row<const N: usize>(&self, k: Option<usize>, a0: usize, b: usize) -> [u32; N] {
