@@ -189,6 +189,25 @@ impl Trilin {
         }
     }
 
+    /// The weights of one slice for [`InSlice::lanes`]: [`Trilin::row_in_slice`]'s set-up made
+    /// once (a frame's slice has one `wx`, `wy` for every anchor).
+    pub fn in_slice(&self, wx: u32, wy: u32) -> InSlice {
+        let (w, f) = (self.cfg.weight_w, self.cfg.frac_w);
+        let ex = self.effective_weight(wx, TrilinMode::Lerp);
+        let ey = self.effective_weight(wy, TrilinMode::Lerp);
+        let one = 1u64 << w;
+        InSlice {
+            narrow: self.cfg.sample_w() + w <= 31,
+            w,
+            f,
+            ex: ex as u32,
+            ey: ey as u32,
+            fx: (one - ex) as u32,
+            fy: (one - ey) as u32,
+            half: 1u32 << (w - 1),
+        }
+    }
+
     /// The seven interpolations of the contract with the effective weights `[ex, ey, ez]`.
     #[inline]
     fn interpolate(&self, voxels: &[u32; 8], [ex, ey, ez]: [u64; 3]) -> u32 {
@@ -221,6 +240,54 @@ impl Trilin {
                 f64::from(item.voxels[c]) * f(0) * f(1) * f(2)
             })
             .sum()
+    }
+}
+
+/// One slice's weights of the in-slice interpolation ([`Trilin::in_slice`]).
+#[derive(Debug, Clone, Copy)]
+pub struct InSlice {
+    /// No intermediate passes `2^32` (`VoxelW + FracW + WeightW <= 31`): 32-bit lanes.
+    narrow: bool,
+    w: u32,
+    f: u32,
+    ex: u32,
+    ey: u32,
+    fx: u32,
+    fy: u32,
+    half: u32,
+}
+
+impl InSlice {
+    /// [`Trilin::row_in_slice`] of `N` anchors (`top`, `bot` at least `N + 1` voxels): the same
+    /// three rounded lerps with the slice's weights made once.
+    #[inline(always)]
+    pub fn lanes<const N: usize>(&self, top: &[u16], bot: &[u16]) -> [u32; N] {
+        let (t, b) = (&top[..N + 1], &bot[..N + 1]);
+        let (w, f) = (self.w, self.f);
+        let mut out = [0u32; N];
+        if self.narrow {
+            let (ex, ey, fx, fy, half) = (self.ex, self.ey, self.fx, self.fy, self.half);
+            // An indexed loop of constant length, which the loop vectorizer makes whole vectors
+            // of (`array::from_fn` stayed a call per element).
+            let c = |v: u16| u32::from(v) << f;
+            for i in 0..N {
+                let p0 = (c(t[i]) * fx + c(t[i + 1]) * ex + half) >> w;
+                let p1 = (c(b[i]) * fx + c(b[i + 1]) * ex + half) >> w;
+                out[i] = (p0 * fy + p1 * ey + half) >> w;
+            }
+        } else {
+            let lerp = |a: u64, b: u64, e: u32| {
+                let e = u64::from(e);
+                round_half_up(a * ((1 << w) - e) + b * e, w)
+            };
+            let c = |v: u16| u64::from(v) << f;
+            for i in 0..N {
+                let p0 = lerp(c(t[i]), c(t[i + 1]), self.ex);
+                let p1 = lerp(c(b[i]), c(b[i + 1]), self.ex);
+                out[i] = lerp(p0, p1, self.ey) as u32;
+            }
+        }
+        out
     }
 }
 
@@ -364,7 +431,8 @@ mod tests {
         .collect()
     }
 
-    /// `row_in_slice` is `sample_in_slice` at every anchor of a row, in both lane widths.
+    /// `row_in_slice` is `sample_in_slice` at every anchor of a row, in both lane widths, and so
+    /// is `InSlice::lanes` (8 lanes and 1) with the same weights.
     #[test]
     fn row_in_slice_is_sample_in_slice_along_a_row() {
         for cfg in in_slice_configs(&[TrilinConfig::new(16, 7, 8).unwrap()]) {
@@ -387,6 +455,15 @@ mod tests {
                 let (wx, wy) = (w(), w());
                 let mut out = vec![0; n];
                 unit.row_in_slice(&top, &bot, wx, wy, &mut out);
+                let lanes = unit.in_slice(wx, wy);
+                assert_eq!(lanes.lanes::<1>(&top, &bot), [out[0]], "{cfg:?} {wx} {wy}");
+                if n >= 8 {
+                    assert_eq!(
+                        lanes.lanes::<8>(&top, &bot)[..],
+                        out[..8],
+                        "{cfg:?} {wx} {wy}"
+                    );
+                }
                 for (i, &o) in out.iter().enumerate() {
                     let c = [top[i], top[i + 1], bot[i], bot[i + 1]].map(u32::from);
                     assert_eq!(

@@ -31,10 +31,11 @@ impl RayLanes {
         }
     }
 
-    /// The coxels, each `init` (the frame's `Coxel::empty`) with the lanes' `R, G, B, A` and flag.
-    pub fn write(&self, init: &Coxel, out: &mut [Coxel]) {
+    /// The coxels, each `init` (the frame's `Coxel::empty`) with the lanes' `R, G, B, A` and flag:
+    /// every one of `out` written.
+    pub fn write(&self, init: &Coxel, out: &mut [std::mem::MaybeUninit<Coxel>]) {
         for (n, x) in out.iter_mut().enumerate() {
-            *x = Coxel {
+            x.write(Coxel {
                 rgba: [
                     u64::from(self.c[0][n]),
                     u64::from(self.c[1][n]),
@@ -43,7 +44,7 @@ impl RayLanes {
                 ],
                 terminated: self.term[n] != 0,
                 ..*init
-            };
+            });
         }
     }
 }
@@ -76,6 +77,43 @@ pub(super) struct LaneRules {
     half_f: u64,
     half_q: u64,
     open: u32,
+    /// The two products of rule 5 in 32-bit lanes ([`rnd_mul32`]), when the widths allow it
+    /// (`narrow_products`): the weight `rnd(t a, Q)` split at `Q`, and a colour's term
+    /// `rnd(w c, AccW)` as `rnd(w (c >> col_k), col_g)`.
+    narrow: bool,
+    col_k: u32,
+    col_g: u32,
+}
+
+/// `rnd(x y, s) = floor((x y + 2^(s-1)) / 2^s)` in 32 bits, for `1 <= s <= 16`, `y <= 2^s` and `x
+/// y / 2^s + 1 < 2^32`: with `x = xh 2^s + xl` (`xl < 2^s`), `x y + 2^(s-1) = xh y 2^s + (xl y +
+/// 2^(s-1))`, and the first term is a multiple of `2^s`, so the quotient is `xh y + floor((xl y +
+/// 2^(s-1)) / 2^s)`; `xl y + 2^(s-1) <= (2^s - 1) 2^s + 2^(s-1) < 2^(2s) <= 2^32`. No 64-bit
+/// product, so AVX2 takes eight lanes a multiply (`vpmulld`) instead of four (`vpmuludq`) and no
+/// narrowing shuffle.
+#[inline(always)]
+fn rnd_mul32(x: u32, y: u32, s: u32) -> u32 {
+    let m = (1u32 << s) - 1;
+    (x >> s) * y + (((x & m) * y + (1 << (s - 1))) >> s)
+}
+
+/// Whether rule 5's products fit [`rnd_mul32`], and the colour term's shift and split `(k, g)`.
+/// The weight: `t <= 2^AccW`, `a <= 2^Q`, split at `Q <= 16`. A colour's term `rnd(w c, AccW)`
+/// with `w <= 2^AccW`, `c <= 2^AccW`: split at `AccW` when `AccW <= 16` (`k = 0`); otherwise, when
+/// `AccW >= 2 ColorW` and `2 ColorW <= 16`, a code is `expand_double(c) 2^k` with `k = AccW - 2
+/// ColorW` (`Compos::code`, `colour_codes`), and `rnd(w e 2^k, g + k) = rnd(w e, g)` (`g = 2
+/// ColorW`; `(w e + 2^(g-1)) 2^k` over `2^(g+k)`), `e <= 2^g`. Otherwise 64-bit products.
+fn narrow_products(f: u32, q: u32, cw: u32) -> Option<(u32, u32)> {
+    if q == 0 || q > 16 || f == 0 {
+        return None;
+    }
+    if f <= 16 {
+        Some((0, f))
+    } else if f >= 2 * cw && 2 * cw <= 16 && cw >= 1 {
+        Some((f - 2 * cw, 2 * cw))
+    } else {
+        None
+    }
 }
 
 impl LaneRules {
@@ -101,6 +139,9 @@ impl LaneRules {
             half_f: 1 << (cfg.acc_w - 1),
             half_q: 1 << (cfg.q() - 1),
             open: u32::from(depth < cfg.z_none()),
+            narrow: narrow_products(cfg.acc_w, cfg.q(), cfg.color_w).is_some(),
+            col_k: narrow_products(cfg.acc_w, cfg.q(), cfg.color_w).map_or(0, |p| p.0),
+            col_g: narrow_products(cfg.acc_w, cfg.q(), cfg.color_w).map_or(1, |p| p.1),
         })
     }
 
@@ -216,48 +257,30 @@ impl LaneRules {
         let (mut shaded, mut none_n, mut after) = (0u32, 0u32, 0u32);
         match self.mode {
             ComposMode::FrontToBack => {
-                let (f, q) = (self.f, self.q);
-                let (et, one, chan_max) = (self.et, self.one, self.chan_max);
-                let (half_f, half_q) = (self.half_f, self.half_q);
-                // Rule 4 (past the depth) gives every lane the weight 0.
-                let open = self.open;
-                for i in 0..N {
-                    let (a_in, t) = (a[i], term[i]);
-                    // Rule 1 (terminated) and rule 3 (at the threshold): no weight. Rule 5
-                    // otherwise; a zero alpha gives a zero weight, which adds 0 to channels
-                    // already saturated. Only the products need 64 bits: the weight `w` is at
-                    // most `2^AccW`, a colour's term at most `2^AccW`, so a channel's sum stays
-                    // below `2^(AccW + 2) <= 2^31` before the saturation.
-                    let live = t == 0 && a_in < et;
-                    let wt = (u32::from(live) & open) * (one - a_in.min(one));
-                    // `rnd(x, s)` with `s >= 1` (`Q >= 1`, `AccW >= 1`).
-                    let w = ((u64::from(wt) * u64::from(sa[i]) + half_q) >> q) as u32;
-                    for ch in 0..3 {
-                        let add = ((u64::from(w) * u64::from(sc[ch][i]) + half_f) >> f) as u32;
-                        c[ch][i] = (c[ch][i] + add).min(chan_max);
-                    }
-                    let a_out = a_in + w;
-                    a[i] = a_out;
-                    term[i] = t | u32::from(a_out >= et);
-                    let none = live && (self.past || sa[i] == 0);
-                    after += u32::from(t != 0);
-                    none_n += u32::from(none);
-                    shaded += u32::from(t == 0 && !none);
-                }
+                // One loop per product width, so that each is straight-line code over the lanes.
+                let lanes = (&mut c, &mut a, &mut term);
+                (shaded, none_n, after) = if self.narrow {
+                    self.front_to_back::<N, true>(lanes, sa, sc)
+                } else {
+                    self.front_to_back::<N, false>(lanes, sa, sc)
+                };
             }
             _ => {
-                let sh = self.f - self.q;
+                let (sh, open) = (self.f - self.q, self.open);
                 for i in 0..N {
                     let t = term[i];
                     let aw = sa[i] << sh;
-                    let wins = t == 0 && !self.past && aw > a[i];
+                    // Rule 5 of `Max`: the sample replaces the coxel when it is above it. As a
+                    // lane mask (`&` of flags, not `&&`, and selects by masks: no branch).
+                    let wins = u32::from(t == 0) & open & u32::from(aw > a[i]);
+                    let m = 0u32.wrapping_sub(wins);
                     for ch in 0..3 {
-                        c[ch][i] = if wins { sc[ch][i] } else { c[ch][i] };
+                        c[ch][i] = (sc[ch][i] & m) | (c[ch][i] & !m);
                     }
-                    a[i] = if wins { aw } else { a[i] };
+                    a[i] = (aw & m) | (a[i] & !m);
                     after += u32::from(t != 0);
-                    none_n += u32::from(t == 0 && !wins);
-                    shaded += u32::from(wins);
+                    none_n += u32::from(t == 0) & (wins ^ 1);
+                    shaded += wins;
                 }
             }
         }
@@ -271,6 +294,60 @@ impl LaneRules {
             without_effect: u64::from(none_n),
             after_termination: u64::from(after),
         }
+    }
+}
+
+impl LaneRules {
+    /// Rule 5 of `FrontToBack` (with rules 1, 3 and 4) on lanes `c`, `a`, `term`; returns the
+    /// counts (shaded, without effect, after termination). `NARROW`: the two products in 32 bits
+    /// ([`rnd_mul32`], `narrow_products`), else in 64 as `Compos::step_coded` takes them.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    fn front_to_back<const N: usize, const NARROW: bool>(
+        &self,
+        (c, a, term): (&mut [[u32; N]; 3], &mut [u32; N], &mut [u32; N]),
+        sa: &[u32; N],
+        sc: &[[u32; N]; 3],
+    ) -> (u32, u32, u32) {
+        let (f, q) = (self.f, self.q);
+        let (et, one, chan_max) = (self.et, self.one, self.chan_max);
+        let (half_f, half_q) = (self.half_f, self.half_q);
+        let (k, g) = (self.col_k, self.col_g);
+        // Rule 4 (past the depth) gives every lane the weight 0.
+        let open = self.open;
+        let (mut shaded, mut none_n, mut after) = (0u32, 0u32, 0u32);
+        for i in 0..N {
+            let (a_in, t) = (a[i], term[i]);
+            // Rule 1 (terminated) and rule 3 (at the threshold): no weight. Rule 5 otherwise; a
+            // zero alpha gives a zero weight, which adds 0 to channels already saturated. Only
+            // the products need more than 32 bits (or `rnd_mul32`'s split): the weight `w` is at
+            // most `2^AccW`, a colour's term at most `2^AccW`, so a channel's sum stays below
+            // `2^(AccW + 2) <= 2^31` before the saturation.
+            let live = (t == 0) & (a_in < et);
+            let wt = (u32::from(live) & open) * (one - a_in.min(one));
+            // `rnd(x, s)` with `s >= 1` (`Q >= 1`, `AccW >= 1`).
+            let w = if NARROW {
+                rnd_mul32(wt, sa[i], q)
+            } else {
+                ((u64::from(wt) * u64::from(sa[i]) + half_q) >> q) as u32
+            };
+            for ch in 0..3 {
+                let add = if NARROW {
+                    rnd_mul32(w, sc[ch][i] >> k, g)
+                } else {
+                    ((u64::from(w) * u64::from(sc[ch][i]) + half_f) >> f) as u32
+                };
+                c[ch][i] = (c[ch][i] + add).min(chan_max);
+            }
+            let a_out = a_in + w;
+            a[i] = a_out;
+            term[i] = t | u32::from(a_out >= et);
+            let none = live & (self.past | (sa[i] == 0));
+            after += u32::from(t != 0);
+            none_n += u32::from(none);
+            shaded += u32::from(t == 0) & u32::from(!none);
+        }
+        (shaded, none_n, after)
     }
 }
 
@@ -317,6 +394,33 @@ mod tests {
         }
     }
 
+    /// `rnd_mul32` is the 64-bit `rnd(x y, s)` at every split `s` it allows, at the extremes
+    /// (`x` up to `2^28`, `y` up to `2^s`) and at random.
+    #[test]
+    fn products_in_32_bits_are_the_64_bit_ones() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 8);
+        for s in 1..=16u32 {
+            let rnd = |x: u32, y: u32| ((u64::from(x) * u64::from(y) + (1 << (s - 1))) >> s) as u32;
+            let ys = [0, 1, (1 << s) - 1, 1 << s];
+            let xs = [0, 1, (1 << s) - 1, 1 << s, (1 << 28) - 1, 1 << 28];
+            for &x in &xs {
+                for &y in &ys {
+                    assert_eq!(rnd_mul32(x, y, s), rnd(x, y), "{x} {y} {s}");
+                }
+            }
+            for _ in 0..20_000 {
+                let (x, y) = (rng.random_range(0..=1 << 28), rng.random_range(0..=1 << s));
+                assert_eq!(rnd_mul32(x, y, s), rnd(x, y), "{x} {y} {s}");
+            }
+        }
+        // Which widths take them: the default (`AccW` 20 over `2 ColorW` 16) and the narrow do,
+        // `ColorW` 10 on `AccW` 24 does not.
+        assert_eq!(narrow_products(20, 16, 8), Some((4, 16)));
+        assert_eq!(narrow_products(8, 8, 8), Some((0, 8)));
+        assert_eq!(narrow_products(24, 12, 10), None);
+        assert_eq!(narrow_products(20, 17, 8), None);
+    }
+
     /// The lanes' rules equal `Compos::step_coded` and `Compos::leaves_unchanged_corrected` on
     /// frame coxels (any reachable `R, G, B, A` and flag, `z = Znone`, no geometry): random
     /// coxels and samples, both modes, depths before and past `Znone`, the narrow, default and
@@ -329,6 +433,10 @@ mod tests {
             ComposConfig::DEFAULT,
             ComposConfig::WIDE,
             ComposConfig::new(12, 12, 6, 28, 16).unwrap(),
+            // The 32-bit products at their edges: `AccW = 16 = Q` (split at 16), and `AccW = 17`
+            // over `2 ColorW = 16` (codes `expand_double(c) 2`).
+            ComposConfig::new(8, 12, 4, 16, 12).unwrap(),
+            ComposConfig::new(8, 10, 6, 17, 12).unwrap(),
         ] {
             let one = cfg.one();
             for regs in thresholds(&cfg) {
@@ -450,8 +558,13 @@ mod tests {
                         }
                         assert_eq!(sum, want, "{mode:?}");
                         for lanes in [&st, &one_by_one] {
-                            let mut out = vec![init; n];
+                            let mut out = vec![std::mem::MaybeUninit::uninit(); n];
                             lanes.write(&init, &mut out);
+                            // SAFETY: `write` wrote every element.
+                            let out: Vec<Coxel> = out
+                                .into_iter()
+                                .map(|x| unsafe { x.assume_init() })
+                                .collect();
                             for (i, (x, s)) in coxels.iter().zip(&samples).enumerate() {
                                 assert_eq!(
                                     out[i],
