@@ -641,3 +641,33 @@ fn benchmark_table() {
         eprintln!("{out}: {e} (the table is printed above)");
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// The compositing window in the top (`Window = 1`; docs/accel.md, *The compositing window in
+// the top*): parks and restores through the scratch area at ParkBase, the final pixels written
+// during the sweep, the rows first written with the initial coxel's code.
+// ---------------------------------------------------------------------------------------------
+
+/// The CI build with the window (the smallest memory), `p` pipelines.
+fn window_rtl(p: usize) -> AccelRtl {
+    AccelRtl::windows()
+        .into_iter()
+        .filter(|r| r.p == p && !r.variant.has_flag("full"))
+        .min_by_key(|r| r.frame.max_dim_log2)
+        .unwrap_or_else(|| panic!("no cube5_accel variant with Window = 1 and P = {p} in CI"))
+}
+
+/// The window's narrow build: the 16^3 head in every view of `some_views`, composite (shaded)
+/// and MIP, each frame under its own random memory (latency 10..200, gaps on all channels).
+#[test]
+fn window_16_every_view_composite_and_mip() {
+    let s = seed(0xacce21);
+    let rtl = window_rtl(4);
+    let n = 1usize << rtl.frame.max_dim_log2;
+    let mut c = Case::new(rtl, head_phantom(n, 8).unwrap(), s);
+    let frames: Vec<(View, Render)> = some_views()
+        .into_iter()
+        .flat_map(|v| [(v, Composite), (v, Mip)])
+        .collect();
+    c.random(&frames);
+}
