@@ -298,23 +298,33 @@ module cube5_accel_win #(
   end
 
   // ---------------------------------------------------------------------------
-  // Restores: the request's slot (tagged with the parks taken so far), a read of Cx bytes once
-  // those parks are all written; the beats assembled into the restored coxel.
+  // Restores: each request's slot, tagged with the parks taken so far, waits in a FIFO (so that
+  // the requests wait for their parks together, not one after another); the head is read (Cx
+  // bytes) once those parks are all written; the beats assembled into the restored coxel.
   // ---------------------------------------------------------------------------
-  logic [TagW-1:0]  ptaken_q, pdone_q, rq_tag_q;
-  logic             rq_v_q, ar_fire, r_fire;
-  logic [AddrW-1:0] rq_addr_q;
+  localparam int unsigned RqDepth = 1 << $clog2(Outstanding);
+  logic [TagW-1:0]  ptaken_q, pdone_q, rq_tag;
+  logic             rq_empty, rq_full, rq_push, ar_fire, r_fire;
+  logic [AddrW-1:0] rq_addr;
   logic [OutW-1:0]  rs_out_q;     // restore reads in flight
   logic             rs_v_q;
   logic [PkBeats*DataW-1:0] rs_q;
   logic signed [TagW-1:0]   behind;
 
-  assign behind     = $signed(pdone_q - rq_tag_q);
-  assign arvalid_o  = rq_v_q && behind >= 0 && rs_out_q < OutW'(Outstanding);
-  assign araddr_o   = rq_addr_q;
+  assign rq_ready_o = !rq_full;
+  assign rq_push    = rq_valid_i && !rq_full;
+
+  cube5_frame_fifo #(.Width(AddrW + TagW), .Depth(RqDepth)) u_rq (
+    .clk_i, .rst_ni, .clear_i(1'b0),
+    .push_i(rq_push), .d_i({slot_of(rq_key_i), ptaken_q + TagW'(take_park)}),
+    .pop_i(ar_fire), .q_o({rq_addr, rq_tag}), .empty_o(rq_empty), .full_o(rq_full)
+  );
+
+  assign behind     = $signed(pdone_q - rq_tag);
+  assign arvalid_o  = !rq_empty && behind >= 0 && rs_out_q < OutW'(Outstanding);
+  assign araddr_o   = rq_addr;
   assign arlen_o    = 8'(PkBeats - 1);
   assign ar_fire    = arvalid_o && arready_i;
-  assign rq_ready_o = !rq_v_q || ar_fire;
   assign rready_o   = !rs_v_q;
   assign r_fire     = rvalid_i && rready_o;
   assign rs_valid_o = rs_v_q;
@@ -324,24 +334,14 @@ module cube5_accel_win #(
     if (!rst_ni) begin
       ptaken_q <= '0;
       pdone_q  <= '0;
-      rq_v_q   <= 1'b0;
       rs_out_q <= '0;
       rs_v_q   <= 1'b0;
     end else begin
       ptaken_q <= ptaken_q + TagW'(take_park);
       pdone_q  <= pdone_q + TagW'(b_fire && bid_i == IdPark);
-      if (rq_valid_i && rq_ready_o) rq_v_q <= 1'b1;
-      else if (ar_fire)             rq_v_q <= 1'b0;
       rs_out_q <= rs_out_q + OutW'(ar_fire) - OutW'(r_fire && rlast_i);
       if (r_fire && rlast_i)        rs_v_q <= 1'b1;
       else if (rs_v_q && rs_ready_i) rs_v_q <= 1'b0;
-    end
-  end
-
-  always_ff @(posedge clk_i) begin
-    if (rq_valid_i && rq_ready_o) begin
-      rq_addr_q <= slot_of(rq_key_i);
-      rq_tag_q  <= ptaken_q + TagW'(take_park);
     end
   end
 
@@ -367,7 +367,7 @@ module cube5_accel_win #(
     end
   end
   assign err_o  = err_q;
-  assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && !rq_v_q
+  assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && rq_empty
                   && rs_out_q == '0 && !rs_v_q;
 
   // The terminated flags of the final lanes (a pixel is R, G, B, A only).

@@ -769,7 +769,7 @@ fn window_soft_reset_mid_frame_drains_then_an_exact_frame() {
 fn window_frames_128() {
     let s = seed(0xacce26);
     let head = head_phantom(128, 12).unwrap();
-    for p in [8, 4, 2, 1] {
+    for p in [4, 8, 2, 1] {
         let mut c = Case::new(window_full(p), head.clone(), s);
         for v in ["+z", "45 xz"] {
             c.frame(view(v), Composite, &ddr(100, 12), ", DDR-like 12 B/cycle");
