@@ -692,7 +692,7 @@ impl Shim {
 
     fn of(v: &Variant) -> Shim {
         // cube5_frame with the compositing window: its window streams played as DRAM.
-        if v.params.iter().any(|(k, x)| k == "Window" && *x != 0) {
+        if v.top == "cube5_frame" && v.params.iter().any(|(k, x)| k == "Window" && *x != 0) {
             return Shim::Win;
         }
         let own = format!("{}.sv", v.top);

@@ -176,6 +176,14 @@ impl<B: RegBus> AccelHost<B> {
         self.write(crate::regs::cube5_accel::REG_IMG_PITCH, pitch)
     }
 
+    /// ParkBase: the scratch area of the parked coxels, for builds with the compositing window
+    /// (`Window = 1`; `Wp H Cx` bytes, docs/accel.md); the others ignore it.
+    pub fn set_park_base(&mut self, park: u64) -> Result<(), HostError<B::Error>> {
+        use crate::regs::cube5_accel::{REG_PARK_BASE_HI, REG_PARK_BASE_LO};
+        self.write(REG_PARK_BASE_LO, park as u32)?;
+        self.write(REG_PARK_BASE_HI, (park >> 32) as u32)
+    }
+
     /// Loads `words` into entries `first ..` of `table` (a `Table` encoding) through the window:
     /// one TableAddr write, then one TableData write per word (the core steps the index).
     pub fn load_table(

@@ -59,7 +59,15 @@ module cube5_accel #(
   parameter int unsigned SpecW       = 8,
   parameter int unsigned ExtraW      = 4,
   parameter int unsigned AccW        = 20,
-  parameter int unsigned ZW          = 12
+  parameter int unsigned ZW          = 12,
+  /// 1: the frame's compositing window (cube5_frame Window = 1; docs/accel.md, *The compositing
+  /// window in the top*): the frame keeps only a section's active rays, parks the others in a
+  /// scratch area at ParkBase and restores them over this port (cube5_accel_win), and its final
+  /// pixels are written during the sweep (no read-out); the image's rows are first written with
+  /// the initial coxel's code. 0: the whole base plane on chip, read out after the sweep.
+  parameter int unsigned Window      = 0,
+  /// Window = 1: the window's write bursts in flight, and its restore reads in flight.
+  parameter int unsigned WinOutstanding = 16
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -148,7 +156,8 @@ module cube5_accel #(
   localparam int unsigned SbOutW   = cube5_section_buf_pkg::out_w(P, VoxelW);
   localparam int unsigned SbCmdW   = 4 * M + 6;
   localparam int unsigned FrInW    = cube5_frame_pkg::in_w(1, P, VoxelW, M);
-  localparam int unsigned FrOutW   = cube5_frame_pkg::out_lanes_w(P, AccW, ZW, ColorW);
+  localparam int unsigned FrLanes  = (Window != 0) ? 1 : P;   // the frame's read-out lanes
+  localparam int unsigned FrOutW   = cube5_frame_pkg::out_lanes_w(FrLanes, AccW, ZW, ColorW);
   localparam int unsigned CoxelW   = cube5_frame_pkg::coxel_w(AccW, ZW, ColorW);
   localparam int unsigned FrSecW   = cube5_frame_pkg::sec_cmd_w(M);
   localparam int unsigned FrCmdW   = 7 * M + 51;
@@ -186,6 +195,9 @@ module cube5_accel #(
   if (Section < 2 * P) begin : gen_bad_section
     $fatal(1, "cube5_accel: Section must be at least 2 P (the frame's rows hold two beats or more)");
   end
+  if (Window > 1 || (Window != 0 && IdW < 2)) begin : gen_bad_window
+    $fatal(1, "cube5_accel: Window must be 0 or 1, and Window = 1 needs IdW >= 2");
+  end
   if (FcLast + 1 != FrCmdW) begin : gen_bad_fc
     $fatal(1, "cube5_accel: the frame command's fields do not add up");
   end
@@ -213,10 +225,12 @@ module cube5_accel #(
   logic [3:0]        tbl_id;
   logic [15:0]       tbl_index;
   logic [31:0]       tbl_data;
+  logic [AddrW-1:0]  img_base, row_step, park_base;
+  logic [M+1:0]      row_pixels;
 
   cube5_accel_ctrl #(
     .P(P), .MaxDim(MaxDim), .BlockDim(BlockDim), .Section(Section), .AddrW(AddrW),
-    .DataW(DataW), .PixelBytes(PixelBytes), .LenW(LenW)
+    .DataW(DataW), .PixelBytes(PixelBytes), .LenW(LenW), .Window(Window)
   ) u_ctrl (
     .clk_i, .rst_ni,
     .s_axil_awvalid_i, .s_axil_awready_o, .s_axil_awaddr_i, .s_axil_wvalid_i, .s_axil_wready_o,
@@ -231,7 +245,9 @@ module cube5_accel #(
     .wr_cpl_valid_i(cpl_valid), .wr_cpl_resp_i(cpl_data[1:0]),
     .flush_o(flush), .drained_i(drain_q),
     .table_valid_o(tbl_valid), .table_id_o(tbl_id), .table_index_o(tbl_index),
-    .table_data_o(tbl_data)
+    .table_data_o(tbl_data),
+    .img_base_o(img_base), .row_step_o(row_step), .park_base_o(park_base),
+    .row_pixels_o(row_pixels)
   );
 
   // ---------------------------------------------------------------------------
@@ -303,6 +319,16 @@ module cube5_accel #(
   // ---------------------------------------------------------------------------
   logic              fe_arvalid, fe_arready;   // the fetch's AR handshake, before the drain's gate
   logic              wr_awvalid, wr_awready, wr_wvalid, wr_wready;  // the writer's AW and W
+  // The fetch's AR and R, and the writer's AW, W and B, before the window's arbiters (Window = 1)
+  // or wired straight to the port (Window = 0).
+  logic [AddrW-1:0]   fe_araddr, wr_awaddr;
+  logic [7:0]         fe_arlen, wr_awlen;
+  logic [2:0]         fe_arsize, wr_awsize;
+  logic [1:0]         fe_arburst, wr_awburst;
+  logic [IdW-1:0]     fe_arid, wr_awid;
+  logic               fe_rvalid, fe_rready, wr_bvalid, wr_bready, wr_wlast;
+  logic [DataW-1:0]   wr_wdata;
+  logic [DataW/8-1:0] wr_wstrb;
   logic              fe_in_valid;
   logic [FeCmdW-1:0] fe_in_data;
   logic              fe_out_valid, fe_out_ready;
@@ -321,9 +347,10 @@ module cube5_accel #(
     .in_valid_i(fe_in_valid), .in_ready_o(fe_in_ready), .in_data_i(fe_in_data),
     .out_valid_o(fe_out_valid), .out_ready_i(fe_out_ready), .out_data_o(fe_out_data),
     .err_o(fe_err),
-    .m_axi_araddr_o, .m_axi_arlen_o, .m_axi_arsize_o, .m_axi_arburst_o, .m_axi_arid_o,
+    .m_axi_araddr_o(fe_araddr), .m_axi_arlen_o(fe_arlen), .m_axi_arsize_o(fe_arsize),
+    .m_axi_arburst_o(fe_arburst), .m_axi_arid_o(fe_arid),
     .m_axi_arvalid_o(fe_arvalid), .m_axi_arready_i(fe_arready), .m_axi_rdata_i, .m_axi_rresp_i, .m_axi_rlast_i,
-    .m_axi_rid_i, .m_axi_rvalid_i, .m_axi_rready_o
+    .m_axi_rid_i, .m_axi_rvalid_i(fe_rvalid), .m_axi_rready_o(fe_rready)
   );
 
   // ---------------------------------------------------------------------------
@@ -430,15 +457,18 @@ module cube5_accel #(
           if (sb_out_valid && fr_in_ready && sb_out_data[SbLastBit]) fr_q <= FrIdle;
         end
       endcase
-      if (fr_out_valid && fr_out_ready) readout_q <= 1'b0;
+      if ((fr_out_valid && fr_out_ready) || win_end) readout_q <= 1'b0;
     end
   end
 
   localparam int unsigned WinKeyW = 2 * ($clog2(MaxDim) + 1);
   localparam int unsigned WinCoxW = 4 * (AccW + 1) + 1;
   logic                 win_park_valid, win_fin_valid, win_rq_valid, win_rs_ready;
+  logic                 win_park_ready, win_fin_ready, win_rq_ready, win_rs_valid;
   logic [WinKeyW-1:0]   win_park_key, win_fin_key, win_rq_key;
-  logic [WinCoxW-1:0]   win_park_cox;
+  logic [WinCoxW-1:0]   win_park_cox, win_rs_cox;
+  logic                 win_idle, win_err;     // Window = 1: cube5_accel_win drained; its errors
+  logic                 win_end;               // Window = 1: the frame's window traffic is done
   logic [P-1:0]         win_fin_mask;
   logic [P*WinCoxW-1:0] win_fin_cox;
 
@@ -447,19 +477,19 @@ module cube5_accel #(
     .BlockDim(BlockDim), .ClassIdxW(ClassIdxW), .MagIdxW(MagIdxW), .MagShift(MagShift),
     .ColorW(ColorW), .AlphaW(AlphaW), .RmLog2(RmLog2), .RmFracW(RmFracW), .DiffW(DiffW),
     .SpecW(SpecW), .ExtraW(ExtraW), .AccW(AccW), .ZW(ZW), .Shade(1), .Source(1),
-    .OutLanes(P), .MaxSection(Section)
+    .OutLanes(FrLanes), .MaxSection(Section), .Window(Window)
   ) u_frame (
     .clk_i, .rst_ni(unit_rst_n),
     .in_valid_i(fr_in_valid), .in_ready_o(fr_in_ready), .in_data_i(fr_in_data),
     .out_valid_o(fr_out_valid), .out_ready_i(fr_out_ready), .out_data_o(fr_out_data),
     .cfg_valid_i(cfg_valid), .cfg_addr_i(cfg_addr), .cfg_data_i(cfg_data),
-    // Window = 0: the compositing-window streams stay idle (docs/accel.md, *Next*, wires them).
-    .park_valid_o(win_park_valid), .park_ready_i(1'b1), .park_key_o(win_park_key),
+    // The compositing-window streams: cube5_accel_win (Window = 1), else idle.
+    .park_valid_o(win_park_valid), .park_ready_i(win_park_ready), .park_key_o(win_park_key),
     .park_cox_o(win_park_cox),
-    .fin_valid_o(win_fin_valid), .fin_ready_i(1'b1), .fin_key_o(win_fin_key),
+    .fin_valid_o(win_fin_valid), .fin_ready_i(win_fin_ready), .fin_key_o(win_fin_key),
     .fin_mask_o(win_fin_mask), .fin_cox_o(win_fin_cox),
-    .rq_valid_o(win_rq_valid), .rq_ready_i(1'b1), .rq_key_o(win_rq_key),
-    .rs_valid_i(1'b0), .rs_ready_o(win_rs_ready), .rs_cox_i('0)
+    .rq_valid_o(win_rq_valid), .rq_ready_i(win_rq_ready), .rq_key_o(win_rq_key),
+    .rs_valid_i(win_rs_valid), .rs_ready_o(win_rs_ready), .rs_cox_i(win_rs_cox)
   );
 
   // The frame's done: its first read-out item (or its error item), passed on once the beams of
@@ -470,9 +500,13 @@ module cube5_accel #(
   logic done_pend_q, done_err_q;
   logic done_ev;
 
-  assign done_ev    = fr_out_valid && fr_out_ready && readout_q;
-  assign done_valid = (done_ev || done_pend_q) && last_in_q;
-  assign done_error = done_pend_q ? done_err_q : fr_error;
+  // Window = 1: no read-out; the frame is done once its last section's sweep is over (the frame
+  // idle again), the window's streams are empty and their traffic has drained (every B and R in).
+  assign win_end    = Window != 0 && readout_q && last_in_q && fr_q == FrIdle && fr_in_ready
+                      && !win_park_valid && !win_fin_valid && win_idle;
+  assign done_ev    = (fr_out_valid && fr_out_ready && readout_q) || win_end;
+  assign done_valid = (done_ev || done_pend_q) && last_in_q && (Window == 0 || win_idle);
+  assign done_error = done_pend_q ? done_err_q : fr_error && fr_out_valid;
 
   always_ff @(posedge clk_i) begin
     if (!unit_rst_n) begin
@@ -492,7 +526,7 @@ module cube5_accel #(
         done_pend_q <= 1'b0;
       end else if (done_ev) begin
         done_pend_q <= 1'b1;
-        done_err_q  <= fr_error;
+        done_err_q  <= fr_error && fr_out_valid;
       end
     end
   end
@@ -508,12 +542,21 @@ module cube5_accel #(
   logic              last_piece;
   logic [ItemW-1:0]  pix_piece;
 
+  // The read-out's P coxels (Window = 0; with the window the frame's output carries error items
+  // only and the final pixels take cube5_accel_win's conversion).
+  logic [P*CoxelW-1:0] fr_cox;
+  if (Window != 0) begin : gen_no_readout
+    assign fr_cox = '0;
+  end else begin : gen_readout
+    assign fr_cox = fr_out_data[P*CoxelW-1:0];
+  end
+
   for (genvar k = 0; k < P; k++) begin : gen_lane
     for (genvar c = 0; c < 4; c++) begin : gen_code
       logic [ChanW-1:0]          chan;
       logic [ChanW+ColorW:0]     scaled;
       logic [ChanW+ColorW-AccW:0] code;
-      assign chan   = fr_out_data[k*CoxelW + c*ChanW +: ChanW];
+      assign chan   = fr_cox[k*CoxelW + c*ChanW +: ChanW];
       assign scaled = ((ChanW+ColorW+1)'(chan) << ColorW) - (ChanW+ColorW+1)'(chan)
                       + ((ChanW+ColorW+1)'(1) << (AccW - 1));
       assign code   = scaled[ChanW+ColorW:AccW];
@@ -546,13 +589,38 @@ module cube5_accel #(
   logic signed [OwedW-1:0] owed_q;
   logic                    wr_dat_valid;
   logic [ItemW-1:0]        wr_dat;
+  logic                    clear_ok_q;    // Window = 1: the frame's mode is known (init_pix_q)
+  logic [PixW-1:0]         init_pix_q;    // Window = 1: the initial coxel's pixel
+  logic [M+1:0]            rows_done_q;   // Window = 1: the clear's rows completed this frame
+
+  // The initial coxel (cube5_frame: zeros, A = all ones for MinIP) as a pixel: its codes.
+  always_ff @(posedge clk_i) begin
+    if (!unit_rst_n) begin
+      clear_ok_q  <= 1'b0;
+      rows_done_q <= '0;
+    end else if (fr_q == FrIdle && rc_valid && rc_data[FcFirst]) begin
+      clear_ok_q  <= 1'b1;
+      rows_done_q <= '0;
+    end else begin
+      rows_done_q <= rows_done_q + (M+2)'(cpl_valid);
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    if (fr_q == FrIdle && rc_valid && rc_data[FcFirst]) begin
+      init_pix_q <= (rc_data[FcMode +: 3] == 3'(cube5_frame_pkg::RenderMinip))
+                    ? PixW'(((1 << ColorW) - 1) << 24) : '0;
+    end
+  end
 
   logic [LenW-1:0]         wc_items;  // a row command's writer items
   assign wc_items     = wc_data[AddrW +: LenW] >> LogL;
-  assign fr_error     = fr_out_data[P*CoxelW];
+  assign fr_error     = fr_out_data[FrLanes*CoxelW];
   assign fr_out_ready = flush_q || !pix_valid_q || (wr_dat_ready && last_piece);
-  assign wr_dat_valid = flush_q ? owed_q > 0 : pix_valid_q;
-  assign wr_dat       = flush_q ? '0 : pix_piece;
+  // Window = 1: the writer's rows are the image's clear, every item the initial coxel's pixels.
+  assign wr_dat_valid = (Window != 0) ? clear_ok_q && owed_q > 0
+                                      : flush_q ? owed_q > 0 : pix_valid_q;
+  assign wr_dat       = (Window != 0) ? {(ItemW/PixW){init_pix_q}}
+                                      : flush_q ? '0 : pix_piece;
 
   always_ff @(posedge clk_i) begin
     if (!unit_rst_n) begin
@@ -593,13 +661,161 @@ module cube5_accel #(
     .dat_valid_i(wr_dat_valid), .dat_ready_o(wr_dat_ready), .dat_data_i(wr_dat),
     .out_valid_o(cpl_valid), .out_ready_i(1'b1), .out_data_o(cpl_data),
     .err_o(wr_err),
-    .m_axi_awaddr_o, .m_axi_awlen_o, .m_axi_awsize_o, .m_axi_awburst_o, .m_axi_awid_o,
-    .m_axi_awvalid_o(wr_awvalid), .m_axi_awready_i(wr_awready), .m_axi_wdata_o, .m_axi_wstrb_o,
-    .m_axi_wlast_o, .m_axi_wvalid_o(wr_wvalid), .m_axi_wready_i(wr_wready), .m_axi_bresp_i, .m_axi_bid_i, .m_axi_bvalid_i,
-    .m_axi_bready_o
+    .m_axi_awaddr_o(wr_awaddr), .m_axi_awlen_o(wr_awlen), .m_axi_awsize_o(wr_awsize),
+    .m_axi_awburst_o(wr_awburst), .m_axi_awid_o(wr_awid),
+    .m_axi_awvalid_o(wr_awvalid), .m_axi_awready_i(wr_awready), .m_axi_wdata_o(wr_wdata),
+    .m_axi_wstrb_o(wr_wstrb), .m_axi_wlast_o(wr_wlast), .m_axi_wvalid_o(wr_wvalid),
+    .m_axi_wready_i(wr_wready), .m_axi_bresp_i, .m_axi_bid_i, .m_axi_bvalid_i(wr_bvalid),
+    .m_axi_bready_o(wr_bready)
   );
 
-  assign err_o = fe_err || wr_err;
+  assign err_o = fe_err || wr_err || win_err;
+
+  // ---------------------------------------------------------------------------
+  // The port's channels before the drain's gates. Window = 0: the fetch's AR and R, the writer's
+  // AW, W and B. Window = 1: cube5_accel_win beside them: AR shared with the fetch (restores, ID
+  // 1), AW shared with the writer (parks ID 1, final pixels ID 2), W in the order of the accepted
+  // AWs, R and B returned by ID (0: the fetch's and the writer's).
+  // ---------------------------------------------------------------------------
+  logic ar_valid, ar_ready, aw_valid, aw_ready, w_valid, w_ready;
+
+  if (Window != 0) begin : gen_win
+    localparam int unsigned WinOrdDepth = 1 << $clog2(WrOutstanding + WinOutstanding + 2);
+    logic [AddrW-1:0]   v_awaddr, v_araddr;
+    logic [7:0]         v_awlen, v_arlen;
+    logic [IdW-1:0]     v_awid;
+    logic               v_awvalid, v_awready, v_wvalid, v_wready, v_wlast, v_bvalid;
+    logic               v_arvalid, v_arready, v_rvalid, v_rready;
+    logic [DataW-1:0]   v_wdata;
+    logic [DataW/8-1:0] v_wstrb;
+    logic               r_win, b_win;
+
+    cube5_accel_win #(
+      .P(P), .DimW(M + 1), .AddrW(AddrW), .DataW(DataW), .IdW(IdW), .AccW(AccW),
+      .ColorW(ColorW), .Outstanding(WinOutstanding)
+    ) u_win (
+      .clk_i, .rst_ni(unit_rst_n),
+      .img_base_i(img_base), .row_step_i(row_step), .park_base_i(park_base),
+      .row_pixels_i(row_pixels), .rows_done_i(rows_done_q),
+      .park_valid_i(win_park_valid), .park_ready_o(win_park_ready), .park_key_i(win_park_key),
+      .park_cox_i(win_park_cox),
+      .fin_valid_i(win_fin_valid), .fin_ready_o(win_fin_ready), .fin_key_i(win_fin_key),
+      .fin_mask_i(win_fin_mask), .fin_cox_i(win_fin_cox),
+      .rq_valid_i(win_rq_valid), .rq_ready_o(win_rq_ready), .rq_key_i(win_rq_key),
+      .rs_valid_o(win_rs_valid), .rs_ready_i(win_rs_ready), .rs_cox_o(win_rs_cox),
+      .awaddr_o(v_awaddr), .awlen_o(v_awlen), .awid_o(v_awid), .awvalid_o(v_awvalid),
+      .awready_i(v_awready), .wdata_o(v_wdata), .wstrb_o(v_wstrb), .wlast_o(v_wlast),
+      .wvalid_o(v_wvalid), .wready_i(v_wready),
+      .bvalid_i(v_bvalid), .bid_i(m_axi_bid_i), .bresp_i(m_axi_bresp_i),
+      .araddr_o(v_araddr), .arlen_o(v_arlen), .arvalid_o(v_arvalid), .arready_i(v_arready),
+      .rvalid_i(v_rvalid), .rdata_i(m_axi_rdata_i), .rresp_i(m_axi_rresp_i),
+      .rlast_i(m_axi_rlast_i), .rready_o(v_rready),
+      .idle_o(win_idle), .err_o(win_err)
+    );
+
+    // AR: the fetch or a restore; a source keeps the port while its address waits (no valid is
+    // withdrawn), else they alternate.
+    logic ar_sel, ar_sel_q, ar_hold_q;   // 1: the restore
+    assign ar_sel = ar_hold_q ? ar_sel_q : (v_arvalid && (!fe_arvalid || !ar_sel_q));
+    assign ar_valid        = ar_sel ? v_arvalid : fe_arvalid;
+    assign fe_arready      = !ar_sel && ar_ready;
+    assign v_arready       = ar_sel && ar_ready;
+    assign m_axi_araddr_o  = ar_sel ? v_araddr : fe_araddr;
+    assign m_axi_arlen_o   = ar_sel ? v_arlen : fe_arlen;
+    assign m_axi_arsize_o  = ar_sel ? 3'($clog2(DataW / 8)) : fe_arsize;
+    assign m_axi_arburst_o = ar_sel ? 2'b01 : fe_arburst;
+    assign m_axi_arid_o    = ar_sel ? IdW'(1) : fe_arid;
+
+    // AW: the writer (the clear) or the window, likewise.
+    logic aw_sel, aw_sel_q, aw_hold_q;   // 1: the window
+    assign aw_sel = aw_hold_q ? aw_sel_q : (v_awvalid && (!wr_awvalid || !aw_sel_q));
+    assign aw_valid        = aw_sel ? v_awvalid : wr_awvalid;
+    assign wr_awready      = !aw_sel && aw_ready;
+    assign v_awready       = aw_sel && aw_ready;
+    assign m_axi_awaddr_o  = aw_sel ? v_awaddr : wr_awaddr;
+    assign m_axi_awlen_o   = aw_sel ? v_awlen : wr_awlen;
+    assign m_axi_awsize_o  = aw_sel ? 3'($clog2(DataW / 8)) : wr_awsize;
+    assign m_axi_awburst_o = aw_sel ? 2'b01 : wr_awburst;
+    assign m_axi_awid_o    = aw_sel ? v_awid : wr_awid;
+
+    always_ff @(posedge clk_i) begin
+      if (!unit_rst_n) begin
+        ar_hold_q <= 1'b0;
+        ar_sel_q  <= 1'b0;
+        aw_hold_q <= 1'b0;
+        aw_sel_q  <= 1'b0;
+      end else begin
+        ar_hold_q <= m_axi_arvalid_o && !m_axi_arready_i;
+        aw_hold_q <= m_axi_awvalid_o && !m_axi_awready_i;
+        if (ar_valid) ar_sel_q <= ar_sel;
+        if (aw_valid) aw_sel_q <= aw_sel;
+      end
+    end
+
+    // W: the bursts' beats in the order their AWs were accepted (a FIFO of sources).
+    logic ord_empty, ord_full, ord_head, w_fire_last;
+    cube5_frame_fifo #(.Width(1), .Depth(WinOrdDepth)) u_ord (
+      .clk_i, .rst_ni(unit_rst_n), .clear_i(1'b0),
+      .push_i(m_axi_awvalid_o && m_axi_awready_i), .d_i(aw_sel),
+      .pop_i(w_fire_last), .q_o(ord_head), .empty_o(ord_empty), .full_o(ord_full)
+    );
+    assign w_valid        = !ord_empty && (ord_head ? v_wvalid : wr_wvalid);
+    assign wr_wready      = !ord_empty && !ord_head && w_ready;
+    assign v_wready       = !ord_empty && ord_head && w_ready;
+    assign m_axi_wdata_o  = ord_head ? v_wdata : wr_wdata;
+    assign m_axi_wstrb_o  = ord_head ? v_wstrb : wr_wstrb;
+    assign m_axi_wlast_o  = ord_head ? v_wlast : wr_wlast;
+    assign w_fire_last    = m_axi_wvalid_o && m_axi_wready_i && m_axi_wlast_o;
+
+    // R and B by ID.
+    assign r_win          = m_axi_rid_i == IdW'(1);
+    assign v_rvalid       = m_axi_rvalid_i && r_win;
+    assign fe_rvalid      = m_axi_rvalid_i && !r_win;
+    assign m_axi_rready_o = r_win ? v_rready : fe_rready;
+    assign b_win          = m_axi_bid_i != '0;
+    assign v_bvalid       = m_axi_bvalid_i && b_win;
+    assign wr_bvalid      = m_axi_bvalid_i && !b_win;
+    assign m_axi_bready_o = b_win || wr_bready;
+
+    logic unused_win;
+    assign unused_win = ord_full;
+  end else begin : gen_no_win
+    assign ar_valid        = fe_arvalid;
+    assign fe_arready      = ar_ready;
+    assign m_axi_araddr_o  = fe_araddr;
+    assign m_axi_arlen_o   = fe_arlen;
+    assign m_axi_arsize_o  = fe_arsize;
+    assign m_axi_arburst_o = fe_arburst;
+    assign m_axi_arid_o    = fe_arid;
+    assign fe_rvalid       = m_axi_rvalid_i;
+    assign m_axi_rready_o  = fe_rready;
+    assign aw_valid        = wr_awvalid;
+    assign wr_awready      = aw_ready;
+    assign m_axi_awaddr_o  = wr_awaddr;
+    assign m_axi_awlen_o   = wr_awlen;
+    assign m_axi_awsize_o  = wr_awsize;
+    assign m_axi_awburst_o = wr_awburst;
+    assign m_axi_awid_o    = wr_awid;
+    assign w_valid         = wr_wvalid;
+    assign wr_wready       = w_ready;
+    assign m_axi_wdata_o   = wr_wdata;
+    assign m_axi_wstrb_o   = wr_wstrb;
+    assign m_axi_wlast_o   = wr_wlast;
+    assign wr_bvalid       = m_axi_bvalid_i;
+    assign m_axi_bready_o  = wr_bready;
+    // The window's streams stay idle (the frame's Window = 0 ties them off).
+    assign win_park_ready = 1'b1;
+    assign win_fin_ready  = 1'b1;
+    assign win_rq_ready   = 1'b1;
+    assign win_rs_valid   = 1'b0;
+    assign win_rs_cox     = '0;
+    assign win_idle       = 1'b1;
+    assign win_err        = 1'b0;
+    logic unused_win;
+    assign unused_win = ^{win_park_valid, win_park_key, win_park_cox, win_fin_valid, win_fin_key,
+                          win_fin_mask, win_fin_cox, win_rq_valid, win_rq_key, clear_ok_q,
+                          init_pix_q};
+  end
 
   // ---------------------------------------------------------------------------
   // Soft reset (docs/accel.md, "Soft reset"): on the core's flush the AXI4 port stops starting
@@ -617,13 +833,13 @@ module cube5_accel #(
   logic [WrOutW-1:0]        wr_out_q;   // write bursts accepted, B not yet in
   logic signed [WOwedW-1:0] w_owed_q;   // beats of accepted write bursts not yet sent
 
-  assign m_axi_arvalid_o = fe_arvalid && !ar_block_q;
-  assign fe_arready      = m_axi_arready_i && !ar_block_q;
-  assign m_axi_awvalid_o = wr_awvalid && !aw_block_q;
-  assign wr_awready      = m_axi_awready_i && !aw_block_q;
+  assign m_axi_arvalid_o = ar_valid && !ar_block_q;
+  assign ar_ready        = m_axi_arready_i && !ar_block_q;
+  assign m_axi_awvalid_o = aw_valid && !aw_block_q;
+  assign aw_ready        = m_axi_awready_i && !aw_block_q;
   assign w_open          = !aw_block_q || w_owed_q > 0;
-  assign m_axi_wvalid_o  = wr_wvalid && w_open;
-  assign wr_wready       = m_axi_wready_i && w_open;
+  assign m_axi_wvalid_o  = w_valid && w_open;
+  assign w_ready         = m_axi_wready_i && w_open;
   assign quiet = ar_block_q && aw_block_q && rd_out_q == '0 && wr_out_q == '0 && w_owed_q == '0;
 
   always_ff @(posedge clk_i) begin
@@ -657,10 +873,9 @@ module cube5_accel #(
   logic unused;
   logic [P-1:0] unused_cox;
   for (genvar k = 0; k < P; k++) begin : gen_unused_cox
-    assign unused_cox[k] = ^fr_out_data[k*CoxelW + 4*ChanW +: CoxelW - 4*ChanW];
+    assign unused_cox[k] = ^fr_cox[k*CoxelW + 4*ChanW +: CoxelW - 4*ChanW];
   end
-  assign unused = ^{fr_out_data[FrOutW-1:P*CoxelW+1], unused_cox, cpl_data[17:2],
-                    win_park_valid, win_park_key, win_park_cox, win_fin_valid, win_fin_key,
-                    win_fin_mask, win_fin_cox, win_rq_valid, win_rq_key, win_rs_ready};
+  assign unused = ^{fr_out_data[FrOutW-1:FrLanes*CoxelW+1], unused_cox, cpl_data[17:2],
+                    win_rs_ready, img_base, row_step, park_base, row_pixels, rows_done_q};
 
 endmodule

@@ -28,7 +28,11 @@ module cube5_accel_ctrl #(
   /// of the row alignment min(P PixelBytes, DataW / 8) bytes (the image writer's item).
   parameter int unsigned PixelBytes = 4,
   /// Bits of the writer's `len` field.
-  parameter int unsigned LenW = 16
+  parameter int unsigned LenW = 16,
+  /// 1: the top has the frame's compositing window (cube5_accel Window = 1): the row commands go
+  /// out from the frame's start (the top writes them with the initial coxel's code before the
+  /// final pixels of each row), not after its last section. 0: after the last section.
+  parameter int unsigned Window = 0
 ) (
   input  logic        clk_i,
   input  logic        rst_ni,
@@ -86,7 +90,14 @@ module cube5_accel_ctrl #(
   output logic        table_valid_o,
   output logic [3:0]  table_id_o,
   output logic [15:0] table_index_o,
-  output logic [31:0] table_data_o
+  output logic [31:0] table_data_o,
+  // ---- the frame's set-up for the top's window writes (held from the checks to the next start) ----
+  /// ImgBase, the bytes from row to row (ImgPitch, or the packed pitch), ParkBase, and the
+  /// pixels of a row as written (W rounded up to P).
+  output logic [AddrW-1:0] img_base_o,
+  output logic [AddrW-1:0] row_step_o,
+  output logic [AddrW-1:0] park_base_o,
+  output logic [$clog2(MaxDim)+1:0] row_pixels_o
 );
 
   localparam int unsigned AxilWords = cube5_accel_regs_pkg::AxilWords;
@@ -104,6 +115,8 @@ module cube5_accel_ctrl #(
   localparam int unsigned RegImgBaseLo = cube5_accel_regs_pkg::RegImgBaseLo;
   localparam int unsigned RegImgBaseHi = cube5_accel_regs_pkg::RegImgBaseHi;
   localparam int unsigned RegImgPitch = cube5_accel_regs_pkg::RegImgPitch;
+  localparam int unsigned RegParkBaseLo = cube5_accel_regs_pkg::RegParkBaseLo;
+  localparam int unsigned RegParkBaseHi = cube5_accel_regs_pkg::RegParkBaseHi;
   localparam int unsigned RegCycleLo = cube5_accel_regs_pkg::RegCycleLo;
   localparam int unsigned RegCycleHi = cube5_accel_regs_pkg::RegCycleHi;
   localparam int unsigned RegSampleLo = cube5_accel_regs_pkg::RegSampleLo;
@@ -216,12 +229,13 @@ module cube5_accel_ctrl #(
   logic             rev_q;
   logic [17:0]      dx_q, dy_q;
   logic [3:0]       mode_q;           // Mode: render (3), tf2d (1)
-  logic [AddrW-1:0] vbase_q, ibase_q;
+  logic [AddrW-1:0] vbase_q, ibase_q, pbase_q;
   logic [31:0]      pitch_q;
-  logic [63:0]      vbase_w, ibase_w;
+  logic [63:0]      vbase_w, ibase_w, pbase_w;
 
   assign vbase_w = {word(reg_q, RegVolBaseHi), word(reg_q, RegVolBaseLo)};
   assign ibase_w = {word(reg_q, RegImgBaseHi), word(reg_q, RegImgBaseLo)};
+  assign pbase_w = {word(reg_q, RegParkBaseHi), word(reg_q, RegParkBaseLo)};
 
   always_ff @(posedge clk_i) begin
     if (start_stb && state_q == StIdle) begin
@@ -237,6 +251,7 @@ module cube5_accel_ctrl #(
       back_q  <= reg_q[RegSkip*32 + 1*M1 +: M1];
       vbase_q <= vbase_w[AddrW-1:0];
       ibase_q <= ibase_w[AddrW-1:0];
+      pbase_q <= pbase_w[AddrW-1:0];
       pitch_q <= word(reg_q, RegImgPitch);
     end
   end
@@ -379,7 +394,7 @@ module cube5_accel_ctrl #(
   assign fetch_cmd_valid_o = run && fidx_q < nsec_q && (!abort_q || fhold_q);
   assign sbuf_cmd_valid_o  = run && sidx_q < nsec_q && (!abort_q || shold_q);
   assign frame_cmd_valid_o = run && gidx_q < nsec_q && (!abort_q || ghold_q);
-  assign wr_cmd_valid_o    = run && gidx_q == nsec_q && row_q < RowW'(h_q) && (!abort_q || whold_q);
+  assign wr_cmd_valid_o    = run && (Window != 0 || gidx_q == nsec_q) && row_q < RowW'(h_q) && (!abort_q || whold_q);
 
   always_comb begin
     state_d  = state_q;
@@ -587,6 +602,10 @@ module cube5_accel_ctrl #(
   assign frame_cmd_data_o = {gidx_q == nsec_q - M1'(1), gidx_q == '0, g_ns, g_a0[M-1:0],
                              back_q, front_q, mode_q, dy_q, dx_q, rev_q, axis_q, nz_q, ny_q, nx_q};
   assign wr_cmd_data_o    = {LenW'(w_q), waddr_q};
+  assign img_base_o       = ibase_q;
+  assign row_step_o       = row_step_q;
+  assign park_base_o      = pbase_q;
+  assign row_pixels_o     = w_q;
 
   // ---------------------------------------------------------------------------------------------
   // Status, counters, interrupt, table port
@@ -610,7 +629,7 @@ module cube5_accel_ctrl #(
   assign table_data_o  = word(reg_q, RegTableData);
 
   logic unused;
-  assign unused = ^{reg_q, rd_stb, wr_stb, nk_q, vbase_w, ibase_w, sec_lo_w, a0_end, tx, ty, ninj, s_a0};
+  assign unused = ^{reg_q, rd_stb, wr_stb, nk_q, vbase_w, ibase_w, pbase_w, sec_lo_w, a0_end, tx, ty, ninj, s_a0};
 
 `ifndef SYNTHESIS
   // A stalled command holds its valid and payload (until the drain of a soft reset ends).

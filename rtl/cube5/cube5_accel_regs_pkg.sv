@@ -44,28 +44,30 @@ package cube5_accel_regs_pkg;
   localparam logic [3:0] TableOpacity = 4'd3;
 
   /// Registers by word offset (byte address / 4 = the offset), access, fields LSB first.
-  localparam int unsigned RegCtrl      = 0;  // WO: start [0], soft_reset [1]
-  localparam int unsigned RegStatus    = 1;  // RO: busy [0], done [1], error [2], code [7:4]
-  localparam int unsigned RegIrqStatus = 2;  // W1C: done [0], error [1]
-  localparam int unsigned RegIrqEnable = 3;  // RW: done [0], error [1]
-  localparam int unsigned RegDims      = 4;  // RW: nx (m + 1), ny (m + 1), nz (m + 1)
-  localparam int unsigned RegView      = 5;  // RW: axis_k [1:0], k_reversed [2]
-  localparam int unsigned RegDx        = 6;  // RW: dx [17:0]
-  localparam int unsigned RegDy        = 7;  // RW: dy [17:0]
-  localparam int unsigned RegMode      = 8;  // RW: render [2:0], tf2d [3]
-  localparam int unsigned RegSkip      = 9;  // RW: front (m + 1), back (m + 1)
-  localparam int unsigned RegVolBaseLo = 10;  // RW
-  localparam int unsigned RegVolBaseHi = 11;  // RW
-  localparam int unsigned RegImgBaseLo = 12;  // RW
-  localparam int unsigned RegImgBaseHi = 13;  // RW
-  localparam int unsigned RegImgPitch  = 14;  // RW
-  localparam int unsigned RegCycleLo   = 16;  // RO
-  localparam int unsigned RegCycleHi   = 17;  // RO
-  localparam int unsigned RegSampleLo  = 18;  // RO
-  localparam int unsigned RegSampleHi  = 19;  // RO
-  localparam int unsigned RegTableAddr = 20;  // RW: index [15:0], table [19:16]
-  localparam int unsigned RegTableData = 21;  // WO
-  localparam int unsigned RegTablePos  = 22;  // RO: index [15:0], table [19:16]
+  localparam int unsigned RegCtrl       = 0;  // WO: start [0], soft_reset [1]
+  localparam int unsigned RegStatus     = 1;  // RO: busy [0], done [1], error [2], code [7:4]
+  localparam int unsigned RegIrqStatus  = 2;  // W1C: done [0], error [1]
+  localparam int unsigned RegIrqEnable  = 3;  // RW: done [0], error [1]
+  localparam int unsigned RegDims       = 4;  // RW: nx (m + 1), ny (m + 1), nz (m + 1)
+  localparam int unsigned RegView       = 5;  // RW: axis_k [1:0], k_reversed [2]
+  localparam int unsigned RegDx         = 6;  // RW: dx [17:0]
+  localparam int unsigned RegDy         = 7;  // RW: dy [17:0]
+  localparam int unsigned RegMode       = 8;  // RW: render [2:0], tf2d [3]
+  localparam int unsigned RegSkip       = 9;  // RW: front (m + 1), back (m + 1)
+  localparam int unsigned RegVolBaseLo  = 10;  // RW
+  localparam int unsigned RegVolBaseHi  = 11;  // RW
+  localparam int unsigned RegImgBaseLo  = 12;  // RW
+  localparam int unsigned RegImgBaseHi  = 13;  // RW
+  localparam int unsigned RegImgPitch   = 14;  // RW
+  localparam int unsigned RegParkBaseLo = 24;  // RW
+  localparam int unsigned RegParkBaseHi = 25;  // RW
+  localparam int unsigned RegCycleLo    = 16;  // RO
+  localparam int unsigned RegCycleHi    = 17;  // RO
+  localparam int unsigned RegSampleLo   = 18;  // RO
+  localparam int unsigned RegSampleHi   = 19;  // RO
+  localparam int unsigned RegTableAddr  = 20;  // RW: index [15:0], table [19:16]
+  localparam int unsigned RegTableData  = 21;  // WO
+  localparam int unsigned RegTablePos   = 22;  // RO: index [15:0], table [19:16]
 
   /// Reset values.
   localparam logic [31:0] RegCtrlReset = 32'h0;
@@ -82,6 +84,8 @@ package cube5_accel_regs_pkg;
   localparam logic [31:0] RegImgBaseLoReset = 32'h0;
   localparam logic [31:0] RegImgBaseHiReset = 32'h0;
   localparam logic [31:0] RegImgPitchReset = 32'h0;
+  localparam logic [31:0] RegParkBaseLoReset = 32'h0;
+  localparam logic [31:0] RegParkBaseHiReset = 32'h0;
   localparam logic [31:0] RegTableAddrReset = 32'h0;
   localparam logic [31:0] RegTableDataReset = 32'h0;
 
@@ -130,32 +134,34 @@ package cube5_accel_regs_pkg;
   /// Tables of the AXI4-Lite register block (rtl/cube5/cube5_axil_regs.sv, docs/accel-regs.md): one
   /// entry per word offset 0 .. AxilWords - 1, bit `[i]` or word `[i*32 +: 32]` for offset `i`, the
   /// highest offset first.
-  localparam int unsigned AxilWords = 23;
+  localparam int unsigned AxilWords = 26;
   // a register is at the offset
-  localparam logic [22:0] AxilMapped = 23'b11111110111111111111111;
+  localparam logic [25:0] AxilMapped = 26'b11011111110111111111111111;
   // the block keeps its value (RW, WO, W1C)
-  localparam logic [22:0] AxilStored = 23'b01100000111111111111101;
+  localparam logic [25:0] AxilStored = 26'b11001100000111111111111101;
   // a read answers OKAY (RW, RO, W1C)
-  localparam logic [22:0] AxilReadable = 23'b10111110111111111111110;
+  localparam logic [25:0] AxilReadable = 26'b11010111110111111111111110;
   // a read returns `ro_i` (RO)
-  localparam logic [22:0] AxilRo = 23'b10011110000000000000010;
+  localparam logic [25:0] AxilRo = 26'b00010011110000000000000010;
   // writing 1 clears a bit, `w1c_set_i` sets it (W1C)
-  localparam logic [22:0] AxilW1c = 23'b00000000000000000000100;
+  localparam logic [25:0] AxilW1c = 26'b00000000000000000000000100;
   // reset sets the register to its AxilReset word
-  localparam logic [22:0] AxilHasReset = 23'b01100000111111111111101;
+  localparam logic [25:0] AxilHasReset = 26'b11001100000111111111111101;
   // the bits a register keeps (its fields; all where a field's place depends on parameters)
-  localparam logic [735:0] AxilMask = {
-      32'h000fffff, 32'hffffffff, 32'h000fffff, 32'hffffffff, 32'hffffffff, 32'hffffffff,
-      32'hffffffff, 32'h00000000, 32'hffffffff, 32'hffffffff, 32'hffffffff, 32'hffffffff,
-      32'hffffffff, 32'hffffffff, 32'h0000000f, 32'h0003ffff, 32'h0003ffff, 32'h00000007,
-      32'hffffffff, 32'h00000003, 32'h00000003, 32'h000000f7, 32'h00000003
+  localparam logic [831:0] AxilMask = {
+      32'hffffffff, 32'hffffffff, 32'h00000000, 32'h000fffff, 32'hffffffff, 32'h000fffff,
+      32'hffffffff, 32'hffffffff, 32'hffffffff, 32'hffffffff, 32'h00000000, 32'hffffffff,
+      32'hffffffff, 32'hffffffff, 32'hffffffff, 32'hffffffff, 32'hffffffff, 32'h0000000f,
+      32'h0003ffff, 32'h0003ffff, 32'h00000007, 32'hffffffff, 32'h00000003, 32'h00000003,
+      32'h000000f7, 32'h00000003
   };
   // reset values
-  localparam logic [735:0] AxilReset = {
+  localparam logic [831:0] AxilReset = {
       32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000,
       32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000,
       32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000,
-      32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000
+      32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000, 32'h00000000,
+      32'h00000000, 32'h00000000
   };
   // irq_o = |(word AxilIrqStatus & word AxilIrqEnable) when AxilHasIrq
   localparam int unsigned AxilHasIrq = 1;

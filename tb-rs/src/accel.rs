@@ -39,6 +39,12 @@ pub struct AccelRtl {
     pub ctrl: AccelCtrlConfig,
     pub p: usize,
     pub section: usize,
+    /// The compositing window (`Window = 1`): coxels parked in a scratch area of the memory.
+    pub window: bool,
+    /// With the window: bytes of a parked coxel's slot (`Cx`).
+    pub park_slot: u64,
+    /// Bursts the top may have in flight on its port (the memory's declared limit).
+    pub port_outstanding: u32,
 }
 
 impl AccelRtl {
@@ -58,15 +64,30 @@ impl AccelRtl {
             ctrl: ac.ctrl(),
             p: ac.frame.p,
             section: ac.section as usize,
+            window: ac.window,
+            park_slot: ac.park_slot_bytes(),
+            port_outstanding: ac.port_outstanding(),
         })
     }
 
-    /// Every build of the top, in `.variants` order.
-    pub fn all() -> Vec<AccelRtl> {
+    /// Every build of the top, in `.variants` order, with the window or without.
+    fn every(window: bool) -> Vec<AccelRtl> {
         variants_of(TOP)
             .into_iter()
             .map(|v| Self::from_variant(v).unwrap_or_else(|e| panic!("{e}")))
+            .filter(|r| r.window == window)
             .collect()
+    }
+
+    /// Every build of the top without the compositing window (the whole base plane on chip), in
+    /// `.variants` order.
+    pub fn all() -> Vec<AccelRtl> {
+        Self::every(false)
+    }
+
+    /// Every build with the compositing window (`Window = 1`), in `.variants` order.
+    pub fn windows() -> Vec<AccelRtl> {
+        Self::every(true)
     }
 
     /// The build with `p` pipelines and the smallest memory that holds `n`^3.
@@ -210,6 +231,8 @@ pub struct AccelBench {
     at_start: (u64, u64, u64),
     /// The `ImgPitch` register the next frames are started with (0: the smallest pitch).
     pub pitch: u32,
+    /// The window's scratch area of the frame being run (`Window = 1`): base and bytes.
+    pub park: (u64, u64),
 }
 
 /// The image's place in memory: right after the volume, 4 KB aligned.
@@ -239,6 +262,7 @@ impl AccelBench {
             lut_loaded: None,
             at_start: (0, 0, 0),
             pitch: 0,
+            park: (0, 0),
         })
     }
 
@@ -352,8 +376,9 @@ impl AccelBench {
             self.dut.axi_wr_counters().aw_accepted,
         );
         let pitch = self.pitch;
+        let park = self.park.0;
         let mut host = AccelHost::new(&mut *self, 0);
-        start_frame(&mut host, &rtl, e, lut, img_base, pitch).map_err(host_err)?;
+        start_frame(&mut host, &rtl, e, lut, (img_base, park), pitch).map_err(host_err)?;
         self.flush(None)?;
         Ok(img_base)
     }
@@ -397,7 +422,16 @@ impl AccelBench {
     ) -> Result<u64, TbError> {
         let rtl = self.rtl;
         let mut img = dram_image(vol, lut, VOL_BASE).map_err(|x| TbError::setup(self.name(), x))?;
-        let end = img.base + img.bytes.len() as u64;
+        let mut end = img.base + img.bytes.len() as u64;
+        // With the window, the parked coxels' scratch area between the volume and the image:
+        // `Wp H Cx` bytes.
+        self.park = (0, 0);
+        if rtl.window {
+            let park = end.div_ceil(4096) * 4096;
+            let bytes = u64::from(rtl.ctrl.row_pixels(e.w as u32)) * e.h as u64 * rtl.park_slot;
+            self.park = (park, bytes);
+            end = park + bytes;
+        }
         let img_base = end.div_ceil(4096) * 4096;
         let img_bytes = self.pitch_bytes(e) * e.h;
         img.bytes
@@ -418,7 +452,7 @@ impl AccelBench {
             aw_gap_permille: env.gaps[2],
             w_gap_permille: env.gaps[3],
             b_gap_permille: env.gaps[4],
-            declared_outstanding: rtl.fetch.outstanding,
+            declared_outstanding: rtl.port_outstanding,
         };
         self.dut.axi_setup(&setup)?;
         self.dut.axi_load(img.base, &img.bytes)?;
@@ -494,7 +528,7 @@ fn start_frame(
     rtl: &AccelRtl,
     e: &Expected,
     lut: &BlockLut,
-    img_base: u64,
+    (img_base, park_base): (u64, u64),
     pitch: u32,
 ) -> Result<(), HostError<TbError>> {
     let lut_loads = rtl.block_loads(lut).map_err(HostError::Bus)?;
@@ -525,6 +559,9 @@ fn start_frame(
     })?;
     host.set_bases(VOL_BASE, img_base)?;
     host.set_pitch(pitch)?;
+    if rtl.window {
+        host.set_park_base(park_base)?;
+    }
     host.enable_irq(true, true)?;
     host.start()
 }

@@ -230,55 +230,62 @@ fn reset_mid_frame_then_an_exact_frame() {
 fn soft_reset_mid_frame_drains_then_an_exact_frame() {
     let s = seed(0xacce19);
     for (n, bits, resets, span) in [(64, 12, 4, 140_000u64), (16, 8, 12, 9_000)] {
-        let mut c = Case::new(rtl(4, n), head_phantom(n, bits).unwrap(), s);
-        let views = some_views();
-        let mut aborted = 0;
-        for k in 0..resets {
-            let env = MemEnv::random(&mut c.rng);
-            let e = c.expect(views[k % views.len()], [Composite, Mip][k % 2]);
-            let mem_seed = c.rng.random();
-            must(c.bench.start(&e, &c.vol, &c.lut, &env, mem_seed));
-            let at = c.rng.random_range(1..span);
-            must(c.bench.idle(at));
-            AccelHost::new(&mut c.bench, 0).soft_reset().unwrap();
-            must(c.bench.wait_irq(200_000));
-            let mut host = AccelHost::new(&mut c.bench, 0);
-            let ended = host.wait_done(1);
-            let code = host.status_code().unwrap();
-            let counters = host.counters().unwrap();
-            match ended {
-                Err(HostError::Frame(_)) => {
-                    assert_eq!(code, CODE_ABORTED, "soft reset after {at} cycles");
-                    aborted += 1;
-                }
-                Ok(_) => eprintln!("the frame had ended before the soft reset ({at} cycles)"),
-                Err(other) => panic!("soft reset after {at} cycles: {other}"),
-            }
-            let [ni, nj, nk] = [e.params.ni, e.params.nj, e.params.nk];
-            assert_eq!(
-                counters.samples,
-                (ni * nj * nk) as u64,
-                "the plan's samples"
-            );
-            let (rd, wr) = (c.bench.dut.axi_counters(), c.bench.dut.axi_wr_counters());
-            assert_eq!(
-                (rd.in_flight, wr.in_flight),
-                (0, 0),
-                "read and write bursts outstanding after the soft reset at {at} cycles"
-            );
-            eprintln!(
-                "{}: soft reset {at} cycles into the frame, ended after {} cycles",
-                c.bench.rtl.variant, counters.cycles
-            );
-            c.frame(
-                views[(k + 1) % views.len()],
-                Composite,
-                &env,
-                " after a soft reset",
-            );
-        }
-        assert!(aborted > 0, "no frame was aborted");
+        soft_resets(rtl(4, n), bits, resets, span, s);
     }
+}
+
+/// `resets` soft resets, each at a random point (up to `span` cycles) of a frame of the head
+/// phantom at the build's largest size under a random memory, and the exact frame after each.
+fn soft_resets(rtl: AccelRtl, bits: u32, resets: usize, span: u64, s: u64) {
+    let n = 1usize << rtl.frame.max_dim_log2;
+    let mut c = Case::new(rtl, head_phantom(n, bits).unwrap(), s);
+    let views = some_views();
+    let mut aborted = 0;
+    for k in 0..resets {
+        let env = MemEnv::random(&mut c.rng);
+        let e = c.expect(views[k % views.len()], [Composite, Mip][k % 2]);
+        let mem_seed = c.rng.random();
+        must(c.bench.start(&e, &c.vol, &c.lut, &env, mem_seed));
+        let at = c.rng.random_range(1..span);
+        must(c.bench.idle(at));
+        AccelHost::new(&mut c.bench, 0).soft_reset().unwrap();
+        must(c.bench.wait_irq(200_000));
+        let mut host = AccelHost::new(&mut c.bench, 0);
+        let ended = host.wait_done(1);
+        let code = host.status_code().unwrap();
+        let counters = host.counters().unwrap();
+        match ended {
+            Err(HostError::Frame(_)) => {
+                assert_eq!(code, CODE_ABORTED, "soft reset after {at} cycles");
+                aborted += 1;
+            }
+            Ok(_) => eprintln!("the frame had ended before the soft reset ({at} cycles)"),
+            Err(other) => panic!("soft reset after {at} cycles: {other}"),
+        }
+        let [ni, nj, nk] = [e.params.ni, e.params.nj, e.params.nk];
+        assert_eq!(
+            counters.samples,
+            (ni * nj * nk) as u64,
+            "the plan's samples"
+        );
+        let (rd, wr) = (c.bench.dut.axi_counters(), c.bench.dut.axi_wr_counters());
+        assert_eq!(
+            (rd.in_flight, wr.in_flight),
+            (0, 0),
+            "read and write bursts outstanding after the soft reset at {at} cycles"
+        );
+        eprintln!(
+            "{}: soft reset {at} cycles into the frame, ended after {} cycles",
+            c.bench.rtl.variant, counters.cycles
+        );
+        c.frame(
+            views[(k + 1) % views.len()],
+            Composite,
+            &env,
+            " after a soft reset",
+        );
+    }
+    assert!(aborted > 0, "no frame was aborted");
 }
 
 /// A frame whose last section the frame refuses (36 anchors in sections of 16: the last has 4,
@@ -599,7 +606,7 @@ fn placed_fmax_bound() -> (f64, String) {
 /// The benchmark (`make bench-accel`; docs/accel.md, *Measured*): whole frames of the head
 /// phantom, start to interrupt (read-out and the image's writes included), at P = 1, 2, 4, 8 on
 /// the MaxDim 256 configurations (8^3 blocks, 32-anchor sections, a 128-bit bus, 16 bursts in
-/// flight) with the DDR-like memory (latency 100..120 cycles, 12 bytes per cycle shared by reads
+/// flight), without and with the compositing window (`w1` builds), with the DDR-like memory (latency 100..120 cycles, 12 bytes per cycle shared by reads
 /// and writes): samples per clock per pipeline, and frames per second at the lowest placed Fmax
 /// of the accelerator and its units. Every image bit-exact. Prints a Markdown table (also written to
 /// target/bench-accel.md). Cycle counts are exact whatever the machine's load.
@@ -613,9 +620,14 @@ fn benchmark_table() {
         "| P | configuration | volume | view | cycles | samples | samples/clock/pipeline | frames/s at {fmax} MHz |\n|--:|---|---|---|--:|--:|--:|--:|\n"
     );
     let heads = [128, 256].map(|n| head_phantom(n, 12).unwrap());
-    // The fastest first: P = 1 at 256^3 alone is 17 M cycles.
-    for p in [8, 4, 2, 1] {
-        let rtl = rtl(p, 256);
+    // The fastest first: P = 1 at 256^3 alone is 17 M cycles. The whole-plane builds, then the
+    // same memory systems with the compositing window (`Window = 1`).
+    let builds = [8, 4, 2, 1]
+        .map(|p| rtl(p, 256))
+        .into_iter()
+        .chain([8, 4, 2, 1].map(window_full));
+    for rtl in builds {
+        let p = rtl.p;
         let mut c = Case::new(rtl, heads[0].clone(), s);
         for (head, views) in heads.iter().zip([&["+z", "45 xz"][..], &["45 xz"][..]]) {
             c = c.with(head.clone());
@@ -641,4 +653,154 @@ fn benchmark_table() {
     if let Err(e) = std::fs::write(out, &table) {
         eprintln!("{out}: {e} (the table is printed above)");
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The compositing window in the top (`Window = 1`; docs/accel.md, *The compositing window in
+// the top*): parks and restores through the scratch area at ParkBase, the final pixels written
+// during the sweep, the rows first written with the initial coxel's code.
+// ---------------------------------------------------------------------------------------------
+
+/// The CI build with the window (the smallest memory), `p` pipelines.
+fn window_rtl(p: usize) -> AccelRtl {
+    AccelRtl::windows()
+        .into_iter()
+        .filter(|r| r.p == p && !r.variant.has_flag("full"))
+        .min_by_key(|r| r.frame.max_dim_log2)
+        .unwrap_or_else(|| panic!("no cube5_accel variant with Window = 1 and P = {p} in CI"))
+}
+
+/// The window's narrow build: the 16^3 head in all 14 acceptance views (the six faces, exactly
+/// 45 degrees, obliques with DX < 0 and reversed sweeps), composite (shaded) and MIP at each,
+/// every frame under its own random memory (latency 10..200, gaps on all five channels, the
+/// host's B and R back-pressured): the image in memory bit-exact, pixels no ray reaches included.
+#[test]
+fn window_16_every_view_composite_and_mip() {
+    let s = seed(0xacce21);
+    let rtl = window_rtl(4);
+    let n = 1usize << rtl.frame.max_dim_log2;
+    let mut c = Case::new(rtl, head_phantom(n, 8).unwrap(), s);
+    let frames: Vec<(View, Render)> = VIEWS
+        .iter()
+        .flat_map(|&v| [(v, Composite), (v, Mip)])
+        .collect();
+    c.random(&frames);
+}
+
+/// The window under the DDR-like memory (latency 100..120) with a bandwidth limit shared by reads
+/// and writes, 12 and 3 bytes per cycle, and the blob with holes (few empty blocks): exact.
+#[test]
+fn window_16_bandwidth_limit_and_bubbles() {
+    let s = seed(0xacce22);
+    let rtl = window_rtl(4);
+    let n = 1usize << rtl.frame.max_dim_log2;
+    let mut c = Case::new(rtl, head_phantom(n, 8).unwrap(), s);
+    for bw in [12, 3] {
+        for v in ["45 xz", "oblique z", "-y"] {
+            c.frame(
+                view(v),
+                Composite,
+                &ddr(100, bw),
+                &format!(", DDR-like {bw} B/cycle"),
+            );
+        }
+    }
+    let mut c = c.with(bubbles_phantom(n, 8).unwrap());
+    c.random(&[(view("45 xz"), Composite), (view("oblique x"), Mip)]);
+}
+
+/// The modes whose initial coxel differs (MinIP: A all ones) or that composite otherwise (X-ray,
+/// first-opaque, the 2-D transfer function) through the window: the untouched pixels carry the
+/// initial coxel's code.
+#[test]
+fn window_16_modes() {
+    let s = seed(0xacce23);
+    let rtl = window_rtl(4);
+    let n = 1usize << rtl.frame.max_dim_log2;
+    let mut c = Case::new(rtl, head_phantom(n, 8).unwrap(), s);
+    let mut modes = newer_modes();
+    modes.push((Render::Minip, Look::default()));
+    for (k, (render, look)) in modes.iter().enumerate() {
+        let v = [view("45 xz"), view("oblique z"), view("diagonal")][k % 3];
+        let e = c.expect_with(v, *render, look);
+        let env = MemEnv::random(&mut c.rng);
+        c.frame_of(&e, &env, "");
+    }
+}
+
+/// A reset in the middle of a window frame (parks, restores and final writes in flight are
+/// dropped on both sides; none is outstanding after it), then the tables reloaded and an exact
+/// frame; at several points of the frame.
+#[test]
+fn window_reset_mid_frame_then_an_exact_frame() {
+    let s = seed(0xacce24);
+    let rtl = window_rtl(4);
+    let n = 1usize << rtl.frame.max_dim_log2;
+    let mut c = Case::new(rtl, head_phantom(n, 8).unwrap(), s);
+    for k in 0..4 {
+        let env = MemEnv::random(&mut c.rng);
+        let e = c.expect(view("45 xz"), Composite);
+        let mem_seed = c.rng.random();
+        must(c.bench.start(&e, &c.vol, &c.lut, &env, mem_seed));
+        must(c.bench.idle(c.rng.random_range(500..8_000)));
+        c.bench.reset();
+        let (rd, wr) = (c.bench.dut.axi_counters(), c.bench.dut.axi_wr_counters());
+        assert_eq!(
+            (rd.in_flight, wr.in_flight),
+            (0, 0),
+            "bursts outstanding after the reset"
+        );
+        let v = [view("45 xz"), view("oblique x")][k % 2];
+        c.frame(v, Composite, &env, " after a reset mid-frame");
+    }
+}
+
+/// `Ctrl.soft_reset` at random points of window frames: code Aborted, no burst outstanding in
+/// either direction (parks, restores, final pixels, the clear), the next frame exact.
+#[test]
+fn window_soft_reset_mid_frame_drains_then_an_exact_frame() {
+    soft_resets(window_rtl(4), 8, 12, 9_000, seed(0xacce25));
+}
+
+/// Window frames at 128^3 on the MaxDim 256 builds at P = 1, 2, 4, 8 (the head phantom): the +z
+/// face and 45 degrees composite with the DDR-like memory, an oblique view in MIP under a random
+/// memory.
+#[test]
+#[ignore = "sim-full: 128^3 window frames at P = 1, 2, 4, 8 (the MaxDim 256 builds)"]
+fn window_frames_128() {
+    let s = seed(0xacce26);
+    let head = head_phantom(128, 12).unwrap();
+    for p in [8, 4, 2, 1] {
+        let mut c = Case::new(window_full(p), head.clone(), s);
+        for v in ["+z", "45 xz"] {
+            c.frame(view(v), Composite, &ddr(100, 12), ", DDR-like 12 B/cycle");
+        }
+        c.random(&[(view("oblique z"), Mip)]);
+    }
+}
+
+/// Window frames at 256^3 at P = 4 and 8: 45 degrees composite with the DDR-like memory.
+#[test]
+#[ignore = "sim-full: 256^3 window frames, minutes each"]
+fn window_frames_256() {
+    let s = seed(0xacce27);
+    let head = head_phantom(256, 12).unwrap();
+    for p in [4, 8] {
+        let mut c = Case::new(window_full(p), head.clone(), s);
+        c.frame(
+            view("45 xz"),
+            Composite,
+            &ddr(100, 12),
+            ", DDR-like 12 B/cycle",
+        );
+    }
+}
+
+/// The window build with `p` pipelines and the largest memory.
+fn window_full(p: usize) -> AccelRtl {
+    AccelRtl::windows()
+        .into_iter()
+        .filter(|r| r.p == p)
+        .max_by_key(|r| r.frame.max_dim_log2)
+        .unwrap_or_else(|| panic!("no cube5_accel variant with Window = 1 and P = {p}"))
 }

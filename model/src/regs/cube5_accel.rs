@@ -124,6 +124,13 @@ pub const REG_IMG_BASE_HI: u32 = 13;
 /// DataW / 8)` (32 serves every build) and at least `W PixelBytes`; 0: the smallest such pitch, `W
 /// PixelBytes` rounded up to the alignment. Fields: .
 pub const REG_IMG_PITCH: u32 = 14;
+/// `ParkBaseLo` (RW): builds with the compositing window (`Window = 1`): byte address of the
+/// scratch area the parked coxels go to, bits 31:0; coxel `(R, Q)` at ParkBase + (Q Wp + R) Cx
+/// (`Wp` = W rounded up to P, `Cx` the coxel slot: docs/accel.md); the low log2(Cx) bits are
+/// ignored; `Wp H Cx` bytes; unused without the window. Fields: .
+pub const REG_PARK_BASE_LO: u32 = 24;
+/// `ParkBaseHi` (RW): park scratch base address, bits 63:32. Fields: .
+pub const REG_PARK_BASE_HI: u32 = 25;
 /// `CycleLo` (RO): clock cycles of the last (or current) frame, bits 31:0; reading it latches
 /// CycleHi (the read strobe). Fields: .
 pub const REG_CYCLE_LO: u32 = 16;
@@ -155,7 +162,7 @@ pub const REG_TABLE_POS_INDEX: Field = Field::new(0, 16);
 pub const REG_TABLE_POS_TABLE: Field = Field::new(16, 4);
 
 /// Every register, by offset.
-pub const REGISTERS: [Register; 22] = [
+pub const REGISTERS: [Register; 24] = [
     Register::new("Ctrl", 0, Access::Wo, Some(0x0)),
     Register::new("Status", 1, Access::Ro, None),
     Register::new("IrqStatus", 2, Access::W1c, Some(0x0)),
@@ -178,14 +185,17 @@ pub const REGISTERS: [Register; 22] = [
     Register::new("TableAddr", 20, Access::Rw, Some(0x0)),
     Register::new("TableData", 21, Access::Wo, Some(0x0)),
     Register::new("TablePos", 22, Access::Ro, None),
+    Register::new("ParkBaseLo", 24, Access::Rw, Some(0x0)),
+    Register::new("ParkBaseHi", 25, Access::Rw, Some(0x0)),
 ];
 
 /// The bits each word offset keeps (AXI4-Lite register block, docs/accel-regs.md): its fields,
 /// every bit where a field's place depends on parameters, 0 where no register is.
-pub const AXIL_MASK: [u32; 23] = [
+pub const AXIL_MASK: [u32; 26] = [
     0x00000003, 0x000000f7, 0x00000003, 0x00000003, 0xffffffff, 0x00000007, 0x0003ffff, 0x0003ffff,
     0x0000000f, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x00000000,
-    0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x000fffff, 0xffffffff, 0x000fffff,
+    0xffffffff, 0xffffffff, 0xffffffff, 0xffffffff, 0x000fffff, 0xffffffff, 0x000fffff, 0x00000000,
+    0xffffffff, 0xffffffff,
 ];
 
 /// The interrupt: `irq_o` is high while (status & enable) != 0, as (status, enable) offsets.

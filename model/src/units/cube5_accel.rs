@@ -28,7 +28,13 @@ pub const FETCH_PARAMS: &[&str] = &[
 
 /// The top's own parameters, with the RTL's defaults: the section width (anchors), the image
 /// writer's bursts in flight and the AXI ID width.
-const OWN_PARAMS: &[(&str, i64)] = &[("Section", 16), ("WrOutstanding", 4), ("IdW", 4)];
+const OWN_PARAMS: &[(&str, i64)] = &[
+    ("Section", 16),
+    ("WrOutstanding", 4),
+    ("IdW", 4),
+    ("Window", 0),
+    ("WinOutstanding", 16),
+];
 
 /// The defaults of the parameters the top passes on, where the top's default differs from (or
 /// must not depend on) the unit's: the RTL's values (`rtl/cube5/cube5_accel.sv`).
@@ -80,10 +86,20 @@ pub struct AccelConfig {
     pub wr_outstanding: u32,
     /// AXI ID width (`IdW`).
     pub id_w: u32,
+    /// The frame's compositing window (`Window = 1`): parks and restores over the port, final
+    /// pixels written during the sweep (docs/accel.md, *The compositing window in the top*).
+    pub window: bool,
+    /// With the window: its write bursts in flight, and its restore reads in flight.
+    pub win_outstanding: u32,
 }
 
 /// Bytes per base-plane pixel in memory (the top's `PixelBytes`: R, G, B, A codes).
 pub const PIXEL_BYTES: u32 = 4;
+
+/// The window's AXI IDs (cube5_accel_win): parks and restores, final pixels (the fetch and the
+/// image's clear use 0).
+pub const ID_PARK: u32 = 1;
+pub const ID_FINAL: u32 = 2;
 
 impl AccelConfig {
     /// The control core inside (cube5_accel.sv: its parameters from the top's), whose plan gives
@@ -98,7 +114,27 @@ impl AccelConfig {
             data_w: self.fetch.data_w,
             pixel_bytes: PIXEL_BYTES,
             len_w: 16,
+            window: u32::from(self.window),
         }
+    }
+}
+
+impl AccelConfig {
+    /// `Cx`: bytes of a parked coxel's slot in the scratch area (`Window = 1`): the stored coxel
+    /// (`4 (AccW + 1) + 1` bits) rounded up to a power-of-two byte count, at least a bus beat.
+    pub fn park_slot_bytes(&self) -> u64 {
+        let store_bits = 4 * (u64::from(self.frame.compos.acc_w) + 1) + 1;
+        store_bits
+            .div_ceil(8)
+            .next_power_of_two()
+            .max(u64::from(self.fetch.data_w / 8))
+    }
+
+    /// The bursts the top may have in flight on its port, reads or writes, whichever is more
+    /// (the fetch's `Outstanding` or the writer's `WrOutstanding`, plus the window's).
+    pub fn port_outstanding(&self) -> u32 {
+        let win = if self.window { self.win_outstanding } else { 0 };
+        (self.fetch.outstanding + win).max(self.wr_outstanding + win)
     }
 }
 
@@ -131,7 +167,9 @@ impl UnitConfig for AccelConfig {
         // The frame's slice FIFOs hold one section (cube5_accel.sv: `.MaxSection(Section)`), and
         // its read-out gives P pixels of a row per item (`.OutLanes(P)`).
         fp.push(("MaxSection", get("Section")));
-        fp.push(("OutLanes", get("P")));
+        // With the compositing window (`Window = 1`) the frame has no read-out: one lane.
+        fp.push(("OutLanes", if get("Window") == 1 { 1 } else { get("P") }));
+        fp.push(("Window", get("Window")));
         let own = |n: &str| {
             u32::try_from(get(n)).map_err(|_| {
                 ModelError::Config(format!("cube5_accel: {n} = {} is out of range", get(n)))
@@ -152,7 +190,14 @@ impl UnitConfig for AccelConfig {
             section: own("Section")?,
             wr_outstanding: own("WrOutstanding")?,
             id_w: own("IdW")?,
+            window: own("Window")? == 1,
+            win_outstanding: own("WinOutstanding")?,
         };
+        if own("Window")? > 1 || (c.window && c.id_w < 2) {
+            return Err(ModelError::Config(
+                "cube5_accel: Window must be 0 or 1, and Window = 1 needs IdW >= 2".into(),
+            ));
+        }
         if c.section < 2 * get("P") as u32 {
             return Err(ModelError::Config(format!(
                 "cube5_accel: Section = {} must be at least 2 P = {}",
@@ -185,6 +230,8 @@ impl UnitConfig for AccelConfig {
             ("Section", i64::from(self.section)),
             ("WrOutstanding", i64::from(self.wr_outstanding)),
             ("IdW", i64::from(self.id_w)),
+            ("Window", i64::from(self.window)),
+            ("WinOutstanding", i64::from(self.win_outstanding)),
         ]);
         out
     }

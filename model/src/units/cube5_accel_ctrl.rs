@@ -46,6 +46,10 @@ pub struct AccelCtrlConfig {
     pub pixel_bytes: u32,
     /// Bits of the writer's `len` field.
     pub len_w: u32,
+    /// `Window`: 1 when the top has the frame's compositing window; the row commands then go out
+    /// from the frame's start (the top writes the rows with the initial coxel's code before the
+    /// final pixels), not after the last section. Each port's commands are the same.
+    pub window: u32,
 }
 
 impl AccelCtrlConfig {
@@ -59,6 +63,7 @@ impl AccelCtrlConfig {
         data_w: 64,
         pixel_bytes: 4,
         len_w: 16,
+        window: 0,
     };
 
     /// P, MaxDim, BlockDim, AddrW and DataW have the fetch's ranges, Section the section
@@ -96,6 +101,9 @@ impl AccelCtrlConfig {
                 "LenW {} outside m + 2 ..= 32 (a row is up to 2 MaxDim pixels)",
                 self.len_w
             ));
+        }
+        if self.window > 1 {
+            return bad(format!("Window {} is not 0 or 1", self.window));
         }
         Ok(())
     }
@@ -399,6 +407,7 @@ crate::unit_config!(AccelCtrlConfig, "cube5_accel_ctrl", DEFAULT, {
     "DataW" => data_w,
     "PixelBytes" => pixel_bytes,
     "LenW" => len_w,
+    "Window" => window,
 });
 
 /// The registers the core latches on `Ctrl.start` (words as the host wrote them; bases 64-bit).

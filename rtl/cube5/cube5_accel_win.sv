@@ -1,0 +1,385 @@
+// cube5_accel_win: the compositing window's memory traffic in the accelerator top (cube5_accel
+// Window = 1; docs/accel.md, *The compositing window in the top*). It turns cube5_frame's window
+// streams into AXI4 transactions on the top's port, with IDs of its own:
+//
+//   park_* (key {Q, R}, stored coxel) ─► one write burst of Cx bytes (ID IdPark) at
+//                                        ParkBase + (Q Wp + R) Cx
+//   fin_*  (key of lane 0, mask, P coxels) ─► codes, then single-beat writes (ID IdFin) of the
+//                                        beats the P pixels at ImgBase + Q pitch + 4 R touch,
+//                                        WSTRB from the mask (R need not be a multiple of P)
+//   rq_*   (key) ─► a read burst of Cx bytes (ID IdRs) at the park address; its beats come back
+//   rs_*   ◄──────  as the restored coxel, in request order
+//
+// Cx = max(StoreW bits rounded up to a power-of-two byte count, DataW / 8): a coxel slot is whole
+// bus beats at a slot-aligned address (no burst crosses 4 KB). Ordering: a final pixel of row Q
+// waits until row Q's clear (the top's row writes of the initial coxel's code) has completed
+// (rows_done_i > Q); a restore read waits until every park taken before its request has its B
+// response (the frame requests a section's restores only after the earlier sections' parks left
+// its park FIFO, so those are the parks the restore may read). Parks go before finals. At most
+// Outstanding write bursts and Outstanding restore reads are in flight.
+module cube5_accel_win #(
+  parameter int unsigned P           = 4,
+  /// Bits of a key coordinate (log2(MaxDim) + 1).
+  parameter int unsigned DimW        = 7,
+  parameter int unsigned AddrW       = 32,
+  parameter int unsigned DataW       = 64,
+  parameter int unsigned IdW         = 4,
+  /// The frame's stored coxel: {terminated, A, B, G, R}, AccW + 1 bits per channel.
+  parameter int unsigned AccW        = 20,
+  parameter int unsigned ColorW      = 8,
+  /// Write bursts in flight, and restore reads in flight.
+  parameter int unsigned Outstanding = 16
+) (
+  input  logic clk_i,
+  input  logic rst_ni,
+
+  /// The frame's set-up (held while it runs): ImgBase, bytes per image row, ParkBase, pixels
+  /// per row as written (Wp), and the rows of the image already cleared.
+  input  logic [AddrW-1:0] img_base_i,
+  input  logic [AddrW-1:0] row_step_i,
+  input  logic [AddrW-1:0] park_base_i,
+  input  logic [DimW:0]    row_pixels_i,
+  input  logic [DimW:0]    rows_done_i,
+
+  // ---- the frame's window streams ----
+  input  logic park_valid_i,
+  output logic park_ready_o,
+  input  logic [2*DimW-1:0] park_key_i,
+  input  logic [4*(AccW+1):0] park_cox_i,
+  input  logic fin_valid_i,
+  output logic fin_ready_o,
+  input  logic [2*DimW-1:0] fin_key_i,
+  input  logic [P-1:0] fin_mask_i,
+  input  logic [P*(4*(AccW+1)+1)-1:0] fin_cox_i,
+  input  logic rq_valid_i,
+  output logic rq_ready_o,
+  input  logic [2*DimW-1:0] rq_key_i,
+  output logic rs_valid_o,
+  input  logic rs_ready_i,
+  output logic [4*(AccW+1):0] rs_cox_o,
+
+  // ---- AXI4: AW, W, B (B of IDs IdPark and IdFin only), AR, R (R of ID IdRs only) ----
+  output logic [AddrW-1:0]   awaddr_o,
+  output logic [7:0]         awlen_o,
+  output logic [IdW-1:0]     awid_o,
+  output logic               awvalid_o,
+  input  logic               awready_i,
+  output logic [DataW-1:0]   wdata_o,
+  output logic [DataW/8-1:0] wstrb_o,
+  output logic               wlast_o,
+  output logic               wvalid_o,
+  input  logic               wready_i,
+  input  logic               bvalid_i,
+  input  logic [IdW-1:0]     bid_i,
+  input  logic [1:0]         bresp_i,
+  output logic [AddrW-1:0]   araddr_o,
+  output logic [7:0]         arlen_o,
+  output logic               arvalid_o,
+  input  logic               arready_i,
+  input  logic               rvalid_i,
+  input  logic [DataW-1:0]   rdata_i,
+  input  logic [1:0]         rresp_i,
+  input  logic               rlast_i,
+  output logic               rready_o,
+
+  /// Nothing taken and not yet written, no burst in flight: the window's traffic has drained.
+  output logic idle_o,
+  /// Sticky: a B or R response of this unit was not OKAY.
+  output logic err_o
+);
+
+  localparam int unsigned ChanW    = AccW + 1;
+  localparam int unsigned StoreW   = 4 * ChanW + 1;
+  localparam int unsigned KeyW     = 2 * DimW;
+  localparam int unsigned Bbus     = DataW / 8;
+  localparam int unsigned LogBus   = $clog2(Bbus);
+  localparam int unsigned StoreLog = $clog2((StoreW + 7) / 8);
+  localparam int unsigned CxLog    = (StoreLog > LogBus) ? StoreLog : LogBus;
+  localparam int unsigned PkBeats  = (1 << CxLog) / Bbus;       // beats of a coxel slot
+  localparam int unsigned PixW     = 32;
+  localparam int unsigned FinBytes = 4 * P;
+  localparam int unsigned FinBeats = (Bbus - 4 + FinBytes + Bbus - 1) / Bbus;
+  localparam int unsigned LineBeats = (FinBeats > PkBeats) ? FinBeats : PkBeats;
+  localparam int unsigned LineW    = LineBeats * DataW;
+  localparam int unsigned TW       = $clog2(LineBeats + 1);
+  localparam int unsigned OutW     = $clog2(Outstanding + 1);
+  localparam int unsigned TagW     = 16;
+  localparam int unsigned AwW      = IdW + 8 + AddrW;
+  localparam int unsigned WW       = 1 + Bbus + DataW;
+  localparam logic [IdW-1:0] IdPark = IdW'(1);
+  localparam logic [IdW-1:0] IdFin  = IdW'(2);
+
+  if (IdW < 2) begin : gen_bad_id
+    $fatal(1, "cube5_accel_win: IdW must be at least 2 (IDs 1 and 2 are the window's)");
+  end
+  if (DataW < 32 || ColorW > 8) begin : gen_bad_width
+    $fatal(1, "cube5_accel_win: DataW must be at least 32 and ColorW at most 8");
+  end
+
+  // The park slot of a key: ParkBase (slot-aligned) + (Q Wp + R) Cx.
+  function automatic logic [AddrW-1:0] slot_of(logic [KeyW-1:0] key);
+    logic [AddrW-1:0] idx;
+    idx = AddrW'(key[DimW +: DimW]) * AddrW'(row_pixels_i) + AddrW'(key[0 +: DimW]);
+    slot_of = (park_base_i & ~AddrW'((1 << CxLog) - 1)) + (idx << CxLog);
+  endfunction
+
+  // ---------------------------------------------------------------------------
+  // Stage 1: the next item (a park before a final; a final once its row is cleared).
+  // ---------------------------------------------------------------------------
+  logic               s1_v_q, s1_park_q;
+  logic [KeyW-1:0]    s1_key_q;
+  logic [P-1:0]       s1_mask_q;
+  logic [P*StoreW-1:0] s1_cox_q;
+  logic               s1_ready, take_park, take_fin, s2_take;
+
+  assign s1_ready     = !s1_v_q || s2_take;
+  assign take_park    = park_valid_i && s1_ready;
+  assign take_fin     = fin_valid_i && !park_valid_i && s1_ready
+                        && (DimW + 1)'(fin_key_i[DimW +: DimW]) < rows_done_i;
+  assign park_ready_o = take_park;
+  assign fin_ready_o  = take_fin;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      s1_v_q <= 1'b0;
+    end else if (s1_ready) begin
+      s1_v_q <= take_park || take_fin;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (take_park) begin
+      s1_park_q <= 1'b1;
+      s1_key_q  <= park_key_i;
+      s1_mask_q <= P'(1);
+      s1_cox_q  <= (P*StoreW)'(park_cox_i);
+    end else if (take_fin) begin
+      s1_park_q <= 1'b0;
+      s1_key_q  <= fin_key_i;
+      s1_mask_q <= fin_mask_i;
+      s1_cox_q  <= fin_cox_i;
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stage 2: the burst's address and its beats (data and strobes, LineBeats bus beats).
+  // ---------------------------------------------------------------------------
+  logic               s2_v_q, s2_park_q, s3_done;
+  logic [AddrW-1:0]   s2_addr_q, s2_addr;
+  logic [LineW-1:0]   s2_line_q, s2_line;
+  logic [LineW/8-1:0] s2_strb_q, s2_strb;
+  logic [P*PixW-1:0]  pix;
+  logic [FinBytes-1:0] pix_strb;
+  logic [AddrW-1:0]   fin_addr;
+
+  // Each channel's pixel code: min(2^ColorW - 1, (c (2^ColorW - 1) + 2^(AccW - 1)) >> AccW)
+  // (docs/numerics/warp.md, "Base-plane codes"), as the read-out's in cube5_accel.
+  for (genvar k = 0; k < P; k++) begin : gen_pix
+    for (genvar c = 0; c < 4; c++) begin : gen_code
+      logic [ChanW-1:0]           chan;
+      logic [ChanW+ColorW:0]      scaled;
+      logic [ChanW+ColorW-AccW:0] code;
+      logic                       unused_low;
+      assign chan   = s1_cox_q[k*StoreW + c*ChanW +: ChanW];
+      assign scaled = ((ChanW+ColorW+1)'(chan) << ColorW) - (ChanW+ColorW+1)'(chan)
+                      + ((ChanW+ColorW+1)'(1) << (AccW - 1));
+      assign code   = scaled[ChanW+ColorW:AccW];
+      assign unused_low = ^scaled[AccW-1:0];
+      assign pix[k*PixW + 8*c +: 8] = 8'(code > (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1)
+                                         ? (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1) : code);
+    end
+    assign pix_strb[4*k +: 4] = {4{s1_mask_q[k]}};
+  end
+
+  assign fin_addr = img_base_i + AddrW'(s1_key_q[DimW +: DimW]) * row_step_i
+                    + (AddrW'(s1_key_q[0 +: DimW]) << 2);
+
+  always_comb begin
+    if (s1_park_q) begin
+      s2_addr = slot_of(s1_key_q);
+      s2_line = LineW'(s1_cox_q[StoreW-1:0]);
+      s2_strb = (LineW/8)'({PkBeats*Bbus{1'b1}});
+    end else begin
+      s2_addr = fin_addr & ~AddrW'(Bbus - 1);
+      s2_line = LineW'(pix) << (8 * fin_addr[LogBus-1:0]);
+      s2_strb = (LineW/8)'(pix_strb) << fin_addr[LogBus-1:0];
+    end
+  end
+
+  assign s2_take = s1_v_q && (!s2_v_q || s3_done);
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      s2_v_q <= 1'b0;
+    end else if (s2_take) begin
+      s2_v_q <= 1'b1;
+    end else if (s3_done) begin
+      s2_v_q <= 1'b0;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (s2_take) begin
+      s2_park_q <= s1_park_q;
+      s2_addr_q <= s2_addr;
+      s2_line_q <= s2_line;
+      s2_strb_q <= s2_strb;
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Stage 3: one beat per cycle into the W FIFO, and a burst's address into the AW FIFO (a park:
+  // one burst of PkBeats beats; a final: one single-beat burst per beat with a strobe set).
+  // ---------------------------------------------------------------------------
+  logic [TW-1:0]      t_q;
+  logic [DataW-1:0]   beat;
+  logic [Bbus-1:0]    beat_strb;
+  logic               t_last, need_aw, push_w, push_aw, can, step;
+  logic               aw_full, aw_empty, w_full, w_empty, aw_pop, w_pop;
+  logic [OutW-1:0]    out_q;      // write bursts in the AW FIFO or in flight, B not yet in
+  logic               b_fire;
+
+  always_comb begin
+    beat      = s2_line_q[0 +: DataW];
+    beat_strb = s2_strb_q[0 +: Bbus];
+    for (int unsigned n = 1; n < LineBeats; n++) begin
+      if (t_q == TW'(n)) begin
+        beat      = s2_line_q[n*DataW +: DataW];
+        beat_strb = s2_strb_q[n*Bbus +: Bbus];
+      end
+    end
+  end
+
+  assign t_last  = s2_park_q ? (t_q == TW'(PkBeats - 1)) : (t_q == TW'(FinBeats - 1));
+  assign need_aw = s2_park_q ? (t_q == '0) : |beat_strb;
+  assign push_w  = s2_park_q || |beat_strb;
+  assign can     = (!need_aw || (!aw_full && out_q < OutW'(Outstanding))) && (!push_w || !w_full);
+  assign step    = s2_v_q && can;
+  assign push_aw = step && need_aw;
+  assign s3_done = step && t_last;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      t_q <= '0;
+    end else if (step) begin
+      t_q <= t_last ? '0 : t_q + TW'(1);
+    end
+  end
+
+  logic [AwW-1:0] aw_d, aw_q;
+  logic [WW-1:0]  w_d, w_q;
+  assign aw_d = s2_park_q ? {IdPark, 8'(PkBeats - 1), s2_addr_q}
+                          : {IdFin, 8'd0, s2_addr_q + (AddrW'(t_q) << LogBus)};
+  assign w_d  = {s2_park_q ? t_last : 1'b1, s2_park_q ? {Bbus{1'b1}} : beat_strb, beat};
+
+  cube5_frame_fifo #(.Width(AwW), .Depth(8)) u_aw (
+    .clk_i, .rst_ni, .clear_i(1'b0),
+    .push_i(push_aw), .d_i(aw_d), .pop_i(aw_pop), .q_o(aw_q), .empty_o(aw_empty), .full_o(aw_full)
+  );
+  cube5_frame_fifo #(.Width(WW), .Depth(8)) u_w (
+    .clk_i, .rst_ni, .clear_i(1'b0),
+    .push_i(step && push_w), .d_i(w_d), .pop_i(w_pop), .q_o(w_q), .empty_o(w_empty), .full_o(w_full)
+  );
+
+  assign {awid_o, awlen_o, awaddr_o} = aw_q;
+  assign awvalid_o = !aw_empty;
+  assign aw_pop    = awvalid_o && awready_i;
+  assign {wlast_o, wstrb_o, wdata_o} = w_q;
+  assign wvalid_o  = !w_empty;
+  assign w_pop     = wvalid_o && wready_i;
+  assign b_fire    = bvalid_i;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      out_q <= '0;
+    end else begin
+      out_q <= out_q + OutW'(push_aw) - OutW'(b_fire);
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Restores: the request's slot (tagged with the parks taken so far), a read of Cx bytes once
+  // those parks are all written; the beats assembled into the restored coxel.
+  // ---------------------------------------------------------------------------
+  logic [TagW-1:0]  ptaken_q, pdone_q, rq_tag_q;
+  logic             rq_v_q, ar_fire, r_fire;
+  logic [AddrW-1:0] rq_addr_q;
+  logic [OutW-1:0]  rs_out_q;     // restore reads in flight
+  logic             rs_v_q;
+  logic [PkBeats*DataW-1:0] rs_q;
+  logic signed [TagW-1:0]   behind;
+
+  assign behind     = $signed(pdone_q - rq_tag_q);
+  assign arvalid_o  = rq_v_q && behind >= 0 && rs_out_q < OutW'(Outstanding);
+  assign araddr_o   = rq_addr_q;
+  assign arlen_o    = 8'(PkBeats - 1);
+  assign ar_fire    = arvalid_o && arready_i;
+  assign rq_ready_o = !rq_v_q || ar_fire;
+  assign rready_o   = !rs_v_q;
+  assign r_fire     = rvalid_i && rready_o;
+  assign rs_valid_o = rs_v_q;
+  assign rs_cox_o   = rs_q[StoreW-1:0];
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      ptaken_q <= '0;
+      pdone_q  <= '0;
+      rq_v_q   <= 1'b0;
+      rs_out_q <= '0;
+      rs_v_q   <= 1'b0;
+    end else begin
+      ptaken_q <= ptaken_q + TagW'(take_park);
+      pdone_q  <= pdone_q + TagW'(b_fire && bid_i == IdPark);
+      if (rq_valid_i && rq_ready_o) rq_v_q <= 1'b1;
+      else if (ar_fire)             rq_v_q <= 1'b0;
+      rs_out_q <= rs_out_q + OutW'(ar_fire) - OutW'(r_fire && rlast_i);
+      if (r_fire && rlast_i)        rs_v_q <= 1'b1;
+      else if (rs_v_q && rs_ready_i) rs_v_q <= 1'b0;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (rq_valid_i && rq_ready_o) begin
+      rq_addr_q <= slot_of(rq_key_i);
+      rq_tag_q  <= ptaken_q + TagW'(take_park);
+    end
+  end
+
+  if (PkBeats > 1) begin : gen_rs_beats
+    always_ff @(posedge clk_i) begin
+      if (r_fire) rs_q <= {rdata_i, rs_q[PkBeats*DataW-1:DataW]};
+    end
+  end else begin : gen_rs_beat
+    always_ff @(posedge clk_i) begin
+      if (r_fire) rs_q <= rdata_i;
+    end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Drained, errors
+  // ---------------------------------------------------------------------------
+  logic err_q;
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      err_q <= 1'b0;
+    end else if ((b_fire && bresp_i != 2'b00) || (r_fire && rresp_i != 2'b00)) begin
+      err_q <= 1'b1;
+    end
+  end
+  assign err_o  = err_q;
+  assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && !rq_v_q
+                  && rs_out_q == '0 && !rs_v_q;
+
+  // The terminated flags of the final lanes (a pixel is R, G, B, A only).
+  logic [P-1:0] unused_term;
+  for (genvar k = 0; k < P; k++) begin : gen_unused
+    assign unused_term[k] = s1_cox_q[k*StoreW + 4*ChanW];
+  end
+  logic unused;
+  if (PkBeats * DataW > StoreW) begin : gen_unused_pad
+    assign unused = ^{unused_term, rs_q[PkBeats*DataW-1:StoreW]};   // the slot's padding
+  end else begin : gen_unused_nopad
+    assign unused = ^unused_term;
+  end
+
+endmodule
