@@ -2,7 +2,7 @@
 CARGO ?= cargo
 DEMO_DIR ?= out
 
-.PHONY: setup demo test sim sim-full lint synth bench bench-accel bench-peer tradeoff regs fmt clippy clean clean-cache
+.PHONY: setup demo test sim sim-full lint synth synth-full bench bench-accel bench-peer tradeoff regs fmt clippy clean clean-cache
 .PHONY: cosim
 
 # The build cache of verilated and compiled RTL variants (shared by every clone on the machine).
@@ -60,6 +60,13 @@ lint:
 synth:
 	@scripts/synth.sh
 	@scripts/synth-docs.sh
+
+## synth plus the `synthfull` configurations (the 256^3 accelerator: tens of minutes of Yosys and
+## place and route, beyond CI's synthesis budget; their rows of the generated table stay as this
+## run writes them). With SYNTH_FLOWS=ecp5 SYNTH_WRITE_DOCS=1 it refreshes those rows.
+synth-full:
+	@SYNTH_FULL=1 scripts/synth.sh
+	@SYNTH_FULL=1 scripts/synth-docs.sh
 
 ## Simulation-speed figures come from RTL variants compiled at C++ -O2 (tests use -O1, which
 ## builds twice as fast; docs/ci.md). The -O2 objects are cached beside the -O1 ones.

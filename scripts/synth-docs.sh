@@ -8,10 +8,15 @@
 #                        longer in a .variants file (or flagged `sim`) are dropped. The Fmax
 #                        column is this run's place and route (configurations flagged fmax or
 #                        fmax85, SYNTH_FMAX not 0); a run that placed nothing keeps the last one.
+#                        The "fits 85k" column compares the counts with the LFE5UM-85F's 83,640
+#                        LUT4 (a CCU2C takes two), 83,640 FF, 208 DP16KD and 156 MULT18 (LUT RAM,
+#                        TRELLIS_DPR16X4, is not in the counts: place and route has the last word).
 #   SYNTH_CHECK_DOCS=1   compare this run's ECP5 counts with the block: one line per differing
 #                        configuration (top, config, column, docs value, synthesized value), a line
 #                        per block row that is no synthesized configuration; exit 1 if any. CI runs it
 #                        (SYNTH_FMAX=0: counts only); with place and route, Fmax is compared too.
+# Rows flagged `synthfull` are synthesized only with SYNTH_FULL=1 (`make synth-full`); a run
+# without it leaves their rows as they are and checks only what it synthesized.
 # Neither set: does nothing. Both need the ecp5 flow, and refuse SYNTH_SPEC (not a .variants line).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -48,11 +53,21 @@ awk -v mode="$mode" -v begin="$begin" -v end="$end" -v docs="$docs" -v out="$tmp
   function fmt(v,   a) { split(v, a, "|"); return "LUT4 " a[1] ", FF " a[2] ", CCU2C " a[3] ", MULT18 " a[4] ", DP16KD " a[5] }
   function trim(s) { gsub(/^[ \t]+|[ \t]+$/, "", s); return s }
   # row(LINE): a data row of a table with top | config | ... ; sets f[] (trimmed cells), or 0.
-  function row(line,   n, i) {
+  # nf: the cell count (f[nf] is the empty one after the last bar; f[nf - 1] is Fmax).
+  function row(line,   i) {
     if (line !~ /^\|/ || line ~ /^\|[-| :]*$/) return 0
-    n = split(line, f, "|")
-    for (i = 1; i <= n; i++) f[i] = trim(f[i])
+    nf = split(line, f, "|")
+    for (i = 1; i <= nf; i++) f[i] = trim(f[i])
     return f[2] != "top"
+  }
+  # fits(COUNTS): LUT4|FF|CCU2C|MULT18|DP16KD against the LFE5UM-85F: "yes", or what is over.
+  function fits(v,   a, m) {
+    split(v, a, "|"); m = ""
+    if (a[1] + 2 * a[3] > 83640) m = m sprintf("%sLUT4 %d > 83640", m == "" ? "" : ", ", a[1] + 2 * a[3])
+    if (a[2] > 83640) m = m sprintf("%sFF %d > 83640", m == "" ? "" : ", ", a[2])
+    if (a[4] > 156) m = m sprintf("%sMULT18 %d > 156", m == "" ? "" : ", ", a[4])
+    if (a[5] > 208) m = m sprintf("%sDP16KD %d > 208", m == "" ? "" : ", ", a[5])
+    return m == "" ? "yes" : "no: " m
   }
   FNR == 1 { file++ }
   file == 1 {
@@ -74,7 +89,7 @@ awk -v mode="$mode" -v begin="$begin" -v end="$end" -v docs="$docs" -v out="$tmp
     else if ($0 == end) inblock = 0
     else if (inblock && row($0)) {
       doc[f[2] " " f[3]] = f[4] "|" f[5] "|" f[6] "|" f[7] "|" f[8]
-      if (f[9] ~ /^[0-9.]+$/) docf[f[2] " " f[3]] = f[9]
+      if (f[nf - 1] ~ /^[0-9.]+$/) docf[f[2] " " f[3]] = f[nf - 1]
     }
   }
   END {
@@ -100,16 +115,16 @@ awk -v mode="$mode" -v begin="$begin" -v end="$end" -v docs="$docs" -v out="$tmp
     }
     for (i = 1; i <= nl; i++) {
       if (lines[i] == end) {
-        print "| top | config | ECP5 LUT4 | ECP5 FF | ECP5 CCU2C | ECP5 MULT18 | ECP5 DP16KD | ECP5 Fmax (MHz) |" > out
-        print "|-----|--------|----------:|--------:|-----------:|------------:|------------:|----------------:|" > out
+        print "| top | config | ECP5 LUT4 | ECP5 FF | ECP5 CCU2C | ECP5 MULT18 | ECP5 DP16KD | fits 85k | ECP5 Fmax (MHz) |" > out
+        print "|-----|--------|----------:|--------:|-----------:|------------:|------------:|----------|----------------:|" > out
         for (j = 1; j <= n; j++) {
           k = order[j]; v = (k in run) ? run[k] : (k in doc) ? doc[k] : ""
           if (v == "") continue
           # Fmax: the place and route of this run, else the last one written (kept while SYNTH_FMAX=0
           # runs, which place nothing); "-" for a configuration not flagged fmax/fmax85.
           fm = !(k in placed) ? "-" : (k in runf) ? runf[k] : (k in docf) ? docf[k] : "not placed yet"
-          split(k, t, " "); gsub(/\|/, " | ", v)
-          print "| " t[1] " | " t[2] " | " v " | " fm " |" > out
+          ft = fits(v); split(k, t, " "); gsub(/\|/, " | ", v)
+          print "| " t[1] " | " t[2] " | " v " | " ft " | " fm " |" > out
         }
         skip = 0
       }

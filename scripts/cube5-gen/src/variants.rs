@@ -8,7 +8,9 @@
 //! (`make synth` places and routes it on the ECP5 25k / 85k part), `ooc` (with `fmax`/`fmax85`:
 //! placed out of context, without I/O pads, for a unit whose ports outnumber the package's pins;
 //! inside a design they are internal nets), `sim` (simulation only: left out of `make synth`),
-//! `bram` (synthesized by the ECP5 flow alone).
+//! `bram` (synthesized by the ECP5 flow alone), `synthfull` (synthesized only by `make synth-full`:
+//! minutes of Yosys and place and route beyond CI's synthesis budget; its row of the generated
+//! table in docs/measurements.md stays as the full run wrote it).
 //!
 //! A filelist holds one path per line, relative to the repository, `//` comments, and `-f
 //! other.f` lines that include another top's filelist (a file named twice is kept once, at its
@@ -24,9 +26,18 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 /// The flags a `.variants` line may carry. `full`: a configuration only the runs too long for CI
-/// use (`make sim-full`); the test bench builds it only when `CUBE5_FULL=1`.
+/// use (`make sim-full`); the test bench builds it only when `CUBE5_FULL=1`. `synthfull`: the
+/// synthesis counterpart, a configuration `make synth` skips unless `SYNTH_FULL=1` (`make synth-full`).
 pub const FLAGS: &[&str] = &[
-    "gate", "mutant", "fmax", "fmax85", "ooc", "sim", "bram", "full",
+    "gate",
+    "mutant",
+    "fmax",
+    "fmax85",
+    "ooc",
+    "sim",
+    "bram",
+    "full",
+    "synthfull",
 ];
 
 /// Words allowed as the leading token of a variant name (schemes that no single parameter
