@@ -3,7 +3,7 @@
 
 mod support;
 
-use support::{assert_refused, cube5, scratch, scratch_file, succeeded};
+use support::{assert_refused, cube5, scratch_file, succeeded};
 
 fn scene_path(name: &str) -> String {
     cube5_model::repo_root()
@@ -89,7 +89,7 @@ fn elaborate_refuses_naming_the_field() {
 #[test]
 fn cosim_runs_a_mip_scene_on_the_frame_without_gradient_and_shader() {
     let scene = scratch_file("elab-mip.toml", "[volume]\nphantom = \"head\"\nsize = 16\n[render]\nmode = \"mip\"\n[image]\nwidth = 32\nheight = 32\n");
-    let dir = scratch("elab-mip-out");
+    let dir = support::scratch("elab-mip-out");
     let out = stdout_of(&[
         "cosim",
         scene.to_str().unwrap(),
