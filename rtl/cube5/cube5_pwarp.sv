@@ -45,7 +45,6 @@ module cube5_pwarp #(
   localparam int unsigned CoordW  = cube5_warp_pkg::CoordW;
   localparam int unsigned CodeW   = cube5_warp_pkg::OutCodeW;
   localparam int unsigned KF      = cube5_pwarp_pkg::SlopeFracW;
-  localparam int unsigned B       = $clog2(MaxBase);
   localparam int unsigned O       = $clog2(MaxOut);
   localparam int unsigned TexW    = 3 * ColorW;
   localparam int unsigned MetaW   = 2 * O + 1;
@@ -53,6 +52,11 @@ module cube5_pwarp #(
   // ColorW, WeightW and MaxBase are checked by cube5_warp_sample.
   if (MaxOut < 4 || MaxOut > 2048 || (1 << O) != MaxOut) begin : gen_bad_max_out
     $fatal(1, "cube5_pwarp: MaxOut must be a power of two in 4..2048 (U0, V0, N fit a payload)");
+  end
+  // BaseW and BaseH are kept by cube5_warp_sample at cube5_warp's offsets.
+  if (cube5_pwarp_pkg::RegBaseW != cube5_warp_pkg::RegBaseW
+      || cube5_pwarp_pkg::RegBaseH != cube5_warp_pkg::RegBaseH) begin : gen_bad_base_regs
+    $fatal(1, "cube5_pwarp: BaseW and BaseH must sit at cube5_warp's offsets");
   end
 
   // ---------------------------------------------------------------------------------------------
@@ -96,15 +100,12 @@ module cube5_pwarp #(
   assign is_texel = in_fire && (op == cube5_pwarp_pkg::OpTexel);
   assign is_line  = in_fire && (op == cube5_pwarp_pkg::OpLine);
 
-  logic [B:0]        base_w_q, base_w_d, base_h_q, base_h_d;
   logic [KF:0]       slope_q, slope_d;
   logic              neg_q, neg_d, tr_q, tr_d;
   logic [CoordW-1:0] xr_q, xr_d, yr_q, yr_d, xsr_q, xsr_d, ysr_q, ysr_d;
   logic [KF-1:0]     phr_q, phr_d;
 
   always_comb begin
-    base_w_d = base_w_q;
-    base_h_d = base_h_q;
     slope_d  = slope_q;
     neg_d    = neg_q;
     tr_d     = tr_q;
@@ -114,8 +115,6 @@ module cube5_pwarp #(
     ysr_d    = ysr_q;
     phr_d    = phr_q;
     if (is_write) begin
-      if (addr == AddrW'(cube5_pwarp_pkg::RegBaseW)) base_w_d = payload[B:0];
-      if (addr == AddrW'(cube5_pwarp_pkg::RegBaseH)) base_h_d = payload[B:0];
       if (addr == AddrW'(cube5_pwarp_pkg::RegSlope)) slope_d  = payload[KF:0];
       if (addr == AddrW'(cube5_pwarp_pkg::RegMode)) begin
         neg_d = payload[cube5_pwarp_pkg::RegModeNegLsb];
@@ -192,8 +191,8 @@ module cube5_pwarp #(
     .issue_i       (issue),
     .x_i           (xcur_q),
     .y_i           (ycur_q),
-    .base_w_i      (base_w_q),
-    .base_h_i      (base_h_q),
+    .reg_wr_i      (is_write),
+    .reg_addr_i    (addr),
     .meta_i        (meta_in),
     .tex_i         (is_texel),
     .tex_restart_i (is_write || is_line),
@@ -211,8 +210,6 @@ module cube5_pwarp #(
     if (!rst_ni) begin
       busy_q   <= 1'b0;
       cnt_q    <= '0;
-      base_w_q <= '0;
-      base_h_q <= '0;
       slope_q  <= '0;
       neg_q    <= 1'b0;
       tr_q     <= 1'b0;
@@ -224,8 +221,6 @@ module cube5_pwarp #(
     end else begin
       busy_q   <= busy_d;
       cnt_q    <= cnt_d;
-      base_w_q <= base_w_d;
-      base_h_q <= base_h_d;
       slope_q  <= slope_d;
       neg_q    <= neg_d;
       tr_q     <= tr_d;

@@ -41,7 +41,6 @@ module cube5_warp #(
   localparam int unsigned AddrW   = cube5_warp_pkg::RegAddrW;
   localparam int unsigned CoordW  = cube5_warp_pkg::CoordW;
   localparam int unsigned CodeW   = cube5_warp_pkg::OutCodeW;
-  localparam int unsigned B       = $clog2(MaxBase);
   localparam int unsigned O       = $clog2(MaxOut);
   localparam int unsigned TexW    = 3 * ColorW;
 
@@ -71,14 +70,11 @@ module cube5_warp #(
   assign is_texel = in_fire && (op == cube5_warp_pkg::OpTexel);
   assign is_go    = in_fire && (op == cube5_warp_pkg::OpGo);
 
-  logic [B:0]        base_w_q, base_w_d, base_h_q, base_h_d;
   logic [O:0]        out_w_q, out_w_d, out_h_q, out_h_d;
   logic [CoordW-1:0] x0_q, x0_d, y0_q, y0_d, xpx_q, xpx_d, ypx_q, ypx_d, xpy_q, xpy_d;
   logic [CoordW-1:0] ypy_q, ypy_d;
 
   always_comb begin
-    base_w_d = base_w_q;
-    base_h_d = base_h_q;
     out_w_d  = out_w_q;
     out_h_d  = out_h_q;
     x0_d     = x0_q;
@@ -88,8 +84,6 @@ module cube5_warp #(
     xpy_d    = xpy_q;
     ypy_d    = ypy_q;
     if (is_write) begin
-      if (addr == AddrW'(cube5_warp_pkg::RegBaseW)) base_w_d = payload[B:0];
-      if (addr == AddrW'(cube5_warp_pkg::RegBaseH)) base_h_d = payload[B:0];
       if (addr == AddrW'(cube5_warp_pkg::RegOutW))  out_w_d  = payload[O:0];
       if (addr == AddrW'(cube5_warp_pkg::RegOutH))  out_h_d  = payload[O:0];
       if (addr == AddrW'(cube5_warp_pkg::RegX0))    x0_d     = payload[CoordW-1:0];
@@ -171,8 +165,8 @@ module cube5_warp #(
     .issue_i       (issue),
     .x_i           (xcur_q),
     .y_i           (ycur_q),
-    .base_w_i      (base_w_q),
-    .base_h_i      (base_h_q),
+    .reg_wr_i      (is_write),
+    .reg_addr_i    (addr),
     .meta_i        (meta_in),
     .tex_i         (is_texel),
     .tex_restart_i (is_write || is_go),
@@ -189,8 +183,6 @@ module cube5_warp #(
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
       busy_q   <= 1'b0;
-      base_w_q <= '0;
-      base_h_q <= '0;
       out_w_q  <= '0;
       out_h_q  <= '0;
       x0_q     <= '0;
@@ -201,8 +193,6 @@ module cube5_warp #(
       ypy_q    <= '0;
     end else begin
       busy_q   <= busy_d;
-      base_w_q <= base_w_d;
-      base_h_q <= base_h_d;
       out_w_q  <= out_w_d;
       out_h_q  <= out_h_d;
       x0_q     <= x0_d;

@@ -1,7 +1,8 @@
 // cube5_warp_sample: the bilinear stage of cube5_warp and cube5_pwarp (contracts
 // docs/numerics/warp.md, "Bilinear filter" and "Block RAM", and docs/numerics/pwarp.md): the base
-// plane in four block-RAM banks by texel parity, and per issued position the four taps read in one
-// clock, widened to U(0.16), three rounded lerps per channel, 8-bit RGB. `meta_i` rides along.
+// plane in four block-RAM banks by texel parity with its size registers (BaseW, BaseH) and texel
+// position, and per issued position the four taps read in one clock, widened to U(0.16), three
+// rounded lerps per channel, 8-bit RGB. `meta_i` rides along.
 //
 //   issue (x_i, y_i, bank addresses) -> [banks' output registers, S1] -> [S1r] -> taps by parity,
 //   widening [S2] -> two lerps along x [S3] -> lerp along y [S4] -> 8-bit rounding [S5] -> out
@@ -29,15 +30,17 @@ module cube5_warp_sample #(
   /// The position, S(15.20) base-plane texels.
   input  logic [cube5_warp_pkg::CoordW-1:0]     x_i,
   input  logic [cube5_warp_pkg::CoordW-1:0]     y_i,
-  /// Base-plane size: taps outside it read 0.
-  input  logic [$clog2(MaxBase):0]              base_w_i,
-  input  logic [$clog2(MaxBase):0]              base_h_i,
+  /// A register write (`wdata_i` to offset `reg_addr_i`): BaseW and BaseH, the base plane's size,
+  /// are kept here (taps outside it read 0); both warps' maps place them at the same offsets.
+  input  logic                                  reg_wr_i,
+  input  logic [cube5_warp_pkg::RegAddrW-1:0]   reg_addr_i,
   /// Carried with the position to the output.
   input  logic [MetaW-1:0]                      meta_i,
 
   /// Texel items: `tex_i` stores codes R, G, B (ColorW each, LSB first) at the texel position
-  /// (raster order over base_w_i; y held at MaxBase once it gets there, and nothing stored) and
-  /// advances it; `tex_restart_i` puts the position back to (0, 0).
+  /// (raster order over BaseW; y held at MaxBase once it gets there, and nothing stored) and
+  /// advances it; `tex_restart_i` puts the position back to (0, 0). `wdata_i` is also a register
+  /// write's data (BaseW and BaseH in its low bits).
   input  logic                                  tex_i,
   input  logic                                  tex_restart_i,
   input  logic [3*ColorW-1:0]                   wdata_i,
@@ -74,6 +77,29 @@ module cube5_warp_sample #(
   end
 
   // ---------------------------------------------------------------------------------------------
+  // The base plane's size (BaseW, BaseH)
+  // ---------------------------------------------------------------------------------------------
+
+  logic [B:0] base_w_q, base_w_d, base_h_q, base_h_d;
+
+  always_comb begin
+    base_w_d = base_w_q;
+    base_h_d = base_h_q;
+    if (reg_wr_i && 32'(reg_addr_i) == cube5_warp_pkg::RegBaseW) base_w_d = wdata_i[B:0];
+    if (reg_wr_i && 32'(reg_addr_i) == cube5_warp_pkg::RegBaseH) base_h_d = wdata_i[B:0];
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      base_w_q <= '0;
+      base_h_q <= '0;
+    end else begin
+      base_w_q <= base_w_d;
+      base_h_q <= base_h_d;
+    end
+  end
+
+  // ---------------------------------------------------------------------------------------------
   // Issue: integer parts, weights, taps
   // ---------------------------------------------------------------------------------------------
 
@@ -102,10 +128,10 @@ module cube5_warp_sample #(
 
   // Inside the base plane: 0 <= c < Base(W|H) and c < MaxBase.
   logic in_x0, in_x1, in_y0, in_y1;
-  assign in_x0 = !xc0[IntW] && (xc0[IntW-1:B] == '0) && ({1'b0, xc0[B-1:0]} < base_w_i);
-  assign in_x1 = !xc1[IntW] && (xc1[IntW-1:B] == '0) && ({1'b0, xc1[B-1:0]} < base_w_i);
-  assign in_y0 = !yc0[IntW] && (yc0[IntW-1:B] == '0) && ({1'b0, yc0[B-1:0]} < base_h_i);
-  assign in_y1 = !yc1[IntW] && (yc1[IntW-1:B] == '0) && ({1'b0, yc1[B-1:0]} < base_h_i);
+  assign in_x0 = !xc0[IntW] && (xc0[IntW-1:B] == '0) && ({1'b0, xc0[B-1:0]} < base_w_q);
+  assign in_x1 = !xc1[IntW] && (xc1[IntW-1:B] == '0) && ({1'b0, xc1[B-1:0]} < base_w_q);
+  assign in_y0 = !yc0[IntW] && (yc0[IntW-1:B] == '0) && ({1'b0, yc0[B-1:0]} < base_h_q);
+  assign in_y1 = !yc1[IntW] && (yc1[IntW-1:B] == '0) && ({1'b0, yc1[B-1:0]} < base_h_q);
 
   logic [3:0]        tap_in;         // by bank {row parity, column parity}
   logic [4*BankAW-1:0] raddr;     // bank k at [k*BankAW +: BankAW]
@@ -133,7 +159,7 @@ module cube5_warp_sample #(
       tx_d = '0;
       ty_d = '0;
     end else if (tex_i) begin
-      if ((tx_q + (B+1)'(1)) >= base_w_i) begin
+      if ((tx_q + (B+1)'(1)) >= base_w_q) begin
         tx_d = '0;
         ty_d = ty_q[B] ? ty_q : ty_q + (B+1)'(1);
       end else begin
