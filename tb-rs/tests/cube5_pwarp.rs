@@ -36,12 +36,7 @@ struct Frame {
 
 impl WarpFrame for Frame {
     type Cfg = PwarpConfig;
-    type Gold = Pwarp;
     const OUT: &'static str = "sample";
-
-    fn gold(cfg: PwarpConfig) -> Pwarp {
-        Pwarp::new(cfg).unwrap()
-    }
 
     fn items(&self, cfg: &PwarpConfig) -> Vec<PwarpIn> {
         let mut items = frame_items(cfg, &self.setup, &self.base);

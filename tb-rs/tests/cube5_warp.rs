@@ -34,12 +34,7 @@ struct Frame {
 
 impl WarpFrame for Frame {
     type Cfg = WarpConfig;
-    type Gold = Warp;
     const OUT: &'static str = "pixel";
-
-    fn gold(cfg: WarpConfig) -> Warp {
-        Warp::new(cfg).unwrap()
-    }
 
     fn items(&self, cfg: &WarpConfig) -> Vec<WarpIn> {
         let mut items = frame_items(cfg, &self.regs, &self.base);

@@ -15,10 +15,9 @@ use crate::regs::cube5_pwarp::{
 };
 use crate::regs::cube5_warp::{COORD_FRAC_W, COORD_LIMIT, COORD_W, OUT_CODE_W, REG_ADDR_W};
 use crate::render::ImageF64;
-use crate::unit::{StreamCodec, StreamUnit};
+use crate::unit::StreamCodec;
 use crate::units::cube5_warp::{
-    bilinear_f64, pixel_at, run_items, BaseCodes, BaseColorW, TexelMem, WarpConfig, WarpIn,
-    WarpItems,
+    bilinear_f64, pixel_at, BaseCodes, WarpConfig, WarpIn, WarpKind, WarpUnit,
 };
 use std::collections::HashSet;
 
@@ -54,16 +53,6 @@ impl PwarpConfig {
         self.sampler()
             .validate()
             .map_err(|e| ModelError::Config(e.to_string().replace("cube5_warp", "cube5_pwarp")))
-    }
-
-    /// The filter's configuration: `cube5_warp`'s bilinear stage at the same widths.
-    pub fn sampler(&self) -> WarpConfig {
-        WarpConfig {
-            color_w: self.color_w,
-            weight_w: self.weight_w,
-            max_base: self.max_base,
-            max_out: self.max_out,
-        }
     }
 
     /// `b = log2 MaxBase`.
@@ -413,12 +402,6 @@ pub fn frame_items(cfg: &PwarpConfig, setup: &PwarpSetup, base: &BaseCodes) -> V
 /// One input item: `cube5_warp`'s (`op`, `addr`, `payload`), whose op 2 is `Line` here.
 pub type PwarpIn = WarpIn;
 
-impl BaseColorW for PwarpConfig {
-    fn color_w(&self) -> u32 {
-        self.color_w
-    }
-}
-
 impl WarpIn {
     /// `Line` with `U0`, `V0` (`o` bits each) and `N` (`o + 1` bits), LSB first.
     pub fn line(cfg: &PwarpConfig, u0: u32, v0: u32, n: u32) -> Self {
@@ -652,42 +635,35 @@ pub fn read_counts(setup: &PwarpSetup) -> ReadCounts {
     counts
 }
 
-/// The golden model of `cube5_pwarp` as a stream unit: registers, the block RAM's base plane and
-/// the texel position, driven by input items; a `Line` emits its samples.
-#[derive(Debug, Clone)]
-pub struct Pwarp {
-    cfg: PwarpConfig,
-    regs: PwarpRegs,
-    tex: TexelMem,
-}
+/// The golden model of `cube5_pwarp`: a `Line` emits its samples.
+pub type Pwarp = WarpUnit<PwarpConfig>;
 
-impl Pwarp {
-    pub fn new(cfg: PwarpConfig) -> Result<Self> {
-        cfg.validate()?;
-        Ok(Self {
-            cfg,
-            regs: PwarpRegs::default(),
-            tex: TexelMem::new(cfg.max_base),
-        })
-    }
-
-    pub fn regs(&self) -> PwarpRegs {
-        self.regs
-    }
-
-    fn stored(&self, x: i64, y: i64) -> [u32; 3] {
-        self.tex.stored(x, y, (self.regs.base_w, self.regs.base_h))
-    }
-}
-
-impl WarpItems for Pwarp {
+impl WarpKind for PwarpConfig {
+    type Regs = PwarpRegs;
     type Out = PwarpOut;
 
-    fn write(&mut self, addr: u32, data: u64) {
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+
+    /// The filter's configuration: `cube5_warp`'s bilinear stage at the same widths.
+    fn sampler(&self) -> WarpConfig {
+        WarpConfig {
+            color_w: self.color_w,
+            weight_w: self.weight_w,
+            max_base: self.max_base,
+            max_out: self.max_out,
+        }
+    }
+
+    fn base_size(regs: &PwarpRegs) -> (u32, u32) {
+        (regs.base_w, regs.base_h)
+    }
+
+    fn write(&self, r: &mut PwarpRegs, addr: u32, data: u64) {
         let field = |w: u32| (data & ((1u64 << w) - 1)) as u32;
         let coord = |d: u64| wrap(d as i64);
-        let b1 = self.cfg.base_log2() + 1;
-        let r = &mut self.regs;
+        let b1 = self.base_log2() + 1;
         match addr {
             REG_BASE_W => r.base_w = field(b1),
             REG_BASE_H => r.base_h = field(b1),
@@ -705,36 +681,18 @@ impl WarpItems for Pwarp {
         }
     }
 
-    fn store(&mut self, payload: u64) {
-        self.tex.store(payload, self.cfg.color_w, self.regs.base_w);
-    }
-
-    fn restart(&mut self) {
-        self.tex.restart();
-    }
-
     /// The samples of a `Line`: `U0`, `V0` (`o` bits each), `N` (`o + 1` bits), LSB first.
-    fn emit(&self, payload: u64, out: &mut Vec<PwarpOut>) {
-        let o = self.cfg.out_log2();
+    fn emit(
+        &self,
+        regs: &PwarpRegs,
+        payload: u64,
+        texel: impl Fn(i64, i64) -> [u32; 3],
+        out: &mut Vec<PwarpOut>,
+    ) {
+        let o = self.out_log2();
         let f = |lsb: u32, w: u32| ((payload >> lsb) & ((1u64 << w) - 1)) as u32;
         let line = (f(0, o), f(o, o), f(2 * o, o + 1));
-        line_samples(&self.cfg, &self.regs, line, |x, y| self.stored(x, y), out);
-    }
-}
-
-impl StreamUnit for Pwarp {
-    type In = PwarpIn;
-    type Out = PwarpOut;
-
-    /// Every sample of the `Line` items among `inputs`.
-    fn run(&mut self, inputs: &[PwarpIn]) -> Vec<PwarpOut> {
-        run_items(self, inputs)
-    }
-
-    /// Registers and texel position to 0; the block RAM keeps its contents (not reset).
-    fn reset(&mut self) {
-        self.regs = PwarpRegs::default();
-        self.tex.restart();
+        line_samples(self, regs, line, texel, out);
     }
 }
 
@@ -772,6 +730,7 @@ impl StreamCodec for PwarpConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::unit::StreamUnit;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

@@ -18,6 +18,7 @@ use crate::units::cube5_compos::ComposConfig;
 use crate::units::cube5_frame::{BasePlane, FrameParams};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::fmt::Debug;
 
 /// One configuration of the `cube5_warp` RTL (the parameters of the same names).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -474,8 +475,8 @@ impl WarpIn {
     }
 
     /// `Texel` with codes `rgb` of the configuration's `ColorW` bits.
-    pub fn texel(cfg: &impl BaseColorW, rgb: [u32; 3]) -> Self {
-        let c = cfg.color_w();
+    pub fn texel(cfg: &impl WarpKind, rgb: [u32; 3]) -> Self {
+        let c = cfg.sampler().color_w;
         let m = (1u64 << c) - 1;
         Self {
             op: OP_TEXEL,
@@ -504,50 +505,101 @@ impl WarpIn {
     }
 }
 
-/// A configuration whose base plane holds codes of `ColorW` bits (both warps').
-pub trait BaseColorW {
-    fn color_w(&self) -> u32;
+/// What sets the two warps (`cube5_warp`, `cube5_pwarp`) apart in their stream model: the
+/// registers and what an op-2 item (`Go`, `Line`) emits. Everything else they do alike
+/// ([`WarpUnit`]): a `Write` restarts the texel position, a `Texel` stores and advances it, op 2
+/// emits and restarts it, op 3 does nothing.
+pub trait WarpKind: Copy {
+    /// The unit's registers, 0 at reset.
+    type Regs: Copy + Default + Debug;
+    /// One output item.
+    type Out: Clone + Debug + PartialEq;
+    /// The configuration's own checks.
+    fn check(&self) -> Result<()>;
+    /// The banks and bilinear stage: `cube5_warp`'s at the same `ColorW`, `WeightW`, `MaxBase`.
+    fn sampler(&self) -> WarpConfig;
+    /// `BaseW`, `BaseH` in `regs`.
+    fn base_size(regs: &Self::Regs) -> (u32, u32);
+    /// Register `addr` of `regs` written with `data`.
+    fn write(&self, regs: &mut Self::Regs, addr: u32, data: u64);
+    /// The outputs of an op-2 item with `payload`, the base plane's taps read by `texel`.
+    fn emit(
+        &self,
+        regs: &Self::Regs,
+        payload: u64,
+        texel: impl Fn(i64, i64) -> [u32; 3],
+        out: &mut Vec<Self::Out>,
+    );
 }
 
-impl BaseColorW for WarpConfig {
-    fn color_w(&self) -> u32 {
-        self.color_w
+/// The golden model of a warp as a stream unit: registers, the block RAM's base plane and the
+/// texel position, driven by input items ([`Warp`], [`crate::units::cube5_pwarp::Pwarp`]).
+#[derive(Debug, Clone)]
+pub struct WarpUnit<K: WarpKind> {
+    cfg: K,
+    regs: K::Regs,
+    tex: TexelMem,
+}
+
+/// The golden model of `cube5_warp`: a `Go` emits its image.
+pub type Warp = WarpUnit<WarpConfig>;
+
+impl<K: WarpKind> WarpUnit<K> {
+    pub fn new(cfg: K) -> Result<Self> {
+        cfg.check()?;
+        Ok(Self {
+            cfg,
+            regs: K::Regs::default(),
+            tex: TexelMem::new(cfg.sampler().max_base),
+        })
+    }
+
+    pub fn config(&self) -> K {
+        self.cfg
+    }
+
+    pub fn regs(&self) -> K::Regs {
+        self.regs
     }
 }
 
-/// A warp's stream model around its own registers: both warps take items alike (a `Write`
-/// restarts the texel position, a `Texel` stores and advances it, op 2 (`Go`, `Line`) emits and
-/// restarts it, op 3 does nothing).
-pub(crate) trait WarpItems {
-    type Out;
-    /// Register `addr` written with `data`.
-    fn write(&mut self, addr: u32, data: u64);
-    /// A `Texel` item's payload stored at the texel position.
-    fn store(&mut self, payload: u64);
-    /// The texel position back to (0, 0).
-    fn restart(&mut self);
-    /// The outputs of an op-2 item with `payload`.
-    fn emit(&self, payload: u64, out: &mut Vec<Self::Out>);
-}
+impl<K: WarpKind> StreamUnit for WarpUnit<K> {
+    type In = WarpIn;
+    type Out = K::Out;
 
-/// The outputs of `inputs` on `unit`.
-pub(crate) fn run_items<U: WarpItems>(unit: &mut U, inputs: &[WarpIn]) -> Vec<U::Out> {
-    let mut out = Vec::new();
-    for it in inputs {
-        match it.op & 3 {
-            OP_WRITE => {
-                unit.write(it.addr & ((1 << REG_ADDR_W) - 1), it.payload);
-                unit.restart();
+    /// The outputs of the op-2 items among `inputs` (a `Go` emits `OutW x OutH` pixels, a `Line`
+    /// its samples).
+    fn run(&mut self, inputs: &[WarpIn]) -> Vec<K::Out> {
+        let mut out = Vec::new();
+        for it in inputs {
+            match it.op & 3 {
+                OP_WRITE => {
+                    let addr = it.addr & ((1 << REG_ADDR_W) - 1);
+                    self.cfg.write(&mut self.regs, addr, it.payload);
+                    self.tex.restart();
+                }
+                OP_TEXEL => {
+                    let (base_w, _) = K::base_size(&self.regs);
+                    self.tex
+                        .store(it.payload, self.cfg.sampler().color_w, base_w);
+                }
+                OP_GO => {
+                    let size = K::base_size(&self.regs);
+                    let texel = |x, y| self.tex.stored(x, y, size);
+                    self.cfg.emit(&self.regs, it.payload, texel, &mut out);
+                    self.tex.restart();
+                }
+                _ => {}
             }
-            OP_TEXEL => unit.store(it.payload),
-            OP_GO => {
-                unit.emit(it.payload, &mut out);
-                unit.restart();
-            }
-            _ => {}
         }
+        out
     }
-    out
+
+    /// Registers and texel position to 0; the block RAM keeps its contents (not reset).
+    fn reset(&mut self) {
+        self.regs = K::Regs::default();
+        self.tex.restart();
+    }
 }
 
 /// One output pixel: 8-bit R, G, B, `last` (end of a row, `tlast`), `user` (frame start, `tuser`).
@@ -621,49 +673,29 @@ impl TexelMem {
     }
 }
 
-/// The golden model of `cube5_warp` as a stream unit: registers, the block RAM's base plane and
-/// the texel position, driven by input items; a `Go` emits its image.
-#[derive(Debug, Clone)]
-pub struct Warp {
-    cfg: WarpConfig,
-    regs: WarpRegs,
-    tex: TexelMem,
-}
-
-impl Warp {
-    pub fn new(cfg: WarpConfig) -> Result<Self> {
-        cfg.validate()?;
-        Ok(Self {
-            cfg,
-            regs: WarpRegs::default(),
-            tex: TexelMem::new(cfg.max_base),
-        })
-    }
-
-    pub fn config(&self) -> WarpConfig {
-        self.cfg
-    }
-
-    pub fn regs(&self) -> WarpRegs {
-        self.regs
-    }
-
-    fn stored(&self, x: i64, y: i64) -> [u32; 3] {
-        self.tex.stored(x, y, (self.regs.base_w, self.regs.base_h))
-    }
-}
-
-impl WarpItems for Warp {
+impl WarpKind for WarpConfig {
+    type Regs = WarpRegs;
     type Out = WarpOut;
 
-    fn write(&mut self, addr: u32, data: u64) {
+    fn check(&self) -> Result<()> {
+        self.validate()
+    }
+
+    fn sampler(&self) -> WarpConfig {
+        *self
+    }
+
+    fn base_size(regs: &WarpRegs) -> (u32, u32) {
+        (regs.base_w, regs.base_h)
+    }
+
+    fn write(&self, r: &mut WarpRegs, addr: u32, data: u64) {
         let field = |w: u32| (data & ((1u64 << w) - 1)) as u32;
         let coord = |d: u64| {
             let sh = 64 - COORD_W;
             ((d << sh) as i64) >> sh
         };
-        let (b1, o1) = (self.cfg.base_log2() + 1, self.cfg.out_log2() + 1);
-        let r = &mut self.regs;
+        let (b1, o1) = (self.base_log2() + 1, self.out_log2() + 1);
         match addr {
             REG_BASE_W => r.base_w = field(b1),
             REG_BASE_H => r.base_h = field(b1),
@@ -679,23 +711,20 @@ impl WarpItems for Warp {
         }
     }
 
-    fn store(&mut self, payload: u64) {
-        self.tex.store(payload, self.cfg.color_w, self.regs.base_w);
-    }
-
-    fn restart(&mut self) {
-        self.tex.restart();
-    }
-
     /// The image of a `Go`: exact steps from `X0, Y0`, raster order.
-    fn emit(&self, _payload: u64, out: &mut Vec<WarpOut>) {
-        let r = self.regs;
+    fn emit(
+        &self,
+        r: &WarpRegs,
+        _payload: u64,
+        texel: impl Fn(i64, i64) -> [u32; 3],
+        out: &mut Vec<WarpOut>,
+    ) {
         let (mut row_x, mut row_y) = (r.x0, r.y0);
         for py in 0..r.out_h {
             let (mut x, mut y) = (row_x, row_y);
             for px in 0..r.out_w {
                 out.push(WarpOut {
-                    rgb: pixel_at(&self.cfg, x, y, |tx, ty| self.stored(tx, ty)),
+                    rgb: pixel_at(self, x, y, &texel),
                     last: px + 1 == r.out_w,
                     user: px == 0 && py == 0,
                 });
@@ -705,22 +734,6 @@ impl WarpItems for Warp {
             row_x += r.xpy;
             row_y += r.ypy;
         }
-    }
-}
-
-impl StreamUnit for Warp {
-    type In = WarpIn;
-    type Out = WarpOut;
-
-    /// Every output pixel of the `Go` items among `inputs` (a `Go` emits `OutW x OutH` of them).
-    fn run(&mut self, inputs: &[WarpIn]) -> Vec<WarpOut> {
-        run_items(self, inputs)
-    }
-
-    /// Registers and texel position to 0; the block RAM keeps its contents (not reset).
-    fn reset(&mut self) {
-        self.regs = WarpRegs::default();
-        self.tex.restart();
     }
 }
 

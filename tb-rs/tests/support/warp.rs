@@ -4,29 +4,30 @@
 
 use super::{configs, gate_configs, seed};
 use cube5_model::unit::{StreamCodec, StreamUnit, UnitConfig};
-use cube5_model::units::cube5_warp::BaseCodes;
+use cube5_model::units::cube5_warp::{BaseCodes, WarpIn, WarpKind, WarpUnit};
 use cube5_tb::rtl::{RtlStream, Traffic};
 use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::fmt::Debug;
 
 /// One frame of a warp test: the items it sends, and how one of its outputs is named.
 pub trait WarpFrame {
-    /// The unit's configuration (its codec).
-    type Cfg: StreamCodec<In: Clone + Debug, Out: Clone + Debug + PartialEq> + UnitConfig + Copy;
-    /// The golden model.
-    type Gold: StreamUnit<
-        In = <Self::Cfg as StreamCodec>::In,
-        Out = <Self::Cfg as StreamCodec>::Out,
-    >;
+    /// The unit's configuration (its codec; the golden model is `WarpUnit<Cfg>`).
+    type Cfg: WarpKind
+        + StreamCodec<In = WarpIn, Out = <Self::Cfg as WarpKind>::Out>
+        + UnitConfig
+        + Copy;
     /// What one output is ("pixel", "sample").
     const OUT: &'static str;
 
-    fn gold(cfg: Self::Cfg) -> Self::Gold;
-    fn items(&self, cfg: &Self::Cfg) -> Vec<<Self::Cfg as StreamCodec>::In>;
+    fn items(&self, cfg: &Self::Cfg) -> Vec<WarpIn>;
     /// Output `at` of this frame (counted from its first), which is frame `i` of the run.
     fn describe(&self, i: usize, at: usize) -> String;
+}
+
+/// The golden model of `F`'s unit on `cfg`.
+fn gold<F: WarpFrame>(cfg: F::Cfg) -> WarpUnit<F::Cfg> {
+    WarpUnit::new(cfg).unwrap()
 }
 
 /// A random base plane: all ones one time in ten, else uniformly random codes.
@@ -58,7 +59,7 @@ pub fn check_frames<F: WarpFrame>(
 ) -> u64 {
     let out = F::OUT;
     let mut dut = RtlStream::new(variant, cfg, seed as u32).unwrap();
-    let mut gold = F::gold(cfg);
+    let mut gold = gold::<F>(cfg);
     let (before, after) = match reset_after {
         Some((n, _)) => frames.split_at(n.min(frames.len())),
         None => (&frames[..0], frames),
@@ -125,7 +126,7 @@ fn compare<F: WarpFrame>(
     let mut at = k;
     let mut who = String::from("(past the frames)");
     for (i, f) in frames.iter().enumerate() {
-        let n = F::gold(*cfg).run(&f.items(cfg)).len();
+        let n = gold::<F>(*cfg).run(&f.items(cfg)).len();
         if at < n {
             who = f.describe(i, at);
             break;
@@ -207,7 +208,7 @@ pub fn a_wrong_model_is_caught<F: WarpFrame>(
     let mut rng = ChaCha8Rng::seed_from_u64(seed(seed_no));
     let frames: Vec<F> = (0..4).map(|_| random(&mut rng, &cfg)).collect();
     let items: Vec<_> = frames.iter().flat_map(|f| f.items(&cfg)).collect();
-    let want = F::gold(wrong(cfg)).run(&items);
+    let want = gold::<F>(wrong(cfg)).run(&items);
     let mut dut = RtlStream::new(variant, cfg, 1).unwrap();
     let n = want.len() as u64;
     let driven = dut
