@@ -241,13 +241,7 @@ fn directed_frames(cfg: &PwarpConfig, rng: &mut ChaCha8Rng) -> Vec<Frame> {
         &base,
         "a one-pixel image",
     );
-    let max = (1u32 << cfg.color_w) - 1;
-    for (code, what) in [(max, "all-ones plane"), (0, "all-zero plane")] {
-        let flat = BaseCodes {
-            width: w as usize,
-            height: h as usize,
-            codes: vec![[code; 3]; (w * h) as usize],
-        };
+    for (flat, what) in warp::flat_bases(w as usize, h as usize, cfg.color_w) {
         push(
             Projective::tilted((out, out), size, 50.0, [35.0, 15.0, 30.0], 1.5, centre),
             (out, out),

@@ -286,13 +286,7 @@ fn directed_frames(cfg: &WarpConfig, rng: &mut ChaCha8Rng) -> Vec<Frame> {
             &format!("{what}, steps of one unit"),
         );
     }
-    let max = (1u32 << cfg.color_w) - 1;
-    for (code, what) in [(max, "all-ones plane"), (0, "all-zero plane")] {
-        let flat = BaseCodes {
-            width: w as usize,
-            height: h as usize,
-            codes: vec![[code; 3]; (w * h) as usize],
-        };
+    for (flat, what) in warp::flat_bases(w as usize, h as usize, cfg.color_w) {
         push(
             affine(-0.5, -0.5, 0.37, 0.11, -0.13, 0.41),
             (out, out),

@@ -32,16 +32,28 @@ fn gold<F: WarpFrame>(cfg: F::Cfg) -> WarpUnit<F::Cfg> {
 
 /// A random base plane: all ones one time in ten, else uniformly random codes.
 pub fn random_base(rng: &mut ChaCha8Rng, w: usize, h: usize, color_w: u32) -> BaseCodes {
-    let max = (1u32 << color_w) - 1;
     if rng.random_bool(0.1) {
-        BaseCodes {
-            width: w,
-            height: h,
-            codes: vec![[max; 3]; w * h],
-        }
+        flat_bases(w, h, color_w).remove(0).0
     } else {
         BaseCodes::random(rng, w, h, color_w)
     }
+}
+
+/// The all-ones and the all-zero base plane of `w x h` texels, with their names.
+pub fn flat_bases(w: usize, h: usize, color_w: u32) -> Vec<(BaseCodes, &'static str)> {
+    let max = (1u32 << color_w) - 1;
+    [(max, "all-ones plane"), (0, "all-zero plane")]
+        .into_iter()
+        .map(|(code, what)| {
+            let codes = vec![[code; 3]; w * h];
+            let plane = BaseCodes {
+                width: w,
+                height: h,
+                codes,
+            };
+            (plane, what)
+        })
+        .collect()
 }
 
 /// Runs `frames` through the RTL under `traffic` and through the model, and compares every
