@@ -11,10 +11,7 @@ use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{
-    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts,
-    configs, seed, with_waves,
-};
+use support::{axi, axi_mem_setup, axi_random_image, configs, seed, with_waves};
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
 /// optionally a reset after `reset_at` cycles followed by `after` commands.
@@ -149,28 +146,15 @@ fn drive_and_compare(
     let (want, bursts) = cfg.expected(cmds, mem);
     let exact = max_cycles.is_none();
     let limit = max_cycles.unwrap_or(200_000 + 40 * want.len() as u64 + 300 * bursts.len() as u64);
-    let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
-    axi_protocol_clean(dut, &driven.stats, variant, seed)?;
-    // AR first: a wrong burst explains a wrong beat.
-    let n_ars = compare_bursts(
-        &dut.axi_take_ar()?,
-        "AR",
-        &bursts,
-        cfg.size(),
-        variant,
-        seed,
-        |k| format!("burst #{k} of commands {cmds:?}"),
-    )?;
-    compare_axi_outputs(
+    let (driven, n_ars) = axi::drive_reads(
         dut,
-        &driven,
-        &want,
-        (n_ars, bursts.len()),
-        exact,
-        limit,
         (variant, seed),
-        "beat",
-        |k| describe_beat(cfg, cmds, k),
+        (cmds, traffic),
+        (&want, "beat", |k| describe_beat(cfg, cmds, k)),
+        (&bursts, cfg.size(), |k| {
+            format!("burst #{k} of commands {cmds:?}")
+        }),
+        (exact, limit),
     )?;
     if exact {
         let any_err = want.iter().any(|b| b.resp != 0);
@@ -202,23 +186,25 @@ fn run(
     let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut report = Report::default();
     let (mem, traffic) = (&case.mem, &case.traffic);
-    let go = |dut: &mut RtlStream<AxiRdConfig>,
-              cmds: &[AxiRdCmd],
-              cut: Option<u64>,
-              report: &mut Report| {
-        drive_and_compare(dut, variant, cfg, seed, cmds, mem, traffic, cut, report)
-    };
-    go(
+    report.dropped_at_reset = axi::run_with_reset(
         &mut dut,
-        &case.cmds,
-        case.reset.as_ref().map(|r| r.0),
-        &mut report,
+        (variant, seed),
+        false,
+        (&case.cmds, &case.reset),
+        |dut, cmds, cut| {
+            drive_and_compare(
+                dut,
+                variant,
+                cfg,
+                seed,
+                cmds,
+                mem,
+                traffic,
+                cut,
+                &mut report,
+            )
+        },
     )?;
-    if let Some((_, after)) = &case.reset {
-        report.dropped_at_reset =
-            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, false)?;
-        go(&mut dut, after, None, &mut report)?;
-    }
     report.rready_low = dut.axi_counters().rready_low;
     Ok(report)
 }

@@ -306,36 +306,36 @@ fn run(
     }
     let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut report = Report::default();
-    let go = |dut: &mut RtlStream<AxiWrConfig>,
-              work: &Work,
-              mem: &AxiMemImage,
-              cut: Option<u64>,
-              report: &mut Report| {
-        drive_and_compare(
-            dut,
-            variant,
-            cfg,
-            seed,
-            work,
-            &work.items,
-            mem,
-            case,
-            cut,
-            report,
-        )
-    };
-    let cut = case.reset.as_ref().map(|r| r.0);
-    go(&mut dut, &case.work, &case.mem, cut, &mut report)?;
-    if let Some((_, after)) = &case.reset {
-        report.dropped_at_reset =
-            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, true)?;
-        // The next work starts from the memory as the cut run left it.
-        let mem = AxiMemImage {
-            bytes: dut.axi_image()?,
-            ..case.mem.clone()
-        };
-        go(&mut dut, after, &mem, None, &mut report)?;
-    }
+    report.dropped_at_reset = axi::run_with_reset(
+        &mut dut,
+        (variant, seed),
+        true,
+        (&case.work, &case.reset),
+        |dut, work, cut| {
+            // The work after a reset starts from the memory as the cut run left it.
+            let mem = if std::ptr::eq(work, &case.work) {
+                case.mem.clone()
+            } else {
+                AxiMemImage {
+                    bytes: dut.axi_image()?,
+                    ..case.mem.clone()
+                }
+            };
+            let items = &work.items;
+            drive_and_compare(
+                dut,
+                variant,
+                cfg,
+                seed,
+                work,
+                items,
+                &mem,
+                case,
+                cut,
+                &mut report,
+            )
+        },
+    )?;
     Ok(report)
 }
 

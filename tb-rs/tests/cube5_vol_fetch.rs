@@ -16,10 +16,7 @@ use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{
-    axi, axi_mem_setup, axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, seed,
-    with_waves,
-};
+use support::{axi, axi_mem_setup, configs, seed, with_waves};
 
 /// One run: LUT writes (loaded first, in full), then commands (sweeps and more LUT writes), the
 /// memory, how the subordinate behaves, the output traffic, and optionally a reset after
@@ -278,28 +275,15 @@ fn drive_and_compare(
         .collect();
     let exact = max_cycles.is_none();
     let limit = max_cycles.unwrap_or(100_000 + 8 * want.len() as u64 + 400 * bursts.len() as u64);
-    let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
-    axi_protocol_clean(dut, &driven.stats, variant, seed)?;
-    // AR first: a wrong burst explains a wrong item.
-    let n_ars = compare_bursts(
-        &dut.axi_take_ar()?,
-        "AR",
-        &bursts,
-        cfg.axi_rd().size(),
-        variant,
-        seed,
-        |k| format!("burst #{k} of {} read commands", run.reads.len()),
-    )?;
-    compare_axi_outputs(
+    let (driven, n_ars) = axi::drive_reads(
         dut,
-        &driven,
-        want,
-        (n_ars, bursts.len()),
-        exact,
-        limit,
         (variant, seed),
-        "item",
-        |k| describe_item(cmds, want, k),
+        (cmds, traffic),
+        (want, "item", |k| describe_item(cmds, want, k)),
+        (&bursts, cfg.axi_rd().size(), |k| {
+            format!("burst #{k} of {} read commands", run.reads.len())
+        }),
+        (exact, limit),
     )?;
     if !exact {
         // Cut by a reset: the model's LUT is what the RTL took before the cut (LUT writes apply
@@ -343,26 +327,23 @@ fn run(
     let mut gold = VolFetch::new(cfg).map_err(|e| TbError::setup(variant.name, e))?;
     let mut report = Report::default();
     let (mem, traffic) = (&case.mem, &case.traffic);
-    let go = |dut: &mut RtlStream<VolFetchConfig>,
-              gold: &mut VolFetch,
-              cmds: &[FetchCmd],
-              cut: Option<u64>,
-              report: &mut Report| {
-        drive_and_compare(dut, gold, variant, seed, cmds, mem, traffic, cut, report)
+    let mut go = |dut: &mut RtlStream<VolFetchConfig>, cmds: &Vec<FetchCmd>, cut: Option<u64>| {
+        drive_and_compare(
+            dut,
+            &mut gold,
+            variant,
+            seed,
+            cmds,
+            mem,
+            traffic,
+            cut,
+            &mut report,
+        )
     };
-    go(&mut dut, &mut gold, &case.lut, None, &mut report)?;
-    go(
-        &mut dut,
-        &mut gold,
-        &case.cmds,
-        case.reset.as_ref().map(|r| r.0),
-        &mut report,
-    )?;
-    if let Some((_, after)) = &case.reset {
-        report.dropped_at_reset =
-            axi::reset_leaves_nothing_in_flight(&mut dut, variant, seed, false)?;
-        go(&mut dut, &mut gold, after, None, &mut report)?;
-    }
+    go(&mut dut, &case.lut, None)?;
+    let cmds = (&case.cmds, &case.reset);
+    let dropped = axi::run_with_reset(&mut dut, (variant, seed), false, cmds, go)?;
+    report.dropped_at_reset = dropped;
     Ok(report)
 }
 

@@ -3,10 +3,10 @@
 //! random subordinate, the pass line, the checker's refusals, and the test loops over the
 //! configurations. The comparisons themselves are in `support` (`compare_*`, `axi_protocol_clean`).
 
-use super::{configs, gate_configs, seed};
+use super::{axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, gate_configs, seed};
 use cube5_model::unit::{StreamCodec, UnitConfig};
-use cube5_model::units::cube5_axi_rd::AxiMemImage;
-use cube5_tb::rtl::{AxiMemSetup, RtlStream};
+use cube5_model::units::cube5_axi_rd::{AxiMemImage, Burst};
+use cube5_tb::rtl::{AxiMemSetup, Driven, RtlStream, Traffic};
 use cube5_tb::{Mismatch, TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -56,6 +56,63 @@ pub fn reset_leaves_nothing_in_flight<C: StreamCodec>(
         });
     }
     Ok(dropped)
+}
+
+/// The runs of one case: `work` (cut `cycles` in when `reset` = `(cycles, after)` follows), then
+/// the reset, which must leave no burst in flight (on the write side with `write`), then `after`.
+/// `go(dut, work, cut)` drives one list of work and compares what came out. Returns the bursts the
+/// reset dropped (0 without a reset).
+pub fn run_with_reset<C: StreamCodec, W>(
+    dut: &mut RtlStream<C>,
+    (variant, seed): (&'static Variant, u64),
+    write: bool,
+    (work, reset): (&W, &Option<(u64, W)>),
+    mut go: impl FnMut(&mut RtlStream<C>, &W, Option<u64>) -> Result<(), TbError>,
+) -> Result<u64, TbError> {
+    go(dut, work, reset.as_ref().map(|r| r.0))?;
+    let Some((_, after)) = reset else {
+        return Ok(0);
+    };
+    let dropped = reset_leaves_nothing_in_flight(dut, variant, seed, write)?;
+    go(dut, after, None)?;
+    Ok(dropped)
+}
+
+/// Drives `cmds` on a read manager for at most `limit` cycles, then compares, AR first (a wrong
+/// burst explains a wrong output): its bursts with `bursts` (ARSIZE `size`, `burst` names one),
+/// then its outputs with `want` (a `noun` each, `describe` names one), in full if `exact`, else as
+/// a prefix (a reset cuts the run). Returns the run and the bursts seen on AR.
+pub fn drive_reads<C: StreamCodec<Out: PartialEq + Debug>>(
+    dut: &mut RtlStream<C>,
+    (variant, seed): (&'static Variant, u64),
+    (cmds, traffic): (&[C::In], &Traffic),
+    (want, noun, describe): (&[C::Out], &str, impl Fn(usize) -> String),
+    (bursts, size, burst): (&[Burst], u32, impl Fn(usize) -> String),
+    (exact, limit): (bool, u64),
+) -> Result<(Driven<C::Out>, usize), TbError> {
+    let driven = dut.drive(cmds, traffic, want.len() as u64, limit)?;
+    axi_protocol_clean(dut, &driven.stats, variant, seed)?;
+    let n_ars = compare_bursts(
+        &dut.axi_take_ar()?,
+        "AR",
+        bursts,
+        size,
+        variant,
+        seed,
+        burst,
+    )?;
+    compare_axi_outputs(
+        dut,
+        &driven,
+        want,
+        (n_ars, bursts.len()),
+        exact,
+        limit,
+        (variant, seed),
+        noun,
+        describe,
+    )?;
+    Ok((driven, n_ars))
 }
 
 /// A bandwidth limit of `U(1..=twice)` half-bytes per cycle on half the seeds, else none.
