@@ -16,6 +16,7 @@ use crate::regs::cube5_accel::{
     REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO, TABLE_BLOCK, TABLE_CLASS, TABLE_OPACITY,
     TABLE_REFLECT,
 };
+use crate::units::cube5_accel_ctrl::CtrlRegs;
 use std::fmt;
 
 /// Bytes per register: the AXI4-Lite data bus is 32 bits (`cube5-gen` refuses an `axil` map with
@@ -77,6 +78,20 @@ impl FrameRegs {
             (REG_MODE, self.mode),
             (REG_SKIP, self.skip),
         ]
+    }
+}
+
+/// The frame words of a controller's register set (the rest are bases, pitch and tables).
+impl From<&CtrlRegs> for FrameRegs {
+    fn from(r: &CtrlRegs) -> Self {
+        Self {
+            dims: r.dims,
+            view: r.view,
+            dx: r.dx,
+            dy: r.dy,
+            mode: r.mode,
+            skip: r.skip,
+        }
     }
 }
 

@@ -14,10 +14,10 @@ use cube5_model::accel_host::{AccelHost, FrameRegs, RegBus};
 use cube5_model::regs::cube5_accel::{
     CODE_ABORTED, CODE_AXIS_K, CODE_DIMS, CODE_FRAME, CODE_IMG_ALIGN, CODE_NONE, CODE_PITCH,
     CODE_RENDER, CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_CTRL,
-    REG_CYCLE_HI, REG_CYCLE_LO, REG_DIMS, REG_DX, REG_DY, REG_IMG_BASE_HI, REG_IMG_BASE_LO,
-    REG_IMG_PITCH, REG_IRQ_ENABLE, REG_IRQ_STATUS, REG_MODE, REG_SAMPLE_HI, REG_SAMPLE_LO,
-    REG_SKIP, REG_STATUS, REG_STATUS_BUSY, REG_STATUS_CODE, REG_TABLE_ADDR, REG_TABLE_DATA,
-    REG_TABLE_POS, REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO, TABLE_CLASS,
+    REG_CYCLE_HI, REG_CYCLE_LO, REG_IMG_BASE_HI, REG_IMG_BASE_LO, REG_IMG_PITCH, REG_IRQ_ENABLE,
+    REG_IRQ_STATUS, REG_SAMPLE_HI, REG_SAMPLE_LO, REG_STATUS, REG_STATUS_BUSY, REG_STATUS_CODE,
+    REG_TABLE_ADDR, REG_TABLE_DATA, REG_TABLE_POS, REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO,
+    TABLE_CLASS,
 };
 use cube5_model::units::cube5_accel_ctrl::{
     AccelCtrlCodec, AccelCtrlConfig, CtrlRecord, CtrlRegs, Outcome, PORTS,
@@ -195,23 +195,19 @@ impl Bench {
 
     fn write_regs(&mut self, r: &CtrlRegs) -> Result<(), TbError> {
         let d = self.host_delay;
-        let t: Vec<AxilTxn> = [
-            (REG_DIMS, r.dims),
-            (REG_VIEW, r.view),
-            (REG_DX, r.dx),
-            (REG_DY, r.dy),
-            (REG_MODE, r.mode),
-            (REG_SKIP, r.skip),
-            (REG_VOL_BASE_LO, r.vol_base as u32),
-            (REG_VOL_BASE_HI, (r.vol_base >> 32) as u32),
-            (REG_IMG_BASE_LO, r.img_base as u32),
-            (REG_IMG_BASE_HI, (r.img_base >> 32) as u32),
-            (REG_IMG_PITCH, r.img_pitch),
-            (REG_IRQ_ENABLE, 3),
-        ]
-        .iter()
-        .map(|&(o, v)| txn(false, o, v, d))
-        .collect();
+        let t: Vec<AxilTxn> = FrameRegs::from(r)
+            .writes()
+            .into_iter()
+            .chain([
+                (REG_VOL_BASE_LO, r.vol_base as u32),
+                (REG_VOL_BASE_HI, (r.vol_base >> 32) as u32),
+                (REG_IMG_BASE_LO, r.img_base as u32),
+                (REG_IMG_BASE_HI, (r.img_base >> 32) as u32),
+                (REG_IMG_PITCH, r.img_pitch),
+                (REG_IRQ_ENABLE, 3),
+            ])
+            .map(|(o, v)| txn(false, o, v, d))
+            .collect();
         self.run(&t, 0).map(|_| ())
     }
 
@@ -778,15 +774,7 @@ fn the_host_driver_renders_a_frame_on_the_rtl() {
     });
     let regs = regs_of(&cfg, [32, 16, 24], 0, true, -5000, 7000);
     let mut host = AccelHost::new(b, 0);
-    let f = FrameRegs {
-        dims: regs.dims,
-        view: regs.view,
-        dx: regs.dx,
-        dy: regs.dy,
-        mode: regs.mode,
-        skip: regs.skip,
-    };
-    host.write_frame(&f).unwrap();
+    host.write_frame(&FrameRegs::from(&regs)).unwrap();
     host.set_bases(regs.vol_base, regs.img_base).unwrap();
     host.load_table(TABLE_CLASS, 5, &[1, 2, 3]).unwrap();
     assert_eq!(host.table_pos().unwrap(), (TABLE_CLASS, 8));
