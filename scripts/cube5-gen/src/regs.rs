@@ -277,6 +277,13 @@ rust = "model/src/regs/cube5_t.rs"
         parse(&format!("{HEAD}{body}"), Path::new("rtl/t.regs.toml")).unwrap_err()
     }
 
+    /// A `[[register]]` of the test block: `name` at `offset` with `access`, then `more` lines.
+    fn reg(name: &str, offset: u32, access: &str, more: &str) -> String {
+        format!(
+            "[[register]]\nname = \"{name}\"\noffset = {offset}\naccess = \"{access}\"\ndoc = \"r\"\n{more}"
+        )
+    }
+
     #[test]
     fn names() {
         assert_eq!(screaming("ComposLatency"), "COMPOS_LATENCY");
@@ -289,18 +296,7 @@ rust = "model/src/regs/cube5_t.rs"
 
     #[test]
     fn duplicate_offset_refused() {
-        let e = err(r#"
-[[register]]
-name = "A"
-offset = 1
-access = "RW"
-doc = "a"
-[[register]]
-name = "B"
-offset = 1
-access = "RO"
-doc = "b"
-"#);
+        let e = err(&(reg("A", 1, "RW", "") + &reg("B", 1, "RO", "")));
         assert_eq!(
             e,
             "rtl/t.regs.toml: register B: offset 1 already taken by register A"
@@ -310,27 +306,20 @@ doc = "b"
 
     #[test]
     fn overlapping_fields_refused() {
-        let e = err(r#"
-[[register]]
-name = "Ctrl"
-offset = 0
-access = "RW"
-doc = "c"
-field = [ { name = "a", lsb = 0, width = 4 }, { name = "b", lsb = 3, width = 2 } ]
-"#);
+        let fields =
+            r#"field = [ { name = "a", lsb = 0, width = 4 }, { name = "b", lsb = 3, width = 2 } ]"#;
+        let e = err(&reg("Ctrl", 0, "RW", fields));
         assert_eq!(e, "rtl/t.regs.toml: register Ctrl: fields a and b overlap");
     }
 
     #[test]
     fn field_above_register_refused() {
-        let e = err(r#"
-[[register]]
-name = "Ctrl"
-offset = 0
-access = "W1C"
-doc = "c"
-field = [ { name = "a", lsb = 30, width = 4 } ]
-"#);
+        let e = err(&reg(
+            "Ctrl",
+            0,
+            "W1C",
+            r#"field = [ { name = "a", lsb = 30, width = 4 } ]"#,
+        ));
         assert_eq!(
             e,
             "rtl/t.regs.toml: register Ctrl: field a (bits 30..=33) above the 32-bit register"
@@ -358,7 +347,7 @@ doc = "b"
             e,
             "rtl/t.regs.toml: constant B: A is not an earlier constant"
         );
-        let e = err("[[register]]\nname = \"A\"\noffset = 0\naccess = \"RX\"\ndoc = \"a\"\n");
+        let e = err(&reg("A", 0, "RX", ""));
         assert!(
             e.starts_with("rtl/t.regs.toml: ") && !e.contains('\n'),
             "{e}"
@@ -434,17 +423,8 @@ field = [ { name = "done", width = 1, doc = "frame done" }, { name = "err", widt
 
     #[test]
     fn duplicate_name_and_wrong_subset_refused() {
-        let e = err(r#"
-[[constant]]
-name = "RegA"
-value = 1
-doc = "clash"
-[[register]]
-name = "A"
-offset = 0
-access = "RO"
-doc = "a"
-"#);
+        let clash = "[[constant]]\nname = \"RegA\"\nvalue = 1\ndoc = \"clash\"\n";
+        let e = err(&format!("{clash}{}", reg("A", 0, "RO", "")));
         assert_eq!(e, "rtl/t.regs.toml: register A: name RegA defined twice");
         let modes = r#"
 [[enum]]
