@@ -138,8 +138,7 @@ fn drive_and_compare(
     cfg: AxiRdConfig,
     seed: u64,
     cmds: &[AxiRdCmd],
-    mem: &AxiMemImage,
-    traffic: &Traffic,
+    (mem, traffic): (&AxiMemImage, &Traffic),
     max_cycles: Option<u64>,
     report: &mut Report,
 ) -> Result<(), TbError> {
@@ -185,25 +184,13 @@ fn run(
     }
     let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut report = Report::default();
-    let (mem, traffic) = (&case.mem, &case.traffic);
+    let io = (&case.mem, &case.traffic);
     report.dropped_at_reset = axi::run_with_reset(
         &mut dut,
         (variant, seed),
         false,
         (&case.cmds, &case.reset),
-        |dut, cmds, cut| {
-            drive_and_compare(
-                dut,
-                variant,
-                cfg,
-                seed,
-                cmds,
-                mem,
-                traffic,
-                cut,
-                &mut report,
-            )
-        },
+        |dut, cmds, cut| drive_and_compare(dut, variant, cfg, seed, cmds, io, cut, &mut report),
     )?;
     report.rready_low = dut.axi_counters().rready_low;
     Ok(report)
@@ -515,8 +502,7 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
             model_cfg,
             1,
             cmds,
-            model_mem,
-            traffic,
+            (model_mem, traffic),
             None,
             &mut report,
         )

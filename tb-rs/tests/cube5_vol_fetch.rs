@@ -258,8 +258,7 @@ fn drive_and_compare(
     variant: &'static Variant,
     seed: u64,
     cmds: &[FetchCmd],
-    mem: &AxiMemImage,
-    traffic: &Traffic,
+    (mem, traffic): (&AxiMemImage, &Traffic),
     max_cycles: Option<u64>,
     report: &mut Report,
 ) -> Result<(), TbError> {
@@ -326,19 +325,9 @@ fn run(
     let mut dut = axi::open(variant, cfg, seed, (&case.setup, &case.mem), &trace)?;
     let mut gold = VolFetch::new(cfg).map_err(|e| TbError::setup(variant.name, e))?;
     let mut report = Report::default();
-    let (mem, traffic) = (&case.mem, &case.traffic);
+    let io = (&case.mem, &case.traffic);
     let mut go = |dut: &mut RtlStream<VolFetchConfig>, cmds: &Vec<FetchCmd>, cut: Option<u64>| {
-        drive_and_compare(
-            dut,
-            &mut gold,
-            variant,
-            seed,
-            cmds,
-            mem,
-            traffic,
-            cut,
-            &mut report,
-        )
+        drive_and_compare(dut, &mut gold, variant, seed, cmds, io, cut, &mut report)
     };
     go(&mut dut, &case.lut, None)?;
     let cmds = (&case.cmds, &case.reset);
@@ -635,16 +624,15 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_skip() {
     };
     let mut wrong = mem.clone();
     wrong.bytes[(u64::from(first_ptr) * cfg.block_bytes()) as usize] ^= 1;
+    let io = (&mem, &traffic);
     let mut dut = open();
     let mut gold = VolFetch::new(cfg).unwrap();
     let mut rep = Report::default();
-    drive_and_compare(
-        &mut dut, &mut gold, variant, 1, &lut, &mem, &traffic, None, &mut rep,
-    )
-    .unwrap();
+    drive_and_compare(&mut dut, &mut gold, variant, 1, &lut, io, None, &mut rep).unwrap();
     let cmds = [FetchCmd::Sweep(sweep)];
+    let wrong_io = (&wrong, &traffic);
     let err = drive_and_compare(
-        &mut dut, &mut gold, variant, 1, &cmds, &wrong, &traffic, None, &mut rep,
+        &mut dut, &mut gold, variant, 1, &cmds, wrong_io, None, &mut rep,
     )
     .unwrap_err();
     let m = err.mismatch().expect("a mismatch");
@@ -654,18 +642,13 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_skip() {
     // The model's LUT marks block (1, 0, 0) empty; the RTL's does not.
     let mut dut = open();
     let mut gold = VolFetch::new(cfg).unwrap();
-    drive_and_compare(
-        &mut dut, &mut gold, variant, 1, &lut, &mem, &traffic, None, &mut rep,
-    )
-    .unwrap();
+    drive_and_compare(&mut dut, &mut gold, variant, 1, &lut, io, None, &mut rep).unwrap();
     if let FetchCmd::Lut { index, mut entry } = lut[1] {
         entry.empty = true;
         gold.run(&[FetchCmd::Lut { index, entry }], &mem).unwrap();
     }
-    let err = drive_and_compare(
-        &mut dut, &mut gold, variant, 1, &cmds, &mem, &traffic, None, &mut rep,
-    )
-    .unwrap_err();
+    let err =
+        drive_and_compare(&mut dut, &mut gold, variant, 1, &cmds, io, None, &mut rep).unwrap_err();
     // AR is compared first: the model issues no burst for the block it thinks empty, so the
     // first burst of that block (the RTL's) is the first difference.
     let m = err.mismatch().expect("a mismatch");
