@@ -49,15 +49,9 @@ impl Report {
     }
 }
 
-fn mem_setup(
-    cfg: VolFetchConfig,
-    mem: &AxiMemImage,
-    lat: (u32, u32),
-    gaps: (u32, u32),
-    bw: (u32, u32),
-    seed: u64,
-) -> AxiMemSetup {
-    axi_mem_setup((cfg.data_w / 8, cfg.addr_w), mem, lat, gaps, bw, seed)
+/// The bus the subordinate serves: bytes per beat, address bits.
+fn bus(cfg: VolFetchConfig) -> (u32, u32) {
+    (cfg.data_w / 8, cfg.addr_w)
 }
 
 /// A random volume image: `slots` blocks of random bytes at a random bus-aligned base (not
@@ -181,7 +175,7 @@ fn random_case(cfg: VolFetchConfig, seed: u64, sweeps: usize, max_blocks: u32) -
     let cmds = random_cmds(cfg, blocks, mem.base, &lut, sweeps, &mut rng);
     let bw = axi::random_bandwidth(&mut rng, cfg.data_w / 4);
     let gaps = (rng.random_range(0..400), rng.random_range(0..400));
-    let setup = mem_setup(cfg, &mem, (10, 190), gaps, bw, rng.random());
+    let setup = axi_mem_setup(bus(cfg), &mem, (10, 190), gaps, bw, rng.random());
     let stall = rng.random_range(0.0..0.6);
     let traffic = Traffic::random(&mut rng, 0.3, stall);
     Case {
@@ -427,7 +421,7 @@ fn directed_extremes() {
             let case = Case {
                 lut: lut.clone(),
                 cmds: cmds.clone(),
-                setup: mem_setup(cfg, &mem, lat, gaps, (0, 1), s),
+                setup: axi_mem_setup(bus(cfg), &mem, lat, gaps, (0, 1), s),
                 traffic: Traffic::random(&mut rng, 0.3, stall),
                 mem: mem.clone(),
                 reset: None,
@@ -476,7 +470,7 @@ fn throughput(variant: &'static Variant, cfg: VolFetchConfig, lat: u32, bw: (u32
     let case = Case {
         lut,
         cmds: vec![FetchCmd::Sweep(sweep); 2],
-        setup: mem_setup(cfg, &mem, (lat, 0), (0, 0), bw, 1),
+        setup: axi_mem_setup(bus(cfg), &mem, (lat, 0), (0, 0), bw, 1),
         traffic: Traffic::full_speed(),
         mem,
         reset: None,
@@ -544,7 +538,7 @@ fn head_phantom_sweep(n: usize, lat: (u32, u32), bw: u32) {
     let case = Case {
         lut: cfg.lut_writes(&lut).unwrap(),
         cmds: vec![FetchCmd::Sweep(sweep)],
-        setup: mem_setup(cfg, &mem, lat, (0, 0), (bw, 1), 3),
+        setup: axi_mem_setup(bus(cfg), &mem, lat, (0, 0), (bw, 1), 3),
         traffic: Traffic::full_speed(),
         mem,
         reset: None,
@@ -615,7 +609,7 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_skip() {
     let (lut, mem) = present_volume(cfg, blocks, &mut rng);
     let sweep = Sweep::whole(mem.base, blocks);
     let traffic = Traffic::full_speed();
-    let setup = mem_setup(cfg, &mem, (10, 0), (0, 0), (0, 1), 1);
+    let setup = axi_mem_setup(bus(cfg), &mem, (10, 0), (0, 0), (0, 1), 1);
     let open = || axi::open(variant, cfg, 1, (&setup, &mem), &None).unwrap();
     // One byte of the first block's slot changed in the model's memory.
     let first_ptr = match lut[0] {
