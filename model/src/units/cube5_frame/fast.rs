@@ -568,7 +568,7 @@ impl SliceWork<'_> {
         if let Some(flat) = self.flat {
             // Without the gradient: the class entries are the samples' coded alphas and colours.
             let (sa, sc) = flat_entries::<N, AVX2>(&flat[..=last], &idx);
-            return count(rules.step::<N>(rays, lane, &sa, &sc), st);
+            return rules.step_counted::<N>(rays, lane, &sa, &sc);
         }
         let corrected = &self.corrected[..=last];
         let sa: [u32; N] = std::array::from_fn(|n| corrected[idx[n]]);
@@ -576,7 +576,7 @@ impl SliceWork<'_> {
         // one composites with colours that are not read. (Each way calls `step` with its own
         // colours: one array merged from two ways was split into scalar registers.)
         if !(LIT && rules.any_changes::<N>(rays, lane, &sa)) {
-            return count(rules.step::<N>(rays, lane, &sa, &[[0; N]; 3]), st);
+            return rules.step_counted::<N>(rays, lane, &sa, &[[0; N]; 3]);
         }
         if c > 0 {
             self.ensure(band, b as isize, c - 1);
@@ -618,9 +618,9 @@ impl SliceWork<'_> {
         // One copy of the rest per illumination width (a constant in each).
         let shaded = (&centre, &grad, &sa);
         if units.shader.lit_in_32_bits() {
-            self.shade_step::<N, AVX2, false>(rays, lane, shaded, st);
+            self.shade_step::<N, AVX2, false>(rays, lane, shaded);
         } else {
-            self.shade_step::<N, AVX2, true>(rays, lane, shaded, st);
+            self.shade_step::<N, AVX2, true>(rays, lane, shaded);
         }
     }
 
@@ -633,7 +633,6 @@ impl SliceWork<'_> {
         rays: &mut RayLanes,
         lane: usize,
         (centre, grad, sa): (&[u32; N], &[[i32; N]; 3], &[u32; N]),
-        st: &mut SweepStats,
     ) {
         // SAFETY: `AVX2` is set only in `sweep_band_avx2`'s copy, which runs only on a CPU with
         // AVX2.
@@ -644,16 +643,8 @@ impl SliceWork<'_> {
         };
         // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
         let sc = self.rules.colour_codes(&rgb);
-        count(self.rules.step::<N>(rays, lane, sa, &sc), st);
+        self.rules.step_counted::<N>(rays, lane, sa, &sc);
     }
-}
-
-/// A row's counts added to the sweep's.
-#[inline(always)]
-fn count(k: lanes::RowCounts, st: &mut SweepStats) {
-    st.shaded += k.shaded;
-    st.without_effect += k.without_effect;
-    st.after_termination += k.after_termination;
 }
 
 /// The class entries `flat[idx[n]]` of `N` lanes as rows of lanes: the corrected alphas and the
@@ -734,6 +725,10 @@ fn sweep_band<const LIT: bool, const AVX2: bool>(slices: &[SliceWork], band: Ban
         st = st.add(work.band::<LIT, AVX2>(b0, &mut rays, at * w, (b1 - b0, w), &mut band));
     }
     rays.write(&init, rows);
+    let k = rays.row_counts();
+    st.shaded += k.shaded;
+    st.without_effect += k.without_effect;
+    st.after_termination += k.after_termination;
     st.rays_terminated = rays.term.iter().filter(|&&t| t != 0).count() as u64;
     st
 }

@@ -19,7 +19,14 @@ pub(super) struct RayLanes {
     pub a: Vec<u32>,
     /// 1: the ray is terminated.
     pub term: Vec<u32>,
+    /// The counts of the rows composited so far (shaded, without effect, after termination),
+    /// per lane of a row: added lane by lane, summed once at the band's end (a sum per row cost
+    /// three horizontal additions).
+    pub counts: [[u32; LANES]; 3],
 }
+
+/// Lanes of the widest row ([`RayLanes::counts`]).
+pub(super) const LANES: usize = 8;
 
 impl RayLanes {
     /// `len` empty coxels.
@@ -28,6 +35,17 @@ impl RayLanes {
             c: std::array::from_fn(|_| vec![0; len]),
             a: vec![0; len],
             term: vec![0; len],
+            counts: [[0; LANES]; 3],
+        }
+    }
+
+    /// The counts of every row composited so far.
+    pub fn row_counts(&self) -> RowCounts {
+        let sum = |k: &[u32; LANES]| k.iter().map(|&x| u64::from(x)).sum::<u64>();
+        RowCounts {
+            shaded: sum(&self.counts[0]),
+            without_effect: sum(&self.counts[1]),
+            after_termination: sum(&self.counts[2]),
         }
     }
 
@@ -242,7 +260,7 @@ impl LaneRules {
     /// `Compos::step_coded` of the samples `sa[n]` (corrected alpha) and `sc[ch][n]` (colour
     /// codes on the coxel's scale) onto lanes `at .. at + N`, in this slice's mode; the colours
     /// of a sample that changes nothing are not read. Returns the sweep's counts of the row.
-    #[inline(always)]
+    #[cfg(test)]
     pub fn step<const N: usize>(
         &self,
         st: &mut RayLanes,
@@ -250,12 +268,48 @@ impl LaneRules {
         sa: &[u32; N],
         sc: &[[u32; N]; 3],
     ) -> RowCounts {
+        let k = self.step_lanes::<N>(st, at, sa, sc);
+        let sum = |k: &[u32; N]| k.iter().map(|&x| u64::from(x)).sum::<u64>();
+        RowCounts {
+            shaded: sum(&k[0]),
+            without_effect: sum(&k[1]),
+            after_termination: sum(&k[2]),
+        }
+    }
+
+    /// [`LaneRules::step`], its counts added to `st.counts` lane by lane (`N <= LANES`).
+    #[inline(always)]
+    pub fn step_counted<const N: usize>(
+        &self,
+        st: &mut RayLanes,
+        at: usize,
+        sa: &[u32; N],
+        sc: &[[u32; N]; 3],
+    ) {
+        let k = self.step_lanes::<N>(st, at, sa, sc);
+        for (acc, k) in st.counts.iter_mut().zip(&k) {
+            for n in 0..N {
+                acc[n] += k[n];
+            }
+        }
+    }
+
+    /// [`LaneRules::step`]'s work: per lane the samples shaded, without effect, after termination
+    /// (`FrontToBack`: 1 or 0 a lane; `Max`: the row's sums in lane 0).
+    #[inline(always)]
+    fn step_lanes<const N: usize>(
+        &self,
+        st: &mut RayLanes,
+        at: usize,
+        sa: &[u32; N],
+        sc: &[[u32; N]; 3],
+    ) -> [[u32; N]; 3] {
         // Each way loads, computes and stores the lanes itself: one set of lanes merged from two
         // ways was split into scalar registers. (No closures: a closure's body is compiled without
         // the AVX2 of the sweep's copy when it is not inlined.)
         let (mut c, mut a, mut term) = load_lanes::<N>(st, at);
         let lanes = (&mut c, &mut a, &mut term);
-        let (shaded, none_n, after) = match self.mode {
+        match self.mode {
             // One loop per product width, so that each is straight-line code over the lanes.
             ComposMode::FrontToBack if self.narrow => {
                 let k = self.front_to_back::<N, true>(lanes, sa, sc);
@@ -268,15 +322,16 @@ impl LaneRules {
                 k
             }
             _ => {
+                // `Max` sums its counts itself (per-lane flags made its lanes scalar code): the
+                // sums go to lane 0.
                 let k = self.max::<N>(lanes, sa, sc);
                 store_lanes(st, at, (&c, &a, &term));
-                k
+                let mut out = [[0u32; N]; 3];
+                for (o, k) in out.iter_mut().zip(k) {
+                    o[0] = k;
+                }
+                out
             }
-        };
-        RowCounts {
-            shaded: u64::from(shaded),
-            without_effect: u64::from(none_n),
-            after_termination: u64::from(after),
         }
     }
 
@@ -289,7 +344,7 @@ impl LaneRules {
         (c, a, term): (&mut [[u32; N]; 3], &mut [u32; N], &mut [u32; N]),
         sa: &[u32; N],
         sc: &[[u32; N]; 3],
-    ) -> (u32, u32, u32) {
+    ) -> [u32; 3] {
         let (sh, open) = (self.f - self.q, self.open);
         let (mut shaded, mut none_n, mut after) = (0u32, 0u32, 0u32);
         for i in 0..N {
@@ -307,7 +362,7 @@ impl LaneRules {
             none_n += u32::from(t == 0) & (wins ^ 1);
             shaded += wins;
         }
-        (shaded, none_n, after)
+        [shaded, none_n, after]
     }
 }
 
@@ -335,7 +390,7 @@ fn store_lanes<const N: usize>(
 
 impl LaneRules {
     /// Rule 5 of `FrontToBack` (with rules 1, 3 and 4) on lanes `c`, `a`, `term`; returns the
-    /// counts (shaded, without effect, after termination). `NARROW`: the two products in 32 bits
+    /// per lane 1 where the sample was shaded, without effect, after termination. `NARROW`: the two products in 32 bits
     /// ([`rnd_mul32`], `narrow_products`), else in 64 as `Compos::step_coded` takes them.
     #[inline(always)]
     #[allow(clippy::type_complexity)]
@@ -344,14 +399,14 @@ impl LaneRules {
         (c, a, term): (&mut [[u32; N]; 3], &mut [u32; N], &mut [u32; N]),
         sa: &[u32; N],
         sc: &[[u32; N]; 3],
-    ) -> (u32, u32, u32) {
+    ) -> [[u32; N]; 3] {
         let (f, q) = (self.f, self.q);
         let (et, one, chan_max) = (self.et, self.one, self.chan_max);
         let (half_f, half_q) = (self.half_f, self.half_q);
         let (k, g) = (self.col_k, self.col_g);
         // Rule 4 (past the depth) gives every lane the weight 0.
         let open = self.open;
-        let (mut shaded, mut none_n, mut after) = (0u32, 0u32, 0u32);
+        let [mut shaded, mut none_n, mut after] = [[0u32; N]; 3];
         for i in 0..N {
             let (a_in, t) = (a[i], term[i]);
             // Rule 1 (terminated) and rule 3 (at the threshold): no weight. Rule 5 otherwise; a
@@ -379,11 +434,11 @@ impl LaneRules {
             a[i] = a_out;
             term[i] = t | u32::from(a_out >= et);
             let none = live & (self.past | (sa[i] == 0));
-            after += u32::from(t != 0);
-            none_n += u32::from(none);
-            shaded += u32::from(t == 0) & u32::from(!none);
+            after[i] = u32::from(t != 0);
+            none_n[i] = u32::from(none);
+            shaded[i] = u32::from(t == 0) & u32::from(!none);
         }
-        (shaded, none_n, after)
+        [shaded, none_n, after]
     }
 }
 
