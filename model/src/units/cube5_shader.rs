@@ -608,6 +608,81 @@ fn floor_to_u32(x: f64) -> u32 {
     (x.floor() + (1u64 << 52) as f64).to_bits() as u32
 }
 
+/// Whether [`gather_avx2`] can index the tables with 32-bit lane offsets (its `i32` indices).
+#[inline(always)]
+fn gather_fits(texels: &[Texel], class: &[Rgba]) -> bool {
+    let limit = (i32::MAX as usize) / 16;
+    !texels.is_empty() && !class.is_empty() && texels.len() < limit && class.len() < limit
+}
+
+/// The reflectance-map texels (`d`, `sp`) of eight lanes' cells, corner `(i0, j0)` at `at[n]`
+/// and the others at `+ 1`, `+ side`, `+ side + 1` (the zero texel where `zero[n]` is all ones),
+/// and the class entries' colours of indices `idx[n]`: eight-lane gathers of the same words the
+/// scalar loop loads. An index past a table (never: the cells and class indices are in range)
+/// reads its last entry instead, so no load leaves the tables.
+///
+/// # Safety
+/// The CPU must have AVX2; the tables meet [`gather_fits`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+#[allow(clippy::type_complexity)]
+unsafe fn gather_avx2(
+    texels: &[Texel],
+    zero_texel: Texel,
+    class: &[Rgba],
+    at: &[u32; 8],
+    side: usize,
+    zero: &[u32; 8],
+    idx: &[u32; 8],
+) -> ([[u32; 8]; 4], [[u32; 8]; 4], [[u32; 8]; 3]) {
+    use std::arch::x86_64::*;
+    use std::mem::{offset_of, size_of};
+    // SAFETY (loads and stores below): each array is 32 bytes; `loadu`/`storeu` take any
+    // alignment.
+    let load = |x: &[u32; 8]| unsafe { _mm256_loadu_si256(x.as_ptr().cast()) };
+    let store = |v: __m256i| {
+        let mut o = [0u32; 8];
+        unsafe { _mm256_storeu_si256(o.as_mut_ptr().cast(), v) };
+        o
+    };
+    let set = |x: usize| _mm256_set1_epi32(x as i32);
+    // 32-bit words per entry, and each field's word within it.
+    let (tw, cwords) = (size_of::<Texel>() / 4, size_of::<Rgba>() / 4);
+    let word = |off: usize| off / 4;
+    // The first corner's index, at most the last one whose `+ side + 1` is in the table.
+    let at = _mm256_min_epu32(load(at), set(texels.len().saturating_sub(side + 2)));
+    let zero = load(zero);
+    let tbase = texels.as_ptr().cast::<i32>();
+    let fields = [
+        (word(offset_of!(Texel, d)), zero_texel.d),
+        (word(offset_of!(Texel, sp)), zero_texel.sp),
+    ];
+    let mut out = [[[0u32; 8]; 4]; 2];
+    for (k, off) in [0, 1, side, side + 1].into_iter().enumerate() {
+        let ix = _mm256_mullo_epi32(_mm256_add_epi32(at, set(off)), set(tw));
+        for (o, &(fw, z)) in out.iter_mut().zip(&fields) {
+            // SAFETY: `ix + fw` is a word of `texels` (the index is at most the last entry's).
+            let v = unsafe { _mm256_i32gather_epi32::<4>(tbase.add(fw), ix) };
+            o[k] = store(_mm256_blendv_epi8(v, set(z as usize), zero));
+        }
+    }
+    let idx = _mm256_min_epu32(load(idx), set(class.len() - 1));
+    let ix = _mm256_mullo_epi32(idx, set(cwords));
+    let cbase = class.as_ptr().cast::<i32>();
+    let colour = [
+        word(offset_of!(Rgba, r)),
+        word(offset_of!(Rgba, g)),
+        word(offset_of!(Rgba, b)),
+    ]
+    .map(|fw| {
+        // SAFETY: `ix + fw` is a word of `class` (the index is at most the last entry's).
+        store(unsafe { _mm256_i32gather_epi32::<4>(cbase.add(fw), ix) })
+    });
+    let [d, sp] = out;
+    (d, sp, colour)
+}
+
 /// `rnd(x, s)`: round half up of `x / 2^s`.
 #[inline]
 fn rnd(x: u64, s: u32) -> u64 {
@@ -816,6 +891,38 @@ impl Shader {
         sample: &[u32; N],
         grad: &[[i32; N]; 3],
     ) -> [[u32; N]; 3] {
+        // SAFETY: without `AVX2`, no requirement.
+        unsafe {
+            if self.lit_in_32_bits() {
+                self.shade_lit_lanes_in::<N, false, false>(sample, grad)
+            } else {
+                self.shade_lit_lanes_in::<N, false, true>(sample, grad)
+            }
+        }
+    }
+
+    /// Whether illumination's sums fit 32-bit lanes (`ColorW + DiffW + SpecW < 32`): `c d
+    /// 2^SpecW + sp 2^(ColorW + DiffW - 1) < 2^(ColorW + DiffW + SpecW + 1)`.
+    #[inline(always)]
+    pub fn lit_in_32_bits(&self) -> bool {
+        self.cfg.color_w + self.cfg.diff_w + self.cfg.spec_w < 32
+    }
+
+    /// [`Shader::shade_lit_lanes`]; with `AVX2` and eight lanes, the texels and class entries are
+    /// gathered by AVX2 instructions ([`gather_avx2`]: the same loads, so the same bits) instead
+    /// of lane by lane (scalar stores that the vector arithmetic then reloads whole: a
+    /// store-forwarding stall per row). `WIDE`: illumination in 64-bit lanes; without it the
+    /// widths must allow 32 ([`Shader::lit_in_32_bits`], else a panic). A constant, so that the
+    /// caller's code after it is one way, not two merged.
+    ///
+    /// # Safety
+    /// With `AVX2`, the CPU must have AVX2.
+    #[inline(always)]
+    pub unsafe fn shade_lit_lanes_in<const N: usize, const AVX2: bool, const WIDE: bool>(
+        &self,
+        sample: &[u32; N],
+        grad: &[[i32; N]; 3],
+    ) -> [[u32; N]; 3] {
         let c = &self.cfg;
         let rm = &self.tables.rmap;
         let f = c.rm_frac_w;
@@ -865,6 +972,24 @@ impl Shader {
         let mut colour = [[0u32; N]; 3];
         let class = &self.tables.class.entries;
         let shift = c.sample_w() - c.class_idx_w;
+        #[cfg(target_arch = "x86_64")]
+        if AVX2 && N == 8 && gather_fits(&rm.texels, class) {
+            let lanes = |x: &[u32; N]| -> [u32; 8] { x.as_slice().try_into().expect("8 lanes") };
+            let zero8: [u32; 8] = std::array::from_fn(|n| 0u32.wrapping_sub(u32::from(zero[n])));
+            let idx: [u32; 8] = std::array::from_fn(|n| sample[n] >> shift);
+            // SAFETY: `AVX2` is set only where the CPU has it (this function's contract);
+            // `gather_avx2` reads within the tables' bounds.
+            let (d8, sp8, c8) =
+                unsafe { gather_avx2(&rm.texels, rm.zero, class, &lanes(&at), s, &zero8, &idx) };
+            for k in 0..4 {
+                td[k].copy_from_slice(&d8[k][..N]);
+                tsp[k].copy_from_slice(&sp8[k][..N]);
+            }
+            for ch in 0..3 {
+                colour[ch].copy_from_slice(&c8[ch][..N]);
+            }
+            return self.lit_lanes::<N, WIDE>(&td, &tsp, &colour, &eu, &ev);
+        }
         for n in 0..N {
             for (k, off) in corner.iter().enumerate() {
                 let t = if zero[n] {
@@ -877,6 +1002,23 @@ impl Shader {
             let e = class[(sample[n] >> shift) as usize];
             [colour[0][n], colour[1][n], colour[2][n]] = [e.r, e.g, e.b];
         }
+        self.lit_lanes::<N, WIDE>(&td, &tsp, &colour, &eu, &ev)
+    }
+
+    /// The bilinear sums of the texels `td`, `tsp` (corners `(i0, j0)`, `(i0 + 1, j0)`, `(i0, j0 +
+    /// 1)`, `(i0 + 1, j0 + 1)`) at weights `eu`, `ev`, and the class colours lit by them
+    /// ([`Shader::shade_lit_lanes`]'s arithmetic, on whole lanes).
+    #[inline(always)]
+    fn lit_lanes<const N: usize, const WIDE: bool>(
+        &self,
+        td: &[[u32; N]; 4],
+        tsp: &[[u32; N]; 4],
+        colour: &[[u32; N]; 3],
+        eu: &[u32; N],
+        ev: &[u32; N],
+    ) -> [[u32; N]; 3] {
+        let c = &self.cfg;
+        let f = c.rm_frac_w;
         let one = 1u32 << f;
         let half = 1u32 << (2 * f - 1);
         let (mut d, mut sp) = ([0u32; N], [0u32; N]);
@@ -898,7 +1040,8 @@ impl Shader {
         let (cw, dw, sw) = (c.color_w, c.diff_w, c.spec_w);
         let (lit_half, lit_shift) = (1u64 << (dw + sw - 2), dw - 1 + sw);
         let mut rgb = [[0u32; N]; 3];
-        if cw + dw + sw < 32 {
+        if !WIDE {
+            assert!(self.lit_in_32_bits(), "shade_lit_lanes_in: 64-bit widths");
             // `c d 2^SpecW + sp 2^(ColorW + DiffW - 1) < 2^(ColorW + DiffW + SpecW + 1)`: 32 bits.
             for ch in 0..3 {
                 for n in 0..N {

@@ -565,84 +565,117 @@ impl SliceWork<'_> {
         // minimum says so to the compiler, which then checks no bound per lane.
         let last = self.corrected.len() - 1;
         let idx: [usize; N] = std::array::from_fn(|n| ((centre[n] >> shift) as usize).min(last));
-        let mut sa = [0u32; N];
-        let mut sc = [[0u32; N]; 3];
         if let Some(flat) = self.flat {
-            let flat = &flat[..=last];
-            #[cfg(target_arch = "x86_64")]
-            if AVX2 && N == 8 {
-                let idx8: &[usize; 8] = idx.as_slice().try_into().expect("8 lanes");
-                // SAFETY: `AVX2` is set only in `sweep_band_avx2`'s copy, which runs only on a
-                // CPU with AVX2; `entries_avx2` reads `flat` within its bounds.
-                let [a, r, g, bl] = unsafe { entries_avx2(flat, idx8) };
-                sa.copy_from_slice(&a[..N]);
-                for (sc, e) in sc.iter_mut().zip([r, g, bl]) {
-                    sc.copy_from_slice(&e[..N]);
-                }
-            }
-            if !(AVX2 && N == 8 && cfg!(target_arch = "x86_64")) {
-                for n in 0..N {
-                    let e = flat[idx[n]];
-                    sa[n] = e[0];
-                    for ch in 0..3 {
-                        sc[ch][n] = e[ch + 1];
-                    }
-                }
-            }
+            // Without the gradient: the class entries are the samples' coded alphas and colours.
+            let (sa, sc) = flat_entries::<N, AVX2>(&flat[..=last], &idx);
+            return rules.step_counted::<N>(rays, lane, &sa, &sc);
+        }
+        let corrected = &self.corrected[..=last];
+        let sa: [u32; N] = std::array::from_fn(|n| corrected[idx[n]]);
+        // Only the samples that change their coxel go through gradient and shader; a row without
+        // one composites with colours that are not read. (Each way calls `step` with its own
+        // colours: one array merged from two ways was split into scalar registers.)
+        if !(LIT && rules.any_changes::<N>(rays, lane, &sa)) {
+            return rules.step_counted::<N>(rays, lane, &sa, &[[0; N]; 3]);
+        }
+        if c > 0 {
+            self.ensure(band, b as isize, c - 1);
+        }
+        if (c + 1) * BLOCK < ni {
+            self.ensure(band, b as isize, c + 1);
+        }
+        self.ensure(band, b as isize - 1, c);
+        self.ensure(band, b as isize + 1, c);
+        // `B = S'(s-1)` and `A = S'(s+1)` of the anchors, in lanes.
+        let before = self.other_row::<N>(self.k_before, a0, b);
+        let after = self.other_row::<N>(self.k_after, a0, b);
+        // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
+        // (`n6_components`, `shader_in`): the differences themselves, 0 read past the faces. The
+        // magnitude is not computed: the frame never classifies in 2-D. Every lane is shaded; a
+        // sample that changes nothing has its colours not read.
+        let row = |rr: usize| &band.rows[rr * ni..(rr + 1) * ni];
+        let (mid, zeros) = (row(r), [0u32; N]);
+        let left = if a0 > 0 { mid[a0 - 1] } else { 0 };
+        let right = if a0 + N < ni { mid[a0 + N] } else { 0 };
+        let xm = |n: usize| if n == 0 { left } else { centre[n - 1] };
+        let xp = |n: usize| if n + 1 == N { right } else { centre[n + 1] };
+        let up = if b > 0 {
+            &row(r - 1)[a0..a0 + N]
         } else {
-            let corrected = &self.corrected[..=last];
-            sa = std::array::from_fn(|n| corrected[idx[n]]);
+            &zeros
+        };
+        let down = if b + 1 < nj {
+            &row(r + 1)[a0..a0 + N]
+        } else {
+            &zeros
+        };
+        let diff = |p: u32, m: u32| p as i32 - m as i32;
+        let grad: [[i32; N]; 3] = [
+            std::array::from_fn(|n| diff(xp(n), xm(n))),
+            std::array::from_fn(|n| diff(down[n], up[n])),
+            std::array::from_fn(|n| diff(after[n], before[n])),
+        ];
+        // One copy of the rest per illumination width (a constant in each).
+        let shaded = (&centre, &grad, &sa);
+        if units.shader.lit_in_32_bits() {
+            self.shade_step::<N, AVX2, false>(rays, lane, shaded);
+        } else {
+            self.shade_step::<N, AVX2, true>(rays, lane, shaded);
         }
-        if LIT && self.flat.is_none() {
-            // The samples that change their coxel go through gradient and shader.
-            if rules.any_changes::<N>(rays, lane, &sa) {
-                if c > 0 {
-                    self.ensure(band, b as isize, c - 1);
-                }
-                if (c + 1) * BLOCK < ni {
-                    self.ensure(band, b as isize, c + 1);
-                }
-                self.ensure(band, b as isize - 1, c);
-                self.ensure(band, b as isize + 1, c);
-                // `B = S'(s-1)` and `A = S'(s+1)` of the anchors, in lanes.
-                let before = self.other_row::<N>(self.k_before, a0, b);
-                let after = self.other_row::<N>(self.k_after, a0, b);
-                // The `N6` components `16 (s(+1) - s(-1))` through the adapter's `>> 4`
-                // (`n6_components`, `shader_in`): the differences themselves, 0 read past the
-                // faces. The magnitude is not computed: the frame never classifies in 2-D. Every
-                // lane is shaded; a sample that changes nothing has its colours not read.
-                let row = |rr: usize| &band.rows[rr * ni..(rr + 1) * ni];
-                let (mid, zeros) = (row(r), [0u32; N]);
-                let left = if a0 > 0 { mid[a0 - 1] } else { 0 };
-                let right = if a0 + N < ni { mid[a0 + N] } else { 0 };
-                let xm = |n: usize| if n == 0 { left } else { centre[n - 1] };
-                let xp = |n: usize| if n + 1 == N { right } else { centre[n + 1] };
-                let up = if b > 0 {
-                    &row(r - 1)[a0..a0 + N]
-                } else {
-                    &zeros
-                };
-                let down = if b + 1 < nj {
-                    &row(r + 1)[a0..a0 + N]
-                } else {
-                    &zeros
-                };
-                let diff = |p: u32, m: u32| p as i32 - m as i32;
-                let grad: [[i32; N]; 3] = [
-                    std::array::from_fn(|n| diff(xp(n), xm(n))),
-                    std::array::from_fn(|n| diff(down[n], up[n])),
-                    std::array::from_fn(|n| diff(after[n], before[n])),
-                ];
-                let rgb = units.shader.shade_lit_lanes(&centre, &grad);
-                // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
-                sc = rules.colour_codes(&rgb);
-            }
-        }
-        let k = rules.step::<N>(rays, lane, &sa, &sc);
-        st.shaded += k.shaded;
-        st.without_effect += k.without_effect;
-        st.after_termination += k.after_termination;
     }
+
+    /// Samples `centre` with gradients `grad` and corrected alphas `sa` through the shader
+    /// (`WIDE`: illumination in 64-bit lanes), coded and composited onto lanes `lane ..`.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    fn shade_step<const N: usize, const AVX2: bool, const WIDE: bool>(
+        &self,
+        rays: &mut RayLanes,
+        lane: usize,
+        (centre, grad, sa): (&[u32; N], &[[i32; N]; 3], &[u32; N]),
+    ) {
+        // SAFETY: `AVX2` is set only in `sweep_band_avx2`'s copy, which runs only on a CPU with
+        // AVX2.
+        let rgb = unsafe {
+            self.units
+                .shader
+                .shade_lit_lanes_in::<N, AVX2, WIDE>(centre, grad)
+        };
+        // `Compos::code` of the colours (its alpha is `sa[n]`: lighting keeps alpha).
+        let sc = self.rules.colour_codes(&rgb);
+        self.rules.step_counted::<N>(rays, lane, sa, &sc);
+    }
+}
+
+/// The class entries `flat[idx[n]]` of `N` lanes as rows of lanes: the corrected alphas and the
+/// three colour codes (`AVX2` with eight lanes: [`entries_avx2`]).
+#[inline(always)]
+fn flat_entries<const N: usize, const AVX2: bool>(
+    flat: &[[u32; 4]],
+    idx: &[usize; N],
+) -> ([u32; N], [[u32; N]; 3]) {
+    let mut sa = [0u32; N];
+    let mut sc = [[0u32; N]; 3];
+    #[cfg(target_arch = "x86_64")]
+    if AVX2 && N == 8 {
+        let idx8: &[usize; 8] = idx.as_slice().try_into().expect("8 lanes");
+        // SAFETY: `AVX2` is set only in `sweep_band_avx2`'s copy, which runs only on a CPU with
+        // AVX2; `entries_avx2` reads `flat` within its bounds.
+        let [a, r, g, bl] = unsafe { entries_avx2(flat, idx8) };
+        sa.copy_from_slice(&a[..N]);
+        for (sc, e) in sc.iter_mut().zip([r, g, bl]) {
+            sc.copy_from_slice(&e[..N]);
+        }
+        return (sa, sc);
+    }
+    for n in 0..N {
+        let e = flat[idx[n]];
+        sa[n] = e[0];
+        for ch in 0..3 {
+            sc[ch][n] = e[ch + 1];
+        }
+    }
+    (sa, sc)
 }
 
 /// One band of the base plane: rows `q ..` (`rows`, `w` coxels each), and the plane rows that its
@@ -692,6 +725,10 @@ fn sweep_band<const LIT: bool, const AVX2: bool>(slices: &[SliceWork], band: Ban
         st = st.add(work.band::<LIT, AVX2>(b0, &mut rays, at * w, (b1 - b0, w), &mut band));
     }
     rays.write(&init, rows);
+    let k = rays.row_counts();
+    st.shaded += k.shaded;
+    st.without_effect += k.without_effect;
+    st.after_termination += k.after_termination;
     st.rays_terminated = rays.term.iter().filter(|&&t| t != 0).count() as u64;
     st
 }

@@ -19,7 +19,14 @@ pub(super) struct RayLanes {
     pub a: Vec<u32>,
     /// 1: the ray is terminated.
     pub term: Vec<u32>,
+    /// The counts of the rows composited so far (shaded, without effect, after termination),
+    /// per lane of a row: added lane by lane, summed once at the band's end (a sum per row cost
+    /// three horizontal additions).
+    pub counts: [[u32; LANES]; 3],
 }
+
+/// Lanes of the widest row ([`RayLanes::counts`]).
+pub(super) const LANES: usize = 8;
 
 impl RayLanes {
     /// `len` empty coxels.
@@ -28,6 +35,17 @@ impl RayLanes {
             c: std::array::from_fn(|_| vec![0; len]),
             a: vec![0; len],
             term: vec![0; len],
+            counts: [[0; LANES]; 3],
+        }
+    }
+
+    /// The counts of every row composited so far.
+    pub fn row_counts(&self) -> RowCounts {
+        let sum = |k: &[u32; LANES]| k.iter().map(|&x| u64::from(x)).sum::<u64>();
+        RowCounts {
+            shaded: sum(&self.counts[0]),
+            without_effect: sum(&self.counts[1]),
+            after_termination: sum(&self.counts[2]),
         }
     }
 
@@ -83,6 +101,10 @@ pub(super) struct LaneRules {
     narrow: bool,
     col_k: u32,
     col_g: u32,
+    /// `unit_code(c, ColorW, AccW)` from `e = expand_double(c)` as `((e << up) + half) >> down`:
+    /// `e 2^(AccW - 2 ColorW)` when `AccW >= 2 ColorW` (`down = 0`, `half = 0`), else `rnd(e, 2
+    /// ColorW - AccW)` (`up = 0`).
+    code_shifts: (u32, u32, u32),
 }
 
 /// `rnd(x y, s) = floor((x y + 2^(s-1)) / 2^s)` in 32 bits, for `1 <= s <= 16`, `y <= 2^s` and `x
@@ -142,6 +164,12 @@ impl LaneRules {
             narrow: narrow_products(cfg.acc_w, cfg.q(), cfg.color_w).is_some(),
             col_k: narrow_products(cfg.acc_w, cfg.q(), cfg.color_w).map_or(0, |p| p.0),
             col_g: narrow_products(cfg.acc_w, cfg.q(), cfg.color_w).map_or(1, |p| p.1),
+            code_shifts: if cfg.acc_w >= 2 * cfg.color_w {
+                (cfg.acc_w - 2 * cfg.color_w, 0, 0)
+            } else {
+                let k = 2 * cfg.color_w - cfg.acc_w;
+                (0, k, 1 << (k - 1))
+            },
         })
     }
 
@@ -150,22 +178,15 @@ impl LaneRules {
     /// 2^(2 ColorW) <= 2^24` (`ColorW <= 12`), and the code is at most `2^AccW <= 2^28`.
     #[inline(always)]
     pub fn colour_codes<const N: usize>(&self, c: &[[u32; N]; 3]) -> [[u32; N]; 3] {
-        let (w, f) = (self.cw, self.f);
+        let w = self.cw;
+        let (up, down, half) = self.code_shifts;
         let expand = |c: u32| c * ((1 << w) + 1) + (c >> (w - 1));
+        // One formula for both cases (`code_shifts`), so that the lanes take it straight, with
+        // no branch whose two results the compiler would merge lane by lane.
         let mut out = [[0u32; N]; 3];
-        // One loop per case, so that each is straight-line code over the lanes.
-        if f >= 2 * w {
-            for ch in 0..3 {
-                for n in 0..N {
-                    out[ch][n] = expand(c[ch][n]) << (f - 2 * w);
-                }
-            }
-        } else {
-            let (k, half) = (2 * w - f, 1 << (2 * w - f - 1));
-            for ch in 0..3 {
-                for n in 0..N {
-                    out[ch][n] = (expand(c[ch][n]) + half) >> k;
-                }
+        for ch in 0..3 {
+            for n in 0..N {
+                out[ch][n] = ((expand(c[ch][n]) << up) + half) >> down;
             }
         }
         out
@@ -239,7 +260,7 @@ impl LaneRules {
     /// `Compos::step_coded` of the samples `sa[n]` (corrected alpha) and `sc[ch][n]` (colour
     /// codes on the coxel's scale) onto lanes `at .. at + N`, in this slice's mode; the colours
     /// of a sample that changes nothing are not read. Returns the sweep's counts of the row.
-    #[inline(always)]
+    #[cfg(test)]
     pub fn step<const N: usize>(
         &self,
         st: &mut RayLanes,
@@ -247,59 +268,129 @@ impl LaneRules {
         sa: &[u32; N],
         sc: &[[u32; N]; 3],
     ) -> RowCounts {
-        let [c0, c1, c2] = &mut st.c;
-        let lanes = |v: &mut Vec<u32>| -> [u32; N] { v[at..at + N].try_into().expect("N lanes") };
-        let (mut c, mut a, mut term) = (
-            [lanes(c0), lanes(c1), lanes(c2)],
-            lanes(&mut st.a),
-            lanes(&mut st.term),
-        );
-        let (mut shaded, mut none_n, mut after) = (0u32, 0u32, 0u32);
-        match self.mode {
-            ComposMode::FrontToBack => {
-                // One loop per product width, so that each is straight-line code over the lanes.
-                let lanes = (&mut c, &mut a, &mut term);
-                (shaded, none_n, after) = if self.narrow {
-                    self.front_to_back::<N, true>(lanes, sa, sc)
-                } else {
-                    self.front_to_back::<N, false>(lanes, sa, sc)
-                };
-            }
-            _ => {
-                let (sh, open) = (self.f - self.q, self.open);
-                for i in 0..N {
-                    let t = term[i];
-                    let aw = sa[i] << sh;
-                    // Rule 5 of `Max`: the sample replaces the coxel when it is above it. As a
-                    // lane mask (`&` of flags, not `&&`, and selects by masks: no branch).
-                    let wins = u32::from(t == 0) & open & u32::from(aw > a[i]);
-                    let m = 0u32.wrapping_sub(wins);
-                    for ch in 0..3 {
-                        c[ch][i] = (sc[ch][i] & m) | (c[ch][i] & !m);
-                    }
-                    a[i] = (aw & m) | (a[i] & !m);
-                    after += u32::from(t != 0);
-                    none_n += u32::from(t == 0) & (wins ^ 1);
-                    shaded += wins;
-                }
-            }
-        }
-        c0[at..at + N].copy_from_slice(&c[0]);
-        c1[at..at + N].copy_from_slice(&c[1]);
-        c2[at..at + N].copy_from_slice(&c[2]);
-        st.a[at..at + N].copy_from_slice(&a);
-        st.term[at..at + N].copy_from_slice(&term);
+        let k = self.step_lanes::<N>(st, at, sa, sc);
+        let sum = |k: &[u32; N]| k.iter().map(|&x| u64::from(x)).sum::<u64>();
         RowCounts {
-            shaded: u64::from(shaded),
-            without_effect: u64::from(none_n),
-            after_termination: u64::from(after),
+            shaded: sum(&k[0]),
+            without_effect: sum(&k[1]),
+            after_termination: sum(&k[2]),
         }
     }
+
+    /// [`LaneRules::step`], its counts added to `st.counts` lane by lane (`N <= LANES`).
+    #[inline(always)]
+    pub fn step_counted<const N: usize>(
+        &self,
+        st: &mut RayLanes,
+        at: usize,
+        sa: &[u32; N],
+        sc: &[[u32; N]; 3],
+    ) {
+        let k = self.step_lanes::<N>(st, at, sa, sc);
+        for (acc, k) in st.counts.iter_mut().zip(&k) {
+            for n in 0..N {
+                acc[n] += k[n];
+            }
+        }
+    }
+
+    /// [`LaneRules::step`]'s work: per lane the samples shaded, without effect, after termination
+    /// (`FrontToBack`: 1 or 0 a lane; `Max`: the row's sums in lane 0).
+    #[inline(always)]
+    fn step_lanes<const N: usize>(
+        &self,
+        st: &mut RayLanes,
+        at: usize,
+        sa: &[u32; N],
+        sc: &[[u32; N]; 3],
+    ) -> [[u32; N]; 3] {
+        // Each way loads, computes and stores the lanes itself: one set of lanes merged from two
+        // ways was split into scalar registers. (No closures: a closure's body is compiled without
+        // the AVX2 of the sweep's copy when it is not inlined.)
+        let (mut c, mut a, mut term) = load_lanes::<N>(st, at);
+        let lanes = (&mut c, &mut a, &mut term);
+        match self.mode {
+            // One loop per product width, so that each is straight-line code over the lanes.
+            ComposMode::FrontToBack if self.narrow => {
+                let k = self.front_to_back::<N, true>(lanes, sa, sc);
+                store_lanes(st, at, (&c, &a, &term));
+                k
+            }
+            ComposMode::FrontToBack => {
+                let k = self.front_to_back::<N, false>(lanes, sa, sc);
+                store_lanes(st, at, (&c, &a, &term));
+                k
+            }
+            _ => {
+                // `Max` sums its counts itself (per-lane flags made its lanes scalar code): the
+                // sums go to lane 0.
+                let k = self.max::<N>(lanes, sa, sc);
+                store_lanes(st, at, (&c, &a, &term));
+                let mut out = [[0u32; N]; 3];
+                for (o, k) in out.iter_mut().zip(k) {
+                    o[0] = k;
+                }
+                out
+            }
+        }
+    }
+
+    /// Rule 5 of `Max` (with rules 1 and 4) on lanes `c`, `a`, `term`; returns the counts
+    /// (shaded, without effect, after termination).
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    fn max<const N: usize>(
+        &self,
+        (c, a, term): (&mut [[u32; N]; 3], &mut [u32; N], &mut [u32; N]),
+        sa: &[u32; N],
+        sc: &[[u32; N]; 3],
+    ) -> [u32; 3] {
+        let (sh, open) = (self.f - self.q, self.open);
+        let (mut shaded, mut none_n, mut after) = (0u32, 0u32, 0u32);
+        for i in 0..N {
+            let t = term[i];
+            let aw = sa[i] << sh;
+            // The sample replaces the coxel when it is above it. As a lane mask (`&` of flags,
+            // not `&&`, and selects by masks: no branch).
+            let wins = u32::from(t == 0) & open & u32::from(aw > a[i]);
+            let m = 0u32.wrapping_sub(wins);
+            for ch in 0..3 {
+                c[ch][i] = (sc[ch][i] & m) | (c[ch][i] & !m);
+            }
+            a[i] = (aw & m) | (a[i] & !m);
+            after += u32::from(t != 0);
+            none_n += u32::from(t == 0) & (wins ^ 1);
+            shaded += wins;
+        }
+        [shaded, none_n, after]
+    }
+}
+
+/// Lanes `at .. at + N` of `st`: colours, alpha, flag.
+#[inline(always)]
+fn load_lanes<const N: usize>(st: &RayLanes, at: usize) -> ([[u32; N]; 3], [u32; N], [u32; N]) {
+    let lanes = |v: &Vec<u32>| -> [u32; N] { v[at..at + N].try_into().expect("N lanes") };
+    (st.c.each_ref().map(lanes), lanes(&st.a), lanes(&st.term))
+}
+
+/// [`load_lanes`]'s lanes written back.
+#[inline(always)]
+#[allow(clippy::type_complexity)]
+fn store_lanes<const N: usize>(
+    st: &mut RayLanes,
+    at: usize,
+    (c, a, term): (&[[u32; N]; 3], &[u32; N], &[u32; N]),
+) {
+    for (v, c) in st.c.iter_mut().zip(c) {
+        v[at..at + N].copy_from_slice(c);
+    }
+    st.a[at..at + N].copy_from_slice(a);
+    st.term[at..at + N].copy_from_slice(term);
 }
 
 impl LaneRules {
     /// Rule 5 of `FrontToBack` (with rules 1, 3 and 4) on lanes `c`, `a`, `term`; returns the
-    /// counts (shaded, without effect, after termination). `NARROW`: the two products in 32 bits
+    /// per lane 1 where the sample was shaded, without effect, after termination. `NARROW`: the two products in 32 bits
     /// ([`rnd_mul32`], `narrow_products`), else in 64 as `Compos::step_coded` takes them.
     #[inline(always)]
     #[allow(clippy::type_complexity)]
@@ -308,14 +399,14 @@ impl LaneRules {
         (c, a, term): (&mut [[u32; N]; 3], &mut [u32; N], &mut [u32; N]),
         sa: &[u32; N],
         sc: &[[u32; N]; 3],
-    ) -> (u32, u32, u32) {
+    ) -> [[u32; N]; 3] {
         let (f, q) = (self.f, self.q);
         let (et, one, chan_max) = (self.et, self.one, self.chan_max);
         let (half_f, half_q) = (self.half_f, self.half_q);
         let (k, g) = (self.col_k, self.col_g);
         // Rule 4 (past the depth) gives every lane the weight 0.
         let open = self.open;
-        let (mut shaded, mut none_n, mut after) = (0u32, 0u32, 0u32);
+        let [mut shaded, mut none_n, mut after] = [[0u32; N]; 3];
         for i in 0..N {
             let (a_in, t) = (a[i], term[i]);
             // Rule 1 (terminated) and rule 3 (at the threshold): no weight. Rule 5 otherwise; a
@@ -343,11 +434,11 @@ impl LaneRules {
             a[i] = a_out;
             term[i] = t | u32::from(a_out >= et);
             let none = live & (self.past | (sa[i] == 0));
-            after += u32::from(t != 0);
-            none_n += u32::from(none);
-            shaded += u32::from(t == 0) & u32::from(!none);
+            after[i] = u32::from(t != 0);
+            none_n[i] = u32::from(none);
+            shaded[i] = u32::from(t == 0) & u32::from(!none);
         }
-        (shaded, none_n, after)
+        [shaded, none_n, after]
     }
 }
 
