@@ -1729,7 +1729,7 @@ impl crate::unit::StreamCodec for ProcessorRtlConfig {
     }
 
     fn out_width(&self) -> u32 {
-        1 + 256 + OUT_COUNTS * COUNT_W
+        1 + 256 + OUT_COUNTS * COUNT_W + 1
     }
 
     fn pack_in(&self, item: &Self::In) -> Vec<u32> {
@@ -1752,7 +1752,7 @@ impl crate::unit::StreamCodec for ProcessorRtlConfig {
             cycles: c(),
             cache_hits: c(),
             cache_misses: c(),
-            flush: false,
+            flush: r.get_bool(),
         }
     }
 }
