@@ -25,10 +25,9 @@ module gicube_deposit #(
   /// The item is taken this clock.
   output logic in_ready_o,
   /// x, y, z (MW bits each), E (red, 12), opacity (12), the fractions f_x, f_y, f_z (8 each), op
-  /// (2: 0 read, 1 deposit, 2 flush); LSB first.
-  input  logic [3*MW+12+12+24+2-1:0] in_data_i,
-  /// The volume's dimensions (7 bits each, x lowest): a corner at or above one gets nothing.
-  input  logic [20:0] dims_i,
+  /// (2: 0 read, 1 deposit, 2 flush), the volume's dimensions (7 bits each, x lowest: a corner at
+  /// or above one gets nothing); LSB first.
+  input  logic [3*MW+12+12+24+2+21-1:0] in_data_i,
 
   /// Cache item valid.
   output logic out_valid_o,
@@ -58,6 +57,7 @@ module gicube_deposit #(
   logic [11:0]      i_e, i_op_a;
   logic [7:0]       i_f [3];
   logic [1:0]       i_op;
+  logic [20:0]      i_dims;
 
   assign i_cell = in_data_i[0 +: CellW];
   assign i_e    = in_data_i[CellW +: 12];
@@ -65,7 +65,8 @@ module gicube_deposit #(
   for (genvar a = 0; a < 3; a++) begin : gen_f
     assign i_f[a] = in_data_i[CellW + 24 + 8 * a +: 8];
   end
-  assign i_op = in_data_i[CellW + 48 +: 2];
+  assign i_op   = in_data_i[CellW + 48 +: 2];
+  assign i_dims = in_data_i[CellW + 50 +: 21];
 
   // Stage 1: E T, the four x-y weight products, the z weights, the corners inside the volume.
   logic             v1_q;
@@ -90,7 +91,7 @@ module gicube_deposit #(
       in_vol[c] = 1'b1;
       for (int a = 0; a < 3; a++) begin
         if ({1'b0, i_cell[a * MW +: MW]} + (MW + 1)'((c >> a) & 1) >=
-            (MW + 1)'(dims_i[7 * a +: 7])) begin
+            (MW + 1)'(i_dims[7 * a +: 7])) begin
           in_vol[c] = 1'b0;
         end
       end

@@ -178,7 +178,7 @@ module gicube_processor #(
   localparam int unsigned WordW    = (Light != 0) ? 32 : (VoxelW <= 8) ? 8 : 16;
   localparam int unsigned IrrW     = gicube_sample_pkg::IrrW;
   localparam int unsigned CaInW    = 3 * MW + ((Light != 0) ? 2 + 8 * IrrW : 0);
-  localparam int unsigned DpInW    = 3 * MW + 12 + 12 + 3 * PosFracW + 2;
+  localparam int unsigned DpInW    = 3 * MW + 12 + 12 + 3 * PosFracW + 2 + 21;
   localparam int unsigned CaOutW   = 8 * WordW + 8 + 2 * 32 + 16;    // vox, hit, hits, misses, stall
   // flush, lighting, colour, weights
   localparam int unsigned CellW    = 1 + 1 + 48 + 3 * PosFracW;
@@ -469,7 +469,7 @@ module gicube_processor #(
     logic [1:0]       dp_op;
     assign dp_op = flush_go ? 2'd2
                  : (o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeLighting) ? 2'd1 : 2'd0;
-    assign dp_in = {dp_op,
+    assign dp_in = {dims_q, dp_op,
                     o_pop_ray[StartLsb + 2 * PosW +: PosFracW],
                     o_pop_ray[StartLsb + PosW +: PosFracW], o_pop_ray[StartLsb +: PosFracW],
                     o_pop_ray[ColLsb + 36 +: 12], o_pop_ray[ColLsb +: 12], cell_xyz};
@@ -483,7 +483,6 @@ module gicube_processor #(
       .in_valid_i  (smp_req || flush_go),
       .in_ready_o  (fetch_ready),
       .in_data_i   (dp_in),
-      .dims_i      (dims_q),
       .out_valid_o (ca_in_valid),
       .out_ready_i (ca_in_ready),
       .out_data_o  (ca_in)

@@ -18,10 +18,11 @@ use crate::camera::Camera;
 use crate::error::{ModelError, Result};
 use crate::transfer::TransferFunction;
 use crate::units::cube5_axi_rd::{AxiMemImage, Burst};
-use crate::units::cube5_compos::{corrected_alpha, rnd};
+use crate::units::cube5_compos::corrected_alpha;
 use crate::units::cube5_shader::ClassLut;
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_cache::{CacheConfig, CacheItem, CacheReq, VolumeCache};
+use crate::units::gicube_deposit as deposit;
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_queue_front::{Chooser, FrontTraffic, QueueFront};
 use crate::units::gicube_sample::{jitter_index, Jitter, SampleConfig, SampleIn, Sampler};
@@ -31,13 +32,13 @@ use crate::volume::Volume;
 
 // The packet channel's maximum, the sample's and the irradiance's fraction bits and the unit
 // configurations of the sample datapath are `gicube_sample`'s (the one description of a sample).
+/// The splat's rounding shift (the deposit unit's, `gicube_deposit`).
+pub use crate::units::gicube_deposit::DEPOSIT_SHIFT;
+/// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
+pub use crate::units::gicube_queue_front::SORTER_SLOTS;
 pub use crate::units::gicube_sample::{
     compos_config, shader_config, CHAN_MAX, IRR_FRAC_W, SAMPLE_FRAC_W,
 };
-/// `E (12) + T (12) + dr (8) + w_c (24) - IRR_FRAC_W`: the splat's rounding shift.
-pub const DEPOSIT_SHIFT: u32 = 12 + 12 + POS_FRAC_W + 3 * POS_FRAC_W - IRR_FRAC_W;
-/// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
-pub use crate::units::gicube_queue_front::SORTER_SLOTS;
 
 /// Largest ring latency, processor cycles (the RTL's `RingLat`: 1..=16).
 pub const MAX_RING_LATENCY: u32 = 16;
@@ -741,23 +742,13 @@ impl Processor {
     pub fn deposit_energies(&self, ray: &RayPacket) -> [u32; 8] {
         let base = ray.start.map(|c| i64::from(c >> POS_FRAC_W));
         let f = ray.start.map(|c| c & ((1 << POS_FRAC_W) - 1));
-        let e = u64::from(ray.color[0]);
         let t = if self.photon_albedo.is_some() {
-            u64::from(CHAN_MAX + 1)
+            CHAN_MAX + 1
         } else {
-            u64::from(CHAN_MAX + 1 - u32::from(ray.opacity))
+            CHAN_MAX + 1 - u32::from(ray.opacity)
         };
-        let ets = e * t * u64::from(self.cfg.step);
-        std::array::from_fn(|c| {
-            if voxel_index(self.vol.dims, corner(base, c)).is_none() {
-                return 0;
-            }
-            let w = (0..3).fold(1u64, |acc, a| {
-                let fa = u64::from(f[a]);
-                acc * if (c >> a) & 1 == 1 { fa } else { 256 - fa }
-            });
-            rnd(ets * w, DEPOSIT_SHIFT).min(u64::from(u16::MAX)) as u32
-        })
+        let inside = std::array::from_fn(|c| voxel_index(self.vol.dims, corner(base, c)).is_some());
+        deposit::energies(u32::from(ray.color[0]), t, self.cfg.step, f, inside)
     }
 
     /// One pipeline cycle on a ray of queue `q`: a sample (or a leap), then the advance.
