@@ -530,6 +530,17 @@ fn gi_lighting_pass_leaves_the_models_field_in_memory_and_lights_the_image() {
     }
 }
 
+/// The two GI passes at 32^3 and 64^3 (the `full` `Light` configurations).
+#[test]
+#[ignore = "sim-full: the two GI passes at 32^3 and 64^3 (the `full` variants)"]
+fn large_gi_passes_equal_the_model() {
+    for (variant, rtl) in configs::<ProcessorRtlConfig>() {
+        if rtl.light == 1 && rtl.side() > 16 {
+            two_pass_gi(variant, rtl, seed(1975));
+        }
+    }
+}
+
 fn ci_configs() -> Vec<(&'static Variant, ProcessorRtlConfig)> {
     configs::<ProcessorRtlConfig>()
         .into_iter()
@@ -691,7 +702,7 @@ fn a_model_with_another_ring_latency_counts_other_cycles() {
 #[ignore = "sim-full: 32^3 and 64^3 frames (the `full` variants), parallel and perspective"]
 fn large_frames_equal_the_model_with_every_count() {
     for (variant, rtl) in configs::<ProcessorRtlConfig>() {
-        if rtl.side() <= 16 {
+        if rtl.side() <= 16 || rtl.light == 1 {
             continue;
         }
         let px = rtl.side();
