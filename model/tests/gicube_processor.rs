@@ -441,6 +441,78 @@ mod gi {
         assert!(db_mc > 25.0, "GI method vs MC {db_mc}");
     }
 
+    /// The lighting pass through a splatting cache (contract, *Splatting through the cache*):
+    /// one item per sample (a lighting sample's deposit is its read), in the sample order, then a
+    /// flush. Memory then holds the volume with the field above it, equal to `irradiance()` and
+    /// to the field of a read-only cache (the same additions in the same order); the counts and
+    /// the two-pass image equal; every missed line read once and every dirty line written back.
+    #[test]
+    fn lighting_through_the_splatting_cache_leaves_the_field_in_memory() {
+        let n = 16;
+        let (vol, tf, light) = shadow_scene(n).unwrap();
+        let splat = CacheConfig {
+            max_dim: 32,
+            word_w: 32,
+            data_w: 64,
+            line_vox: 8,
+            sets: 8,
+            splat: 1,
+            ..CacheConfig::DEFAULT
+        };
+        let cfg = |cache| ProcessorConfig {
+            block_log2: 2,
+            ring_latency: 3,
+            cache: Some(cache),
+            ..ProcessorConfig::DEFAULT
+        };
+        let mut p = Processor::new(cfg(splat), &vol, &tf).unwrap();
+        let (lc, t) = p.light_cache_traced(&light).unwrap();
+        check_conservation(&lc);
+        let field = p.irradiance().unwrap().to_vec();
+        assert!(field.iter().any(|&v| v > 0));
+        let m = splat.max_dim as usize;
+        for z in 0..m {
+            for y in 0..m {
+                for x in 0..m {
+                    let w = t.memory[x + m * (y + m * z)];
+                    let inside = x < n && y < n && z < n;
+                    let irr = if inside {
+                        field[x + n * (y + n * z)]
+                    } else {
+                        0
+                    };
+                    assert_eq!(w >> 16, u32::from(irr), "field at ({x}, {y}, {z})");
+                    assert_eq!(w & 0xffff, vol.get(x as i64, y as i64, z as i64));
+                }
+            }
+        }
+        assert_eq!(t.reads.len() as u64, lc.counts.cache_misses);
+        assert!(!t.writes.is_empty());
+        let read_only = CacheConfig {
+            word_w: 16,
+            splat: 0,
+            ..splat
+        };
+        let mut q = Processor::new(cfg(read_only), &vol, &tf).unwrap();
+        let (lq, tq) = q.light_cache_traced(&light).unwrap();
+        assert_eq!(q.irradiance().unwrap(), field.as_slice());
+        // The same lines (at other byte addresses: the words are narrower).
+        assert_eq!((lq.counts, tq.reads.len()), (lc.counts, t.reads.len()));
+        assert!(tq.writes.is_empty());
+        let cam = scene_camera(&vol, 16);
+        let (fp, fq) = (
+            p.render(&cam, Projection::Parallel).unwrap(),
+            q.render(&cam, Projection::Parallel).unwrap(),
+        );
+        assert_eq!((fp.rgb, fp.counts), (fq.rgb, fq.counts));
+        println!(
+            "16^3 lighting pass: {} samples, {} lines read, {} written back (flush included)",
+            lc.counts.samples,
+            t.reads.len(),
+            t.writes.len()
+        );
+    }
+
     #[test]
     fn irradiance_does_not_depend_on_queue_order() {
         let (vol, tf, light) = shadow_scene(24).unwrap();

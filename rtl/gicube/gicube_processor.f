@@ -4,5 +4,6 @@
 -f rtl/gicube/gicube_cache.f
 rtl/gicube/gicube_step_div.sv
 rtl/gicube/gicube_step.sv
+rtl/gicube/gicube_deposit.sv
 rtl/cube5/cube5_frame_fifo.sv
 rtl/gicube/gicube_processor.sv

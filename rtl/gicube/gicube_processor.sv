@@ -24,6 +24,14 @@
 // layout, padded to MaxDim > N): a sampling ray's cell goes to the cache at dispatch (which waits
 // while the cache holds a request for its fills), its eight voxels to gicube_sample. A cache
 // stall delays processor cycles (the issue waits for the ring's head), never reorders them.
+//
+// Light = 1 (the lighting pass of GI, docs/gicube-rtl.md step 7; contract "Splatting through the
+// cache"): 32-bit words, the irradiance field above the voxel; every sampling ray's cell goes to
+// the cache through gicube_deposit, which gives a lighting ray's item its eight corner energies
+// (a deposit: its read too), a rendering ray's a read; the cache splats (Splat = 1) and writes its
+// dirty lines back through the AXI4 write channels; a flush (configuration region 3) enters the
+// same stream when the processor holds no ray, and its output item (`flush`) comes when memory
+// holds every deposit. Rendering rays are lit by the field when `lit` (region 2) is set.
 module gicube_processor #(
   /// Block side n = 2^BlockLog2 voxels, 2..8.
   parameter int unsigned BlockLog2 = 2,
@@ -46,7 +54,10 @@ module gicube_processor #(
   /// Lines per cache bank (gicube_cache's Sets).
   parameter int unsigned Sets        = 32,
   /// Line reads in flight at most (gicube_cache's Outstanding).
-  parameter int unsigned Outstanding = 8
+  parameter int unsigned Outstanding = 8,
+  /// 1: lighting rays splat into the field in memory (32-bit words, the cache's Splat = 1, the
+  /// AXI4 write channels, the flush); 0: direct volume rendering (the write channels idle).
+  parameter int unsigned Light       = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -64,21 +75,23 @@ module gicube_processor #(
   input  logic out_ready_i,
   /// done (1: finished, 0: overflowed), ray (256), then the counts after it: rays_in,
   /// rays_finished, rays_overflowed, samples, leaps, cycles, cache_hits, cache_misses (32
-  /// each); LSB first.
-  output logic [1+gicube_pkg::PacketW+8*32-1:0] out_data_o,
+  /// each), then flush (1: the flush's item, done and ray 0); LSB first.
+  output logic [1+gicube_pkg::PacketW+8*32+1-1:0] out_data_o,
 
   /// Configuration write this clock (tables, empty flags; they survive reset).
   input  logic cfg_valid_i,
   /// Region (top 2 bits): 0 gicube_sample's address (low 14 bits), 1 the empty flag of queue
-  /// (low bits).
+  /// (low bits); Light: 2 the volume's dimensions and lit, 3 a flush.
   input  logic [2+gicube_sample_pkg::CfgAddrW-1:0] cfg_addr_i,
-  /// gicube_sample's data; the empty flag in bit 0.
+  /// gicube_sample's data; the empty flag in bit 0; region 2: x, y, z dimensions (7 bits each),
+  /// lit (bit 21).
   input  logic [gicube_sample_pkg::CfgDataW-1:0] cfg_data_i,
 
-  /// Sticky: some volume read since reset came back with RRESP != OKAY (gicube_cache's).
+  /// Sticky: some volume read (or write-back) since reset came back with RRESP (BRESP) != OKAY
+  /// (gicube_cache's).
   output logic err_o,
 
-  // AXI4 read address channel (the volume in memory; no write channels).
+  // AXI4 read address channel (the volume in memory).
   /// Burst start address.
   output logic [31:0] m_axi_araddr_o,
   /// Beats in the burst minus one.
@@ -106,7 +119,41 @@ module gicube_processor #(
   /// Read data valid.
   input  logic m_axi_rvalid_i,
   /// Read data ready.
-  output logic m_axi_rready_o
+  output logic m_axi_rready_o,
+
+  // AXI4 write channels (Light: the cache's write-back of dirty lines; else idle).
+  /// Burst start address.
+  output logic [31:0] m_axi_awaddr_o,
+  /// Beats in the burst minus one.
+  output logic [7:0] m_axi_awlen_o,
+  /// log2 of the bytes per beat.
+  output logic [2:0] m_axi_awsize_o,
+  /// INCR.
+  output logic [1:0] m_axi_awburst_o,
+  /// Always 0.
+  output logic [3:0] m_axi_awid_o,
+  /// Address valid.
+  output logic m_axi_awvalid_o,
+  /// Subordinate takes the address.
+  input  logic m_axi_awready_i,
+  /// Write data.
+  output logic [DataW-1:0] m_axi_wdata_o,
+  /// Byte strobes (all set).
+  output logic [DataW/8-1:0] m_axi_wstrb_o,
+  /// Last beat of the burst.
+  output logic m_axi_wlast_o,
+  /// Write data valid.
+  output logic m_axi_wvalid_o,
+  /// Subordinate takes the beat.
+  input  logic m_axi_wready_i,
+  /// Write response.
+  input  logic [1:0] m_axi_bresp_i,
+  /// Write ID (one ID).
+  input  logic [3:0] m_axi_bid_i,
+  /// Write response valid.
+  input  logic m_axi_bvalid_i,
+  /// Write response ready.
+  output logic m_axi_bready_o
 );
 
   localparam int unsigned PacketW  = gicube_pkg::PacketW;
@@ -124,12 +171,18 @@ module gicube_processor #(
   localparam int unsigned FeInW    = 3 + 2 * PacketW;
   localparam int unsigned FeOutW   = 7 + 3 * QueueW + LenW + TotW + 2 * PacketW;
   localparam int unsigned Side     = VolBlocks << BlockLog2;         // N
-  // The cache: the volume padded to the smallest power of two above N, a voxel per word.
+  // The cache: the volume padded to the smallest power of two above N, a voxel per word (Light:
+  // the irradiance field in the word's top 16 bits).
   localparam int unsigned MaxDim   = 1 << $clog2(Side + 1);
   localparam int unsigned MW       = $clog2(MaxDim);                 // bits of a cache coordinate
-  localparam int unsigned WordW    = (VoxelW <= 8) ? 8 : 16;
+  localparam int unsigned WordW    = (Light != 0) ? 32 : (VoxelW <= 8) ? 8 : 16;
+  localparam int unsigned IrrW     = gicube_sample_pkg::IrrW;
+  localparam int unsigned CaInW    = 3 * MW + ((Light != 0) ? 2 + 8 * IrrW : 0);
+  localparam int unsigned DpInW    = 3 * MW + 12 + 12 + 3 * PosFracW + 2 + 21;
   localparam int unsigned CaOutW   = 8 * WordW + 8 + 2 * 32 + 16;    // vox, hit, hits, misses, stall
-  localparam int unsigned CellW    = 1 + 48 + 3 * PosFracW;          // lighting, colour, weights
+  // flush, lighting, colour, weights
+  localparam int unsigned CellW    = 1 + 1 + 48 + 3 * PosFracW;
+  localparam int unsigned CellD    = (Light != 0) ? 8 : 4;
   // 2 region bits over gicube_sample's address.
   localparam int unsigned CfgAW    = 2 + gicube_sample_pkg::CfgAddrW;
   localparam int unsigned SmInW    = gicube_sample_pkg::in_w(VoxelW);
@@ -142,7 +195,7 @@ module gicube_processor #(
   localparam int unsigned FifoD    = (RingLat < 2) ? 2 : (1 << $clog2(RingLat));
   localparam int unsigned LeadW    = $clog2(RingLat + 1);
   localparam int unsigned CntW     = 32;
-  localparam int unsigned OutW     = 1 + PacketW + 8 * CntW;
+  localparam int unsigned OutW     = 1 + PacketW + 8 * CntW + 1;
 
   if (BlockLog2 < 2 || BlockLog2 > 8) begin : gen_bad_block_log2
     $fatal(1, "gicube_processor: BlockLog2 must be 2..8");
@@ -153,22 +206,34 @@ module gicube_processor #(
   if (RingLat < 1 || RingLat > 16) begin : gen_bad_ring_lat
     $fatal(1, "gicube_processor: RingLat must be 1..16");
   end
+  if (Light > 1 || (Light != 0 && DataW < 64)) begin : gen_bad_light
+    $fatal(1, "gicube_processor: Light must be 0 or 1, with DataW >= 64");
+  end
 
   // ---------------------------------------------------------------------------
   // Configuration: the empty flags (gicube_sample takes region 0)
   // ---------------------------------------------------------------------------
   logic [1:0]        cfg_region;
-  logic              cfg_sample, cfg_empty;
+  logic              cfg_sample, cfg_empty, cfg_gi, cfg_flush;
   logic [Queues-1:0] empty_q;
+  logic [20:0]       dims_q;    // Light: the volume's dimensions, x lowest (7 bits each)
+  logic              lit_q;     // Light: rendering rays are lit by the field
 
   assign cfg_region = cfg_addr_i[CfgAW-1 -: 2];
   assign cfg_sample = cfg_valid_i && (cfg_region == 2'd0);
   assign cfg_empty  = cfg_valid_i && (cfg_region == 2'd1);
+  assign cfg_gi     = cfg_valid_i && (cfg_region == 2'd2) && (Light != 0);
+  assign cfg_flush  = cfg_valid_i && (cfg_region == 2'd3) && (Light != 0);
 
-  // The block LUT of empty flags [357] (datapath state: no reset, written by the host).
+  // The block LUT of empty flags [357] and the GI registers (datapath state: no reset, written by
+  // the host).
   always_ff @(posedge clk_i) begin
     if (cfg_empty) begin
       empty_q[cfg_addr_i[0 +: QueueW]] <= cfg_data_i[0];
+    end
+    if (cfg_gi) begin
+      dims_q <= cfg_data_i[20:0];
+      lit_q  <= cfg_data_i[21];
     end
   end
 
@@ -245,12 +310,14 @@ module gicube_processor #(
   // A cycle is issued only while the host offers or a ray is in the processor (the model's frame
   // loop): idle cycles would step the sorter (its Noops move its scan), which the model's frame
   // does not see.
-  assign issue      = !waiting_q && fe_in_ready && of_empty && head_ready && busy;
-  // A sampling ray's cell goes to the cache in the dispatch clock: the dispatch waits while the
-  // cache holds a request for its fills.
-  logic smp_req, ca_in_ready;
+  // While a flush is in the cache, no cycle is issued (its output item has the output alone).
+  logic flush_fly_q;
+  assign issue      = !waiting_q && fe_in_ready && of_empty && head_ready && busy && !flush_fly_q;
+  // A sampling ray's cell goes to the cache (Light: to gicube_deposit) in the dispatch clock: the
+  // dispatch waits while the cache (or the deposit pipeline) cannot take it.
+  logic smp_req, fetch_ready;
   assign smp_req    = waiting_q && fe_out_valid && o_popped && !rec_leap;
-  assign dispatch   = waiting_q && fe_out_valid && (!smp_req || ca_in_ready);
+  assign dispatch   = waiting_q && fe_out_valid && (!smp_req || fetch_ready);
 
   // The front end's item: take, ring, host, ring ray, host ray.
   logic ring_v;
@@ -284,9 +351,12 @@ module gicube_processor #(
 
   assign of_push_fin = issue && (lead_q == '0) && h_ray && h_done;
   assign of_push_ovf = dispatch && o_ring_ovf;
-  assign of_push     = of_push_fin || of_push_ovf;
-  assign of_d        = {c_mis_d, c_hit_d, c_cyc_d, c_leap_d, c_smp_d, c_ovf_d, c_fin_d, c_in_d,
-                        of_push_fin ? h_out : o_ovf_ray, of_push_fin};
+  assign of_push     = of_push_fin || of_push_ovf || of_push_flush;
+  logic of_push_flush;
+  assign of_d        = {of_push_flush, c_mis_d, c_hit_d, c_cyc_d, c_leap_d, c_smp_d, c_ovf_d,
+                        c_fin_d, c_in_d,
+                        of_push_fin ? h_out : of_push_flush ? PacketW'(0) : o_ovf_ray,
+                        of_push_fin};
   assign of_pop      = out_valid_o && out_ready_i;
 
   always_ff @(posedge clk_i) begin
@@ -350,31 +420,79 @@ module gicube_processor #(
   // ---------------------------------------------------------------------------
   // Fetch: the sampling ray's cell through the volume cache (the volume in memory)
   // ---------------------------------------------------------------------------
-  logic               ca_in_valid;
-  logic [3*MW-1:0]    ca_in;
-  logic               cell_push, cell_empty, cell_full;
+  logic               ca_in_valid, ca_in_ready;
+  logic [CaInW-1:0]   ca_in;
+  logic               cell_push, cell_empty, cell_full, cell_flush;
   logic [CellW-1:0]   cell_d, cell_q;
+  logic [3*MW-1:0]    cell_xyz;
+  logic               flush_pend_q, flush_go;
 
   // The cell's lowest voxel: the start's integer part (below N < MaxDim).
-  assign ca_in_valid = smp_req;
-  assign ca_in       = {o_pop_ray[StartLsb + 2 * PosW + PosFracW +: MW],
+  assign cell_xyz    = {o_pop_ray[StartLsb + 2 * PosW + PosFracW +: MW],
                         o_pop_ray[StartLsb + PosW + PosFracW +: MW],
                         o_pop_ray[StartLsb + PosFracW +: MW]};
-  // What the sample needs beside the voxels: lighting, colour and opacity, the weights.
-  assign cell_push   = smp_req && ca_in_ready;
-  assign cell_d      = {o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeLighting,
+  // The flush enters the cache's stream when the processor holds no ray and no cycle is in
+  // flight (the host wrote it after the pass's last ray came out), and the output is empty.
+  assign flush_go    = (Light != 0) && flush_pend_q && !waiting_q && !issue && (ring_rays_q == '0)
+                       && !held_q && of_empty && fetch_ready;
+  // What the sample needs beside the voxels: lighting, colour and opacity, the weights; a
+  // flush's record says so.
+  assign cell_push   = (smp_req && fetch_ready) || flush_go;
+  assign cell_d      = {flush_go,
+                        o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeLighting,
                         o_pop_ray[ColLsb +: 48],
                         o_pop_ray[StartLsb + 2 * PosW +: PosFracW],
                         o_pop_ray[StartLsb + PosW +: PosFracW], o_pop_ray[StartLsb +: PosFracW]};
+  assign cell_flush  = cell_q[CellW-1];
 
-  logic [31:0]       ca_awaddr;
-  logic [7:0]        ca_awlen;
-  logic [2:0]        ca_awsize;
-  logic [1:0]        ca_awburst;
-  logic [3:0]        ca_awid;
-  logic [DataW-1:0]  ca_wdata;
-  logic [DataW/8-1:0] ca_wstrb;
-  logic              ca_awvalid, ca_wlast, ca_wvalid, ca_bready;
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      flush_pend_q <= 1'b0;
+      flush_fly_q  <= 1'b0;
+    end else begin
+      if (cfg_flush) begin
+        flush_pend_q <= 1'b1;
+      end else if (flush_go) begin
+        flush_pend_q <= 1'b0;
+      end
+      if (flush_go) begin
+        flush_fly_q <= 1'b1;
+      end else if (of_push_flush) begin
+        flush_fly_q <= 1'b0;
+      end
+    end
+  end
+
+  if (Light != 0) begin : gen_deposit
+    // The item: a lighting ray's deposit, a rendering ray's read, or the flush.
+    logic [DpInW-1:0] dp_in;
+    logic [1:0]       dp_op;
+    assign dp_op = flush_go ? 2'd2
+                 : (o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeLighting) ? 2'd1 : 2'd0;
+    assign dp_in = {dims_q, dp_op,
+                    o_pop_ray[StartLsb + 2 * PosW +: PosFracW],
+                    o_pop_ray[StartLsb + PosW +: PosFracW], o_pop_ray[StartLsb +: PosFracW],
+                    o_pop_ray[ColLsb + 36 +: 12], o_pop_ray[ColLsb +: 12], cell_xyz};
+
+    gicube_deposit #(
+      .MW   (MW),
+      .Step (Step)
+    ) u_deposit (
+      .clk_i       (clk_i),
+      .rst_ni      (rst_ni),
+      .in_valid_i  (smp_req || flush_go),
+      .in_ready_o  (fetch_ready),
+      .in_data_i   (dp_in),
+      .out_valid_o (ca_in_valid),
+      .out_ready_i (ca_in_ready),
+      .out_data_o  (ca_in)
+    );
+  end else begin : gen_read
+    assign ca_in_valid = smp_req;
+    assign ca_in       = cell_xyz;
+    assign fetch_ready = ca_in_ready;
+  end
+
 
   gicube_cache #(
     .MaxDim      (MaxDim),
@@ -383,7 +501,8 @@ module gicube_processor #(
     .LineVox     (LineVox),
     .Sets        (Sets),
     .Outstanding (Outstanding),
-    .AddrW       (32)
+    .AddrW       (32),
+    .Splat       (Light)
   ) u_cache (
     .clk_i           (clk_i),
     .rst_ni          (rst_ni),
@@ -407,28 +526,28 @@ module gicube_processor #(
     .m_axi_rid_i     (m_axi_rid_i),
     .m_axi_rvalid_i  (m_axi_rvalid_i),
     .m_axi_rready_o  (m_axi_rready_o),
-    // Splat = 0: the cache writes nothing; its write channels are tied off until GI's splat
-    // joins the ring (docs/gicube-rtl.md, step 7).
-    .m_axi_awaddr_o  (ca_awaddr),
-    .m_axi_awlen_o   (ca_awlen),
-    .m_axi_awsize_o  (ca_awsize),
-    .m_axi_awburst_o (ca_awburst),
-    .m_axi_awid_o    (ca_awid),
-    .m_axi_awvalid_o (ca_awvalid),
-    .m_axi_awready_i (1'b0),
-    .m_axi_wdata_o   (ca_wdata),
-    .m_axi_wstrb_o   (ca_wstrb),
-    .m_axi_wlast_o   (ca_wlast),
-    .m_axi_wvalid_o  (ca_wvalid),
-    .m_axi_wready_i  (1'b0),
-    .m_axi_bresp_i   (2'b00),
-    .m_axi_bid_i     (4'd0),
-    .m_axi_bvalid_i  (1'b0),
-    .m_axi_bready_o  (ca_bready)
+    // Light: the write-back of dirty lines; Splat = 0 keeps them idle.
+    .m_axi_awaddr_o  (m_axi_awaddr_o),
+    .m_axi_awlen_o   (m_axi_awlen_o),
+    .m_axi_awsize_o  (m_axi_awsize_o),
+    .m_axi_awburst_o (m_axi_awburst_o),
+    .m_axi_awid_o    (m_axi_awid_o),
+    .m_axi_awvalid_o (m_axi_awvalid_o),
+    .m_axi_awready_i (m_axi_awready_i),
+    .m_axi_wdata_o   (m_axi_wdata_o),
+    .m_axi_wstrb_o   (m_axi_wstrb_o),
+    .m_axi_wlast_o   (m_axi_wlast_o),
+    .m_axi_wvalid_o  (m_axi_wvalid_o),
+    .m_axi_wready_i  (m_axi_wready_i),
+    .m_axi_bresp_i   (m_axi_bresp_i),
+    .m_axi_bid_i     (m_axi_bid_i),
+    .m_axi_bvalid_i  (m_axi_bvalid_i),
+    .m_axi_bready_o  (m_axi_bready_o)
   );
 
-  // The cache holds two requests at most (the one at its check, its output register).
-  cube5_frame_fifo #(.Width(CellW), .Depth(4)) u_cell_fifo (
+  // The cache holds two requests at most (the one at its check, its output register); Light:
+  // three more in gicube_deposit.
+  cube5_frame_fifo #(.Width(CellW), .Depth(CellD)) u_cell_fifo (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
     .clear_i (1'b0),
@@ -440,11 +559,21 @@ module gicube_processor #(
     .full_o  (cell_full)
   );
 
-  // Corner c's voxel: the low VoxelW bits of the cache's word c.
+  // Corner c's voxel: the low VoxelW bits of the cache's word c; its irradiance (Light): the
+  // word's top IrrW bits.
   logic [8*VoxelW-1:0] voxels;
+  logic [8*IrrW-1:0]   irrs;
   for (genvar c = 0; c < 8; c++) begin : gen_voxel
     assign voxels[c * VoxelW +: VoxelW] = ca_out[c * WordW +: VoxelW];
+    if (Light != 0) begin : gen_irr
+      assign irrs[c * IrrW +: IrrW] = ca_out[c * WordW + WordW - IrrW +: IrrW];
+    end else begin : gen_no_irr
+      assign irrs[c * IrrW +: IrrW] = '0;
+    end
   end
+  // A rendering ray is lit when the field is loaded (Light, `lit`).
+  logic irr_en;
+  assign irr_en = (Light != 0) && lit_q && !cell_q[CellW-2];
 
   // The record of the dispatched cycle, one clock later.
   logic               f_v_q, f_ray_q, f_leap_q;
@@ -479,10 +608,10 @@ module gicube_processor #(
   logic [StOutW-1:0] st_out;
 
   assign go        = f_v_q && f_ray_q;
-  assign go_sample = ca_out_valid;
-  // voxels, weights (the start's fraction bits), no irradiance, colour and opacity, lighting.
-  assign sm_in = {cell_q[CellW-1 -: 49], {8 * gicube_sample_pkg::IrrW{1'b0}}, 1'b0,
-                  cell_q[0 +: 3 * PosFracW], voxels};
+  assign go_sample = ca_out_valid && !cell_flush;
+  assign of_push_flush = ca_out_valid && cell_flush;
+  // voxels, weights (the start's fraction bits), irradiance, colour and opacity, lighting.
+  assign sm_in = {cell_q[CellW-2 -: 49], irrs, irr_en, cell_q[0 +: 3 * PosFracW], voxels};
   // start, dir, queue, leap.
   assign st_in = {f_leap_q, f_q_q, f_pkt_q[DirLsb +: 48], f_pkt_q[StartLsb +: 3 * PosW]};
 
@@ -577,8 +706,7 @@ module gicube_processor #(
   logic unused;
   assign unused = ^{st_out[0 +: KW], st_out[KW + TvW +: QueueW], sd_full, sm_full, tv_full,
                     of_full, sm_in_ready, st_in_ready, o_act_v, fe_out, cell_full, cell_empty,
-                    ca_out, ca_awaddr, ca_awlen, ca_awsize, ca_awburst, ca_awid, ca_awvalid,
-                    ca_wdata, ca_wstrb, ca_wlast, ca_wvalid, ca_bready};
+                    ca_out, dims_q};
 
 `ifndef SYNTHESIS
   // A stalled output holds its item (STYLE.md rule 3).

@@ -14,11 +14,13 @@ mod support;
 
 use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
+use cube5_model::phantom::sphere_floor_phantom;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::units::cube5_axi_rd::Burst;
 use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
 use cube5_model::units::gicube_processor::{
-    host_rays, Processor, ProcessorFrame, ProcessorOut, ProcessorRtlConfig, Projection,
+    host_rays, light_rays, shadow_scene, Processor, ProcessorFrame, ProcessorOut,
+    ProcessorRtlConfig, Projection,
 };
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::Variant;
@@ -159,6 +161,7 @@ fn run_host(
         }
         for o in d.outputs {
             let o = o.value;
+            assert!(!o.flush, "{name}: a flush item without a flush");
             outputs += 1;
             last = o;
             if o.done {
@@ -203,18 +206,52 @@ fn open(
     mem: Memory,
     s: u64,
 ) -> RtlStream<ProcessorRtlConfig> {
-    let img = scene.proc.rtl_memory().unwrap().expect("the RTL's cache");
-    let setup = AxiMemSetup {
+    open_proc(variant, rtl, &scene.proc, mem, s)
+}
+
+/// The subordinate as `mem` says, the write channels' gaps as the read channels' (AW and B as
+/// AR, W as R).
+fn mem_setup(
+    rtl: &ProcessorRtlConfig,
+    img: &cube5_model::units::cube5_axi_rd::AxiMemImage,
+    mem: Memory,
+    s: u64,
+) -> AxiMemSetup {
+    AxiMemSetup {
         declared_outstanding: rtl.outstanding,
-        ..axi_mem_setup((rtl.data_w / 8, 32), &img, mem.lat, mem.gaps, mem.bw, s)
-    };
+        aw_gap_permille: mem.gaps.0,
+        w_gap_permille: mem.gaps.1,
+        b_gap_permille: mem.gaps.0,
+        ..axi_mem_setup((rtl.data_w / 8, 32), img, mem.lat, mem.gaps, mem.bw, s)
+    }
+}
+
+/// Opens `variant` over `proc`'s memory image (`Processor::rtl_memory`) and loads its tables,
+/// flags and (`Light`) GI registers.
+fn open_proc(
+    variant: &'static Variant,
+    rtl: ProcessorRtlConfig,
+    proc: &Processor,
+    mem: Memory,
+    s: u64,
+) -> RtlStream<ProcessorRtlConfig> {
+    let img = proc.rtl_memory().unwrap().expect("the RTL's cache");
+    let setup = mem_setup(&rtl, &img, mem, s);
     let mut dut = RtlStream::new(variant, rtl, s as u32).unwrap();
     dut.axi_setup(&setup).unwrap();
     dut.axi_load(img.base, &img.bytes).unwrap();
-    for (a, d) in scene.proc.rtl_config_writes(&rtl).unwrap() {
+    load_config(&mut dut, &rtl, proc);
+    dut
+}
+
+fn load_config(
+    dut: &mut RtlStream<ProcessorRtlConfig>,
+    rtl: &ProcessorRtlConfig,
+    proc: &Processor,
+) {
+    for (a, d) in proc.rtl_config_writes(rtl).unwrap() {
         dut.write_config(a, &d).unwrap();
     }
-    dut
 }
 
 /// The image and the conservation of rays; with `exact_counts` every count equals the model's.
@@ -335,6 +372,173 @@ fn frame_line(variant: &'static Variant, what: &str, got: &RtlFrame, want: &Proc
         c.cache_hit_rate(),
         got.ars.len()
     );
+}
+
+/// The flush at the end of a lighting pass (`Light`): the write, then clocks until its output
+/// item, the output taken at random with probability `1 - stall`; the item.
+fn flush(
+    dut: &mut RtlStream<ProcessorRtlConfig>,
+    rtl: &ProcessorRtlConfig,
+    stall: f64,
+    rng: &mut ChaCha8Rng,
+) -> ProcessorOut {
+    let name = dut.name();
+    let (a, d) = Processor::rtl_flush_write(rtl);
+    dut.write_config(a, &d).unwrap();
+    for _ in 0..2_000_000 {
+        let traffic = Traffic {
+            idle: vec![0],
+            stall: vec![u8::from(rng.random_bool(stall))],
+        };
+        let d = dut.drive(&[], &traffic, 1, 1).unwrap();
+        if let Some(o) = d.outputs.first() {
+            assert!(
+                o.value.flush,
+                "{name}: the item after a flush is the flush's"
+            );
+            return o.value;
+        }
+    }
+    panic!("{name}: the flush never came out");
+}
+
+/// The lighting pass of the GI shadow scene (a sphere over a floor, the scene's light) at the
+/// RTL's side and voxel width, then its flush: every lighting ray and every count equal to the
+/// model's `light`, the AR and AW bursts (the flush's write-backs included) equal to its cache's,
+/// and the memory after the flush, the volume with the irradiance field above it, equal to the
+/// model's word for word (the field is `irradiance()`). Then, after a reset, the rendering pass
+/// lit by that field: every pixel and count. Under random memory latency, gaps on all five
+/// channels, bandwidth limits and output back-pressure.
+fn two_pass_gi(variant: &'static Variant, rtl: ProcessorRtlConfig, s: u64) {
+    let n = rtl.side() as usize;
+    let (_, tf, light) = shadow_scene(n).unwrap();
+    let vol = sphere_floor_phantom(n, rtl.voxel_w).unwrap();
+    let mut proc = Processor::new(rtl.processor_config(), &vol, &tf).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    let mem = random_memory(&mut rng, &rtl);
+    let mut dut = open_proc(variant, rtl, &proc, mem, s);
+    let (rays, energy) = light_rays(&vol, &light, proc.config().host_order).unwrap();
+    let packets: Vec<Bits> = rays
+        .iter()
+        .map(|r| {
+            Processor::light_packet(r, energy)
+                .unwrap()
+                .to_bits()
+                .unwrap()
+        })
+        .collect();
+    let (want, trace) = proc.light_cache_traced(&light).unwrap();
+    let b = Behaviour {
+        idle: 0.0,
+        stall: 0.3,
+    };
+    let got = run_host(&mut dut, &packets, light.grid, b, &mut rng, None);
+    check_frame(variant.name, "lighting pass", &got, &want, true);
+    let f = flush(&mut dut, &rtl, 0.3, &mut rng);
+    assert_eq!(
+        (
+            u64::from(f.cache_hits),
+            u64::from(f.cache_misses),
+            u64::from(f.cycles)
+        ),
+        (
+            want.counts.cache_hits,
+            want.counts.cache_misses,
+            want.counts.cycles
+        ),
+        "{variant}: the flush's counts"
+    );
+    let size = (rtl.data_w / 8).trailing_zeros();
+    let mut ars = got.ars.clone();
+    ars.extend(dut.axi_take_ar().unwrap());
+    let ctx = |k| format!("the lighting pass's burst #{k}");
+    let n_ar = compare_bursts(&ars, "AR", &trace.reads, size, variant, s, ctx)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let aws = dut.axi_take_aw().unwrap();
+    let n_aw = compare_bursts(&aws, "AW", &trace.writes, size, variant, s, ctx)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!((n_ar, n_aw), (trace.reads.len(), trace.writes.len()));
+    let c = dut.axi_counters();
+    assert_eq!(
+        c.protocol_errors,
+        0,
+        "{variant}: AXI checker: {}",
+        dut.axi_first_error()
+    );
+    let cache = rtl.cache_config();
+    let words = cache.words_of(&dut.axi_image().unwrap());
+    let m = cache.max_dim as usize;
+    let differ = (0..m * m * m)
+        .filter(|&i| words[i] != trace.memory[i])
+        .count();
+    assert_eq!(
+        differ, 0,
+        "{variant}: {differ} memory words differ from the model's after the flush"
+    );
+    let field = proc.irradiance().unwrap();
+    let at = |x: usize, y: usize, z: usize| words[x + m * (y + m * z)] >> 16;
+    let lit = (0..n * n * n)
+        .filter(|&i| {
+            assert_eq!(at(i % n, (i / n) % n, i / (n * n)), u32::from(field[i]));
+            field[i] > 0
+        })
+        .count();
+    eprintln!(
+        "{variant} lighting pass ({mem:?}): {} rays, {} samples (deposits), {} processor cycles, {} clocks, hit rate {:.4}, {} lines read, {} written back (flush included); {lit} voxels lit; the field in memory equals the model's",
+        want.counts.rays_made,
+        want.counts.samples,
+        want.counts.cycles,
+        got.clocks,
+        want.counts.cache_hit_rate(),
+        trace.reads.len(),
+        trace.writes.len()
+    );
+    // The rendering pass from a reset (memory kept), lit by the field.
+    dut.reset();
+    load_config(&mut dut, &rtl, &proc);
+    let px = rtl.side();
+    let cam = gi_camera(&vol, px);
+    let proj = Projection::Parallel;
+    let (want, bursts) = proc.render_cache_traced(&cam, proj).unwrap();
+    let packets: Vec<Bits> = host_rays(&vol, &cam, proj, proc.config().host_order)
+        .unwrap()
+        .iter()
+        .map(|r| Processor::packet(r).unwrap().to_bits().unwrap())
+        .collect();
+    let got = run_host(&mut dut, &packets, px, b, &mut rng, None);
+    check_frame(variant.name, "GI rendering pass", &got, &want, true);
+    check_bursts(variant, &rtl, &got, &bursts, s);
+    assert!(
+        want.rgb.iter().any(|p| p.iter().any(|&c| c > 0)),
+        "{variant}: a lit image"
+    );
+    frame_line(variant, "GI rendering pass", &got, &want);
+}
+
+/// The GI scene's camera: azimuth 30, elevation 25 (the floor and the sphere's shadow in view).
+fn gi_camera(vol: &cube5_model::volume::Volume, px: u32) -> Camera {
+    let (a, e) = (30f64.to_radians(), 25f64.to_radians());
+    let dir = [-e.cos() * a.cos(), -e.cos() * a.sin(), -e.sin()];
+    Camera::new(dir.into(), vol.dims, vol.spacing, px, px)
+}
+
+/// The two GI passes on the `Light` configurations at 16^3 (CI).
+#[test]
+fn gi_lighting_pass_leaves_the_models_field_in_memory_and_lights_the_image() {
+    for (variant, rtl) in ci_configs().into_iter().filter(|(_, c)| c.light == 1) {
+        two_pass_gi(variant, rtl, seed(1970));
+    }
+}
+
+/// The two GI passes at 32^3 and 64^3 (the `full` `Light` configurations).
+#[test]
+#[ignore = "sim-full: the two GI passes at 32^3 and 64^3 (the `full` variants)"]
+fn large_gi_passes_equal_the_model() {
+    for (variant, rtl) in configs::<ProcessorRtlConfig>() {
+        if rtl.light == 1 && rtl.side() > 16 {
+            two_pass_gi(variant, rtl, seed(1975));
+        }
+    }
 }
 
 fn ci_configs() -> Vec<(&'static Variant, ProcessorRtlConfig)> {
@@ -498,7 +702,7 @@ fn a_model_with_another_ring_latency_counts_other_cycles() {
 #[ignore = "sim-full: 32^3 and 64^3 frames (the `full` variants), parallel and perspective"]
 fn large_frames_equal_the_model_with_every_count() {
     for (variant, rtl) in configs::<ProcessorRtlConfig>() {
-        if rtl.side() <= 16 {
+        if rtl.side() <= 16 || rtl.light == 1 {
             continue;
         }
         let px = rtl.side();

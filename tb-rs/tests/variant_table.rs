@@ -16,6 +16,7 @@ use cube5_model::units::cube5_er::ErConfig;
 use cube5_model::units::cube5_pwarp::PwarpConfig;
 use cube5_model::units::cube5_section_buf::SectionBufConfig;
 use cube5_model::units::gicube_cache::CacheConfig;
+use cube5_model::units::gicube_deposit::DepositConfig;
 use cube5_model::units::gicube_processor::ProcessorRtlConfig;
 use cube5_model::units::gicube_queue_front::QueueFrontConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
@@ -85,6 +86,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == ProcessorRtlConfig::TOP => agree::<ProcessorRtlConfig>(v),
         t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
         t if t == StepConfig::TOP => agree::<StepConfig>(v),
+        t if t == DepositConfig::TOP => agree::<DepositConfig>(v),
         t if t == CacheConfig::TOP => agree::<CacheConfig>(v),
         t if t == SampleRtlConfig::TOP => agree::<SampleRtlConfig>(v),
         t if t == ErConfig::TOP => agree::<ErConfig>(v),

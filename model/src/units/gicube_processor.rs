@@ -18,10 +18,11 @@ use crate::camera::Camera;
 use crate::error::{ModelError, Result};
 use crate::transfer::TransferFunction;
 use crate::units::cube5_axi_rd::{AxiMemImage, Burst};
-use crate::units::cube5_compos::{corrected_alpha, rnd};
+use crate::units::cube5_compos::corrected_alpha;
 use crate::units::cube5_shader::ClassLut;
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
-use crate::units::gicube_cache::{CacheConfig, CacheReq, VolumeCache};
+use crate::units::gicube_cache::{CacheConfig, CacheItem, CacheReq, VolumeCache};
+use crate::units::gicube_deposit as deposit;
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_queue_front::{Chooser, FrontTraffic, QueueFront};
 use crate::units::gicube_sample::{jitter_index, Jitter, SampleConfig, SampleIn, Sampler};
@@ -31,13 +32,13 @@ use crate::volume::Volume;
 
 // The packet channel's maximum, the sample's and the irradiance's fraction bits and the unit
 // configurations of the sample datapath are `gicube_sample`'s (the one description of a sample).
+/// The splat's rounding shift (the deposit unit's, `gicube_deposit`).
+pub use crate::units::gicube_deposit::DEPOSIT_SHIFT;
+/// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
+pub use crate::units::gicube_queue_front::SORTER_SLOTS;
 pub use crate::units::gicube_sample::{
     compos_config, shader_config, CHAN_MAX, IRR_FRAC_W, SAMPLE_FRAC_W,
 };
-/// `E (12) + T (12) + dr (8) + w_c (24) - IRR_FRAC_W`: the splat's rounding shift.
-pub const DEPOSIT_SHIFT: u32 = 12 + 12 + POS_FRAC_W + 3 * POS_FRAC_W - IRR_FRAC_W;
-/// Sorter steps per pipeline cycle: the sorter is over-clocked by two ([371]).
-pub use crate::units::gicube_queue_front::SORTER_SLOTS;
 
 /// Largest ring latency, processor cycles (the RTL's `RingLat`: 1..=16).
 pub const MAX_RING_LATENCY: u32 = 16;
@@ -394,27 +395,66 @@ pub fn interaction_draw(bits: u32) -> u16 {
     (jenkins_hash(bits ^ INTERACTION_KEY) >> 16).min(65520) as u16
 }
 
-/// The volume cache of one frame (contract, *The volume cache*): the samples' requests, in order,
-/// and the bursts of their misses when traced.
+/// The volume cache of one frame (contract, *The volume cache*): the samples' items, in order,
+/// and, when traced, the bursts of their misses and write-backs.
 #[derive(Debug, Clone)]
 struct FrameCache {
     cache: VolumeCache,
-    bursts: Option<Vec<Burst>>,
+    /// The words hold the irradiance field above the voxel (contract, *Splatting through the
+    /// cache*): a lighting sample is a deposit item.
+    splats: bool,
+    /// The voxel's bits of a word.
+    voxel_mask: u32,
+    trace: Option<CacheTrace>,
+}
+
+/// What the volume cache of a traced pass did: the AXI4 bursts of its misses (AR) and of its
+/// write-backs (AW) in order, and, after a lighting pass's flush, the words memory holds.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CacheTrace {
+    pub reads: Vec<Burst>,
+    pub writes: Vec<Burst>,
+    /// `M^3` words, x fastest (`VolumeCache::memory_words`) at the end of the pass.
+    pub memory: Vec<u32>,
 }
 
 impl FrameCache {
-    /// The eight corner voxels of the cell at `base`, read through the cache; the corners found
-    /// and not found are counted.
-    fn read(&mut self, base: [i64; 3], counts: &mut ProcessorCounts) -> [u32; 8] {
+    /// The eight corner voxels of the cell at `base` through the cache: a read, or, for a
+    /// lighting sample when the words hold the field, a deposit of `energies` (the same voxels:
+    /// a deposit adds above them); the corners found and not found are counted.
+    fn sample(
+        &mut self,
+        base: [i64; 3],
+        energies: Option<[u32; 8]>,
+        counts: &mut ProcessorCounts,
+    ) -> [u32; 8] {
         let [x, y, z] = base.map(|a| a as u32);
-        let step = self.cache.request(&CacheReq { x, y, z });
+        let req = CacheReq { x, y, z };
+        let item = match energies {
+            Some(e) if self.splats => CacheItem::Deposit(req, e),
+            _ => CacheItem::Read(req),
+        };
+        let step = self.cache.item(&item);
         let found = u64::from(step.out.hit.count_ones());
         counts.cache_hits += found;
         counts.cache_misses += 8 - found;
-        if let Some(b) = self.bursts.as_mut() {
-            b.extend(step.bursts);
+        self.record(step.reads, step.writes);
+        step.out.vox.map(|v| v & self.voxel_mask)
+    }
+
+    fn record(&mut self, reads: Vec<Burst>, writes: Vec<Burst>) {
+        if let Some(t) = self.trace.as_mut() {
+            t.reads.extend(reads);
+            t.writes.extend(writes);
         }
-        step.out.vox
+    }
+
+    /// The flush at the end of a lighting pass: every dirty line written back.
+    fn flush(&mut self) {
+        if self.splats {
+            let step = self.cache.item(&CacheItem::Flush);
+            self.record(step.reads, step.writes);
+        }
     }
 }
 
@@ -506,10 +546,7 @@ impl Processor {
             })?,
             cache: None,
         };
-        p.cache = match p.cache_config()? {
-            Some(c) => Some(VolumeCache::new(c, &p.padded_words(c.max_dim))?),
-            None => None,
-        };
+        p.load_cache()?;
         p.empty = (0..blocks * blocks * blocks)
             .map(|q| p.block_is_empty(q))
             .collect();
@@ -540,11 +577,37 @@ impl Processor {
         Ok(Some(c))
     }
 
-    /// The volume padded with zeros to `m^3` words, x fastest (the cache's memory).
-    fn padded_words(&self, m: u32) -> Vec<u32> {
-        let m = i64::from(m);
+    /// The volume cache after reset over the memory of the next pass (`padded_words`).
+    fn load_cache(&mut self) -> Result<()> {
+        self.cache = match self.cache_config()? {
+            Some(c) => Some(VolumeCache::new(c, &self.padded_words(c))?),
+            None => None,
+        };
+        Ok(())
+    }
+
+    /// The cache's words hold the irradiance field above the voxel (contract, *Splatting
+    /// through the cache*): a splatting cache whose field lies above the voxel's bits.
+    fn field_in_words(&self, c: &CacheConfig) -> bool {
+        c.splat == 1 && c.irr_shift() >= self.vol.bits
+    }
+
+    /// The volume padded with zeros to `M^3` words, x fastest (the cache's memory); when the
+    /// words hold the field, the loaded irradiance (0 before a lighting pass) above each voxel.
+    fn padded_words(&self, c: CacheConfig) -> Vec<u32> {
+        let m = i64::from(c.max_dim);
+        let field = self
+            .irradiance
+            .as_deref()
+            .filter(|_| self.field_in_words(&c));
         (0..m * m * m)
-            .map(|i| self.vol.get(i % m, (i / m) % m, i / (m * m)))
+            .map(|i| {
+                let v = [i % m, (i / m) % m, i / (m * m)];
+                let irr = field
+                    .and_then(|f| voxel_index(self.vol.dims, v).map(|k| u32::from(f[k])))
+                    .unwrap_or(0);
+                self.vol.get(v[0], v[1], v[2]) | irr << c.irr_shift()
+            })
             .collect()
     }
 
@@ -552,7 +615,7 @@ impl Processor {
     /// the cache's bank-major layout at byte address 0 (`None`: no cache).
     pub fn rtl_memory(&self) -> Result<Option<AxiMemImage>> {
         match self.cache_config()? {
-            Some(c) => Ok(Some(c.image(&self.padded_words(c.max_dim))?)),
+            Some(c) => Ok(Some(c.image(&self.padded_words(c))?)),
             None => Ok(None),
         }
     }
@@ -626,16 +689,25 @@ impl Processor {
     }
 
     /// The classified, composited sample at the ray's position (the pipeline's datapath). A
-    /// lighting ray deposits into `irr` first; a rendering ray is lit by the loaded irradiance.
-    fn sample(&self, ray: &mut RayPacket, voxels: [u32; 8], irr: Option<&mut [u16]>) -> bool {
+    /// lighting ray adds its `energies` into `irr` first; a rendering ray is lit by the loaded
+    /// irradiance.
+    fn sample(
+        &self,
+        ray: &mut RayPacket,
+        voxels: [u32; 8],
+        energies: Option<[u32; 8]>,
+        irr: Option<&mut [u16]>,
+    ) -> bool {
         let p = ray.start;
         let base = p.map(|c| i64::from(c >> POS_FRAC_W));
         let mask = (1u32 << POS_FRAC_W) - 1;
         let weights = p.map(|c| c & mask);
         let lighting = ray.ray_type == RayType::Lighting;
-        if lighting {
-            if let Some(irr) = irr {
-                self.deposit(ray, base, weights, irr);
+        if let (Some(irr), Some(e)) = (irr, energies) {
+            for (c, &ec) in e.iter().enumerate() {
+                if let Some(i) = voxel_index(self.vol.dims, corner(base, c)) {
+                    irr[i] = (u32::from(irr[i]) + ec).min(u32::from(u16::MAX)) as u16;
+                }
             }
         }
         let lit = match (&self.irradiance, lighting) {
@@ -662,30 +734,21 @@ impl Processor {
         out.terminated
     }
 
-    /// The splat of a lighting ray's sample ([362], [381]): corner `c` of the sample's cell gets
-    /// `rnd(E * T * dr * w_c, 42)` (`U(2.14)`), `E` the ray's energy (`red`), `T = 4096 - opacity`
-    /// the light left before this sample, `w_c` the product of the corner's three weights
-    /// (`256 - f` or `f`, `U(1.8)` each); added saturating at `2^16 - 1`; corners outside the
-    /// volume are dropped.
-    fn deposit(&self, ray: &RayPacket, base: [i64; 3], f: [u32; 3], irr: &mut [u16]) {
-        let e = u64::from(ray.color[0]);
+    /// The splat of a lighting ray's sample ([362], [381]; contract, *Global illumination*): the
+    /// energy of corner `c` of the sample's cell, `min(rnd(E * T * dr * w_c, 42), 2^16 - 1)`
+    /// (`U(2.14)`), `E` the ray's energy (`red`), `T = 4096 - opacity` the light left before this
+    /// sample (4096 for a photon), `w_c` the product of the corner's three weights (`256 - f` or
+    /// `f`, `U(1.8)` each); 0 for a corner outside the volume. A function of the packet alone.
+    pub fn deposit_energies(&self, ray: &RayPacket) -> [u32; 8] {
+        let base = ray.start.map(|c| i64::from(c >> POS_FRAC_W));
+        let f = ray.start.map(|c| c & ((1 << POS_FRAC_W) - 1));
         let t = if self.photon_albedo.is_some() {
-            u64::from(CHAN_MAX + 1)
+            CHAN_MAX + 1
         } else {
-            u64::from(CHAN_MAX + 1 - u32::from(ray.opacity))
+            CHAN_MAX + 1 - u32::from(ray.opacity)
         };
-        let ets = e * t * u64::from(self.cfg.step);
-        for c in 0..8usize {
-            let Some(i) = voxel_index(self.vol.dims, corner(base, c)) else {
-                continue;
-            };
-            let w = (0..3).fold(1u64, |acc, a| {
-                let fa = u64::from(f[a]);
-                acc * if (c >> a) & 1 == 1 { fa } else { 256 - fa }
-            });
-            let d = rnd(ets * w, DEPOSIT_SHIFT);
-            irr[i] = (u64::from(irr[i]) + d).min(u64::from(u16::MAX)) as u16;
-        }
+        let inside = std::array::from_fn(|c| voxel_index(self.vol.dims, corner(base, c)).is_some());
+        deposit::energies(u32::from(ray.color[0]), t, self.cfg.step, f, inside)
     }
 
     /// One pipeline cycle on a ray of queue `q`: a sample (or a leap), then the advance.
@@ -703,16 +766,21 @@ impl Processor {
             counts.leaps += 1;
         } else {
             counts.samples += 1;
-            // The cell's eight voxels, through the volume cache (contract, *The volume cache*).
+            // A lighting ray's deposit in a lighting pass: a function of the packet before
+            // this sample (contract, *Global illumination*).
+            let energies = (irr.is_some() && ray.ray_type == RayType::Lighting)
+                .then(|| self.deposit_energies(&ray));
+            // The cell's eight voxels, through the volume cache (contract, *The volume cache*):
+            // a read, or the deposit itself when the words hold the field.
             let base = ray.start.map(|c| i64::from(c >> POS_FRAC_W));
             let voxels = match cache {
-                Some(cache) => cache.read(base, counts),
+                Some(cache) => cache.sample(base, energies, counts),
                 None => std::array::from_fn(|c| {
                     let [x, y, z] = corner(base, c);
                     self.vol.get(x, y, z)
                 }),
             };
-            let terminated = self.sample(&mut ray, voxels, irr);
+            let terminated = self.sample(&mut ray, voxels, energies, irr);
             if let Some(albedo) = self.photon_albedo {
                 // A photon interacts when its opacity reaches its interaction value [364].
                 if u32::from(ray.opacity) << 4 >= u32::from(ray.interaction) {
@@ -803,16 +871,9 @@ impl Processor {
         proj: Projection,
     ) -> Result<(ProcessorFrame, Vec<Burst>)> {
         let packets = self.frame_packets(cam, proj)?;
-        let mut bursts = Vec::new();
-        let f = self.run(
-            packets,
-            cam.width,
-            cam.height,
-            None,
-            None,
-            Some(&mut bursts),
-        )?;
-        Ok((f, bursts))
+        let mut t = CacheTrace::default();
+        let f = self.run(packets, cam.width, cam.height, None, None, Some(&mut t))?;
+        Ok((f, t.reads))
     }
 
     /// The lighting pass of volumetric GI ([358]-[363], low albedo, single scattering): lighting
@@ -820,6 +881,23 @@ impl Processor {
     /// irradiance field, which then lights every rendering ray of `render` (until the next
     /// `light`). Returns the pass's counts (its image is the lighting grid, all 0).
     pub fn light(&mut self, light: &GiLight) -> Result<ProcessorFrame> {
+        self.light_pass(light, None)
+    }
+
+    /// `light`, and what its volume cache did (contract, *Splatting through the cache*): the AR
+    /// and AW bursts in order, the flush's included, and the words memory holds after the flush
+    /// (the volume and, above it when the words hold the field, the irradiance).
+    pub fn light_cache_traced(&mut self, light: &GiLight) -> Result<(ProcessorFrame, CacheTrace)> {
+        let mut t = CacheTrace::default();
+        let f = self.light_pass(light, Some(&mut t))?;
+        Ok((f, t))
+    }
+
+    fn light_pass(
+        &mut self,
+        light: &GiLight,
+        trace: Option<&mut CacheTrace>,
+    ) -> Result<ProcessorFrame> {
         let (rays, energy) = light_rays(&self.vol, light, self.cfg.host_order)?;
         let mut packets = rays
             .iter()
@@ -836,17 +914,20 @@ impl Processor {
             }
         };
         let mut field = vec![0u16; self.vol.len()];
+        // The field starts at 0: memory holds the volume alone.
         self.irradiance = None;
+        self.load_cache()?;
         let f = self.run(
             packets,
             light.grid,
             light.grid,
             Some(&mut field),
             None,
-            None,
+            trace,
         );
         self.photon_albedo = None;
         self.irradiance = Some(field);
+        self.load_cache()?;
         f
     }
 
@@ -876,7 +957,7 @@ impl Processor {
         h: u32,
         mut irr: Option<&mut Vec<u16>>,
         trace: Option<&mut FrontTrace>,
-        bursts: Option<&mut Vec<Burst>>,
+        cache_trace: Option<&mut CacheTrace>,
     ) -> Result<ProcessorFrame> {
         let rays = packets.len();
         let packets_lives = packets
@@ -911,7 +992,9 @@ impl Processor {
         // The volume cache from reset (contract, *The volume cache*).
         let mut cache = self.cache.as_ref().map(|c| FrameCache {
             cache: c.clone(),
-            bursts: bursts.is_some().then(Vec::new),
+            splats: self.field_in_words(&c.config()),
+            voxel_mask: (1 << self.vol.bits) - 1,
+            trace: cache_trace.is_some().then(CacheTrace::default),
         });
         let mut last_active: Option<u32> = None;
         // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
@@ -1003,8 +1086,18 @@ impl Processor {
         if let Some(t) = trace {
             *t = front.take_trace();
         }
-        if let (Some(b), Some(c)) = (bursts, cache) {
-            *b = c.bursts.unwrap_or_default();
+        if let Some(c) = cache.as_mut() {
+            // A lighting pass ends with a flush: memory holds every deposit (contract,
+            // *Splatting through the cache*).
+            if irr.is_some() {
+                c.flush();
+            }
+        }
+        if let (Some(t), Some(c)) = (cache_trace, cache) {
+            *t = CacheTrace {
+                memory: c.cache.memory_words().to_vec(),
+                ..c.trace.unwrap_or_default()
+            };
         }
         Ok(ProcessorFrame {
             width: w,
@@ -1440,12 +1533,22 @@ pub struct ProcessorRtlConfig {
     pub line_vox: u32,
     pub sets: u32,
     pub outstanding: u32,
+    /// 1: the lighting pass of GI (contract, *Splatting through the cache*): 32-bit words with
+    /// the irradiance field above the voxel, the cache's `Splat = 1` and its AXI4 write port, the
+    /// deposit energies, the flush; the rendering rays lit by the field. 0: direct volume
+    /// rendering only.
+    pub light: u32,
 }
 
 /// Region of a configuration address (its top two bits): `gicube_sample`'s tables, the empty
 /// flags.
 pub const CFG_REGION_SAMPLE: u32 = 0;
 pub const CFG_REGION_EMPTY: u32 = 1;
+/// `Light = 1`: the volume's dimensions (7 bits each, x lowest) and, in bit 21, `lit` (rendering
+/// rays are lit by the field in the words).
+pub const CFG_REGION_GI: u32 = 2;
+/// `Light = 1`: a flush of the cache's dirty lines (the end of a lighting pass).
+pub const CFG_REGION_FLUSH: u32 = 3;
 /// Address bits of `gicube_sample`'s configuration port.
 const SAMPLE_CFG_ADDR_W: u32 = 14;
 /// Bits of a configuration word (`gicube_sample`'s).
@@ -1472,10 +1575,14 @@ impl ProcessorRtlConfig {
         line_vox: 16,
         sets: 32,
         outstanding: 8,
+        light: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(ModelError::Config(format!("gicube_processor: {m}")));
+        if self.light > 1 {
+            return bad(format!("Light {} is not 0 or 1", self.light));
+        }
         if !(2..=8).contains(&self.block_log2) {
             return bad(format!("BlockLog2 {} outside 2..=8", self.block_log2));
         }
@@ -1512,17 +1619,24 @@ impl ProcessorRtlConfig {
     }
 
     /// The volume cache (contract, *The RTL*): `MaxDim` the smallest power of two above `N` (at
-    /// least 4), `WordW` 8 for voxels of up to 8 bits, else 16, `AddrW = 32`, the rest the RTL's.
+    /// least 4), `WordW` 8 for voxels of up to 8 bits, else 16 (32 and `Splat = 1` with
+    /// `Light`), `AddrW = 32`, the rest the RTL's.
     pub fn cache_config(&self) -> CacheConfig {
         CacheConfig {
             max_dim: (self.side() + 1).next_power_of_two().max(4),
-            word_w: if self.voxel_w <= 8 { 8 } else { 16 },
+            word_w: if self.light == 1 {
+                32
+            } else if self.voxel_w <= 8 {
+                8
+            } else {
+                16
+            },
             data_w: self.data_w,
             line_vox: self.line_vox,
             sets: self.sets,
             outstanding: self.outstanding,
             addr_w: RTL_ADDR_W,
-            splat: 0,
+            splat: self.light,
         }
     }
 
@@ -1572,6 +1686,7 @@ crate::unit_config!(ProcessorRtlConfig, "gicube_processor", DEFAULT, {
     "LineVox" => line_vox,
     "Sets" => sets,
     "Outstanding" => outstanding,
+    "Light" => light,
 });
 
 /// One output item of the RTL: a finished or an overflowed ray, and the counts after it.
@@ -1591,6 +1706,8 @@ pub struct ProcessorOut {
     /// The volume cache's corner reads found and not found since reset.
     pub cache_hits: u32,
     pub cache_misses: u32,
+    /// The item of a flush (`Light = 1`): memory holds every deposit; `done` and the ray are 0.
+    pub flush: bool,
 }
 
 impl crate::unit::StreamCodec for ProcessorRtlConfig {
@@ -1603,7 +1720,7 @@ impl crate::unit::StreamCodec for ProcessorRtlConfig {
     }
 
     fn out_width(&self) -> u32 {
-        1 + 256 + OUT_COUNTS * COUNT_W
+        1 + 256 + OUT_COUNTS * COUNT_W + 1
     }
 
     fn pack_in(&self, item: &Self::In) -> Vec<u32> {
@@ -1626,6 +1743,7 @@ impl crate::unit::StreamCodec for ProcessorRtlConfig {
             cycles: c(),
             cache_hits: c(),
             cache_misses: c(),
+            flush: r.get_bool(),
         }
     }
 }
@@ -1666,6 +1784,26 @@ impl Processor {
             let e = self.cfg.space_leap && self.empty.get(q as usize).copied().unwrap_or(false);
             writes.push((region(CFG_REGION_EMPTY, q), word(u32::from(e))));
         }
+        if rtl.light == 1 {
+            let [x, y, z] = self.vol.dims.map(|d| d as u32);
+            let lit = u32::from(self.irradiance.is_some());
+            writes.push((
+                region(CFG_REGION_GI, 0),
+                word(x | y << 7 | z << 14 | lit << 21),
+            ));
+        }
         Ok(writes)
+    }
+
+    /// The write that flushes the RTL's cache at the end of a lighting pass (`Light = 1`,
+    /// contract, *Splatting through the cache*): made when every lighting ray has finished; its
+    /// output item (`flush`) comes when memory holds every deposit.
+    pub fn rtl_flush_write(rtl: &ProcessorRtlConfig) -> (u32, Vec<u32>) {
+        let mut w = crate::bits::BitWriter::new();
+        w.put(0, CFG_WORD_W);
+        (
+            (CFG_REGION_FLUSH << (rtl.cfg_addr_w() - 2)),
+            w.finish(CFG_WORD_W),
+        )
     }
 }

@@ -26,6 +26,7 @@ pub mod cube5_vol_fetch;
 pub mod cube5_warp;
 pub mod gicube_bucket;
 pub mod gicube_cache;
+pub mod gicube_deposit;
 pub mod gicube_packet_loop;
 pub mod gicube_processor;
 pub mod gicube_queue_front;
