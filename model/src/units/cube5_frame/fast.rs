@@ -789,8 +789,18 @@ unsafe fn entries_avx2(flat: &[[u32; 4]], idx: &[usize; 8]) -> [[u32; 8]; 4] {
     out
 }
 
+/// Set by a test: every sweep takes the portable code even where the CPU has AVX2, so that the
+/// code a CPU without AVX2 runs is checked against the reference on any machine (both give the
+/// same bits, so a sweep running beside that test is not disturbed).
+#[cfg(test)]
+static PORTABLE_ONLY: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// [`sweep_band`], in AVX2 where the CPU has it.
 fn sweep_band_dispatch<const LIT: bool>(slices: &[SliceWork], band: Band) -> SweepStats {
+    #[cfg(test)]
+    if PORTABLE_ONLY.load(std::sync::atomic::Ordering::Relaxed) {
+        return sweep_band::<LIT, false>(slices, band);
+    }
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has AVX2 (detected just above), `sweep_band_avx2`'s one requirement.
@@ -1183,6 +1193,34 @@ mod tests {
     fn lifted(vol: &Volume, floor: u16) -> Volume {
         let data = vol.data.iter().map(|&v| v.max(floor)).collect();
         Volume::new(vol.dims, vol.spacing, vol.bits, data).unwrap()
+    }
+
+    /// The portable sweep (what a CPU without AVX2 runs; this machine may take the AVX2 code
+    /// everywhere else): lit composite and MIP, unlit composite, from faces, 45 degrees and random views,
+    /// with early termination, equal to the reference.
+    #[test]
+    fn portable_sweep_equals_the_reference() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed() + 9);
+        let vs = views(2, &mut rng);
+        let head = head_phantom(32, 12).unwrap();
+        let tf = TransferFunction::head_default();
+        super::PORTABLE_ONLY.store(true, std::sync::atomic::Ordering::Relaxed);
+        let cfg = FrameConfig::DEFAULT;
+        let mut st = check_equal("head, portable", &head, &cfg, &tf, Some(ET_DEFAULT), &vs);
+        for (n, v) in vs.iter().enumerate() {
+            let view = (*v, [1, 4, 8][n % 3], FrameMode::Composite);
+            st = st.add(check_one_lit(
+                "head unlit, portable",
+                &head,
+                &cfg,
+                &tf,
+                None,
+                view,
+                false,
+            ));
+        }
+        super::PORTABLE_ONLY.store(false, std::sync::atomic::Ordering::Relaxed);
+        assert!(st.shaded > 0, "{st:?}");
     }
 
     /// The sweep's block skipping, directed: a transfer function with transparent bands over a
