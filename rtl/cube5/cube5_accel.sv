@@ -552,19 +552,9 @@ module cube5_accel #(
   end
 
   for (genvar k = 0; k < P; k++) begin : gen_lane
-    for (genvar c = 0; c < 4; c++) begin : gen_code
-      logic [ChanW-1:0]          chan;
-      logic [ChanW+ColorW:0]     scaled;
-      logic [ChanW+ColorW-AccW:0] code;
-      assign chan   = fr_cox[k*CoxelW + c*ChanW +: ChanW];
-      assign scaled = ((ChanW+ColorW+1)'(chan) << ColorW) - (ChanW+ColorW+1)'(chan)
-                      + ((ChanW+ColorW+1)'(1) << (AccW - 1));
-      assign code   = scaled[ChanW+ColorW:AccW];
-      assign pix_d[k*PixW + 8*c +: 8] = 8'(code > (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1)
-                                           ? (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1) : code);
-      logic unused_low;
-      assign unused_low = ^scaled[AccW-1:0];
-    end
+    cube5_accel_pix #(.AccW(AccW), .ColorW(ColorW)) u_pix (
+      .cox_i(fr_cox[k*CoxelW +: 4*ChanW]), .pix_o(pix_d[k*PixW +: PixW])
+    );
   end
 
   if (Pieces > 1) begin : gen_pieces
@@ -689,6 +679,7 @@ module cube5_accel #(
     logic [DataW-1:0]   v_wdata;
     logic [DataW/8-1:0] v_wstrb;
     logic               r_win, b_win;
+    logic               v_wait;       // the window's write beats wait: no new volume read
 
     cube5_accel_win #(
       .P(P), .DimW(M + 1), .AddrW(AddrW), .DataW(DataW), .IdW(IdW), .AccW(AccW),
@@ -710,47 +701,38 @@ module cube5_accel #(
       .araddr_o(v_araddr), .arlen_o(v_arlen), .arvalid_o(v_arvalid), .arready_i(v_arready),
       .rvalid_i(v_rvalid), .rdata_i(m_axi_rdata_i), .rresp_i(m_axi_rresp_i),
       .rlast_i(m_axi_rlast_i), .rready_o(v_rready),
-      .idle_o(win_idle), .err_o(win_err)
+      .wr_wait_o(v_wait), .idle_o(win_idle), .err_o(win_err)
     );
 
-    // AR: the fetch or a restore; a source keeps the port while its address waits (no valid is
-    // withdrawn), else they alternate.
-    logic ar_sel, ar_sel_q, ar_hold_q;   // 1: the restore
-    assign ar_sel = ar_hold_q ? ar_sel_q : (v_arvalid && (!fe_arvalid || !ar_sel_q));
-    assign ar_valid        = ar_sel ? v_arvalid : fe_arvalid;
-    assign fe_arready      = !ar_sel && ar_ready;
-    assign v_arready       = ar_sel && ar_ready;
-    assign m_axi_araddr_o  = ar_sel ? v_araddr : fe_araddr;
-    assign m_axi_arlen_o   = ar_sel ? v_arlen : fe_arlen;
-    assign m_axi_arsize_o  = ar_sel ? 3'($clog2(DataW / 8)) : fe_arsize;
-    assign m_axi_arburst_o = ar_sel ? 2'b01 : fe_arburst;
-    assign m_axi_arid_o    = ar_sel ? IdW'(1) : fe_arid;
-
-    // AW: the writer (the clear) or the window, likewise.
-    logic aw_sel, aw_sel_q, aw_hold_q;   // 1: the window
-    assign aw_sel = aw_hold_q ? aw_sel_q : (v_awvalid && (!wr_awvalid || !aw_sel_q));
-    assign aw_valid        = aw_sel ? v_awvalid : wr_awvalid;
-    assign wr_awready      = !aw_sel && aw_ready;
-    assign v_awready       = aw_sel && aw_ready;
-    assign m_axi_awaddr_o  = aw_sel ? v_awaddr : wr_awaddr;
-    assign m_axi_awlen_o   = aw_sel ? v_awlen : wr_awlen;
-    assign m_axi_awsize_o  = aw_sel ? 3'($clog2(DataW / 8)) : wr_awsize;
-    assign m_axi_awburst_o = aw_sel ? 2'b01 : wr_awburst;
-    assign m_axi_awid_o    = aw_sel ? v_awid : wr_awid;
-
-    always_ff @(posedge clk_i) begin
-      if (!unit_rst_n) begin
-        ar_hold_q <= 1'b0;
-        ar_sel_q  <= 1'b0;
-        aw_hold_q <= 1'b0;
-        aw_sel_q  <= 1'b0;
-      end else begin
-        ar_hold_q <= m_axi_arvalid_o && !m_axi_arready_i;
-        aw_hold_q <= m_axi_awvalid_o && !m_axi_awready_i;
-        if (ar_valid) ar_sel_q <= ar_sel;
-        if (aw_valid) aw_sel_q <= aw_sel;
-      end
-    end
+    // AR: the fetch (source 0) or a restore (source 1); AW: the writer (the clear, source 0) or
+    // the window (source 1). A source keeps the channel while its address waits (no valid is
+    // withdrawn), else they alternate (cube5_axi_arb). The fetch starts no new read while the
+    // window's write beats wait (v_wait): the memory serves reads first, and a fetch that keeps
+    // its bursts queued would starve the parks (docs/accel.md, *The compositing window in the
+    // top*, What limits it).
+    localparam int unsigned ArbW = AddrW + 8 + 3 + 2 + IdW;
+    localparam logic [2:0] BeatSize = 3'($clog2(DataW / 8));
+    logic ar_sel, aw_sel;   // 1: the window's
+    cube5_axi_arb #(.Width(ArbW)) u_ar_arb (
+      .clk_i, .rst_ni(unit_rst_n),
+      .s0_allow_i(!v_wait), .s0_valid_i(fe_arvalid), .s0_ready_o(fe_arready),
+      .s0_data_i({fe_araddr, fe_arlen, fe_arsize, fe_arburst, fe_arid}),
+      .s1_valid_i(v_arvalid), .s1_ready_o(v_arready),
+      .s1_data_i({v_araddr, v_arlen, BeatSize, 2'b01, IdW'(1)}),
+      .valid_o(ar_valid), .ready_i(ar_ready),
+      .data_o({m_axi_araddr_o, m_axi_arlen_o, m_axi_arsize_o, m_axi_arburst_o, m_axi_arid_o}),
+      .sel_o(ar_sel)
+    );
+    cube5_axi_arb #(.Width(ArbW)) u_aw_arb (
+      .clk_i, .rst_ni(unit_rst_n),
+      .s0_allow_i(1'b1), .s0_valid_i(wr_awvalid), .s0_ready_o(wr_awready),
+      .s0_data_i({wr_awaddr, wr_awlen, wr_awsize, wr_awburst, wr_awid}),
+      .s1_valid_i(v_awvalid), .s1_ready_o(v_awready),
+      .s1_data_i({v_awaddr, v_awlen, BeatSize, 2'b01, v_awid}),
+      .valid_o(aw_valid), .ready_i(aw_ready),
+      .data_o({m_axi_awaddr_o, m_axi_awlen_o, m_axi_awsize_o, m_axi_awburst_o, m_axi_awid_o}),
+      .sel_o(aw_sel)
+    );
 
     // W: the bursts' beats in the order their AWs were accepted (a FIFO of sources).
     logic ord_empty, ord_full, ord_head, w_fire_last;
@@ -778,7 +760,7 @@ module cube5_accel #(
     assign m_axi_bready_o = b_win || wr_bready;
 
     logic unused_win;
-    assign unused_win = ord_full;
+    assign unused_win = ^{ord_full, ar_sel};
   end else begin : gen_no_win
     assign ar_valid        = fe_arvalid;
     assign fe_arready      = ar_ready;

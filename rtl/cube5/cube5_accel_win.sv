@@ -82,6 +82,9 @@ module cube5_accel_win #(
   input  logic               rlast_i,
   output logic               rready_o,
 
+  /// Write beats are queued and not yet on the port: the top starts no new volume read meanwhile
+  /// (the memory serves reads first; docs/accel.md, *The compositing window in the top*).
+  output logic wr_wait_o,
   /// Nothing taken and not yet written, no burst in flight: the window's traffic has drained.
   output logic idle_o,
   /// Sticky: a B or R response of this unit was not OKAY.
@@ -172,22 +175,11 @@ module cube5_accel_win #(
   logic [FinBytes-1:0] pix_strb;
   logic [AddrW-1:0]   fin_addr;
 
-  // Each channel's pixel code: min(2^ColorW - 1, (c (2^ColorW - 1) + 2^(AccW - 1)) >> AccW)
-  // (docs/numerics/warp.md, "Base-plane codes"), as the read-out's in cube5_accel.
+  // Each lane's pixel codes (cube5_accel_pix, as the read-out's in cube5_accel).
   for (genvar k = 0; k < P; k++) begin : gen_pix
-    for (genvar c = 0; c < 4; c++) begin : gen_code
-      logic [ChanW-1:0]           chan;
-      logic [ChanW+ColorW:0]      scaled;
-      logic [ChanW+ColorW-AccW:0] code;
-      logic                       unused_low;
-      assign chan   = s1_cox_q[k*StoreW + c*ChanW +: ChanW];
-      assign scaled = ((ChanW+ColorW+1)'(chan) << ColorW) - (ChanW+ColorW+1)'(chan)
-                      + ((ChanW+ColorW+1)'(1) << (AccW - 1));
-      assign code   = scaled[ChanW+ColorW:AccW];
-      assign unused_low = ^scaled[AccW-1:0];
-      assign pix[k*PixW + 8*c +: 8] = 8'(code > (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1)
-                                         ? (ChanW+ColorW-AccW+1)'((1 << ColorW) - 1) : code);
-    end
+    cube5_accel_pix #(.AccW(AccW), .ColorW(ColorW)) u_pix (
+      .cox_i(s1_cox_q[k*StoreW +: 4*ChanW]), .pix_o(pix[k*PixW +: PixW])
+    );
     assign pix_strb[4*k +: 4] = {4{s1_mask_q[k]}};
   end
 
@@ -367,6 +359,7 @@ module cube5_accel_win #(
     end
   end
   assign err_o  = err_q;
+  assign wr_wait_o = !w_empty;
   assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && rq_empty
                   && rs_out_q == '0 && !rs_v_q;
 
