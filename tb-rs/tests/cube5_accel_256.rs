@@ -15,8 +15,7 @@ mod support;
 
 use cube5_model::phantom::head_phantom;
 use cube5_model::units::cube5_skewmem::BlockLut;
-use cube5_model::volume::Volume;
-use cube5_tb::accel::{AccelBench, AccelRtl, FrameRun, MemEnv, TOP};
+use cube5_tb::accel::{AccelBench, AccelRtl, MemEnv, TOP};
 use cube5_tb::frame::{Expected, Look, Render, OBLIQUE_Z, VIEWS};
 use cube5_tb::variants::variants_of;
 use rand::{Rng, SeedableRng};
@@ -38,52 +37,39 @@ fn synthesized() -> Vec<AccelRtl> {
     builds
 }
 
+type View = (&'static str, [f64; 3]);
+
 /// Exactly 45 degrees between +x and +z (`cube5_tb::frame::VIEWS`).
-fn view_45() -> (&'static str, [f64; 3]) {
+fn view_45() -> View {
     *VIEWS
         .iter()
         .find(|v| v.0 == "45 xz")
         .expect("the 45 degree view")
 }
 
-/// The head phantom (12-bit voxels) at `n`^3 in the memory of one build.
-struct Case {
-    bench: AccelBench,
-    vol: Rc<Volume>,
-    lut: BlockLut,
-    rng: ChaCha8Rng,
-}
-
-impl Case {
-    fn new(rtl: AccelRtl, n: usize, s: u64) -> Self {
-        let vol = head_phantom(n, 12).unwrap();
-        let lut = BlockLut::from_volume(&vol, rtl.fetch.block_dim as usize, 0).unwrap();
-        Self {
-            bench: must(AccelBench::new(rtl, s)),
-            vol: Rc::new(vol),
-            lut,
-            rng: ChaCha8Rng::seed_from_u64(s),
-        }
-    }
-
-    /// One frame (the default look: composite is shaded) under `env`, bit-exact; its figures.
-    fn frame(
-        &mut self,
-        (name, dir): (&str, [f64; 3]),
-        render: Render,
-        env: &MemEnv,
-        what: &str,
-    ) -> FrameRun {
-        let rtl = self.bench.rtl;
-        let e = Expected::new(&rtl.frame, &self.vol, name, dir, render, &Look::default())
+/// The head phantom (12-bit voxels) at `n`^3 in the memory of `rtl`, and `frames` rendered in
+/// turn (the default look: composite is shaded), each under its memory (`None`: a random one,
+/// `MemEnv::random`) and bit-exact; their figures printed.
+fn head_frames(rtl: AccelRtl, n: usize, s: u64, frames: &[(View, Render, Option<&MemEnv>)]) {
+    let vol = Rc::new(head_phantom(n, 12).unwrap());
+    let lut = BlockLut::from_volume(&vol, rtl.fetch.block_dim as usize, 0).unwrap();
+    let mut bench = must(AccelBench::new(rtl, s));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    for &((name, dir), render, env) in frames {
+        let e = Expected::new(&rtl.frame, &vol, name, dir, render, &Look::default())
             .unwrap_or_else(|err| panic!("{}: {err}", rtl.variant));
-        let mem_seed = self.rng.random();
-        let img_base = must(self.bench.start(&e, &self.vol, &self.lut, env, mem_seed));
-        let run = must(self.bench.finish(&e, img_base, mem_seed));
-        let n = self.vol.dims[0];
+        let (env, what) = match env {
+            Some(env) => (env.clone(), "the given memory"),
+            None => (MemEnv::random(&mut rng), "a random memory"),
+        };
+        let mem_seed = rng.random();
+        let img_base = must(bench.start(&e, &vol, &lut, &env, mem_seed));
+        let run = must(bench.finish(&e, img_base, mem_seed));
         eprintln!(
-            "{}: {n}^3 head {name} {render:?}{what}: {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
+            "{}: {n}^3 head {name} {render:?}, {what} (latency {:?}, bytes/cycle {:?}): {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
             rtl.variant,
+            env.latency,
+            env.bw,
             run.cycles,
             run.samples,
             run.rate(rtl.p),
@@ -91,7 +77,6 @@ impl Case {
             run.r_beats,
             run.aw
         );
-        run
     }
 }
 
@@ -103,11 +88,11 @@ impl Case {
 fn synthesized_lines_64() {
     let s = seed(0xacce256);
     for rtl in synthesized() {
-        let mut c = Case::new(rtl, 64, s);
-        for (view, render) in [(view_45(), Render::Composite), (OBLIQUE_Z, Render::Mip)] {
-            let env = MemEnv::random(&mut c.rng);
-            c.frame(view, render, &env, ", random memory");
-        }
+        let frames = [
+            (view_45(), Render::Composite, None),
+            (OBLIQUE_Z, Render::Mip, None),
+        ];
+        head_frames(rtl, 64, s, &frames);
     }
 }
 
@@ -126,7 +111,6 @@ fn synthesized_lines_256() {
         host_stall: Vec::new(),
     };
     for rtl in synthesized() {
-        let mut c = Case::new(rtl, 256, s);
-        c.frame(view_45(), Render::Composite, &ddr, ", DDR-like 12 B/cycle");
+        head_frames(rtl, 256, s, &[(view_45(), Render::Composite, Some(&ddr))]);
     }
 }
