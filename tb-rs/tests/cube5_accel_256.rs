@@ -66,16 +66,11 @@ fn head_frames(rtl: AccelRtl, n: usize, s: u64, frames: &[(View, Render, Option<
         let img_base = must(bench.start(&e, &vol, &lut, &env, mem_seed));
         let run = must(bench.finish(&e, img_base, mem_seed));
         eprintln!(
-            "{}: {n}^3 head {name} {render:?}, {what} (latency {:?}, bytes/cycle {:?}): {} cycles, {} samples, {:.3} samples/clock/pipeline; {} read bursts ({} beats), {} write bursts",
+            "{}: {n}^3 head {name} {render:?}, {what} (latency {:?}, bytes/cycle {:?}): {:.3} samples/clock/pipeline, {run:?}",
             rtl.variant,
             env.latency,
             env.bw,
-            run.cycles,
-            run.samples,
-            run.rate(rtl.p),
-            run.ar,
-            run.r_beats,
-            run.aw
+            run.rate(rtl.p)
         );
     }
 }
