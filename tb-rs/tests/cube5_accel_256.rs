@@ -1,0 +1,111 @@
+//! Co-simulation of the synthesized 256^3 lines of the accelerator top `cube5_accel` (the
+//! `.variants` lines flagged `synthfull`: the window's MaxDim 256 memory system with 16-anchor
+//! sections and the widths narrowed so that the LFE5UM-85F holds it; docs/accel.md, *Synthesis*,
+//! *The 256^3 lines*). The lines are `full` (only `make sim-full` builds them: minutes of Verilator
+//! each), so every test here is `sim-full`. The driver and the comparison are the other accelerator
+//! tests' (`cube5_tb::accel`): the image in the memory bit-exact against the frame model at the
+//! line's widths.
+//!
+//!     CUBE5_FULL=1 CUBE5_TOPS=cube5_accel:Section=16:AccW=16:ClassIdxW=10 \
+//!       cargo test --release -p cube5-tb --test cube5_accel_256 -- --include-ignored
+//!
+//! (`CUBE5_TOPS=cube5_accel:...:P=4` builds and runs one line.)
+
+mod support;
+
+use cube5_model::phantom::head_phantom;
+use cube5_model::units::cube5_skewmem::BlockLut;
+use cube5_tb::accel::{AccelBench, AccelRtl, MemEnv, TOP};
+use cube5_tb::frame::{Expected, Look, Render, OBLIQUE_Z, VIEWS};
+use cube5_tb::variants::variants_of;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::rc::Rc;
+use support::{must, seed};
+
+/// The synthesized lines that this run built (`synthfull`, in `.variants` order).
+fn synthesized() -> Vec<AccelRtl> {
+    let builds: Vec<AccelRtl> = variants_of(TOP)
+        .into_iter()
+        .filter(|v| v.has_flag("synthfull"))
+        .map(|v| must(AccelRtl::from_variant(v)))
+        .collect();
+    assert!(
+        !builds.is_empty(),
+        "no `synthfull` line of {TOP} built (CUBE5_FULL=1 builds them)"
+    );
+    builds
+}
+
+type View = (&'static str, [f64; 3]);
+
+/// Exactly 45 degrees between +x and +z (`cube5_tb::frame::VIEWS`).
+fn view_45() -> View {
+    *VIEWS
+        .iter()
+        .find(|v| v.0 == "45 xz")
+        .expect("the 45 degree view")
+}
+
+/// The head phantom (12-bit voxels) at `n`^3 in the memory of `rtl`, and `frames` rendered in
+/// turn (the default look: composite is shaded), each under its memory (`None`: a random one,
+/// `MemEnv::random`) and bit-exact; their figures printed.
+fn head_frames(rtl: AccelRtl, n: usize, s: u64, frames: &[(View, Render, Option<&MemEnv>)]) {
+    let vol = Rc::new(head_phantom(n, 12).unwrap());
+    let lut = BlockLut::from_volume(&vol, rtl.fetch.block_dim as usize, 0).unwrap();
+    let mut bench = must(AccelBench::new(rtl, s));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    for &((name, dir), render, env) in frames {
+        let e = Expected::new(&rtl.frame, &vol, name, dir, render, &Look::default())
+            .unwrap_or_else(|err| panic!("{}: {err}", rtl.variant));
+        let (env, what) = match env {
+            Some(env) => (env.clone(), "the given memory"),
+            None => (MemEnv::random(&mut rng), "a random memory"),
+        };
+        let mem_seed = rng.random();
+        let img_base = must(bench.start(&e, &vol, &lut, &env, mem_seed));
+        let run = must(bench.finish(&e, img_base, mem_seed));
+        eprintln!(
+            "{}: {n}^3 head {name} {render:?}, {what} (latency {:?}, bytes/cycle {:?}): {:.3} samples/clock/pipeline, {run:?}",
+            rtl.variant,
+            env.latency,
+            env.bw,
+            run.rate(rtl.p)
+        );
+    }
+}
+
+/// Every synthesized line: the 64^3 head at exactly 45 degrees composite (shaded) and at an
+/// oblique view (DX < 0, a reversed sweep) in MIP, each under its own random memory (latency
+/// 10..200, gaps on all five channels, the host's B and R back-pressured); bit-exact.
+#[test]
+#[ignore = "sim-full: the synthesized 256^3 lines are `full` (minutes of Verilator each)"]
+fn synthesized_lines_64() {
+    let s = seed(0xacce256);
+    for rtl in synthesized() {
+        let frames = [
+            (view_45(), Render::Composite, None),
+            (OBLIQUE_Z, Render::Mip, None),
+        ];
+        head_frames(rtl, 64, s, &frames);
+    }
+}
+
+/// Every synthesized line at its size: the 256^3 head at exactly 45 degrees, composite (shaded),
+/// under the DDR-like memory of the benchmark (latency 100 + U(0..20), 12 bytes per cycle shared by
+/// reads and writes): bit-exact, and the cycles the frames per second at the placed Fmax come from
+/// (docs/accel.md, *The 256^3 lines*).
+#[test]
+#[ignore = "sim-full: 256^3 frames on the synthesized lines, minutes each"]
+fn synthesized_lines_256() {
+    let s = seed(0xacce257);
+    let ddr = MemEnv {
+        latency: (100, 20),
+        gaps: [0; 5],
+        bw: (12, 1),
+        host_stall: Vec::new(),
+    };
+    for rtl in synthesized() {
+        head_frames(rtl, 256, s, &[(view_45(), Render::Composite, Some(&ddr))]);
+    }
+}
