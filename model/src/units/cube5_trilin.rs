@@ -375,6 +375,17 @@ mod tests {
     }
 
     #[test]
+    fn the_frames_trilin_latency_is_its_pipe_s() {
+        // cube5_frame.regs.toml's TrilinLatency follows TrilinPipe (the frame's interpolators).
+        use crate::regs::cube5_frame::{TRILIN_LATENCY, TRILIN_PIPE};
+        let cfg = TrilinConfig {
+            pipe: TRILIN_PIPE,
+            ..TrilinConfig::DEFAULT
+        };
+        assert_eq!(cfg.latency(), TRILIN_LATENCY);
+    }
+
+    #[test]
     fn error_within_contract_bound() {
         for cfg in [
             TrilinConfig::NARROW,
