@@ -2,7 +2,7 @@
 // block cube5_axil_regs (the map of cube5_accel.regs.toml, instantiated here) it sequences one
 // frame as sections of `Section` anchors. Contract: docs/numerics/accel_ctrl.md.
 //
-// On a write of Ctrl.start (idle): latch the frame registers and the bases; three cycles of checks
+// On a write of Ctrl.start (idle): latch the frame registers and the bases; four cycles of checks
 // (refused: IrqStatus.error, Status.code); then, per section in order (left to right when DX >= 0,
 // right to left when DX < 0), one command on each of the fetch, section-buffer and frame ports
 // (each port independent, its own back-pressure); once the frame port has its last section, one
@@ -213,7 +213,7 @@ module cube5_accel_ctrl #(
     word = v[i*32 +: 32];
   endfunction
 
-  typedef enum logic [2:0] {StIdle, StAxes, StSetup, StCheck, StRun} state_e;
+  typedef enum logic [2:0] {StIdle, StAxes, StSetup, StSize, StCheck, StRun} state_e;
   state_e state_q, state_d;
 
   logic start_stb, abort_stb;
@@ -339,31 +339,43 @@ module cube5_accel_ctrl #(
   logic [2*M+1:0]     ninj_q, ni_nj1_q;
   logic [3:0]         code_a_q;
 
-  // Stage 2 (the Check cycle, t0 + 3): the rules that need the products, the base plane, samples.
+  // Stage 2 (the Size cycle, t0 + 3): the base plane, a row's bytes, the samples and the rules
+  // that need the products, but for the pitch against a row's bytes (code_b).
   // A row as written: W rounded up to P pixels (the frame's read-out items), its bytes (the
   // pitch when ImgPitch is 0; a multiple of the row alignment, which divides P PixelBytes).
   localparam int unsigned RowBW = M + LogPix + 2;
   logic [M+1:0]     wpad;
   logic [RowBW-1:0] row_bytes;
+  logic [3:0]       code_b;
   always_comb begin
     wpix = ni_q + M1'(abs_shift(sx_q));
     wpad = ((M+2)'(wpix) + (M+2)'(P - 1)) >> LogP << LogP;
     row_bytes = RowBW'(wpad) << LogPix;
     hpix = nj_q + M1'(abs_shift(sy_q));
     samples = (3*M+3)'(ninj_q) * (3*M+3)'(swept_q);
-    if (code_a_q != cube5_accel_regs_pkg::CodeNone) code = code_a_q;
-    else if (ni_q < M1'(2 * P) || (ni_nj1_q >> LogP) < (2*M+2)'(9)) code = cube5_accel_regs_pkg::CodeSmall;
-    else if ((vbase_q & AddrW'(VolMask)) != '0) code = cube5_accel_regs_pkg::CodeVolAlign;
-    else if ((ibase_q & AddrW'(ImgMask)) != '0) code = cube5_accel_regs_pkg::CodeImgAlign;
-    else if (pitch_q != '0 && ((pitch_q & 32'(ImgMask)) != '0 || pitch_q < 32'(row_bytes)))
-      code = cube5_accel_regs_pkg::CodePitch;
-    else code = cube5_accel_regs_pkg::CodeNone;
+    if (code_a_q != cube5_accel_regs_pkg::CodeNone) code_b = code_a_q;
+    else if (ni_q < M1'(2 * P) || (ni_nj1_q >> LogP) < (2*M+2)'(9)) code_b = cube5_accel_regs_pkg::CodeSmall;
+    else if ((vbase_q & AddrW'(VolMask)) != '0) code_b = cube5_accel_regs_pkg::CodeVolAlign;
+    else if ((ibase_q & AddrW'(ImgMask)) != '0) code_b = cube5_accel_regs_pkg::CodeImgAlign;
+    else if ((pitch_q & 32'(ImgMask)) != '0) code_b = cube5_accel_regs_pkg::CodePitch;
+    else code_b = cube5_accel_regs_pkg::CodeNone;
   end
 
-  // Stage 2's results.
+  // Stage 2's results: the row command's pixels and rows, the row step, the samples (held from
+  // here to the next start), a row's bytes and the codes so far.
   logic [M:0]       h_q;
   logic [M+1:0]     w_q;           // pixels per row command: W rounded up to P
   logic [AddrW-1:0] row_step_q;
+  logic [RowBW-1:0] row_bytes_q;
+  logic [3*M+2:0]   samples_q;
+  logic [3:0]       code_b_q;
+
+  // Stage 3 (the Check cycle, t0 + 4): a nonzero pitch below a row's bytes, the verdict.
+  always_comb begin
+    if (code_b_q != cube5_accel_regs_pkg::CodeNone) code = code_b_q;
+    else if (pitch_q != '0 && pitch_q < 32'(row_bytes_q)) code = cube5_accel_regs_pkg::CodePitch;
+    else code = cube5_accel_regs_pkg::CodeNone;
+  end
 
   // ---------------------------------------------------------------------------------------------
   // Sequencer
@@ -446,7 +458,8 @@ module cube5_accel_ctrl #(
         end
       end
       StAxes:  state_d = StSetup;
-      StSetup: state_d = StCheck;
+      StSetup: state_d = StSize;
+      StSize:  state_d = StCheck;
       StCheck: begin
         fidx_d  = '0;
         sidx_d  = '0;
@@ -464,7 +477,7 @@ module cube5_accel_ctrl #(
           code_d  = code;
         end else begin
           state_d = StRun;
-          samp_d  = 64'(samples);
+          samp_d  = 64'(samples_q);
         end
       end
       StRun: begin
@@ -561,10 +574,13 @@ module cube5_accel_ctrl #(
       ninj_q   <= ninj;
       ni_nj1_q <= ni_nj1;
     end
-    if (state_q == StCheck) begin
-      w_q        <= wpad;
-      h_q        <= hpix;
-      row_step_q <= (pitch_q != '0) ? AddrW'(pitch_q) : AddrW'(row_bytes);
+    if (state_q == StSize) begin
+      w_q         <= wpad;
+      h_q         <= hpix;
+      row_step_q  <= (pitch_q != '0) ? AddrW'(pitch_q) : AddrW'(row_bytes);
+      row_bytes_q <= row_bytes;
+      samples_q   <= samples;
+      code_b_q    <= code_b;
     end
     waddr_q <= waddr_d;
   end

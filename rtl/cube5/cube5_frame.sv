@@ -379,6 +379,7 @@ module cube5_frame #(
   logic                 skip_ok_q, skip_ok_d;
   logic                 sec_ok_q, sec_ok_d;
   logic [DimW:0]        sec_end, sec_end_q;
+  logic [DimW-1:0]      nbr_q;                                     // beats per row
 
   // Source = 1 sweeps every slice of a section (the stream brings them all): Skip is ignored.
   assign skip_front = (Source == 0) ? skip_q[0 +: DimW] : '0;
@@ -415,11 +416,12 @@ module cube5_frame #(
       skip_ok_q <= skip_ok_d;
       sec_ok_q  <= sec_ok_d;
       sec_end_q <= sec_end;
+      nbr_q     <= sns >> LogP;
     end
   end
 
-  // Set-up 3: beats per row and slice (wires of registers that hold until the next set-up), the
-  // base plane, the flush, the volume rule.
+  // Set-up 3: beats per row (registered in set-up 2) and slice (wires of registers that hold until
+  // the next set-up), the base plane, the flush, the volume rule.
   logic [DimW-1:0]      nbr, max_sx_q, max_sy_q, max_sx_d, max_sy_d;
   logic [NbsW-1:0]      nbs;
   logic [TotW-1:0]      total_q, total_d;
@@ -430,8 +432,9 @@ module cube5_frame #(
   logic [DimW-1:0]      abs_sx, abs_sy;
   logic                 frame_ok;
 
+  assign nbr = nbr_q;
+
   always_comb begin
-    nbr      = sns >> LogP;
     nbs      = nij_q >> LogP;
     sx_last  = tx_last_q >>> StepW;
     sy_last  = ty_last_q >>> StepW;

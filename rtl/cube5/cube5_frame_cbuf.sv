@@ -180,7 +180,7 @@ module cube5_frame_cbuf #(
   // ---------------------------------------------------------------------------
   logic [DimW-1:0] pos_m, pos_b, pos_s;
   logic signed [TW-1:0] tx, ty;
-  logic unused_f0, unused_f1, unused_f2, unused_f3, unused_f4, unused_f5;
+  logic unused_f0, pos_last_beat, unused_f2, pos_last_row, unused_f4, unused_f5;
 
   cube5_frame_pos #(
     .DimW (DimW),
@@ -205,9 +205,9 @@ module cube5_frame_cbuf #(
     .tx_o          (tx),
     .ty_o          (ty),
     .first_beat_o  (unused_f0),
-    .last_beat_o   (unused_f1),
+    .last_beat_o   (pos_last_beat),
     .first_row_o   (unused_f2),
-    .last_row_o    (unused_f3),
+    .last_row_o    (pos_last_row),
     .first_slice_o (unused_f4),
     .last_slice_o  (unused_f5)
   );
@@ -237,8 +237,8 @@ module cube5_frame_cbuf #(
 
   always_comb begin
     for (int unsigned l = 0; l < P; l++) begin
-      past[l] = ((ty[StepW-1:0] != '0) && (pos_b == nj_i - DimW'(1)))
-                || ((tx[StepW-1:0] != '0) && far_x_i && (pos_m == nbr_i - DimW'(1))
+      past[l] = ((ty[StepW-1:0] != '0) && pos_last_row)
+                || ((tx[StepW-1:0] != '0) && far_x_i && pos_last_beat
                     && (l == P - 1));
     end
   end
@@ -562,7 +562,7 @@ module cube5_frame_cbuf #(
   assign out_pop     = out_valid_o && out_ready_i;
 
   logic unused_cbuf;
-  assign unused_cbuf = ^{unused_f0, unused_f1, unused_f2, unused_f3, unused_f4, unused_f5,
+  assign unused_cbuf = ^{unused_f0, unused_f2, unused_f4, unused_f5,
                          unused_wb_empty, unused_wb_full, unused_out_full, offx_s, offy_s, tx, ty,
                          unused_col};
 

@@ -300,7 +300,8 @@ module cube5_frame_interp #(
   end
 
   // ---------------------------------------------------------------------------
-  // 3P interpolators, never stalled
+  // 3P interpolators, never stalled; Pipe = TrilinPipe (every multiplier between registers,
+  // latency TrilinLatency)
   // ---------------------------------------------------------------------------
   logic [NTri-1:0] tri_ready, tri_valid;
 
@@ -308,7 +309,8 @@ module cube5_frame_interp #(
     cube5_trilin #(
       .VoxelW  (VoxelW),
       .WeightW (WeightW),
-      .FracW   (FracW)
+      .FracW   (FracW),
+      .Pipe    (cube5_frame_pkg::TrilinPipe)
     ) u_trilin (
       .clk_i       (clk_i),
       .rst_ni      (rst_ni),

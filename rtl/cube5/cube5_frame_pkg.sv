@@ -12,8 +12,14 @@ package cube5_frame_pkg;
   /// Width of the status counters in every output item (memory beats read, sweep cycles).
   localparam int unsigned CntW = 32;
 
-  /// Latency of cube5_trilin in cycles (docs/numerics/trilin.md, "Timing").
-  localparam int unsigned TrilinLatency = 3;
+  /// `Pipe` of the frame's interpolators (cube5_trilin): 1, per axis the difference, the product
+  /// and the rounded sum each in a register, so that no multiplier of the frame has logic on either
+  /// side (docs/numerics/trilin.md, "Timing"; docs/accel.md, *Synthesis*).
+  localparam int unsigned TrilinPipe = 1;
+
+  /// Latency of the frame's cube5_trilin in cycles: 3, or 9 with `TrilinPipe` = 1
+  /// (docs/numerics/trilin.md, "Timing").
+  localparam int unsigned TrilinLatency = 3 + 6 * TrilinPipe;
 
   /// Latency of cube5_gradient in cycles: five register stages (docs/numerics/gradient.md,
   /// "Timing").

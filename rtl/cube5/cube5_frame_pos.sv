@@ -6,6 +6,11 @@
 // The sweep may cover a range of slices s_first ..= s_last (the empty slices before and after are
 // skipped): the counters start at s_first with T_x(s_first), T_y(s_first) from the set-up. Items
 // past the last slice (the flush) keep counting into slice s_last + 1; the frame ignores them.
+//
+// The geometry (nbr - 1, nj - 1, s_first, s_last) is taken at start_i into registers, so that each
+// flag is an equality of two registers: the inputs need hold only in start_i's cycle, and no
+// subtraction sits before a flag (in the accelerator the flags feed the compositing window's
+// admission of the next beat, docs/accel.md, *Synthesis*).
 module cube5_frame_pos #(
   /// Bits of a dimension (MaxDimLog2 + 1).
   parameter int unsigned DimW = 7,
@@ -17,7 +22,7 @@ module cube5_frame_pos #(
   input  logic clk_i,
   input  logic rst_ni,
 
-  /// Back to the first item of a frame (beat 0, row 0, slice s_first).
+  /// Back to the first item of a frame (beat 0, row 0, slice s_first); takes the geometry below.
   input  logic start_i,
   /// The current item moves on.
   input  logic step_i,
@@ -53,13 +58,28 @@ module cube5_frame_pos #(
 
   logic [DimW-1:0] m_q, m_d, b_q, b_d, s_q, s_d;
   logic signed [TW-1:0] tx_q, tx_d, ty_q, ty_d;
+  logic [DimW-1:0] last_m_q, last_b_q, s_first_q, s_last_q;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      last_m_q  <= '0;
+      last_b_q  <= '0;
+      s_first_q <= '0;
+      s_last_q  <= '0;
+    end else if (start_i) begin
+      last_m_q  <= nbr_i - DimW'(1);
+      last_b_q  <= nj_i - DimW'(1);
+      s_first_q <= s_first_i;
+      s_last_q  <= s_last_i;
+    end
+  end
 
   assign first_beat_o  = (m_q == '0);
-  assign last_beat_o   = (m_q == nbr_i - DimW'(1));
+  assign last_beat_o   = (m_q == last_m_q);
   assign first_row_o   = (b_q == '0);
-  assign last_row_o    = (b_q == nj_i - DimW'(1));
-  assign first_slice_o = (s_q == s_first_i);
-  assign last_slice_o  = (s_q == s_last_i);
+  assign last_row_o    = (b_q == last_b_q);
+  assign first_slice_o = (s_q == s_first_q);
+  assign last_slice_o  = (s_q == s_last_q);
 
   always_comb begin
     m_d  = m_q;

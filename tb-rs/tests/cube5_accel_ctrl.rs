@@ -20,7 +20,7 @@ use cube5_model::regs::cube5_accel::{
     TABLE_CLASS,
 };
 use cube5_model::units::cube5_accel_ctrl::{
-    AccelCtrlCodec, AccelCtrlConfig, CtrlRecord, CtrlRegs, Outcome, PORTS,
+    AccelCtrlCodec, AccelCtrlConfig, CtrlRecord, CtrlRegs, Outcome, CHECK_CYCLES, PORTS,
 };
 use cube5_model::units::cube5_axil::{AxilRecordKind, AxilTxn, RESP_OKAY};
 use cube5_tb::rtl::{RtlStream, Taken, Traffic};
@@ -282,9 +282,9 @@ fn frame(b: &mut Bench, regs: &CtrlRegs, env: &Env) -> Result<u32, TbError> {
             ))));
         }
     }
-    // The end cycle te: one after the last handshake or event (the check cycle t0 + 3 when
-    // refused; accepted frames issue from t0 + 4).
-    let mut last = t0 + 2;
+    // The end cycle te: one after the last handshake or event (the check cycle t0 + CHECK_CYCLES
+    // when refused; accepted frames issue from t0 + CHECK_CYCLES + 1).
+    let mut last = t0 + CHECK_CYCLES - 1;
     let mut rows = 0u32;
     for t in &b.recs {
         match &t.value {

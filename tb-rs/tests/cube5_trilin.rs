@@ -11,8 +11,8 @@ use cube5_tb::{Mismatch, TbError, Variant};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use support::{
-    configs, directed_on_every_config, expect_mismatch, gate_smoke_then_directed,
-    million_across_a_reset, random_items_one_per_clock, seed,
+    assert_one_item_per_clock, configs, directed_on_every_config, expect_mismatch,
+    gate_smoke_then_directed, million_across_a_reset, random_items, seed,
 };
 
 fn random_item(cfg: TrilinConfig) -> impl FnMut(&mut ChaCha8Rng) -> TrilinIn {
@@ -92,9 +92,13 @@ fn directed_extremes() {
     });
 }
 
+/// One sample per clock, each configuration at its own latency (3, or 9 with `Pipe = 1`).
 #[test]
 fn one_sample_per_cycle_when_never_stalled() {
-    random_items_one_per_clock(random_item, 11, 3);
+    for (variant, cfg) in configs::<TrilinConfig>() {
+        let items = random_items(seed(11), 100_000, random_item(cfg));
+        assert_one_item_per_clock(variant, cfg, &[], &items, cfg.latency());
+    }
 }
 
 #[test]

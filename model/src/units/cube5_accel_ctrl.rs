@@ -27,6 +27,12 @@ use crate::units::cube5_vol_fetch::{frame_axes, Sweep, VolFetchConfig};
 /// `StepW` of the frame's `S(2.StepW)` ray steps.
 const STEP_W: u32 = 16;
 
+/// The check cycles after the start strobe `t0` (docs/numerics/accel_ctrl.md, "Start and
+/// checks"): a refused frame ends in `te = t0 + CHECK_CYCLES` (`Cycle` reads `CHECK_CYCLES`), an
+/// accepted frame's ports offer their first commands from `t0 + CHECK_CYCLES + 1`, and `Sample`
+/// is set in `t0 + CHECK_CYCLES`.
+pub const CHECK_CYCLES: u64 = 4;
+
 /// The RTL parameters of one `cube5_accel_ctrl` configuration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct AccelCtrlConfig {

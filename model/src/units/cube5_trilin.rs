@@ -11,6 +11,9 @@ pub struct TrilinConfig {
     pub voxel_w: u32,
     pub weight_w: u32,
     pub frac_w: u32,
+    /// 0: one register stage per axis (latency 3); 1: three per axis, every multiplier between
+    /// registers (latency 9; the frame's interpolators). The same bits either way.
+    pub pipe: u32,
 }
 
 impl TrilinConfig {
@@ -18,16 +21,19 @@ impl TrilinConfig {
         voxel_w: 8,
         weight_w: 6,
         frac_w: 2,
+        pipe: 0,
     };
     pub const DEFAULT: Self = Self {
         voxel_w: 12,
         weight_w: 8,
         frac_w: 4,
+        pipe: 0,
     };
     pub const WIDE: Self = Self {
         voxel_w: 16,
         weight_w: 10,
         frac_w: 6,
+        pipe: 0,
     };
 
     pub fn new(voxel_w: u32, weight_w: u32, frac_w: u32) -> Result<Self> {
@@ -35,6 +41,7 @@ impl TrilinConfig {
             voxel_w,
             weight_w,
             frac_w,
+            pipe: 0,
         };
         cfg.validate()?;
         Ok(cfg)
@@ -51,7 +58,20 @@ impl TrilinConfig {
         if self.frac_w > 8 {
             return bad(&format!("FracW {} outside 0..=8", self.frac_w));
         }
+        if self.pipe > 1 {
+            return bad(&format!("Pipe {} outside 0..=1", self.pipe));
+        }
         Ok(())
+    }
+
+    /// Cycles from an item in to its sample out: one register stage per axis, or three with
+    /// `Pipe = 1` (docs/numerics/trilin.md, "Timing").
+    pub fn latency(&self) -> u64 {
+        if self.pipe != 0 {
+            9
+        } else {
+            3
+        }
     }
 
     /// Width of the output sample, `U(VoxelW.FracW)`.
@@ -337,6 +357,7 @@ crate::unit_config!(TrilinConfig, "cube5_trilin", DEFAULT, {
     "VoxelW" => voxel_w,
     "WeightW" => weight_w,
     "FracW" => frac_w,
+    "Pipe" => pipe,
 });
 
 #[cfg(test)]
@@ -351,6 +372,17 @@ mod tests {
             weights: std::array::from_fn(|_| rng.random_range(0..=cfg.weight_max())),
             mode: TrilinMode::from_bits(rng.random_range(0..4)),
         }
+    }
+
+    #[test]
+    fn the_frames_trilin_latency_is_its_pipe_s() {
+        // cube5_frame.regs.toml's TrilinLatency follows TrilinPipe (the frame's interpolators).
+        use crate::regs::cube5_frame::{TRILIN_LATENCY, TRILIN_PIPE};
+        let cfg = TrilinConfig {
+            pipe: TRILIN_PIPE,
+            ..TrilinConfig::DEFAULT
+        };
+        assert_eq!(cfg.latency(), TRILIN_LATENCY);
     }
 
     #[test]
