@@ -40,7 +40,10 @@ module gicube_cache #(
   /// Byte address width of the AXI port (13..64; the volume's M^3 WordW/8 bytes sit at 0).
   parameter int unsigned AddrW       = 32,
   /// 1: deposits, dirty lines, write-back and flush (contract, "Splatting"); 0: read-only.
-  parameter int unsigned Splat       = 0
+  parameter int unsigned Splat       = 0,
+  /// Requests checked ahead of the data read (contract, "Prefetch"): 0 blocking, 1..8 the
+  /// prefetch queue's entries (Splat = 0 only).
+  parameter int unsigned Prefetch    = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -190,6 +193,9 @@ module gicube_cache #(
   if (Splat > 1) begin : gen_bad_splat
     $fatal(1, "gicube_cache: Splat must be 0 or 1");
   end
+  if (Prefetch > 8 || (Prefetch != 0 && Splat != 0)) begin : gen_bad_prefetch
+    $fatal(1, "gicube_cache: Prefetch must be in 0..8, and 0 with Splat");
+  end
 
   // ==============================================================================================
   // Bank decode: the corner of the cell in bank p along each axis (contract, "Tags")
@@ -236,7 +242,7 @@ module gicube_cache #(
     StMiss    // issuing the miss queue and writing the fills (Splat: or the phases below)
   } state_e;
 
-  logic             in_fire;
+  logic             in_fire, in_ready_b;
   logic             busy_q, busy_d;      // a request is held
   state_e           state_q, state_d;
   logic             replay_q, replay_d;  // this check follows the request's fills
@@ -284,7 +290,15 @@ module gicube_cache #(
   logic [8*DataW-1:0] dep_beat;          // ... in its beat
   logic              dep_we;             // the deposit's words are written this cycle
 
-  // RAM ports, per bank.
+  // RAM ports, per bank, and cube5_axi_rd's command: the blocking unit's or the prefetching
+  // one's (the _r wires).
+  logic [7:0]             tag_we_r, tag_re_r, dat_we_r, dat_re_r;
+  logic [8*SetW-1:0]      tag_waddr_r, tag_raddr_r, fill_set_r;
+  logic [8*TagW-1:0]      tag_wdata_r;
+  logic [8*DAddrW-1:0]    dat_raddr_r;
+  logic [BplW-1:0]        fill_beat_r;
+  logic                   cmd_valid_r;
+  logic [AddrW+LenW-1:0]  cmd_data_r;
   logic [7:0]             ram_re;
   logic [InW-1:0]         rd_xyz;          // the request whose words the RAMs read
   logic [8*SetW-1:0]      tag_raddr;
@@ -314,7 +328,7 @@ module gicube_cache #(
   logic [DataW+2:0]       beat_data;
   logic [2:0]             issue_p, fill_p;
 
-  assign in_fire  = in_valid_i && in_ready_o;
+  assign in_fire  = in_valid_i && in_ready_b;
   assign out_free = !out_valid_q || out_ready_i;
   // The held item with its op and energies (zero without Splat).
   logic [XyzW+2+8*IrrW-1:0] req_e;
@@ -391,7 +405,7 @@ module gicube_cache #(
   assign in_fl      = busy_q && state_q == StMiss && flst_q;
   assign in_miss    = busy_q && state_q == StMiss && !wbst_q && !flst_q;
   assign fleave     = in_fl && fl_done && out_free;
-  assign in_ready_o = !busy_q || (leave && !is_dep) || fleave;
+  assign in_ready_b = !busy_q || (leave && !is_dep) || fleave;
   assign reread     = in_miss && issue_q == '0 && fill_q == '0;
   assign rd_xyz     = reread ? req_q : in_data_i;
   assign ram_re     = {8{in_fire || reread}};
@@ -730,8 +744,273 @@ module gicube_cache #(
                                   eng_tk_d};
   end
 
-  assign out_valid_o = out_valid_q;
-  assign out_data_o  = out_data_q;
+  // The blocking unit's ports, or the prefetching one's (gen_prefetch below).
+  if (Prefetch == 0) begin : gen_blocking_ports
+    assign in_ready_o  = in_ready_b;
+    assign out_valid_o = out_valid_q;
+    assign out_data_o  = out_data_q;
+    assign tag_we_r    = tag_we;
+    assign tag_waddr_r = set_of;
+    assign tag_wdata_r = tag_of;
+    assign tag_re_r    = ram_re | {8{fl_rd}};
+    assign tag_raddr_r = tag_raddr;
+    assign dat_we_r    = dat_we;
+    assign dat_re_r    = ram_re;
+    assign dat_raddr_r = dat_raddr;
+    assign fill_set_r  = set_of;
+    assign fill_beat_r = beat_q;
+    assign cmd_valid_r = cmd_valid;
+    assign cmd_data_r  = cmd_data;
+  end
+
+
+  // ==============================================================================================
+  // Prefetch > 0 (contract, "Prefetch"): the tags are checked ahead of the data read. A request
+  // is taken (its tags read), checked in request order (its misses allocated and queued for
+  // cube5_axi_rd at once), and waits in the prefetch queue until every line allocated up to its
+  // check is filled; then its words are read and it leaves. A check whose miss would evict a
+  // line that a queued request still reads waits until that request has read it.
+  // ==============================================================================================
+
+  if (Prefetch != 0) begin : gen_prefetch
+    localparam int unsigned SeqW = 8;                 // lines allocated / filled, modulo 2^8
+    localparam int unsigned PfW  = $clog2(Prefetch + 1);
+    localparam int unsigned FqD  = 16;                // lines offered and not yet filled
+    localparam int unsigned FqW  = $clog2(FqD);
+    localparam int unsigned EntW = XyzW + 8 + SeqW;   // a queued request: cell, hit mask, need
+
+    // The check stage (the request whose tags the RAMs' outputs hold).
+    logic             c_v_q;
+    logic [XyzW-1:0]  c_xyz_q;
+    // The prefetch queue, entry 0 the oldest.
+    logic [EntW-1:0]  q_q [Prefetch];
+    logic [PfW-1:0]   q_n_q;
+    // The data stage (the request whose words the RAMs' outputs hold) and the output.
+    logic             d_v_q;
+    logic [XyzW+7:0]  d_q;
+    logic             o_v_q;
+    logic [OutW-1:0]  o_q;
+    logic [CountW-1:0] p_hits_q, p_misses_q;
+    logic [StallW-1:0] ost_q;
+    // Allocation and fills.
+    logic [8*Sets-1:0] p_valid_q;
+    logic [SeqW-1:0]  alloc_q, filled_q;
+    logic [7:0]       iss_q;                           // the last check's misses not yet offered
+    logic [XyzW-1:0]  iss_xyz_q;
+    logic [3+SetW-1:0] fq_q [FqD];                    // bank and set of each line in flight
+    logic [FqW:0]     fq_n_q;
+    logic [FqW-1:0]   fq_rd_q, fq_wr_q;
+    logic [BplW-1:0]  p_beat_q;
+
+    // The check.
+    logic [7:0]       c_hit, c_conf;
+    logic [8*SetW-1:0] c_set;
+    logic [8*TagW-1:0] c_tag;
+    logic             c_go, c_alloc, q_room, q_pop, q_push, d_go, o_free, take;
+    logic [3:0]       c_nhit;
+    logic [SeqW-1:0]  c_need;
+
+    for (genvar p = 0; p < 8; p++) begin : gen_pf_bank
+      logic [IdxW-1:0] idx_c, idx_in, idx_h;
+      logic [Sets-1:0] vb;
+      assign idx_c  = bank_index(InW'(c_xyz_q), p);
+      assign idx_in = bank_index(in_data_i, p);
+      assign idx_h  = bank_index(InW'(q_q[0][0 +: XyzW]), p);
+      assign c_set[p*SetW +: SetW] = set_of_line(idx_c[IdxW-1:LineLog]);
+      if (LineW > SetW) begin : gen_tag
+        assign c_tag[p*TagW +: TagW] = idx_c[IdxW-1:LineLog+SetW];
+      end else begin : gen_no_tag
+        assign c_tag[p*TagW +: TagW] = '0;
+      end
+      assign vb = p_valid_q[p*Sets +: Sets];
+      assign c_hit[p] = vb[c_set[p*SetW +: SetW]]
+          && (tag_rdata[p*TagW +: TagW] == c_tag[p*TagW +: TagW]);
+      // A miss here evicts the set's line: held while a queued request has the same set.
+      always_comb begin
+        logic [LineW-1:0] ln_e;
+        c_conf[p] = 1'b0;
+        for (int unsigned e = 0; e < Prefetch; e++) begin
+          ln_e = LineW'(bank_index(InW'(q_q[e][0 +: XyzW]), p) >> LineLog);
+          if (PfW'(e) < q_n_q && set_of_line(ln_e) == c_set[p*SetW +: SetW])
+            c_conf[p] = 1'b1;
+        end
+        c_conf[p] = c_conf[p] && !c_hit[p];
+      end
+      assign tag_raddr_r[p*SetW +: SetW] = set_of_line(idx_in[IdxW-1:LineLog]);
+      assign dat_raddr_r[p*DAddrW +: DAddrW] = {set_of_line(idx_h[IdxW-1:LineLog]),
+                                                idx_h[VLog +: BplW]};
+      logic unused_idx;
+      assign unused_idx = ^{idx_in[LineLog-1:0], idx_h[VLog-1:0], idx_c[LineLog-1:0]};
+    end
+
+    always_comb begin
+      c_nhit = '0;
+      for (int unsigned p = 0; p < 8; p++) c_nhit = c_nhit + 4'(c_hit[p]);
+    end
+    // The head is ready when every line allocated up to its check is filled.
+    logic [SeqW-1:0] h_need;
+    logic            h_ready;
+    assign h_need  = q_q[0][XyzW + 8 +: SeqW];
+    assign h_ready = q_n_q != '0 && SeqW'(alloc_q - h_need) >= SeqW'(alloc_q - filled_q);
+    assign o_free  = !o_v_q || out_ready_i;
+    assign d_go    = d_v_q && o_free;
+    assign q_pop   = h_ready && (!d_v_q || d_go);
+    assign q_room  = q_n_q != PfW'(Prefetch) || q_pop;
+    assign c_alloc = c_hit != '1;
+    assign c_go    = c_v_q && q_room && (!c_alloc || (iss_q == '0 && c_conf == '0));
+    assign q_push  = c_go;
+    assign c_need  = alloc_q + (SeqW'(4'd8) - SeqW'(c_nhit));
+    // Taken while the check is empty or leaves without writing tags (the next take reads them).
+    assign take    = in_valid_i && (!c_v_q || (c_go && !c_alloc));
+    assign in_ready_o = !c_v_q || (c_go && !c_alloc);
+
+    assign tag_re_r    = {8{take}};
+    assign tag_we_r    = (c_go && c_alloc) ? ~c_hit : 8'h00;
+    assign tag_waddr_r = c_set;
+    assign tag_wdata_r = c_tag;
+    assign dat_re_r    = {8{q_pop}};
+
+    // The misses of the last allocating check, offered in bank order; fills in command order.
+    logic [2:0]       iss_p;
+    logic [IdxW-1:0]  iss_idx [8];
+    logic [LineW-1:0] iss_line;
+    logic [3+SetW-1:0] fq_head;
+    logic             fill_last;
+    for (genvar p = 0; p < 8; p++) begin : gen_pf_iss
+      assign iss_idx[p] = bank_index(InW'(iss_xyz_q), p);
+    end
+    assign iss_p = lowest(iss_q);
+    always_comb begin
+      iss_line = '0;
+      for (int unsigned p = 0; p < 8; p++) begin
+        if (iss_p == 3'(p)) iss_line = iss_idx[p][IdxW-1:LineLog];
+      end
+    end
+    assign cmd_valid_r = iss_q != '0 && fq_n_q != (FqW+1)'(FqD);
+    assign cmd_data_r  = {LenW'(Bpl), AddrW'({iss_p, iss_line, ZeroW'(0)})};
+    assign fq_head     = fq_q[fq_rd_q];
+    assign fill_last   = beat_valid && beat_data[DataW];
+    always_comb begin
+      dat_we_r = '0;
+      if (beat_valid) dat_we_r[fq_head[SetW +: 3]] = 1'b1;
+    end
+    assign fill_set_r  = {8{fq_head[SetW-1:0]}};
+    assign fill_beat_r = p_beat_q;
+
+    // The output: the data stage's voxels (corner c from bank c ^ parity), mask, counts, stall.
+    logic [8*WordW-1:0] d_word;
+    logic [3:0]         d_nhit;
+    for (genvar p = 0; p < 8; p++) begin : gen_pf_word
+      logic [IdxW-1:0]  idx_d;
+      logic [DataW-1:0] bw;
+      logic [VLog-1:0]  ws;
+      assign idx_d = bank_index(InW'(d_q[0 +: XyzW]), p);
+      assign ws    = idx_d[0 +: VLog];
+      assign bw    = dat_rdata[p*DataW +: DataW];
+      assign d_word[p*WordW +: WordW] = bw[ws*WordW +: WordW];
+      logic unused_d;
+      assign unused_d = ^idx_d[IdxW-1:VLog];
+    end
+    always_comb begin
+      d_nhit = '0;
+      for (int unsigned p = 0; p < 8; p++) d_nhit = d_nhit + 4'(d_q[XyzW + p]);
+    end
+
+    always_ff @(posedge clk_i) begin
+      logic [2:0] cp;
+      if (!rst_ni) begin
+        c_v_q      <= 1'b0;
+        q_n_q      <= '0;
+        d_v_q      <= 1'b0;
+        o_v_q      <= 1'b0;
+        p_hits_q   <= '0;
+        p_misses_q <= '0;
+        ost_q      <= '0;
+        p_valid_q  <= '0;
+        alloc_q    <= '0;
+        filled_q   <= '0;
+        iss_q      <= '0;
+        fq_n_q     <= '0;
+        fq_rd_q    <= '0;
+        fq_wr_q    <= '0;
+        p_beat_q   <= '0;
+      end else begin
+        // Check stage.
+        if (take) begin
+          c_v_q   <= 1'b1;
+          c_xyz_q <= in_data_i[XyzW-1:0];
+        end else if (c_go) begin
+          c_v_q <= 1'b0;
+        end
+        if (c_go && c_alloc) begin
+          alloc_q   <= c_need;
+          iss_q     <= ~c_hit;
+          iss_xyz_q <= c_xyz_q;
+          for (int unsigned p = 0; p < 8; p++) begin
+            if (!c_hit[p]) p_valid_q[p*Sets + 32'(c_set[p*SetW +: SetW])] <= 1'b1;
+          end
+        end
+        // The queue: pop shifts, push appends.
+        for (int unsigned e = 0; e < Prefetch; e++) begin
+          if (q_pop && e + 1 < Prefetch) q_q[e] <= q_q[e + 1];
+          if (q_push && PfW'(e) == q_n_q - PfW'(q_pop)) q_q[e] <= {c_need, c_hit, c_xyz_q};
+        end
+        q_n_q <= q_n_q + PfW'(q_push) - PfW'(q_pop);
+        // Data stage.
+        if (q_pop) begin
+          d_v_q <= 1'b1;
+          d_q   <= q_q[0][XyzW+7:0];
+        end else if (d_go) begin
+          d_v_q <= 1'b0;
+        end
+        // Output register; the stall counts the cycles it could take an item and none was ready
+        // while the unit held a request (contract, "Prefetch").
+        if (o_v_q && out_ready_i) o_v_q <= 1'b0;
+        if (d_go) begin
+          o_v_q <= 1'b1;
+          for (int unsigned c = 0; c < 8; c++) begin
+            cp = 3'(c) ^ {d_q[2*CoordW], d_q[CoordW], d_q[0]};
+            o_q[c*WordW +: WordW] <= d_word[cp*WordW +: WordW];
+          end
+          o_q[8*WordW +: 8 + 2*CountW + StallW] <= {ost_q,
+              p_misses_q + (CountW'(4'd8) - CountW'(d_nhit)), p_hits_q + CountW'(d_nhit), d_q[XyzW +: 8]};
+          p_hits_q   <= p_hits_q + CountW'(d_nhit);
+          p_misses_q <= p_misses_q + (CountW'(4'd8) - CountW'(d_nhit));
+          ost_q      <= '0;
+        end else if (o_free && (c_v_q || q_n_q != '0 || d_v_q) && ost_q != '1) begin
+          ost_q <= ost_q + StallW'(1);
+        end
+        // Miss issue and fills.
+        if (cmd_valid_r && cmd_ready) begin
+          iss_q[iss_p]     <= 1'b0;
+          fq_q[fq_wr_q]    <= {iss_p, set_of_line(iss_line)};
+          fq_wr_q          <= fq_wr_q + FqW'(1);
+        end
+        if (beat_valid) p_beat_q <= p_beat_q + BplW'(1);
+        if (fill_last) begin
+          fq_rd_q  <= fq_rd_q + FqW'(1);
+          filled_q <= filled_q + SeqW'(1);
+        end
+        fq_n_q <= fq_n_q + (FqW+1)'(cmd_valid_r && cmd_ready) - (FqW+1)'(fill_last);
+      end
+    end
+
+    assign out_valid_o = o_v_q;
+    assign out_data_o  = o_q;
+
+    // The blocking unit's logic is unused here.
+    logic unused_blocking;
+    assign unused_blocking = ^{in_ready_b, out_valid_q, out_data_q, tag_we, ram_re, fl_rd,
+                               tag_raddr, dat_we, dat_raddr, beat_q, cmd_valid, cmd_data,
+                               set_of, tag_of};
+
+`ifndef SYNTHESIS
+    // A fill beat has its line's destination; the line's last beat ends at beat Bpl - 1.
+    PfFillQueued: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        beat_valid |-> fq_n_q != '0 && (beat_data[DataW] == (p_beat_q == BplW'(Bpl - 1))))
+      else $error("gicube_cache: a fill beat with no line in flight");
+`endif
+  end
 
   // ==============================================================================================
   // The eight banks: tags and words in block RAM (one write port, one registered read port)
@@ -744,11 +1023,11 @@ module gicube_cache #(
       .AddrW(SetW)
     ) u_tags (
       .clk_i  (clk_i),
-      .we_i   (tag_we[p]),
-      .waddr_i(set_of[p*SetW +: SetW]),
-      .wdata_i(tag_of[p*TagW +: TagW]),
-      .re_i   (ram_re[p] || fl_rd),
-      .raddr_i(tag_raddr[p*SetW +: SetW]),
+      .we_i   (tag_we_r[p]),
+      .waddr_i(tag_waddr_r[p*SetW +: SetW]),
+      .wdata_i(tag_wdata_r[p*TagW +: TagW]),
+      .re_i   (tag_re_r[p]),
+      .raddr_i(tag_raddr_r[p*SetW +: SetW]),
       .rdata_o(tag_rdata[p*TagW +: TagW])
     );
 
@@ -758,11 +1037,11 @@ module gicube_cache #(
       .AddrW(DAddrW)
     ) u_words (
       .clk_i  (clk_i),
-      .we_i   (dat_we[p]),
-      .waddr_i({set_of[p*SetW +: SetW], dep_we ? idx_req_beat[p*BplW +: BplW] : beat_q}),
+      .we_i   (dat_we_r[p]),
+      .waddr_i({fill_set_r[p*SetW +: SetW], dep_we ? idx_req_beat[p*BplW +: BplW] : fill_beat_r}),
       .wdata_i(dep_we ? dep_beat[p*DataW +: DataW] : beat_data[DataW-1:0]),
-      .re_i   (ram_re[p] || (rd_go && eng_p_q == 3'(p))),
-      .raddr_i(dat_raddr[p*DAddrW +: DAddrW]),
+      .re_i   (dat_re_r[p] || (rd_go && eng_p_q == 3'(p))),
+      .raddr_i(dat_raddr_r[p*DAddrW +: DAddrW]),
       .rdata_o(dat_rdata[p*DataW +: DataW])
     );
   end
@@ -781,9 +1060,9 @@ module gicube_cache #(
   ) u_rd (
     .clk_i          (clk_i),
     .rst_ni         (rst_ni),
-    .in_valid_i     (cmd_valid),
+    .in_valid_i     (cmd_valid_r),
     .in_ready_o     (cmd_ready),
-    .in_data_i      (cmd_data),
+    .in_data_i      (cmd_data_r),
     .out_valid_o    (beat_valid),
     .out_ready_i    (1'b1),
     .out_data_o     (beat_data),
@@ -884,12 +1163,12 @@ module gicube_cache #(
     else $error("gicube_cache: output changed while stalled");
   // Fills arrive only for queued misses, and the line's last beat ends at beat Bpl - 1.
   FillOnlyWhenQueued: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      beat_valid |-> busy_q && state_q == StMiss && fill_q != '0
+      beat_valid && Prefetch == 0 |-> busy_q && state_q == StMiss && fill_q != '0
       && (beat_data[DataW] == (beat_q == BplW'(Bpl - 1))))
     else $error("gicube_cache: a fill beat with no miss queued, or a line of the wrong length");
   // The re-check after the fills hits in every bank.
   ReplayHits: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      busy_q && state_q == StCheck && replay_q |-> all_hit)
+      Prefetch == 0 && busy_q && state_q == StCheck && replay_q |-> all_hit)
     else $error("gicube_cache: the check after the fills missed");
 `endif
 

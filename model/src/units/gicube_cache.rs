@@ -17,8 +17,12 @@ use crate::error::{ModelError, Result};
 use crate::unit::{StreamCodec, StreamUnit};
 use crate::units::cube5_axi_rd::{AxiMemImage, AxiRdConfig, Burst};
 
-/// Cycles from taking a request that hits to its output (contract, *Cycles*).
+/// Cycles from taking a request that hits to its output (contract, *Cycles*), `Prefetch = 0`.
 pub const HIT_LATENCY: u64 = 2;
+/// ... with `Prefetch > 0` (contract, *Prefetch*): take, check, queue, data read.
+pub const PREFETCH_HIT_LATENCY: u64 = 4;
+/// Largest `Prefetch`: entries of the prefetch queue.
+pub const MAX_PREFETCH: u32 = 8;
 /// Bits of the running counts `hits`, `misses` in the output item.
 pub const COUNT_W: u32 = 32;
 /// Bits of the output item's `stall` (saturating).
@@ -48,6 +52,9 @@ pub struct CacheConfig {
     /// 1: the splatting side (deposits, dirty lines, write-back, flush; contract, *Splatting*);
     /// 0: the read-only cache.
     pub splat: u32,
+    /// Requests checked ahead of the data read (contract, *Prefetch*): 0 the blocking unit,
+    /// 1..=8 the prefetch queue's entries (`Splat = 0` only). Changes only the cycles.
+    pub prefetch: u32,
 }
 
 impl CacheConfig {
@@ -61,6 +68,7 @@ impl CacheConfig {
         outstanding: 8,
         addr_w: 32,
         splat: 0,
+        prefetch: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
@@ -127,6 +135,12 @@ impl CacheConfig {
         if self.splat > 1 {
             return bad(format!("Splat {} is not 0 or 1", self.splat));
         }
+        if self.prefetch > MAX_PREFETCH || (self.prefetch > 0 && self.splat == 1) {
+            return bad(format!(
+                "Prefetch {} outside 0..={MAX_PREFETCH} (0 with Splat)",
+                self.prefetch
+            ));
+        }
         Ok(())
     }
 
@@ -147,6 +161,26 @@ impl CacheConfig {
             OP_W + 8 * self.irr_w()
         } else {
             0
+        }
+    }
+
+    /// Cycles from taking a request that hits to its output (contract, *Cycles*, *Prefetch*).
+    pub fn hit_latency(&self) -> u64 {
+        if self.prefetch == 0 {
+            HIT_LATENCY
+        } else {
+            PREFETCH_HIT_LATENCY
+        }
+    }
+
+    /// Requests the unit holds at most (taken, not yet out of its output register): the
+    /// blocking unit's check and output; with `Prefetch`, the check, the queue, the data read and
+    /// the output. A consumer that keeps a record per request sizes its FIFO by this.
+    pub fn held_max(&self) -> u32 {
+        if self.prefetch == 0 {
+            2
+        } else {
+            self.prefetch + 3
         }
     }
 
@@ -298,6 +332,7 @@ crate::unit_config!(CacheConfig, "gicube_cache", DEFAULT, {
     "Outstanding" => outstanding,
     "AddrW" => addr_w,
     "Splat" => splat,
+    "Prefetch" => prefetch,
 });
 
 /// One request: the cell whose lowest voxel is `(x, y, z)` (taken modulo `M`).
@@ -792,6 +827,7 @@ mod tests {
         outstanding: 2,
         addr_w: 16,
         splat: 0,
+        prefetch: 0,
     };
 
     fn ramp(cfg: CacheConfig) -> Vec<u32> {
@@ -833,7 +869,22 @@ mod tests {
                 outstanding: 16,
                 ..SMALL
             },
+            CacheConfig {
+                prefetch: 9,
+                ..SMALL
+            },
+            CacheConfig {
+                prefetch: 1,
+                splat: 1,
+                ..SMALL
+            },
         ];
+        CacheConfig {
+            prefetch: 8,
+            ..SMALL
+        }
+        .validate()
+        .unwrap();
         for c in bad {
             assert!(c.validate().is_err(), "{c:?}");
         }
@@ -993,6 +1044,7 @@ mod tests {
         outstanding: 2,
         addr_w: 13,
         splat: 1,
+        prefetch: 0,
     };
 
     #[test]

@@ -1637,6 +1637,7 @@ impl ProcessorRtlConfig {
             outstanding: self.outstanding,
             addr_w: RTL_ADDR_W,
             splat: self.light,
+            prefetch: 0,
         }
     }
 
