@@ -817,11 +817,8 @@ module gicube_cache #(
       assign idx_in = bank_index(in_data_i, p);
       assign idx_h  = bank_index(InW'(q_q[0][0 +: XyzW]), p);
       assign c_set[p*SetW +: SetW] = set_of_line(idx_c[IdxW-1:LineLog]);
-      if (LineW > SetW) begin : gen_tag
-        assign c_tag[p*TagW +: TagW] = idx_c[IdxW-1:LineLog+SetW];
-      end else begin : gen_no_tag
-        assign c_tag[p*TagW +: TagW] = '0;
-      end
+      // The tag: the line's bits above the set's (0 when there are none).
+      assign c_tag[p*TagW +: TagW] = TagW'({1'b0, idx_c[IdxW-1:LineLog]} >> SetW);
       assign vb = p_valid_q[p*Sets +: Sets];
       assign c_hit[p] = vb[c_set[p*SetW +: SetW]]
           && (tag_rdata[p*TagW +: TagW] == c_tag[p*TagW +: TagW]);

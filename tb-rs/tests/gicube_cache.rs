@@ -565,9 +565,8 @@ fn drive_and_compare(
         let flush = *it == CacheItem::Flush;
         // With Prefetch the stall is the output's wait (contract, *Prefetch*): any request may
         // wait behind another's lines; the full-speed identity below pins the sum.
-        if cfg.prefetch > 0 {
-            w.stall = got.value.stall;
-        } else if (flush && u64::from(got.value.stall) >= walk.min(0xffff))
+        if cfg.prefetch > 0
+            || (flush && u64::from(got.value.stall) >= walk.min(0xffff))
             || (!flush && w.hit != 0xff && got.value.stall >= least)
         {
             w.stall = got.value.stall;
