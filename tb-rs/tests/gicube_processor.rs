@@ -604,20 +604,24 @@ fn high_albedo_photons_scatter_in_the_ring_like_the_model() {
         let hi = two_pass_gi(variant, rtl, HIGH_ALBEDO, 2, seed(1980));
         let lo = two_pass_gi(variant, rtl, GiMode::LowAlbedo, 2, seed(1981));
         assert_ne!(hi.rgb, lo.rgb, "{variant}: high albedo changes the image");
-        // GICUBE_GI_PPM=<file>: the two images (equal to the RTL's), low albedo left, as a
-        // binary PPM (docs/measurements.md, *gicube_processor*, converts it to a PNG).
-        if let Ok(path) = std::env::var("GICUBE_GI_PPM") {
-            let (w, h) = (lo.width, lo.height);
-            let mut ppm = format!("P6\n{} {h}\n255\n", 2 * w).into_bytes();
-            for y in 0..h {
-                for f in [&lo, &hi] {
-                    for x in 0..w {
-                        let px = f.rgb[(y * w + x) as usize];
-                        ppm.extend(px.map(|c| (c >> 4).min(255) as u8));
-                    }
-                }
-            }
-            std::fs::write(&path, ppm).unwrap();
+        // GICUBE_GI_PNG=<file>: the two images (equal to the RTL's), low albedo left, each pixel
+        // 8 x 8 (docs/img/gicube-processor-gi-albedo.png).
+        if let Ok(path) = std::env::var("GICUBE_GI_PNG") {
+            let (w, h, k) = (lo.width, lo.height, 8);
+            let (lo, hi) = (lo.to_f64(), hi.to_f64());
+            let rgb = (0..h * k)
+                .flat_map(|y| (0..2 * w * k).map(move |x| (x / k, y / k)))
+                .map(|(x, y)| {
+                    let f = if x < w { &lo } else { &hi };
+                    f[(y * w + x % w) as usize]
+                })
+                .collect();
+            let img = cube5_model::render::ImageF64 {
+                width: 2 * w * k,
+                height: h * k,
+                rgb,
+            };
+            img.to_rgb8().save(&path).unwrap();
         }
     }
 }
