@@ -69,6 +69,17 @@ impl VariantLine {
     }
 }
 
+/// The folder (repository-relative) every RTL `` `include `` is found in: the port-list macros
+/// of `cube5_axi_ports.svh`. Every tool that reads RTL gets it (`-I`: Verilator in
+/// `tb-rs/build.rs` and `scripts/lint.sh`, Yosys through [`crate::yosys::prelude`]); a filelist
+/// of a top that includes a header names the header too, so a change to it rebuilds that top.
+pub const INCLUDE_DIR: &str = "rtl";
+
+/// `-I<repo>/rtl`: the include folder as Verilator's and Yosys's `read_verilog` option.
+pub fn include_arg(repo: &Path) -> String {
+    format!("-I{}", repo.join(INCLUDE_DIR).display())
+}
+
 /// A top with its filelist (resolved, repository-relative, packages first) and its variants.
 #[derive(Debug, Clone)]
 pub struct Top {
