@@ -712,6 +712,14 @@ impl Shim {
             .find(|f| f.file_name().is_some_and(|n| n.to_string_lossy() == own))
             .and_then(|f| fs::read_to_string(f).ok())
             .unwrap_or_default();
+        // The port lists a macro of the filelist's headers (rtl/cube5_axi_ports.svh) stands for.
+        let headers: String = v
+            .files
+            .iter()
+            .filter(|f| f.extension().is_some_and(|e| e == "svh"))
+            .filter_map(|f| fs::read_to_string(f).ok())
+            .collect();
+        let text = cube5_gen::variants::expand_port_macros(&text, &headers);
         // A port of the top itself: a declaration line (`input` / `output`), not an instance's
         // connection to a sub-unit's port of the same name.
         let has = |port: &str| {
