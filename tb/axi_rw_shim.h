@@ -20,30 +20,11 @@ class AxiRwShim final : public AxiTopBase<V> {
  public:
   AxiRwShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     idle_axi();
-    if constexpr (HasConfigPort<V>::value) top_->cfg_valid_i = 0;
     top_->eval();
   }
 
-  /// One write on the optional configuration port (as AxiShim's), both AXI4 ports idle: no
-  /// address or beat taken, no beat or response offered in that clock.
   bool write_config(uint32_t addr, const uint32_t* words, uint32_t n_words) override {
-    if constexpr (HasConfigPort<V>::value) {
-      top_->in_valid_i = 0;
-      top_->out_ready_i = 0;
-      idle_axi();
-      top_->cfg_valid_i = 1;
-      top_->cfg_addr_i = addr;
-      write_port(top_->cfg_data_i, words, n_words);
-      this->tick();
-      top_->cfg_valid_i = 0;
-      top_->eval();
-      return true;
-    } else {
-      (void)addr;
-      (void)words;
-      (void)n_words;
-      return false;
-    }
+    return this->config_write(addr, words, n_words, [this] { idle_axi(); });
   }
 
   /// Resets the top and the subordinate together: bursts in flight are dropped on both sides. A
