@@ -137,15 +137,18 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
   AxiMem mem_;
 };
 
-template <class V>
-class AxiShim final : public AxiTopBase<V> {
+/// A streaming top with an AXI4 manager port answered by one AxiMem: AxiShim (`Write` false) a
+/// read port (m_axi_ar*, m_axi_r*); AxiRwShim (tb/axi_rw_shim.h, `Write` true) a port that also
+/// writes (m_axi_aw*, m_axi_w*, m_axi_b*) into the same image (gicube_cache's write-back).
+template <class V, bool Write>
+class AxiManagerShim final : public AxiTopBase<V> {
   using B = AxiTopBase<V>;
   using B::cycle_;
   using B::mem_;
   using B::top_;
 
  public:
-  AxiShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
+  AxiManagerShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     idle_axi();
     top_->eval();
   }
@@ -155,10 +158,17 @@ class AxiShim final : public AxiTopBase<V> {
   }
 
   /// Resets the top and the subordinate together: bursts in flight are dropped on both sides. A
-  /// manager still driving ARVALID out of reset is a protocol error.
+  /// manager still driving ARVALID (or, writing, AWVALID or WVALID) out of reset is a protocol
+  /// error.
   void reset(uint32_t cycles) override {
-    this->reset_with_mem(cycles, [this] { idle_axi(); }, [this] {
-      return top_->m_axi_arvalid_o ? "ARVALID high out of reset" : nullptr;
+    this->reset_with_mem(cycles, [this] { idle_axi(); }, [this]() -> const char* {
+      if constexpr (Write) {
+        return top_->m_axi_arvalid_o || top_->m_axi_awvalid_o || top_->m_axi_wvalid_o
+                   ? "ARVALID, AWVALID or WVALID high out of reset"
+                   : nullptr;
+      } else {
+        return top_->m_axi_arvalid_o ? "ARVALID high out of reset" : nullptr;
+      }
     });
   }
 
@@ -172,8 +182,10 @@ class AxiShim final : public AxiTopBase<V> {
       const auto [offer, take] =
           this->drive_stream(items, n_items, in_words, next, idle, idle_len, stall, stall_len);
       axi_read_drive(*top_, mem_, cycle_, rwords);
+      if constexpr (Write) axi_write_drive(*top_, mem_, cycle_);
       top_->eval();
       axi_read_observe(*top_, mem_, cycle_);
+      if constexpr (Write) wobs_.observe(*top_, mem_, cycle_);
       if (!this->end_cycle(st, offer, next, take, out, out_words)) break;
     }
     this->idle_stream();
@@ -184,7 +196,17 @@ class AxiShim final : public AxiTopBase<V> {
   void idle_axi() {
     top_->m_axi_arready_i = 0;
     top_->m_axi_rvalid_i = 0;
+    if constexpr (Write) {
+      top_->m_axi_awready_i = 0;
+      top_->m_axi_wready_i = 0;
+      top_->m_axi_bvalid_i = 0;
+    }
   }
+
+  AxiWriteObserver wobs_;  // unused without Write
 };
+
+template <class V>
+using AxiShim = AxiManagerShim<V, false>;
 
 }  // namespace cube5
