@@ -408,17 +408,26 @@ mod tests {
                       input logic PFX``bvalid_i\n";
         let text = "module m (\n  input logic clk_i,\n  `BOTH(m_axi_, 32)\n);\n";
         let got = expand_port_macros(text, header);
-        assert!(got.contains("  output logic [(W)-1:0] m_axi_araddr_o,\n"), "{got}");
+        assert!(
+            got.contains("  output logic [(W)-1:0] m_axi_araddr_o,\n"),
+            "{got}"
+        );
         assert!(got.contains("output logic m_axi_arvalid_o"), "{got}");
         assert!(got.contains("input logic m_axi_bvalid_i"), "{got}");
         assert!(!got.contains('`'), "{got}");
         let real = include_str!("../../../rtl/cube5_axi_ports.svh");
         let got = expand_port_macros("  `CUBE5_AXI4_MGR_PORTS(m_axi_, AddrW, DataW, IdW)\n", real);
         assert_eq!(got.lines().count(), 29, "{got}");
-        assert!(got.contains("output logic                  m_axi_bready_o"), "{got}");
+        assert!(
+            got.contains("output logic                  m_axi_bready_o"),
+            "{got}"
+        );
         let got = expand_port_macros("  `CUBE5_AXIL_SUB_PORTS(s_axil_, 10),\n", real);
         assert_eq!(got.lines().count(), 17, "{got}");
-        assert!(got.contains("input  logic                  s_axil_awvalid_i,"), "{got}");
+        assert!(
+            got.contains("input  logic                  s_axil_awvalid_i,"),
+            "{got}"
+        );
     }
 
     fn line(config: &str, params: &[(&str, i64)]) -> VariantLine {
