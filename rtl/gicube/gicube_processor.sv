@@ -42,6 +42,9 @@
 // direction. The issue takes that path's outcome for a photon that scatters (new direction,
 // opacity 0, generation + 1, lifetime - 1, a new interaction value) and finishes one that is
 // absorbed. The output item carries a ninth count, the scatterings.
+
+`include "cube5_axi_ports.svh"
+
 module gicube_processor #(
   /// Block side n = 2^BlockLog2 voxels, 2..8.
   parameter int unsigned BlockLog2 = 2,
@@ -105,69 +108,9 @@ module gicube_processor #(
   /// (gicube_cache's).
   output logic err_o,
 
-  // AXI4 read address channel (the volume in memory).
-  /// Burst start address.
-  output logic [31:0] m_axi_araddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_arlen_o,
-  /// log2 of the bytes per beat.
-  output logic [2:0] m_axi_arsize_o,
-  /// INCR.
-  output logic [1:0] m_axi_arburst_o,
-  /// Always 0.
-  output logic [3:0] m_axi_arid_o,
-  /// Address valid.
-  output logic m_axi_arvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_arready_i,
-
-  // AXI4 read data channel.
-  /// Read data.
-  input  logic [DataW-1:0] m_axi_rdata_i,
-  /// Read response.
-  input  logic [1:0] m_axi_rresp_i,
-  /// Last beat of the burst.
-  input  logic m_axi_rlast_i,
-  /// Read ID (one ID).
-  input  logic [3:0] m_axi_rid_i,
-  /// Read data valid.
-  input  logic m_axi_rvalid_i,
-  /// Read data ready.
-  output logic m_axi_rready_o,
-
-  // AXI4 write channels (Light: the cache's write-back of dirty lines; else idle).
-  /// Burst start address.
-  output logic [31:0] m_axi_awaddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_awlen_o,
-  /// log2 of the bytes per beat.
-  output logic [2:0] m_axi_awsize_o,
-  /// INCR.
-  output logic [1:0] m_axi_awburst_o,
-  /// Always 0.
-  output logic [3:0] m_axi_awid_o,
-  /// Address valid.
-  output logic m_axi_awvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_awready_i,
-  /// Write data.
-  output logic [DataW-1:0] m_axi_wdata_o,
-  /// Byte strobes (all set).
-  output logic [DataW/8-1:0] m_axi_wstrb_o,
-  /// Last beat of the burst.
-  output logic m_axi_wlast_o,
-  /// Write data valid.
-  output logic m_axi_wvalid_o,
-  /// Subordinate takes the beat.
-  input  logic m_axi_wready_i,
-  /// Write response.
-  input  logic [1:0] m_axi_bresp_i,
-  /// Write ID (one ID).
-  input  logic [3:0] m_axi_bid_i,
-  /// Write response valid.
-  input  logic m_axi_bvalid_i,
-  /// Write response ready.
-  output logic m_axi_bready_o
+  // AXI4 channels (gicube_cache's): the volume in memory (AR, R); Light: the cache's
+  // write-back of dirty lines (AW, W, B), else idle.
+  `CUBE5_AXI4_MGR_PORTS(m_axi_, 32, DataW, 4)
 );
 
   localparam int unsigned PacketW  = gicube_pkg::PacketW;
