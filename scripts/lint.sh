@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # verilator --lint-only -Wall (with assertions elaborated) on every top at every verified
-# configuration. Waivers live only in rtl/lint/verilator.vlt.
+# configuration. Waivers live only in rtl/lint/verilator.vlt. `-Irtl`: the include folder
+# (cube5_gen::variants::INCLUDE_DIR, where cube5_axi_ports.svh is).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 fail=0
@@ -8,7 +9,7 @@ count=0
 while read -r top name flags files params; do
   gflags=()
   for p in $params; do gflags+=("-G$p"); done
-  if ! verilator --lint-only -Wall --assert rtl/lint/verilator.vlt --top-module "$top" "${gflags[@]}" ${files//,/ }; then
+  if ! verilator --lint-only -Wall --assert -Irtl rtl/lint/verilator.vlt --top-module "$top" "${gflags[@]}" ${files//,/ }; then
     echo "lint FAILED: $top $name ($params)"
     fail=1
   fi

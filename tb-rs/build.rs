@@ -370,7 +370,7 @@ fn main() {
                         own_headers,
                     ],
                 );
-                match build_variant(v, &cache, &tb, &vl_include, &vlt, &stamp) {
+                match build_variant(v, &repo, &cache, &tb, &vl_include, &vlt, &stamp) {
                     Ok(b) => built.lock().unwrap().push(b),
                     Err(e) => failures
                         .lock()
@@ -513,6 +513,7 @@ fn run(cmd: &mut Command, what: &str) -> Result<(), String> {
 
 fn build_variant(
     v: &Variant,
+    repo: &Path,
     cache: &Cache,
     tb: &Path,
     vl_include: &Path,
@@ -529,7 +530,7 @@ fn build_variant(
     }
     let started = Instant::now();
     let dir = cache.scratch(&v.full_name);
-    let result = compile_variant(v, &dir, tb, vl_include, vlt, stamp);
+    let result = compile_variant(v, repo, &dir, tb, vl_include, vlt, stamp);
     if let Err(e) = result {
         let _ = fs::remove_dir_all(&dir);
         return Err(e);
@@ -549,6 +550,7 @@ fn build_variant(
 /// Verilates (after Yosys, for a gate-level variant) and compiles one variant into `dir`.
 fn compile_variant(
     v: &Variant,
+    repo: &Path,
     dir: &Path,
     tb: &Path,
     vl_include: &Path,
@@ -583,7 +585,7 @@ fn compile_variant(
         };
         let script = format!(
             "{} synth -flatten -top {} -run begin:fine; {GATE_FINE}{mutation} splitnets; opt_clean; write_verilog -noattr {}",
-            cube5_gen::yosys::prelude(&v.files, &v.top, &v.params),
+            cube5_gen::yosys::prelude(repo, &v.files, &v.top, &v.params),
             v.top,
             netlist.display()
         );
@@ -599,7 +601,10 @@ fn compile_variant(
         )?;
         verilate.args(GATE_VERILATE_FLAGS).arg(&netlist);
     } else {
-        verilate.arg("-Wall").arg(vlt);
+        verilate
+            .arg("-Wall")
+            .arg(cube5_gen::variants::include_arg(repo))
+            .arg(vlt);
         for (k, val) in &v.params {
             verilate.arg(format!("-G{k}={val}"));
         }
@@ -707,6 +712,14 @@ impl Shim {
             .find(|f| f.file_name().is_some_and(|n| n.to_string_lossy() == own))
             .and_then(|f| fs::read_to_string(f).ok())
             .unwrap_or_default();
+        // The port lists a macro of the filelist's headers (rtl/cube5_axi_ports.svh) stands for.
+        let headers: String = v
+            .files
+            .iter()
+            .filter(|f| f.extension().is_some_and(|e| e == "svh"))
+            .filter_map(|f| fs::read_to_string(f).ok())
+            .collect();
+        let text = cube5_gen::variants::expand_port_macros(&text, &headers);
         // A port of the top itself: a declaration line (`input` / `output`), not an instance's
         // connection to a sub-unit's port of the same name.
         let has = |port: &str| {
@@ -1081,6 +1094,7 @@ fn resolve_params(
     let dir = cache.scratch(&format!("{}.params", line.full_name()));
     let mut cmd = Command::new("verilator");
     cmd.args(["--xml-only", "-Wno-fatal", "--top-module", &top.name])
+        .arg(cube5_gen::variants::include_arg(repo))
         .arg("--Mdir")
         .arg(&dir)
         .arg("--xml-output")

@@ -18,9 +18,9 @@ struct HasErrFlag : std::false_type {};
 template <class V>
 struct HasErrFlag<V, std::void_t<decltype(std::declval<V&>().err_o)>> : std::true_type {};
 
-/// What the shims of tops with an AXI port share (AxiShim here, AxiWrShim in tb/axi_wr_shim.h)
-/// beyond ClockedTop: the subordinate, and the output stream's stall rule and collection. The
-/// derived shim idles its own inputs and evals.
+/// What the shims of tops with an AXI port share (AxiShim here, AxiWrShim in tb/axi_wr_shim.h,
+/// AxiRwShim in tb/axi_rw_shim.h) beyond ClockedTop: the subordinate, the configuration write, and
+/// the output stream's stall rule and collection. The derived shim idles its own inputs and evals.
 template <class V>
 class AxiTopBase : public ClockedTop<V>, public AxiHost {
   using C = ClockedTop<V>;
@@ -42,6 +42,31 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
   AxiTopBase(uint32_t seed, PortWidths widths) : C(seed, widths) {
     top_->in_valid_i = 0;
     top_->out_ready_i = 0;
+    if constexpr (HasConfigPort<V>::value) top_->cfg_valid_i = 0;
+  }
+
+  /// One write on the optional configuration port (as StreamShim's): the stream idle and `idle`
+  /// idling the AXI4 port (no address or beat taken, no beat or response offered) in that clock.
+  /// False when the top has no configuration port.
+  template <class Idle>
+  bool config_write(uint32_t addr, const uint32_t* words, uint32_t n_words, Idle idle) {
+    if constexpr (HasConfigPort<V>::value) {
+      top_->in_valid_i = 0;
+      top_->out_ready_i = 0;
+      idle();
+      top_->cfg_valid_i = 1;
+      top_->cfg_addr_i = addr;
+      write_port(top_->cfg_data_i, words, n_words);
+      this->tick();
+      top_->cfg_valid_i = 0;
+      top_->eval();
+      return true;
+    } else {
+      (void)addr;
+      (void)words;
+      (void)n_words;
+      return false;
+    }
   }
 
   /// Resets the top and the subordinate together (bursts in flight are dropped on both sides):
@@ -112,54 +137,39 @@ class AxiTopBase : public ClockedTop<V>, public AxiHost {
   AxiMem mem_;
 };
 
-template <class V>
-class AxiShim final : public AxiTopBase<V> {
+/// A streaming top with an AXI4 manager port answered by one AxiMem: AxiShim (`Write` false) a
+/// read port (m_axi_ar*, m_axi_r*); AxiRwShim (tb/axi_rw_shim.h, `Write` true) a port that also
+/// writes (m_axi_aw*, m_axi_w*, m_axi_b*) into the same image (gicube_cache's write-back).
+template <class V, bool Write>
+class AxiManagerShim final : public AxiTopBase<V> {
   using B = AxiTopBase<V>;
   using B::cycle_;
   using B::mem_;
   using B::top_;
 
  public:
-  AxiShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
-    top_->m_axi_arready_i = 0;
-    top_->m_axi_rvalid_i = 0;
-    if constexpr (HasConfigPort<V>::value) top_->cfg_valid_i = 0;
+  AxiManagerShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
+    idle_axi();
     top_->eval();
   }
 
-  /// One write on the optional configuration port (as StreamShim's), the AXI4 port idle: no
-  /// address taken, no beat offered in that clock.
   bool write_config(uint32_t addr, const uint32_t* words, uint32_t n_words) override {
-    if constexpr (HasConfigPort<V>::value) {
-      top_->in_valid_i = 0;
-      top_->out_ready_i = 0;
-      top_->m_axi_arready_i = 0;
-      top_->m_axi_rvalid_i = 0;
-      top_->cfg_valid_i = 1;
-      top_->cfg_addr_i = addr;
-      write_port(top_->cfg_data_i, words, n_words);
-      this->tick();
-      top_->cfg_valid_i = 0;
-      top_->eval();
-      return true;
-    } else {
-      (void)addr;
-      (void)words;
-      (void)n_words;
-      return false;
-    }
+    return this->config_write(addr, words, n_words, [this] { idle_axi(); });
   }
 
   /// Resets the top and the subordinate together: bursts in flight are dropped on both sides. A
-  /// manager still driving ARVALID out of reset is a protocol error.
+  /// manager still driving ARVALID (or, writing, AWVALID or WVALID) out of reset is a protocol
+  /// error.
   void reset(uint32_t cycles) override {
-    this->reset_with_mem(
-        cycles,
-        [this] {
-          top_->m_axi_arready_i = 0;
-          top_->m_axi_rvalid_i = 0;
-        },
-        [this] { return top_->m_axi_arvalid_o ? "ARVALID high out of reset" : nullptr; });
+    this->reset_with_mem(cycles, [this] { idle_axi(); }, [this]() -> const char* {
+      if constexpr (Write) {
+        return top_->m_axi_arvalid_o || top_->m_axi_awvalid_o || top_->m_axi_wvalid_o
+                   ? "ARVALID, AWVALID or WVALID high out of reset"
+                   : nullptr;
+      } else {
+        return top_->m_axi_arvalid_o ? "ARVALID high out of reset" : nullptr;
+      }
+    });
   }
 
   RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t* idle,
@@ -172,13 +182,31 @@ class AxiShim final : public AxiTopBase<V> {
       const auto [offer, take] =
           this->drive_stream(items, n_items, in_words, next, idle, idle_len, stall, stall_len);
       axi_read_drive(*top_, mem_, cycle_, rwords);
+      if constexpr (Write) axi_write_drive(*top_, mem_, cycle_);
       top_->eval();
       axi_read_observe(*top_, mem_, cycle_);
+      if constexpr (Write) wobs_.observe(*top_, mem_, cycle_);
       if (!this->end_cycle(st, offer, next, take, out, out_words)) break;
     }
     this->idle_stream();
     return st;
   }
+
+ private:
+  void idle_axi() {
+    top_->m_axi_arready_i = 0;
+    top_->m_axi_rvalid_i = 0;
+    if constexpr (Write) {
+      top_->m_axi_awready_i = 0;
+      top_->m_axi_wready_i = 0;
+      top_->m_axi_bvalid_i = 0;
+    }
+  }
+
+  AxiWriteObserver wobs_;  // unused without Write
 };
+
+template <class V>
+using AxiShim = AxiManagerShim<V, false>;
 
 }  // namespace cube5

@@ -23,6 +23,8 @@
 // Rows are written whole items at ImgBase + r ImgPitch (the core's row commands). The frame's done goes to the core with the first read-out item of a frame (once the
 // last section's beams are in); the core ends the frame when every row's write has completed as
 // well. After an error item of the frame (a section it refused) the writer is fed zero pixels.
+`include "cube5_axi_ports.svh"
+
 module cube5_accel #(
   /// Pipelines: voxels per beam (1, 2, 4, 8).
   parameter int unsigned P           = 4,
@@ -73,58 +75,14 @@ module cube5_accel #(
   input  logic rst_ni,
 
   // ---- AXI4-Lite subordinate: the host registers (docs/accel-regs.md) ----
-  input  logic        s_axil_awvalid_i,
-  output logic        s_axil_awready_o,
-  input  logic [9:0]  s_axil_awaddr_i,
-  input  logic        s_axil_wvalid_i,
-  output logic        s_axil_wready_o,
-  input  logic [31:0] s_axil_wdata_i,
-  input  logic [3:0]  s_axil_wstrb_i,
-  output logic        s_axil_bvalid_o,
-  input  logic        s_axil_bready_i,
-  output logic [1:0]  s_axil_bresp_o,
-  input  logic        s_axil_arvalid_i,
-  output logic        s_axil_arready_o,
-  input  logic [9:0]  s_axil_araddr_i,
-  output logic        s_axil_rvalid_o,
-  input  logic        s_axil_rready_i,
-  output logic [31:0] s_axil_rdata_o,
-  output logic [1:0]  s_axil_rresp_o,
+  `CUBE5_AXIL_SUB_PORTS(s_axil_, 10),
   /// Level interrupt: |(IrqStatus & IrqEnable).
   output logic        irq_o,
   /// Sticky: some AXI4 response (R or B) since reset was not OKAY.
   output logic        err_o,
 
   // ---- AXI4 manager: the volume (AR, R) and the image (AW, W, B) ----
-  output logic [AddrW-1:0]   m_axi_araddr_o,
-  output logic [7:0]         m_axi_arlen_o,
-  output logic [2:0]         m_axi_arsize_o,
-  output logic [1:0]         m_axi_arburst_o,
-  output logic [IdW-1:0]     m_axi_arid_o,
-  output logic               m_axi_arvalid_o,
-  input  logic               m_axi_arready_i,
-  input  logic [DataW-1:0]   m_axi_rdata_i,
-  input  logic [1:0]         m_axi_rresp_i,
-  input  logic               m_axi_rlast_i,
-  input  logic [IdW-1:0]     m_axi_rid_i,
-  input  logic               m_axi_rvalid_i,
-  output logic               m_axi_rready_o,
-  output logic [AddrW-1:0]   m_axi_awaddr_o,
-  output logic [7:0]         m_axi_awlen_o,
-  output logic [2:0]         m_axi_awsize_o,
-  output logic [1:0]         m_axi_awburst_o,
-  output logic [IdW-1:0]     m_axi_awid_o,
-  output logic               m_axi_awvalid_o,
-  input  logic               m_axi_awready_i,
-  output logic [DataW-1:0]   m_axi_wdata_o,
-  output logic [DataW/8-1:0] m_axi_wstrb_o,
-  output logic               m_axi_wlast_o,
-  output logic               m_axi_wvalid_o,
-  input  logic               m_axi_wready_i,
-  input  logic [1:0]         m_axi_bresp_i,
-  input  logic [IdW-1:0]     m_axi_bid_i,
-  input  logic               m_axi_bvalid_i,
-  output logic               m_axi_bready_o
+  `CUBE5_AXI4_MGR_PORTS(m_axi_, AddrW, DataW, IdW)
 );
 
   // ---------------------------------------------------------------------------

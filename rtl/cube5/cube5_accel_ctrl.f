@@ -1,3 +1,4 @@
+rtl/cube5_axi_ports.svh
 rtl/cube5/cube5_accel_regs_pkg.sv
 rtl/cube5/cube5_axil_regs.sv
 rtl/cube5/cube5_accel_ctrl.sv

@@ -11,6 +11,8 @@
 // command, flush_o until the data path reports drained_i (its AXI4 transactions finished, its
 // units reset), then the frame ends with code Aborted. The table window's TableData writes become
 // writes on the table port, the index stepping after each.
+`include "cube5_axi_ports.svh"
+
 module cube5_accel_ctrl #(
   /// Pipelines: voxels per beam (1, 2, 4, 8).
   parameter int unsigned P = 4,
@@ -37,23 +39,7 @@ module cube5_accel_ctrl #(
   input  logic        clk_i,
   input  logic        rst_ni,
   // ---- AXI4-Lite subordinate: the host registers ----
-  input  logic        s_axil_awvalid_i,
-  output logic        s_axil_awready_o,
-  input  logic [9:0]  s_axil_awaddr_i,
-  input  logic        s_axil_wvalid_i,
-  output logic        s_axil_wready_o,
-  input  logic [31:0] s_axil_wdata_i,
-  input  logic [3:0]  s_axil_wstrb_i,
-  output logic        s_axil_bvalid_o,
-  input  logic        s_axil_bready_i,
-  output logic [1:0]  s_axil_bresp_o,
-  input  logic        s_axil_arvalid_i,
-  output logic        s_axil_arready_o,
-  input  logic [9:0]  s_axil_araddr_i,
-  output logic        s_axil_rvalid_o,
-  input  logic        s_axil_rready_i,
-  output logic [31:0] s_axil_rdata_o,
-  output logic [1:0]  s_axil_rresp_o,
+  `CUBE5_AXIL_SUB_PORTS(s_axil_, 10),
   /// Level interrupt: |(IrqStatus & IrqEnable).
   output logic        irq_o,
   // ---- command ports (valid/ready; payload LSB first, docs/numerics/accel_ctrl.md) ----

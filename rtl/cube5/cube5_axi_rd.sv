@@ -11,6 +11,8 @@
 //   command ─► cube5_axi_split (splitter ─► plan register ─► AR register) ─► AR channel
 //                                     last-of-command flag per burst ─► info FIFO (Outstanding) ─┐
 //   R channel (RREADY = 1) ─► {resp, last, data} ─► return FIFO (RAM) ─► read register ─► out
+`include "cube5_axi_ports.svh"
+
 module cube5_axi_rd #(
   /// Byte address width of the AXI port (>= 13).
   parameter int unsigned AddrW = 32,
@@ -45,35 +47,9 @@ module cube5_axi_rd #(
   /// Sticky: some beat since reset came back with RRESP != OKAY.
   output logic err_o,
 
-  // AXI4 read address channel.
-  /// Burst start address.
-  output logic [AddrW-1:0] m_axi_araddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_arlen_o,
-  /// log2 of the bytes per beat (the full bus width).
-  output logic [2:0] m_axi_arsize_o,
-  /// INCR (2'b01).
-  output logic [1:0] m_axi_arburst_o,
-  /// Always 0.
-  output logic [IdW-1:0] m_axi_arid_o,
-  /// Address valid.
-  output logic m_axi_arvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_arready_i,
-
-  // AXI4 read data channel.
-  /// Read data.
-  input  logic [DataW-1:0] m_axi_rdata_i,
-  /// Read response.
-  input  logic [1:0] m_axi_rresp_i,
-  /// Last beat of the burst.
-  input  logic m_axi_rlast_i,
-  /// Read ID (always 0: unused).
-  input  logic [IdW-1:0] m_axi_rid_i,
-  /// Read data valid.
-  input  logic m_axi_rvalid_i,
-  /// Always 1 out of reset (credit rule).
-  output logic m_axi_rready_o
+  // AXI4 read channels: ID 0 only (responses in order); RREADY always 1 out of reset (the
+  // credit rule).
+  `CUBE5_AXI4_RD_MGR_PORTS(m_axi_, AddrW, DataW, IdW)
 );
 
   // ==============================================================================================

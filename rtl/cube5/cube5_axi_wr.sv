@@ -14,6 +14,8 @@
 //          └─► packer command FIFO (lane, items) ─┐      │ burst lengths ─► WLAST count
 //   items ─► packer (lane, strobes) ─► W buffer (RAM) ─► read register ─► W channel
 //   B channel ─► {last-of-command per burst} ─► completion register ─► out {count, resp}
+`include "cube5_axi_ports.svh"
+
 module cube5_axi_wr #(
   /// Byte address width of the AXI port (13 .. 64).
   parameter int unsigned AddrW = 32,
@@ -58,43 +60,10 @@ module cube5_axi_wr #(
   /// Sticky: some B response since reset was not OKAY.
   output logic err_o,
 
-  // AXI4 write address channel.
-  /// Burst start address (aligned to the bus).
-  output logic [AddrW-1:0] m_axi_awaddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_awlen_o,
-  /// log2 of the bytes per beat (the full bus width).
-  output logic [2:0] m_axi_awsize_o,
-  /// INCR (2'b01).
-  output logic [1:0] m_axi_awburst_o,
-  /// Always 0.
-  output logic [IdW-1:0] m_axi_awid_o,
-  /// Address valid.
-  output logic m_axi_awvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_awready_i,
-
-  // AXI4 write data channel.
-  /// Write data (bytes whose strobe is 0 are unspecified).
-  output logic [DataW-1:0] m_axi_wdata_o,
-  /// Byte strobes.
-  output logic [DataW/8-1:0] m_axi_wstrb_o,
-  /// Last beat of the burst.
-  output logic m_axi_wlast_o,
-  /// Write data valid.
-  output logic m_axi_wvalid_o,
-  /// Subordinate takes the beat.
-  input  logic m_axi_wready_i,
-
-  // AXI4 write response channel.
-  /// Write response.
-  input  logic [1:0] m_axi_bresp_i,
-  /// Response ID (always 0: unused).
-  input  logic [IdW-1:0] m_axi_bid_i,
-  /// Response valid.
-  input  logic m_axi_bvalid_i,
-  /// The unit takes the response (low only while a completion waits for the consumer).
-  output logic m_axi_bready_o
+  // AXI4 write channels: ID 0 only (responses in order); bursts start aligned to the bus;
+  // bytes whose strobe is 0 are unspecified; BREADY low only while a completion waits for
+  // the consumer.
+  `CUBE5_AXI4_WR_MGR_PORTS(m_axi_, AddrW, DataW, IdW)
 );
 
   // ==============================================================================================

@@ -9,6 +9,8 @@
 //   only while `hw_set_i` is high), so each offset sees a different value;
 // - `wsel_i` selects the word shown on `hw_q_o` and the write strobe on `hw_wr_stb_o`, `rsel_i`
 //   the read strobe on `hw_rd_stb_o` (0 for an offset outside the map).
+`include "cube5_axi_ports.svh"
+
 module cube5_axil #(
   /// Which generated map: 0 cube5_accel.regs.toml, 1 the exercise map (cube5_axil_regs.regs.toml).
   parameter int unsigned Map = 0,
@@ -17,23 +19,7 @@ module cube5_axil #(
 ) (
   input  logic             clk_i,
   input  logic             rst_ni,
-  input  logic             s_axil_awvalid_i,
-  output logic             s_axil_awready_o,
-  input  logic [AddrW-1:0] s_axil_awaddr_i,
-  input  logic             s_axil_wvalid_i,
-  output logic             s_axil_wready_o,
-  input  logic [31:0]      s_axil_wdata_i,
-  input  logic [3:0]       s_axil_wstrb_i,
-  output logic             s_axil_bvalid_o,
-  input  logic             s_axil_bready_i,
-  output logic [1:0]       s_axil_bresp_o,
-  input  logic             s_axil_arvalid_i,
-  output logic             s_axil_arready_o,
-  input  logic [AddrW-1:0] s_axil_araddr_i,
-  output logic             s_axil_rvalid_o,
-  input  logic             s_axil_rready_i,
-  output logic [31:0]      s_axil_rdata_o,
-  output logic [1:0]       s_axil_rresp_o,
+  `CUBE5_AXIL_SUB_PORTS(s_axil_, AddrW),
   /// RO values and W1C set bits, rotated per offset (see the header).
   input  logic [31:0]      hw_i,
   /// W1C set inputs follow `hw_i` in this cycle.

@@ -19,6 +19,8 @@
 //   offset answers SLVERR and changes nothing; a SLVERR read returns 0.
 // - Reset (synchronous, active low): registers with a reset value take it, the others keep theirs
 //   (their flops have no reset); responses in flight are dropped.
+`include "cube5_axi_ports.svh"
+
 module cube5_axil_regs #(
   /// Word offsets 0 .. Words - 1 (the table length).
   parameter int unsigned Words = 1,
@@ -45,26 +47,11 @@ module cube5_axil_regs #(
 ) (
   input  logic                  clk_i,
   input  logic                  rst_ni,
-  // ---- AXI4-Lite subordinate ----
-  input  logic                  s_axil_awvalid_i,
-  output logic                  s_axil_awready_o,
-  input  logic [AddrW-1:0]      s_axil_awaddr_i,
-  input  logic [2:0]            s_axil_awprot_i,   /// ignored
-  input  logic                  s_axil_wvalid_i,
-  output logic                  s_axil_wready_o,
-  input  logic [31:0]           s_axil_wdata_i,
-  input  logic [3:0]            s_axil_wstrb_i,
-  output logic                  s_axil_bvalid_o,
-  input  logic                  s_axil_bready_i,
-  output logic [1:0]            s_axil_bresp_o,    /// 0 OKAY, 2 SLVERR
-  input  logic                  s_axil_arvalid_i,
-  output logic                  s_axil_arready_o,
-  input  logic [AddrW-1:0]      s_axil_araddr_i,
-  input  logic [2:0]            s_axil_arprot_i,   /// ignored
-  output logic                  s_axil_rvalid_o,
-  input  logic                  s_axil_rready_i,
-  output logic [31:0]           s_axil_rdata_o,
-  output logic [1:0]            s_axil_rresp_o,    /// 0 OKAY, 2 SLVERR
+  // ---- AXI4-Lite subordinate (BRESP and RRESP: 0 OKAY, 2 SLVERR) ----
+  `CUBE5_AXIL_SUB_PORTS(s_axil_, AddrW),
+  // AxPROT: ignored.
+  input  logic [2:0]            s_axil_awprot_i,
+  input  logic [2:0]            s_axil_arprot_i,
   // ---- hardware side ----
   /// Every register's value, word i at [i*32 +: 32] (0 where nothing is kept).
   output logic [Words*32-1:0]   reg_q_o,

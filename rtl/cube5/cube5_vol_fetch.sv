@@ -9,6 +9,8 @@
 //          └─► sweep registers ─► walker (t, bj, bi) ─► LUT read ─► stage 2 ─┬─► cube5_axi_rd ─ AXI4
 //                                                                            └─► tag FIFO
 //   out item ◄── gearbox (R items per bus beat) ◄── reader's beats + head tag (skip / error / data)
+`include "cube5_axi_ports.svh"
+
 module cube5_vol_fetch #(
   /// Byte address width of the AXI port (13..64).
   parameter int unsigned AddrW = 32,
@@ -50,35 +52,8 @@ module cube5_vol_fetch #(
   /// Sticky: some beat since reset had RRESP != OKAY.
   output logic err_o,
 
-  // AXI4 read address channel.
-  /// Burst start address.
-  output logic [AddrW-1:0] m_axi_araddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_arlen_o,
-  /// log2 of the bytes per beat.
-  output logic [2:0] m_axi_arsize_o,
-  /// INCR.
-  output logic [1:0] m_axi_arburst_o,
-  /// Always 0.
-  output logic [IdW-1:0] m_axi_arid_o,
-  /// Address valid.
-  output logic m_axi_arvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_arready_i,
-
-  // AXI4 read data channel.
-  /// Read data.
-  input  logic [DataW-1:0] m_axi_rdata_i,
-  /// Read response.
-  input  logic [1:0] m_axi_rresp_i,
-  /// Last beat of the burst.
-  input  logic m_axi_rlast_i,
-  /// Read ID.
-  input  logic [IdW-1:0] m_axi_rid_i,
-  /// Read data valid.
-  input  logic m_axi_rvalid_i,
-  /// Always 1 out of reset (the reader's credit rule).
-  output logic m_axi_rready_o
+  // AXI4 read channels (cube5_axi_rd's: ID 0, RREADY always 1 out of reset).
+  `CUBE5_AXI4_RD_MGR_PORTS(m_axi_, AddrW, DataW, IdW)
 );
 
   // ==============================================================================================

@@ -24,6 +24,8 @@
 // read from the bank's RAM), waits for the write-backs' B responses, then reads its lines; a
 // flush writes back every dirty line, bank by bank, set by set, and leaves when all are answered.
 // Splat = 0 ties the write channels off (AWVALID, WVALID low, BREADY high).
+`include "cube5_axi_ports.svh"
+
 module gicube_cache #(
   /// The volume's edge in memory, M: a power of two, 4..1024.
   parameter int unsigned MaxDim      = 64,
@@ -67,73 +69,10 @@ module gicube_cache #(
   /// Sticky: some fill beat since reset came back with RRESP != OKAY, or some write-back's BRESP.
   output logic err_o,
 
-  // AXI4 read address channel.
-  /// Burst start address.
-  output logic [AddrW-1:0] m_axi_araddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_arlen_o,
-  /// log2 of the bytes per beat.
-  output logic [2:0] m_axi_arsize_o,
-  /// INCR.
-  output logic [1:0] m_axi_arburst_o,
-  /// Always 0.
-  output logic [3:0] m_axi_arid_o,
-  /// Address valid.
-  output logic m_axi_arvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_arready_i,
-
-  // AXI4 read data channel.
-  /// Read data.
-  input  logic [DataW-1:0] m_axi_rdata_i,
-  /// Read response.
-  input  logic [1:0] m_axi_rresp_i,
-  /// Last beat of the burst.
-  input  logic m_axi_rlast_i,
-  /// Read ID (unused: one ID).
-  input  logic [3:0] m_axi_rid_i,
-  /// Read data valid.
-  input  logic m_axi_rvalid_i,
-  /// Read data ready (always 1 out of reset: cube5_axi_rd's credit rule).
-  output logic m_axi_rready_o,
-
-  // AXI4 write address channel (the write-back of dirty lines; idle without Splat).
-  /// Burst start address (a line's).
-  output logic [AddrW-1:0] m_axi_awaddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_awlen_o,
-  /// log2 of the bytes per beat.
-  output logic [2:0] m_axi_awsize_o,
-  /// INCR.
-  output logic [1:0] m_axi_awburst_o,
-  /// Always 0.
-  output logic [3:0] m_axi_awid_o,
-  /// Address valid.
-  output logic m_axi_awvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_awready_i,
-
-  // AXI4 write data channel.
-  /// Write data.
-  output logic [DataW-1:0] m_axi_wdata_o,
-  /// Byte strobes (all set: whole lines).
-  output logic [DataW/8-1:0] m_axi_wstrb_o,
-  /// Last beat of the burst.
-  output logic m_axi_wlast_o,
-  /// Write data valid.
-  output logic m_axi_wvalid_o,
-  /// Subordinate takes the beat.
-  input  logic m_axi_wready_i,
-
-  // AXI4 write response channel.
-  /// Write response.
-  input  logic [1:0] m_axi_bresp_i,
-  /// Response ID (unused: one ID).
-  input  logic [3:0] m_axi_bid_i,
-  /// Response valid.
-  input  logic m_axi_bvalid_i,
-  /// Response ready.
-  output logic m_axi_bready_o
+  // AXI4 read channels (ID 0; RREADY always 1 out of reset: cube5_axi_rd's credit rule) and
+  // write channels (the write-back of dirty lines, whole lines, all strobes set; idle
+  // without Splat).
+  `CUBE5_AXI4_MGR_PORTS(m_axi_, AddrW, DataW, 4)
 );
 
   // ==============================================================================================

@@ -32,6 +32,19 @@
 // dirty lines back through the AXI4 write channels; a flush (configuration region 3) enters the
 // same stream when the processor holds no ray, and its output item (`flush`) comes when memory
 // holds every deposit. Rendering rays are lit by the field when `lit` (region 2) is set.
+//
+// Scatter = 1 (high albedo, photons; contract "Photons in the ring"): with `photons` set (region
+// 2, address 1) a lighting ray is a photon: its deposit takes T = 4096 (the deposit sees opacity
+// 0), it never terminates early, and at the issue it interacts when the sample's opacity * 16
+// reaches its interaction value. Beside the sample and the step, every ring ray also enters a
+// second path from its packet alone: the albedo and interaction draws (two gicube_scatter_hash),
+// gicube_scatter (isotropic, the ray's mangling bits) and a second gicube_step on the scattered
+// direction. The issue takes that path's outcome for a photon that scatters (new direction,
+// opacity 0, generation + 1, lifetime - 1, a new interaction value) and finishes one that is
+// absorbed. The output item carries a ninth count, the scatterings.
+
+`include "cube5_axi_ports.svh"
+
 module gicube_processor #(
   /// Block side n = 2^BlockLog2 voxels, 2..8.
   parameter int unsigned BlockLog2 = 2,
@@ -57,7 +70,10 @@ module gicube_processor #(
   parameter int unsigned Outstanding = 8,
   /// 1: lighting rays splat into the field in memory (32-bit words, the cache's Splat = 1, the
   /// AXI4 write channels, the flush); 0: direct volume rendering (the write channels idle).
-  parameter int unsigned Light       = 0
+  parameter int unsigned Light       = 0,
+  /// 1 (with Light): high-albedo photons scatter in the ring (gicube_scatter, the photon
+  /// registers, the scatterings count in the output); 0: lighting rays never scatter.
+  parameter int unsigned Scatter     = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -75,8 +91,9 @@ module gicube_processor #(
   input  logic out_ready_i,
   /// done (1: finished, 0: overflowed), ray (256), then the counts after it: rays_in,
   /// rays_finished, rays_overflowed, samples, leaps, cycles, cache_hits, cache_misses (32
-  /// each), then flush (1: the flush's item, done and ray 0); LSB first.
-  output logic [1+gicube_pkg::PacketW+8*32+1-1:0] out_data_o,
+  /// each), then flush (1: the flush's item, done and ray 0), then (Scatter) scatterings (32);
+  /// LSB first.
+  output logic [1+gicube_pkg::PacketW+8*32+1+Scatter*32-1:0] out_data_o,
 
   /// Configuration write this clock (tables, empty flags; they survive reset).
   input  logic cfg_valid_i,
@@ -91,69 +108,9 @@ module gicube_processor #(
   /// (gicube_cache's).
   output logic err_o,
 
-  // AXI4 read address channel (the volume in memory).
-  /// Burst start address.
-  output logic [31:0] m_axi_araddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_arlen_o,
-  /// log2 of the bytes per beat.
-  output logic [2:0] m_axi_arsize_o,
-  /// INCR.
-  output logic [1:0] m_axi_arburst_o,
-  /// Always 0.
-  output logic [3:0] m_axi_arid_o,
-  /// Address valid.
-  output logic m_axi_arvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_arready_i,
-
-  // AXI4 read data channel.
-  /// Read data.
-  input  logic [DataW-1:0] m_axi_rdata_i,
-  /// Read response.
-  input  logic [1:0] m_axi_rresp_i,
-  /// Last beat of the burst.
-  input  logic m_axi_rlast_i,
-  /// Read ID (one ID).
-  input  logic [3:0] m_axi_rid_i,
-  /// Read data valid.
-  input  logic m_axi_rvalid_i,
-  /// Read data ready.
-  output logic m_axi_rready_o,
-
-  // AXI4 write channels (Light: the cache's write-back of dirty lines; else idle).
-  /// Burst start address.
-  output logic [31:0] m_axi_awaddr_o,
-  /// Beats in the burst minus one.
-  output logic [7:0] m_axi_awlen_o,
-  /// log2 of the bytes per beat.
-  output logic [2:0] m_axi_awsize_o,
-  /// INCR.
-  output logic [1:0] m_axi_awburst_o,
-  /// Always 0.
-  output logic [3:0] m_axi_awid_o,
-  /// Address valid.
-  output logic m_axi_awvalid_o,
-  /// Subordinate takes the address.
-  input  logic m_axi_awready_i,
-  /// Write data.
-  output logic [DataW-1:0] m_axi_wdata_o,
-  /// Byte strobes (all set).
-  output logic [DataW/8-1:0] m_axi_wstrb_o,
-  /// Last beat of the burst.
-  output logic m_axi_wlast_o,
-  /// Write data valid.
-  output logic m_axi_wvalid_o,
-  /// Subordinate takes the beat.
-  input  logic m_axi_wready_i,
-  /// Write response.
-  input  logic [1:0] m_axi_bresp_i,
-  /// Write ID (one ID).
-  input  logic [3:0] m_axi_bid_i,
-  /// Write response valid.
-  input  logic m_axi_bvalid_i,
-  /// Write response ready.
-  output logic m_axi_bready_o
+  // AXI4 channels (gicube_cache's): the volume in memory (AR, R); Light: the cache's
+  // write-back of dirty lines (AW, W, B), else idle.
+  `CUBE5_AXI4_MGR_PORTS(m_axi_, 32, DataW, 4)
 );
 
   localparam int unsigned PacketW  = gicube_pkg::PacketW;
@@ -195,7 +152,10 @@ module gicube_processor #(
   localparam int unsigned FifoD    = (RingLat < 2) ? 2 : (1 << $clog2(RingLat));
   localparam int unsigned LeadW    = $clog2(RingLat + 1);
   localparam int unsigned CntW     = 32;
-  localparam int unsigned OutW     = 1 + PacketW + 8 * CntW + 1;
+  localparam int unsigned OutW     = 1 + PacketW + 8 * CntW + 1 + Scatter * CntW;
+  localparam int unsigned IntLsb   = 192;                            // interaction, lifetime,
+  localparam int unsigned LifeLsb  = 208;                            // generation
+  localparam int unsigned GenLsb   = 216;
 
   if (BlockLog2 < 2 || BlockLog2 > 8) begin : gen_bad_block_log2
     $fatal(1, "gicube_processor: BlockLog2 must be 2..8");
@@ -208,6 +168,9 @@ module gicube_processor #(
   end
   if (Light > 1 || (Light != 0 && DataW < 64)) begin : gen_bad_light
     $fatal(1, "gicube_processor: Light must be 0 or 1, with DataW >= 64");
+  end
+  if (Scatter > 1 || (Scatter != 0 && Light == 0)) begin : gen_bad_scatter
+    $fatal(1, "gicube_processor: Scatter must be 0 or 1, and 1 only with Light");
   end
 
   // ---------------------------------------------------------------------------
@@ -222,7 +185,10 @@ module gicube_processor #(
   assign cfg_region = cfg_addr_i[CfgAW-1 -: 2];
   assign cfg_sample = cfg_valid_i && (cfg_region == 2'd0);
   assign cfg_empty  = cfg_valid_i && (cfg_region == 2'd1);
-  assign cfg_gi     = cfg_valid_i && (cfg_region == 2'd2) && (Light != 0);
+  // Scatter: region 2 address 0 the GI registers, 1 the photon registers, 2 the top bits of a
+  // scattering-table entry, 0x2000 + a the scattering unit's address a.
+  assign cfg_gi     = cfg_valid_i && (cfg_region == 2'd2) && (Light != 0)
+                      && (Scatter == 0 || cfg_addr_i[13:0] == 14'd0);
   assign cfg_flush  = cfg_valid_i && (cfg_region == 2'd3) && (Light != 0);
 
   // The block LUT of empty flags [357] and the GI registers (datapath state: no reset, written by
@@ -284,19 +250,43 @@ module gicube_processor #(
   logic rec_leap;
   assign rec_leap = empty_q[o_act_q] && (o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeRendering);
 
+  // Scatter: the photon path's results at the ring's head (the scattered direction, the albedo
+  // draw, the new interaction value; the step on the scattered direction), and the photon mode.
+  logic              photon_q;   // Scatter: lighting rays are photons (region 2, address 1)
+  logic [16:0]       albedo_q;   // Scatter: the albedo, U(0.16), up to 65536
+  logic              sc_empty, sc_full, t2_empty, t2_full;
+  logic [16+1+48-1:0] sc_head;   // new interaction, scatter (albedo draw and lifetime), dir
+  logic [TvW-1:0]    t2_head;    // exit, next on the scattered direction
+  logic              h_photon, h_meet, h_scat, h_absorb, h_exit;
+
   // The outcome (contract, "One pipeline cycle on one ray"): a sample's colour and opacity unless
-  // the ray leapt; terminated, or out of the volume: finished; else advanced to `next`.
+  // the ray leapt; terminated, or out of the volume: finished; else advanced to `next`. A photon
+  // (Scatter, "Photons in the ring") never terminates; when its opacity reaches its interaction
+  // value it scatters (the photon path's direction and step) or is absorbed (finished).
   always_comb begin
-    h_out  = h_pkt;
-    h_term = !h_leap && sm_head[SmOutW-1];
+    h_out    = h_pkt;
+    h_photon = (Scatter != 0) && photon_q
+               && (h_pkt[TypeLsb +: 2] == gicube_pkg::RayTypeLighting);
+    h_meet   = h_photon && ({sm_head[36 +: 12], 4'b0} >= h_pkt[IntLsb +: 16]);
+    h_scat   = h_meet && sc_head[48];
+    h_absorb = h_meet && !sc_head[48];
+    h_term   = !h_leap && sm_head[SmOutW-1] && !h_photon;
     if (!h_leap) begin
       h_out[ColLsb +: 48] = sm_head[0 +: 48];
     end
-    h_done = h_term || tv_head[0];
+    h_exit = h_scat ? t2_head[0] : tv_head[0];
+    h_done = h_term || h_absorb || h_exit;
+    if (h_scat) begin
+      h_out[DirLsb +: 48]     = sc_head[0 +: 48];
+      h_out[ColLsb + 36 +: 12] = 12'd0;
+      h_out[IntLsb +: 16]     = sc_head[49 +: 16];
+      h_out[LifeLsb +: 8]     = h_pkt[LifeLsb +: 8] - 8'd1;
+      h_out[GenLsb +: 8]      = h_pkt[GenLsb +: 8] + {7'd0, h_pkt[GenLsb +: 8] != 8'hff};
+    end
     if (h_term) begin
       h_out[TermBit] = 1'b1;
-    end else if (!tv_head[0]) begin
-      h_out[StartLsb +: 3 * PosW] = tv_head[1 +: 3 * PosW];
+    end else if (!h_absorb && !h_exit) begin
+      h_out[StartLsb +: 3 * PosW] = h_scat ? t2_head[1 +: 3 * PosW] : tv_head[1 +: 3 * PosW];
     end
   end
 
@@ -304,9 +294,11 @@ module gicube_processor #(
   logic            of_empty, of_full, of_push_fin, of_push_ovf, of_push, of_pop;
   logic [OutW-1:0] of_d, of_q;
 
-  // A leap's slot needs its step only; a sample's, its sample too.
+  // A leap's slot needs its step only; a sample's, its sample too; Scatter: every ray's the
+  // photon path's results too.
   assign head_ready = (lead_q != '0)
-      || (!sd_empty && (!h_ray || (!tv_empty && (h_leap || !sm_empty))));
+      || (!sd_empty && (!h_ray || (!tv_empty && (h_leap || !sm_empty)
+                                   && (Scatter == 0 || (!sc_empty && !t2_empty)))));
   // A cycle is issued only while the host offers or a ray is in the processor (the model's frame
   // loop): idle cycles would step the sorter (its Noops move its scan), which the model's frame
   // does not see.
@@ -334,6 +326,7 @@ module gicube_processor #(
   // Counts.
   logic [CntW-1:0] c_in_q, c_fin_q, c_ovf_q, c_smp_q, c_leap_q, c_cyc_q, c_hit_q, c_mis_q;
   logic [CntW-1:0] c_in_d, c_fin_d, c_ovf_d, c_smp_d, c_leap_d, c_cyc_d, c_hit_d, c_mis_d;
+  logic [CntW-1:0] c_sct_q, c_sct_d;
   logic              ca_out_valid;
   logic [CaOutW-1:0] ca_out;
 
@@ -344,6 +337,7 @@ module gicube_processor #(
     c_leap_d = c_leap_q + CntW'(dispatch && o_popped && rec_leap);
     c_fin_d  = c_fin_q  + CntW'(issue && (lead_q == '0) && h_ray && h_done);
     c_cyc_d  = c_cyc_q  + CntW'(issue);
+    c_sct_d  = c_sct_q  + CntW'(issue && (lead_q == '0) && h_ray && h_scat);
     // The cache's running counts, as its last output gave them.
     c_hit_d  = ca_out_valid ? ca_out[8 * WordW + 8 +: CntW] : c_hit_q;
     c_mis_d  = ca_out_valid ? ca_out[8 * WordW + 8 + CntW +: CntW] : c_mis_q;
@@ -353,10 +347,17 @@ module gicube_processor #(
   assign of_push_ovf = dispatch && o_ring_ovf;
   assign of_push     = of_push_fin || of_push_ovf || of_push_flush;
   logic of_push_flush;
-  assign of_d        = {of_push_flush, c_mis_d, c_hit_d, c_cyc_d, c_leap_d, c_smp_d, c_ovf_d,
+  logic [OutW-CntW*Scatter-1:0] of_base;
+  assign of_base     = {of_push_flush, c_mis_d, c_hit_d, c_cyc_d, c_leap_d, c_smp_d, c_ovf_d,
                         c_fin_d, c_in_d,
                         of_push_fin ? h_out : of_push_flush ? PacketW'(0) : o_ovf_ray,
                         of_push_fin};
+  // Scatter: the scatterings above the flush bit.
+  if (Scatter != 0) begin : gen_out_sct
+    assign of_d = {c_sct_d, of_base};
+  end else begin : gen_out_base
+    assign of_d = of_base;
+  end
   assign of_pop      = out_valid_o && out_ready_i;
 
   always_ff @(posedge clk_i) begin
@@ -373,6 +374,7 @@ module gicube_processor #(
       c_cyc_q     <= '0;
       c_hit_q     <= '0;
       c_mis_q     <= '0;
+      c_sct_q     <= '0;
     end else begin
       if (issue) begin
         waiting_q <= 1'b1;
@@ -398,6 +400,7 @@ module gicube_processor #(
       c_cyc_q  <= c_cyc_d;
       c_hit_q  <= c_hit_d;
       c_mis_q  <= c_mis_d;
+      c_sct_q  <= c_sct_d;
     end
   end
 
@@ -467,12 +470,15 @@ module gicube_processor #(
     // The item: a lighting ray's deposit, a rendering ray's read, or the flush.
     logic [DpInW-1:0] dp_in;
     logic [1:0]       dp_op;
-    assign dp_op = flush_go ? 2'd2
-                 : (o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeLighting) ? 2'd1 : 2'd0;
-    assign dp_in = {dims_q, dp_op,
-                    o_pop_ray[StartLsb + 2 * PosW +: PosFracW],
-                    o_pop_ray[StartLsb + PosW +: PosFracW], o_pop_ray[StartLsb +: PosFracW],
-                    o_pop_ray[ColLsb + 36 +: 12], o_pop_ray[ColLsb +: 12], cell_xyz};
+    logic [11:0]      dp_opa;
+    assign dp_op  = flush_go ? 2'd2
+                  : (o_pop_ray[TypeLsb +: 2] == gicube_pkg::RayTypeLighting) ? 2'd1 : 2'd0;
+    // A photon deposits with T = 4096: its deposit sees opacity 0 (Scatter).
+    assign dp_opa = photon_q ? 12'd0 : o_pop_ray[ColLsb + 36 +: 12];
+    assign dp_in  = {dims_q, dp_op,
+                     o_pop_ray[StartLsb + 2 * PosW +: PosFracW],
+                     o_pop_ray[StartLsb + PosW +: PosFracW], o_pop_ray[StartLsb +: PosFracW],
+                     dp_opa, o_pop_ray[ColLsb +: 12], cell_xyz};
 
     gicube_deposit #(
       .MW   (MW),
@@ -650,6 +656,196 @@ module gicube_processor #(
   logic pop_head;
   assign pop_head = issue && (lead_q == '0);
 
+  // ---------------------------------------------------------------------------
+  // Scatter: the photon path beside the sample and the step (contract, "Photons in the ring")
+  // ---------------------------------------------------------------------------
+  if (Scatter != 0) begin : gen_photon
+    localparam int unsigned ScF    = 14;                                  // S(2.14) directions
+    localparam int unsigned ScGW   = 21;
+    localparam int unsigned ScM    = 8;
+    localparam int unsigned ScInW  = gicube_scatter_pkg::in_w(ScF, ScGW, ScM);
+    localparam int unsigned ScOutW = gicube_scatter_pkg::out_w(ScF);
+    localparam int unsigned ScCfgW = gicube_scatter_pkg::cfg_data_w(ScF);
+    localparam int unsigned HashL  = gicube_scatter_pkg::HashLatency;
+    localparam int unsigned AuxW   = 16 + 1 + 3 * PosW;                  // interaction, scatter, start
+    localparam logic [31:0] AlbedoKey      = 32'h2545_f491;
+    localparam logic [31:0] InteractionKey = 32'h5bd1_e995;
+
+    // The photon registers and the top bits of a scattering-table entry (no reset: host state).
+    logic               cfg_photon, cfg_hi, cfg_sc;
+    logic [ScCfgW-gicube_sample_pkg::CfgDataW-1:0] hi_q;
+    assign cfg_photon = cfg_valid_i && (cfg_region == 2'd2) && (cfg_addr_i[13:0] == 14'd1);
+    assign cfg_hi     = cfg_valid_i && (cfg_region == 2'd2) && (cfg_addr_i[13:0] == 14'd2);
+    assign cfg_sc     = cfg_valid_i && (cfg_region == 2'd2) && cfg_addr_i[13];
+
+    always_ff @(posedge clk_i) begin
+      if (cfg_photon) begin
+        albedo_q <= cfg_data_i[16:0];
+        photon_q <= cfg_data_i[17];
+      end
+      if (cfg_hi) begin
+        hi_q <= cfg_data_i[0 +: ScCfgW - gicube_sample_pkg::CfgDataW];
+      end
+    end
+
+    // The ray's mangling bits ([380], [385]): u + 2^12 v + 2^24 generation, XOR the position
+    // x ^ rotl(y, 10) ^ rotl(z, 20); with the next generation (saturating) for the new draw.
+    logic [31:0] pos_bits, bits, bits_next, sy, sz;
+    logic [7:0]  gen, gen_next;
+    assign sy        = 32'(f_pkt_q[StartLsb + PosW +: PosW]);
+    assign sz        = 32'(f_pkt_q[StartLsb + 2 * PosW +: PosW]);
+    assign pos_bits  = 32'(f_pkt_q[StartLsb +: PosW]) ^ {sy[21:0], sy[31:22]}
+                       ^ {sz[11:0], sz[31:12]};
+    assign gen       = f_pkt_q[GenLsb +: 8];
+    assign gen_next  = gen + {7'd0, gen != 8'hff};
+    assign bits      = {gen, f_pkt_q[0 +: 24]} ^ pos_bits;
+    assign bits_next = {gen_next, f_pkt_q[0 +: 24]} ^ pos_bits;
+
+    // The albedo draw and the next interaction value: lane 0 of two hash units, HashL clocks.
+    logic [95:0] pool_a, pool_i;
+    gicube_scatter_hash u_hash_albedo (
+      .clk_i      (clk_i),
+      .en_i       (1'b1),
+      .ray_bits_i (bits ^ AlbedoKey),
+      .pool_o     (pool_a)
+    );
+    gicube_scatter_hash u_hash_interaction (
+      .clk_i      (clk_i),
+      .en_i       (1'b1),
+      .ray_bits_i (bits_next ^ InteractionKey),
+      .pool_o     (pool_i)
+    );
+
+    // The ray's start and whether it may scatter (lifetime > 0), beside the hashes.
+    logic [HashL-1:0]   hv_q;
+    logic [3*PosW-1:0]  hstart_q [HashL];
+    logic [HashL-1:0]   hlive_q;
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni) begin
+        hv_q <= '0;
+      end else begin
+        hv_q <= {hv_q[HashL-2:0], go};
+      end
+    end
+    always_ff @(posedge clk_i) begin
+      hstart_q[0] <= f_pkt_q[StartLsb +: 3 * PosW];
+      hlive_q[0]  <= f_pkt_q[LifeLsb +: 8] != 8'd0;
+      for (int i = 1; i < HashL; i++) begin
+        hstart_q[i] <= hstart_q[i-1];
+        hlive_q[i]  <= hlive_q[i-1];
+      end
+    end
+
+    // Scatter (the albedo draw below the albedo, lifetime left) and the new interaction value
+    // min(H >> 16, 65520).
+    logic [AuxW-1:0] aux_d, aux_q;
+    logic            aux_empty, aux_full;
+    logic [15:0]     int_new;
+    assign int_new = (pool_i[31:16] > 16'd65520) ? 16'd65520 : pool_i[31:16];
+    assign aux_d   = {int_new, ({1'b0, pool_a[15:0]} < albedo_q) && hlive_q[HashL-1],
+                      hstart_q[HashL-1]};
+
+    // gicube_scatter: isotropic (iso = 1, no reflection, refraction or gloss, eta = 1, zero
+    // gradient) from the ray's direction and bits; 42 clocks, never stalled.
+    logic [ScInW-1:0]  sc_in;
+    logic [ScOutW-1:0] sc_out;
+    logic              sc_in_ready, sc_out_valid;
+    assign sc_in = {bits, (ScM + 2)'(1 << ScM), (ScM + 1)'(0), (ScM + 1)'(1 << ScM),
+                    (ScM + 1)'(0), (ScM + 1)'(0), (3 * ScGW)'(0), f_pkt_q[DirLsb +: 48]};
+
+    gicube_scatter u_scatter (
+      .clk_i       (clk_i),
+      .rst_ni      (rst_ni),
+      .in_valid_i  (go),
+      .in_ready_o  (sc_in_ready),
+      .in_data_i   (sc_in),
+      .out_valid_o (sc_out_valid),
+      .out_ready_i (1'b1),
+      .out_data_o  (sc_out),
+      .cfg_valid_i (cfg_sc),
+      .cfg_addr_i  (cfg_addr_i[gicube_scatter_pkg::CfgAddrW-1:0]),
+      .cfg_data_i  ({hi_q, cfg_data_i})
+    );
+
+    cube5_frame_fifo #(.Width(AuxW), .Depth(FifoD)) u_aux_fifo (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (1'b0),
+      .push_i  (hv_q[HashL-1]),
+      .d_i     (aux_d),
+      .pop_i   (sc_out_valid),
+      .q_o     (aux_q),
+      .empty_o (aux_empty),
+      .full_o  (aux_full)
+    );
+
+    // The step on the scattered direction (no leap: a photon never leaps).
+    logic [StOutW-1:0] t2_out;
+    logic              t2_in_ready, t2_out_valid;
+    gicube_step #(
+      .BlockLog2 (BlockLog2),
+      .VolBlocks (VolBlocks),
+      .Step      (Step)
+    ) u_step_scattered (
+      .clk_i       (clk_i),
+      .rst_ni      (rst_ni),
+      .in_valid_i  (sc_out_valid),
+      .in_ready_o  (t2_in_ready),
+      .in_data_i   ({1'b0, QueueW'(0), sc_out[0 +: 48], aux_q[0 +: 3 * PosW]}),
+      .out_valid_o (t2_out_valid),
+      .out_ready_i (1'b1),
+      .out_data_o  (t2_out)
+    );
+
+    cube5_frame_fifo #(.Width(16 + 1 + 48), .Depth(FifoD)) u_scatter_fifo (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (1'b0),
+      .push_i  (sc_out_valid),
+      .d_i     ({aux_q[AuxW-1 -: 17], sc_out[0 +: 48]}),
+      .pop_i   (pop_head && h_ray),
+      .q_o     (sc_head),
+      .empty_o (sc_empty),
+      .full_o  (sc_full)
+    );
+
+    cube5_frame_fifo #(.Width(TvW), .Depth(FifoD)) u_step2_fifo (
+      .clk_i   (clk_i),
+      .rst_ni  (rst_ni),
+      .clear_i (1'b0),
+      .push_i  (t2_out_valid),
+      .d_i     (t2_out[KW +: TvW]),
+      .pop_i   (pop_head && h_ray),
+      .q_o     (t2_head),
+      .empty_o (t2_empty),
+      .full_o  (t2_full)
+    );
+
+    logic unused_photon;
+    assign unused_photon = ^{sc_out[ScOutW-1:48], t2_out[0 +: KW], t2_out[KW + TvW +: QueueW],
+                             sc_in_ready, t2_in_ready, aux_empty, aux_full, pool_a[95:16],
+                             pool_i[95:32], pool_i[15:0]};
+
+`ifndef SYNTHESIS
+    // The photon path keeps pace with the ring: its units take every ray, and its FIFOs hold
+    // a record each of the ring's RingLat at most.
+    PhotonPathInStep: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        (!go || sc_in_ready) && (!sc_out_valid || (t2_in_ready && !aux_empty))
+        && !(hv_q[HashL-1] && aux_full) && !(sc_out_valid && sc_full)
+        && !(t2_out_valid && t2_full))
+      else $error("gicube_processor: the photon path fell out of step");
+`endif
+  end else begin : gen_no_photon
+    assign photon_q = 1'b0;
+    assign albedo_q = '0;
+    assign sc_head  = '0;
+    assign t2_head  = '0;
+    assign sc_empty = 1'b1;
+    assign t2_empty = 1'b1;
+    assign sc_full  = 1'b0;
+    assign t2_full  = 1'b0;
+  end
+
   cube5_frame_fifo #(.Width(SideW), .Depth(FifoD)) u_side_fifo (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
@@ -706,7 +902,7 @@ module gicube_processor #(
   logic unused;
   assign unused = ^{st_out[0 +: KW], st_out[KW + TvW +: QueueW], sd_full, sm_full, tv_full,
                     of_full, sm_in_ready, st_in_ready, o_act_v, fe_out, cell_full, cell_empty,
-                    ca_out, dims_q};
+                    ca_out, dims_q, albedo_q, sc_full, t2_full};
 
 `ifndef SYNTHESIS
   // A stalled output holds its item (STYLE.md rule 3).

@@ -19,9 +19,10 @@ use cube5_model::transfer::TransferFunction;
 use cube5_model::units::cube5_axi_rd::Burst;
 use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
 use cube5_model::units::gicube_processor::{
-    host_rays, light_rays, shadow_scene, Processor, ProcessorFrame, ProcessorOut,
+    host_rays, light_rays, shadow_scene, GiLight, GiMode, Processor, ProcessorFrame, ProcessorOut,
     ProcessorRtlConfig, Projection,
 };
+use cube5_model::units::gicube_processor::{interaction_draw, ray_bits};
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
@@ -305,6 +306,12 @@ fn check_frame(name: &str, what: &str, got: &RtlFrame, want: &ProcessorFrame, ex
             "{name} {what}: cache hits and misses equal the model's"
         );
     }
+    // Photons scattered (Scatter = 1; a function of each ray's packets, whatever the order).
+    assert_eq!(
+        u64::from(l.scatterings),
+        c.scatterings,
+        "{name} {what}: scatterings equal the model's"
+    );
 }
 
 /// The AR bursts of a frame from reset equal the model cache's, in order.
@@ -409,29 +416,31 @@ fn flush(
 /// model's word for word (the field is `irradiance()`). Then, after a reset, the rendering pass
 /// lit by that field: every pixel and count. Under random memory latency, gaps on all five
 /// channels, bandwidth limits and output back-pressure.
-fn two_pass_gi(variant: &'static Variant, rtl: ProcessorRtlConfig, s: u64) {
+fn two_pass_gi(
+    variant: &'static Variant,
+    rtl: ProcessorRtlConfig,
+    mode: GiMode,
+    grid_div: u32,
+    s: u64,
+) -> ProcessorFrame {
     let n = rtl.side() as usize;
-    let (_, tf, light) = shadow_scene(n).unwrap();
+    let light = gi_light(n, mode, grid_div);
+    let tf = shadow_scene(n).unwrap().1;
     let vol = sphere_floor_phantom(n, rtl.voxel_w).unwrap();
     let mut proc = Processor::new(rtl.processor_config(), &vol, &tf).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let mem = random_memory(&mut rng, &rtl);
+    let mem = gi_memory(&mut rng, &rtl, grid_div);
     let mut dut = open_proc(variant, rtl, &proc, mem, s);
-    let (rays, energy) = light_rays(&vol, &light, proc.config().host_order).unwrap();
-    let packets: Vec<Bits> = rays
-        .iter()
-        .map(|r| {
-            Processor::light_packet(r, energy)
-                .unwrap()
-                .to_bits()
-                .unwrap()
-        })
-        .collect();
+    let packets = light_packets(&proc, &light);
     let (want, trace) = proc.light_cache_traced(&light).unwrap();
     let b = Behaviour {
         idle: 0.0,
         stall: 0.3,
     };
+    if rtl.scatter == 1 {
+        let (a, d) = Processor::rtl_photon_write(&rtl, Some(&light));
+        dut.write_config(a, &d).unwrap();
+    }
     let got = run_host(&mut dut, &packets, light.grid, b, &mut rng, None);
     check_frame(variant.name, "lighting pass", &got, &want, true);
     let f = flush(&mut dut, &rtl, 0.3, &mut rng);
@@ -483,12 +492,20 @@ fn two_pass_gi(variant: &'static Variant, rtl: ProcessorRtlConfig, s: u64) {
             field[i] > 0
         })
         .count();
+    assert_eq!(
+        u64::from(f.scatterings),
+        want.counts.scatterings,
+        "{variant}: the flush's scatterings"
+    );
     eprintln!(
-        "{variant} lighting pass ({mem:?}): {} rays, {} samples (deposits), {} processor cycles, {} clocks, hit rate {:.4}, {} lines read, {} written back (flush included); {lit} voxels lit; the field in memory equals the model's",
+        "{variant} lighting pass {mode:?} ({mem:?}): {} rays, {} scattered, {} absorbed, {} samples (deposits), {} processor cycles, {} clocks: {:.3} samples/clock, hit rate {:.4}, {} lines read, {} written back (flush included); {lit} voxels lit; the field in memory equals the model's",
         want.counts.rays_made,
+        want.counts.scatterings,
+        want.counts.absorbed,
         want.counts.samples,
         want.counts.cycles,
         got.clocks,
+        want.counts.samples as f64 / got.clocks as f64,
         want.counts.cache_hit_rate(),
         trace.reads.len(),
         trace.writes.len()
@@ -512,8 +529,53 @@ fn two_pass_gi(variant: &'static Variant, rtl: ProcessorRtlConfig, s: u64) {
         want.rgb.iter().any(|p| p.iter().any(|&c| c > 0)),
         "{variant}: a lit image"
     );
-    frame_line(variant, "GI rendering pass", &got, &want);
+    frame_line(variant, &format!("GI rendering pass {mode:?}"), &got, &want);
+    want
 }
+
+/// The packets of `light`'s lighting rays, as the host sends them (a high-albedo light's with
+/// their lifetime and first interaction value).
+fn light_packets(proc: &Processor, light: &GiLight) -> Vec<Bits> {
+    let (rays, energy) = light_rays(proc.volume(), light, proc.config().host_order).unwrap();
+    rays.iter()
+        .map(|r| {
+            let mut p = Processor::light_packet(r, energy).unwrap();
+            if let GiMode::HighAlbedo { lifetime, .. } = light.mode {
+                p.lifetime = lifetime;
+                p.interaction = interaction_draw(ray_bits(&p));
+            }
+            p.to_bits().unwrap()
+        })
+        .collect()
+}
+
+/// The shadow scene's light at side `n` in `mode`, its grid divided by `grid_div` (fewer lighting
+/// rays, each carrying more energy: a shorter pass for CI).
+fn gi_light(n: usize, mode: GiMode, grid_div: u32) -> GiLight {
+    let (_, _, light) = shadow_scene(n).unwrap();
+    GiLight {
+        mode,
+        grid: light.grid / grid_div,
+        ..light
+    }
+}
+
+/// The memory of a GI pass: random (`random_memory`), its latency 10-40 for a short pass
+/// (`grid_div > 1`: CI).
+fn gi_memory(rng: &mut ChaCha8Rng, rtl: &ProcessorRtlConfig, grid_div: u32) -> Memory {
+    let m = random_memory(rng, rtl);
+    if grid_div > 1 {
+        Memory { lat: (10, 30), ..m }
+    } else {
+        m
+    }
+}
+
+/// High albedo (albedo 0.8, up to 8 bounces, the example scene's).
+const HIGH_ALBEDO: GiMode = GiMode::HighAlbedo {
+    albedo: 0.8,
+    lifetime: 8,
+};
 
 /// The GI scene's camera: azimuth 30, elevation 25 (the floor and the sphere's shadow in view).
 fn gi_camera(vol: &cube5_model::volume::Volume, px: u32) -> Camera {
@@ -525,8 +587,109 @@ fn gi_camera(vol: &cube5_model::volume::Volume, px: u32) -> Camera {
 /// The two GI passes on the `Light` configurations at 16^3 (CI).
 #[test]
 fn gi_lighting_pass_leaves_the_models_field_in_memory_and_lights_the_image() {
+    // The Scatter lines' low-albedo pass: in the high-albedo test (a shorter pass).
     for (variant, rtl) in ci_configs().into_iter().filter(|(_, c)| c.light == 1) {
-        two_pass_gi(variant, rtl, seed(1970));
+        two_pass_gi(variant, rtl, GiMode::LowAlbedo, 1, seed(1970));
+    }
+}
+
+/// High albedo (`Scatter = 1`): the photons' lighting pass, whose rays scatter in the ring
+/// (gicube_scatter), every photon, count (scatterings too), burst and memory word after the
+/// flush equal to the model's, then the rendering pass lit by that field; the same for a
+/// low-albedo pass (photons off), whose image differs. The lighting grid is halved (a quarter
+/// of the rays) to keep the passes short.
+#[test]
+fn high_albedo_photons_scatter_in_the_ring_like_the_model() {
+    for (variant, rtl) in scatter_configs() {
+        let hi = two_pass_gi(variant, rtl, HIGH_ALBEDO, 2, seed(1980));
+        let lo = two_pass_gi(variant, rtl, GiMode::LowAlbedo, 2, seed(1981));
+        assert_ne!(hi.rgb, lo.rgb, "{variant}: high albedo changes the image");
+        // GICUBE_GI_PNG=<file>: the two images (equal to the RTL's), low albedo left, each pixel
+        // 8 x 8 (docs/img/gicube-processor-gi-albedo.png).
+        if let Ok(path) = std::env::var("GICUBE_GI_PNG") {
+            let (w, h, k) = (lo.width, lo.height, 8);
+            let (lo, hi) = (lo.to_f64(), hi.to_f64());
+            let rgb = (0..h * k)
+                .flat_map(|y| (0..2 * w * k).map(move |x| (x / k, y / k)))
+                .map(|(x, y)| {
+                    let f = if x < w { &lo } else { &hi };
+                    f[(y * w + x % w) as usize]
+                })
+                .collect();
+            let img = cube5_model::render::ImageF64 {
+                width: 2 * w * k,
+                height: h * k,
+                rgb,
+            };
+            img.to_rgb8().save(&path).unwrap();
+        }
+    }
+}
+
+/// A reset in the middle of a high-albedo lighting pass (photons and bursts in flight, some
+/// scattered): the memory is loaded again, and the next pass is exact, photons, counts,
+/// scatterings and bursts.
+#[test]
+fn mid_pass_reset_then_an_exact_high_albedo_pass() {
+    for (variant, rtl) in scatter_configs() {
+        let n = rtl.side() as usize;
+        let light = gi_light(n, HIGH_ALBEDO, 2);
+        let tf = shadow_scene(n).unwrap().1;
+        let vol = sphere_floor_phantom(n, rtl.voxel_w).unwrap();
+        let mut proc = Processor::new(rtl.processor_config(), &vol, &tf).unwrap();
+        let img = proc.rtl_memory().unwrap().unwrap();
+        let s = seed(1985);
+        let mut rng = ChaCha8Rng::seed_from_u64(s);
+        let mem = gi_memory(&mut rng, &rtl, 2);
+        let mut dut = open_proc(variant, rtl, &proc, mem, s);
+        let packets = light_packets(&proc, &light);
+        let (want, trace) = proc.light_cache_traced(&light).unwrap();
+        let photons = Processor::rtl_photon_write(&rtl, Some(&light));
+        dut.write_config(photons.0, &photons.1).unwrap();
+        let b = Behaviour {
+            idle: 0.2,
+            stall: 0.2,
+        };
+        let part = run_host(
+            &mut dut,
+            &packets,
+            light.grid,
+            b,
+            &mut rng,
+            Some(60 * want.counts.cycles),
+        );
+        assert!(
+            part.last.scatterings > 0 && u64::from(part.last.rays_finished) < want.counts.rays_made,
+            "{variant}: the reset falls mid-pass, after some scatterings ({:?})",
+            part.last
+        );
+        let dropped = axi::reset_leaves_nothing_in_flight(&mut dut, variant, s, false).unwrap();
+        assert_eq!(
+            dut.axi_wr_counters().in_flight,
+            0,
+            "{variant}: no write burst in flight after the reset"
+        );
+        dut.axi_take_aw().unwrap();
+        dut.axi_load(img.base, &img.bytes).unwrap();
+        load_config(&mut dut, &rtl, &proc);
+        dut.write_config(photons.0, &photons.1).unwrap();
+        let got = run_host(&mut dut, &packets, light.grid, FULL_SPEED, &mut rng, None);
+        check_frame(variant.name, "high albedo after a reset", &got, &want, true);
+        let size = (rtl.data_w / 8).trailing_zeros();
+        compare_bursts(&got.ars, "AR", &trace.reads, size, variant, s, |k| {
+            format!("burst #{k}")
+        })
+        .unwrap_or_else(|e| panic!("{e}"));
+        eprintln!(
+            "{variant}: reset after {} clocks, {} of {} photons finished, {} scattered, {} bursts dropped; then {} photons, {} scatterings, exact",
+            part.clocks,
+            part.last.rays_finished,
+            want.counts.rays_made,
+            part.last.scatterings,
+            dropped,
+            want.counts.rays_made,
+            got.last.scatterings
+        );
     }
 }
 
@@ -536,15 +699,25 @@ fn gi_lighting_pass_leaves_the_models_field_in_memory_and_lights_the_image() {
 fn large_gi_passes_equal_the_model() {
     for (variant, rtl) in configs::<ProcessorRtlConfig>() {
         if rtl.light == 1 && rtl.side() > 16 {
-            two_pass_gi(variant, rtl, seed(1975));
+            two_pass_gi(variant, rtl, GiMode::LowAlbedo, 1, seed(1975));
         }
     }
 }
 
+/// The CI configurations (16^3) without the photon path (the `Scatter` lines' rendering rays
+/// are verified by their GI tests' rendering passes).
 fn ci_configs() -> Vec<(&'static Variant, ProcessorRtlConfig)> {
     configs::<ProcessorRtlConfig>()
         .into_iter()
-        .filter(|(_, c)| c.side() <= 16)
+        .filter(|(_, c)| c.side() <= 16 && c.scatter == 0)
+        .collect()
+}
+
+/// The CI configurations with the photon path (`Scatter = 1`).
+fn scatter_configs() -> Vec<(&'static Variant, ProcessorRtlConfig)> {
+    configs::<ProcessorRtlConfig>()
+        .into_iter()
+        .filter(|(_, c)| c.side() <= 16 && c.scatter == 1)
         .collect()
 }
 

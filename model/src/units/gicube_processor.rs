@@ -375,6 +375,11 @@ fn voxel_index(dims: [usize; 3], v: [i64; 3]) -> Option<usize> {
     inside.then(|| (v[0] + nx * (v[1] + ny * v[2])) as usize)
 }
 
+/// The albedo of a high-albedo pass, `U(0.16)` raw: `round(albedo 65536)`, at most 65536.
+pub fn albedo_raw(albedo: f64) -> u32 {
+    (albedo * 65536.0).round().clamp(0.0, 65536.0) as u32
+}
+
 /// Key of the albedo draw (`jenkins_hash(ray_bits ^ ALBEDO_KEY)`, low 16 bits).
 pub const ALBEDO_KEY: u32 = 0x2545_f491;
 /// Key of the interaction-value draw.
@@ -910,7 +915,7 @@ impl Processor {
                     p.lifetime = lifetime;
                     p.interaction = interaction_draw(ray_bits(p));
                 }
-                Some((albedo * 65536.0).round().min(65536.0) as u32)
+                Some(albedo_raw(albedo))
             }
         };
         let mut field = vec![0u16; self.vol.len()];
@@ -1538,6 +1543,9 @@ pub struct ProcessorRtlConfig {
     /// deposit energies, the flush; the rendering rays lit by the field. 0: direct volume
     /// rendering only.
     pub light: u32,
+    /// 1 (with `light`): high-albedo photons scatter in the ring (contract, *Photons in the
+    /// ring*): the scattering unit, the photon registers, the scatterings count in the output.
+    pub scatter: u32,
 }
 
 /// Region of a configuration address (its top two bits): `gicube_sample`'s tables, the empty
@@ -1549,6 +1557,14 @@ pub const CFG_REGION_EMPTY: u32 = 1;
 pub const CFG_REGION_GI: u32 = 2;
 /// `Light = 1`: a flush of the cache's dirty lines (the end of a lighting pass).
 pub const CFG_REGION_FLUSH: u32 = 3;
+/// `Scatter = 1`, region 2: the photon registers (the albedo `U(0.16)` in bits 0..=16, photons
+/// on in bit 17).
+pub const CFG_GI_PHOTONS: u32 = 1;
+/// `Scatter = 1`, region 2: the bits of the next scattering-table entry above the 36 of a
+/// configuration word.
+pub const CFG_GI_SCATTER_HI: u32 = 2;
+/// `Scatter = 1`, region 2: the scattering unit's table address `a` at `CFG_GI_SCATTER + a`.
+pub const CFG_GI_SCATTER: u32 = 1 << 13;
 /// Address bits of `gicube_sample`'s configuration port.
 const SAMPLE_CFG_ADDR_W: u32 = 14;
 /// Bits of a configuration word (`gicube_sample`'s).
@@ -1576,12 +1592,19 @@ impl ProcessorRtlConfig {
         sets: 32,
         outstanding: 8,
         light: 0,
+        scatter: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(ModelError::Config(format!("gicube_processor: {m}")));
         if self.light > 1 {
             return bad(format!("Light {} is not 0 or 1", self.light));
+        }
+        if self.scatter > self.light {
+            return bad(format!(
+                "Scatter {} needs Light = 1 and is 0 or 1",
+                self.scatter
+            ));
         }
         if !(2..=8).contains(&self.block_log2) {
             return bad(format!("BlockLog2 {} outside 2..=8", self.block_log2));
@@ -1688,6 +1711,7 @@ crate::unit_config!(ProcessorRtlConfig, "gicube_processor", DEFAULT, {
     "Sets" => sets,
     "Outstanding" => outstanding,
     "Light" => light,
+    "Scatter" => scatter,
 });
 
 /// One output item of the RTL: a finished or an overflowed ray, and the counts after it.
@@ -1709,6 +1733,8 @@ pub struct ProcessorOut {
     pub cache_misses: u32,
     /// The item of a flush (`Light = 1`): memory holds every deposit; `done` and the ray are 0.
     pub flush: bool,
+    /// Photons scattered since reset (`Scatter = 1`; 0 otherwise).
+    pub scatterings: u32,
 }
 
 impl crate::unit::StreamCodec for ProcessorRtlConfig {
@@ -1721,7 +1747,7 @@ impl crate::unit::StreamCodec for ProcessorRtlConfig {
     }
 
     fn out_width(&self) -> u32 {
-        1 + 256 + OUT_COUNTS * COUNT_W + 1
+        1 + 256 + OUT_COUNTS * COUNT_W + 1 + self.scatter * COUNT_W
     }
 
     fn pack_in(&self, item: &Self::In) -> Vec<u32> {
@@ -1745,6 +1771,11 @@ impl crate::unit::StreamCodec for ProcessorRtlConfig {
             cache_hits: c(),
             cache_misses: c(),
             flush: r.get_bool(),
+            scatterings: if self.scatter == 1 {
+                r.get(COUNT_W) as u32
+            } else {
+                0
+            },
         }
     }
 }
@@ -1793,7 +1824,41 @@ impl Processor {
                 word(x | y << 7 | z << 14 | lit << 21),
             ));
         }
+        if rtl.scatter == 1 {
+            // The scattering unit's tables (contract, *Photons in the ring*): each entry's bits
+            // above the word's 36 first, then the entry.
+            let cfg = self.scatter.config();
+            for (a, d) in self.scatter.tables().config_writes(&cfg) {
+                let mut r = crate::bits::BitReader::new(&d);
+                let lo = r.get(CFG_WORD_W);
+                let hi = r.get(cfg.cfg_data_w() - CFG_WORD_W);
+                writes.push((region(CFG_REGION_GI, CFG_GI_SCATTER_HI), word(hi as u32)));
+                let mut w = crate::bits::BitWriter::new();
+                w.put(lo, CFG_WORD_W);
+                writes.push((
+                    region(CFG_REGION_GI, CFG_GI_SCATTER + a),
+                    w.finish(CFG_WORD_W),
+                ));
+            }
+            writes.push(Self::rtl_photon_write(rtl, None));
+        }
         Ok(writes)
+    }
+
+    /// The write that sets the RTL's photon registers for a lighting pass of `light` (`Scatter =
+    /// 1`, contract, *Photons in the ring*): photons on with the albedo `round(albedo 65536)`
+    /// for a high-albedo light, off otherwise (`None`: off). Made after `rtl_config_writes`.
+    pub fn rtl_photon_write(rtl: &ProcessorRtlConfig, light: Option<&GiLight>) -> (u32, Vec<u32>) {
+        let v = match light.map(|l| l.mode) {
+            Some(GiMode::HighAlbedo { albedo, .. }) => 1 << 17 | albedo_raw(albedo),
+            _ => 0,
+        };
+        let mut w = crate::bits::BitWriter::new();
+        w.put(u64::from(v), CFG_WORD_W);
+        (
+            (CFG_REGION_GI << (rtl.cfg_addr_w() - 2)) | CFG_GI_PHOTONS,
+            w.finish(CFG_WORD_W),
+        )
     }
 
     /// The write that flushes the RTL's cache at the end of a lighting pass (`Light = 1`,

@@ -69,6 +69,71 @@ impl VariantLine {
     }
 }
 
+/// The folder (repository-relative) every RTL `` `include `` is found in: the port-list macros
+/// of `cube5_axi_ports.svh`. Every tool that reads RTL gets it (`-I`: Verilator in
+/// `tb-rs/build.rs` and `scripts/lint.sh`, Yosys through [`crate::yosys::prelude`]); a filelist
+/// of a top that includes a header names the header too, so a change to it rebuilds that top.
+pub const INCLUDE_DIR: &str = "rtl";
+
+/// `-I<repo>/rtl`: the include folder as Verilator's and Yosys's `read_verilog` option.
+pub fn include_arg(repo: &Path) -> String {
+    format!("-I{}", repo.join(INCLUDE_DIR).display())
+}
+
+/// `text` (a module's source) with every line that invokes a port-list macro of `header` (the text
+/// of `cube5_axi_ports.svh`, say) replaced by the port declarations it expands to, so that a reader
+/// that looks for a port's declaration line (`tb-rs/build.rs` choosing a top's shim) sees it. Only
+/// the prefix, the macro's first argument, is substituted (`PFX``araddr_o` -> `m_axi_araddr_o`);
+/// widths stay as written. A macro inside a macro is expanded too.
+pub fn expand_port_macros(text: &str, header: &str) -> String {
+    // name -> (first formal, body lines)
+    let mut macros: Vec<(String, String, Vec<String>)> = Vec::new();
+    let mut lines = header.lines();
+    while let Some(line) = lines.next() {
+        let Some(rest) = line.trim_start().strip_prefix("`define ") else {
+            continue;
+        };
+        let Some((name, formals)) = rest.split_once('(') else {
+            continue;
+        };
+        let formal = formals.split([',', ')']).next().unwrap_or("").trim();
+        let mut body = Vec::new();
+        let mut more = line.trim_end().ends_with('\\');
+        while more {
+            let Some(b) = lines.next() else { break };
+            more = b.trim_end().ends_with('\\');
+            body.push(b.trim_end().trim_end_matches('\\').trim_end().to_string());
+        }
+        macros.push((name.trim().to_string(), formal.to_string(), body));
+    }
+    fn expand(line: &str, macros: &[(String, String, Vec<String>)], out: &mut String, depth: u32) {
+        let call = line.trim_start().strip_prefix('`').and_then(|r| {
+            let (name, args) = r.split_once('(')?;
+            let m = macros.iter().find(|m| m.0 == name.trim())?;
+            Some((m, args.split([',', ')']).next().unwrap_or("").trim()))
+        });
+        match call {
+            Some(((_, formal, body), prefix)) if depth < 8 => {
+                for b in body {
+                    let b = b
+                        .replace(&format!("{formal}``"), prefix)
+                        .replace(&format!("({formal},"), &format!("({prefix},"));
+                    expand(&b, macros, out, depth + 1);
+                }
+            }
+            _ => {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+    let mut out = String::new();
+    for line in text.lines() {
+        expand(line, &macros, &mut out, 0);
+    }
+    out
+}
+
 /// A top with its filelist (resolved, repository-relative, packages first) and its variants.
 #[derive(Debug, Clone)]
 pub struct Top {
@@ -335,6 +400,35 @@ pub fn main(args: &[String]) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn port_macros_expand_to_their_declarations() {
+        let header = "`define RD(PFX, W) \\\n  output logic [(W)-1:0] PFX``araddr_o, \\\n  \
+                      output logic PFX``arvalid_o\n`define BOTH(PFX, W) \\\n  `RD(PFX, W), \\\n  \
+                      input logic PFX``bvalid_i\n";
+        let text = "module m (\n  input logic clk_i,\n  `BOTH(m_axi_, 32)\n);\n";
+        let got = expand_port_macros(text, header);
+        assert!(
+            got.contains("  output logic [(W)-1:0] m_axi_araddr_o,\n"),
+            "{got}"
+        );
+        assert!(got.contains("output logic m_axi_arvalid_o"), "{got}");
+        assert!(got.contains("input logic m_axi_bvalid_i"), "{got}");
+        assert!(!got.contains('`'), "{got}");
+        let real = include_str!("../../../rtl/cube5_axi_ports.svh");
+        let got = expand_port_macros("  `CUBE5_AXI4_MGR_PORTS(m_axi_, AddrW, DataW, IdW)\n", real);
+        assert_eq!(got.lines().count(), 29, "{got}");
+        assert!(
+            got.contains("output logic                  m_axi_bready_o"),
+            "{got}"
+        );
+        let got = expand_port_macros("  `CUBE5_AXIL_SUB_PORTS(s_axil_, 10),\n", real);
+        assert_eq!(got.lines().count(), 17, "{got}");
+        assert!(
+            got.contains("input  logic                  s_axil_awvalid_i,"),
+            "{got}"
+        );
+    }
 
     fn line(config: &str, params: &[(&str, i64)]) -> VariantLine {
         VariantLine {

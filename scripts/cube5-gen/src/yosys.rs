@@ -1,15 +1,20 @@
 //! The Yosys commands every flow starts with, written once for `tb-rs/build.rs` (gate-level
 //! netlists) and `scripts/synth.sh` (cell counts, place and route).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Yosys fails on the warnings that signal a wrong netlist (docs/toolchain.md).
 pub const FATAL_WARNINGS: &str = "implicitly declared|Resizing cell port|out of bounds";
 
-/// `read_verilog -sv FILES; chparam -set K V ... TOP;` for one configuration of `top`.
-pub fn prelude(files: &[PathBuf], top: &str, params: &[(String, i64)]) -> String {
+/// `read_verilog -sv -I<repo>/rtl FILES; chparam -set K V ... TOP;` for one configuration of
+/// `top` (the include folder: [`crate::variants::INCLUDE_DIR`]).
+pub fn prelude(repo: &Path, files: &[PathBuf], top: &str, params: &[(String, i64)]) -> String {
     let files: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
-    let mut s = format!("read_verilog -sv {};", files.join(" "));
+    let mut s = format!(
+        "read_verilog -sv {} {};",
+        crate::variants::include_arg(repo),
+        files.join(" ")
+    );
     if !params.is_empty() {
         s.push_str(" chparam");
         for (k, v) in params {
@@ -50,6 +55,6 @@ pub fn main(args: &[String]) -> Result<(), String> {
         .find(|v| &v.config == config)
         .ok_or_else(|| format!("yosys: {top_name} has no variant `{config}`"))?;
     let files: Vec<PathBuf> = top.files.iter().map(|f| repo.join(f)).collect();
-    println!("{}", prelude(&files, &top.name, &line.params));
+    println!("{}", prelude(&repo, &files, &top.name, &line.params));
     Ok(())
 }
