@@ -68,6 +68,9 @@ module gicube_processor #(
   parameter int unsigned Sets        = 32,
   /// Line reads in flight at most (gicube_cache's Outstanding).
   parameter int unsigned Outstanding = 8,
+  /// gicube_cache's Prefetch: requests whose tags are checked ahead of the data read, 0..8 (0
+  /// with Light: the splatting cache blocks).
+  parameter int unsigned Prefetch    = 0,
   /// 1: lighting rays splat into the field in memory (32-bit words, the cache's Splat = 1, the
   /// AXI4 write channels, the flush); 0: direct volume rendering (the write channels idle).
   parameter int unsigned Light       = 0,
@@ -139,7 +142,8 @@ module gicube_processor #(
   localparam int unsigned CaOutW   = 8 * WordW + 8 + 2 * 32 + 16;    // vox, hit, hits, misses, stall
   // flush, lighting, colour, weights
   localparam int unsigned CellW    = 1 + 1 + 48 + 3 * PosFracW;
-  localparam int unsigned CellD    = (Light != 0) ? 8 : 4;
+  // The cell FIFO covers the requests the cache holds (P + 3 with prefetch: CacheConfig::held_max).
+  localparam int unsigned CellD    = (Light != 0) ? 8 : (1 << $clog2(Prefetch + 4));
   // 2 region bits over gicube_sample's address.
   localparam int unsigned CfgAW    = 2 + gicube_sample_pkg::CfgAddrW;
   localparam int unsigned SmInW    = gicube_sample_pkg::in_w(VoxelW);
@@ -508,7 +512,8 @@ module gicube_processor #(
     .Sets        (Sets),
     .Outstanding (Outstanding),
     .AddrW       (32),
-    .Splat       (Light)
+    .Splat       (Light),
+    .Prefetch    (Prefetch)
   ) u_cache (
     .clk_i           (clk_i),
     .rst_ni          (rst_ni),

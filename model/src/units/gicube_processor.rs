@@ -1538,6 +1538,9 @@ pub struct ProcessorRtlConfig {
     pub line_vox: u32,
     pub sets: u32,
     pub outstanding: u32,
+    /// The cache's `Prefetch` (requests checked ahead of the data read; 0 with `light`): clocks
+    /// only, never a pixel or a count.
+    pub prefetch: u32,
     /// 1: the lighting pass of GI (contract, *Splatting through the cache*): 32-bit words with
     /// the irradiance field above the voxel, the cache's `Splat = 1` and its AXI4 write port, the
     /// deposit energies, the flush; the rendering rays lit by the field. 0: direct volume
@@ -1591,6 +1594,7 @@ impl ProcessorRtlConfig {
         line_vox: 16,
         sets: 32,
         outstanding: 8,
+        prefetch: 0,
         light: 0,
         scatter: 0,
     };
@@ -1660,7 +1664,7 @@ impl ProcessorRtlConfig {
             outstanding: self.outstanding,
             addr_w: RTL_ADDR_W,
             splat: self.light,
-            prefetch: 0,
+            prefetch: self.prefetch,
         }
     }
 
@@ -1710,6 +1714,7 @@ crate::unit_config!(ProcessorRtlConfig, "gicube_processor", DEFAULT, {
     "LineVox" => line_vox,
     "Sets" => sets,
     "Outstanding" => outstanding,
+    "Prefetch" => prefetch,
     "Light" => light,
     "Scatter" => scatter,
 });
