@@ -671,9 +671,34 @@ module cube5_accel #(
     localparam int unsigned ArbW = AddrW + 8 + 3 + 2 + IdW;
     localparam logic [2:0] BeatSize = 3'($clog2(DataW / 8));
     logic ar_sel, aw_sel;   // 1: the window's
+    // While the window's write beats wait, the fetch keeps at most FetchHold (+ 1) read bursts
+    // granted and not yet returned (0: it starts none; docs/accel.md, *The compositing window in
+    // the top*).
+    localparam int unsigned FetchHold = 0;
+    logic fe_allow;   // the fetch may be granted while the window's write beats wait
+    if (FetchHold != 0) begin : gen_fe_hold
+      // The fetch's read bursts granted (into the AR arbiter's slice) whose last beat is not in;
+      // the flag from the count a cycle before (so at most FetchHold + 1 of them).
+      localparam int unsigned FeHoldW = $clog2(Outstanding + FetchHold + 2) + 1;
+      logic [FeHoldW-1:0] fe_out_q;
+      logic               fe_allow_q;
+      always_ff @(posedge clk_i) begin
+        if (!unit_rst_n) begin
+          fe_out_q   <= '0;
+          fe_allow_q <= 1'b0;
+        end else begin
+          fe_out_q   <= fe_out_q + FeHoldW'(fe_arvalid && fe_arready)
+                                 - FeHoldW'(fe_rvalid && fe_rready && m_axi_rlast_i);
+          fe_allow_q <= fe_out_q < FeHoldW'(FetchHold);
+        end
+      end
+      assign fe_allow = fe_allow_q;
+    end else begin : gen_fe_stop
+      assign fe_allow = 1'b0;
+    end
     cube5_axi_arb #(.Width(ArbW)) u_ar_arb (
       .clk_i, .rst_ni(unit_rst_n),
-      .s0_allow_i(!v_wait), .s0_valid_i(fe_arvalid), .s0_ready_o(fe_arready),
+      .s0_allow_i(!v_wait || fe_allow), .s0_valid_i(fe_arvalid), .s0_ready_o(fe_arready),
       .s0_data_i({fe_araddr, fe_arlen, fe_arsize, fe_arburst, fe_arid}),
       .s1_valid_i(v_arvalid), .s1_ready_o(v_arready),
       .s1_data_i({v_araddr, v_arlen, BeatSize, 2'b01, IdW'(1)}),

@@ -109,6 +109,7 @@ module cube5_accel_win #(
   localparam int unsigned TagW     = 16;
   localparam int unsigned AwW      = IdW + 8 + AddrW;
   localparam int unsigned WW       = 1 + Bbus + DataW;
+  localparam int unsigned WDepth   = 8;    // the AW and W FIFOs
   localparam logic [IdW-1:0] IdPark = IdW'(1);
   localparam logic [IdW-1:0] IdFin  = IdW'(2);
 
@@ -264,11 +265,11 @@ module cube5_accel_win #(
                           : {IdFin, 8'd0, s2_addr_q + (AddrW'(t_q) << LogBus)};
   assign w_d  = {s2_park_q ? t_last : 1'b1, s2_park_q ? {Bbus{1'b1}} : beat_strb, beat};
 
-  cube5_frame_fifo #(.Width(AwW), .Depth(8)) u_aw (
+  cube5_frame_fifo #(.Width(AwW), .Depth(WDepth)) u_aw (
     .clk_i, .rst_ni, .clear_i(1'b0),
     .push_i(push_aw), .d_i(aw_d), .pop_i(aw_pop), .q_o(aw_q), .empty_o(aw_empty), .full_o(aw_full)
   );
-  cube5_frame_fifo #(.Width(WW), .Depth(8)) u_w (
+  cube5_frame_fifo #(.Width(WW), .Depth(WDepth)) u_w (
     .clk_i, .rst_ni, .clear_i(1'b0),
     .push_i(step && push_w), .d_i(w_d), .pop_i(w_pop), .q_o(w_q), .empty_o(w_empty), .full_o(w_full)
   );
@@ -291,17 +292,21 @@ module cube5_accel_win #(
 
   // ---------------------------------------------------------------------------
   // Restores: each request's slot, tagged with the parks taken so far, waits in a FIFO (so that
-  // the requests wait for their parks together, not one after another); the head is read (Cx
-  // bytes) once those parks are all written; the beats assembled into the restored coxel.
+  // the requests wait for their parks together, not one after another). The FIFO's head moves
+  // into a head register, whose tag check (every park taken before it has its B response) is a
+  // registered flag computed as the head is loaded; a head whose flag is set moves into the AR
+  // register (Cx bytes read), so the read address and its valid come from flip-flops. The beats
+  // come back assembled into the restored coxel.
   // ---------------------------------------------------------------------------
   localparam int unsigned RqDepth = 1 << $clog2(Outstanding);
-  logic [TagW-1:0]  ptaken_q, pdone_q, rq_tag;
+  logic [TagW-1:0]  ptaken_q, pdone_q, rq_tag, hd_tag_q, tag_d;
   logic             rq_empty, rq_full, rq_push, ar_fire, r_fire;
-  logic [AddrW-1:0] rq_addr;
-  logic [OutW-1:0]  rs_out_q;     // restore reads in flight
+  logic [AddrW-1:0] rq_addr, hd_addr_q, ar_addr_q;
+  logic [OutW-1:0]  rs_out_q;     // restore reads in the AR register or in flight
+  logic             hd_v_q, hd_ok_q, ar_v_q, hd_move, hd_load;
+  logic signed [TagW-1:0] behind;   // parks done minus the head's tag (wraps: compare its sign)
   logic             rs_v_q;
   logic [PkBeats*DataW-1:0] rs_q;
-  logic signed [TagW-1:0]   behind;
 
   assign rq_ready_o = !rq_full;
   assign rq_push    = rq_valid_i && !rq_full;
@@ -309,14 +314,43 @@ module cube5_accel_win #(
   cube5_frame_fifo #(.Width(AddrW + TagW), .Depth(RqDepth)) u_rq (
     .clk_i, .rst_ni, .clear_i(1'b0),
     .push_i(rq_push), .d_i({slot_of(rq_key_i), ptaken_q + TagW'(take_park)}),
-    .pop_i(ar_fire), .q_o({rq_addr, rq_tag}), .empty_o(rq_empty), .full_o(rq_full)
+    .pop_i(hd_load), .q_o({rq_addr, rq_tag}), .empty_o(rq_empty), .full_o(rq_full)
   );
 
-  assign behind     = $signed(pdone_q - rq_tag);
-  assign arvalid_o  = !rq_empty && behind >= 0 && rs_out_q < OutW'(Outstanding);
-  assign araddr_o   = rq_addr;
+  // The head moves on once its parks are written, a read may start and the AR register is free;
+  // the head register then takes the FIFO's next request. Its flag compares with the parks done
+  // so far (pdone_q: a count that only grows, so a set flag stays true).
+  assign hd_move = hd_v_q && hd_ok_q && rs_out_q < OutW'(Outstanding) && (!ar_v_q || arready_i);
+  assign hd_load = !rq_empty && (!hd_v_q || hd_move);
+  assign tag_d   = hd_load ? rq_tag : hd_tag_q;
+  assign behind  = $signed(pdone_q - tag_d);
+  assign ar_fire = ar_v_q && arready_i;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      hd_v_q  <= 1'b0;
+      hd_ok_q <= 1'b0;
+      ar_v_q  <= 1'b0;
+    end else begin
+      if (hd_load)      hd_v_q <= 1'b1;
+      else if (hd_move) hd_v_q <= 1'b0;
+      hd_ok_q <= !behind[TagW-1];
+      if (hd_move)      ar_v_q <= 1'b1;
+      else if (ar_fire) ar_v_q <= 1'b0;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (hd_load) begin
+      hd_addr_q <= rq_addr;
+      hd_tag_q  <= rq_tag;
+    end
+    if (hd_move) ar_addr_q <= hd_addr_q;
+  end
+
+  assign arvalid_o  = ar_v_q;
+  assign araddr_o   = ar_addr_q;
   assign arlen_o    = 8'(PkBeats - 1);
-  assign ar_fire    = arvalid_o && arready_i;
   assign rready_o   = !rs_v_q;
   assign r_fire     = rvalid_i && rready_o;
   assign rs_valid_o = rs_v_q;
@@ -331,7 +365,7 @@ module cube5_accel_win #(
     end else begin
       ptaken_q <= ptaken_q + TagW'(take_park);
       pdone_q  <= pdone_q + TagW'(b_fire && bid_i == IdPark);
-      rs_out_q <= rs_out_q + OutW'(ar_fire) - OutW'(r_fire && rlast_i);
+      rs_out_q <= rs_out_q + OutW'(hd_move) - OutW'(r_fire && rlast_i);
       if (r_fire && rlast_i)        rs_v_q <= 1'b1;
       else if (rs_v_q && rs_ready_i) rs_v_q <= 1'b0;
     end
@@ -361,7 +395,7 @@ module cube5_accel_win #(
   assign err_o  = err_q;
   assign wr_wait_o = !w_empty;
   assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && rq_empty
-                  && rs_out_q == '0 && !rs_v_q;
+                  && !hd_v_q && rs_out_q == '0 && !rs_v_q;
 
   // The terminated flags of the final lanes (a pixel is R, G, B, A only).
   logic [P-1:0] unused_term;

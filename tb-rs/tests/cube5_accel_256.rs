@@ -91,14 +91,10 @@ fn synthesized_lines_64() {
     }
 }
 
-/// Every synthesized line at its size: the 256^3 head at exactly 45 degrees, composite (shaded),
-/// under the DDR-like memory of the benchmark (latency 100 + U(0..20), 12 bytes per cycle shared by
-/// reads and writes): bit-exact, and the cycles the frames per second at the placed Fmax come from
-/// (docs/accel.md, *The 256^3 lines*).
-#[test]
-#[ignore = "sim-full: 256^3 frames on the synthesized lines, minutes each"]
-fn synthesized_lines_256() {
-    let s = seed(0xacce257);
+/// Every synthesized line: the `n`^3 head at exactly 45 degrees, composite (shaded), under the
+/// benchmark's DDR-like memory (latency 100 + U(0..20), 12 bytes per cycle shared by reads and
+/// writes, no gaps): bit-exact, its cycles printed.
+fn head_45_ddr(n: usize, s: u64) {
     let ddr = MemEnv {
         latency: (100, 20),
         gaps: [0; 5],
@@ -106,6 +102,23 @@ fn synthesized_lines_256() {
         host_stall: Vec::new(),
     };
     for rtl in synthesized() {
-        head_frames(rtl, 256, s, &[(view_45(), Render::Composite, Some(&ddr))]);
+        head_frames(rtl, n, s, &[(view_45(), Render::Composite, Some(&ddr))]);
     }
+}
+
+/// Every synthesized line: the 128^3 head at 45 degrees under the DDR-like memory, an eighth of
+/// the 256^3 frame's simulation for the throughput work (docs/accel.md, *The 256^3 lines*).
+#[test]
+#[ignore = "sim-full: 128^3 frames on the synthesized lines, a minute each"]
+fn synthesized_lines_128() {
+    head_45_ddr(128, seed(0xacce128));
+}
+
+/// Every synthesized line at its size: the 256^3 head at 45 degrees under the DDR-like memory:
+/// the cycles the frames per second at the placed Fmax come from (docs/accel.md, *The 256^3
+/// lines*).
+#[test]
+#[ignore = "sim-full: 256^3 frames on the synthesized lines, minutes each"]
+fn synthesized_lines_256() {
+    head_45_ddr(256, seed(0xacce257));
 }
