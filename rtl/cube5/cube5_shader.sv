@@ -4,11 +4,12 @@
 // The sample's density (or density and gradient magnitude, mode tf2d) indexes the classification
 // LUT; the gradient's major axis and sign pick one of six cube faces, an exact pipelined divider
 // places the two minor components on that face, and four texels around that point, read in one
-// cycle from four banks split by (i, j) parity, are interpolated bilinearly into a diffuse and a
-// specular intensity. Output: colour * diffuse + specular, rounded once and saturated; alpha passes
-// through. Both tables and the zero-gradient entry are written through the configuration port and
-// survive reset. Every stage holds while the next one is full, so the unit takes one item per
-// cycle when the output is never stalled and never drops or duplicates an item.
+// cycle from four banks split by (i, j) parity (two per dual-port memory), are interpolated
+// bilinearly into a diffuse and a specular intensity. Output: colour * diffuse + specular, rounded
+// once and saturated; alpha passes through. Both tables and the zero-gradient entry are written
+// through the configuration port and survive reset. Every stage holds while the next one is full,
+// so the unit takes one item per cycle when the output is never stalled and never drops or
+// duplicates an item.
 module cube5_shader #(
   /// Voxel width; the sample is U(VoxelW.FracW).
   parameter int unsigned VoxelW    = 12,
@@ -397,19 +398,22 @@ module cube5_shader #(
   logic [ClassIdxW-1:0] rd_cidx_q;
   logic                 rd_zero_q, rd_unlit_q;
 
-  for (genvar b = 0; b < 4; b++) begin : gen_bank
-    cube5_shader_ram #(
+  // Banks 2 bj and 2 bj + 1 (the two i parities of one j parity) in one memory, one port each
+  // (cube5_shader_ram2): a dual-port block RAM holds two banks. A texel write disturbs the texel
+  // reads of its cycle (docs/numerics/shader.md, "Configuration port").
+  for (genvar bj = 0; bj < 2; bj++) begin : gen_bank
+    cube5_shader_ram2 #(
       .Depth (BankDepth),
       .Width (TexW),
       .AddrW (BankAW)
-    ) u_bank (
+    ) u_banks (
       .clk_i   (clk_i),
-      .we_i    (bank_we[b]),
+      .we_i    (bank_we[2*bj +: 2]),
       .waddr_i (bank_waddr),
       .wdata_i (cfg_data_i[TexW-1:0]),
       .re_i    (en[StRd]),
-      .raddr_i (adr_bank_q[b*BankAW +: BankAW]),
-      .rdata_o (bank_rdata[b*TexW +: TexW])
+      .raddr_i (adr_bank_q[2*bj*BankAW +: 2*BankAW]),
+      .rdata_o (bank_rdata[2*bj*TexW +: 2*TexW])
     );
   end
 

@@ -1,11 +1,15 @@
 // cube5_shader_lerp: one exact linear interpolation of cube5_shader's bilinear lookup
-// (docs/numerics/shader.md, § Bilinear interpolation), in two register stages so that the
-// multiplier sits alone between registers:
+// (docs/numerics/shader.md, § Bilinear interpolation), in two register stages:
 //
-//   prep:    base = a * 2^WgtFracW + rnd,   diff = b - a        (rnd = 2^(RndShift-1), or 0)
+//   prep:    base = a * 2^WgtFracW + rnd,   diff = b - a,  3 diff    (rnd = 2^(RndShift-1), or 0)
 //   product: y    = (base + e * diff) >> RndShift
 //
-// i.e. y = (a * (2^WgtFracW - e) + b * e + rnd) >> RndShift with one signed multiplier. For e in
+// i.e. y = (a * (2^WgtFracW - e) + b * e + rnd) >> RndShift with one signed product. The weight
+// is narrow (WgtFracW + 1 bits, 5 at the frame's widths), so the product is built in LUTs rather
+// than on a MULT18X18D, which Yosys 0.23 gives every `*` whatever its widths (docs/accel.md,
+// *P = 8 on the 85k part*): radix 4, each two weight bits pick 0, diff, 2 diff or 3 diff
+// (registered in the prep stage), shifted to their place and summed; e = 2^WgtFracW, the weight's
+// top bit, is diff shifted alone (the other bits are then zero). For e in
 // 0 ..= 2^WgtFracW the sum lies in [rnd, max(a, b) * 2^WgtFracW + rnd] < 2^(ValW + WgtFracW): no
 // saturation, and the dropped bits are only the RndShift fraction bits that the rounding covers.
 // The caller gives `e_i` aligned with the product stage (its copy of the weight held beside the
@@ -41,9 +45,12 @@ module cube5_shader_lerp #(
     $fatal(1, "cube5_shader_lerp: RndShift must be at most ValW + WgtFracW");
   end
 
+  localparam int unsigned Digits = (WgtFracW + 1) / 2;  // radix-4 digits of the fraction bits
+
   logic        [BaseW-1:0] base_d, base_q;
   logic signed [ValW:0]    diff_d, diff_q;
-  logic signed [AccW-1:0]  acc;
+  logic signed [ValW+2:0]  diff3_d, diff3_q;
+  logic signed [AccW-1:0]  acc, d1, d3, prod;
   logic        [YW-1:0]    y_d, y_q;
 
   always_comb begin
@@ -51,15 +58,38 @@ module cube5_shader_lerp #(
     if (RndShift > 0) begin
       base_d = base_d + (BaseW'(1) << (RndShift - 1));
     end
-    diff_d = $signed({1'b0, b_i}) - $signed({1'b0, a_i});
-    acc    = $signed(AccW'(base_q)) + AccW'(diff_q * $signed({1'b0, e_i}));
-    y_d    = YW'(acc >>> RndShift);
+    diff_d  = $signed({1'b0, b_i}) - $signed({1'b0, a_i});
+    diff3_d = {{2{diff_d[ValW]}}, diff_d} + {diff_d[ValW], diff_d, 1'b0};
+
+    // e * diff: diff and 3 diff sign-extended; digit j (weight bits 2j, 2j + 1 below WgtFracW)
+    // adds 0, 1, 2 or 3 diff shifted by 2j.
+    d1   = {{(AccW - ValW - 1){diff_q[ValW]}}, diff_q};
+    d3   = {{(AccW - ValW - 3){diff3_q[ValW+2]}}, diff3_q};
+    prod = '0;
+    for (int unsigned j = 0; j < Digits; j++) begin
+      logic [1:0]      digit;
+      logic [AccW-1:0] term;
+      digit = {2 * j + 1 < WgtFracW && e_i[2*j+1], e_i[2*j]};
+      unique case (digit)
+        2'd0:    term = '0;
+        2'd1:    term = d1;
+        2'd2:    term = d1 << 1;
+        default: term = d3;
+      endcase
+      prod = prod + (term << (2 * j));
+    end
+    if (e_i[WgtFracW]) begin
+      prod = d1 << WgtFracW;
+    end
+    acc = $signed(AccW'(base_q)) + prod;
+    y_d = YW'(acc >>> RndShift);
   end
 
   always_ff @(posedge clk_i) begin
     if (en_prep_i) begin
-      base_q <= base_d;
-      diff_q <= diff_d;
+      base_q  <= base_d;
+      diff_q  <= diff_d;
+      diff3_q <= diff3_d;
     end
     if (en_mul_i) begin
       y_q <= y_d;
