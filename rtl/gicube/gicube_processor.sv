@@ -142,7 +142,8 @@ module gicube_processor #(
   localparam int unsigned CaOutW   = 8 * WordW + 8 + 2 * 32 + 16;    // vox, hit, hits, misses, stall
   // flush, lighting, colour, weights
   localparam int unsigned CellW    = 1 + 1 + 48 + 3 * PosFracW;
-  // The cell FIFO covers the requests the cache holds (P + 3 with prefetch: CacheConfig::held_max).
+  // The cell FIFO covers the requests the cache holds (P + 3 with prefetch: CacheConfig::held_max)
+  // and the one in the skid before it.
   localparam int unsigned CellD    = (Light != 0) ? 8 : (1 << $clog2(Prefetch + 4));
   // 2 region bits over gicube_sample's address.
   localparam int unsigned CfgAW    = 2 + gicube_sample_pkg::CfgAddrW;
@@ -427,8 +428,8 @@ module gicube_processor #(
   // ---------------------------------------------------------------------------
   // Fetch: the sampling ray's cell through the volume cache (the volume in memory)
   // ---------------------------------------------------------------------------
-  logic               ca_in_valid, ca_in_ready;
-  logic [CaInW-1:0]   ca_in;
+  logic               ca_in_valid, ca_in_ready, fx_valid, fx_ready;
+  logic [CaInW-1:0]   ca_in, fx_data;
   logic               cell_push, cell_empty, cell_full, cell_flush;
   logic [CellW-1:0]   cell_d, cell_q;
   logic [3*MW-1:0]    cell_xyz;
@@ -493,14 +494,41 @@ module gicube_processor #(
       .in_valid_i  (smp_req || flush_go),
       .in_ready_o  (fetch_ready),
       .in_data_i   (dp_in),
-      .out_valid_o (ca_in_valid),
-      .out_ready_i (ca_in_ready),
-      .out_data_o  (ca_in)
+      .out_valid_o (fx_valid),
+      .out_ready_i (fx_ready),
+      .out_data_o  (fx_data)
     );
   end else begin : gen_read
-    assign ca_in_valid = smp_req;
-    assign ca_in       = cell_xyz;
-    assign fetch_ready = ca_in_ready;
+    assign fx_valid    = smp_req;
+    assign fx_data     = cell_xyz;
+    assign fetch_ready = fx_ready;
+  end
+
+  // The skid before the cache: its ready is a register, so the dispatch (and with it the ring's
+  // issue) does not wait on the cache's hit, miss or flush decision of the same clock. An item
+  // the cache refuses parks in the skid (in order), and the next item waits until the cache has
+  // taken it; the cache sees the same items in the same order.
+  logic             skid_v_q;
+  logic [CaInW-1:0] skid_q;
+
+  assign fx_ready    = !skid_v_q;
+  assign ca_in_valid = skid_v_q || fx_valid;
+  assign ca_in       = skid_v_q ? skid_q : fx_data;
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      skid_v_q <= 1'b0;
+    end else if (skid_v_q) begin
+      skid_v_q <= !ca_in_ready;
+    end else begin
+      skid_v_q <= fx_valid && !ca_in_ready;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!skid_v_q) begin
+      skid_q <= fx_data;
+    end
   end
 
 
@@ -556,8 +584,8 @@ module gicube_processor #(
     .m_axi_bready_o  (m_axi_bready_o)
   );
 
-  // The cache holds two requests at most (the one at its check, its output register); Light:
-  // three more in gicube_deposit.
+  // The cache holds two requests at most (the one at its check, its output register), the skid
+  // one; Light: three more in gicube_deposit.
   cube5_frame_fifo #(.Width(CellW), .Depth(CellD)) u_cell_fifo (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),
