@@ -427,7 +427,9 @@ module cube5_frame_win #(
       rq_valid_q  <= rq_valid_d;
       rq_out_q    <= rq_out_q + RsCntW'(g_go && g_emit) - RsCntW'(rs_pop);
       if (start_i) begin
-        old_parks_q <= CntW'(Depth) - park_free_q;
+        // The parks reserved or queued at the end of this cycle: a pop (or a reservation) in
+        // the start cycle itself counts (else the walker waits for a park that already left).
+        old_parks_q <= CntW'(Depth) - park_free_q - CntW'(park_pop) + CntW'(admit && need_park);
       end else if (park_pop && old_parks_q != '0) begin
         old_parks_q <= old_parks_q - CntW'(1);
       end
