@@ -22,7 +22,7 @@
 #include <type_traits>
 
 #include "axil_mgr.h"
-#include "clocked_top.h"
+#include "stream_shim.h"
 
 namespace cube5 {
 
@@ -134,7 +134,7 @@ class AccelCtrlShim final : public AxilTopBase<V> {
                          static_cast<uint32_t>(top_->table_data_o)};
         record(out, 3, 0, 0, w, 2);
       }
-      if (!this->end_cycle(st)) break;
+      if (!this->clock_cycle(st)) break;
     }
     this->end_run(st, responses, port_errors_, first_port_error_);
     idle_inputs();

@@ -12,20 +12,19 @@
 #include "axi_mem.h"
 #include "axi_ports.h"
 #include "axil_mgr.h"
-#include "clocked_top.h"
+#include "stream_shim.h"
 
 namespace cube5 {
 
 template <class V>
-class AccelShim final : public ClockedTop<V>, public AxiHost {
-  using C = ClockedTop<V>;
-  using C::ctx_;
-  using C::cycle_;
-  using C::tick;
-  using C::top_;
+class AccelShim final : public AxilTopBase<V>, public AxiHost {
+  using B = AxilTopBase<V>;
+  using B::cycle_;
+  using B::mgr_;
+  using B::top_;
 
  public:
-  AccelShim(uint32_t seed, PortWidths widths) : C(seed, widths) {
+  AccelShim(uint32_t seed, PortWidths widths) : B(seed, widths) {
     idle_inputs();
     top_->eval();
   }
@@ -37,31 +36,19 @@ class AccelShim final : public ClockedTop<V>, public AxiHost {
   /// so are the host's transactions. A manager still driving a VALID out of reset is a protocol
   /// error.
   void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    idle_inputs();
-    mem_.reset();
-    mgr_.reset();
-    for (uint32_t i = 0; i < cycles; ++i) {
-      top_->eval();
-      tick();
-    }
-    top_->rst_ni = 1;
-    top_->eval();
+    this->reset_with_mgr(cycles, [this] {
+      idle_inputs();
+      mem_.reset();
+    }, [] {});
     if (top_->m_axi_arvalid_o || top_->m_axi_awvalid_o || top_->m_axi_wvalid_o)
-      violation("ARVALID, AWVALID or WVALID high out of reset");
-    if (top_->s_axil_bvalid_o || top_->s_axil_rvalid_o)
-      mgr_.error(cycle_, "BVALID or RVALID high out of reset");
+      mem_.stats.violation(cycle_, "ARVALID, AWVALID or WVALID high out of reset");
   }
 
   RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t*, size_t,
                const uint8_t* stall, size_t stall_len, uint64_t expect_out, uint64_t max_cycles,
                std::vector<uint32_t>& out, uint32_t out_words) override {
     RunStats st;
-    if (in_words != AxilMgr::kItemWords || out_words != AxilMgr::kRecordWords) {
-      st.protocol_errors = 1;
-      return st;
-    }
-    mgr_.load(items, n_items);
+    if (!this->start_run(st, items, n_items, in_words, out_words, AxilMgr::kRecordWords)) return st;
     uint64_t responses = 0;
     auto stalled = [&](uint64_t off) { return stall_len && stall[(cycle_ + off) % stall_len]; };
     std::vector<uint32_t> rwords;
@@ -77,31 +64,15 @@ class AccelShim final : public ClockedTop<V>, public AxiHost {
       responses += mgr_.observe(cycle_, s, out);
       axi_read_observe(*top_, mem_, cycle_);
       wobs_.observe(*top_, mem_, cycle_);
-      tick();
-      ++st.cycles;
-      if (ctx_->gotFinish()) {
-        st.finished = true;
-        break;
-      }
+      if (!this->clock_cycle(st)) break;
     }
-    st.consumed = mgr_.issued();
-    st.produced = responses;
-    st.protocol_errors = mgr_.errors();
-    st.first_protocol_error_cycle = mgr_.first_error_cycle();
+    this->end_run(st, responses);
     axil_idle(*top_);
     top_->eval();
     return st;
   }
 
  private:
-  void violation(const char* what) {
-    AxiStats& st = mem_.stats;
-    if (st.protocol_errors++ == 0) {
-      st.first_error_cycle = cycle_;
-      st.first_error = what;
-    }
-  }
-
   void idle_inputs() {
     axil_idle(*top_);
     top_->m_axi_arready_i = 0;
@@ -111,7 +82,6 @@ class AccelShim final : public ClockedTop<V>, public AxiHost {
     top_->m_axi_bvalid_i = 0;
   }
 
-  AxilMgr mgr_;
   AxiMem mem_;
   AxiWriteObserver wobs_;
 };

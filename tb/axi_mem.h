@@ -89,6 +89,14 @@ struct AxiStats {
   uint64_t w_bytes = 0;           ///< strobed bytes accepted on W (written or refused with an error)
   uint64_t b_responses = 0;
   uint64_t w_dropped_at_reset = 0;  ///< write bursts outstanding when a reset cleared them
+
+  /// Counts a protocol violation in clock `cycle`, keeping the first one's cycle and text.
+  void violation(uint64_t cycle, const std::string& what) {
+    if (protocol_errors++ == 0) {
+      first_error_cycle = cycle;
+      first_error = what;
+    }
+  }
   uint64_t bready_low = 0;        ///< cycles BVALID was high and BREADY low
 };
 
@@ -128,12 +136,7 @@ class AxiPortBase {
  protected:
   AxiPortBase(AxiStats& stats) : st_(stats) {}
 
-  void fail(uint64_t cycle, const std::string& what) {
-    if (st_.protocol_errors++ == 0) {
-      st_.first_error_cycle = cycle;
-      st_.first_error = what;
-    }
-  }
+  void fail(uint64_t cycle, const std::string& what) { st_.violation(cycle, what); }
 
   static std::string hex(uint64_t v) {
     char buf[24];

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "clocked_top.h"
+#include "stream_shim.h"
 
 namespace cube5 {
 
@@ -322,7 +322,6 @@ class AxilTopBase : public ClockedTop<V> {
   using C = ClockedTop<V>;
 
  protected:
-  using C::ctx_;
   using C::cycle_;
   using C::tick;
   using C::top_;
@@ -358,17 +357,6 @@ class AxilTopBase : public ClockedTop<V> {
       return false;
     }
     mgr_.load(items, n_items);
-    return true;
-  }
-
-  /// The clock of a run's cycle. False once the top has called $finish.
-  bool end_cycle(RunStats& st) {
-    tick();
-    ++st.cycles;
-    if (ctx_->gotFinish()) {
-      st.finished = true;
-      return false;
-    }
     return true;
   }
 

@@ -6,7 +6,6 @@
 #pragma once
 
 #include "axil_mgr.h"
-#include "clocked_top.h"
 #include "stream_shim.h"
 
 namespace cube5 {
@@ -55,7 +54,7 @@ class AxilShim final : public AxilTopBase<V> {
       s.wr_stb = top_->hw_wr_stb_o;
       s.rd_stb = top_->hw_rd_stb_o;
       responses += mgr_.observe(cycle_, s, out);
-      if (!this->end_cycle(st)) break;
+      if (!this->clock_cycle(st)) break;
     }
     this->end_run(st, responses);
     idle_inputs();

@@ -1,10 +1,22 @@
-// stream_shim.h: DutCore for any Verilated streaming top V. Included once per variant by the unity
-// file that build.rs generates; the clock loop runs here, in C++, so a whole batch costs one FFI call.
+// stream_shim.h: what every shim shares, and DutCore for a plain streaming top V (StreamShim).
+// Included once per variant by the unity file that build.rs generates; the clock loop runs here, in
+// C++, so a whole batch costs one FFI call. The shared pieces live in this header because it enters
+// every variant's build stamp (tb-rs/build.rs), so a change to them rebuilds every top that uses
+// them:
+//   port helpers: write_port, read_port, port_equal, HasConfigPort;
+//   ClockedTop<V>: the Verilated top in its own context, the clock, the trace window, the cycle
+//     count (AxilTopBase in tb/axil_mgr.h, AccelShim in tb/accel_shim.h, StreamTop);
+//   OutWatch<V>: the output stream's valid/ready rule and the record of each output taken;
+//   StreamTop<V>: ClockedTop with the command and output streams (in_*, out_*, optional cfg_*)
+//     driven and watched (StreamShim here, AxiTopBase in tb/axi_shim.h, WinShim in tb/win_shim.h).
 #pragma once
 
 #include <cstring>
+#include <memory>
+#include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "dut_core.h"
 #include "verilated.h"
@@ -56,24 +68,9 @@ struct HasConfigPort<V, std::void_t<decltype(std::declval<V&>().cfg_valid_i),
                                     decltype(std::declval<V&>().cfg_data_i)>> : std::true_type {};
 
 template <class V>
-class StreamShim final : public DutCore {
+class ClockedTop : public DutCore {
  public:
-  StreamShim(uint32_t seed, PortWidths widths) : widths_(widths) {
-    ctx_ = std::make_unique<VerilatedContext>();
-    // Uninitialised state comes up random, so a missing reset shows as a mismatch.
-    ctx_->randReset(2);
-    ctx_->randSeed(static_cast<int>(seed & 0x7fffffff));
-    ctx_->traceEverOn(true);
-    top_ = std::make_unique<V>(ctx_.get(), "top");
-    top_->clk_i = 0;
-    top_->rst_ni = 1;
-    top_->in_valid_i = 0;
-    top_->out_ready_i = 0;
-    if constexpr (HasConfigPort<V>::value) top_->cfg_valid_i = 0;
-    top_->eval();
-  }
-
-  ~StreamShim() override {
+  ~ClockedTop() override {
     if (trace_) trace_->close();
     // Verilator 5.006 erases a model's scopes through the *thread's* current context, which is
     // whichever model was built last: point it at ours, or the erase locks a dead context's mutex.
@@ -82,80 +79,7 @@ class StreamShim final : public DutCore {
     top_.reset();
   }
 
-  void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    top_->in_valid_i = 0;
-    top_->out_ready_i = 0;
-    for (uint32_t i = 0; i < cycles; ++i) tick();
-    top_->rst_ni = 1;
-    top_->eval();
-    has_stalled_ = false;
-  }
-
-  RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t* idle,
-               size_t idle_len, const uint8_t* stall, size_t stall_len, uint64_t expect_out,
-               uint64_t max_cycles, std::vector<uint32_t>& out, uint32_t out_words) override {
-    RunStats st;
-    size_t next = 0;
-    while (st.cycles < max_cycles && (next < n_items || st.produced < expect_out)) {
-      const bool offer = next < n_items && !(idle_len && idle[cycle_ % idle_len]);
-      const bool take = !(stall_len && stall[cycle_ % stall_len]);
-      top_->in_valid_i = offer;
-      if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
-      top_->out_ready_i = take;
-      top_->eval();
-
-      // Valid/ready rule: an output held back last cycle must still be offered, unchanged.
-      if (has_stalled_ && (!top_->out_valid_o || !port_equal(top_->out_data_o, stalled_data_))) {
-        if (st.protocol_errors++ == 0) st.first_protocol_error_cycle = cycle_;
-      }
-      has_stalled_ = top_->out_valid_o && !take;
-      if (has_stalled_) stalled_data_ = top_->out_data_o;
-
-      if (offer && top_->in_ready_o) {
-        ++next;
-        ++st.consumed;
-      }
-      if (top_->out_valid_o && take) {
-        // Each record: the cycle (two words, low first), then the item's words.
-        const size_t at = out.size();
-        out.resize(at + 2 + out_words);
-        out[at] = static_cast<uint32_t>(cycle_);
-        out[at + 1] = static_cast<uint32_t>(cycle_ >> 32);
-        read_port(top_->out_data_o, out.data() + at + 2, out_words);
-        ++st.produced;
-      }
-      tick();
-      ++st.cycles;
-      if (ctx_->gotFinish()) {
-        st.finished = true;
-        break;
-      }
-    }
-    top_->in_valid_i = 0;
-    top_->out_ready_i = 0;
-    top_->eval();
-    return st;
-  }
-
-  bool write_config(uint32_t addr, const uint32_t* words, uint32_t n_words) override {
-    if constexpr (HasConfigPort<V>::value) {
-      top_->in_valid_i = 0;
-      top_->out_ready_i = 0;
-      top_->cfg_valid_i = 1;
-      top_->cfg_addr_i = addr;
-      write_port(top_->cfg_data_i, words, n_words);
-      tick();
-      top_->cfg_valid_i = 0;
-      top_->eval();
-      return true;
-    } else {
-      (void)addr;
-      (void)words;
-      (void)n_words;
-      return false;
-    }
-  }
+  bool write_config(uint32_t, const uint32_t*, uint32_t) override { return false; }
 
   bool trace_window(const std::string& path, uint64_t from_cycle, uint64_t to_cycle) override {
     if (trace_) trace_->close();
@@ -170,12 +94,26 @@ class StreamShim final : public DutCore {
   uint64_t cycle() const override { return cycle_; }
   PortWidths widths() const override { return widths_; }
 
- private:
+ protected:
+  /// The top in a context seeded from `seed` (Verilator's random initial values, so a missing
+  /// reset shows as a mismatch), clock low and reset released; the derived shim idles its own
+  /// inputs and evals.
+  ClockedTop(uint32_t seed, PortWidths widths) : widths_(widths) {
+    ctx_ = std::make_unique<VerilatedContext>();
+    ctx_->randReset(2);
+    ctx_->randSeed(static_cast<int>(seed & 0x7fffffff));
+    ctx_->traceEverOn(true);
+    top_ = std::make_unique<V>(ctx_.get(), "top");
+    top_->clk_i = 0;
+    top_->rst_ni = 1;
+  }
+
   void dump() {
     if (trace_ && cycle_ >= trace_from_ && cycle_ <= trace_to_) trace_->dump(ctx_->time());
   }
 
-  // One full clock: the falling half first (inputs were set before), then the rising edge.
+  // One full clock: the falling half first (inputs were set before), then the rising edge. The
+  // clock runs only inside run() and reset().
   void tick() {
     top_->clk_i = 0;
     top_->eval();
@@ -190,14 +128,176 @@ class StreamShim final : public DutCore {
     ++cycle_;
   }
 
+  /// The clock of a run's cycle, counted in `st`. False once the top has called $finish.
+  bool clock_cycle(RunStats& st) {
+    tick();
+    ++st.cycles;
+    if (ctx_->gotFinish()) {
+      st.finished = true;
+      return false;
+    }
+    return true;
+  }
+
   PortWidths widths_;
   std::unique_ptr<VerilatedContext> ctx_;
   std::unique_ptr<V> top_;
   std::unique_ptr<VerilatedVcdC> trace_;
   uint64_t trace_from_ = 0, trace_to_ = 0;
   uint64_t cycle_ = 0;
+};
+
+template <class V>
+class OutWatch {
+ public:
+  /// After eval, in clock `cycle`: an output held back last cycle must still be offered,
+  /// unchanged (else a protocol error in `st`); the output taken this cycle (if `take`) is appended
+  /// to `out` as DutCore::run describes (the cycle, two words, low first, then the item's words).
+  void watch(const V& top, uint64_t cycle, bool take, RunStats& st, std::vector<uint32_t>& out,
+             uint32_t out_words) {
+    if (has_stalled_ && (!top.out_valid_o || !port_equal(top.out_data_o, stalled_data_))) {
+      if (st.protocol_errors++ == 0) st.first_protocol_error_cycle = cycle;
+    }
+    has_stalled_ = top.out_valid_o && !take;
+    if (has_stalled_) stalled_data_ = top.out_data_o;
+    if (top.out_valid_o && take) {
+      const size_t at = out.size();
+      out.resize(at + 2 + out_words);
+      out[at] = static_cast<uint32_t>(cycle);
+      out[at + 1] = static_cast<uint32_t>(cycle >> 32);
+      read_port(top.out_data_o, out.data() + at + 2, out_words);
+      ++st.produced;
+    }
+  }
+
+  /// Reset: nothing is held back.
+  void clear() { has_stalled_ = false; }
+
+ private:
   bool has_stalled_ = false;
   std::remove_reference_t<decltype(V::out_data_o)> stalled_data_{};
+};
+
+/// A top with the command stream (in_valid_i, in_ready_o, in_data_i), the output stream
+/// (out_valid_o, out_ready_i, out_data_o) and maybe the configuration port: the pieces of a run
+/// that StreamShim, AxiTopBase and WinShim share. The derived shim idles its own inputs and evals.
+template <class V>
+class StreamTop : public ClockedTop<V> {
+  using C = ClockedTop<V>;
+
+ protected:
+  using C::cycle_;
+  using C::top_;
+
+  StreamTop(uint32_t seed, PortWidths widths) : C(seed, widths) {
+    top_->in_valid_i = 0;
+    top_->out_ready_i = 0;
+    if constexpr (HasConfigPort<V>::value) top_->cfg_valid_i = 0;
+  }
+
+  /// One write on the optional configuration port: the stream idle and `idle` idling the shim's
+  /// other inputs in that clock. False when the top has no configuration port.
+  template <class Idle>
+  bool config_write(uint32_t addr, const uint32_t* words, uint32_t n_words, Idle idle) {
+    if constexpr (HasConfigPort<V>::value) {
+      top_->in_valid_i = 0;
+      top_->out_ready_i = 0;
+      idle();
+      top_->cfg_valid_i = 1;
+      top_->cfg_addr_i = addr;
+      write_port(top_->cfg_data_i, words, n_words);
+      this->tick();
+      top_->cfg_valid_i = 0;
+      top_->eval();
+      return true;
+    } else {
+      (void)addr;
+      (void)words;
+      (void)n_words;
+      (void)idle;
+      return false;
+    }
+  }
+
+  /// `cycles` clocks of reset with the stream idle and `idle` idling (and resetting) the shim's
+  /// own side; then reset released and evaluated, nothing held back on the output.
+  template <class Idle>
+  void reset_stream(uint32_t cycles, Idle idle) {
+    top_->rst_ni = 0;
+    top_->in_valid_i = 0;
+    top_->out_ready_i = 0;
+    idle();
+    for (uint32_t i = 0; i < cycles; ++i) this->tick();
+    top_->rst_ni = 1;
+    top_->eval();
+    out_watch_.clear();
+  }
+
+  /// Before eval: command `next` offered unless `idle` says idle or none is left, the output
+  /// taken unless `stall` says stalled. Returns {offered, taken}.
+  std::pair<bool, bool> drive_stream(const uint32_t* items, size_t n_items, uint32_t in_words,
+                                     size_t next, const uint8_t* idle, size_t idle_len,
+                                     const uint8_t* stall, size_t stall_len) {
+    const bool offer = next < n_items && !(idle_len && idle[cycle_ % idle_len]);
+    const bool take = !(stall_len && stall[cycle_ % stall_len]);
+    top_->in_valid_i = offer;
+    if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
+    top_->out_ready_i = take;
+    return {offer, take};
+  }
+
+  /// After eval (and whatever else the shim observes): the command taken (if `offered`), the
+  /// output watched, the clock ticked. False once the top has called $finish.
+  bool end_cycle(RunStats& st, bool offered, size_t& next, bool take, std::vector<uint32_t>& out,
+                 uint32_t out_words) {
+    if (offered && top_->in_ready_o) {
+      ++next;
+      ++st.consumed;
+    }
+    out_watch_.watch(*top_, cycle_, take, st, out, out_words);
+    return this->clock_cycle(st);
+  }
+
+  /// After a run: the stream's inputs idle.
+  void idle_stream() {
+    top_->in_valid_i = 0;
+    top_->out_ready_i = 0;
+    top_->eval();
+  }
+
+  OutWatch<V> out_watch_;
+};
+
+template <class V>
+class StreamShim final : public StreamTop<V> {
+  using S = StreamTop<V>;
+  using S::top_;
+
+ public:
+  StreamShim(uint32_t seed, PortWidths widths) : S(seed, widths) { top_->eval(); }
+
+  void reset(uint32_t cycles) override {
+    this->reset_stream(cycles, [] {});
+  }
+
+  RunStats run(const uint32_t* items, size_t n_items, uint32_t in_words, const uint8_t* idle,
+               size_t idle_len, const uint8_t* stall, size_t stall_len, uint64_t expect_out,
+               uint64_t max_cycles, std::vector<uint32_t>& out, uint32_t out_words) override {
+    RunStats st;
+    size_t next = 0;
+    while (st.cycles < max_cycles && (next < n_items || st.produced < expect_out)) {
+      const auto [offer, take] =
+          this->drive_stream(items, n_items, in_words, next, idle, idle_len, stall, stall_len);
+      top_->eval();
+      if (!this->end_cycle(st, offer, next, take, out, out_words)) break;
+    }
+    this->idle_stream();
+    return st;
+  }
+
+  bool write_config(uint32_t addr, const uint32_t* words, uint32_t n_words) override {
+    return this->config_write(addr, words, n_words, [] {});
+  }
 };
 
 }  // namespace cube5

@@ -1,5 +1,5 @@
 // win_shim.h: DutCore for cube5_frame with the compositing window (Window = 1): the command and
-// output streams as StreamShim's (tb/stream_shim.h), and the window's streams played as DRAM in
+// output streams as StreamShim's (StreamTop in tb/stream_shim.h), and the window's streams played as DRAM in
 // the same clock loop: park items (key {Q, R}, coxel) stored by key, restore requests answered in
 // order from that store after a random latency, final pixels collected; each output under its own
 // random back-pressure, the restore input with random idle cycles. Every item taken on the three
@@ -9,49 +9,36 @@
 #include <deque>
 #include <unordered_map>
 
-#include "clocked_top.h"
-#include "out_watch.h"
 #include "stream_shim.h"
 #include "win_host.h"
 
 namespace cube5 {
 
 template <class V>
-class WinShim final : public ClockedTop<V>, public WinHost {
-  using C = ClockedTop<V>;
-  using C::cycle_;
-  using C::top_;
+class WinShim final : public StreamTop<V>, public WinHost {
+  using S = StreamTop<V>;
+  using S::cycle_;
+  using S::out_watch_;
+  using S::top_;
   static constexpr uint32_t kCoxWords = sizeof(V::park_cox_o) > 8 ? sizeof(V::park_cox_o) / 4 : 2;
   static constexpr uint32_t kFinWords = sizeof(V::fin_cox_o) > 8 ? sizeof(V::fin_cox_o) / 4 : 2;
 
  public:
   static constexpr uint32_t kRecordWords = 4 + kFinWords;
 
-  WinShim(uint32_t seed, PortWidths widths) : C(seed, widths) {
+  WinShim(uint32_t seed, PortWidths widths) : S(seed, widths) {
     idle_inputs();
     top_->eval();
   }
 
   bool write_config(uint32_t addr, const uint32_t* words, uint32_t n_words) override {
-    idle_inputs();
-    top_->cfg_valid_i = 1;
-    top_->cfg_addr_i = addr;
-    write_port(top_->cfg_data_i, words, n_words);
-    this->tick();
-    top_->cfg_valid_i = 0;
-    top_->eval();
-    return true;
+    return this->config_write(addr, words, n_words, [this] { idle_inputs(); });
   }
 
   void reset(uint32_t cycles) override {
-    top_->rst_ni = 0;
-    idle_inputs();
-    for (uint32_t i = 0; i < cycles; ++i) this->tick();
-    top_->rst_ni = 1;
-    top_->eval();
+    this->reset_stream(cycles, [this] { idle_inputs(); });
     dram_.clear();
     answers_.clear();
-    out_watch_.clear();
     park_held_ = fin_held_ = rq_held_ = false;
   }
 
@@ -76,11 +63,8 @@ class WinShim final : public ClockedTop<V>, public WinHost {
     size_t next = 0;
     while (st.cycles < max_cycles &&
            (next < n_items || st.produced < expect_out || finals_ < cfg_.expect_final)) {
-      const bool offer = next < n_items && !(idle_len && idle[cycle_ % idle_len]);
-      const bool take = !(stall_len && stall[cycle_ % stall_len]);
-      top_->in_valid_i = offer;
-      if (offer) write_port(top_->in_data_i, items + next * in_words, in_words);
-      top_->out_ready_i = take;
+      const auto [offer, take] =
+          this->drive_stream(items, n_items, in_words, next, idle, idle_len, stall, stall_len);
       const bool park_take = !chance(cfg_.park_stall);
       const bool fin_take = !chance(cfg_.fin_stall);
       const bool rq_take = !chance(cfg_.rq_stall);
@@ -93,18 +77,13 @@ class WinShim final : public ClockedTop<V>, public WinHost {
       if (rs_offer) write_port(top_->rs_cox_i, answers_.front().cox.data(), kCoxWords);
       top_->eval();
 
-      // The valid/ready rule on all four outputs.
-      out_watch_.watch(*top_, cycle_, take, st, out, out_words);
+      // The valid/ready rule on the window's three outputs (the output stream's in end_cycle).
       held(park_held_, top_->park_valid_o, park_take, top_->park_key_o, park_key_, top_->park_cox_o,
            park_cox_);
       held(fin_held_, top_->fin_valid_o, fin_take, top_->fin_key_o, fin_key_, top_->fin_cox_o,
            fin_cox_);
       held(rq_held_, top_->rq_valid_o, rq_take, top_->rq_key_o, rq_key_, top_->rq_key_o, rq_key2_);
 
-      if (offer && top_->in_ready_o) {
-        ++next;
-        ++st.consumed;
-      }
       if (top_->park_valid_o && park_take) {
         uint32_t* r = record(kWinPark, top_->park_key_o, 0);
         read_port(top_->park_cox_o, r + 4, kCoxWords);
@@ -129,12 +108,7 @@ class WinShim final : public ClockedTop<V>, public WinHost {
         answers_.push_back(std::move(a));
       }
       if (rs_offer && top_->rs_ready_o) answers_.pop_front();
-      this->tick();
-      ++st.cycles;
-      if (this->ctx_->gotFinish()) {
-        st.finished = true;
-        break;
-      }
+      if (!this->end_cycle(st, offer, next, take, out, out_words)) break;
     }
     idle_inputs();
     top_->eval();
@@ -194,7 +168,6 @@ class WinShim final : public ClockedTop<V>, public WinHost {
   std::vector<uint32_t> records_;
   std::unordered_map<uint64_t, std::vector<uint32_t>> dram_;
   std::deque<Answer> answers_;
-  OutWatch<V> out_watch_;
   bool park_held_ = false, fin_held_ = false, rq_held_ = false;
   std::remove_reference_t<decltype(V::park_key_o)> park_key_{}, fin_key_{}, rq_key_{}, rq_key2_{};
   std::remove_reference_t<decltype(V::park_cox_o)> park_cox_{};
