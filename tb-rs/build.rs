@@ -350,41 +350,24 @@ fn main() {
         .and_then(|j| j.parse().ok())
         .unwrap_or(2)
         .max(1);
-    let next = AtomicUsize::new(0);
-    let built = Mutex::new(Vec::new());
-    let failures = Mutex::new(Vec::new());
-    std::thread::scope(|s| {
-        for _ in 0..jobs.min(selected.len().max(1)) {
-            s.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::SeqCst);
-                let Some(v) = selected.get(i) else { break };
-                let own_headers = &shim_headers[Shim::of(v) as usize];
-                let stamp = variant_stamp(
-                    v,
-                    &repo,
-                    &[
-                        &verilator_version,
-                        &yosys_version,
-                        &shim_text,
-                        &vlt_text,
-                        own_headers,
-                    ],
-                );
-                match build_variant(v, &repo, &cache, &tb, &vl_include, &vlt, &stamp) {
-                    Ok(b) => built.lock().unwrap().push(b),
-                    Err(e) => failures
-                        .lock()
-                        .unwrap()
-                        .push(format!("{}: {e}", v.full_name)),
-                }
-            });
-        }
-    });
-    let failures = failures.into_inner().unwrap();
-    if !failures.is_empty() {
-        panic!("RTL variants failed to build:\n{}", failures.join("\n"));
-    }
-    let mut built = built.into_inner().unwrap();
+    let built = in_parallel(jobs, &selected, |v| {
+        let own_headers = &shim_headers[Shim::of(v) as usize];
+        let stamp = variant_stamp(
+            v,
+            &repo,
+            &[
+                &verilator_version,
+                &yosys_version,
+                &shim_text,
+                &vlt_text,
+                own_headers,
+            ],
+        );
+        build_variant(v, &repo, &cache, &tb, &vl_include, &vlt, &stamp)
+            .map_err(|e| format!("{}: {e}", v.full_name))
+    })
+    .unwrap_or_else(|failures| panic!("RTL variants failed to build:\n{}", failures.join("\n")));
+    let mut built = built;
     built.sort_by(|a, b| a.full_name.cmp(&b.full_name));
     report(&repo, &cache, &built);
 
@@ -1027,38 +1010,49 @@ fn resolve_all_params(
         .iter()
         .flat_map(|t| t.variants.iter().map(move |l| (t, l)))
         .collect();
+    in_parallel(2, &lines, |(top, line)| {
+        resolve_params(cache, repo, top, line, verilator_version)
+            .map(|p| ((top.name.clone(), line.config.clone()), p))
+            .map_err(|e| format!("{}: {e}", line.origin))
+    })
+    .unwrap_or_else(|failures| {
+        panic!(
+            "cannot elaborate the variants' parameters:\n{}",
+            failures.join("\n")
+        )
+    })
+    .into_iter()
+    .collect()
+}
+
+/// `work` on every item, `jobs` threads each taking the next item in turn (so the caller's order
+/// is the start order): the results in no particular order, or every failure's message.
+fn in_parallel<T: Sync, R: Send>(
+    jobs: usize,
+    items: &[T],
+    work: impl Fn(&T) -> Result<R, String> + Sync,
+) -> Result<Vec<R>, Vec<String>> {
     let next = AtomicUsize::new(0);
-    let out = Mutex::new(Resolved::new());
+    let done = Mutex::new(Vec::new());
     let failures = Mutex::new(Vec::new());
     std::thread::scope(|s| {
-        for _ in 0..2 {
+        for _ in 0..jobs.min(items.len().max(1)) {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, Ordering::SeqCst);
-                let Some((top, line)) = lines.get(i) else {
-                    break;
-                };
-                match resolve_params(cache, repo, top, line, verilator_version) {
-                    Ok(p) => {
-                        out.lock()
-                            .unwrap()
-                            .insert((top.name.clone(), line.config.clone()), p);
-                    }
-                    Err(e) => failures
-                        .lock()
-                        .unwrap()
-                        .push(format!("{}: {e}", line.origin)),
+                let Some(item) = items.get(i) else { break };
+                match work(item) {
+                    Ok(r) => done.lock().unwrap().push(r),
+                    Err(e) => failures.lock().unwrap().push(e),
                 }
             });
         }
     });
     let failures = failures.into_inner().unwrap();
-    if !failures.is_empty() {
-        panic!(
-            "cannot elaborate the variants' parameters:\n{}",
-            failures.join("\n")
-        );
+    if failures.is_empty() {
+        Ok(done.into_inner().unwrap())
+    } else {
+        Err(failures)
     }
-    out.into_inner().unwrap()
 }
 
 fn resolve_params(

@@ -260,6 +260,13 @@ fn document(
         s.push_str(t);
         s.push('\n');
     };
+    // A sweep's table, then its figure (`{img}<table name>.png`), each followed by a blank line.
+    let table_and_figure = |s: &mut String, name: &str, alt: &str| {
+        s.push_str(&table(name).to_markdown());
+        w(s, "");
+        w(s, &format!("![{alt}]({img}{name}.png)"));
+        w(s, "");
+    };
     w(&mut s, "# Speed against accuracy, measured");
     w(&mut s, "");
     w(
@@ -371,10 +378,7 @@ fn document(
          sampling and warp, which the columns against the reference include.",
     );
     w(&mut s, "");
-    s.push_str(&table("tradeoff-widths").to_markdown());
-    w(&mut s, "");
-    w(&mut s, &format!("![widths]({img}tradeoff-widths.png)"));
-    w(&mut s, "");
+    table_and_figure(&mut s, "tradeoff-widths", "widths");
     w(&mut s, "### Verified configurations");
     w(&mut s, "");
     s.push_str(&table("tradeoff-configs").to_markdown());
@@ -560,10 +564,7 @@ fn document(
         );
     }
     w(&mut s, "");
-    s.push_str(&table("tradeoff-gradient").to_markdown());
-    w(&mut s, "");
-    w(&mut s, &format!("![gradient]({img}tradeoff-gradient.png)"));
-    w(&mut s, "");
+    table_and_figure(&mut s, "tradeoff-gradient", "gradient");
     w(
         &mut s,
         "The paper gives Figure 15 as curves without printed values, so the comparison is of shape: \
@@ -588,10 +589,7 @@ fn document(
          the 96^3 perspective scene, with MIP, where the geometry alone is measured.",
     );
     w(&mut s, "");
-    s.push_str(&table("tradeoff-slabs").to_markdown());
-    w(&mut s, "");
-    w(&mut s, &format!("![slabs]({img}tradeoff-slabs.png)"));
-    w(&mut s, "");
+    table_and_figure(&mut s, "tradeoff-slabs", "slabs");
     w(&mut s, "## ER-perspective");
     w(&mut s, "");
     w(
@@ -609,10 +607,7 @@ fn document(
          are the model's on a shared two-core machine. No RTL yet.",
     );
     w(&mut s, "");
-    s.push_str(&table("tradeoff-er").to_markdown());
-    w(&mut s, "");
-    w(&mut s, &format!("![ER-perspective]({img}tradeoff-er.png)"));
-    w(&mut s, "");
+    table_and_figure(&mut s, "tradeoff-er", "ER-perspective");
     w(
         &mut s,
         &format!(

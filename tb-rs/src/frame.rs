@@ -11,7 +11,7 @@
 use crate::error::{Mismatch, TbError};
 use crate::rtl::{RtlStream, Taken, Traffic};
 use crate::variants::{variants_of, Variant};
-use cube5_model::bits::{BitReader, BitWriter};
+use cube5_model::bits::BitWriter;
 use cube5_model::error::ModelError;
 use cube5_model::geometry::{self, Solid};
 use cube5_model::scene_render::{FrameJob, FrameRun};
@@ -138,19 +138,9 @@ pub use cube5_model::units::cube5_frame::FrameMode as Render;
 /// A `render` code the frame refuses (the field's top code; the modes take 0..=4).
 pub const RENDER_REFUSED: u32 = (1 << REG_MODE_RENDER.width) - 1;
 
-/// One output item: a base-plane coxel and the frame's status. With `OutLanes = P` an item holds
-/// P pixels of a row: `coxel` is the first, `rest` the others (the drivers expand an item into
-/// its pixels with [`pixels_of`], each with an empty `rest`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct FrameOut {
-    pub coxel: Coxel,
-    pub rest: Vec<Coxel>,
-    pub error: bool,
-    /// Memory beats the sweep read from the modules.
-    pub reads: u32,
-    /// The sweep counter: command accepted to read-out start.
-    pub cycles: u32,
-}
+/// One output item: a base-plane coxel and the frame's status (the drivers expand an item of
+/// `OutLanes = P` pixels into its pixels with [`pixels_of`], each with an empty `rest`).
+pub use cube5_model::units::cube5_frame::ports::FrameOut;
 
 pub use crate::rtl::ConfigWrites;
 
@@ -353,40 +343,6 @@ impl FrameRtl {
             ));
         }
         Ok(())
-    }
-}
-
-impl StreamCodec for FrameRtl {
-    type In = u32;
-    type Out = FrameOut;
-
-    fn in_width(&self) -> u32 {
-        2
-    }
-
-    fn out_width(&self) -> u32 {
-        self.out_lanes as u32 * self.compos.coxel_w() + 1 + 64
-    }
-
-    fn pack_in(&self, op: &u32) -> Vec<u32> {
-        let mut w = BitWriter::new();
-        w.put(u64::from(*op), 2);
-        w.finish(2)
-    }
-
-    fn unpack_out(&self, words: &[u32]) -> FrameOut {
-        let mut r = BitReader::new(words);
-        let coxel = cube5_compos::get_coxel(&mut r, &self.compos);
-        let rest = (1..self.out_lanes)
-            .map(|_| cube5_compos::get_coxel(&mut r, &self.compos))
-            .collect();
-        FrameOut {
-            coxel,
-            rest,
-            error: r.get_bool(),
-            reads: r.get(32) as u32,
-            cycles: r.get(32) as u32,
-        }
     }
 }
 
@@ -817,7 +773,7 @@ pub struct FrameStats {
 /// A loaded DUT: one variant with one volume in its memory.
 pub struct FrameBench {
     pub rtl: FrameRtl,
-    pub dut: RtlStream<FrameRtl>,
+    pub dut: RtlStream<FrameConfig>,
     pub dims: [usize; 3],
     pub lut: BlockLut,
     /// The tables loaded last (render mode, 2-D table, opacity ratio, compositing registers):
@@ -837,7 +793,7 @@ impl FrameBench {
         lut: &BlockLut,
         dut_seed: u32,
     ) -> Result<Self, TbError> {
-        let mut dut = RtlStream::new(rtl.variant, rtl, dut_seed)?;
+        let mut dut = RtlStream::new(rtl.variant, rtl.cfg, dut_seed)?;
         for (a, d) in rtl.volume_writes(vol, lut)? {
             dut.write_config(a, &d)?;
         }

@@ -11,11 +11,8 @@ use crate::frame::{
 };
 use crate::rtl::{RtlStream, Traffic};
 use crate::variants::variants_of;
-use cube5_model::bits::BitWriter;
-use cube5_model::regs::cube5_frame::{KIND_BEAT, KIND_CMD, OP_RENDER};
-use cube5_model::unit::StreamCodec;
+use cube5_model::regs::cube5_frame::OP_RENDER;
 use cube5_model::units::cube5_frame::sections::{section_beats, section_order, Section};
-use cube5_model::units::cube5_section_buf::Beam;
 
 impl FrameRtl {
     /// The configurations fed by a beat stream (`Source = 1`) with the whole base plane and its
@@ -37,76 +34,8 @@ impl FrameRtl {
     }
 }
 
-/// A section command: `op`, the first anchor, the columns, first and last section of a frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct SecCmd {
-    pub op: u32,
-    pub a0: u32,
-    pub ns: u32,
-    pub first: bool,
-    pub last: bool,
-}
-
-/// One input item of a stream frame.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum StreamIn {
-    Cmd(SecCmd),
-    Beat(Beam),
-}
-
-/// The stream frame's codec: commands and beats in, the frame's output items out.
-#[derive(Debug, Clone, Copy)]
-pub struct StreamFrame(pub FrameRtl);
-
-impl StreamFrame {
-    fn m(&self) -> u32 {
-        self.0.max_dim_log2
-    }
-
-    fn cmd_w(&self) -> u32 {
-        2 + self.m() + (self.m() + 1) + 2
-    }
-
-    fn beat_w(&self) -> u32 {
-        Beam::width(self.0.p as u32, self.0.trilin.voxel_w)
-    }
-}
-
-impl StreamCodec for StreamFrame {
-    type In = StreamIn;
-    type Out = FrameOut;
-
-    fn in_width(&self) -> u32 {
-        1 + self.cmd_w().max(self.beat_w())
-    }
-
-    fn out_width(&self) -> u32 {
-        self.0.out_width()
-    }
-
-    fn pack_in(&self, item: &StreamIn) -> Vec<u32> {
-        let mut w = BitWriter::new();
-        match item {
-            StreamIn::Cmd(c) => {
-                w.put(u64::from(KIND_CMD), 1);
-                w.put(u64::from(c.op), 2);
-                w.put(u64::from(c.a0), self.m());
-                w.put(u64::from(c.ns), self.m() + 1);
-                w.put(u64::from(c.first), 1);
-                w.put(u64::from(c.last), 1);
-            }
-            StreamIn::Beat(b) => {
-                w.put(u64::from(KIND_BEAT), 1);
-                b.pack(&mut w, self.0.trilin.voxel_w);
-            }
-        }
-        w.finish_padded(self.in_width())
-    }
-
-    fn unpack_out(&self, words: &[u32]) -> FrameOut {
-        self.0.unpack_out(words)
-    }
-}
+/// The stream frame's items and codec: the model's (`cube5_frame::ports`).
+pub use cube5_model::units::cube5_frame::ports::{SecCmd, StreamFrame, StreamIn};
 
 /// The input items of a whole frame swept in sections of `width` anchors (in the order of
 /// `section_order`), and the beats among them.
@@ -156,7 +85,7 @@ impl StreamBench {
     /// Opens the DUT and waits out the compositing buffer's clear pass after reset (a command
     /// refused for a reserved render mode; `load` rewrites the mode register).
     pub fn new(rtl: FrameRtl, dut_seed: u32) -> Result<Self, TbError> {
-        let dut = RtlStream::new(rtl.variant, StreamFrame(rtl), dut_seed)?;
+        let dut = RtlStream::new(rtl.variant, StreamFrame(rtl.cfg), dut_seed)?;
         let mut bench = Self {
             rtl,
             dut,

@@ -181,29 +181,21 @@ impl<C: StreamCodec> RtlStream<C> {
 
     /// Sets up the AXI memory subordinate of a top with an AXI port (tb/axi_mem.h).
     pub fn axi_setup(&mut self, setup: &AxiMemSetup) -> Result<(), TbError> {
-        if self.dut.pin_mut().axi_setup(setup) {
-            Ok(())
-        } else {
-            Err(self.no_axi())
-        }
+        let present = self.dut.pin_mut().axi_setup(setup);
+        self.axi_present(present)
     }
 
     /// Loads the subordinate's memory image: `bytes` from byte address `base` (replaces the last).
     pub fn axi_load(&mut self, base: u64, bytes: &[u8]) -> Result<(), TbError> {
-        if self.dut.pin_mut().axi_load(base, bytes) {
-            Ok(())
-        } else {
-            Err(self.no_axi())
-        }
+        let present = self.dut.pin_mut().axi_load(base, bytes);
+        self.axi_present(present)
     }
 
     /// The AR handshakes the subordinate accepted since the last call, in order.
     pub fn axi_take_ar(&mut self) -> Result<Vec<ArHandshake>, TbError> {
         let mut raw = Vec::new();
-        if !self.dut.pin_mut().axi_take_ar(&mut raw) {
-            return Err(self.no_axi());
-        }
-        Ok(handshakes(&raw))
+        let present = self.dut.pin_mut().axi_take_ar(&mut raw);
+        self.axi_present(present).map(|()| handshakes(&raw))
     }
 
     /// The subordinate's counters and the top's `err_o`.
@@ -219,30 +211,22 @@ impl<C: StreamCodec> RtlStream<C> {
     /// Queues `items` (packed, `words` words each) for the data stream of a top with an AXI write
     /// port, offered except where `idle` (a repeating pattern) is nonzero; replaces the last.
     pub fn axi_feed(&mut self, items: &[u32], words: u32, idle: &[u8]) -> Result<(), TbError> {
-        if self.dut.pin_mut().axi_feed(items, words, idle) {
-            Ok(())
-        } else {
-            Err(self.no_axi())
-        }
+        let present = self.dut.pin_mut().axi_feed(items, words, idle);
+        self.axi_present(present)
     }
 
     /// The AW handshakes the subordinate accepted since the last call, in order.
     pub fn axi_take_aw(&mut self) -> Result<Vec<ArHandshake>, TbError> {
         let mut raw = Vec::new();
-        if !self.dut.pin_mut().axi_take_aw(&mut raw) {
-            return Err(self.no_axi());
-        }
-        Ok(handshakes(&raw))
+        let present = self.dut.pin_mut().axi_take_aw(&mut raw);
+        self.axi_present(present).map(|()| handshakes(&raw))
     }
 
     /// The subordinate's memory image as it is now (the bytes from the loaded base).
     pub fn axi_image(&self) -> Result<Vec<u8>, TbError> {
         let mut out = Vec::new();
-        if self.dut.axi_image(&mut out) {
-            Ok(out)
-        } else {
-            Err(self.no_axi())
-        }
+        let present = self.dut.axi_image(&mut out);
+        self.axi_present(present).map(|()| out)
     }
 
     /// The subordinate's write-port counters.
@@ -274,11 +258,16 @@ impl<C: StreamCodec> RtlStream<C> {
         self.dut.win_errors()
     }
 
-    fn no_axi(&self) -> TbError {
-        TbError::setup(
-            self.variant.name,
-            "this top has no AXI4 manager port (m_axi_ar*, m_axi_r*)",
-        )
+    /// `Ok` where the top has the AXI4 manager port the call went to, else the set-up error.
+    fn axi_present(&self, present: bool) -> Result<(), TbError> {
+        if present {
+            Ok(())
+        } else {
+            Err(TbError::setup(
+                self.variant.name,
+                "this top has no AXI4 manager port (m_axi_ar*, m_axi_r*)",
+            ))
+        }
     }
 
     /// Records cycles `[from, to]` into a VCD file.

@@ -27,6 +27,19 @@ fn stream(p: usize) -> FrameRtl {
         .unwrap_or_else(|| panic!("no cube5_frame variant with Source = 1 and P = {p}"))
 }
 
+/// The head phantom of edge `n` (12-bit voxels).
+fn phantom(n: usize) -> Rc<Volume> {
+    Rc::new(head_phantom(n, 12).unwrap())
+}
+
+/// A bench of `rtl` (the DUT seeded with `s`) and random traffic from seed `s`: `idle` of the input
+/// cycles idle, `stall` of the output cycles stalled.
+fn bench_with_traffic(rtl: FrameRtl, s: u64, idle: f64, stall: f64) -> (StreamBench, Traffic) {
+    let bench = must(StreamBench::new(rtl, s as u32));
+    let mut rng = ChaCha8Rng::seed_from_u64(s);
+    (bench, Traffic::random(&mut rng, idle, stall))
+}
+
 /// Faces (DX = 0), 45 degrees, obliques with DX > 0 and DX < 0 along the beam axis.
 const VIEWS: &[(&str, [f64; 3])] = &[
     ("+z", [0.0, 0.0, 1.0]),
@@ -49,10 +62,8 @@ fn expect(rtl: &FrameRtl, vol: &Rc<Volume>, view: (&str, [f64; 3]), render: Rend
 fn sectioned_frames_bit_exact_p4() {
     let s = seed(1);
     let rtl = stream(4);
-    let vol = Rc::new(head_phantom(32, 12).unwrap());
-    let mut bench = must(StreamBench::new(rtl, s as u32));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let traffic = Traffic::random(&mut rng, 0.3, 0.3);
+    let vol = phantom(32);
+    let (mut bench, traffic) = bench_with_traffic(rtl, s, 0.3, 0.3);
     for (n, &view) in VIEWS.iter().enumerate() {
         for render in [Render::Mip, Render::Composite] {
             let e = expect(&rtl, &vol, view, render);
@@ -78,10 +89,8 @@ fn sectioned_frames_bit_exact_p4() {
 fn sectioned_frames_bit_exact_p1() {
     let s = seed(2);
     let rtl = stream(1);
-    let vol = Rc::new(head_phantom(16, 12).unwrap());
-    let mut bench = must(StreamBench::new(rtl, s as u32));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let traffic = Traffic::random(&mut rng, 0.2, 0.3);
+    let vol = phantom(16);
+    let (mut bench, traffic) = bench_with_traffic(rtl, s, 0.2, 0.3);
     for &view in &VIEWS[3..] {
         for (render, w) in [(Render::Composite, 4), (Render::Mip, 16)] {
             let e = expect(&rtl, &vol, view, render);
@@ -96,10 +105,8 @@ fn sectioned_frames_bit_exact_p1() {
 fn reset_mid_frame_and_an_abandoned_frame() {
     let s = seed(3);
     let rtl = stream(4);
-    let vol = Rc::new(head_phantom(32, 12).unwrap());
-    let mut bench = must(StreamBench::new(rtl, s as u32));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let traffic = Traffic::random(&mut rng, 0.2, 0.2);
+    let vol = phantom(32);
+    let (mut bench, traffic) = bench_with_traffic(rtl, s, 0.2, 0.2);
     let e = expect(&rtl, &vol, VIEWS[6], Render::Composite);
     must(bench.load(&e));
     let order = section_order(&e.params, 16, rtl.p).unwrap();
@@ -132,7 +139,7 @@ fn reset_mid_frame_and_an_abandoned_frame() {
 fn bad_sections_refused() {
     let s = seed(4);
     let rtl = stream(4);
-    let vol = Rc::new(head_phantom(32, 12).unwrap());
+    let vol = phantom(32);
     let mut bench = must(StreamBench::new(rtl, s as u32));
     let e = expect(&rtl, &vol, VIEWS[0], Render::Mip);
     must(bench.load(&e));
@@ -159,10 +166,8 @@ fn bad_sections_refused() {
 fn sectioned_frames_64_bit_exact() {
     let s = seed(5);
     let rtl = stream(4);
-    let vol = Rc::new(head_phantom(64, 12).unwrap());
-    let mut bench = must(StreamBench::new(rtl, s as u32));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let traffic = Traffic::random(&mut rng, 0.135, 0.2);
+    let vol = phantom(64);
+    let (mut bench, traffic) = bench_with_traffic(rtl, s, 0.135, 0.2);
     for &view in VIEWS {
         for render in [Render::Mip, Render::Composite] {
             let e = expect(&rtl, &vol, view, render);
@@ -186,9 +191,7 @@ fn budget(
     idle: f64,
     s: u64,
 ) -> (u64, u64, u64) {
-    let mut bench = must(StreamBench::new(*rtl, s as u32));
-    let mut rng = ChaCha8Rng::seed_from_u64(s);
-    let traffic = Traffic::random(&mut rng, idle, 0.0);
+    let (mut bench, traffic) = bench_with_traffic(*rtl, s, idle, 0.0);
     let e = expect(rtl, vol, view, Render::Composite);
     must(bench.load(&e));
     let order = section_order(&e.params, w, rtl.p).unwrap();
@@ -225,7 +228,7 @@ fn budget(
 #[test]
 fn cycle_budget_of_a_sectioned_frame() {
     let s = seed(6);
-    let vol = Rc::new(head_phantom(32, 12).unwrap());
+    let vol = phantom(32);
     for rtl in [stream(4), stream(1)] {
         for w in [16, 32] {
             let (sweep, ideal, beats) = budget(&rtl, &vol, VIEWS[6], w, 0.0, s);
@@ -257,7 +260,7 @@ fn cycle_budget_of_a_sectioned_frame() {
 #[ignore = "sim-full: the measurement of docs/measurements.md, 64^3 frames"]
 fn measure_sectioned_frames_64() {
     let s = seed(7);
-    let vol = Rc::new(head_phantom(64, 12).unwrap());
+    let vol = phantom(64);
     let rtl = stream(4);
     for w in [16, 32, 64] {
         for idle in [0.0, 0.135] {

@@ -26,6 +26,7 @@ mod fast;
 pub use fast::{
     render_base_plane_stats as render_base_plane_stats_fast, render_sweep, SweepStats, SweepVolume,
 };
+pub mod ports;
 pub mod sections;
 pub mod window;
 
