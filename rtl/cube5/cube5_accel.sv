@@ -646,6 +646,7 @@ module cube5_accel #(
       .clk_i, .rst_ni(unit_rst_n),
       .img_base_i(img_base), .row_step_i(row_step), .park_base_i(park_base),
       .row_pixels_i(row_pixels), .rows_done_i(rows_done_q),
+      .frame_start_i(fr_q == FrIdle && rc_valid && rc_data[FcFirst]),
       .park_valid_i(win_park_valid), .park_ready_o(win_park_ready), .park_key_i(win_park_key),
       .park_cox_i(win_park_cox),
       .fin_valid_i(win_fin_valid), .fin_ready_o(win_fin_ready), .fin_key_i(win_fin_key),

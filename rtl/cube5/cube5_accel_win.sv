@@ -17,6 +17,16 @@
 // response (the frame requests a section's restores only after the earlier sections' parks left
 // its park FIFO, so those are the parks the restore may read). Parks go before finals. At most
 // Outstanding write bursts and Outstanding restore reads are in flight.
+//
+// Zero parks (ZeroSkip = 1; docs/accel.md, *Fewer window bytes*): the frame restores coxels in
+// exactly the order it parked them (docs/numerics/compos_window.md), so one on-chip bit per park,
+// in a FIFO of ZeroDepth bits (block RAM), says whether the parked coxel is all zero bits. Such a
+// park writes nothing and its restore reads nothing (its coxel, zeros, is handed over in request
+// order behind the reads before it). A park that finds the bit FIFO full is written as before and
+// recorded in no FIFO (a count); while such parks are outstanding every park is written, so the
+// recorded parks are always older than the unrecorded ones: a restore request is the bit FIFO's
+// head when that FIFO is not empty, else an unrecorded park's (a read). frame_start_i empties the
+// bit FIFO (a frame that ended without restoring its parks leaves nothing behind).
 module cube5_accel_win #(
   parameter int unsigned P           = 4,
   /// Bits of a key coordinate (log2(MaxDim) + 1).
@@ -28,7 +38,11 @@ module cube5_accel_win #(
   parameter int unsigned AccW        = 20,
   parameter int unsigned ColorW      = 8,
   /// Write bursts in flight, and restore reads in flight.
-  parameter int unsigned Outstanding = 16
+  parameter int unsigned Outstanding = 16,
+  /// 1: all-zero parks cost no bytes (a bit per park on chip); 0: every park is written.
+  parameter int unsigned ZeroSkip    = 1,
+  /// Bits of the zero-park FIFO (a power of two; 0: MaxDim^2, a section's parks at 45 degrees).
+  parameter int unsigned ZeroDepth   = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -40,6 +54,8 @@ module cube5_accel_win #(
   input  logic [AddrW-1:0] park_base_i,
   input  logic [DimW:0]    row_pixels_i,
   input  logic [DimW:0]    rows_done_i,
+  /// A frame starts (its first section command): the zero-park FIFO empties.
+  input  logic frame_start_i,
 
   // ---- the frame's window streams ----
   input  logic park_valid_i,
@@ -130,13 +146,16 @@ module cube5_accel_win #(
   // ---------------------------------------------------------------------------
   // Stage 1: the next item (a park before a final; a final once its row is cleared).
   // ---------------------------------------------------------------------------
-  logic               s1_v_q, s1_park_q;
+  logic               s1_v_q, s1_park_q, s1_new_q;
   logic [KeyW-1:0]    s1_key_q;
   logic [P-1:0]       s1_mask_q;
   logic [P*StoreW-1:0] s1_cox_q;
   logic               s1_ready, take_park, take_fin, s2_take;
+  // A park is decided in its first cycle in stage 1: recorded in the zero FIFO or not, dropped
+  // (all zero, recorded: nothing written) or kept for stage 2 (a write).
+  logic               p_decide, p_rec, p_drop, p_write;
 
-  assign s1_ready     = !s1_v_q || s2_take;
+  assign s1_ready     = !s1_v_q || s2_take || p_drop;
   assign take_park    = park_valid_i && s1_ready;
   assign take_fin     = fin_valid_i && !park_valid_i && s1_ready
                         && (DimW + 1)'(fin_key_i[DimW +: DimW]) < rows_done_i;
@@ -145,9 +164,11 @@ module cube5_accel_win #(
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
-      s1_v_q <= 1'b0;
-    end else if (s1_ready) begin
-      s1_v_q <= take_park || take_fin;
+      s1_v_q   <= 1'b0;
+      s1_new_q <= 1'b0;
+    end else begin
+      if (s1_ready) s1_v_q <= take_park || take_fin;
+      s1_new_q <= s1_ready ? take_park : 1'b0;
     end
   end
 
@@ -164,6 +185,10 @@ module cube5_accel_win #(
       s1_cox_q  <= fin_cox_i;
     end
   end
+
+  assign p_decide = s1_v_q && s1_new_q;   // s1_new_q: a park, loaded last cycle
+  assign p_drop   = p_decide && p_rec && s1_cox_q[StoreW-1:0] == '0;
+  assign p_write  = p_decide && !p_drop;
 
   // ---------------------------------------------------------------------------
   // Stage 2: the burst's address and its beats (data and strobes, LineBeats bus beats).
@@ -199,7 +224,7 @@ module cube5_accel_win #(
     end
   end
 
-  assign s2_take = s1_v_q && (!s2_v_q || s3_done);
+  assign s2_take = s1_v_q && !p_drop && (!s2_v_q || s3_done);
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -302,25 +327,90 @@ module cube5_accel_win #(
   logic [TagW-1:0]  ptaken_q, pdone_q, rq_tag, hd_tag_q, tag_d;
   logic             rq_empty, rq_full, rq_push, ar_fire, r_fire;
   logic [AddrW-1:0] rq_addr, hd_addr_q, ar_addr_q;
-  logic [OutW-1:0]  rs_out_q;     // restore reads in the AR register or in flight
+  logic [OutW-1:0]  rs_out_q;     // restores past the head register, not yet handed over
   logic             hd_v_q, hd_ok_q, ar_v_q, hd_move, hd_load;
   logic signed [TagW-1:0] behind;   // parks done minus the head's tag (wraps: compare its sign)
   logic             rs_v_q;
   logic [PkBeats*DataW-1:0] rs_q;
+  logic             rq_zero, rq_zero_q, hd_zero_q, rq_ok;
+  logic             ord_zero, ord_empty, ord_full, ord_pop, rs_take;
 
-  assign rq_ready_o = !rq_full;
-  assign rq_push    = rq_valid_i && !rq_full;
+  // ---- the zero-park FIFO: a bit per recorded park, in park order ----
+  if (ZeroSkip != 0) begin : gen_zero
+    localparam int unsigned ZDepth = (ZeroDepth != 0) ? ZeroDepth : (1 << (2 * (DimW - 1)));
+    localparam int unsigned ZPtrW  = $clog2(ZDepth);
+    localparam int unsigned UnW    = 2 * DimW + 2;
+    logic [ZPtrW:0] zw_q, zr_q;     // bits written, bits read into the head
+    logic           zh_v_q;         // the head bit (the RAM's registered output) is valid
+    logic           zh_bit;
+    logic [UnW-1:0] unrec_q;        // parks written and recorded nowhere, not yet restored
+    logic           z_push, z_re, z_pop, z_any, un_pop;
 
-  cube5_frame_fifo #(.Width(AddrW + TagW), .Depth(RqDepth)) u_rq (
+    if (ZDepth < 2 || (1 << ZPtrW) != ZDepth) begin : gen_bad_zdepth
+      $fatal(1, "cube5_accel_win: ZeroDepth must be 0 or a power of two >= 2");
+    end
+
+    assign p_rec  = unrec_q == '0 && (zw_q - zr_q) != (ZPtrW+1)'(ZDepth);
+    assign z_push = p_decide && p_rec;
+    // A request belongs to the FIFO's head while the FIFO holds a bit (the recorded parks are
+    // older than the unrecorded ones), else to an unrecorded park: a read.
+    assign z_any  = zh_v_q || zw_q != zr_q;
+    assign rq_ok  = !z_any || zh_v_q;
+    assign rq_zero = z_any && zh_bit;
+    assign z_pop  = rq_push && z_any;
+    assign un_pop = rq_push && !z_any;
+    assign z_re   = zw_q != zr_q && (!zh_v_q || z_pop);
+
+    cube5_section_buf_ram #(.Depth(ZDepth), .Width(1), .AddrW(ZPtrW)) u_zbits (
+      .clk_i,
+      .we_i(z_push), .waddr_i(zw_q[ZPtrW-1:0]), .wdata_i(p_drop),
+      .re_i(z_re), .raddr_i(zr_q[ZPtrW-1:0]), .rdata_o(zh_bit)
+    );
+
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni || frame_start_i) begin
+        zw_q    <= '0;
+        zr_q    <= '0;
+        zh_v_q  <= 1'b0;
+        unrec_q <= '0;
+      end else begin
+        zw_q    <= zw_q + (ZPtrW+1)'(z_push);
+        zr_q    <= zr_q + (ZPtrW+1)'(z_re);
+        if (z_re)       zh_v_q <= 1'b1;
+        else if (z_pop) zh_v_q <= 1'b0;
+        unrec_q <= unrec_q + UnW'(p_write && !p_rec) - UnW'(un_pop);
+      end
+    end
+
+`ifndef SYNTHESIS
+    WinZeroKnown: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        un_pop |-> unrec_q != '0)
+      else $error("cube5_accel_win: a restore request before its park");
+`endif
+  end else begin : gen_no_zero
+    logic unused_zero;
+    assign p_rec   = 1'b0;
+    assign rq_ok   = 1'b1;
+    assign rq_zero = 1'b0;
+    assign unused_zero = frame_start_i;
+  end
+
+  assign rq_ready_o = !rq_full && rq_ok;
+  assign rq_push    = rq_valid_i && rq_ready_o;
+
+  cube5_frame_fifo #(.Width(AddrW + TagW + 1), .Depth(RqDepth)) u_rq (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i(rq_push), .d_i({slot_of(rq_key_i), ptaken_q + TagW'(take_park)}),
-    .pop_i(hd_load), .q_o({rq_addr, rq_tag}), .empty_o(rq_empty), .full_o(rq_full)
+    .push_i(rq_push), .d_i({rq_zero, slot_of(rq_key_i), ptaken_q + TagW'(p_write)}),
+    .pop_i(hd_load), .q_o({rq_zero_q, rq_addr, rq_tag}), .empty_o(rq_empty), .full_o(rq_full)
   );
 
-  // The head moves on once its parks are written, a read may start and the AR register is free;
-  // the head register then takes the FIFO's next request. Its flag compares with the parks done
-  // so far (pdone_q: a count that only grows, so a set flag stays true).
-  assign hd_move = hd_v_q && hd_ok_q && rs_out_q < OutW'(Outstanding) && (!ar_v_q || arready_i);
+  // The head moves on once its parks are written, a read may start and the AR register is free
+  // (a zero request: at once); the head register then takes the FIFO's next request. Its flag
+  // compares with the parks done so far (pdone_q: a count that only grows, so a set flag stays
+  // true). Every request leaving the head enters the order FIFO (zero or a read), which hands
+  // the coxels over in request order.
+  assign hd_move = hd_v_q && rs_out_q < OutW'(Outstanding)
+                   && (hd_zero_q || (hd_ok_q && (!ar_v_q || arready_i)));
   assign hd_load = !rq_empty && (!hd_v_q || hd_move);
   assign tag_d   = hd_load ? rq_tag : hd_tag_q;
   assign behind  = $signed(pdone_q - tag_d);
@@ -335,8 +425,8 @@ module cube5_accel_win #(
       if (hd_load)      hd_v_q <= 1'b1;
       else if (hd_move) hd_v_q <= 1'b0;
       hd_ok_q <= !behind[TagW-1];
-      if (hd_move)      ar_v_q <= 1'b1;
-      else if (ar_fire) ar_v_q <= 1'b0;
+      if (hd_move && !hd_zero_q) ar_v_q <= 1'b1;
+      else if (ar_fire)          ar_v_q <= 1'b0;
     end
   end
 
@@ -344,17 +434,26 @@ module cube5_accel_win #(
     if (hd_load) begin
       hd_addr_q <= rq_addr;
       hd_tag_q  <= rq_tag;
+      hd_zero_q <= rq_zero_q;
     end
-    if (hd_move) ar_addr_q <= hd_addr_q;
+    if (hd_move && !hd_zero_q) ar_addr_q <= hd_addr_q;   // (held while AR waits)
   end
+
+  cube5_frame_fifo #(.Width(1), .Depth(RqDepth)) u_ord (
+    .clk_i, .rst_ni, .clear_i(1'b0),
+    .push_i(hd_move), .d_i(hd_zero_q), .pop_i(ord_pop), .q_o(ord_zero),
+    .empty_o(ord_empty), .full_o(ord_full)
+  );
 
   assign arvalid_o  = ar_v_q;
   assign araddr_o   = ar_addr_q;
   assign arlen_o    = 8'(PkBeats - 1);
   assign rready_o   = !rs_v_q;
   assign r_fire     = rvalid_i && rready_o;
-  assign rs_valid_o = rs_v_q;
-  assign rs_cox_o   = rs_q[StoreW-1:0];
+  assign rs_valid_o = !ord_empty && (ord_zero || rs_v_q);
+  assign rs_cox_o   = ord_zero ? '0 : rs_q[StoreW-1:0];
+  assign ord_pop    = rs_valid_o && rs_ready_i;
+  assign rs_take    = ord_pop && !ord_zero;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -363,11 +462,11 @@ module cube5_accel_win #(
       rs_out_q <= '0;
       rs_v_q   <= 1'b0;
     end else begin
-      ptaken_q <= ptaken_q + TagW'(take_park);
+      ptaken_q <= ptaken_q + TagW'(p_write);
       pdone_q  <= pdone_q + TagW'(b_fire && bid_i == IdPark);
-      rs_out_q <= rs_out_q + OutW'(hd_move) - OutW'(r_fire && rlast_i);
-      if (r_fire && rlast_i)        rs_v_q <= 1'b1;
-      else if (rs_v_q && rs_ready_i) rs_v_q <= 1'b0;
+      rs_out_q <= rs_out_q + OutW'(hd_move) - OutW'(ord_pop);
+      if (r_fire && rlast_i) rs_v_q <= 1'b1;
+      else if (rs_take)      rs_v_q <= 1'b0;
     end
   end
 
@@ -396,6 +495,8 @@ module cube5_accel_win #(
   assign wr_wait_o = !w_empty;
   assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && rq_empty
                   && !hd_v_q && rs_out_q == '0 && !rs_v_q;
+  logic unused_ord;
+  assign unused_ord = ord_full;
 
   // The terminated flags of the final lanes (a pixel is R, G, B, A only).
   logic [P-1:0] unused_term;
