@@ -1450,8 +1450,8 @@ mod tests {
                 it.color = [0; 3];
                 let o = s.sample(&it);
                 let r = s.reference(&it);
-                for ch in 0..3 {
-                    let e = f64::from(o.color[ch]) - r[ch];
+                for (&got, &want) in o.color.iter().zip(&r) {
+                    let e = f64::from(got) - want;
                     worst = worst.max(e.abs());
                     sq += e * e;
                     n += 1;
@@ -1459,12 +1459,11 @@ mod tests {
             }
             let rms = (sq / f64::from(n)).sqrt();
             eprintln!("shaded step, VoxelW {voxel_w}: max {worst:.2} RMS {rms:.3} (U(0.12) LSB)");
-            // An 8-bit colour code is 16 LSB of the packet: the map's error near a face edge
-            // and the gradient's rounding stay within a few codes.
-            assert!(
-                rms < 16.0 && worst < 16.0 * 64.0,
-                "{voxel_w}: {worst} {rms}"
-            );
+            // An 8-bit colour code is 16 LSB of the packet: its rounding (half a code), the
+            // map's face-coordinate rounding and the gradient's (a step of `2^-Fg` turns a
+            // short gradient most) measured at most 1.6 codes (22.8 and 25.2 LSB at VoxelW 4
+            // and 12, RMS 1.5 and 1.6 LSB): bounded at 2 codes and a quarter code RMS.
+            assert!(rms < 4.0 && worst <= 32.0, "{voxel_w}: {worst} {rms}");
         }
     }
 }
