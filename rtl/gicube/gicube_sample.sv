@@ -20,7 +20,15 @@ module gicube_sample #(
   parameter int unsigned VoxelW = 8,
   /// 1: the jitter stage (random, log and power LUTs, [353], [380]) before the compositor, whose
   /// LUT is then bypassed; 0: the compositor's opacity table corrects for the fixed step.
-  parameter int unsigned Jitter = 0
+  parameter int unsigned Jitter = 0,
+  /// 1: shading ([352], [378], [379], [383]): the corners' gradient indices decoded by eight
+  /// gradient LUTs and interpolated tri-linearly, the nearest corner's tag in the classification
+  /// index, and the reflectance map lighting rendering rays without irradiance; 0: unlit.
+  parameter int unsigned Shade = 0,
+  /// Gradient index bits per voxel (Shade = 1), 2..11.
+  parameter int unsigned GradIdxW = 11,
+  /// Tag bits per voxel (Shade = 1), 0..4 and below ClassIdxW; 0 with Shade = 0.
+  parameter int unsigned TagW = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -30,8 +38,9 @@ module gicube_sample #(
   /// Unit can take an item this cycle.
   output logic in_ready_o,
   /// voxels[8] (VoxelW), weights x, y, z (U(0.8)), irr_en, irr[8] (U(2.14)), red, green, blue,
-  /// opacity (U(0.12)), lighting; LSB first.
-  input  logic [gicube_sample_pkg::in_w(VoxelW)-1:0] in_data_i,
+  /// opacity (U(0.12)), lighting, with Shade = 1 grad_idx[8] (GradIdxW), tag[8] (TagW); LSB first.
+  input  logic [gicube_sample_pkg::in_w(VoxelW)
+                + gicube_sample_pkg::shade_in_w(Shade, GradIdxW, TagW)-1:0] in_data_i,
 
   /// Output item valid.
   output logic out_valid_o,
@@ -42,8 +51,9 @@ module gicube_sample #(
 
   /// Configuration write this cycle (tables and registers; they survive reset).
   input  logic cfg_valid_i,
-  /// Bit 13 clear: classification entry (the index below); set: cube5_compos word (bits 12:0).
-  input  logic [gicube_sample_pkg::CfgAddrW-1:0] cfg_addr_i,
+  /// Bit 13 clear: classification entry (the index below); set: cube5_compos word (bits 12:0);
+  /// with Shade = 1, bit 14 set: the gradient LUTs, texels and zero-gradient entry.
+  input  logic [gicube_sample_pkg::cfg_addr_w(Shade)-1:0] cfg_addr_i,
   /// r, g, b (8 each), a (12) for a classification entry; the cube5_compos word in bits 12:0.
   input  logic [gicube_sample_pkg::CfgDataW-1:0] cfg_data_i
 );
@@ -59,16 +69,21 @@ module gicube_sample #(
   localparam int unsigned ColorW    = gicube_sample_pkg::ColorW;
   localparam int unsigned AlphaW    = gicube_sample_pkg::AlphaW;
   localparam int unsigned CfgAW     = gicube_sample_pkg::CfgAddrW;
-  localparam int unsigned InW       = gicube_sample_pkg::in_w(VoxelW);
+  localparam int unsigned InW       = gicube_sample_pkg::in_w(VoxelW)
+                                      + gicube_sample_pkg::shade_in_w(Shade, GradIdxW, TagW);
+  localparam int unsigned CfgPortAW = gicube_sample_pkg::cfg_addr_w(Shade);
   localparam int unsigned SampleW   = VoxelW + FracW;
   localparam int unsigned ClassIdxW = gicube_sample_pkg::class_idx_w(VoxelW);
 
-  // cube5_shader: only its classification table is used; the reflectance map is the smallest the
-  // unit allows (its divider sets the latency: div_stages(1, 1) + 9 = 12 stages).
-  localparam int unsigned RmLog2    = 1;
-  localparam int unsigned RmFracW   = 1;
-  localparam int unsigned DiffW     = 2;
-  localparam int unsigned SpecW     = 1;
+  // cube5_shader: unlit (Shade = 0), only its classification table is used and the reflectance
+  // map is the smallest the unit allows (its divider sets the latency: div_stages(1, 1) + 9 = 12
+  // stages); with Shade = 1 the map of its v12 widths, 8 x 8 cells a face (17 stages).
+  localparam int unsigned RmLog2    = Shade != 0 ? 3 : 1;
+  localparam int unsigned RmFracW   = Shade != 0 ? 4 : 1;
+  localparam int unsigned DiffW     = Shade != 0 ? 9 : 2;
+  localparam int unsigned SpecW     = Shade != 0 ? 8 : 1;
+  // The tag rides on the shader's magnitude input: the 2-D index of density bits over TagW.
+  localparam int unsigned MagIdxW   = TagW > 0 ? TagW : 1;
   localparam int unsigned ShGradW   = cube5_shader_pkg::grad_w(VoxelW, FracW);
   localparam int unsigned ShInW     = cube5_shader_pkg::in_w(VoxelW, FracW);
   localparam int unsigned ShCfgAW   = cube5_shader_pkg::cfg_addr_w(ClassIdxW, RmLog2);
@@ -82,8 +97,9 @@ module gicube_sample #(
   localparam int unsigned CoxelW    = cube5_compos_pkg::coxel_w(ColorW, AccW, ZW);
   localparam int unsigned CxInW     = cube5_compos_pkg::in_w(ColorW, AlphaW, AccW, ZW);
 
-  // The FIFOs hold at most the items in the density trilin (3) and the shader.
-  localparam int unsigned FifoAW    = $clog2(3 + ShStages);
+  // The FIFOs hold at most the items in the gradient LUT stage (Shade), the density trilin (3)
+  // and the shader.
+  localparam int unsigned FifoAW    = $clog2(Shade + 3 + ShStages);
   localparam int unsigned FifoDepth = 1 << FifoAW;
 
   // Input fields, LSB first.
@@ -108,7 +124,15 @@ module gicube_sample #(
   if (Jitter != 0 && WeightW != 8) begin : gen_bad_jitter_weight_w
     $fatal(1, "gicube_sample: Jitter = 1 needs gicube_sample_pkg::WeightW = 8");
   end
-  if (LightingBit != InW - 1) begin : gen_bad_packing
+  if (Shade > 1 || (Shade == 0 && TagW != 0)) begin : gen_bad_shade
+    $fatal(1, "gicube_sample: Shade must be 0 or 1, TagW 0 without it");
+  end
+  if (Shade != 0 && (GradIdxW < 2 || GradIdxW > 11 || TagW > 4 || TagW >= ClassIdxW))
+  begin : gen_bad_shade_w
+    $fatal(1, "gicube_sample: GradIdxW must be 2..11, TagW 0..4 and below ClassIdxW");
+  end
+  if (LightingBit + 1 + gicube_sample_pkg::shade_in_w(Shade, GradIdxW, TagW) != InW)
+  begin : gen_bad_packing
     $fatal(1, "gicube_sample: input packing and gicube_sample_pkg::in_w disagree");
   end
 
@@ -118,18 +142,39 @@ module gicube_sample #(
   // Configuration: the region bit routes a write to the shader's classification region or to
   // cube5_compos's word address
   // ---------------------------------------------------------------------------
-  logic                cfg_class, cfg_compos;
+  logic                cfg_low, cfg_class, cfg_compos, cfg_grad, cfg_texel, cfg_zero;
+  logic                sh_cfg_valid;
   logic [ShCfgAW-1:0]  sh_cfg_addr;
   logic [ShCfgDW-1:0]  sh_cfg_data;
 
   always_comb begin
-    cfg_class   = cfg_valid_i && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionClass
+    // With Shade = 1 the top address bit selects the shading tables.
+    cfg_low     = cfg_valid_i && !(Shade != 0 && cfg_addr_i[CfgPortAW-1]);
+    cfg_class   = cfg_low && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionClass
                   && cfg_addr_i[CfgAW-2:ClassIdxW] == '0;
     // The jitter tables' addresses above the compositor's registers are not its words.
-    cfg_compos  = cfg_valid_i && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionCompos
+    cfg_compos  = cfg_low && cfg_addr_i[CfgAW-1] == gicube_sample_pkg::RegionCompos
                   && !(Jitter != 0 && cfg_addr_i[CfgAW-2] && cfg_addr_i[CfgAW-3]);
-    // Region 0 (classification) of the shader's map at the entry's index.
-    sh_cfg_addr = {cube5_shader_pkg::RegionClass, (ShCfgAW-2)'(cfg_addr_i[ClassIdxW-1:0])};
+    // Shading: bits 13:12 pick the gradient LUTs (0), a texel (1, offset below 2^11) or the
+    // zero-gradient entry (2, offset 0).
+    cfg_grad    = 1'b0;
+    cfg_texel   = 1'b0;
+    cfg_zero    = 1'b0;
+    if (Shade != 0 && cfg_valid_i && cfg_addr_i[CfgPortAW-1]) begin
+      cfg_grad  = cfg_addr_i[13:12] == 2'd0 && cfg_addr_i[11:0] < 12'(1 << GradIdxW);
+      cfg_texel = cfg_addr_i[13:12] == 2'd1 && !cfg_addr_i[11];
+      cfg_zero  = cfg_addr_i[13:12] == 2'd2 && cfg_addr_i[11:0] == '0;
+    end
+    sh_cfg_valid = cfg_class || cfg_texel || cfg_zero;
+    // Region 0 (classification) of the shader's map at the entry's index; region 1 (texel) at
+    // its offset; region 2 (the zero-gradient entry).
+    if (cfg_texel) begin
+      sh_cfg_addr = {cube5_shader_pkg::RegionTexel, (ShCfgAW-2)'(cfg_addr_i[10:0])};
+    end else if (cfg_zero) begin
+      sh_cfg_addr = {cube5_shader_pkg::RegionZero, (ShCfgAW-2)'(0)};
+    end else begin
+      sh_cfg_addr = {cube5_shader_pkg::RegionClass, (ShCfgAW-2)'(cfg_addr_i[ClassIdxW-1:0])};
+    end
     sh_cfg_data = ShCfgDW'(cfg_data_i);
   end
 
@@ -139,6 +184,10 @@ module gicube_sample #(
   logic               tri_in_ready, tri_out_valid, tri_out_ready;
   logic [SampleW-1:0] tri_sample;
 
+  // The density trilin's input: the item itself, or with Shade = 1 the gradient LUT stage.
+  logic                             tri_in_valid;
+  logic [8*VoxelW+3*WeightW-1:0]    tri_in;
+
   cube5_trilin #(
     .VoxelW  (VoxelW),
     .WeightW (WeightW),
@@ -146,16 +195,185 @@ module gicube_sample #(
   ) u_trilin (
     .clk_i       (clk_i),
     .rst_ni      (rst_ni),
-    .in_valid_i  (in_valid_i),
+    .in_valid_i  (tri_in_valid),
     .in_ready_o  (tri_in_ready),
-    .in_data_i   ({cube5_pkg::TrilinModeLerp, in_data_i[0 +: 8*VoxelW + 3*WeightW]}),
+    .in_data_i   ({cube5_pkg::TrilinModeLerp, tri_in}),
     .out_valid_o (tri_out_valid),
     .out_ready_i (tri_out_ready),
     .out_data_o  (tri_sample)
   );
 
-  assign in_ready_o = tri_in_ready;
-  assign in_fire    = in_valid_i && tri_in_ready;
+  assign in_fire = in_valid_i && in_ready_o;
+
+  // ---------------------------------------------------------------------------
+  // Shade = 1, I (the gradient) and J (the tag): a stage that registers the item while the
+  // eight gradient LUTs decode the corners' indices ([378]); three trilins (S(10) components
+  // offset to unsigned: the sign bit flipped, and back) beside the density trilin, in lockstep
+  // with it (the same handshake); the nearest corner's tag and the shader's mode (unlit for a
+  // lighting ray or one with irradiance) in a FIFO read as the sample enters the shader.
+  // ---------------------------------------------------------------------------
+  localparam int unsigned GradCompW = gicube_sample_pkg::GradCompW;
+  localparam int unsigned GFracW    = VoxelW - 4 < FracW ? VoxelW - 4 : FracW;
+  localparam int unsigned GSampleW  = GradCompW + GFracW;
+
+  logic [3*ShGradW-1:0] sh_grad;
+  logic [ShGradW-1:0]   sh_mag;
+  logic                 sh_unlit, sh_tf2d;
+
+  if (Shade != 0) begin : gen_shade
+    localparam int unsigned GidxLsb = LightingBit + 1;
+    localparam int unsigned TagLsb  = GidxLsb + 8 * GradIdxW;
+    localparam int unsigned TagSW   = TagW > 0 ? TagW : 1;
+    localparam int unsigned MfAW    = 3;  // the tag FIFO: at most the stage and the trilin's 3
+
+    logic                          s0_en, s0_valid_q;
+    logic [8*VoxelW+3*WeightW-1:0] s0_q;
+    logic [8*3*GradCompW-1:0]      lut_q;
+
+    assign s0_en      = !s0_valid_q || tri_in_ready;
+    assign in_ready_o = s0_en;
+
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni) begin
+        s0_valid_q <= 1'b0;
+      end else if (s0_en) begin
+        s0_valid_q <= in_valid_i;
+      end
+    end
+
+    always_ff @(posedge clk_i) begin
+      if (s0_en) begin
+        s0_q <= in_data_i[0 +: 8*VoxelW + 3*WeightW];
+      end
+    end
+
+    assign tri_in_valid = s0_valid_q;
+    assign tri_in       = s0_q;
+
+    // Eight identical gradient LUTs, one per corner, written together.
+    for (genvar c = 0; c < 8; c++) begin : gen_grad_lut
+      cube5_shader_ram #(
+        .Depth (2**GradIdxW),
+        .Width (3*GradCompW),
+        .AddrW (GradIdxW)
+      ) u_grad_lut (
+        .clk_i   (clk_i),
+        .we_i    (cfg_grad),
+        .waddr_i (cfg_addr_i[GradIdxW-1:0]),
+        .wdata_i (cfg_data_i[3*GradCompW-1:0]),
+        .re_i    (s0_en),
+        .raddr_i (in_data_i[GidxLsb + c*GradIdxW +: GradIdxW]),
+        .rdata_o (lut_q[c*3*GradCompW +: 3*GradCompW])
+      );
+    end
+
+    for (genvar a = 0; a < 3; a++) begin : gen_grad_trilin
+      logic [8*GradCompW-1:0] corners;
+      logic [GSampleW-1:0]    g;
+      logic                   g_in_ready, g_out_valid;
+
+      // Offset binary: component + 2^9 is the two's complement with its sign bit flipped.
+      always_comb begin
+        for (int c = 0; c < 8; c++) begin
+          corners[c*GradCompW +: GradCompW] = lut_q[(3*c + a)*GradCompW +: GradCompW]
+                                              ^ (GradCompW'(1) << (GradCompW - 1));
+        end
+      end
+
+      cube5_trilin #(
+        .VoxelW  (GradCompW),
+        .WeightW (WeightW),
+        .FracW   (GFracW)
+      ) u_grad_trilin (
+        .clk_i       (clk_i),
+        .rst_ni      (rst_ni),
+        .in_valid_i  (s0_valid_q),
+        .in_ready_o  (g_in_ready),
+        .in_data_i   ({cube5_pkg::TrilinModeLerp, s0_q[8*VoxelW +: 3*WeightW], corners}),
+        .out_valid_o (g_out_valid),
+        .out_ready_i (tri_out_ready),
+        .out_data_o  (g)
+      );
+
+      // Back to two's complement (the offset 2^(9 + Fg) off: the top bit flipped), widened.
+      assign sh_grad[a*ShGradW +: ShGradW] =
+          ShGradW'($signed({~g[GSampleW-1], g[GSampleW-2:0]}));
+
+`ifndef SYNTHESIS
+      GradTrilinInStep: assert property (@(posedge clk_i) disable iff (!rst_ni)
+          g_in_ready == tri_in_ready && g_out_valid == tri_out_valid)
+        else $error("gicube_sample: a gradient trilin left the density trilin's step");
+`endif
+      logic unused_g;
+      assign unused_g = ^{g_in_ready, g_out_valid};
+    end
+
+    // The tag of the nearest corner (the weights' top bits) and the mode, written as the item
+    // enters, read as its sample enters the shader.
+    logic [WeightW-1:0] wx, wy, wz;
+    logic [2:0]         near;
+    logic [TagSW:0]     mf_wr, mf_rd;
+    logic [TagSW:0]     mf_mem [2**MfAW];
+    logic [MfAW-1:0]    mf_wp_q, mf_rp_q;
+    logic               sh_fire;
+
+    assign wx   = in_data_i[WeightsLsb +: WeightW];
+    assign wy   = in_data_i[WeightsLsb + WeightW +: WeightW];
+    assign wz   = in_data_i[WeightsLsb + 2*WeightW +: WeightW];
+    assign near = {wz[WeightW-1], wy[WeightW-1], wx[WeightW-1]};
+
+    if (TagW > 0) begin : gen_tag
+      assign mf_wr[TagSW-1:0] = in_data_i[TagLsb + 32'(near)*TagW +: TagSW];
+    end else begin : gen_no_tag
+      assign mf_wr[TagSW-1:0] = '0;
+      logic unused_near;
+      assign unused_near = ^near;
+    end
+    assign mf_wr[TagSW] = in_data_i[LightingBit] || in_data_i[IrrEnBit];
+    assign sh_fire      = tri_out_valid && tri_out_ready;
+
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni) begin
+        mf_wp_q <= '0;
+        mf_rp_q <= '0;
+      end else begin
+        if (in_fire) begin
+          mf_wp_q <= mf_wp_q + MfAW'(1);
+        end
+        if (sh_fire) begin
+          mf_rp_q <= mf_rp_q + MfAW'(1);
+        end
+      end
+    end
+
+    always_ff @(posedge clk_i) begin
+      if (in_fire) begin
+        mf_mem[mf_wp_q] <= mf_wr;
+      end
+    end
+
+    assign mf_rd    = mf_mem[mf_rp_q];
+    assign sh_mag   = ShGradW'(mf_rd[TagSW-1:0]);
+    assign sh_unlit = mf_rd[TagSW];
+    assign sh_tf2d  = TagW > 0;
+
+`ifndef SYNTHESIS
+    // The tag FIFO holds the items in the stage and the trilin, at most 4 of its 8.
+    TagFifoNeverOverflows: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        in_fire && !sh_fire |-> mf_wp_q + MfAW'(1) != mf_rp_q)
+      else $error("gicube_sample: tag FIFO overflow");
+`endif
+  end else begin : gen_no_shade
+    assign in_ready_o   = tri_in_ready;
+    assign tri_in_valid = in_valid_i;
+    assign tri_in       = in_data_i[0 +: 8*VoxelW + 3*WeightW];
+    assign sh_grad      = '0;
+    assign sh_mag       = '0;
+    assign sh_unlit     = 1'b1;
+    assign sh_tf2d      = 1'b0;
+    logic unused_grad;
+    assign unused_grad = cfg_grad;
+  end
 
   // ---------------------------------------------------------------------------
   // L (first half): the irradiance, U(2.14). Never stalled (its output goes to a FIFO that never
@@ -191,16 +409,19 @@ module gicube_sample #(
   logic [3*ColorW+AlphaW-1:0]        sh_rgba;
 
   always_comb begin
-    sh_in = '0;  // gradient and magnitude 0
-    sh_in[0 +: SampleW] = tri_sample;
-    sh_in[SampleW + 4*ShGradW + cube5_shader_pkg::ModeUnlit] = 1'b1;
+    sh_in = '0;
+    sh_in[0 +: SampleW]                                      = tri_sample;
+    sh_in[SampleW +: 3*ShGradW]                              = sh_grad;
+    sh_in[SampleW + 3*ShGradW +: ShGradW]                    = sh_mag;
+    sh_in[SampleW + 4*ShGradW + cube5_shader_pkg::ModeTf2d]  = sh_tf2d;
+    sh_in[SampleW + 4*ShGradW + cube5_shader_pkg::ModeUnlit] = sh_unlit;
   end
 
   cube5_shader #(
     .VoxelW    (VoxelW),
     .FracW     (FracW),
     .ClassIdxW (ClassIdxW),
-    .MagIdxW   (1),
+    .MagIdxW   (MagIdxW),
     .MagShift  (0),
     .ColorW    (ColorW),
     .AlphaW    (AlphaW),
@@ -217,7 +438,7 @@ module gicube_sample #(
     .out_valid_o (sh_out_valid),
     .out_ready_i (sh_out_ready),
     .out_data_o  (sh_rgba),
-    .cfg_valid_i (cfg_class),
+    .cfg_valid_i (sh_cfg_valid),
     .cfg_addr_i  (sh_cfg_addr),
     .cfg_data_i  (sh_cfg_data)
   );
@@ -378,9 +599,9 @@ module gicube_sample #(
     logic [LogW-1:0] log_q;
     logic [JitW-1:0] jit_q;
 
-    assign cfg_log = cfg_valid_i && cfg_addr_i[CfgAW-1:AlphaW] == 2'b01;
-    assign cfg_exp = cfg_valid_i && cfg_addr_i[CfgAW-1:ExpIdxW] == 4'b1110;
-    assign cfg_jit = cfg_valid_i && cfg_addr_i[CfgAW-1:JitIdxW] == 6'b111100;
+    assign cfg_log = cfg_low && cfg_addr_i[CfgAW-1:AlphaW] == 2'b01;
+    assign cfg_exp = cfg_low && cfg_addr_i[CfgAW-1:ExpIdxW] == 4'b1110;
+    assign cfg_jit = cfg_low && cfg_addr_i[CfgAW-1:JitIdxW] == 6'b111100;
 
     cube5_shader_ram #(
       .Depth (2**JitIdxW),

@@ -37,6 +37,20 @@ package gicube_sample_pkg;
   localparam int unsigned ExpIdxW  = 10;
   localparam int unsigned ExpDiffW = 7;
 
+  /// Shading (Shade = 1; contract "Gradient, tag and reflectance map"): the decoded gradient
+  /// component bits ([378]: 3 x 10), and the input bits the corners' gradient indices and tags
+  /// add after `lighting`.
+  localparam int unsigned GradCompW = 10;
+  function automatic int unsigned shade_in_w(int unsigned shade, int unsigned grad_idx_w,
+                                             int unsigned tag_w);
+    shade_in_w = shade * 8 * (grad_idx_w + tag_w);
+  endfunction
+
+  /// Shading's tables sit above the other regions: configuration address bit 14 (one more bit).
+  function automatic int unsigned cfg_addr_w(int unsigned shade);
+    cfg_addr_w = CfgAddrW + shade;
+  endfunction
+
   /// Bits of one output item: colour, opacity, terminated.
   localparam int unsigned OutW = 3 * ChanW + ChanW + 1;
 

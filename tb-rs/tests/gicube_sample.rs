@@ -6,11 +6,13 @@
 mod support;
 
 use cube5_model::camera::Camera;
-use cube5_model::units::cube5_shader::{ClassLut, Rgba};
+use cube5_model::units::cube5_shader::{
+    ClassLut, Phong, ReflectanceMap, Rgba, ShaderTables, Texel,
+};
 use cube5_model::units::gicube_processor::{shadow_scene, Processor, ProcessorConfig, Projection};
 use cube5_model::units::gicube_sample::{
-    random_class_lut, random_sample_in, shader_config, trace_samples, SampleIn, SampleRtlConfig,
-    Sampler, IRR_FRAC_W,
+    random_class_lut, random_sample_for, shader_config_for, trace_samples, GradLut, SampleIn,
+    SampleRtlConfig, Sampler, IRR_FRAC_W,
 };
 use cube5_tb::harness::{check_stream, StreamCheck};
 use cube5_tb::Variant;
@@ -22,7 +24,45 @@ use support::{
 };
 
 fn random_item(cfg: SampleRtlConfig) -> impl FnMut(&mut ChaCha8Rng) -> SampleIn {
-    move |rng| random_sample_in(rng, cfg.voxel_w)
+    move |rng| random_sample_for(rng, cfg)
+}
+
+/// The shading tables of a `Shade = 1` configuration, by kind: 0 a random reflectance map and
+/// gradient LUT, 1 Phong's two lights over the LUT of uniform directions, 2 every gradient zero
+/// (the zero-gradient entry alone), 3 a map whose texels are their own coordinates (every texel
+/// distinct) over random directions. `sampler` unchanged without shading.
+fn shaded(sampler: Sampler, cfg: SampleRtlConfig, kind: usize, rng: &mut ChaCha8Rng) -> Sampler {
+    let Some(sh) = cfg.shade_config() else {
+        return sampler;
+    };
+    let scfg = shader_config_for(cfg.voxel_w, Some(sh));
+    let (rmap, grad) = match kind % 4 {
+        0 => (
+            ShaderTables::random(&scfg, rng).unwrap().rmap,
+            GradLut::random(rng, sh.grad_idx_w).unwrap(),
+        ),
+        1 => (
+            ReflectanceMap::from_lights(&scfg, &Phong::two_lights()).unwrap(),
+            GradLut::directions(sh.grad_idx_w).unwrap(),
+        ),
+        2 => (
+            ShaderTables::random(&scfg, rng).unwrap().rmap,
+            GradLut::zero(sh.grad_idx_w).unwrap(),
+        ),
+        _ => (
+            ReflectanceMap::from_fn(
+                &scfg,
+                |face, i, j| Texel {
+                    d: ((face * 81 + j * 9 + i) % 512) as u32,
+                    sp: ((face * 37 + i * 9 + j) % 256) as u32,
+                },
+                Texel { d: 511, sp: 255 },
+            )
+            .unwrap(),
+            GradLut::random(rng, sh.grad_idx_w).unwrap(),
+        ),
+    };
+    sampler.with_shading(rmap, grad).unwrap()
 }
 
 /// Items in flight that a reset may drop: the pipeline's stages plus the handshake's slack.
@@ -43,7 +83,8 @@ fn random_sampler(rng: &mut ChaCha8Rng, cfg: SampleRtlConfig) -> Sampler {
         _ => Some(rng.random_range(3000..=4096)),
     };
     let class = random_class_lut(rng, cfg.voxel_w).unwrap();
-    Sampler::new(cfg.sample_config(step, et), class).unwrap()
+    let s = Sampler::new(cfg.sample_config(step, et), class).unwrap();
+    shaded(s, cfg, 0, rng)
 }
 
 /// `must_match` with `gold`'s tables loaded into the RTL first.
@@ -111,7 +152,8 @@ fn a_full_pipeline_under_heavy_back_pressure() {
 /// index's bits (so every index bit reaches the output), with `dr` at 16 and 1024 and the
 /// threshold at 1, 4096 or off.
 fn extreme_samplers(cfg: SampleRtlConfig) -> Vec<Sampler> {
-    let scfg = shader_config(cfg.voxel_w);
+    let scfg = shader_config_for(cfg.voxel_w, cfg.shade_config());
+    let mut rng = ChaCha8Rng::seed_from_u64(seed(1625));
     let luts: [fn(usize) -> Rgba; 3] = [
         |_| Rgba {
             r: 255,
@@ -137,7 +179,9 @@ fn extreme_samplers(cfg: SampleRtlConfig) -> Vec<Sampler> {
         for (step, et) in [(16, None), (1024, Some(1)), (256, Some(4096)), (1024, None)] {
             if k == 2 || step == 1024 || et.is_none() {
                 let class = ClassLut::from_fn(&scfg, f).unwrap();
-                out.push(Sampler::new(cfg.sample_config(step, et), class).unwrap());
+                let s = Sampler::new(cfg.sample_config(step, et), class).unwrap();
+                let kind = out.len();
+                out.push(shaded(s, cfg, kind, &mut rng));
             }
         }
     }
@@ -146,9 +190,12 @@ fn extreme_samplers(cfg: SampleRtlConfig) -> Vec<Sampler> {
 
 /// Directed items: corners all 0, all max, alternating, each alone at max; weights 0, 128, 255;
 /// the irradiance absent, 0, 1.0, the largest, one corner alone; the packet's colour and opacity
-/// 0, 4095 and next to the threshold; rendering and lighting.
+/// 0, 4095 and next to the threshold; rendering and lighting; with shading the corners' gradient
+/// indices all 0, all the largest, or distinct, and their tags distinct.
 fn directed_items(cfg: SampleRtlConfig) -> Vec<SampleIn> {
     let vmax = (1u32 << cfg.voxel_w) - 1;
+    let imax = (1u32 << cfg.grad_idx_w) - 1;
+    let tmask = (1u32 << cfg.tag_w) - 1;
     let mut corner_sets: Vec<[u32; 8]> = vec![
         [0; 8],
         [vmax; 8],
@@ -193,6 +240,11 @@ fn directed_items(cfg: SampleRtlConfig) -> Vec<SampleIn> {
             for (ii, &irr) in irrs.iter().enumerate() {
                 let (color, opacity) = packets[(vi + wi + ii) % packets.len()];
                 for lighting in [false, true] {
+                    let grad_idx = match (vi + ii) % 3 {
+                        0 => [0; 8],
+                        1 => [imax; 8],
+                        _ => std::array::from_fn(|c| (c as u32 * (vi as u32 + 3) + 1) & imax),
+                    };
                     items.push(SampleIn {
                         voxels,
                         weights,
@@ -200,6 +252,8 @@ fn directed_items(cfg: SampleRtlConfig) -> Vec<SampleIn> {
                         color,
                         opacity,
                         lighting,
+                        grad_idx: if cfg.shade != 0 { grad_idx } else { [0; 8] },
+                        tags: std::array::from_fn(|c| (c as u32 + wi as u32) & tmask),
                     });
                 }
             }
@@ -299,6 +353,60 @@ fn a_model_with_another_jitter_is_caught() {
     assert!(ran > 0, "a jitter configuration");
 }
 
+/// The scoreboard bites on the shading: a `Shade = 1` configuration's RTL loaded with one
+/// gradient LUT against a model with another (every entry's x component negated), and against a
+/// model whose reflectance map differs, is caught.
+#[test]
+fn a_model_with_another_gradient_or_map_is_caught() {
+    let mut ran = 0;
+    for (variant, cfg) in configs::<SampleRtlConfig>() {
+        let Some(sh) = cfg.shade_config() else {
+            continue;
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(seed(1654));
+        let class = random_class_lut(&mut rng, cfg.voxel_w).unwrap();
+        let base = Sampler::new(cfg.sample_config(300, None), class).unwrap();
+        let rtl = shaded(base.clone(), cfg, 1, &mut rng);
+        let scfg = shader_config_for(cfg.voxel_w, Some(sh));
+        let good = ReflectanceMap::from_lights(&scfg, &Phong::two_lights()).unwrap();
+        let dirs = GradLut::directions(sh.grad_idx_w).unwrap();
+        let mirrored = GradLut::from_fn(sh.grad_idx_w, |i| {
+            let e = dirs.entries()[i];
+            [-e[0].max(-511), e[1], e[2]]
+        })
+        .unwrap();
+        let dark =
+            ReflectanceMap::from_fn(&scfg, |_, _, _| Texel::default(), Texel::default()).unwrap();
+        for (what, mut other) in [
+            (
+                "a mirrored gradient",
+                base.clone().with_shading(good, mirrored).unwrap(),
+            ),
+            (
+                "a dark map",
+                base.clone().with_shading(dark, dirs.clone()).unwrap(),
+            ),
+        ] {
+            let mut check = check_for(
+                &rtl,
+                StreamCheck::new(seed(1655), 5_000).with_traffic(0.1, 0.1),
+            );
+            check.waveform_on_mismatch = false;
+            let err = expect_mismatch(
+                check_stream(variant, cfg, &mut other, &mut random_item(cfg), &check),
+                what,
+            );
+            assert!(
+                err.item < 200,
+                "{variant}: {what} caught at item {}",
+                err.item
+            );
+        }
+        ran += 1;
+    }
+    assert!(ran > 0, "a shading configuration");
+}
+
 /// Tables survive a reset: loaded once, a reset in the first batch, the rest still matches (the
 /// long runs above reset too; this one resets before most items).
 #[test]
@@ -350,8 +458,8 @@ fn processor_gi_frame_sample_traffic_replays_on_the_rtl() {
     );
     let mut ran = 0;
     for (variant, cfg) in configs::<SampleRtlConfig>() {
-        // The processor's traffic is unjittered (ProcessorConfig::jitter off).
-        if cfg.voxel_w != vol.bits || cfg.jitter != 0 {
+        // The processor's traffic is unjittered and unshaded (ProcessorConfig::jitter off).
+        if cfg.voxel_w != vol.bits || cfg.jitter != 0 || cfg.shade != 0 {
             continue;
         }
         let check = check_for(

@@ -523,6 +523,7 @@ impl Processor {
                 step: cfg.step,
                 et_threshold: cfg.et_threshold,
                 jitter: cfg.jitter,
+                shade: None,
             },
             class,
         )?;
@@ -733,6 +734,8 @@ impl Processor {
             color: ray.color,
             opacity: ray.opacity,
             lighting,
+            grad_idx: [0; 8],
+            tags: [0; 8],
         });
         ray.color = out.color;
         ray.opacity = out.opacity;

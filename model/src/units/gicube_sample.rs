@@ -46,6 +46,150 @@ pub struct SampleConfig {
     /// Jitter ([353], [380]): each sample's opacity is corrected for a step `r dr`, `r` in
     /// `[1/2, 1)` from the random LUT at the mangled position bits ([`Jitter`]); off: `r = 1`.
     pub jitter: bool,
+    /// Shading by reflectance map with the gradient of the gradient LUT and the nearest tag
+    /// ([352], [378], [379], [383]; contract *Gradient, tag and reflectance map*); `None`: unlit.
+    pub shade: Option<ShadeConfig>,
+}
+
+/// The widths of the shaded datapath (`Shade = 1`): the gradient index and the tag.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ShadeConfig {
+    /// Bits of a voxel's gradient index, 2..=11 (the patent's 11): `2^GradIdxW` LUT entries.
+    pub grad_idx_w: u32,
+    /// Bits of a voxel's tag, 0..=4 and below the classification index bits; 0: no tag.
+    pub tag_w: u32,
+}
+
+/// Bits of one decoded gradient component, two's complement ([378]: three 10-bit components).
+pub const GRAD_COMP_W: u32 = 10;
+/// The largest gradient index width ([378]) and tag width.
+pub const GRAD_IDX_W_MAX: u32 = 11;
+pub const TAG_W_MAX: u32 = 4;
+
+impl ShadeConfig {
+    pub fn validate(&self, voxel_w: u32) -> Result<()> {
+        let class_idx_w = shader_config(voxel_w).class_idx_w;
+        if !(2..=GRAD_IDX_W_MAX).contains(&self.grad_idx_w)
+            || self.tag_w > TAG_W_MAX
+            || self.tag_w >= class_idx_w
+        {
+            return Err(ModelError::Config(format!(
+                "gicube_sample: GradIdxW {} outside 2..={GRAD_IDX_W_MAX} or TagW {} outside \
+                 0..={} (below ClassIdxW {class_idx_w})",
+                self.grad_idx_w,
+                self.tag_w,
+                TAG_W_MAX.min(class_idx_w - 1)
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Fraction bits of the interpolated gradient, `min(4, VoxelW - 4)`: the `S(10.Fg)` components
+/// fit the shader's `VoxelW + 6`-bit gradient inputs.
+pub fn grad_frac_w(voxel_w: u32) -> u32 {
+    SAMPLE_FRAC_W.min(voxel_w.saturating_sub(4))
+}
+
+/// The corner nearest the sample ([352], [379]: the tag is zero-order interpolated): bit `a` of
+/// the corner is the top bit of axis `a`'s weight (`w >= 1/2`).
+pub fn nearest_corner(weights: [u32; 3]) -> usize {
+    (0..3).fold(0, |c, a| {
+        c | (((weights[a] >> (POS_FRAC_W - 1)) & 1) as usize) << a
+    })
+}
+
+/// The gradient LUT ([378]): `2^GradIdxW` entries of three `S(10)` components, the decoding of a
+/// voxel's gradient index; loaded by the host (eight identical copies in the RTL).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GradLut {
+    idx_w: u32,
+    entries: Vec<[i32; 3]>,
+}
+
+impl GradLut {
+    /// Entry `i` is `f(i)`; every component in `-512..=511`.
+    pub fn from_fn(idx_w: u32, f: impl FnMut(usize) -> [i32; 3]) -> Result<Self> {
+        let entries: Vec<[i32; 3]> = (0..1usize << idx_w.min(GRAD_IDX_W_MAX)).map(f).collect();
+        let half = 1i32 << (GRAD_COMP_W - 1);
+        if !(2..=GRAD_IDX_W_MAX).contains(&idx_w)
+            || entries
+                .iter()
+                .flatten()
+                .any(|&g| !(-half..half).contains(&g))
+        {
+            return Err(ModelError::Config(format!(
+                "gicube_sample: a gradient LUT of {idx_w} index bits with components in \
+                 -{half}..{half}"
+            )));
+        }
+        Ok(Self { idx_w, entries })
+    }
+
+    /// Every entry zero (every gradient zero: the reflectance map's zero-gradient entry).
+    pub fn zero(idx_w: u32) -> Result<Self> {
+        Self::from_fn(idx_w, |_| [0; 3])
+    }
+
+    /// Quantized directions for a host that bins its gradients ([352]): entry 0 is the zero
+    /// gradient, entries `1..2^GradIdxW` are the points of a Fibonacci sphere (uniform
+    /// directions), each component `511` times the unit vector's, rounded to nearest.
+    pub fn directions(idx_w: u32) -> Result<Self> {
+        let n = ((1usize << idx_w.min(GRAD_IDX_W_MAX)) - 1) as f64;
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        Self::from_fn(idx_w, |i| {
+            if i == 0 {
+                return [0; 3];
+            }
+            let k = (i - 1) as f64;
+            let z = 1.0 - 2.0 * (k + 0.5) / n;
+            let r = (1.0 - z * z).sqrt();
+            let phi = golden * k;
+            [r * phi.cos(), r * phi.sin(), z].map(|v| (v * 511.0).round() as i32)
+        })
+    }
+
+    /// The index whose direction is nearest `g` (largest cosine); 0 for the zero vector.
+    pub fn index_of(&self, g: [f64; 3]) -> u32 {
+        if g == [0.0; 3] {
+            return 0;
+        }
+        let cos = |e: &[i32; 3]| {
+            let len = e.iter().map(|&c| f64::from(c).powi(2)).sum::<f64>().sqrt();
+            if len == 0.0 {
+                return f64::NEG_INFINITY;
+            }
+            (0..3).map(|a| f64::from(e[a]) * g[a]).sum::<f64>() / len
+        };
+        (0..self.entries.len())
+            .max_by(|&a, &b| cos(&self.entries[a]).total_cmp(&cos(&self.entries[b])))
+            .unwrap_or(0) as u32
+    }
+
+    /// Random entries (one in eight zero, else every component uniform) for tests.
+    pub fn random(rng: &mut impl rand::Rng, idx_w: u32) -> Result<Self> {
+        let half = 1i32 << (GRAD_COMP_W - 1);
+        Self::from_fn(idx_w, |_| {
+            if rng.random_range(0..8) == 0 {
+                [0; 3]
+            } else {
+                std::array::from_fn(|_| rng.random_range(-half..half))
+            }
+        })
+    }
+
+    pub fn idx_w(&self) -> u32 {
+        self.idx_w
+    }
+
+    pub fn entries(&self) -> &[[i32; 3]] {
+        &self.entries
+    }
+
+    /// The entry of index `i` (its low `GradIdxW` bits: the field's width).
+    pub fn entry(&self, i: u32) -> [i32; 3] {
+        self.entries[(i & ((1 << self.idx_w) - 1)) as usize]
+    }
 }
 
 /// One sample: the cell's eight voxels and weights, the packet's colour and opacity.
@@ -63,6 +207,10 @@ pub struct SampleIn {
     pub opacity: u16,
     /// A lighting ray: its colour is its energy and is not composited (`rgb = 0`, colour kept).
     pub lighting: bool,
+    /// The corners' gradient indices (`GradIdxW` bits each; read only with shading).
+    pub grad_idx: [u32; 8],
+    /// The corners' tags (`TagW` bits each; read only with shading and `TagW > 0`).
+    pub tags: [u32; 8],
 }
 
 /// What the sample did to the packet.
@@ -85,6 +233,8 @@ pub struct Sampler {
     shader: Shader,
     compos: Compos,
     jitter: Option<Jitter>,
+    grad_trilin: Trilin,
+    grad: Option<GradLut>,
 }
 
 fn unlit() -> ShaderMode {
@@ -103,6 +253,21 @@ pub fn shader_config(voxel_w: u32) -> ShaderConfig {
         class_idx_w: 12.min(voxel_w + SAMPLE_FRAC_W),
         mag_shift: 10.min(voxel_w + 1 + SAMPLE_FRAC_W),
         ..ShaderConfig::DEFAULT
+    }
+}
+
+/// The classification and reflectance map of a datapath with `shade`: [`shader_config`], and with
+/// a tag the 2-D index of density bits over `TagW` tag bits (the shader's magnitude input
+/// carries the tag: `MagIdxW = TagW`, `MagShift = 0`).
+pub fn shader_config_for(voxel_w: u32, shade: Option<ShadeConfig>) -> ShaderConfig {
+    let base = shader_config(voxel_w);
+    match shade {
+        Some(s) if s.tag_w > 0 => ShaderConfig {
+            mag_idx_w: s.tag_w,
+            mag_shift: 0,
+            ..base
+        },
+        _ => base,
     }
 }
 
@@ -237,7 +402,10 @@ impl Sampler {
     /// [`shader_config`]`(cfg.voxel_w)`).
     pub fn new(cfg: SampleConfig, class: ClassLut) -> Result<Self> {
         let trilin = Trilin::new(TrilinConfig::new(cfg.voxel_w, POS_FRAC_W, SAMPLE_FRAC_W)?)?;
-        let scfg = shader_config(cfg.voxel_w);
+        if let Some(sh) = cfg.shade {
+            sh.validate(cfg.voxel_w)?;
+        }
+        let scfg = shader_config_for(cfg.voxel_w, cfg.shade);
         let rmap = ReflectanceMap::from_fn(&scfg, |_, _, _| Texel::default(), Texel::default())?;
         let shader = Shader::new(scfg, ShaderTables { class, rmap })?;
         let ccfg = compos_config();
@@ -259,7 +427,37 @@ impl Sampler {
             shader,
             compos: Compos::new(ccfg, lut, regs)?,
             jitter: cfg.jitter.then(|| Jitter::new(cfg.step)),
+            grad_trilin: Trilin::new(TrilinConfig::new(
+                GRAD_COMP_W,
+                POS_FRAC_W,
+                grad_frac_w(cfg.voxel_w),
+            )?)?,
+            grad: cfg.shade.map(|s| GradLut::zero(s.grad_idx_w)).transpose()?,
         })
+    }
+
+    /// The shading tables of a datapath with `shade`: the reflectance map (built for
+    /// [`shader_config_for`]) and the gradient LUT (of `GradIdxW` index bits).
+    pub fn with_shading(mut self, rmap: ReflectanceMap, grad: GradLut) -> Result<Self> {
+        match self.cfg.shade {
+            Some(s) if s.grad_idx_w == grad.idx_w => {}
+            _ => {
+                return Err(ModelError::Config(
+                    "gicube_sample: shading tables for a datapath without them or of another \
+                     GradIdxW"
+                        .into(),
+                ))
+            }
+        }
+        let class = self.shader.tables().class.clone();
+        self.shader = Shader::new(self.shader.config(), ShaderTables { class, rmap })?;
+        self.grad = Some(grad);
+        Ok(self)
+    }
+
+    /// The gradient LUT (shading on).
+    pub fn grad_lut(&self) -> Option<&GradLut> {
+        self.grad.as_ref()
     }
 
     pub fn config(&self) -> SampleConfig {
@@ -282,18 +480,74 @@ impl Sampler {
         })
     }
 
-    /// Rules 1 and 2: the tri-linear density sample's classification entry.
-    fn classified(&self, it: &SampleIn) -> crate::units::cube5_shader::Rgba {
-        let s = self.trilin.sample(&TrilinIn {
+    /// The shader's item: rule 1's density sample; with shading, rule 1's gradient (S(10.Fg)),
+    /// the nearest corner's tag as the magnitude (the 2-D index) and the mode: lit for a
+    /// rendering ray without irradiance, unlit otherwise.
+    fn shader_in(&self, it: &SampleIn) -> ShaderIn {
+        let sample = self.trilin.sample(&TrilinIn {
             voxels: it.voxels,
             weights: it.weights,
             mode: TrilinMode::Lerp,
         });
-        self.shader.classify(&ShaderIn {
-            sample: s,
-            grad: [0; 3],
-            mag: 0,
-            mode: unlit(),
+        match self.cfg.shade {
+            None => ShaderIn {
+                sample,
+                grad: [0; 3],
+                mag: 0,
+                mode: unlit(),
+            },
+            Some(sh) => ShaderIn {
+                sample,
+                grad: self.gradient(it),
+                mag: it.tags[nearest_corner(it.weights)] & ((1 << sh.tag_w) - 1),
+                mode: ShaderMode {
+                    tf2d: sh.tag_w > 0,
+                    unlit: it.lighting || it.irr.is_some(),
+                },
+            },
+        }
+    }
+
+    /// Rule 1's gradient (shading on; zero otherwise): per axis, the corners' LUT components
+    /// offset by `2^9` (unsigned), tri-linear at `VoxelW = 10`, `FracW = Fg`, the offset
+    /// `2^(9 + Fg)` taken off again: `S(10.Fg)`, exactly the signed tri-linear interpolation.
+    pub fn gradient(&self, it: &SampleIn) -> [i32; 3] {
+        let Some(lut) = &self.grad else {
+            return [0; 3];
+        };
+        let half = 1i32 << (GRAD_COMP_W - 1);
+        let fg = self.grad_trilin.config().frac_w;
+        std::array::from_fn(|a| {
+            let voxels = std::array::from_fn(|c| (lut.entry(it.grad_idx[c])[a] + half) as u32);
+            self.grad_trilin.sample(&TrilinIn {
+                voxels,
+                weights: it.weights,
+                mode: TrilinMode::Lerp,
+            }) as i32
+                - (half << fg)
+        })
+    }
+
+    /// The f64 gradient (shading on): the corners' LUT components tri-linear in reals, in
+    /// units of the LUT's integers.
+    pub fn gradient_f64(&self, it: &SampleIn) -> [f64; 3] {
+        let Some(lut) = &self.grad else {
+            return [0.0; 3];
+        };
+        let w = it
+            .weights
+            .map(|x| f64::from(x) / f64::from(1u32 << POS_FRAC_W));
+        std::array::from_fn(|a| {
+            (0..8).fold(0.0, |acc, c| {
+                let k = (0..3).fold(1.0, |k, ax| {
+                    k * if (c >> ax) & 1 == 1 {
+                        w[ax]
+                    } else {
+                        1.0 - w[ax]
+                    }
+                });
+                acc + k * f64::from(lut.entry(it.grad_idx[c])[a])
+            })
         })
     }
 
@@ -304,7 +558,8 @@ impl Sampler {
                 tr.record(self, it);
             }
         });
-        let e = self.classified(it);
+        // Rules 2 and 3's reflectance map: the classified entry, lit when the shader's mode is.
+        let e = self.shader.shade(&self.shader_in(it));
         let rgb = if it.lighting {
             [0; 3]
         } else if let Some(corners) = it.irr {
@@ -364,8 +619,12 @@ impl Sampler {
     /// 4096`; termination compares the input opacity with the threshold (the compositor's rule).
     /// With jitter the step is `r dr` with the datapath's factor `r` of the item's position bits.
     /// Returns red, green, blue, opacity on the packet's scale (`4096 = 1.0`), unsaturated.
+    /// With shading, a rendering ray without irradiance takes its colour from the shader's f64
+    /// reference (`Shader::reference_exact`: exact face coordinates, bilinear weights and
+    /// `c d + sp`) at the f64 gradient ([`Sampler::gradient_f64`]).
     pub fn reference(&self, it: &SampleIn) -> [f64; 4] {
-        let e = self.classified(it);
+        let si = self.shader_in(it);
+        let e = self.shader.classify(&si);
         let one = f64::from(CHAN_MAX + 1);
         let c_in = it.color.map(|c| f64::from(c) / one);
         let a_in = f64::from(it.opacity) / one;
@@ -388,13 +647,22 @@ impl Sampler {
             })
         });
         let ccfg = compos_config();
-        let rgb = [e.r, e.g, e.b].map(|c| {
+        let mut rgb = [e.r, e.g, e.b].map(|c| {
             if it.lighting {
                 0.0
             } else {
                 (color_value(c, &ccfg) * irr.unwrap_or(1.0)).min(1.0)
             }
         });
+        if !si.mode.unlit {
+            // The f64 gradient on a fine integer grid (2^16 per LUT unit: exact to 2^-17 of a
+            // unit, the direction is all the map reads).
+            let g = self
+                .gradient_f64(it)
+                .map(|v| (v * f64::from(1u32 << 16)).round() as i32);
+            let lit = self.shader.reference_exact(&ShaderIn { grad: g, ..si });
+            rgb = lit.map(|v| v / f64::from(ccfg.color_max()));
+        }
         let r = self
             .jitter
             .as_ref()
@@ -463,6 +731,11 @@ pub const CFG_REGION_COMPOS: u32 = 1 << 13;
 pub const CFG_LOG: u32 = 1 << 12;
 pub const CFG_EXP: u32 = CFG_REGION_COMPOS | 0x1800;
 pub const CFG_JIT: u32 = CFG_REGION_COMPOS | 0x1C00;
+/// Shading tables (`Shade = 1`, address bit 14): the gradient LUT at `CFG_GRAD + i`, the texels
+/// at `CFG_TEXEL +` the shader's region-1 offset, the zero-gradient entry at `CFG_ZERO`.
+pub const CFG_GRAD: u32 = 1 << 14;
+pub const CFG_TEXEL: u32 = CFG_GRAD | 1 << 12;
+pub const CFG_ZERO: u32 = CFG_GRAD | 2 << 12;
 
 impl Sampler {
     /// The writes that load this datapath's tables and registers into the RTL's configuration
@@ -506,6 +779,27 @@ impl Sampler {
             );
             writes.extend((0u32..).zip(&j.jit).map(|(i, &r)| (CFG_JIT + i, word(r))));
         }
+        if let Some(g) = &self.grad {
+            let mask = (1u64 << GRAD_COMP_W) - 1;
+            writes.extend((0u32..).zip(g.entries()).map(|(i, e)| {
+                let mut w = BitWriter::new();
+                for c in e {
+                    w.put(i64::from(*c) as u64 & mask, GRAD_COMP_W);
+                }
+                (CFG_GRAD + i, w.finish_padded(CFG_DATA_W))
+            }));
+            // The shader's texel and zero-gradient writes, moved from its regions 1 and 2.
+            let scfg = self.shader.config();
+            let region_shift = scfg.cfg_addr_w() - 2;
+            for (addr, data) in self.shader.tables().config_writes(&scfg) {
+                let off = addr & ((1 << region_shift) - 1);
+                match addr >> region_shift {
+                    1 => writes.push((CFG_TEXEL + off, data)),
+                    2 => writes.push((CFG_ZERO + off, data)),
+                    _ => {}
+                }
+            }
+        }
         writes
     }
 }
@@ -518,6 +812,12 @@ pub struct SampleRtlConfig {
     pub voxel_w: u32,
     /// 1: the jitter stage (random, log and power LUTs) before the compositor; 0: none.
     pub jitter: u32,
+    /// 1: the gradient LUTs, the gradient tri-linear and the reflectance map (shading); 0: unlit.
+    pub shade: u32,
+    /// Gradient index bits (`Shade = 1`), 2..=11.
+    pub grad_idx_w: u32,
+    /// Tag bits (`Shade = 1`), 0..=4; 0 with `Shade = 0`.
+    pub tag_w: u32,
 }
 
 impl SampleRtlConfig {
@@ -525,6 +825,9 @@ impl SampleRtlConfig {
     pub const DEFAULT: Self = Self {
         voxel_w: 8,
         jitter: 0,
+        shade: 0,
+        grad_idx_w: 11,
+        tag_w: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
@@ -540,14 +843,34 @@ impl SampleRtlConfig {
                 self.jitter
             )));
         }
-        Ok(())
+        if self.shade > 1 || (self.shade == 0 && self.tag_w != 0) {
+            return Err(ModelError::Config(format!(
+                "gicube_sample: Shade {} is not 0 or 1, or TagW {} without Shade",
+                self.shade, self.tag_w
+            )));
+        }
+        self.shade_config()
+            .unwrap_or(ShadeConfig {
+                grad_idx_w: self.grad_idx_w,
+                tag_w: 0,
+            })
+            .validate(self.voxel_w)
+    }
+
+    /// The shading widths (`Shade = 1`).
+    pub fn shade_config(&self) -> Option<ShadeConfig> {
+        (self.shade != 0).then_some(ShadeConfig {
+            grad_idx_w: self.grad_idx_w,
+            tag_w: self.tag_w,
+        })
     }
 
     /// Clocks from input to output: density trilin 3, shader 12 (its divider at the smallest
     /// reflectance map), shade 1, the jitter stage 1 (`Jitter = 1`), compositor 6 (contract,
-    /// *The RTL*).
+    /// *The RTL*); with `Shade = 1` the gradient LUT stage 1 and the shader 17 (its divider at
+    /// the 8 x 8-cell map): 6 more.
     pub fn latency(&self) -> u64 {
-        22 + u64::from(self.jitter)
+        22 + u64::from(self.jitter) + 6 * u64::from(self.shade)
     }
 
     /// The model's configuration of this voxel width with a sample distance and threshold.
@@ -557,6 +880,7 @@ impl SampleRtlConfig {
             step,
             et_threshold,
             jitter: self.jitter != 0,
+            shade: self.shade_config(),
         }
     }
 }
@@ -564,6 +888,9 @@ impl SampleRtlConfig {
 crate::unit_config!(SampleRtlConfig, "gicube_sample", DEFAULT, {
     "VoxelW" => voxel_w,
     "Jitter" => jitter,
+    "Shade" => shade,
+    "GradIdxW" => grad_idx_w,
+    "TagW" => tag_w,
 });
 
 /// Bits of one packet channel, `U(0.12)`.
@@ -576,7 +903,13 @@ impl StreamCodec for SampleRtlConfig {
     type Out = SampleOut;
 
     fn in_width(&self) -> u32 {
-        8 * self.voxel_w + 3 * POS_FRAC_W + 1 + 8 * IRR_W + 4 * CHAN_W + 1
+        8 * self.voxel_w
+            + 3 * POS_FRAC_W
+            + 1
+            + 8 * IRR_W
+            + 4 * CHAN_W
+            + 1
+            + self.shade * 8 * (self.grad_idx_w + self.tag_w)
     }
 
     fn out_width(&self) -> u32 {
@@ -600,6 +933,13 @@ impl StreamCodec for SampleRtlConfig {
         }
         w.put(u64::from(it.opacity), CHAN_W);
         w.put_bool(it.lighting);
+        if self.shade != 0 {
+            for (fields, width) in [(it.grad_idx, self.grad_idx_w), (it.tags, self.tag_w)] {
+                for v in fields {
+                    w.put(u64::from(v) & ((1 << width) - 1), width);
+                }
+            }
+        }
         w.finish(self.in_width())
     }
 
@@ -671,7 +1011,25 @@ pub fn random_sample_in(rng: &mut impl rand::Rng, voxel_w: u32) -> SampleIn {
         color: [chan(rng), chan(rng), chan(rng)],
         opacity: chan(rng),
         lighting: rng.random_bool(0.2),
+        grad_idx: [0; 8],
+        tags: [0; 8],
     }
+}
+
+/// [`random_sample_in`] for a datapath of `cfg`: with shading, the corners' gradient indices
+/// uniform, all one index, or 0 (the zero gradient) one time in eight, and the tags uniform.
+pub fn random_sample_for(rng: &mut impl rand::Rng, cfg: SampleRtlConfig) -> SampleIn {
+    let mut it = random_sample_in(rng, cfg.voxel_w);
+    if cfg.shade != 0 {
+        let imax = (1u32 << cfg.grad_idx_w) - 1;
+        it.grad_idx = match rng.random_range(0..8) {
+            0 => [0; 8],
+            1 => [rng.random_range(0..=imax); 8],
+            _ => std::array::from_fn(|_| rng.random_range(0..=imax)),
+        };
+        it.tags = std::array::from_fn(|_| rng.random_range(0..1u32 << cfg.tag_w));
+    }
+    it
 }
 
 #[cfg(test)]
@@ -685,6 +1043,7 @@ mod tests {
             step: 256,
             et_threshold: et,
             jitter: false,
+            shade: None,
         };
         let tf = TransferFunction::head_default();
         let class = ClassLut::from_transfer(&shader_config(8), &tf).unwrap();
@@ -699,6 +1058,8 @@ mod tests {
             color: [100, 200, 300],
             opacity,
             lighting: false,
+            grad_idx: [0; 8],
+            tags: [0; 8],
         }
     }
 
@@ -762,7 +1123,10 @@ mod tests {
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         for voxel_w in [4, 8, 12, 16] {
-            let rtl = SampleRtlConfig { voxel_w, jitter: 0 };
+            let rtl = SampleRtlConfig {
+                voxel_w,
+                ..SampleRtlConfig::DEFAULT
+            };
             rtl.validate().unwrap();
             assert_eq!(rtl.in_width(), 8 * voxel_w + 202);
             assert_eq!(rtl.out_width(), 49);
@@ -784,8 +1148,8 @@ mod tests {
         }
         // With jitter the three tables follow, each address written once.
         let rtl = SampleRtlConfig {
-            voxel_w: 8,
             jitter: 1,
+            ..SampleRtlConfig::DEFAULT
         };
         assert_eq!(rtl.latency(), 23);
         let class = random_class_lut(&mut rng, 8).unwrap();
@@ -799,7 +1163,7 @@ mod tests {
         assert_eq!(addrs.len(), w.len(), "no address written twice");
         assert!(SampleRtlConfig {
             voxel_w: 3,
-            jitter: 0
+            ..SampleRtlConfig::DEFAULT
         }
         .validate()
         .is_err());
@@ -826,7 +1190,10 @@ mod tests {
     fn one_step_against_f64(jitter: u32, seed: u64, extra: f64) {
         use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let rtl = SampleRtlConfig { voxel_w: 8, jitter };
+        let rtl = SampleRtlConfig {
+            jitter,
+            ..SampleRtlConfig::DEFAULT
+        };
         for step in [16, 200, 1024] {
             let class = random_class_lut(&mut rng, 8).unwrap();
             let s = Sampler::new(rtl.sample_config(step, None), class).unwrap();
@@ -915,5 +1282,188 @@ mod tests {
     #[test]
     fn one_jittered_step_is_within_its_bound_of_the_f64_reference() {
         one_step_against_f64(1, 11, JITTER_ALPHA_BOUND);
+    }
+
+    fn shaded_sampler(voxel_w: u32, tag_w: u32, step: u32) -> Sampler {
+        use crate::units::cube5_shader::Phong;
+        let shade = ShadeConfig {
+            grad_idx_w: 11,
+            tag_w,
+        };
+        let cfg = SampleConfig {
+            voxel_w,
+            step,
+            et_threshold: None,
+            jitter: false,
+            shade: Some(shade),
+        };
+        let scfg = shader_config_for(voxel_w, Some(shade));
+        let class = ClassLut::from_transfer(&scfg, &TransferFunction::head_default()).unwrap();
+        let rmap = ReflectanceMap::from_lights(&scfg, &Phong::two_lights()).unwrap();
+        Sampler::new(cfg, class)
+            .unwrap()
+            .with_shading(rmap, GradLut::directions(11).unwrap())
+            .unwrap()
+    }
+
+    #[test]
+    fn the_gradient_lut_of_directions_finds_its_own_entries() {
+        let lut = GradLut::directions(11).unwrap();
+        assert_eq!(lut.entries().len(), 2048);
+        assert_eq!(lut.index_of([0.0; 3]), 0);
+        for k in [1u32, 2, 100, 1000, 2047] {
+            let e = lut.entry(k).map(f64::from);
+            assert_eq!(lut.index_of(e), k, "entry {k}");
+        }
+        assert!(lut.entries().iter().skip(1).all(|e| e
+            .iter()
+            .map(|&c| f64::from(c).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            > 509.0));
+        assert!(GradLut::from_fn(4, |_| [512, 0, 0]).is_err());
+        assert!(GradLut::zero(12).is_err());
+    }
+
+    #[test]
+    fn the_gradient_is_the_signed_trilinear_interpolation_of_the_lut_entries() {
+        use rand::SeedableRng;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
+        for voxel_w in [4, 6, 8, 12] {
+            let rtl = SampleRtlConfig {
+                voxel_w,
+                shade: 1,
+                grad_idx_w: 6,
+                ..SampleRtlConfig::DEFAULT
+            };
+            let class = random_class_lut(&mut rng, voxel_w).unwrap();
+            let scfg = shader_config_for(voxel_w, rtl.shade_config());
+            let rmap = crate::units::cube5_shader::ShaderTables::random(&scfg, &mut rng)
+                .unwrap()
+                .rmap;
+            let s = Sampler::new(rtl.sample_config(256, None), class)
+                .unwrap()
+                .with_shading(rmap, GradLut::random(&mut rng, 6).unwrap())
+                .unwrap();
+            let fg = grad_frac_w(voxel_w);
+            for _ in 0..5000 {
+                let it = random_sample_for(&mut rng, rtl);
+                let g = s.gradient(&it);
+                let r = s.gradient_f64(&it);
+                for a in 0..3 {
+                    let err = f64::from(g[a]) - r[a] * f64::from(1u32 << fg);
+                    // Three roundings of half an output LSB (the trilin's bound).
+                    assert!(err.abs() <= 1.5, "{voxel_w}: {g:?} vs {r:?}");
+                }
+                if it.grad_idx.iter().all(|&i| i == it.grad_idx[0]) {
+                    let e = s.grad_lut().unwrap().entry(it.grad_idx[0]);
+                    assert_eq!(g, e.map(|c| c << fg), "one entry at every corner is exact");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_shaded_rendering_ray_is_lit_by_the_map_and_lit_or_lighting_rays_are_not() {
+        let s = shaded_sampler(8, 0, 256);
+        let plain = sampler(None);
+        let mut it = item(200, 0);
+        it.color = [0; 3];
+        // Every corner the direction of entry 5: the gradient is that entry, exactly.
+        it.grad_idx = [5; 8];
+        let si = s.shader_in(&it);
+        assert!(!si.mode.unlit);
+        let want = s.shader().shade(&si);
+        let o = s.sample(&it);
+        let e = plain.sample(&it);
+        assert_eq!(o.opacity, e.opacity, "shading changes no opacity");
+        assert_ne!(o.color, e.color, "the map lights the colour");
+        let lit_alone = Sampler::new(
+            SampleConfig {
+                shade: None,
+                ..s.config()
+            },
+            ClassLut::from_fn(&s.shader().config(), |_| want).unwrap(),
+        )
+        .unwrap()
+        .sample(&it);
+        assert_eq!(
+            o, lit_alone,
+            "the composited colour is the shader's lit entry"
+        );
+        // With irradiance, or as a lighting ray, the unshaded datapath's result.
+        let mut lit = it;
+        lit.irr = Some([3 << 13; 8]);
+        assert_eq!(s.sample(&lit), plain.sample(&lit));
+        let mut light = it;
+        light.lighting = true;
+        assert_eq!(s.sample(&light), plain.sample(&light));
+    }
+
+    #[test]
+    fn the_tag_of_the_nearest_corner_indexes_the_classification() {
+        let s = shaded_sampler(8, 2, 256);
+        let mut it = item(200, 0);
+        it.tags = [0, 1, 2, 3, 3, 2, 1, 0];
+        for (w, corner) in [
+            ([0, 0, 0], 0),
+            ([128, 0, 0], 1),
+            ([127, 255, 0], 2),
+            ([200, 200, 0], 3),
+            ([0, 0, 128], 4),
+            ([255, 0, 255], 5),
+            ([0, 255, 255], 6),
+            ([255, 255, 255], 7),
+        ] {
+            it.weights = w;
+            assert_eq!(nearest_corner(w), corner);
+            let si = s.shader_in(&it);
+            assert_eq!(si.mag, it.tags[corner]);
+            let idx = s.shader().class_index(&si);
+            assert_eq!(
+                idx & 3,
+                it.tags[corner] as usize,
+                "the tag's bits under the density"
+            );
+        }
+    }
+
+    /// One shaded step against the f64 reference (the gradient in reals, the map's exact face
+    /// coordinates and bilinear sums): the measured error, and a bound on it.
+    #[test]
+    fn one_shaded_step_against_its_f64_reference() {
+        use rand::SeedableRng;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
+        for voxel_w in [4, 12] {
+            let s = shaded_sampler(voxel_w, 0, 256);
+            let rtl = SampleRtlConfig {
+                voxel_w,
+                shade: 1,
+                ..SampleRtlConfig::DEFAULT
+            };
+            let (mut worst, mut sq, mut n) = (0.0f64, 0.0, 0u32);
+            for _ in 0..50_000 {
+                let mut it = random_sample_for(&mut rng, rtl);
+                it.lighting = false;
+                it.irr = None;
+                it.opacity = 0;
+                it.color = [0; 3];
+                let o = s.sample(&it);
+                let r = s.reference(&it);
+                for (&got, &want) in o.color.iter().zip(&r) {
+                    let e = f64::from(got) - want;
+                    worst = worst.max(e.abs());
+                    sq += e * e;
+                    n += 1;
+                }
+            }
+            let rms = (sq / f64::from(n)).sqrt();
+            eprintln!("shaded step, VoxelW {voxel_w}: max {worst:.2} RMS {rms:.3} (U(0.12) LSB)");
+            // An 8-bit colour code is 16 LSB of the packet: its rounding (half a code), the
+            // map's face-coordinate rounding and the gradient's (a step of `2^-Fg` turns a
+            // short gradient most) measured at most 1.6 codes (22.8 and 25.2 LSB at VoxelW 4
+            // and 12, RMS 1.5 and 1.6 LSB): bounded at 2 codes and a quarter code RMS.
+            assert!(rms < 4.0 && worst <= 32.0, "{voxel_w}: {worst} {rms}");
+        }
     }
 }
