@@ -44,7 +44,7 @@ module gicube_cache #(
   /// 1: deposits, dirty lines, write-back and flush (contract, "Splatting"); 0: read-only.
   parameter int unsigned Splat       = 0,
   /// Requests checked ahead of the data read (contract, "Prefetch"): 0 blocking, 1..8 the
-  /// prefetch queue's entries (Splat = 0 only).
+  /// prefetch queue's entries (with Splat: contract "Prefetch with splatting").
   parameter int unsigned Prefetch    = 0
 ) (
   input  logic clk_i,
@@ -132,8 +132,8 @@ module gicube_cache #(
   if (Splat > 1) begin : gen_bad_splat
     $fatal(1, "gicube_cache: Splat must be 0 or 1");
   end
-  if (Prefetch > 8 || (Prefetch != 0 && Splat != 0)) begin : gen_bad_prefetch
-    $fatal(1, "gicube_cache: Prefetch must be in 0..8, and 0 with Splat");
+  if (Prefetch > 8) begin : gen_bad_prefetch
+    $fatal(1, "gicube_cache: Prefetch must be in 0..8");
   end
 
   // ==============================================================================================
@@ -229,6 +229,22 @@ module gicube_cache #(
   logic [8*DataW-1:0] dep_beat;          // ... in its beat
   logic              dep_we;             // the deposit's words are written this cycle
 
+  // Prefetch with Splat: what the prefetching side drives into the shared splatting state (0
+  // for the blocking unit): the data stage's item into the request register (whose fields, the
+  // deposit's words and the write-back engine then serve it), dirty bits set and cleared, an
+  // evicted line for the engine, the flush's walk.
+  logic              pf_req_load;
+  logic [InW-1:0]    pf_req_data;
+  logic [8*Sets-1:0] pf_dirty_set, pf_dirty_clr;
+  logic              pf_wb_start;
+  logic [2:0]        pf_wb_p;
+  logic [SetW-1:0]   pf_wb_set;
+  logic [TagW-1:0]   pf_wb_tag;
+  logic              pf_fl, pf_fl_start;
+  logic              pf_eng_hold;        // the engine may not read the RAMs (data stage full)
+  // The data RAMs' write: a deposit's words (set and beat per bank) or a fill beat.
+  logic              dwr_dep;
+
   // RAM ports, per bank, and cube5_axi_rd's command: the blocking unit's or the prefetching
   // one's (the _r wires).
   logic [7:0]             tag_we_r, tag_re_r, dat_we_r, dat_re_r;
@@ -267,7 +283,8 @@ module gicube_cache #(
   logic [DataW+2:0]       beat_data;
   logic [2:0]             issue_p, fill_p;
 
-  assign in_fire  = in_valid_i && in_ready_b;
+  // The blocking state machine takes nothing with Prefetch (it is idle but for the flush walk).
+  assign in_fire  = in_valid_i && in_ready_b && Prefetch == 0;
   assign out_free = !out_valid_q || out_ready_i;
   // The held item with its op and energies (zero without Splat).
   logic [XyzW+2+8*IrrW-1:0] req_e;
@@ -341,7 +358,7 @@ module gicube_cache #(
   assign dep_we     = leave && is_dep;
   assign fl_done    = fl_idx_q[SlotW] && !eng_q && pend_q == '0;
   assign in_wb      = busy_q && state_q == StMiss && wbst_q;
-  assign in_fl      = busy_q && state_q == StMiss && flst_q;
+  assign in_fl      = (busy_q && state_q == StMiss && flst_q) || pf_fl;
   assign in_miss    = busy_q && state_q == StMiss && !wbst_q && !flst_q;
   assign fleave     = in_fl && fl_done && out_free;
   assign in_ready_b = !busy_q || (leave && !is_dep) || fleave;
@@ -432,6 +449,7 @@ module gicube_cache #(
       flst_d   = 1'b1;
       fl_idx_d = '0;
     end
+    if (pf_fl_start) fl_idx_d = '0;
     if (in_fl) begin
       if (stall_q != '1) stall_d = stall_q + StallW'(1);
       if (fl_rd) begin
@@ -502,6 +520,8 @@ module gicube_cache #(
       req_d    = in_data_i;
       stall_d  = '0;
     end
+    if (pf_req_load) req_d = pf_req_data;
+    dirty_d = (dirty_d & ~pf_dirty_clr) | pf_dirty_set;
   end
 
   always_comb begin
@@ -539,6 +559,12 @@ module gicube_cache #(
         end
       end
     end
+    if (pf_wb_start) begin
+      start     = 1'b1;
+      sp        = pf_wb_p;
+      eng_set_d = pf_wb_set;
+      eng_tag_d = pf_wb_tag;
+    end
     if (fl_tag_q) begin
       start     = 1'b1;
       sp        = fl_idx_q[SlotW-1:SetW];
@@ -575,7 +601,8 @@ module gicube_cache #(
 
   assign wr_cmd_valid = eng_q && !eng_cmd_q;
   // A beat is read when the RAM's output register is free or being taken.
-  assign rd_go        = eng_q && eng_rd_q != (BplW+1)'(Bpl) && (!rd_pend_q || wr_dat_ready);
+  assign rd_go        = eng_q && eng_rd_q != (BplW+1)'(Bpl) && (!rd_pend_q || wr_dat_ready)
+                        && !pf_eng_hold;
   assign rd_pend_d    = rd_go || (rd_pend_q && !wr_dat_ready);
   always_comb begin
     wr_dat_data = '0;
@@ -700,15 +727,32 @@ module gicube_cache #(
     assign fill_beat_r = beat_q;
     assign cmd_valid_r = cmd_valid;
     assign cmd_data_r  = cmd_data;
+    assign dwr_dep     = dep_we;
+    assign pf_req_load  = 1'b0;
+    assign pf_req_data  = '0;
+    assign pf_dirty_set = '0;
+    assign pf_dirty_clr = '0;
+    assign pf_wb_start  = 1'b0;
+    assign pf_wb_p      = '0;
+    assign pf_wb_set    = '0;
+    assign pf_wb_tag    = '0;
+    assign pf_fl        = 1'b0;
+    assign pf_fl_start  = 1'b0;
+    assign pf_eng_hold  = 1'b0;
   end
 
 
   // ==============================================================================================
-  // Prefetch > 0 (contract, "Prefetch"): the tags are checked ahead of the data read. A request
-  // is taken (its tags read), checked in request order (its misses allocated and queued for
+  // Prefetch > 0 (contract, "Prefetch"): the tags are checked ahead of the data read. An item
+  // is taken (its tags read), checked in item order (its misses allocated and queued for
   // cube5_axi_rd at once), and waits in the prefetch queue until every line allocated up to its
   // check is filled; then its words are read and it leaves. A check whose miss would evict a
-  // line that a queued request still reads waits until that request has read it.
+  // line that a queued item still reads waits until that item has read it.
+  // With Splat ("Prefetch with splatting"): the evicted dirty lines of a check are written back
+  // and answered before its misses are offered; a deposit adds and writes its words (and dirty
+  // bits) as it leaves the data stage, in a clock without a fill beat, and the next item's words
+  // are read the clock after; the write-back engine reads the banks while the data stage is
+  // empty; a flush waits until everything before it is done, walks, and leaves through the queue.
   // ==============================================================================================
 
   if (Prefetch != 0) begin : gen_prefetch
@@ -716,15 +760,17 @@ module gicube_cache #(
     localparam int unsigned PfW  = $clog2(Prefetch + 1);
     localparam int unsigned FqD  = 16;                // lines offered and not yet filled
     localparam int unsigned FqW  = $clog2(FqD);
-    localparam int unsigned EntW = XyzW + 8 + SeqW;   // a queued request: cell, hit mask, need
+    localparam int unsigned EntW = InW + 8 + SeqW;    // a queued item: item, hit mask, need
 
-    // The check stage (the request whose tags the RAMs' outputs hold).
+    // The check stage (the item whose tags the RAMs' outputs hold).
     logic             c_v_q;
+    logic [InW-1:0]   c_item_q;
     logic [XyzW-1:0]  c_xyz_q;
     // The prefetch queue, entry 0 the oldest.
     logic [EntW-1:0]  q_q [Prefetch];
     logic [PfW-1:0]   q_n_q;
-    // The data stage (the request whose words the RAMs' outputs hold) and the output.
+    // The data stage (the item whose words the RAMs' outputs hold; Splat: its item also in the
+    // request register) and the output.
     logic             d_v_q;
     logic [XyzW+7:0]  d_q;
     logic             o_v_q;
@@ -735,23 +781,36 @@ module gicube_cache #(
     logic [8*Sets-1:0] p_valid_q;
     logic [SeqW-1:0]  alloc_q, filled_q;
     logic [7:0]       iss_q;                           // the last check's misses not yet offered
+    logic [7:0]       iss_wb_q;                        // ... its evicted dirty lines not yet
+    logic [8*TagW-1:0] iss_vtag_q;                     //     written back, and their tags
     logic [XyzW-1:0]  iss_xyz_q;
     logic [3+SetW-1:0] fq_q [FqD];                    // bank and set of each line in flight
     logic [FqW:0]     fq_n_q;
     logic [FqW-1:0]   fq_rd_q, fq_wr_q;
     logic [BplW-1:0]  p_beat_q;
+    logic             fl_q;                            // Splat: the check's flush walks
+
+    assign c_xyz_q = c_item_q[XyzW-1:0];
 
     // The check.
-    logic [7:0]       c_hit, c_conf;
+    logic [7:0]       c_hit, c_conf, c_wb;
     logic [8*SetW-1:0] c_set;
     logic [8*TagW-1:0] c_tag;
-    logic             c_go, c_alloc, q_room, q_pop, q_push, d_go, o_free, take;
+    logic             c_go, c_alloc, c_flush, q_room, q_pop, q_push, d_go, o_free, take;
+    logic             d_dep, d_flush, drained;
     logic [3:0]       c_nhit;
     logic [SeqW-1:0]  c_need;
 
+    // The data stage's kind (Splat: the request register holds its item).
+    assign d_dep   = d_v_q && is_dep;
+    assign d_flush = d_v_q && is_flush;
+    logic [XyzW+2+8*IrrW-1:0] c_item_e;           // with its op (zero without Splat)
+    assign c_item_e = (XyzW+2+8*IrrW)'(c_item_q);
+    assign c_flush  = Splat != 0 && c_item_e[XyzW + 1];
+
     for (genvar p = 0; p < 8; p++) begin : gen_pf_bank
       logic [IdxW-1:0] idx_c, idx_in, idx_h;
-      logic [Sets-1:0] vb;
+      logic [Sets-1:0] vb, db;
       assign idx_c  = bank_index(InW'(c_xyz_q), p);
       assign idx_in = bank_index(in_data_i, p);
       assign idx_h  = bank_index(InW'(q_q[0][0 +: XyzW]), p);
@@ -759,9 +818,13 @@ module gicube_cache #(
       // The tag: the line's bits above the set's (0 when there are none).
       assign c_tag[p*TagW +: TagW] = TagW'({1'b0, idx_c[IdxW-1:LineLog]} >> SetW);
       assign vb = p_valid_q[p*Sets +: Sets];
+      assign db = dirty_q[p*Sets +: Sets];
       assign c_hit[p] = vb[c_set[p*SetW +: SetW]]
           && (tag_rdata[p*TagW +: TagW] == c_tag[p*TagW +: TagW]);
-      // A miss here evicts the set's line: held while a queued request has the same set.
+      // Splat: a miss whose set holds a dirty line evicts it (written back before the reads).
+      assign c_wb[p] = !c_hit[p] && db[c_set[p*SetW +: SetW]];
+      // A miss here evicts the set's line: held while a queued item has the same set, or (Splat)
+      // while the data stage's deposit into it has not written its words.
       always_comb begin
         logic [LineW-1:0] ln_e;
         c_conf[p] = 1'b0;
@@ -770,11 +833,22 @@ module gicube_cache #(
           if (PfW'(e) < q_n_q && set_of_line(ln_e) == c_set[p*SetW +: SetW])
             c_conf[p] = 1'b1;
         end
+        if (d_dep && set_of[p*SetW +: SetW] == c_set[p*SetW +: SetW]) c_conf[p] = 1'b1;
         c_conf[p] = c_conf[p] && !c_hit[p];
       end
-      assign tag_raddr_r[p*SetW +: SetW] = set_of_line(idx_in[IdxW-1:LineLog]);
-      assign dat_raddr_r[p*DAddrW +: DAddrW] = {set_of_line(idx_h[IdxW-1:LineLog]),
-                                                idx_h[VLog +: BplW]};
+      assign tag_raddr_r[p*SetW +: SetW] = fl_rd ? fl_idx_q[SetW-1:0]
+                                                 : set_of_line(idx_in[IdxW-1:LineLog]);
+      // The write-back engine reads its line's beats while the data stage is empty.
+      assign dat_raddr_r[p*DAddrW +: DAddrW] = rd_go ? {eng_set_q, eng_rd_q[BplW-1:0]}
+                                                     : {set_of_line(idx_h[IdxW-1:LineLog]),
+                                                        idx_h[VLog +: BplW]};
+      // Splat: a deposit leaving the data stage dirties its eight lines; an allocation cleans
+      // the sets it takes.
+      for (genvar s = 0; s < Sets; s++) begin : gen_pf_dirty
+        assign pf_dirty_set[p*Sets + s] = dwr_dep && set_of[p*SetW +: SetW] == SetW'(s);
+        assign pf_dirty_clr[p*Sets + s] = c_go && c_alloc && !c_hit[p]
+                                          && c_set[p*SetW +: SetW] == SetW'(s);
+      end
       logic unused_idx;
       assign unused_idx = ^{idx_in[LineLog-1:0], idx_h[VLog-1:0], idx_c[LineLog-1:0]};
     end
@@ -786,27 +860,42 @@ module gicube_cache #(
     // The head is ready when every line allocated up to its check is filled.
     logic [SeqW-1:0] h_need;
     logic            h_ready;
-    assign h_need  = q_q[0][XyzW + 8 +: SeqW];
+    assign h_need  = q_q[0][InW + 8 +: SeqW];
     assign h_ready = q_n_q != '0 && SeqW'(alloc_q - h_need) >= SeqW'(alloc_q - filled_q);
     assign o_free  = !o_v_q || out_ready_i;
-    assign d_go    = d_v_q && o_free;
-    assign q_pop   = h_ready && (!d_v_q || d_go);
+    // A deposit writes its words as it leaves the data stage, not in a cycle with a fill beat
+    // (one write port); the next item's words are read the cycle after (it sees them). The
+    // queue does not pop while the engine holds a line (it reads the RAMs).
+    assign d_go    = d_v_q && o_free && !(d_dep && beat_valid);
+    assign q_pop   = h_ready && !eng_q && (!d_v_q || (d_go && !d_dep));
     assign q_room  = q_n_q != PfW'(Prefetch) || q_pop;
-    assign c_alloc = c_hit != '1;
-    assign c_go    = c_v_q && q_room && (!c_alloc || (iss_q == '0 && c_conf == '0));
+    assign c_alloc = !c_flush && c_hit != '1;
+    // Splat: a flush walks once everything before it is done, and is queued when its walk is.
+    assign drained = q_n_q == '0 && !d_v_q && iss_q == '0 && iss_wb_q == '0 && !eng_q
+                     && pend_q == '0 && fq_n_q == '0;
+    assign c_go    = c_v_q && q_room
+                     && (c_flush ? fl_q && fl_done
+                                 : (!c_alloc || (iss_q == '0 && iss_wb_q == '0 && c_conf == '0)));
     assign q_push  = c_go;
-    assign c_need  = alloc_q + (SeqW'(4'd8) - SeqW'(c_nhit));
+    assign c_need  = alloc_q + (c_flush ? '0 : SeqW'(4'd8) - SeqW'(c_nhit));
     // Taken while the check is empty or leaves without writing tags (the next take reads them).
     assign take    = in_valid_i && (!c_v_q || (c_go && !c_alloc));
     assign in_ready_o = !c_v_q || (c_go && !c_alloc);
+    assign pf_fl_start = c_v_q && c_flush && !fl_q && drained;
+    assign pf_fl       = fl_q;
 
-    assign tag_re_r    = {8{take}};
+    assign tag_re_r    = {8{take || fl_rd}};
     assign tag_we_r    = (c_go && c_alloc) ? ~c_hit : 8'h00;
     assign tag_waddr_r = c_set;
     assign tag_wdata_r = c_tag;
     assign dat_re_r    = {8{q_pop}};
+    assign pf_eng_hold = d_v_q;
+    assign pf_req_load = q_pop;
+    assign pf_req_data = q_q[0][InW-1:0];
 
-    // The misses of the last allocating check, offered in bank order; fills in command order.
+    // The last allocating check's evicted dirty lines go to the write-back engine in bank order;
+    // its misses are offered (in bank order) once every write-back is answered. Fills in
+    // command order.
     logic [2:0]       iss_p;
     logic [IdxW-1:0]  iss_idx [8];
     logic [LineW-1:0] iss_line;
@@ -816,26 +905,38 @@ module gicube_cache #(
       assign iss_idx[p] = bank_index(InW'(iss_xyz_q), p);
     end
     assign iss_p = lowest(iss_q);
+    assign pf_wb_start = iss_wb_q != '0 && !eng_q;
+    assign pf_wb_p     = lowest(iss_wb_q);
     always_comb begin
-      iss_line = '0;
+      iss_line  = '0;
+      pf_wb_set = '0;
+      pf_wb_tag = '0;
       for (int unsigned p = 0; p < 8; p++) begin
         if (iss_p == 3'(p)) iss_line = iss_idx[p][IdxW-1:LineLog];
+        if (pf_wb_p == 3'(p)) begin
+          pf_wb_set = set_of_line(iss_idx[p][IdxW-1:LineLog]);
+          pf_wb_tag = iss_vtag_q[p*TagW +: TagW];
+        end
       end
     end
-    assign cmd_valid_r = iss_q != '0 && fq_n_q != (FqW+1)'(FqD);
+    assign cmd_valid_r = iss_q != '0 && fq_n_q != (FqW+1)'(FqD)
+                         && iss_wb_q == '0 && !eng_q && pend_q == '0;
     assign cmd_data_r  = {LenW'(Bpl), AddrW'({iss_p, iss_line, ZeroW'(0)})};
     assign fq_head     = fq_q[fq_rd_q];
     assign fill_last   = beat_valid && beat_data[DataW];
     always_comb begin
       dat_we_r = '0;
       if (beat_valid) dat_we_r[fq_head[SetW +: 3]] = 1'b1;
+      if (dwr_dep) dat_we_r = '1;
     end
+    assign dwr_dep     = d_go && d_dep;
     assign fill_set_r  = {8{fq_head[SetW-1:0]}};
     assign fill_beat_r = p_beat_q;
 
-    // The output: the data stage's voxels (corner c from bank c ^ parity), mask, counts, stall.
+    // The output: the data stage's voxels (corner c from bank c ^ parity; a deposit's after its
+    // addition; a flush's 0), mask, counts, stall.
     logic [8*WordW-1:0] d_word;
-    logic [3:0]         d_nhit;
+    logic [3:0]         d_nhit, d_nmiss;
     for (genvar p = 0; p < 8; p++) begin : gen_pf_word
       logic [IdxW-1:0]  idx_d;
       logic [DataW-1:0] bw;
@@ -843,13 +944,15 @@ module gicube_cache #(
       assign idx_d = bank_index(InW'(d_q[0 +: XyzW]), p);
       assign ws    = idx_d[0 +: VLog];
       assign bw    = dat_rdata[p*DataW +: DataW];
-      assign d_word[p*WordW +: WordW] = bw[ws*WordW +: WordW];
+      assign d_word[p*WordW +: WordW] = d_flush ? '0
+                                      : d_dep ? dep_word[p*WordW +: WordW] : bw[ws*WordW +: WordW];
       logic unused_d;
       assign unused_d = ^idx_d[IdxW-1:VLog];
     end
     always_comb begin
       d_nhit = '0;
       for (int unsigned p = 0; p < 8; p++) d_nhit = d_nhit + 4'(d_q[XyzW + p]);
+      d_nmiss = d_flush ? 4'd0 : 4'd8 - d_nhit;
     end
 
     always_ff @(posedge clk_i) begin
@@ -866,41 +969,49 @@ module gicube_cache #(
         alloc_q    <= '0;
         filled_q   <= '0;
         iss_q      <= '0;
+        iss_wb_q   <= '0;
         fq_n_q     <= '0;
         fq_rd_q    <= '0;
         fq_wr_q    <= '0;
         p_beat_q   <= '0;
+        fl_q       <= 1'b0;
       end else begin
         // Check stage.
         if (take) begin
-          c_v_q   <= 1'b1;
-          c_xyz_q <= in_data_i[XyzW-1:0];
+          c_v_q    <= 1'b1;
+          c_item_q <= in_data_i;
         end else if (c_go) begin
           c_v_q <= 1'b0;
         end
+        if (pf_fl_start) fl_q <= 1'b1;
+        if (c_go) fl_q <= 1'b0;
         if (c_go && c_alloc) begin
-          alloc_q   <= c_need;
-          iss_q     <= ~c_hit;
-          iss_xyz_q <= c_xyz_q;
+          alloc_q    <= c_need;
+          iss_q      <= ~c_hit;
+          iss_wb_q   <= Splat != 0 ? c_wb : 8'h00;
+          iss_vtag_q <= tag_rdata;
+          iss_xyz_q  <= c_xyz_q;
           for (int unsigned p = 0; p < 8; p++) begin
             if (!c_hit[p]) p_valid_q[p*Sets + 32'(c_set[p*SetW +: SetW])] <= 1'b1;
           end
         end
-        // The queue: pop shifts, push appends.
+        if (pf_wb_start) iss_wb_q[pf_wb_p] <= 1'b0;
+        // The queue: pop shifts, push appends (a flush with an empty mask).
         for (int unsigned e = 0; e < Prefetch; e++) begin
           if (q_pop && e + 1 < Prefetch) q_q[e] <= q_q[e + 1];
-          if (q_push && PfW'(e) == q_n_q - PfW'(q_pop)) q_q[e] <= {c_need, c_hit, c_xyz_q};
+          if (q_push && PfW'(e) == q_n_q - PfW'(q_pop))
+            q_q[e] <= {c_need, c_flush ? 8'h00 : c_hit, c_item_q};
         end
         q_n_q <= q_n_q + PfW'(q_push) - PfW'(q_pop);
         // Data stage.
         if (q_pop) begin
           d_v_q <= 1'b1;
-          d_q   <= q_q[0][XyzW+7:0];
+          d_q   <= {q_q[0][InW +: 8], q_q[0][0 +: XyzW]};
         end else if (d_go) begin
           d_v_q <= 1'b0;
         end
         // Output register; the stall counts the cycles it could take an item and none was ready
-        // while the unit held a request (contract, "Prefetch").
+        // while the unit held an item (contract, "Prefetch").
         if (o_v_q && out_ready_i) o_v_q <= 1'b0;
         if (d_go) begin
           o_v_q <= 1'b1;
@@ -909,9 +1020,9 @@ module gicube_cache #(
             o_q[c*WordW +: WordW] <= d_word[cp*WordW +: WordW];
           end
           o_q[8*WordW +: 8 + 2*CountW + StallW] <= {ost_q,
-              p_misses_q + (CountW'(4'd8) - CountW'(d_nhit)), p_hits_q + CountW'(d_nhit), d_q[XyzW +: 8]};
+              p_misses_q + CountW'(d_nmiss), p_hits_q + CountW'(d_nhit), d_q[XyzW +: 8]};
           p_hits_q   <= p_hits_q + CountW'(d_nhit);
-          p_misses_q <= p_misses_q + (CountW'(4'd8) - CountW'(d_nhit));
+          p_misses_q <= p_misses_q + CountW'(d_nmiss);
           ost_q      <= '0;
         end else if (o_free && (c_v_q || q_n_q != '0 || d_v_q) && ost_q != '1) begin
           ost_q <= ost_q + StallW'(1);
@@ -936,17 +1047,21 @@ module gicube_cache #(
 
     // The blocking unit's logic is unused here.
     logic unused_blocking;
-    assign unused_blocking = ^{in_ready_b, out_valid_q, out_data_q, tag_we, ram_re, fl_rd,
-                               tag_raddr, dat_we, dat_raddr, beat_q, cmd_valid, cmd_data,
-                               set_of, tag_of};
+    assign unused_blocking = ^{in_ready_b, out_valid_q, out_data_q, tag_we, ram_re, tag_raddr,
+                               dat_we, dat_raddr, beat_q, cmd_valid, cmd_data, tag_of};
 
 `ifndef SYNTHESIS
     // A fill beat has its line's destination; the line's last beat ends at beat Bpl - 1.
     PfFillQueued: assert property (@(posedge clk_i) disable iff (!rst_ni)
         beat_valid |-> fq_n_q != '0 && (beat_data[DataW] == (p_beat_q == BplW'(Bpl - 1))))
       else $error("gicube_cache: a fill beat with no line in flight");
+    // The engine never reads the RAMs under the data stage's words.
+    PfEngineAlone: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        !(rd_go && (q_pop || d_v_q)))
+      else $error("gicube_cache: the write-back engine read under the data stage");
 `endif
   end
+
 
   // ==============================================================================================
   // The eight banks: tags and words in block RAM (one write port, one registered read port)
@@ -974,8 +1089,9 @@ module gicube_cache #(
     ) u_words (
       .clk_i  (clk_i),
       .we_i   (dat_we_r[p]),
-      .waddr_i({fill_set_r[p*SetW +: SetW], dep_we ? idx_req_beat[p*BplW +: BplW] : fill_beat_r}),
-      .wdata_i(dep_we ? dep_beat[p*DataW +: DataW] : beat_data[DataW-1:0]),
+      .waddr_i(dwr_dep ? {set_of[p*SetW +: SetW], idx_req_beat[p*BplW +: BplW]}
+                       : {fill_set_r[p*SetW +: SetW], fill_beat_r}),
+      .wdata_i(dwr_dep ? dep_beat[p*DataW +: DataW] : beat_data[DataW-1:0]),
       .re_i   (dat_re_r[p] || (rd_go && eng_p_q == 3'(p))),
       .raddr_i(dat_raddr_r[p*DAddrW +: DAddrW]),
       .rdata_o(dat_rdata[p*DataW +: DataW])

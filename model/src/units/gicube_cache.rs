@@ -53,7 +53,8 @@ pub struct CacheConfig {
     /// 0: the read-only cache.
     pub splat: u32,
     /// Requests checked ahead of the data read (contract, *Prefetch*): 0 the blocking unit,
-    /// 1..=8 the prefetch queue's entries (`Splat = 0` only). Changes only the cycles.
+    /// 1..=8 the prefetch queue's entries (with `Splat`: *Prefetch with splatting*). Changes
+    /// only the cycles.
     pub prefetch: u32,
 }
 
@@ -135,9 +136,9 @@ impl CacheConfig {
         if self.splat > 1 {
             return bad(format!("Splat {} is not 0 or 1", self.splat));
         }
-        if self.prefetch > MAX_PREFETCH || (self.prefetch > 0 && self.splat == 1) {
+        if self.prefetch > MAX_PREFETCH {
             return bad(format!(
-                "Prefetch {} outside 0..={MAX_PREFETCH} (0 with Splat)",
+                "Prefetch {} outside 0..={MAX_PREFETCH}",
                 self.prefetch
             ));
         }
@@ -873,14 +874,17 @@ mod tests {
                 prefetch: 9,
                 ..SMALL
             },
-            CacheConfig {
-                prefetch: 1,
-                splat: 1,
-                ..SMALL
-            },
         ];
         CacheConfig {
             prefetch: 8,
+            ..SMALL
+        }
+        .validate()
+        .unwrap();
+        // Prefetch with Splat (contract, *Prefetch with splatting*).
+        CacheConfig {
+            prefetch: 2,
+            splat: 1,
             ..SMALL
         }
         .validate()

@@ -22,7 +22,7 @@ pub const DIM_W: u32 = 7;
 /// Bits of the packet's channels (`E`, the opacity).
 const CHAN_W: u32 = 12;
 /// The stages of the RTL pipeline.
-pub const LATENCY: u64 = 3;
+pub const LATENCY: u64 = 5;
 
 /// Operations of an item (the cache's `op`): 0 read, 1 deposit, 2 flush.
 pub const OP_READ: u32 = 0;
