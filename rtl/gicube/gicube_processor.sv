@@ -68,8 +68,8 @@ module gicube_processor #(
   parameter int unsigned Sets        = 32,
   /// Line reads in flight at most (gicube_cache's Outstanding).
   parameter int unsigned Outstanding = 8,
-  /// gicube_cache's Prefetch: requests whose tags are checked ahead of the data read, 0..8 (0
-  /// with Light: the splatting cache blocks).
+  /// gicube_cache's Prefetch: requests whose tags are checked ahead of the data read, 0..8 (with
+  /// Light too: the splatting cache prefetches since session 16).
   parameter int unsigned Prefetch    = 0,
   /// 1: lighting rays splat into the field in memory (32-bit words, the cache's Splat = 1, the
   /// AXI4 write channels, the flush); 0: direct volume rendering (the write channels idle).
@@ -144,7 +144,9 @@ module gicube_processor #(
   localparam int unsigned CellW    = 1 + 1 + 48 + 3 * PosFracW;
   // The cell FIFO covers the requests the cache holds (P + 3 with prefetch: CacheConfig::held_max)
   // and the one in the skid before it.
-  localparam int unsigned CellD    = (Light != 0) ? 8 : (1 << $clog2(Prefetch + 4));
+  // Light: five more in gicube_deposit (P + 3 + 1 + 5, a power of two; 8 without prefetch).
+  localparam int unsigned CellD    = (Light != 0) ? ((Prefetch == 0) ? 8 : (1 << $clog2(Prefetch + 9)))
+                                                : (1 << $clog2(Prefetch + 4));
   // 2 region bits over gicube_sample's address.
   localparam int unsigned CfgAW    = 2 + gicube_sample_pkg::CfgAddrW;
   localparam int unsigned SmInW    = gicube_sample_pkg::in_w(VoxelW);
@@ -585,7 +587,7 @@ module gicube_processor #(
   );
 
   // The cache holds two requests at most (the one at its check, its output register), the skid
-  // one; Light: three more in gicube_deposit.
+  // one; Light: five more in gicube_deposit.
   cube5_frame_fifo #(.Width(CellW), .Depth(CellD)) u_cell_fifo (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),

@@ -1541,7 +1541,7 @@ pub struct ProcessorRtlConfig {
     pub line_vox: u32,
     pub sets: u32,
     pub outstanding: u32,
-    /// The cache's `Prefetch` (requests checked ahead of the data read; 0 with `light`): clocks
+    /// The cache's `Prefetch` (requests checked ahead of the data read): clocks
     /// only, never a pixel or a count.
     pub prefetch: u32,
     /// 1: the lighting pass of GI (contract, *Splatting through the cache*): 32-bit words with
