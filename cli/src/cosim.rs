@@ -29,6 +29,9 @@ pub struct CosimArgs {
     /// Seed of the DUT's random initial state (randReset).
     #[arg(long, default_value_t = 1)]
     seed: u32,
+    /// `[gi]` scenes: how the test bench's AXI4 memory answers the GI-Cube processor.
+    #[arg(long, value_enum, default_value_t = crate::cosim_gi::MemoryKind::Ddr)]
+    memory: crate::cosim_gi::MemoryKind,
 }
 
 /// What a co-simulated frame showed.
@@ -39,7 +42,11 @@ pub struct CosimResult {
 pub fn run(args: CosimArgs) -> Result<()> {
     let (scene, origin) = crate::elaborate::load_valid(args.scene.as_deref())?;
     if scene.gi.is_some() {
-        bail!("{origin}: [gi]: the scene renders on the GI-Cube processor model, and there is no GI-Cube RTL yet to co-simulate (`cube5 render` renders it)");
+        // The GI-Cube block processor (gicube_processor), not cube5_frame.
+        if !crate::cosim_gi::run(&scene, &origin, &args.out_dir, args.seed, args.memory)? {
+            bail!("the RTL GI-Cube processor differs from the model (report above)");
+        }
+        return Ok(());
     }
     if let Some(p) = args.pipelines {
         if !FrameRtl::all().iter().any(|r| r.p == p && r.variant.built) {

@@ -13,6 +13,8 @@ macro_rules! say {
 mod bench;
 #[cfg(feature = "rtl")]
 mod cosim;
+#[cfg(feature = "rtl")]
+mod cosim_gi;
 mod elaborate;
 mod tradeoff;
 

@@ -1,7 +1,8 @@
 //! GI scenes (`[gi]`) on the command line: `cube5 render` runs them on the GI-Cube processor model
 //! (the plan line names it and gives the counts of both passes), `--compare` measures them against
-//! the processor's f64 reference, the light's shadow shows in the image, and the RTL paths refuse
-//! them in one line (there is no GI-Cube RTL yet).
+//! the processor's f64 reference, the light's shadow shows in the image; `cube5 cosim` runs them
+//! on the RTL block processor (`gicube_processor`) bit for bit, and `run.target = "rtl"`/`"both"`
+//! refuse them in one line.
 
 mod support;
 
@@ -119,9 +120,54 @@ fn gi_scenes_refuse_the_rtl_in_one_line() {
     assert!(!png.exists());
     #[cfg(feature = "rtl")]
     {
-        let dir = scratch("gi-cosim");
-        let out = cube5(&["cosim", s(&example()), "-o", s(&dir)]);
-        assert_refused(&out, &["gi-shadow.toml", "[gi]", "no GI-Cube RTL"]);
+        // No gicube_processor line has a 24^3 volume.
+        let text = std::fs::read_to_string(example()).unwrap();
+        let odd = scratch_file("gi-24.toml", text.replace("size = 64", "size = 24"));
+        let out = cube5(&["cosim", s(&odd), "-o", s(&scratch("gi-cosim"))]);
+        assert_refused(
+            &out,
+            &["gi-24.toml", "no gicube_processor configuration", "24^3"],
+        );
+    }
+}
+
+/// `cube5 cosim` of the 16^3 GI scene on `gicube_processor` (its `Light = 1` line, in every
+/// cube5), a quarter of its lighting rays and 16 x 16 pixels (seconds), under the random memory:
+/// both passes MATCH, with rays in = finished + overflowed, and both images written.
+#[cfg(feature = "rtl")]
+#[test]
+fn gi_scene_cosimulates_on_the_processor_rtl() {
+    let path = cube5_model::repo_root().join("scenes/gi-shadow-16.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let short = text
+        .replace("width = 32", "width = 16")
+        .replace("height = 32", "height = 16")
+        .replace("albedo = 0.0 ", "light_rays = 28\nalbedo = 0.0 ");
+    assert!(short.contains("light_rays = 28"), "{short}");
+    let scene = scratch_file("gi-cosim-16.toml", short);
+    let dir = scratch("gi-cosim-16");
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = cube5(&["cosim", s(&scene), "-o", s(&dir), "--memory", "random"]);
+    let stdout = succeeded(&out, "cosim");
+    for pass in ["MATCH: lighting pass", "MATCH: rendering pass"] {
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with(pass))
+            .unwrap_or_else(|| panic!("no `{pass}`: {stdout}"));
+        let rays_in = number_after(line, "): ");
+        assert_eq!(
+            rays_in,
+            number_after(line, "in = ") + number_after(line, "finished + "),
+            "{line}"
+        );
+    }
+    assert!(
+        stdout.contains("the field in memory after the flush"),
+        "{stdout}"
+    );
+    for png in ["model-gi.png", "rtl-gi.png"] {
+        let img = image::open(dir.join(png)).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (16, 16));
     }
 }
 
@@ -143,5 +189,105 @@ fn bad_gi_fields_are_refused_in_one_line() {
         let (out, png) = render_scene("gi-bad", text);
         assert_refused(&out, &["gi-bad.toml", field]);
         assert!(!png.exists(), "{text}");
+    }
+}
+
+/// Directed extremes of the RTL block processor through `cube5 cosim` (16^3, a few pixels each,
+/// the random memory): a transparent volume (every block empty: rays only leap), an opaque one
+/// (every ray terminates at its first sample), views along the axes (direction components 0),
+/// one pixel, a wide perspective, and a lit pass over the opaque volume. Every pass MATCHes the
+/// model, rays conserved.
+#[cfg(feature = "rtl")]
+#[test]
+fn gi_extremes_cosimulate_on_the_processor_rtl() {
+    let path = cube5_model::repo_root().join("scenes/gi-shadow-16.toml");
+    let base = std::fs::read_to_string(path).unwrap();
+    let unlit = base.replace("passes = 2", "passes = 1");
+    let small = |t: &str, w: u32| {
+        t.replace("width = 32", &format!("width = {w}"))
+            .replace("height = 32", &format!("height = {w}"))
+    };
+    let points = |alpha: f64| {
+        format!(
+            "points = [\n  {{ density = 0.0, rgba = [0.9, 0.5, 0.2, {alpha}] }},\n  {{ density = 1.0, rgba = [0.2, 0.5, 0.9, {alpha}] }},\n]\n"
+        )
+    };
+    let with_points = |t: &str, alpha: f64| {
+        let start = t.find("points = [").unwrap();
+        let end = start + t[start..].find("]\n\n").unwrap() + 3;
+        format!("{}{}\n{}", &t[..start], points(alpha), &t[end..])
+    };
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            "transparent",
+            with_points(&small(&unlit, 8), 0.0),
+            ", 0 samples, ",
+        ),
+        ("opaque", with_points(&small(&unlit, 8), 1.0), " samples"),
+        (
+            "along-z",
+            small(&unlit, 8).replace(
+                "direction = [0.35, 0.75, -0.55]",
+                "direction = [0.0, 0.0, -1.0]",
+            ),
+            " samples",
+        ),
+        (
+            "along-x",
+            small(&unlit, 8).replace(
+                "direction = [0.35, 0.75, -0.55]",
+                "direction = [1.0, 0.0, 0.0]",
+            ),
+            " samples",
+        ),
+        ("one-pixel", small(&unlit, 1), " samples"),
+        (
+            "wide-perspective",
+            small(&unlit, 8).replace(
+                "zoom = 1.3",
+                "zoom = 1.3\nprojection = \"perspective\"\nfov = 90.0",
+            ),
+            " samples",
+        ),
+        (
+            "lit-opaque",
+            with_points(&small(&base, 8), 1.0)
+                .replace("albedo = 0.0 ", "light_rays = 28\nalbedo = 0.0 "),
+            "MATCH: lighting pass",
+        ),
+    ];
+    for (name, text, needle) in cases {
+        let scene = scratch_file(&format!("gi-extreme-{name}.toml"), &text);
+        let dir = scratch(&format!("gi-extreme-{name}"));
+        let out = cube5(&[
+            "cosim",
+            s(&scene),
+            "-o",
+            s(&dir),
+            "--memory",
+            "random",
+            "--seed",
+            "3",
+        ]);
+        let stdout = succeeded(&out, name);
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with("MATCH: rendering pass"))
+            .unwrap_or_else(|| panic!("{name}: no MATCH: {stdout}"));
+        assert!(stdout.contains(needle), "{name}: `{needle}`: {stdout}");
+        if name == "opaque" {
+            // Every ray terminates at its first sample.
+            assert_eq!(
+                number_after(line, "%), "),
+                number_after(line, "in = "),
+                "{name}: one sample per ray: {line}"
+            );
+        }
+        assert_eq!(
+            number_after(line, "): "),
+            number_after(line, "in = ") + number_after(line, "finished + "),
+            "{name}: {line}"
+        );
+        eprintln!("{name}: {line}");
     }
 }

@@ -18,6 +18,7 @@ mod cube5_trilin;
 mod cube5_warp;
 mod gicube_bucket;
 mod gicube_packet_loop;
+mod gicube_processor;
 mod gicube_ray_queues;
 mod gicube_sample;
 mod gicube_scatter;
@@ -103,6 +104,11 @@ const BENCHES: &[Bench] = &[
         top: gicube_sample::TOP,
         alias: "sample",
         run: gicube_sample::run,
+    },
+    Bench {
+        top: gicube_processor::TOP,
+        alias: "processor",
+        run: gicube_processor::run,
     },
     Bench {
         top: cube5_skewmem::TOP,
