@@ -28,7 +28,9 @@ module cube5_accel_win #(
   parameter int unsigned AccW        = 20,
   parameter int unsigned ColorW      = 8,
   /// Write bursts in flight, and restore reads in flight.
-  parameter int unsigned Outstanding = 16
+  parameter int unsigned Outstanding = 16,
+  /// Depth of the AW and W FIFOs (a power of two).
+  parameter int unsigned WDepth      = 8
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -109,7 +111,6 @@ module cube5_accel_win #(
   localparam int unsigned TagW     = 16;
   localparam int unsigned AwW      = IdW + 8 + AddrW;
   localparam int unsigned WW       = 1 + Bbus + DataW;
-  localparam int unsigned WDepth   = 8;    // the AW and W FIFOs
   localparam logic [IdW-1:0] IdPark = IdW'(1);
   localparam logic [IdW-1:0] IdFin  = IdW'(2);
 
