@@ -5,6 +5,7 @@
 -f rtl/cube5/cube5_frame.f
 -f rtl/cube5/cube5_axi_wr.f
 rtl/cube5/cube5_axi_arb.sv
+rtl/cube5/cube5_axi_slice.sv
 rtl/cube5/cube5_accel_pix.sv
 rtl/cube5/cube5_accel_win.sv
 rtl/cube5/cube5_accel.sv

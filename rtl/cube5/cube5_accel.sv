@@ -69,7 +69,13 @@ module cube5_accel #(
   /// the initial coxel's code. 0: the whole base plane on chip, read out after the sweep.
   parameter int unsigned Window      = 0,
   /// Window = 1: the window's write bursts in flight, and its restore reads in flight.
-  parameter int unsigned WinOutstanding = 16
+  parameter int unsigned WinOutstanding = 16,
+  /// Window = 1: the depth of the window's AW and W FIFOs (cube5_accel_win), a power of two.
+  parameter int unsigned WinWDepth   = 8,
+  /// Window = 1: while the window's write beats wait, the fetch keeps at most FetchHold (+ 1)
+  /// read bursts granted and not yet returned; 0: it starts none (docs/accel.md, *The
+  /// compositing window in the top*).
+  parameter int unsigned FetchHold   = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -641,7 +647,7 @@ module cube5_accel #(
 
     cube5_accel_win #(
       .P(P), .DimW(M + 1), .AddrW(AddrW), .DataW(DataW), .IdW(IdW), .AccW(AccW),
-      .ColorW(ColorW), .Outstanding(WinOutstanding)
+      .ColorW(ColorW), .Outstanding(WinOutstanding), .WDepth(WinWDepth)
     ) u_win (
       .clk_i, .rst_ni(unit_rst_n),
       .img_base_i(img_base), .row_step_i(row_step), .park_base_i(park_base),
@@ -668,29 +674,32 @@ module cube5_accel #(
     // withdrawn), else they alternate (cube5_axi_arb). The fetch starts no new read while the
     // window's write beats wait (v_wait): the memory serves reads first, and a fetch that keeps
     // its bursts queued would starve the parks (docs/accel.md, *The compositing window in the
-    // top*, What limits it).
+    // top*, What limits it). Each arbiter's grant goes into a two-entry register slice
+    // (cube5_axi_slice), so the port's AR and AW leave from flip-flops and no source's ready
+    // depends on the port's ready or on the other source's offer in the same cycle.
     localparam int unsigned ArbW = AddrW + 8 + 3 + 2 + IdW;
     localparam logic [2:0] BeatSize = 3'($clog2(DataW / 8));
-    logic ar_sel, aw_sel;   // 1: the window's
-    // While the window's write beats wait, the fetch keeps at most FetchHold (+ 1) read bursts
-    // granted and not yet returned (0: it starts none; docs/accel.md, *The compositing window in
-    // the top*).
-    localparam int unsigned FetchHold = 0;
+    logic            ar_sel, aw_sel;   // 1: the window's (into the slice)
+    logic            aw_sel_out;       // the source of the AW the slice offers on the port
+    logic            ar_g_valid, ar_g_ready, aw_g_valid, aw_g_ready;
+    logic [ArbW-1:0] ar_g_data, aw_g_data;
     logic fe_allow;   // the fetch may be granted while the window's write beats wait
     if (FetchHold != 0) begin : gen_fe_hold
-      // The fetch's read bursts granted (into the AR arbiter's slice) whose last beat is not in;
-      // the flag from the count a cycle before (so at most FetchHold + 1 of them).
+      // The fetch's read bursts granted (into the AR slice) whose last beat is not in; the flag
+      // from the count a cycle before (so at most FetchHold + 1 of them).
       localparam int unsigned FeHoldW = $clog2(Outstanding + FetchHold + 2) + 1;
-      logic [FeHoldW-1:0] fe_out_q;
-      logic               fe_allow_q;
+      logic [FeHoldW-1:0] fe_out_q, fe_out_d;
+      logic               fe_allow_q, fe_allow_d;
+      assign fe_out_d   = fe_out_q + FeHoldW'(fe_arvalid && fe_arready)
+                                   - FeHoldW'(fe_rvalid && fe_rready && m_axi_rlast_i);
+      assign fe_allow_d = fe_out_q < FeHoldW'(FetchHold);
       always_ff @(posedge clk_i) begin
         if (!unit_rst_n) begin
           fe_out_q   <= '0;
           fe_allow_q <= 1'b0;
         end else begin
-          fe_out_q   <= fe_out_q + FeHoldW'(fe_arvalid && fe_arready)
-                                 - FeHoldW'(fe_rvalid && fe_rready && m_axi_rlast_i);
-          fe_allow_q <= fe_out_q < FeHoldW'(FetchHold);
+          fe_out_q   <= fe_out_d;
+          fe_allow_q <= fe_allow_d;
         end
       end
       assign fe_allow = fe_allow_q;
@@ -703,9 +712,13 @@ module cube5_accel #(
       .s0_data_i({fe_araddr, fe_arlen, fe_arsize, fe_arburst, fe_arid}),
       .s1_valid_i(v_arvalid), .s1_ready_o(v_arready),
       .s1_data_i({v_araddr, v_arlen, BeatSize, 2'b01, IdW'(1)}),
-      .valid_o(ar_valid), .ready_i(ar_ready),
-      .data_o({m_axi_araddr_o, m_axi_arlen_o, m_axi_arsize_o, m_axi_arburst_o, m_axi_arid_o}),
-      .sel_o(ar_sel)
+      .valid_o(ar_g_valid), .ready_i(ar_g_ready), .data_o(ar_g_data), .sel_o(ar_sel)
+    );
+    cube5_axi_slice #(.Width(ArbW)) u_ar_slice (
+      .clk_i, .rst_ni(unit_rst_n),
+      .in_valid_i(ar_g_valid), .in_ready_o(ar_g_ready), .in_data_i(ar_g_data),
+      .out_valid_o(ar_valid), .out_ready_i(ar_ready),
+      .out_data_o({m_axi_araddr_o, m_axi_arlen_o, m_axi_arsize_o, m_axi_arburst_o, m_axi_arid_o})
     );
     cube5_axi_arb #(.Width(ArbW)) u_aw_arb (
       .clk_i, .rst_ni(unit_rst_n),
@@ -713,16 +726,22 @@ module cube5_accel #(
       .s0_data_i({wr_awaddr, wr_awlen, wr_awsize, wr_awburst, wr_awid}),
       .s1_valid_i(v_awvalid), .s1_ready_o(v_awready),
       .s1_data_i({v_awaddr, v_awlen, BeatSize, 2'b01, v_awid}),
-      .valid_o(aw_valid), .ready_i(aw_ready),
-      .data_o({m_axi_awaddr_o, m_axi_awlen_o, m_axi_awsize_o, m_axi_awburst_o, m_axi_awid_o}),
-      .sel_o(aw_sel)
+      .valid_o(aw_g_valid), .ready_i(aw_g_ready), .data_o(aw_g_data), .sel_o(aw_sel)
+    );
+    // The AW slice carries the source beside the address: W follows the port's accepted AWs.
+    cube5_axi_slice #(.Width(ArbW + 1)) u_aw_slice (
+      .clk_i, .rst_ni(unit_rst_n),
+      .in_valid_i(aw_g_valid), .in_ready_o(aw_g_ready), .in_data_i({aw_sel, aw_g_data}),
+      .out_valid_o(aw_valid), .out_ready_i(aw_ready),
+      .out_data_o({aw_sel_out, m_axi_awaddr_o, m_axi_awlen_o, m_axi_awsize_o, m_axi_awburst_o,
+                   m_axi_awid_o})
     );
 
     // W: the bursts' beats in the order their AWs were accepted (a FIFO of sources).
     logic ord_empty, ord_full, ord_head, w_fire_last;
     cube5_frame_fifo #(.Width(1), .Depth(WinOrdDepth)) u_ord (
       .clk_i, .rst_ni(unit_rst_n), .clear_i(1'b0),
-      .push_i(m_axi_awvalid_o && m_axi_awready_i), .d_i(aw_sel),
+      .push_i(m_axi_awvalid_o && m_axi_awready_i), .d_i(aw_sel_out),
       .pop_i(w_fire_last), .q_o(ord_head), .empty_o(ord_empty), .full_o(ord_full)
     );
     assign w_valid        = !ord_empty && (ord_head ? v_wvalid : wr_wvalid);

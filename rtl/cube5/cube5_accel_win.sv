@@ -42,7 +42,9 @@ module cube5_accel_win #(
   /// 1: all-zero parks cost no bytes (a bit per park on chip); 0: every park is written.
   parameter int unsigned ZeroSkip    = 1,
   /// Bits of the zero-park FIFO (a power of two; 0: MaxDim^2, a section's parks at 45 degrees).
-  parameter int unsigned ZeroDepth   = 0
+  parameter int unsigned ZeroDepth   = 0,
+  /// Depth of the AW and W FIFOs (a power of two).
+  parameter int unsigned WDepth      = 8
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -125,7 +127,6 @@ module cube5_accel_win #(
   localparam int unsigned TagW     = 16;
   localparam int unsigned AwW      = IdW + 8 + AddrW;
   localparam int unsigned WW       = 1 + Bbus + DataW;
-  localparam int unsigned WDepth   = 8;    // the AW and W FIFOs
   localparam logic [IdW-1:0] IdPark = IdW'(1);
   localparam logic [IdW-1:0] IdFin  = IdW'(2);
 

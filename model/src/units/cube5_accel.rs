@@ -34,6 +34,8 @@ const OWN_PARAMS: &[(&str, i64)] = &[
     ("IdW", 4),
     ("Window", 0),
     ("WinOutstanding", 16),
+    ("WinWDepth", 8),
+    ("FetchHold", 0),
 ];
 
 /// The defaults of the parameters the top passes on, where the top's default differs from (or
@@ -91,6 +93,11 @@ pub struct AccelConfig {
     pub window: bool,
     /// With the window: its write bursts in flight, and its restore reads in flight.
     pub win_outstanding: u32,
+    /// With the window: the depth of its AW and W FIFOs (`WinWDepth`).
+    pub win_w_depth: u32,
+    /// With the window: the fetch's read bursts kept in flight while window write beats wait
+    /// (`FetchHold`; 0 stops it). Timing only: the image is the same.
+    pub fetch_hold: u32,
 }
 
 /// Bytes per base-plane pixel in memory (the top's `PixelBytes`: R, G, B, A codes).
@@ -192,7 +199,15 @@ impl UnitConfig for AccelConfig {
             id_w: own("IdW")?,
             window: own("Window")? == 1,
             win_outstanding: own("WinOutstanding")?,
+            win_w_depth: own("WinWDepth")?,
+            fetch_hold: own("FetchHold")?,
         };
+        if !c.win_w_depth.is_power_of_two() || c.win_w_depth < 2 {
+            return Err(ModelError::Config(format!(
+                "cube5_accel: WinWDepth = {} must be a power of two of at least 2",
+                c.win_w_depth
+            )));
+        }
         if own("Window")? > 1 || (c.window && c.id_w < 2) {
             return Err(ModelError::Config(
                 "cube5_accel: Window must be 0 or 1, and Window = 1 needs IdW >= 2".into(),
@@ -232,6 +247,8 @@ impl UnitConfig for AccelConfig {
             ("IdW", i64::from(self.id_w)),
             ("Window", i64::from(self.window)),
             ("WinOutstanding", i64::from(self.win_outstanding)),
+            ("WinWDepth", i64::from(self.win_w_depth)),
+            ("FetchHold", i64::from(self.fetch_hold)),
         ]);
         out
     }
