@@ -115,7 +115,7 @@ fn gi_scenes_refuse_the_rtl_in_one_line() {
     let png = scratch("gi-rtl.png");
     for target in ["rtl", "both"] {
         let out = cube5(&["render", s(&example()), "-o", s(&png), "--target", target]);
-        assert_refused(&out, &["run.target", "no GI-Cube RTL"]);
+        assert_refused(&out, &["run.target", "processor model only"]);
     }
     assert!(!png.exists());
     #[cfg(feature = "rtl")]

@@ -353,6 +353,7 @@ mod tests {
             ("head-perspective-slabs", &["view.projection"]),
             ("head-perspective-er", &["view.projection"]),
             ("gi-shadow", &["[gi]"]),
+            ("gi-shadow-16", &["[gi]"]),
         ];
         let dir = crate::repo_root().join("scenes");
         let mut seen = Vec::new();

@@ -5,7 +5,8 @@
 //! This module reads the section (`GiSpec`), checks what a GI scene may say, makes the plan, and
 //! runs the two passes (`GiJob`); `--compare` is against the processor's f64 reference.
 //!
-//! There is no GI-Cube RTL yet: a GI scene runs on the model only (`run.target = "model"`).
+//! `cube5 render` runs a GI scene on the processor model only (`run.target = "model"`);
+//! `cube5 cosim` co-simulates it on the `gicube_processor` RTL (cli/src/cosim_gi.rs).
 
 use crate::camera::Camera;
 use crate::error::{ModelError, Result};
@@ -130,7 +131,7 @@ pub fn validate(scene: &Scene, gi: &GiSpec) -> std::result::Result<(), (String, 
         return bad(
             "run.target",
             format!(
-                "\"{}\": a [gi] scene runs on the GI-Cube processor model only (there is no GI-Cube RTL yet)",
+                "\"{}\": a [gi] scene renders on the GI-Cube processor model only (`cube5 cosim` runs it on the gicube_processor RTL)",
                 scene.run.target.name()
             ),
         );
@@ -614,7 +615,7 @@ mod tests {
         // cube5 cosim refuses a GI scene in one line.
         let why = crate::scene_render::not_expressible(&s);
         assert!(
-            why.len() == 1 && why[0].contains("no GI-Cube RTL"),
+            why.len() == 1 && why[0].contains("gicube_processor"),
             "{why:?}"
         );
     }

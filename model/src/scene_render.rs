@@ -35,7 +35,7 @@ pub fn not_expressible(scene: &Scene) -> Vec<String> {
     if scene.gi.is_some() {
         // `cube5 cosim` on a GI scene: one line, and nothing else to say.
         return vec![
-            "the scene has a [gi] section: it renders on the GI-Cube processor model, and there is no GI-Cube RTL yet".into(),
+            "the scene has a [gi] section: it is no cube5_frame frame (`cube5 cosim` runs it on gicube_processor)".into(),
         ];
     }
     if scene.view.projection != Projection::Parallel {
