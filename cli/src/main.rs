@@ -22,11 +22,12 @@ use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
 use cube5_model::er_perspective::render_er;
 use cube5_model::phantom::{phantom_by_name, PHANTOMS};
-use cube5_model::render::{render_pipeline, render_reference_geometry, ImageF64, Projection};
+use cube5_model::render::{
+    image_error, render_pipeline, render_reference_geometry, ImageF64, Projection,
+};
 use cube5_model::scene::{Plan, Renderer, Scene, Target};
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
 use cube5_model::slab_perspective::render_slabs;
-use cube5_model::studies::tradeoff::image_error;
 use cube5_model::volume_io::{self, Endian, NrrdEncoding};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

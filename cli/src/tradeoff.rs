@@ -1,4 +1,4 @@
-//! `cube5 tradeoff [SCENE]`: runs the sweeps of `cube5_model::studies::tradeoff` with progress bars and
+//! `cube5 tradeoff [SCENE]`: runs the sweeps of `cube5_studies::tradeoff` with progress bars and
 //! writes the tables (Markdown and CSV) and plots (PNG). `--write-docs` regenerates
 //! `docs/tradeoffs.md` and `docs/img/tradeoff-*`.
 //!
@@ -13,12 +13,12 @@ use ab_glyph::{point, Font, FontRef, ScaleFont};
 use anyhow::{bail, Context, Result};
 use cube5_model::render::{Quality, RenderParams};
 use cube5_model::scene::Scene;
-use cube5_model::studies::tradeoff::{
+use cube5_model::transfer::TransferFunction;
+use cube5_model::volume_io::write_atomically;
+use cube5_studies::tradeoff::{
     run as run_sweeps, Figure, Progress, Report, Series, Setup, Synth, Table, PAPER_VS_IMAGE_ORDER,
     PAPER_VS_TRUE3D,
 };
-use cube5_model::transfer::TransferFunction;
-use cube5_model::volume_io::write_atomically;
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::RgbImage;
 use indicatif::{ProgressBar, ProgressStyle};

@@ -10,9 +10,9 @@
 mod support;
 
 use cube5_model::er_perspective::{render_er, render_er_f64, ErMerge, ErScheme};
+use cube5_model::render::image_error;
 use cube5_model::render::render_reference;
 use cube5_model::scene_render::frame_config;
-use cube5_model::studies::tradeoff::image_error;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

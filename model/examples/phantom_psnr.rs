@@ -14,11 +14,11 @@
 //! sampling the classified signal once per slice.
 
 use cube5_model::camera::Camera;
+use cube5_model::render::image_error;
 use cube5_model::render::{
     render_pipeline, render_reference, GradientScheme, ImageF64, Quality, RenderParams, SliceSetup,
 };
 use cube5_model::scene::Scene;
-use cube5_model::studies::tradeoff::image_error;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::units::cube5_frame::{
     frame_phong, render_base_plane, warp, FrameMode, FrameSetup, FrameUnits,

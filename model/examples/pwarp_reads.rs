@@ -7,7 +7,7 @@
 //! random views of a 128 x 128 base plane (field of view 30-60 degrees, tilts up to 35 degrees,
 //! any roll, zoom 0.8-1.25: the plane seen within 35 degrees of square on, as ER-perspective sees its base plane) at 64^2, 128^2, 256^2 and 512^2 pixels, seed 14.
 
-use cube5_model::studies::tradeoff::image_error;
+use cube5_model::render::image_error;
 use cube5_model::units::cube5_pwarp::{
     read_counts, reference, reference_at_samples, warp_image, warp_samples, Projective,
     PwarpConfig, PwarpSetup,

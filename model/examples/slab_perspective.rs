@@ -7,9 +7,9 @@
 
 mod support;
 
+use cube5_model::render::image_error;
 use cube5_model::render::render_reference;
 use cube5_model::slab_perspective::{render_slabs, SlabSpacing, Slabs};
-use cube5_model::studies::tradeoff::image_error;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -10,8 +10,8 @@
 //! `scene_render` (what `cube5 render` runs: a scene on the frame model, or a named what-if);
 //! `slab_perspective` (a what-if: perspective approximated by parallel slabs);
 //! `er_perspective` (ER-perspective: exponential regions, Bartlett ray merging, on the frame's units);
-//! `scene_gi` (a scene with `[gi]`: the GI-Cube processor model, lighting and rendering passes);
-//! `studies` (the tradeoff sweeps, not part of the golden model).
+//! `scene_gi` (a scene with `[gi]`: the GI-Cube processor model, lighting and rendering passes).
+//! The tradeoff sweeps are not part of the golden model: they are the `cube5-studies` crate.
 
 pub mod accel_host;
 pub mod bits;
@@ -29,7 +29,6 @@ pub mod scene_elab;
 pub mod scene_gi;
 pub mod scene_render;
 pub mod slab_perspective;
-pub mod studies;
 pub mod transfer;
 pub mod unit;
 pub mod units;

@@ -348,6 +348,49 @@ impl ImageF64 {
     }
 }
 
+/// How far an image is from a reference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageError {
+    /// `10 log10(1 / MSE)` over the R, G, B channels in 0..1 (infinite for identical images).
+    pub psnr_db: f64,
+    /// Largest absolute channel difference (0..1).
+    pub max_abs: f64,
+    /// cube3-paper §6.1: the Euclidean RGB distance per pixel, summed, over the reference's summed
+    /// RGB length, percent.
+    pub rel_euclid: f64,
+    /// The mean Euclidean RGB distance over the largest possible one (`sqrt 3`), percent.
+    pub full_scale_euclid: f64,
+}
+
+/// The error of `test` against `reference` (same size).
+pub fn image_error(test: &ImageF64, reference: &ImageF64) -> ImageError {
+    assert_eq!(
+        (test.width, test.height),
+        (reference.width, reference.height),
+        "images of different sizes"
+    );
+    let (mut se, mut max_abs, mut dist, mut norm) = (0.0, 0.0f64, 0.0, 0.0);
+    for (a, b) in test.rgb.iter().zip(&reference.rgb) {
+        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        se += d.iter().map(|x| x * x).sum::<f64>();
+        max_abs = d.iter().fold(max_abs, |m, x| m.max(x.abs()));
+        dist += d.iter().map(|x| x * x).sum::<f64>().sqrt();
+        norm += b.iter().map(|x| x * x).sum::<f64>().sqrt();
+    }
+    let n = test.rgb.len().max(1) as f64;
+    let mse = se / (3.0 * n);
+    ImageError {
+        psnr_db: if mse > 0.0 {
+            10.0 * (1.0 / mse).log10()
+        } else {
+            f64::INFINITY
+        },
+        max_abs,
+        rel_euclid: if norm > 0.0 { 100.0 * dist / norm } else { 0.0 },
+        full_scale_euclid: 100.0 * dist / n / 3f64.sqrt(),
+    }
+}
+
 /// Phong shading of colour `c` at a sample with `gradient` (physical units), view `dir`.
 /// A zero gradient (homogeneous region) is lit as if head-on without specular.
 pub fn shade(c: DVec3, gradient: DVec3, dir: DVec3, lights: &[Light], m: &Material) -> DVec3 {
@@ -1380,6 +1423,24 @@ mod tests {
     use super::*;
     use crate::phantom::{head_phantom, sphere_phantom};
     use crate::transfer::TfPoint;
+
+    #[test]
+    fn error_measures() {
+        let a = ImageF64 {
+            width: 2,
+            height: 1,
+            rgb: vec![[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
+        };
+        let b = ImageF64 {
+            rgb: vec![[0.5, 0.0, 0.0], [0.0, 0.0, 0.0]],
+            ..a.clone()
+        };
+        let e = image_error(&b, &a);
+        assert!((e.max_abs - 0.5).abs() < 1e-12);
+        assert!((e.rel_euclid - 50.0).abs() < 1e-9);
+        assert!((e.psnr_db - 10.0 * (1.0f64 / (0.25 / 6.0)).log10()).abs() < 1e-9);
+        assert!(image_error(&a, &a).psnr_db.is_infinite());
+    }
 
     #[test]
     fn renders_something_with_a_dark_border() {

@@ -4,10 +4,10 @@
 //! reference's cost does. It also prints the PSNR of the f64 warp of the unquantized coxels (what
 //! `cube5 render` showed before the warp unit), so the warp's share of the error is on record.
 
+use cube5_model::render::image_error;
 use cube5_model::render::render_reference;
 use cube5_model::scene::Scene;
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
-use cube5_model::studies::tradeoff::image_error;
 
 #[test]
 fn the_default_scene_is_a_frame_within_40_db_of_the_reference() {

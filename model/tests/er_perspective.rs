@@ -6,8 +6,8 @@ use cube5_model::er_perspective::{
     merge_coxels, render_er, render_er_f64, render_er_f64_with, ErJob, ErMerge, ErScheme, ErSetup,
 };
 use cube5_model::phantom::head_phantom;
+use cube5_model::render::image_error;
 use cube5_model::render::{render_reference, CompositeMode, Projection, RenderParams};
-use cube5_model::studies::tradeoff::image_error;
 use cube5_model::units::cube5_compos::{ComposConfig, Coxel};
 use cube5_model::units::cube5_frame::{FrameConfig, FrameSetup};
 use glam::DVec3;

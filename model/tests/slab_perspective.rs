@@ -1,10 +1,10 @@
 //! Approximate perspective by parallel slabs (`slab_perspective`, docs/numerics/slab_perspective.md):
 //! its error against the f64 perspective reference falls as the slab count grows.
 
+use cube5_model::render::image_error;
 use cube5_model::render::{render_reference, CompositeMode, Projection, RenderParams};
 use cube5_model::scene::Scene;
 use cube5_model::slab_perspective::{render_slabs, SlabSpacing, Slabs};
-use cube5_model::studies::tradeoff::image_error;
 
 /// `scenes/head-perspective.toml` at 48^3 and 97 x 97 pixels (an odd size: one pixel on the axis).
 fn scene(mode: &str) -> Scene {

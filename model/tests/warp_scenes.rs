@@ -3,9 +3,9 @@
 //! codes, and against the f64 warp of the unquantized coxels (what `cube5 render` showed before the
 //! warp unit): within the contract's bound, and >= 40 dB.
 
+use cube5_model::render::image_error;
 use cube5_model::scene::Scene;
 use cube5_model::scene_render::{frame_config, not_expressible, FrameJob};
-use cube5_model::studies::tradeoff::image_error;
 use cube5_model::units::cube5_warp;
 
 #[test]

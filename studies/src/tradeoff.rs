@@ -11,19 +11,19 @@
 //! The data come out as [`Table`]s and [`Figure`]s; the command line writes them as Markdown, CSV
 //! and PNG.
 
-use crate::er_perspective::{render_er, render_er_f64, ErMerge, ErScheme};
-use crate::error::{ModelError, Result};
-use crate::phantom::{sphere_phantom, SphereGeometry};
-use crate::render::{
-    render_pipeline, render_reference, CompositeMode, GradientScheme, ImageF64, Interpolation,
-    Projection, Quality, RenderParams, SliceSetup, View, STEP_W,
+use cube5_model::er_perspective::{render_er, render_er_f64, ErMerge, ErScheme};
+use cube5_model::error::{ModelError, Result};
+use cube5_model::phantom::{sphere_phantom, SphereGeometry};
+use cube5_model::render::{
+    image_error, render_pipeline, render_reference, CompositeMode, GradientScheme, ImageError,
+    Interpolation, Projection, Quality, RenderParams, SliceSetup, View, STEP_W,
 };
-use crate::slab_perspective::{render_slabs, SlabSpacing, Slabs};
-use crate::transfer::TransferFunction;
-use crate::units::cube5_frame::FrameConfig;
-use crate::units::cube5_gradient::{block_index, Gradient, GradientConfig, GradientIn};
-use crate::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
-use crate::volume::Volume;
+use cube5_model::slab_perspective::{render_slabs, SlabSpacing, Slabs};
+use cube5_model::transfer::TransferFunction;
+use cube5_model::units::cube5_frame::FrameConfig;
+use cube5_model::units::cube5_gradient::{block_index, Gradient, GradientConfig, GradientIn};
+use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig, TrilinIn, TrilinMode};
+use cube5_model::volume::Volume;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -33,53 +33,6 @@ use std::collections::BTreeMap;
 pub const PAPER_VS_IMAGE_ORDER: f64 = 1.3;
 /// cube3-paper §6.1: the same against the exact 8-neighbourhood at the same positions (True3D).
 pub const PAPER_VS_TRUE3D: f64 = 0.3;
-
-// =================================================================================================
-// Error measures
-// =================================================================================================
-
-/// How far an image is from a reference.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ImageError {
-    /// `10 log10(1 / MSE)` over the R, G, B channels in 0..1 (infinite for identical images).
-    pub psnr_db: f64,
-    /// Largest absolute channel difference (0..1).
-    pub max_abs: f64,
-    /// cube3-paper §6.1: the Euclidean RGB distance per pixel, summed, over the reference's summed
-    /// RGB length, percent.
-    pub rel_euclid: f64,
-    /// The mean Euclidean RGB distance over the largest possible one (`sqrt 3`), percent.
-    pub full_scale_euclid: f64,
-}
-
-/// The error of `test` against `reference` (same size).
-pub fn image_error(test: &ImageF64, reference: &ImageF64) -> ImageError {
-    assert_eq!(
-        (test.width, test.height),
-        (reference.width, reference.height),
-        "images of different sizes"
-    );
-    let (mut se, mut max_abs, mut dist, mut norm) = (0.0, 0.0f64, 0.0, 0.0);
-    for (a, b) in test.rgb.iter().zip(&reference.rgb) {
-        let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        se += d.iter().map(|x| x * x).sum::<f64>();
-        max_abs = d.iter().fold(max_abs, |m, x| m.max(x.abs()));
-        dist += d.iter().map(|x| x * x).sum::<f64>().sqrt();
-        norm += b.iter().map(|x| x * x).sum::<f64>().sqrt();
-    }
-    let n = test.rgb.len().max(1) as f64;
-    let mse = se / (3.0 * n);
-    ImageError {
-        psnr_db: if mse > 0.0 {
-            10.0 * (1.0 / mse).log10()
-        } else {
-            f64::INFINITY
-        },
-        max_abs,
-        rel_euclid: if norm > 0.0 { 100.0 * dist / norm } else { 0.0 },
-        full_scale_euclid: 100.0 * dist / n / 3f64.sqrt(),
-    }
-}
 
 // =================================================================================================
 // Tables, figures, synthesis results
@@ -1278,25 +1231,7 @@ pub fn sphere_gradient_error(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::phantom::head_phantom;
-
-    #[test]
-    fn error_measures() {
-        let a = ImageF64 {
-            width: 2,
-            height: 1,
-            rgb: vec![[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
-        };
-        let b = ImageF64 {
-            rgb: vec![[0.5, 0.0, 0.0], [0.0, 0.0, 0.0]],
-            ..a.clone()
-        };
-        let e = image_error(&b, &a);
-        assert!((e.max_abs - 0.5).abs() < 1e-12);
-        assert!((e.rel_euclid - 50.0).abs() < 1e-9);
-        assert!((e.psnr_db - 10.0 * (1.0f64 / (0.25 / 6.0)).log10()).abs() < 1e-9);
-        assert!(image_error(&a, &a).psnr_db.is_infinite());
-    }
+    use cube5_model::phantom::head_phantom;
 
     #[test]
     fn synth_table_joins_variants() {
