@@ -619,30 +619,32 @@ pub fn outside_face(params: &FrameParams, t: i64, a: i64, b: i64) -> bool {
         || b >= params.nj as i64
 }
 
-/// The bilinear sample of slice number `t` (processing order; zero outside `0..nk`) at anchor
-/// `(a, b)` (zero outside the face) with the weights of slice `c`: `S'(t)` of the contract.
+/// The voxels of `vol` as the samples read them: `(t, i, j)` is voxel `(i, j)` of slice number
+/// `t` (processing order), 0 off the face ([`FrameParams::voxel`]).
+pub fn volume_voxels<'a>(
+    params: &'a FrameParams,
+    vol: &'a Volume,
+) -> impl Fn(usize, usize, usize) -> u32 + 'a {
+    move |t, i, j| params.voxel(vol, i, j, params.slice(t).k)
+}
+
+/// `S'(t)` of the contract: the bilinear sample of slice number `t` (processing order; zero
+/// outside `0..nk`) at anchor `(a, b)` (zero outside the face) with the weights of slice `c`, from
+/// `voxel(t, i, j)` (the whole volume's [`volume_voxels`], or a section's own).
 pub fn sample_at(
     params: &FrameParams,
-    vol: &Volume,
     c: &SliceConst,
-    t: i64,
-    a: i64,
-    b: i64,
+    (t, a, b): (i64, i64, i64),
     trilin: &Trilin,
+    voxel: &impl Fn(usize, usize, usize) -> u32,
 ) -> u32 {
     if outside_face(params, t, a, b) {
         return 0;
     }
-    let other = params.slice(t as usize);
-    let at = SliceConst { k: other.k, ..*c };
-    trilin.sample(&sample_input(
-        params,
-        vol,
-        &at,
-        a as usize,
-        b as usize,
-        &trilin.config(),
-    ))
+    let (t, a, b) = (t as usize, a as usize, b as usize);
+    let v = |da: usize, db: usize| voxel(t, a + da, b + db);
+    let corners = [v(0, 0), v(1, 0), v(0, 1), v(1, 1)];
+    trilin.sample(&bilinear_input(c, corners, &trilin.config()))
 }
 
 /// The gradient neighbourhood of the contract: `[C, x-, x+, y-, y+, B (slice before), A (after)]`.
@@ -654,21 +656,23 @@ pub fn neighbourhood(
     b: usize,
     trilin: &Trilin,
 ) -> [u32; 7] {
-    neighbourhood_from(c, a, b, |t, a, b| {
-        sample_at(params, vol, c, t, a, b, trilin)
-    })
+    neighbourhood_from(params, c, (a, b), trilin, &volume_voxels(params, vol))
 }
 
-/// The seven samples of anchor `(a, b)`'s neighbourhood in slice `c`, in [`N6_OFFSETS`] order
-/// (`[C, x-, x+, y-, y+, B, A]`), each `at(t, a', b')` = `S'(t)` at anchor `(a', b')`.
+/// The seven samples `S'(t)` of anchor `(a, b)`'s neighbourhood in slice `c`, in [`N6_OFFSETS`]
+/// order (`[C, x-, x+, y-, y+, B, A]`), from `voxel` (as [`sample_at`]).
 pub fn neighbourhood_from(
+    params: &FrameParams,
     c: &SliceConst,
-    a: usize,
-    b: usize,
-    at: impl Fn(i64, i64, i64) -> u32,
+    (a, b): (usize, usize),
+    trilin: &Trilin,
+    voxel: &impl Fn(usize, usize, usize) -> u32,
 ) -> [u32; 7] {
     let (a, b, s) = (a as i64, b as i64, c.s as i64);
-    N6_OFFSETS.map(|(di, dj, dk)| at(s + i64::from(dk), a + i64::from(di), b + i64::from(dj)))
+    N6_OFFSETS.map(|(di, dj, dk)| {
+        let at = (s + i64::from(dk), a + i64::from(di), b + i64::from(dj));
+        sample_at(params, c, at, trilin, voxel)
+    })
 }
 
 /// One plane of samples in anchor order (`b` outer, `a` inner), for slice `s`.
@@ -1239,18 +1243,36 @@ impl FrameUnits {
         a: usize,
         b: usize,
     ) -> Sample {
+        self.shaded_from(params, c, (a, b), &volume_voxels(params, vol))
+    }
+
+    /// [`Self::shaded_sample`] from `voxel` (as [`sample_at`]: the whole volume's, or a section's
+    /// own voxels): every mode (MinIP's depth past a far face, the unlit modes, the 2-D table).
+    pub fn shaded_from(
+        &self,
+        params: &FrameParams,
+        c: &SliceConst,
+        (a, b): (usize, usize),
+        voxel: &impl Fn(usize, usize, usize) -> u32,
+    ) -> Sample {
         let mode = self.mode.compos_mode();
         let depth = self
             .mode
             .sample_depth(params, c, (a, b), &self.compos.config());
         if !self.shade {
-            let centre = sample_at(params, vol, c, c.s as i64, a as i64, b as i64, &self.trilin);
+            let centre = sample_at(
+                params,
+                c,
+                (c.s as i64, a as i64, b as i64),
+                &self.trilin,
+                voxel,
+            );
             return Sample {
                 mode,
                 ..classify_only(&self.shader, centre, depth)
             };
         }
-        let n = neighbourhood(params, vol, c, a, b, &self.trilin);
+        let n = neighbourhood_from(params, c, (a, b), &self.trilin, voxel);
         Sample {
             mode,
             ..shade_n6(&self.gradient, &self.shader, &n, self.shader_mode(), depth)

@@ -9,13 +9,9 @@
 //! (the order `cube5_section_buf` delivers), and [`render_sections`] renders from those beats
 //! alone, the samples and gradients at a section's edges included.
 
-use super::{
-    bilinear_input, neighbourhood_from, outside_face, shade_n6, BasePlane, FrameParams, FrameUnits,
-    SliceConst,
-};
+use super::{volume_voxels, BasePlane, FrameParams, FrameUnits, SliceConst};
 use crate::error::{ModelError, Result};
 use crate::units::cube5_section_buf::Beam;
-use crate::units::cube5_trilin::Trilin;
 use crate::volume::Volume;
 
 /// One section: anchors `a0 .. a0 + ns` along `i`.
@@ -47,14 +43,6 @@ pub fn section_order(params: &FrameParams, width: usize, p: usize) -> Result<Vec
     Ok(v)
 }
 
-/// The voxel at frame position `(i, j)` of slice `s` (processing order), zero outside the face.
-fn voxel_at(params: &FrameParams, vol: &Volume, i: i64, j: usize, s: usize) -> u32 {
-    if i < 0 {
-        return 0;
-    }
-    params.voxel(vol, i as usize, j, params.slice(s).k)
-}
-
 /// The beats of one section in the frame's order (slice `s`, row `b`, beat `m`): `P` voxels at
 /// `i = a0 + P m ..`, `lo` (voxel `a0 - 1`) on a row's first beat, `hi0`, `hi1` (voxels
 /// `a0 + ns`, `a0 + ns + 1`) on its last, each zero outside `0 .. ni` and on the other beats, and
@@ -62,11 +50,13 @@ fn voxel_at(params: &FrameParams, vol: &Volume, i: i64, j: usize, s: usize) -> u
 pub fn section_beats(params: &FrameParams, vol: &Volume, sec: Section, p: usize) -> Vec<Beam> {
     let nbr = sec.ns / p;
     let mut out = Vec::with_capacity(params.nk * params.nj * nbr);
+    let voxel = volume_voxels(params, vol);
     for s in 0..params.nk {
         for b in 0..params.nj {
             for m in 0..nbr {
                 let (first, last) = (m == 0, m + 1 == nbr);
-                let at = |i: i64| voxel_at(params, vol, i, b, s);
+                // Zero outside the face.
+                let at = |i: i64| if i < 0 { 0 } else { voxel(s, i as usize, b) };
                 let a = (sec.a0 + p * m) as i64;
                 let e = (sec.a0 + sec.ns) as i64;
                 out.push(Beam {
@@ -143,41 +133,14 @@ impl SectionVoxels {
         self.cols[(s * self.nj + j) * w + (i - a0 + 1) as usize]
     }
 
-    /// `S'(t)` at anchor `(a, b)` with slice `c`'s weights (the contract's, zero for a slice or
-    /// anchor outside the volume), from this section's voxels: `a` in `a0 - 1 ..= a0 + ns`.
-    pub fn sample(
-        &self,
-        params: &FrameParams,
-        c: &SliceConst,
-        t: i64,
-        a: i64,
-        b: i64,
-        trilin: &Trilin,
-    ) -> u32 {
-        if outside_face(params, t, a, b) {
-            return 0;
-        }
-        let (t, b) = (t as usize, b as usize);
-        let v = |da: i64, db: usize| self.voxel(t, a + da, b + db);
-        let corners = [v(0, 0), v(1, 0), v(0, 1), v(1, 1)];
-        trilin.sample(&bilinear_input(c, corners, &trilin.config()))
-    }
-
-    /// The gradient neighbourhood `[C, x-, x+, y-, y+, B, A]` of anchor `(a, b)` of slice `c`, an
-    /// anchor of this section, from this section's voxels.
-    pub fn neighbourhood(
-        &self,
-        params: &FrameParams,
-        c: &SliceConst,
-        a: usize,
-        b: usize,
-        trilin: &Trilin,
-    ) -> [u32; 7] {
-        neighbourhood_from(c, a, b, |t, a, b| self.sample(params, c, t, a, b, trilin))
+    /// This section's voxels as [`super::sample_at`] reads them: `(t, i, j)` is voxel `(i, j)` of
+    /// slice `t`, `i` in `a0 - 1 ..= a0 + ns + 1` (the anchors `a0 - 1 ..= a0 + ns`).
+    pub fn voxels(&self) -> impl Fn(usize, usize, usize) -> u32 + '_ {
+        |t, i, j| self.voxel(t, i as i64, j)
     }
 
     /// The shaded sample at anchor `(a, b)` of slice `c` (an anchor of this section) that the
-    /// compositing unit takes: gradient and shader, or the classification alone (`Shade = 0`).
+    /// compositing unit takes, from the section's own voxels ([`FrameUnits::shaded_from`]).
     pub fn shaded(
         &self,
         params: &FrameParams,
@@ -186,32 +149,7 @@ impl SectionVoxels {
         a: usize,
         b: usize,
     ) -> crate::units::cube5_compos::Sample {
-        let s = c.s;
-        // As `FrameUnits::shaded_sample`: every mode (MinIP's depth past a far face, the unlit
-        // modes, the 2-D table), from the section's own voxels.
-        let mode = units.mode.compos_mode();
-        let depth = units
-            .mode
-            .sample_depth(params, c, (a, b), &units.compos.config());
-        if units.shade {
-            let nb = self.neighbourhood(params, c, a, b, &units.trilin);
-            crate::units::cube5_compos::Sample {
-                mode,
-                ..shade_n6(
-                    &units.gradient,
-                    &units.shader,
-                    &nb,
-                    units.shader_mode(),
-                    depth,
-                )
-            }
-        } else {
-            let centre = self.sample(params, c, s as i64, a as i64, b as i64, &units.trilin);
-            crate::units::cube5_compos::Sample {
-                mode,
-                ..super::classify_only(&units.shader, centre, depth)
-            }
-        }
+        units.shaded_from(params, c, (a, b), &self.voxels())
     }
 }
 
@@ -268,7 +206,7 @@ mod tests {
     use super::*;
     use crate::transfer::TransferFunction;
     use crate::units::cube5_frame::{
-        frame_phong, neighbourhood, render_base_plane, FrameMode, FrameSetup,
+        frame_phong, neighbourhood, neighbourhood_from, render_base_plane, FrameMode, FrameSetup,
     };
     use glam::DVec3;
 
@@ -367,7 +305,10 @@ mod tests {
     #[test]
     fn edge_voxels_give_the_whole_frames_samples_and_gradients() {
         let vol = crate::phantom::head_phantom(24, 12).unwrap();
-        let trilin = Trilin::new(crate::units::cube5_trilin::TrilinConfig::DEFAULT).unwrap();
+        let trilin = crate::units::cube5_trilin::Trilin::new(
+            crate::units::cube5_trilin::TrilinConfig::DEFAULT,
+        )
+        .unwrap();
         for v in [
             [0.3, -0.7, 1.0],
             [-1.0, 0.4, 0.2],
@@ -386,7 +327,7 @@ mod tests {
                         for b in 0..params.nj {
                             for a in sec.a0..sec.a0 + sec.ns {
                                 assert_eq!(
-                                    data.neighbourhood(&params, &c, a, b, &trilin),
+                                    neighbourhood_from(&params, &c, (a, b), &trilin, &data.voxels()),
                                     neighbourhood(&params, &vol, &c, a, b, &trilin),
                                     "view {v:?} S {width} P {p} section {sec:?} slice {s} anchor ({a}, {b})"
                                 );
