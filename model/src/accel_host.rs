@@ -16,7 +16,7 @@ use crate::regs::cube5_accel::{
     REG_VIEW, REG_VOL_BASE_HI, REG_VOL_BASE_LO, TABLE_BLOCK, TABLE_CLASS, TABLE_OPACITY,
     TABLE_REFLECT,
 };
-use crate::units::cube5_accel_ctrl::CtrlRegs;
+pub use crate::units::cube5_accel_ctrl::FrameRegs;
 use std::fmt;
 
 /// Bytes per register: the AXI4-Lite data bus is 32 bits (`cube5-gen` refuses an `axil` map with
@@ -41,58 +41,6 @@ pub enum HostError<E: fmt::Display> {
     Frame(u32),
     #[error("refused: {0}")]
     Refused(String),
-}
-
-/// A frame's set-up words, as cube5_frame's registers carry them (cube5_frame.regs.toml: Dims,
-/// View, Dx, Dy, Mode, Skip); the accelerator's registers of the same names hold them unchanged.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct FrameRegs {
-    pub dims: u32,
-    pub view: u32,
-    pub dx: u32,
-    pub dy: u32,
-    pub mode: u32,
-    pub skip: u32,
-}
-
-impl FrameRegs {
-    /// An example frame for tests and docs: a 64^3 volume at `m` = 7 (8-bit dimension fields),
-    /// slices along z swept in reverse, steps -2 / 65536 and 12 / 65536, composite with the 2-D
-    /// transfer function, two empty slices skipped in front and three behind.
-    pub const EXAMPLE: Self = Self {
-        dims: 0x0040_4040,
-        view: 6,
-        dx: 0x3_fffe,
-        dy: 12,
-        mode: 9,
-        skip: 0x0302,
-    };
-
-    /// (accelerator register, word) in the order the driver writes them.
-    pub fn writes(&self) -> [(u32, u32); 6] {
-        [
-            (REG_DIMS, self.dims),
-            (REG_VIEW, self.view),
-            (REG_DX, self.dx),
-            (REG_DY, self.dy),
-            (REG_MODE, self.mode),
-            (REG_SKIP, self.skip),
-        ]
-    }
-}
-
-/// The frame words of a controller's register set (the rest are bases, pitch and tables).
-impl From<&CtrlRegs> for FrameRegs {
-    fn from(r: &CtrlRegs) -> Self {
-        Self {
-            dims: r.dims,
-            view: r.view,
-            dx: r.dx,
-            dy: r.dy,
-            mode: r.mode,
-            skip: r.skip,
-        }
-    }
 }
 
 /// The Status register, decoded.

@@ -195,7 +195,8 @@ impl Bench {
 
     fn write_regs(&mut self, r: &CtrlRegs) -> Result<(), TbError> {
         let d = self.host_delay;
-        let t: Vec<AxilTxn> = FrameRegs::from(r)
+        let t: Vec<AxilTxn> = r
+            .frame
             .writes()
             .into_iter()
             .chain([
@@ -362,12 +363,14 @@ fn regs_of(
     dy: i32,
 ) -> CtrlRegs {
     CtrlRegs {
-        dims: pack_dims(cfg, dims),
-        view: axis_k | u32::from(rev) << 2,
-        dx: dx as u32 & 0x3_ffff,
-        dy: dy as u32 & 0x3_ffff,
-        mode: 1,
-        skip: 0,
+        frame: FrameRegs {
+            dims: pack_dims(cfg, dims),
+            view: axis_k | u32::from(rev) << 2,
+            dx: dx as u32 & 0x3_ffff,
+            dy: dy as u32 & 0x3_ffff,
+            mode: 1,
+            skip: 0,
+        },
         vol_base: 0x40 * u64::from(cfg.data_w / 8),
         img_base: 0x100 * u64::from(cfg.pixel_bytes),
         img_pitch: 0,
@@ -421,17 +424,19 @@ fn random_regs(rng: &mut ChaCha8Rng, cfg: &AccelCtrlConfig) -> CtrlRegs {
         }
     };
     CtrlRegs {
-        dims: pack_dims(cfg, dims)
-            | if rng.random_bool(0.1) {
-                rng.random::<u32>() & !((1 << (3 * m1)) - 1)
-            } else {
-                0
-            },
-        view: axis | rng.random_range(0..2) << 2,
-        dx: step(rng) as u32 & 0x3_ffff,
-        dy: step(rng) as u32 & 0x3_ffff,
-        mode,
-        skip,
+        frame: FrameRegs {
+            dims: pack_dims(cfg, dims)
+                | if rng.random_bool(0.1) {
+                    rng.random::<u32>() & !((1 << (3 * m1)) - 1)
+                } else {
+                    0
+                },
+            view: axis | rng.random_range(0..2) << 2,
+            dx: step(rng) as u32 & 0x3_ffff,
+            dy: step(rng) as u32 & 0x3_ffff,
+            mode,
+            skip,
+        },
         vol_base: align(rng, u64::from(cfg.data_w / 8)),
         img_base: align(rng, cfg.row_align()),
         // ImgPitch: mostly 0 (the smallest), else aligned (some below the row), rarely not.
@@ -497,29 +502,51 @@ fn directed_extremes_faces_directions_and_section_counts() {
         }
         // Each refusal.
         let ok = regs_of(&cfg, [16, 16, 16], 2, false, 0, 0);
-        let dims = |d: [u32; 3]| CtrlRegs {
-            dims: pack_dims(&cfg, d),
-            ..ok
+        // `ok` with other frame words.
+        let with = |frame: FrameRegs| CtrlRegs { frame, ..ok };
+        let dims = |d: [u32; 3]| {
+            with(FrameRegs {
+                dims: pack_dims(&cfg, d),
+                ..ok.frame
+            })
         };
         let mut cases: Vec<(CtrlRegs, u32)> = vec![
-            (CtrlRegs { view: 3, ..ok }, CODE_AXIS_K),
+            (
+                with(FrameRegs {
+                    view: 3,
+                    ..ok.frame
+                }),
+                CODE_AXIS_K,
+            ),
             (dims([16, 16 + p / 2, 16]), CODE_DIMS),
             (dims([16, 0, 16]), CODE_DIMS),
             (dims([16, 2 * md, 16]), CODE_DIMS),
-            (CtrlRegs { mode: 5, ..ok }, CODE_RENDER),
             (
-                CtrlRegs {
+                with(FrameRegs {
+                    mode: 5,
+                    ..ok.frame
+                }),
+                CODE_RENDER,
+            ),
+            (
+                with(FrameRegs {
                     dx: (1 << 16) + 1,
-                    ..ok
-                },
+                    ..ok.frame
+                }),
                 CODE_STEP,
             ),
-            (CtrlRegs { dy: 1 << 17, ..ok }, CODE_STEP),
             (
-                CtrlRegs {
+                with(FrameRegs {
+                    dy: 1 << 17,
+                    ..ok.frame
+                }),
+                CODE_STEP,
+            ),
+            (
+                with(FrameRegs {
                     skip: 8 | 8 << (cfg.m() + 1),
-                    ..ok
-                },
+                    ..ok.frame
+                }),
                 CODE_SKIP,
             ),
             (dims([p, 16, 16]), CODE_SMALL),
@@ -774,7 +801,7 @@ fn the_host_driver_renders_a_frame_on_the_rtl() {
     });
     let regs = regs_of(&cfg, [32, 16, 24], 0, true, -5000, 7000);
     let mut host = AccelHost::new(b, 0);
-    host.write_frame(&FrameRegs::from(&regs)).unwrap();
+    host.write_frame(&regs.frame).unwrap();
     host.set_bases(regs.vol_base, regs.img_base).unwrap();
     host.load_table(TABLE_CLASS, 5, &[1, 2, 3]).unwrap();
     assert_eq!(host.table_pos().unwrap(), (TABLE_CLASS, 8));

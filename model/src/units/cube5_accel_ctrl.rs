@@ -14,9 +14,9 @@ use crate::bits::{words_for, BitReader, BitWriter};
 use crate::error::{ModelError, Result};
 use crate::regs::cube5_accel::{
     CODE_ABORTED, CODE_AXIS_K, CODE_DIMS, CODE_FRAME, CODE_IMG_ALIGN, CODE_NONE, CODE_PITCH,
-    CODE_RENDER, CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_DX_DX,
-    REG_MODE_RENDER, REG_STATUS_CODE, REG_STATUS_DONE, REG_STATUS_ERROR, REG_VIEW_AXIS_K,
-    REG_VIEW_K_REVERSED,
+    CODE_RENDER, CODE_SKIP, CODE_SMALL, CODE_STEP, CODE_VOL_ALIGN, CODE_WRITE, REG_DIMS, REG_DX,
+    REG_DX_DX, REG_DY, REG_MODE, REG_MODE_RENDER, REG_SKIP, REG_STATUS_CODE, REG_STATUS_DONE,
+    REG_STATUS_ERROR, REG_VIEW, REG_VIEW_AXIS_K, REG_VIEW_K_REVERSED,
 };
 use crate::unit::StreamCodec;
 use crate::units::cube5_axil::{AxilCodec, AxilRecord, AxilTxn};
@@ -184,18 +184,19 @@ impl AccelCtrlConfig {
 
     /// What the core does with `regs` on `Ctrl.start`: the plan, or the refusal code.
     pub fn plan(&self, regs: &CtrlRegs) -> std::result::Result<Plan, u32> {
+        let f = &regs.frame;
         let m1 = self.m() + 1;
         let fmask = (1u32 << m1) - 1;
-        let dims = [0, 1, 2].map(|a| (regs.dims >> (m1 * a)) & fmask);
-        let axis_k = REG_VIEW_AXIS_K.get(u64::from(regs.view)) as u32;
-        let reversed = REG_VIEW_K_REVERSED.get(u64::from(regs.view)) != 0;
+        let dims = [0, 1, 2].map(|a| (f.dims >> (m1 * a)) & fmask);
+        let axis_k = REG_VIEW_AXIS_K.get(u64::from(f.view)) as u32;
+        let reversed = REG_VIEW_K_REVERSED.get(u64::from(f.view)) != 0;
         let sext = |w: u32| {
             let v = (w & ((1 << (STEP_W + 2)) - 1)) as i32;
             (v << (32 - STEP_W - 2)) >> (32 - STEP_W - 2)
         };
-        let (dx, dy) = (sext(regs.dx), sext(regs.dy));
-        let render = REG_MODE_RENDER.get(u64::from(regs.mode));
-        let (front, back) = (regs.skip & fmask, (regs.skip >> m1) & fmask);
+        let (dx, dy) = (sext(f.dx), sext(f.dy));
+        let render = REG_MODE_RENDER.get(u64::from(f.mode));
+        let (front, back) = (f.skip & fmask, (f.skip >> m1) & fmask);
         if axis_k == 3 {
             return Err(CODE_AXIS_K);
         }
@@ -319,7 +320,7 @@ impl AccelCtrlConfig {
     /// widths), then `sec_a0`, `sec_ns`, `sec_first`, `sec_last`.
     pub fn pack_frame(&self, plan: &Plan, sec: &Section) -> Vec<u32> {
         let m1 = self.m() + 1;
-        let r = &plan.regs;
+        let r = &plan.regs.frame;
         let mask = |v: u32, w: u32| u64::from(v) & ((1u64 << w) - 1);
         let mut b = BitWriter::new();
         b.put(mask(r.dims, 3 * m1), 3 * m1)
@@ -416,15 +417,49 @@ crate::unit_config!(AccelCtrlConfig, "cube5_accel_ctrl", DEFAULT, {
     "Window" => window,
 });
 
-/// The registers the core latches on `Ctrl.start` (words as the host wrote them; bases 64-bit).
+/// A frame's set-up words, as cube5_frame's registers carry them (cube5_frame.regs.toml: Dims,
+/// View, Dx, Dy, Mode, Skip); the accelerator's registers of the same names hold them unchanged.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct CtrlRegs {
+pub struct FrameRegs {
     pub dims: u32,
     pub view: u32,
     pub dx: u32,
     pub dy: u32,
     pub mode: u32,
     pub skip: u32,
+}
+
+impl FrameRegs {
+    /// An example frame for tests and docs: a 64^3 volume at `m` = 7 (8-bit dimension fields),
+    /// slices along z swept in reverse, steps -2 / 65536 and 12 / 65536, composite with the 2-D
+    /// transfer function, two empty slices skipped in front and three behind.
+    pub const EXAMPLE: Self = Self {
+        dims: 0x0040_4040,
+        view: 6,
+        dx: 0x3_fffe,
+        dy: 12,
+        mode: 9,
+        skip: 0x0302,
+    };
+
+    /// (accelerator register, word) in the order the driver writes them.
+    pub fn writes(&self) -> [(u32, u32); 6] {
+        [
+            (REG_DIMS, self.dims),
+            (REG_VIEW, self.view),
+            (REG_DX, self.dx),
+            (REG_DY, self.dy),
+            (REG_MODE, self.mode),
+            (REG_SKIP, self.skip),
+        ]
+    }
+}
+
+/// The registers the core latches on `Ctrl.start` (words as the host wrote them; bases 64-bit).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CtrlRegs {
+    /// The frame's set-up words (`Dims` .. `Skip`).
+    pub frame: FrameRegs,
     pub vol_base: u64,
     pub img_base: u64,
     /// `ImgPitch` (0: the smallest legal pitch).
@@ -605,12 +640,14 @@ mod tests {
     fn regs(dims: [u32; 3], view: u32, dx: i32) -> CtrlRegs {
         let m1 = AccelCtrlConfig::DEFAULT.m() + 1;
         CtrlRegs {
-            dims: dims[0] | dims[1] << m1 | dims[2] << (2 * m1),
-            view,
-            dx: (dx as u32) & 0x3_ffff,
-            dy: 0,
-            mode: 1,
-            skip: 0,
+            frame: FrameRegs {
+                dims: dims[0] | dims[1] << m1 | dims[2] << (2 * m1),
+                view,
+                dx: (dx as u32) & 0x3_ffff,
+                dy: 0,
+                mode: 1,
+                skip: 0,
+            },
             vol_base: 0x1000,
             img_base: 0x8000,
             img_pitch: 0,
@@ -681,9 +718,9 @@ mod tests {
         assert_eq!(c.plan(&regs([40, 128, 24], 2, 0)), Err(CODE_DIMS));
         assert_eq!(c.plan(&regs([40, 0, 24], 2, 0)), Err(CODE_DIMS));
         let mut r = regs([40, 32, 24], 2, 0);
-        r.mode = 5;
+        r.frame.mode = 5;
         assert_eq!(c.plan(&r), Err(CODE_RENDER));
-        r.mode = 4 | 1 << 3;
+        r.frame.mode = 4 | 1 << 3;
         assert!(c.plan(&r).is_ok(), "first-opaque with the 2-D table");
         assert_eq!(
             c.plan(&regs([40, 32, 24], 2, (1 << 16) + 1)),
@@ -692,7 +729,7 @@ mod tests {
         assert_eq!(c.plan(&regs([40, 32, 24], 2, -(1 << 17))), Err(CODE_STEP));
         assert!(c.plan(&regs([40, 32, 24], 2, -(1 << 16))).is_ok());
         let mut r = regs([40, 32, 24], 2, 0);
-        r.skip = 12 | 12 << 7;
+        r.frame.skip = 12 | 12 << 7;
         assert_eq!(c.plan(&r), Err(CODE_SKIP));
         assert_eq!(c.plan(&regs([4, 32, 24], 2, 0)), Err(CODE_SMALL));
         // ni (nj - 1) / P: 12 x 3 / 4 = 9 passes, 8 x 3 / 4 = 6 fails.
