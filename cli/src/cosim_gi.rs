@@ -23,6 +23,7 @@ use cube5_model::units::gicube_processor::{
     ProcessorFrame, ProcessorOut, ProcessorRtlConfig, Projection,
 };
 use cube5_model::volume::Volume;
+use cube5_tb::harness::count_differing;
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::variants::Netlist;
 use cube5_tb::Variant;
@@ -329,11 +330,7 @@ impl GiBench {
         differences.extend(self.bursts("AW", &aws, &trace.writes));
         let cache = self.rtl.cache_config();
         let words = cache.words_of(&self.dut.axi_image()?);
-        let differ = words
-            .iter()
-            .zip(&trace.memory)
-            .filter(|(a, b)| a != b)
-            .count();
+        let differ = count_differing(&words, &trace.memory);
         if differ > 0 || words.len() != trace.memory.len() {
             differences.push(format!(
                 "{differ} memory words (volume and irradiance field) differ from the model's after the flush"
@@ -382,12 +379,7 @@ impl GiBench {
 /// in = finished + overflowed on both sides.
 fn compare(got: &RtlPass, want: &ProcessorFrame) -> Vec<String> {
     let mut d = Vec::new();
-    let differ = got
-        .rgb
-        .iter()
-        .zip(&want.rgb)
-        .filter(|(a, b)| a != b)
-        .count();
+    let differ = count_differing(&got.rgb, &want.rgb);
     if differ > 0 {
         d.push(format!("{differ} pixels differ from the model's"));
     }

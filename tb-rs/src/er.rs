@@ -145,12 +145,7 @@ pub fn first_difference(got: &ErRtlRun, want: &ErRun) -> Option<String> {
         want.extent.m0 + (k % w) as i64,
         want.extent.n0 + (k / w) as i64,
     );
-    let wrong = got
-        .coxels
-        .iter()
-        .zip(&want.coxels)
-        .filter(|(a, b)| a != b)
-        .count();
+    let wrong = crate::harness::count_differing(&got.coxels, &want.coxels);
     Some(format!(
         "coxel {k} (ray ({m}, {n}) of region 0): RTL {:?}, model {:?} ({wrong} of {} coxels differ)",
         got.coxels[k],

@@ -128,6 +128,12 @@ impl StreamReport {
     }
 }
 
+/// At how many places of two lists (pixels, coxels, memory words) the RTL's item differs from the
+/// model's; places beyond the shorter list are not counted.
+pub fn count_differing<T: PartialEq>(got: &[T], want: &[T]) -> usize {
+    got.iter().zip(want).filter(|(a, b)| a != b).count()
+}
+
 /// Runs a check and turns any failure into a panic whose message is the full report (the
 /// tests' one entry point); prints what the run did when it passes.
 pub fn must_match<C, G>(

@@ -259,12 +259,7 @@ fn load_config(
 fn check_frame(name: &str, what: &str, got: &RtlFrame, want: &ProcessorFrame, exact_counts: bool) {
     let c = &want.counts;
     let l = &got.last;
-    let differ = got
-        .rgb
-        .iter()
-        .zip(&want.rgb)
-        .filter(|(a, b)| a != b)
-        .count();
+    let differ = cube5_tb::harness::count_differing(&got.rgb, &want.rgb);
     assert_eq!(
         differ, 0,
         "{name} {what}: {differ} pixels differ from the model"
