@@ -135,6 +135,23 @@ fn err(path: &Path, field: &str, message: impl std::fmt::Display) -> ModelError 
     ModelError::Volume(format!("{}: {field}: {message}", path.display()))
 }
 
+/// A header field of one value per axis (`sizes`, `spacings`), white space between; a value that
+/// does not read as `T` is refused as not `what`.
+fn per_axis<T: std::str::FromStr>(
+    path: &Path,
+    field: &str,
+    value: &str,
+    what: &str,
+) -> Result<Vec<T>> {
+    value
+        .split_whitespace()
+        .map(|v| {
+            v.parse::<T>()
+                .map_err(|_| err(path, field, format!("`{v}` is not {what}")))
+        })
+        .collect()
+}
+
 fn read_file(path: &Path) -> Result<Vec<u8>> {
     std::fs::read(path).map_err(|source| ModelError::Io {
         path: path.display().to_string(),
@@ -628,17 +645,7 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
                         .map_err(|_| e("dimension", format!("`{value}` is not a number")))?,
                 )
             }
-            "sizes" => {
-                sizes = Some(
-                    value
-                        .split_whitespace()
-                        .map(|v| {
-                            v.parse::<usize>()
-                                .map_err(|_| e("sizes", format!("`{v}` is not a size")))
-                        })
-                        .collect::<Result<_>>()?,
-                )
-            }
+            "sizes" => sizes = Some(per_axis(origin, "sizes", value, "a size")?),
             "encoding" => {
                 encoding = Some(match value.to_ascii_lowercase().as_str() {
                     "raw" => NrrdEncoding::Raw,
@@ -654,17 +661,7 @@ pub fn parse_nrrd_header(bytes: &[u8], origin: &Path) -> Result<(NrrdHeader, usi
                     other => return Err(e("endian", format!("`{other}` is not little or big"))),
                 })
             }
-            "spacings" => {
-                spacings = Some(
-                    value
-                        .split_whitespace()
-                        .map(|v| {
-                            v.parse::<f64>()
-                                .map_err(|_| e("spacings", format!("`{v}` is not a number")))
-                        })
-                        .collect::<Result<_>>()?,
-                )
-            }
+            "spacings" => spacings = Some(per_axis(origin, "spacings", value, "a number")?),
             "space directions" => directions = Some(parse_space_directions(value, origin)?),
             "space" => space = Some(value.to_string()),
             "space dimension" => space_dimension = Some(value.to_string()),
