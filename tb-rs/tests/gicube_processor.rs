@@ -905,3 +905,28 @@ fn gate_level_netlist_renders_an_exact_frame() {
         );
     }
 }
+
+/// The gate-level netlists of the `Light` configurations (`b2v2l1`): a short lighting pass (the
+/// shadow scene's grid halved: a quarter of its rays, the fewest its energy allows), its flush and the rendering pass lit by the field, every
+/// ray, count, burst and memory word after the flush and every pixel equal to the model's
+/// (`two_pass_gi`); high albedo on a `Scatter` netlist.
+#[test]
+#[ignore = "sim-full: the gate-level netlist is a `full` build (minutes of Yosys and Verilator)"]
+fn gate_level_netlist_runs_an_exact_lighting_pass() {
+    let lit = support::gate_configs::<ProcessorRtlConfig>()
+        .into_iter()
+        .filter(|(_, c)| c.light == 1);
+    for (variant, rtl) in lit {
+        let t = std::time::Instant::now();
+        let mode = if rtl.scatter == 1 {
+            HIGH_ALBEDO
+        } else {
+            GiMode::LowAlbedo
+        };
+        two_pass_gi(variant, rtl, mode, 2, seed(1990));
+        eprintln!(
+            "{variant}: both GI passes on the netlist in {:.1} s",
+            t.elapsed().as_secs_f64()
+        );
+    }
+}
