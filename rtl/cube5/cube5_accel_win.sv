@@ -524,7 +524,9 @@ module cube5_accel_win #(
     localparam int unsigned AccBits  = DataW + StoreW;   // under a beat held, plus a coxel
     localparam int unsigned FillW    = $clog2(AccBits + 1);
     localparam int unsigned CntW     = 2 * DimW + 8;     // beat and coxel counts (they wrap)
-    localparam int unsigned QDepth   = 2 * RingBurst;    // beats packed / beats read ahead
+    localparam int unsigned QDepth   = 2 * RingBurst;    // beats packed, not yet written
+    localparam int unsigned RdDepth  = 4 * RingBurst;    // beats read ahead (the memory serves
+                                                         // the fetch's queued reads first)
     localparam int unsigned QW       = $clog2(QDepth + 1);
     localparam int unsigned BLog     = $clog2(RingBurst);
     localparam int unsigned PadDepth = 4;
@@ -633,10 +635,12 @@ module cube5_accel_win #(
     assign r_off   = BLog'(base >> LogBus) + BLog'(rpos_q);
     assign r_end   = ring_n_q - rpos_q;
     assign r_avail = w_ack_q - r_iss_q;
-    assign r_cred  = CntW'(QDepth) - (r_iss_q - r_pop_q);
+    assign r_cred  = CntW'(RdDepth) - (r_iss_q - r_pop_q);
     assign r_lim   = min2(CntW'(RingBurst) - CntW'(r_off), r_end);
-    assign r_len   = min2(min2(r_avail, r_cred), r_lim);
-    assign ar_go   = r_len != '0 && (!rg_ar_v_q || arready_i) && r_out_q < OutW'(Outstanding);
+    // A read waits until the buffer has room for the whole burst (not a beat at a time).
+    assign r_len   = min2(r_avail, r_lim);
+    assign ar_go   = r_len != '0 && r_len <= r_cred && (!rg_ar_v_q || arready_i)
+                     && r_out_q < OutW'(Outstanding);
 
     always_ff @(posedge clk_i) begin
       if (!rst_ni || frame_start_i) begin
@@ -688,7 +692,7 @@ module cube5_accel_win #(
     assign rg_araddr  = rg_addr_q;
     assign rg_arlen   = rg_len_q;
 
-    cube5_frame_fifo #(.Width(DataW), .Depth(QDepth)) u_rb (
+    cube5_frame_fifo #(.Width(DataW), .Depth(RdDepth)) u_rb (
       .clk_i, .rst_ni, .clear_i(frame_start_i),
       .push_i(r_fire), .d_i(rdata_i), .pop_i(rb_pop), .q_o(rb_q), .empty_o(rb_empty),
       .full_o(rb_full)
