@@ -72,6 +72,13 @@ module cube5_accel #(
   parameter int unsigned WinOutstanding = 16,
   /// Window = 1: the depth of the window's AW and W FIFOs (cube5_accel_win), a power of two.
   parameter int unsigned WinWDepth   = 8,
+  /// Window = 1: the zero-park bit FIFO's depth (cube5_accel_win ZeroDepth; 0: MaxDim^2).
+  parameter int unsigned WinZeroDepth = 0,
+  /// Window = 1: 1 parks into a packed ring in park order, written and read in bursts of up to
+  /// WinRingBurst beats (cube5_accel_win Ring; docs/numerics/compos_window.md, *The ring in
+  /// park order*); 0: a slot per pixel, a burst per park and per restore.
+  parameter int unsigned WinRing     = 0,
+  parameter int unsigned WinRingBurst = 16,
   /// Window = 1: while the window's write beats wait, the fetch keeps at most FetchHold (+ 1)
   /// read bursts granted and not yet returned; 0: it starts none (docs/accel.md, *The
   /// compositing window in the top*).
@@ -647,12 +654,16 @@ module cube5_accel #(
 
     cube5_accel_win #(
       .P(P), .DimW(M + 1), .AddrW(AddrW), .DataW(DataW), .IdW(IdW), .AccW(AccW),
-      .ColorW(ColorW), .Outstanding(WinOutstanding), .WDepth(WinWDepth)
+      .ColorW(ColorW), .Outstanding(WinOutstanding), .WDepth(WinWDepth),
+      .ZeroDepth(WinZeroDepth), .Ring(WinRing), .RingBurst(WinRingBurst)
     ) u_win (
       .clk_i, .rst_ni(unit_rst_n),
       .img_base_i(img_base), .row_step_i(row_step), .park_base_i(park_base),
       .row_pixels_i(row_pixels), .rows_done_i(rows_done_q),
       .frame_start_i(fr_q == FrIdle && rc_valid && rc_data[FcFirst]),
+      // nj: the volume's z extent, y when the slices are along z (i, j ascending)
+      .park_rows_i(rc_data[FcView +: 2] == 2'd2 ? rc_data[FcDims + DimW +: DimW]
+                                                : rc_data[FcDims + 2*DimW +: DimW]),
       .park_valid_i(win_park_valid), .park_ready_o(win_park_ready), .park_key_i(win_park_key),
       .park_cox_i(win_park_cox),
       .fin_valid_i(win_fin_valid), .fin_ready_o(win_fin_ready), .fin_key_i(win_fin_key),

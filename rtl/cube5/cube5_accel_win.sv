@@ -27,6 +27,17 @@
 // recorded parks are always older than the unrecorded ones: a restore request is the bit FIFO's
 // head when that FIFO is not empty, else an unrecorded park's (a read). frame_start_i empties the
 // bit FIFO (a frame that ended without restoring its parks leaves nothing behind).
+//
+// The ring (Ring = 1; docs/numerics/compos_window.md, *The ring in park order*): the written
+// parks, in park order, are one packed bit stream (StoreW bits each, no slot padding) in a ring
+// of RB = Wp nj PkBeats beats at ParkBase (the first Wp nj slots' bytes of the slot layout's
+// area). Its beats go out as INCR bursts of up to RingBurst beats, cut at address multiples of
+// RingBurst beats and at the ring's end, each once its beats are complete; the restores read the
+// written beats (B received) in order, in bursts, ahead of the requests, into an on-chip buffer
+// and unpack them. A flush (the frame waits for a restore whose bits are still on chip and
+// nothing else is on its way) writes the beats held, the last padded with zeros; the pad's place
+// (the count of coxels before it) goes to the reader through a small FIFO. A beat is read only
+// after its write's B and rewritten only after its read's data is back.
 module cube5_accel_win #(
   parameter int unsigned P           = 4,
   /// Bits of a key coordinate (log2(MaxDim) + 1).
@@ -44,7 +55,12 @@ module cube5_accel_win #(
   /// Bits of the zero-park FIFO (a power of two; 0: MaxDim^2, a section's parks at 45 degrees).
   parameter int unsigned ZeroDepth   = 0,
   /// Depth of the AW and W FIFOs (a power of two).
-  parameter int unsigned WDepth      = 8
+  parameter int unsigned WDepth      = 8,
+  /// 1: the parks are a packed ring in park order, written and read in bursts; 0: a slot per
+  /// pixel, one burst per park and per restore.
+  parameter int unsigned Ring        = 0,
+  /// Ring = 1: the longest burst in beats (a power of two, at most 256 and 4 KB).
+  parameter int unsigned RingBurst   = 16
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -58,6 +74,9 @@ module cube5_accel_win #(
   input  logic [DimW:0]    rows_done_i,
   /// A frame starts (its first section command): the zero-park FIFO empties.
   input  logic frame_start_i,
+  /// Ring = 1: the frame's rows of anchors (nj), sampled with frame_start_i: the ring is Wp nj
+  /// coxel slots' bytes.
+  input  logic [DimW-1:0]  park_rows_i,
 
   // ---- the frame's window streams ----
   input  logic park_valid_i,
@@ -152,11 +171,12 @@ module cube5_accel_win #(
   logic [P-1:0]       s1_mask_q;
   logic [P*StoreW-1:0] s1_cox_q;
   logic               s1_ready, take_park, take_fin, s2_take;
+  logic               rg_take;    // Ring = 1: a written park leaves stage 1 into the packer
   // A park is decided in its first cycle in stage 1: recorded in the zero FIFO or not, dropped
   // (all zero, recorded: nothing written) or kept for stage 2 (a write).
   logic               p_decide, p_rec, p_drop, p_write;
 
-  assign s1_ready     = !s1_v_q || s2_take || p_drop;
+  assign s1_ready     = !s1_v_q || s2_take || rg_take || p_drop;
   assign take_park    = park_valid_i && s1_ready;
   assign take_fin     = fin_valid_i && !park_valid_i && s1_ready
                         && (DimW + 1)'(fin_key_i[DimW +: DimW]) < rows_done_i;
@@ -225,7 +245,7 @@ module cube5_accel_win #(
     end
   end
 
-  assign s2_take = s1_v_q && !p_drop && (!s2_v_q || s3_done);
+  assign s2_take = s1_v_q && !p_drop && (!s2_v_q || s3_done) && !(Ring != 0 && s1_park_q);
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
@@ -257,6 +277,11 @@ module cube5_accel_win #(
   logic               aw_full, aw_empty, w_full, w_empty, aw_pop, w_pop;
   logic [OutW-1:0]    out_q;      // write bursts in the AW FIFO or in flight, B not yet in
   logic               b_fire;
+  logic               rg_use;     // Ring = 1: a ring burst's AW or beats go into the FIFOs
+  logic               rg_aw;      // Ring = 1: a ring burst starts (its AW pushed)
+  logic               rg_w;       // Ring = 1: a ring burst's beat into the W FIFO
+  logic [AwW-1:0]     rg_aw_d;
+  logic [WW-1:0]      rg_w_d;
 
   always_comb begin
     beat      = s2_line_q[0 +: DataW];
@@ -273,7 +298,7 @@ module cube5_accel_win #(
   assign need_aw = s2_park_q ? (t_q == '0) : |beat_strb;
   assign push_w  = s2_park_q || |beat_strb;
   assign can     = (!need_aw || (!aw_full && out_q < OutW'(Outstanding))) && (!push_w || !w_full);
-  assign step    = s2_v_q && can;
+  assign step    = s2_v_q && can && !rg_use;
   assign push_aw = step && need_aw;
   assign s3_done = step && t_last;
 
@@ -293,11 +318,11 @@ module cube5_accel_win #(
 
   cube5_frame_fifo #(.Width(AwW), .Depth(WDepth)) u_aw (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i(push_aw), .d_i(aw_d), .pop_i(aw_pop), .q_o(aw_q), .empty_o(aw_empty), .full_o(aw_full)
+    .push_i(push_aw || rg_aw), .d_i(rg_use ? rg_aw_d : aw_d), .pop_i(aw_pop), .q_o(aw_q), .empty_o(aw_empty), .full_o(aw_full)
   );
   cube5_frame_fifo #(.Width(WW), .Depth(WDepth)) u_w (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i(step && push_w), .d_i(w_d), .pop_i(w_pop), .q_o(w_q), .empty_o(w_empty), .full_o(w_full)
+    .push_i((step && push_w) || rg_w), .d_i(rg_use ? rg_w_d : w_d), .pop_i(w_pop), .q_o(w_q), .empty_o(w_empty), .full_o(w_full)
   );
 
   assign {awid_o, awlen_o, awaddr_o} = aw_q;
@@ -312,7 +337,7 @@ module cube5_accel_win #(
     if (!rst_ni) begin
       out_q <= '0;
     end else begin
-      out_q <= out_q + OutW'(push_aw) - OutW'(b_fire);
+      out_q <= out_q + OutW'(push_aw || rg_aw) - OutW'(b_fire);
     end
   end
 
@@ -396,12 +421,18 @@ module cube5_accel_win #(
     assign unused_zero = frame_start_i;
   end
 
-  assign rq_ready_o = !rq_full && rq_ok;
+  logic             rg_cx_v, rg_idle;   // Ring = 1: a restored coxel unpacked; nothing in flight
+  logic [StoreW-1:0] rg_cx;
+  logic [AddrW-1:0] rg_araddr;
+  logic [7:0]       rg_arlen;
+  logic             rg_arvalid;
+
+  assign rq_ready_o = ((Ring != 0) ? !ord_full : !rq_full) && rq_ok;
   assign rq_push    = rq_valid_i && rq_ready_o;
 
   cube5_frame_fifo #(.Width(AddrW + TagW + 1), .Depth(RqDepth)) u_rq (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i(rq_push), .d_i({rq_zero, slot_of(rq_key_i), ptaken_q + TagW'(p_write)}),
+    .push_i(rq_push && Ring == 0), .d_i({rq_zero, slot_of(rq_key_i), ptaken_q + TagW'(p_write)}),
     .pop_i(hd_load), .q_o({rq_zero_q, rq_addr, rq_tag}), .empty_o(rq_empty), .full_o(rq_full)
   );
 
@@ -442,17 +473,18 @@ module cube5_accel_win #(
 
   cube5_frame_fifo #(.Width(1), .Depth(RqDepth)) u_ord (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i(hd_move), .d_i(hd_zero_q), .pop_i(ord_pop), .q_o(ord_zero),
+    .push_i((Ring != 0) ? rq_push : hd_move), .d_i((Ring != 0) ? rq_zero : hd_zero_q),
+    .pop_i(ord_pop), .q_o(ord_zero),
     .empty_o(ord_empty), .full_o(ord_full)
   );
 
-  assign arvalid_o  = ar_v_q;
-  assign araddr_o   = ar_addr_q;
-  assign arlen_o    = 8'(PkBeats - 1);
-  assign rready_o   = !rs_v_q;
+  assign arvalid_o  = (Ring != 0) ? rg_arvalid : ar_v_q;
+  assign araddr_o   = (Ring != 0) ? rg_araddr : ar_addr_q;
+  assign arlen_o    = (Ring != 0) ? rg_arlen : 8'(PkBeats - 1);
+  assign rready_o   = (Ring != 0) || !rs_v_q;   // Ring = 1: the buffer has room (credits)
   assign r_fire     = rvalid_i && rready_o;
-  assign rs_valid_o = !ord_empty && (ord_zero || rs_v_q);
-  assign rs_cox_o   = ord_zero ? '0 : rs_q[StoreW-1:0];
+  assign rs_valid_o = !ord_empty && (ord_zero || ((Ring != 0) ? rg_cx_v : rs_v_q));
+  assign rs_cox_o   = ord_zero ? '0 : (Ring != 0) ? rg_cx : rs_q[StoreW-1:0];
   assign ord_pop    = rs_valid_o && rs_ready_i;
   assign rs_take    = ord_pop && !ord_zero;
 
@@ -465,8 +497,8 @@ module cube5_accel_win #(
     end else begin
       ptaken_q <= ptaken_q + TagW'(p_write);
       pdone_q  <= pdone_q + TagW'(b_fire && bid_i == IdPark);
-      rs_out_q <= rs_out_q + OutW'(hd_move) - OutW'(ord_pop);
-      if (r_fire && rlast_i) rs_v_q <= 1'b1;
+      rs_out_q <= rs_out_q + OutW'(hd_move) - OutW'(ord_pop && Ring == 0);
+      if (r_fire && rlast_i && Ring == 0) rs_v_q <= 1'b1;
       else if (rs_take)      rs_v_q <= 1'b0;
     end
   end
@@ -479,6 +511,259 @@ module cube5_accel_win #(
     always_ff @(posedge clk_i) begin
       if (r_fire) rs_q <= rdata_i;
     end
+  end
+
+  // ---------------------------------------------------------------------------
+  // Ring = 1: the written parks as one packed bit stream in a ring at ParkBase, in park order
+  // (docs/numerics/compos_window.md, *The ring in park order*). Packer: coxels in, whole beats
+  // out into a queue; bursts of the queued beats; the restores' reader: the acknowledged beats,
+  // in order, read ahead in bursts, unpacked into coxels.
+  // ---------------------------------------------------------------------------
+  if (Ring != 0) begin : gen_ring
+    localparam int unsigned LogW     = $clog2(DataW);
+    localparam int unsigned AccBits  = DataW + StoreW;   // under a beat held, plus a coxel
+    localparam int unsigned FillW    = $clog2(AccBits + 1);
+    localparam int unsigned CntW     = 2 * DimW + 8;     // beat and coxel counts (they wrap)
+    localparam int unsigned QDepth   = 2 * RingBurst;    // beats packed, not yet written
+    localparam int unsigned RdDepth  = 4 * RingBurst;    // beats read ahead (the memory serves
+                                                         // the fetch's queued reads first)
+    localparam int unsigned QW       = $clog2(QDepth + 1);
+    localparam int unsigned BLog     = $clog2(RingBurst);
+    localparam int unsigned PadDepth = 4;
+    localparam int unsigned CxDepth  = 4;
+    localparam int unsigned BlDepth  = 1 << $clog2(Outstanding);
+
+    if (RingBurst < 2 || (1 << BLog) != RingBurst || RingBurst > 256 || RingBurst * Bbus > 4096)
+    begin : gen_bad_burst
+      $fatal(1, "cube5_accel_win: RingBurst must be a power of two, 2 to 256 beats, at most 4 KB");
+    end
+
+    logic [AddrW-1:0] base;            // ParkBase, slot-aligned (as the slots')
+    logic [DimW-1:0]  rows_q;          // the frame's nj
+    logic [CntW-1:0]  ring_n_q;        // beats of the ring: Wp nj PkBeats
+    assign base = park_base_i & ~AddrW'((1 << CxLog) - 1);
+
+    always_ff @(posedge clk_i) begin
+      if (frame_start_i) rows_q <= park_rows_i;
+      ring_n_q <= (CntW'(row_pixels_i) * CntW'(rows_q)) << $clog2(PkBeats);
+    end
+
+    // ---- the packer: acc_q holds fill_q bits (LSB first; the bits above are zero) ----
+    logic [AccBits-1:0] acc_q, acc_s;
+    logic [FillW-1:0]   fill_q, fill_s;
+    logic [CntW-1:0]    cin_q;         // coxels packed
+    logic               flush_q, emit, pad;
+    logic               bq_empty, bq_full, pf_empty, pf_full, pf_pop;
+    logic [DataW-1:0]   bq_q;
+    logic [CntW-1:0]    pf_q;
+    logic [QW-1:0]      bq_n_q;        // queued beats not yet in a burst
+
+    assign emit    = fill_q >= FillW'(DataW) && !bq_full;
+    assign fill_s  = emit ? fill_q - FillW'(DataW) : fill_q;
+    assign acc_s   = emit ? acc_q >> DataW : acc_q;
+    assign rg_take = s1_v_q && s1_park_q && !p_drop && fill_s < FillW'(DataW);
+    // A flush pads the partial beat: the next coxel starts at the next beat.
+    assign pad     = flush_q && !rg_take && fill_q != '0 && fill_q < FillW'(DataW) && !pf_full
+                     && !bq_full;
+
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni || frame_start_i) begin
+        acc_q  <= '0;
+        fill_q <= '0;
+        cin_q  <= '0;
+      end else if (pad) begin
+        acc_q  <= '0;
+        fill_q <= '0;
+      end else begin
+        acc_q  <= rg_take ? acc_s | (AccBits'(s1_cox_q[StoreW-1:0]) << fill_s) : acc_s;
+        fill_q <= fill_s + (rg_take ? FillW'(StoreW) : FillW'(0));
+        cin_q  <= cin_q + CntW'(rg_take);
+      end
+    end
+
+    cube5_frame_fifo #(.Width(DataW), .Depth(QDepth)) u_bq (
+      .clk_i, .rst_ni, .clear_i(frame_start_i),
+      .push_i(emit || pad), .d_i(acc_q[DataW-1:0]), .pop_i(rg_w), .q_o(bq_q),
+      .empty_o(bq_empty), .full_o(bq_full)
+    );
+    // The pads' places: the count of coxels packed before each.
+    cube5_frame_fifo #(.Width(CntW), .Depth(PadDepth)) u_pf (
+      .clk_i, .rst_ni, .clear_i(frame_start_i),
+      .push_i(pad), .d_i(cin_q), .pop_i(pf_pop), .q_o(pf_q), .empty_o(pf_empty), .full_o(pf_full)
+    );
+
+    // ---- write bursts: cut at address multiples of RingBurst beats and at the ring's end ----
+    logic [CntW-1:0] wpos_q, rpos_q;            // ring positions (beats) of the next write, read
+    logic [CntW-1:0] w_iss_q, w_ack_q;          // beats in write bursts; acknowledged (B)
+    logic [CntW-1:0] r_iss_q, r_ret_q, r_pop_q; // beats read (AR), returned (R), unpacked
+    logic [CntW-1:0] w_lim, w_len, w_room, w_end, r_lim, r_len, r_end, r_avail, r_cred;
+    logic [QW-1:0]   mv_q;                      // beats of the current burst still to move
+    logic            bl_empty, bl_full, bl_pop, ar_go, rg_ar_v_q;
+    logic [QW-1:0]   bl_q;
+    logic [BLog-1:0] w_off, r_off;
+
+    function automatic logic [CntW-1:0] min2(logic [CntW-1:0] a, logic [CntW-1:0] b);
+      min2 = (a < b) ? a : b;
+    endfunction
+
+    assign w_off  = BLog'(base >> LogBus) + BLog'(wpos_q);
+    assign w_end  = ring_n_q - wpos_q;
+    assign w_lim  = min2(CntW'(RingBurst) - CntW'(w_off), w_end);
+    assign w_len  = min2(CntW'(bq_n_q), w_lim);
+    assign w_room = ring_n_q - (w_iss_q - r_ret_q);
+    assign rg_aw  = mv_q == '0 && w_len != '0 && (CntW'(bq_n_q) >= w_lim || flush_q)
+                    && w_len <= w_room && !aw_full && out_q < OutW'(Outstanding);
+    assign rg_w   = mv_q != '0 && !w_full;
+    assign rg_use = rg_aw || mv_q != '0;
+    assign rg_aw_d = {IdPark, 8'(w_len - CntW'(1)), base + (AddrW'(wpos_q) << LogBus)};
+    assign rg_w_d  = {mv_q == QW'(1), {Bbus{1'b1}}, bq_q};
+    assign bl_pop  = b_fire && bid_i == IdPark;
+
+    cube5_frame_fifo #(.Width(QW), .Depth(BlDepth)) u_bl (
+      .clk_i, .rst_ni, .clear_i(1'b0),
+      .push_i(rg_aw), .d_i(QW'(w_len)), .pop_i(bl_pop), .q_o(bl_q), .empty_o(bl_empty),
+      .full_o(bl_full)
+    );
+
+    // ---- restore reads: the acknowledged beats in order, ahead, as the buffer has room ----
+    logic [AddrW-1:0] rg_addr_q;
+    logic [7:0]       rg_len_q;
+    logic             rb_empty, rb_full, rb_pop;
+    logic [DataW-1:0] rb_q;
+    logic [OutW-1:0]  r_out_q;          // read bursts issued, last beat not yet in
+
+    assign r_off   = BLog'(base >> LogBus) + BLog'(rpos_q);
+    assign r_end   = ring_n_q - rpos_q;
+    assign r_avail = w_ack_q - r_iss_q;
+    assign r_cred  = CntW'(RdDepth) - (r_iss_q - r_pop_q);
+    assign r_lim   = min2(CntW'(RingBurst) - CntW'(r_off), r_end);
+    // A read waits until the buffer has room for the whole burst (not a beat at a time).
+    assign r_len   = min2(r_avail, r_lim);
+    assign ar_go   = r_len != '0 && r_len <= r_cred && (!rg_ar_v_q || arready_i)
+                     && r_out_q < OutW'(Outstanding);
+
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni || frame_start_i) begin
+        wpos_q <= '0;
+        rpos_q <= '0;
+        w_iss_q <= '0;
+        w_ack_q <= '0;
+        r_iss_q <= '0;
+        r_ret_q <= '0;
+        r_pop_q <= '0;
+        bq_n_q <= '0;
+        mv_q   <= '0;
+        rg_ar_v_q <= 1'b0;
+        flush_q <= 1'b0;
+        r_out_q <= '0;
+      end else begin
+        bq_n_q <= bq_n_q + QW'(emit || pad) - (rg_aw ? QW'(w_len) : QW'(0));
+        if (rg_aw) begin
+          mv_q    <= QW'(w_len);
+          w_iss_q <= w_iss_q + w_len;
+          wpos_q  <= (w_len == w_end) ? '0 : wpos_q + w_len;
+        end else if (rg_w) begin
+          mv_q <= mv_q - QW'(1);
+        end
+        if (bl_pop) w_ack_q <= w_ack_q + CntW'(bl_q);
+        if (ar_go) begin
+          rg_ar_v_q <= 1'b1;
+          r_iss_q   <= r_iss_q + r_len;
+          rpos_q    <= (r_len == r_end) ? '0 : rpos_q + r_len;
+        end else if (arready_i) begin
+          rg_ar_v_q <= 1'b0;
+        end
+        r_ret_q <= r_ret_q + CntW'(r_fire);
+        r_out_q <= r_out_q + OutW'(ar_go) - OutW'(r_fire && rlast_i);
+        r_pop_q <= r_pop_q + CntW'(rb_pop);
+        // The frame waits for a restore whose bits are not on their way: write what is held.
+        flush_q <= !ord_empty && !ord_zero && !rg_cx_v && rb_empty && r_avail == '0
+                   && r_iss_q == r_ret_q && !rg_ar_v_q && bl_empty && mv_q == '0;
+      end
+    end
+
+    always_ff @(posedge clk_i) begin
+      if (ar_go) begin
+        rg_addr_q <= base + (AddrW'(rpos_q) << LogBus);
+        rg_len_q  <= 8'(r_len - CntW'(1));
+      end
+    end
+    assign rg_arvalid = rg_ar_v_q;
+    assign rg_araddr  = rg_addr_q;
+    assign rg_arlen   = rg_len_q;
+
+    cube5_frame_fifo #(.Width(DataW), .Depth(RdDepth)) u_rb (
+      .clk_i, .rst_ni, .clear_i(frame_start_i),
+      .push_i(r_fire), .d_i(rdata_i), .pop_i(rb_pop), .q_o(rb_q), .empty_o(rb_empty),
+      .full_o(rb_full)
+    );
+
+    // ---- the unpacker: dbuf_q holds dfill_q bits, ending at a beat's end ----
+    localparam int unsigned DBits = StoreW + DataW;
+    localparam int unsigned DFillW = $clog2(DBits + 1);
+    logic [DBits-1:0]  dbuf_q;
+    logic [DFillW-1:0] dfill_q, drop;
+    logic [CntW-1:0]   cout_q;          // coxels unpacked
+    logic              pad_hit, ex, ap, cx_full, cx_empty;
+
+    assign pad_hit = !pf_empty && pf_q == cout_q;
+    assign drop    = DFillW'(dfill_q[LogW-1:0]);   // the rest of the beat under way
+    assign ex      = !pad_hit && dfill_q >= DFillW'(StoreW) && !cx_full;
+    assign ap      = !pad_hit && dfill_q < DFillW'(StoreW) && !rb_empty;
+    assign pf_pop  = pad_hit;
+    assign rb_pop  = ap;
+
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni || frame_start_i) begin
+        dbuf_q  <= '0;
+        dfill_q <= '0;
+        cout_q  <= '0;
+      end else if (pad_hit) begin
+        dbuf_q  <= dbuf_q >> drop;
+        dfill_q <= dfill_q - drop;
+      end else if (ex) begin
+        dbuf_q  <= dbuf_q >> StoreW;
+        dfill_q <= dfill_q - DFillW'(StoreW);
+        cout_q  <= cout_q + CntW'(1);
+      end else if (ap) begin
+        dbuf_q  <= dbuf_q | (DBits'(rb_q) << dfill_q);
+        dfill_q <= dfill_q + DFillW'(DataW);
+      end
+    end
+
+    cube5_frame_fifo #(.Width(StoreW), .Depth(CxDepth)) u_cx (
+      .clk_i, .rst_ni, .clear_i(frame_start_i),
+      .push_i(ex), .d_i(dbuf_q[StoreW-1:0]), .pop_i(rs_take), .q_o(rg_cx),
+      .empty_o(cx_empty), .full_o(cx_full)
+    );
+    assign rg_cx_v = !cx_empty;
+    assign rg_idle = mv_q == '0 && bl_empty && r_iss_q == r_ret_q && !rg_ar_v_q;
+
+`ifndef SYNTHESIS
+    WinRingRoom: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        !(w_len != '0 && w_len > w_room))
+      else $error("cube5_accel_win: the ring is full (docs/numerics/compos_window.md bound)");
+    WinRingOrder: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        rs_take |-> !cx_empty)
+      else $error("cube5_accel_win: a restore handed over before its coxel");
+`endif
+    logic unused_ring;
+    assign unused_ring = ^{bl_full, rb_full, bq_empty};
+  end else begin : gen_no_ring
+    assign rg_take    = 1'b0;
+    assign rg_aw      = 1'b0;
+    assign rg_w       = 1'b0;
+    assign rg_use     = 1'b0;
+    assign rg_aw_d    = '0;
+    assign rg_w_d     = '0;
+    assign rg_cx_v    = 1'b0;
+    assign rg_cx      = '0;
+    assign rg_idle    = 1'b1;
+    assign rg_arvalid = 1'b0;
+    assign rg_araddr  = '0;
+    assign rg_arlen   = '0;
+    logic unused_rows;
+    assign unused_rows = ^park_rows_i;
   end
 
   // ---------------------------------------------------------------------------
@@ -495,7 +780,7 @@ module cube5_accel_win #(
   assign err_o  = err_q;
   assign wr_wait_o = !w_empty;
   assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && rq_empty
-                  && !hd_v_q && rs_out_q == '0 && !rs_v_q;
+                  && !hd_v_q && rs_out_q == '0 && !rs_v_q && ord_empty && rg_idle;
   logic unused_ord;
   assign unused_ord = ord_full;
 

@@ -36,6 +36,9 @@ const OWN_PARAMS: &[(&str, i64)] = &[
     ("WinOutstanding", 16),
     ("WinWDepth", 8),
     ("FetchHold", 0),
+    ("WinZeroDepth", 0),
+    ("WinRing", 0),
+    ("WinRingBurst", 16),
 ];
 
 /// The defaults of the parameters the top passes on, where the top's default differs from (or
@@ -98,6 +101,14 @@ pub struct AccelConfig {
     /// With the window: the fetch's read bursts kept in flight while window write beats wait
     /// (`FetchHold`; 0 stops it). Timing only: the image is the same.
     pub fetch_hold: u32,
+    /// With the window: the zero-park bit FIFO's depth (`WinZeroDepth`; 0: `MaxDim^2`).
+    /// Timing only.
+    pub win_zero_depth: u32,
+    /// With the window: the parks as a packed ring in park order, written and read in bursts of
+    /// up to `win_ring_burst` beats (`WinRing`, `WinRingBurst`; docs/numerics/compos_window.md,
+    /// *The ring in park order*). Timing and scratch layout only: the image is the same.
+    pub win_ring: bool,
+    pub win_ring_burst: u32,
 }
 
 /// Bytes per base-plane pixel in memory (the top's `PixelBytes`: R, G, B, A codes).
@@ -201,7 +212,22 @@ impl UnitConfig for AccelConfig {
             win_outstanding: own("WinOutstanding")?,
             win_w_depth: own("WinWDepth")?,
             fetch_hold: own("FetchHold")?,
+            win_zero_depth: own("WinZeroDepth")?,
+            win_ring: own("WinRing")? == 1,
+            win_ring_burst: own("WinRingBurst")?,
         };
+        let pow2 = |v: u32| v.is_power_of_two();
+        if own("WinRing")? > 1
+            || !pow2(c.win_ring_burst)
+            || !(2..=256).contains(&c.win_ring_burst)
+            || (c.win_zero_depth != 0 && (!pow2(c.win_zero_depth) || c.win_zero_depth < 2))
+        {
+            return Err(ModelError::Config(format!(
+                "cube5_accel: WinRing must be 0 or 1, WinRingBurst = {} a power of two from 2 to \
+                 256, WinZeroDepth = {} 0 or a power of two of at least 2",
+                c.win_ring_burst, c.win_zero_depth
+            )));
+        }
         if !c.win_w_depth.is_power_of_two() || c.win_w_depth < 2 {
             return Err(ModelError::Config(format!(
                 "cube5_accel: WinWDepth = {} must be a power of two of at least 2",
@@ -249,6 +275,9 @@ impl UnitConfig for AccelConfig {
             ("WinOutstanding", i64::from(self.win_outstanding)),
             ("WinWDepth", i64::from(self.win_w_depth)),
             ("FetchHold", i64::from(self.fetch_hold)),
+            ("WinZeroDepth", i64::from(self.win_zero_depth)),
+            ("WinRing", i64::from(self.win_ring)),
+            ("WinRingBurst", i64::from(self.win_ring_burst)),
         ]);
         out
     }
