@@ -120,23 +120,38 @@ module cube5_frame_win #(
   // ---------------------------------------------------------------------------
   // Admission: the position of the next sample beat to be triggered
   // ---------------------------------------------------------------------------
+  // For clock rate (docs/accel.md, *Synthesis*) adm_ok_o is a few gates of registers: the flags
+  // of the next sample beat to be triggered are computed a beat ahead (the position counter runs
+  // one beat in front of the admission and its flags are registered when the admission steps),
+  // the trigger count's comparison is a register, and so is each credit's "none left".
   logic [TrigW-1:0] adm_cnt_q;
-  logic             trig;       // the next admitted beat triggers a sample beat
+  logic             trig_q;     // the next admitted beat triggers a sample beat
   logic             adm_step;
+  logic             prime_q;    // a section started: the flags of its first beat are not in yet
+  logic             pos_step;   // the position counter moves on (it leads the admission by one)
   logic [DimW-1:0]  am, ab, as;
   logic signed [TW-1:0] atx, aty;
   logic af_beat, al_beat, af_row, al_row, af_slice, al_slice;
 
-  assign trig     = adm_cnt_q >= trig_i;
-  assign adm_step = adm_i && trig;
+  assign adm_step = adm_i && trig_q;
+  assign pos_step = adm_step || (prime_q && !start_i);
 
+  // trig_i (the frame's flush count, at least 1) is valid from the cycle after start_i.
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
       adm_cnt_q <= '0;
+      trig_q    <= 1'b0;
+      prime_q   <= 1'b0;
     end else if (start_i) begin
       adm_cnt_q <= '0;
-    end else if (adm_i && !trig) begin
-      adm_cnt_q <= adm_cnt_q + TrigW'(1);
+      trig_q    <= 1'b0;
+      prime_q   <= 1'b1;
+    end else begin
+      prime_q <= 1'b0;
+      if (adm_i && !trig_q) begin
+        adm_cnt_q <= adm_cnt_q + TrigW'(1);
+        trig_q    <= adm_cnt_q + TrigW'(1) >= trig_i;
+      end
     end
   end
 
@@ -148,7 +163,7 @@ module cube5_frame_win #(
     .clk_i         (clk_i),
     .rst_ni        (rst_ni),
     .start_i       (start_i),
-    .step_i        (adm_step),
+    .step_i        (pos_step),
     .nbr_i         (nbr_i),
     .nj_i          (nj_i),
     .s_first_i     ('0),
@@ -177,6 +192,7 @@ module cube5_frame_win #(
   logic signed [TW-1:0] sx_now, sy_now;
   logic unused_adm;
 
+  // The flags of the beat at the position counter (the one after the next to be admitted).
   always_comb begin
     dsx_p     = step_of(atx, dx_i);
     dsy_p     = step_of(aty, dy_i);
@@ -203,20 +219,40 @@ module cube5_frame_win #(
   end
   assign unused_adm = ^{as, sx_now, sy_now};
 
+  // The next sample beat's descriptor and needs, registered when the position counter steps.
+  logic [DescW-1:0] adm_desc_q;
+  logic             need_rs, need_park, need_fin;
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      need_rs   <= 1'b0;
+      need_park <= 1'b0;
+      need_fin  <= 1'b0;
+    end else if (pos_step) begin
+      need_rs   <= |f_restore;
+      need_park <= |(f_leave & ~f_final);
+      need_fin  <= |f_final;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    if (pos_step) adm_desc_q <= {q0, r0, f_final, f_leave, f_restore, f_enter};
+  end
+
   // Credits: restored coxels present and not yet promised, free places in the park and final
-  // FIFOs not yet promised, free descriptors.
+  // FIFOs not yet promised, free descriptors; beside each, whether none is left (a register
+  // that follows the count: its next value from the count's compares and the cycle's events).
   logic [RsCntW-1:0] rs_avail_q;
   logic [CntW-1:0]   park_free_q, fin_free_q, desc_cnt_q;
-  logic              need_rs, need_park, need_fin, admit, rs_push, park_pop, fin_pop, rd_pop;
+  logic              rs_none_q, park_none_q, fin_none_q, desc_full_q;
+  logic              admit, rs_push, park_pop, fin_pop, rd_pop, take_rs, take_park, take_fin;
 
-  assign need_rs   = |f_restore;
-  assign need_park = |(f_leave & ~f_final);
-  assign need_fin  = |f_final;
-  assign adm_ok_o  = !trig || ((desc_cnt_q != CntW'(Depth))
-                               && (!need_rs || rs_avail_q != '0)
-                               && (!need_park || park_free_q != '0)
-                               && (!need_fin || fin_free_q != '0));
+  assign adm_ok_o  = !trig_q || (!prime_q && !desc_full_q
+                                 && (!need_rs || !rs_none_q)
+                                 && (!need_park || !park_none_q)
+                                 && (!need_fin || !fin_none_q));
   assign admit     = adm_step;
+  assign take_rs   = admit && need_rs;
+  assign take_park = admit && need_park;
+  assign take_fin  = admit && need_fin;
   assign rs_push   = rs_valid_i && rs_ready_o;
   assign park_pop  = park_valid_o && park_ready_i;
   assign fin_pop   = fin_valid_o && fin_ready_i;
@@ -228,11 +264,22 @@ module cube5_frame_win #(
       park_free_q <= CntW'(Depth);
       fin_free_q  <= CntW'(Depth);
       desc_cnt_q  <= '0;
+      rs_none_q   <= 1'b1;
+      park_none_q <= 1'b0;
+      fin_none_q  <= 1'b0;
+      desc_full_q <= 1'b0;
     end else begin
-      rs_avail_q  <= rs_avail_q + RsCntW'(rs_push) - RsCntW'(admit && need_rs);
-      park_free_q <= park_free_q + CntW'(park_pop) - CntW'(admit && need_park);
-      fin_free_q  <= fin_free_q + CntW'(fin_pop) - CntW'(admit && need_fin);
+      rs_avail_q  <= rs_avail_q + RsCntW'(rs_push) - RsCntW'(take_rs);
+      park_free_q <= park_free_q + CntW'(park_pop) - CntW'(take_park);
+      fin_free_q  <= fin_free_q + CntW'(fin_pop) - CntW'(take_fin);
       desc_cnt_q  <= desc_cnt_q + CntW'(admit) - CntW'(rd_pop);
+      // A take needs a count of at least one, so with no increment the count ends at zero
+      // (full) when it is zero (full) or one short and taken.
+      rs_none_q   <= !rs_push && (rs_avail_q == '0 || (rs_avail_q == RsCntW'(1) && take_rs));
+      park_none_q <= !park_pop && (park_free_q == '0 || (park_free_q == CntW'(1) && take_park));
+      fin_none_q  <= !fin_pop && (fin_free_q == '0 || (fin_free_q == CntW'(1) && take_fin));
+      desc_full_q <= !rd_pop && (desc_cnt_q == CntW'(Depth)
+                                 || (desc_cnt_q == CntW'(Depth - 1) && admit));
     end
   end
 
@@ -250,7 +297,7 @@ module cube5_frame_win #(
     .rst_ni  (rst_ni),
     .clear_i (1'b0),
     .push_i  (admit),
-    .d_i     ({q0, r0, f_final, f_leave, f_restore, f_enter}),
+    .d_i     (adm_desc_q),
     .pop_i   (rd_pop),
     .q_o     (desc_head),
     .empty_o (unused_d0),
@@ -429,7 +476,7 @@ module cube5_frame_win #(
       if (start_i) begin
         // The parks reserved or queued at the end of this cycle: a pop (or a reservation) in
         // the start cycle itself counts (else the walker waits for a park that already left).
-        old_parks_q <= CntW'(Depth) - park_free_q - CntW'(park_pop) + CntW'(admit && need_park);
+        old_parks_q <= CntW'(Depth) - park_free_q - CntW'(park_pop) + CntW'(take_park);
       end else if (park_pop && old_parks_q != '0) begin
         old_parks_q <= old_parks_q - CntW'(1);
       end
@@ -452,6 +499,12 @@ module cube5_frame_win #(
                         unused_rf, rs_empty, g_sx, g_sy, wb_desc[0 +: 2*P]};
 
 `ifndef SYNTHESIS
+  WinAdmittedWhenOk: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      adm_i |-> adm_ok_o)
+    else $error("cube5_frame_win: a beat admitted without the window's consent");
+  WinTrigNonzero: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      $past(start_i) |-> trig_i != '0)
+    else $error("cube5_frame_win: a zero trigger count (the flags' register needs one)");
   WinOneRestorePerBeat: assert property (@(posedge clk_i) disable iff (!rst_ni)
       rd_i |-> $onehot0(rd_restore_o))
     else $error("cube5_frame_win: two restores in one beat");
