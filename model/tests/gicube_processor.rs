@@ -5,11 +5,11 @@
 use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
-use cube5_model::units::gicube_cache::CacheConfig;
 use cube5_model::units::cube5_shader::Phong;
+use cube5_model::units::gicube_cache::CacheConfig;
 use cube5_model::units::gicube_processor::{
-    half_tags, host_rays, psnr, HostOrder, Processor, ProcessorConfig, ProcessorCounts, ProcessorFrame,
-    Projection, QueueOrder,
+    half_tags, host_rays, psnr, HostOrder, Processor, ProcessorConfig, ProcessorCounts,
+    ProcessorFrame, Projection, QueueOrder,
 };
 use cube5_model::units::gicube_sample::ShadeConfig;
 use cube5_model::volume::Volume;
@@ -716,7 +716,10 @@ fn shaded_head_within_psnr_of_its_f64_reference() {
             "shaded (GradIdxW {grad_idx_w}, jitter {jitter}): PSNR {db:.2} dB, max {max:.4}; against the unshaded image {db_flat:.2} dB"
         );
         assert!(db >= min_db, "PSNR {db:.2} dB below {min_db} dB");
-        assert!(db_flat < db - 6.0, "shading changed the image ({db_flat:.2} dB)");
+        assert!(
+            db_flat < db - 6.0,
+            "shading changed the image ({db_flat:.2} dB)"
+        );
     }
 }
 

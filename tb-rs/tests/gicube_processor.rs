@@ -17,13 +17,13 @@ use cube5_model::phantom::head_phantom;
 use cube5_model::phantom::sphere_floor_phantom;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::units::cube5_axi_rd::Burst;
+use cube5_model::units::cube5_shader::Phong;
 use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
+use cube5_model::units::gicube_processor::{half_tags, interaction_draw, ray_bits};
 use cube5_model::units::gicube_processor::{
     host_rays, light_rays, shadow_scene, GiLight, GiMode, Processor, ProcessorFrame, ProcessorOut,
     ProcessorRtlConfig, Projection,
 };
-use cube5_model::units::cube5_shader::Phong;
-use cube5_model::units::gicube_processor::{half_tags, interaction_draw, ray_bits};
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
@@ -617,23 +617,28 @@ fn high_albedo_photons_scatter_in_the_ring_like_the_model() {
         // GICUBE_GI_PNG=<file>: the two images (equal to the RTL's), low albedo left, each pixel
         // 8 x 8 (docs/img/gicube-processor-gi-albedo.png).
         if let Ok(path) = std::env::var("GICUBE_GI_PNG") {
-            let (w, h, k) = (lo.width, lo.height, 8);
-            let (lo, hi) = (lo.to_f64(), hi.to_f64());
-            let rgb = (0..h * k)
-                .flat_map(|y| (0..2 * w * k).map(move |x| (x / k, y / k)))
-                .map(|(x, y)| {
-                    let f = if x < w { &lo } else { &hi };
-                    f[(y * w + x % w) as usize]
-                })
-                .collect();
-            let img = cube5_model::render::ImageF64 {
-                width: 2 * w * k,
-                height: h * k,
-                rgb,
-            };
-            img.to_rgb8().save(&path).unwrap();
+            save_side_by_side(&path, &lo, &hi, 8);
         }
     }
+}
+
+/// A PNG of two frames of one size side by side, `left` on the left, each pixel `k x k`.
+fn save_side_by_side(path: &str, left: &ProcessorFrame, right: &ProcessorFrame, k: u32) {
+    let (w, h) = (left.width, left.height);
+    let (l, r) = (left.to_f64(), right.to_f64());
+    let rgb = (0..h * k)
+        .flat_map(|y| (0..2 * w * k).map(move |x| (x / k, y / k)))
+        .map(|(x, y)| {
+            let f = if x < w { &l } else { &r };
+            f[(y * w + x % w) as usize]
+        })
+        .collect();
+    let img = cube5_model::render::ImageF64 {
+        width: 2 * w * k,
+        height: h * k,
+        rgb,
+    };
+    img.to_rgb8().save(path).unwrap();
 }
 
 /// A reset in the middle of a high-albedo lighting pass (photons and bursts in flight, some
@@ -800,7 +805,12 @@ fn shaded_jittered_frame_is_lit_and_equals_the_model() {
             ..rtl
         };
         let (flat, _) = Scene::new(&plain, px, proj).model();
-        let differ = want.rgb.iter().zip(&flat.rgb).filter(|(a, b)| a != b).count();
+        let differ = want
+            .rgb
+            .iter()
+            .zip(&flat.rgb)
+            .filter(|(a, b)| a != b)
+            .count();
         let rays = want.counts.rays_made as usize;
         eprintln!("{variant}: {differ} of {rays} rays' pixels differ from the unshaded image");
         assert!(
@@ -808,21 +818,7 @@ fn shaded_jittered_frame_is_lit_and_equals_the_model() {
             "{variant}: shading changes the image ({differ} of {rays} rays' pixels)"
         );
         if let Some(path) = png {
-            let (w, h) = (want.width, want.height);
-            let (flat, lit) = (flat.to_f64(), want.to_f64());
-            let rgb = (0..h)
-                .flat_map(|y| (0..2 * w).map(move |x| (x, y)))
-                .map(|(x, y)| {
-                    let f = if x < w { &flat } else { &lit };
-                    f[(y * w + x % w) as usize]
-                })
-                .collect();
-            let img = cube5_model::render::ImageF64 {
-                width: 2 * w,
-                height: h,
-                rgb,
-            };
-            img.to_rgb8().save(&path).unwrap();
+            save_side_by_side(&path, &flat, &want, 2);
         }
     }
 }

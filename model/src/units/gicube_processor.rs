@@ -26,8 +26,7 @@ use crate::units::gicube_deposit as deposit;
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_queue_front::{Chooser, FrontTraffic, QueueFront};
 use crate::units::gicube_sample::{
-    jitter_index, shader_config_for, GradLut, Jitter, SampleConfig, SampleIn,
-    Sampler, ShadeConfig,
+    jitter_index, shader_config_for, GradLut, Jitter, SampleConfig, SampleIn, Sampler, ShadeConfig,
 };
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_step::{StepConfig, Stepper};
@@ -685,7 +684,8 @@ impl Processor {
             ));
         };
         let tags = tags.unwrap_or_else(|| vec![0; self.vol.len()]);
-        if tags.len() != self.vol.len() || tags.iter().any(|&t| u32::from(t) >> sh.widths.tag_w != 0)
+        if tags.len() != self.vol.len()
+            || tags.iter().any(|&t| u32::from(t) >> sh.widths.tag_w != 0)
         {
             return Err(ModelError::Config(format!(
                 "gicube processor: {} tags for {} voxels, each below 2^{}",
@@ -695,7 +695,11 @@ impl Processor {
             )));
         }
         let rmap = ReflectanceMap::from_lights(&self.sampler.shader().config(), phong)?;
-        let lut = self.sampler.grad_lut().cloned().unwrap_or(GradLut::zero(2)?);
+        let lut = self
+            .sampler
+            .grad_lut()
+            .cloned()
+            .unwrap_or(GradLut::zero(2)?);
         self.sampler = self.sampler.clone().with_shading(rmap, lut)?;
         sh.phong = phong.clone();
         sh.tags = tags;
@@ -718,8 +722,7 @@ impl Processor {
         match (&self.shading, voxel_index(self.vol.dims, v)) {
             (Some(sh), Some(i)) => {
                 let w = self.vol.bits;
-                d | u32::from(sh.tags[i]) << w
-                    | u32::from(sh.grad_idx[i]) << (w + sh.widths.tag_w)
+                d | u32::from(sh.tags[i]) << w | u32::from(sh.grad_idx[i]) << (w + sh.widths.tag_w)
             }
             _ => d,
         }
@@ -1831,7 +1834,9 @@ impl ProcessorRtlConfig {
         if self.jitter > 1 {
             return bad(format!("Jitter {} is not 0 or 1", self.jitter));
         }
-        if self.shade > 1 || (self.shade == 1 && self.light == 1) || (self.shade == 0 && self.tag_w != 0)
+        if self.shade > 1
+            || (self.shade == 1 && self.light == 1)
+            || (self.shade == 0 && self.tag_w != 0)
         {
             return bad(format!(
                 "Shade {} is not 0 or 1, or with Light {}, or TagW {} without it",
