@@ -5,11 +5,13 @@
 use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
+use cube5_model::units::cube5_shader::Phong;
 use cube5_model::units::gicube_cache::CacheConfig;
 use cube5_model::units::gicube_processor::{
-    host_rays, psnr, HostOrder, Processor, ProcessorConfig, ProcessorCounts, ProcessorFrame,
-    Projection, QueueOrder,
+    half_tags, host_rays, psnr, HostOrder, Processor, ProcessorConfig, ProcessorCounts,
+    ProcessorFrame, Projection, QueueOrder,
 };
+use cube5_model::units::gicube_sample::ShadeConfig;
 use cube5_model::volume::Volume;
 use glam::DVec3;
 
@@ -672,6 +674,53 @@ fn jittered_head_within_psnr_of_its_f64_reference() {
     );
     assert!(db >= 40.0, "PSNR {db:.2} dB below 40 dB");
     assert!(f.rgb != g.rgb, "the jitter changed the image");
+}
+
+/// Shading (contract, *Shading and jitter in the processor*): the head at 32^3 with the
+/// viewer's two-light map, tagged in two halves (`half_tags`), its voxel words holding 11-bit
+/// (and 7-bit, the CI line's) gradient indices; alone and with jitter, each within its bound of
+/// the f64 reference (Phong at the interpolated exact gradient directions, the tag's colour, the
+/// same jitter factors), and far from the unshaded image (the map lights it). Measured 51.8 dB
+/// (max 0.049), with jitter 46.4 dB (0.072), 7-bit indices 48.3 dB (0.085); the unshaded image
+/// is 25.6-27.3 dB away.
+#[test]
+fn shaded_head_within_psnr_of_its_f64_reference() {
+    let vol = head_phantom(32, 12).unwrap();
+    let tf = TransferFunction::head_default();
+    let cam = camera(&vol, 64);
+    let proj = Projection::Perspective { fov_deg: 30.0 };
+    let phong = Phong {
+        view: (-view_dir()).to_array(),
+        ..Phong::two_lights()
+    };
+    let flat = Processor::new(cfg_for(32), &vol, &tf)
+        .unwrap()
+        .render(&cam, proj)
+        .unwrap();
+    for (jitter, grad_idx_w, min_db) in [(false, 11, 48.0), (true, 11, 43.0), (false, 7, 45.0)] {
+        let cfg = ProcessorConfig {
+            jitter,
+            shade: Some(ShadeConfig {
+                grad_idx_w,
+                tag_w: 1,
+            }),
+            ..cfg_for(32)
+        };
+        let mut p = Processor::new(cfg, &vol, &tf).unwrap();
+        p.set_shading(&phong, Some(half_tags(&vol))).unwrap();
+        let f = p.render(&cam, proj).unwrap();
+        check_conservation(&f);
+        let (db, max) = psnr(&f.to_f64(), &p.reference(&tf, &cam, proj).unwrap());
+        let (db_flat, _) = psnr(&f.to_f64(), &flat.to_f64());
+        println!(
+            "shaded (GradIdxW {grad_idx_w}, jitter {jitter}): PSNR {db:.2} dB, max {max:.4}; against the unshaded image {db_flat:.2} dB"
+        );
+        assert!(db >= min_db, "PSNR {db:.2} dB below {min_db} dB");
+        assert!(
+            db_flat < db - 6.0,
+            "shading changed the image ({db_flat:.2} dB)"
+        );
+    }
 }
 
 /// The samples read through the volume cache (contract, *The volume cache*): another cache

@@ -42,6 +42,13 @@
 // direction. The issue takes that path's outcome for a photon that scatters (new direction,
 // opacity 0, generation + 1, lifetime - 1, a new interaction value) and finishes one that is
 // absorbed. The output item carries a ninth count, the scatterings.
+//
+// Jitter = 1 and Shade = 1 (contract "Shading and jitter in the processor") are gicube_sample's
+// own: with Shade the cache's words hold each voxel's density, tag and gradient index (the host's
+// quantization of the volume's central differences), passed from the cache's eight words to the
+// sample unit with the voxels; its gradient LUTs and reflectance map load through region 0 (one
+// more address bit). Jitter's random LUT reads the sample position's fraction bits, which the
+// sample item carries as its weights.
 
 `include "cube5_axi_ports.svh"
 
@@ -76,7 +83,19 @@ module gicube_processor #(
   parameter int unsigned Light       = 0,
   /// 1 (with Light): high-albedo photons scatter in the ring (gicube_scatter, the photon
   /// registers, the scatterings count in the output); 0: lighting rays never scatter.
-  parameter int unsigned Scatter     = 0
+  parameter int unsigned Scatter     = 0,
+  /// 1: jitter ([353], [380]): gicube_sample's random, log and power LUTs correct each sample's
+  /// opacity for a step r dr, r from the sample position's fraction bits; 0: none.
+  parameter int unsigned Jitter      = 0,
+  /// 1 (without Light): shading ([352], [378], [379], [383]): a voxel word holds the density,
+  /// the tag above it and the gradient index above the tag; gicube_sample decodes the corners'
+  /// indices (gradient LUTs), interpolates the gradient, classifies by density and the nearest
+  /// tag and lights rendering rays by the reflectance map; 0: unlit.
+  parameter int unsigned Shade       = 0,
+  /// Gradient index bits of a voxel word (Shade = 1), 2..11.
+  parameter int unsigned GradIdxW    = 11,
+  /// Tag bits of a voxel word (Shade = 1), 0..4; 0 with Shade = 0.
+  parameter int unsigned TagW        = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -100,9 +119,9 @@ module gicube_processor #(
 
   /// Configuration write this clock (tables, empty flags; they survive reset).
   input  logic cfg_valid_i,
-  /// Region (top 2 bits): 0 gicube_sample's address (low 14 bits), 1 the empty flag of queue
-  /// (low bits); Light: 2 the volume's dimensions and lit, 3 a flush.
-  input  logic [2+gicube_sample_pkg::CfgAddrW-1:0] cfg_addr_i,
+  /// Region (top 2 bits): 0 gicube_sample's address (low 14 bits; Shade: 15), 1 the empty flag
+  /// of queue (low bits); Light: 2 the volume's dimensions and lit, 3 a flush.
+  input  logic [2+gicube_sample_pkg::cfg_addr_w(Shade)-1:0] cfg_addr_i,
   /// gicube_sample's data; the empty flag in bit 0; region 2: x, y, z dimensions (7 bits each),
   /// lit (bit 21).
   input  logic [gicube_sample_pkg::CfgDataW-1:0] cfg_data_i,
@@ -132,10 +151,15 @@ module gicube_processor #(
   localparam int unsigned FeOutW   = 7 + 3 * QueueW + LenW + TotW + 2 * PacketW;
   localparam int unsigned Side     = VolBlocks << BlockLog2;         // N
   // The cache: the volume padded to the smallest power of two above N, a voxel per word (Light:
-  // the irradiance field in the word's top 16 bits).
+  // the irradiance field in the word's top 16 bits; Shade: the density, tag and gradient index
+  // in the smallest of 8, 16 or 32 bits that holds them).
   localparam int unsigned MaxDim   = 1 << $clog2(Side + 1);
   localparam int unsigned MW       = $clog2(MaxDim);                 // bits of a cache coordinate
-  localparam int unsigned WordW    = (Light != 0) ? 32 : (VoxelW <= 8) ? 8 : 16;
+  localparam int unsigned FieldsW  = VoxelW + ((Shade != 0) ? TagW + GradIdxW : 0);
+  localparam int unsigned WordW    = (Light != 0) ? 32 : (FieldsW <= 8) ? 8
+                                   : (FieldsW <= 16) ? 16 : 32;
+  localparam int unsigned TagLsb   = VoxelW;                         // Shade: the tag,
+  localparam int unsigned GradLsb  = VoxelW + TagW;                  // the gradient index
   localparam int unsigned IrrW     = gicube_sample_pkg::IrrW;
   localparam int unsigned CaInW    = 3 * MW + ((Light != 0) ? 2 + 8 * IrrW : 0);
   localparam int unsigned DpInW    = 3 * MW + 12 + 12 + 3 * PosFracW + 2 + 21;
@@ -148,8 +172,10 @@ module gicube_processor #(
   localparam int unsigned CellD    = (Light != 0) ? ((Prefetch == 0) ? 8 : (1 << $clog2(Prefetch + 9)))
                                                 : (1 << $clog2(Prefetch + 4));
   // 2 region bits over gicube_sample's address.
-  localparam int unsigned CfgAW    = 2 + gicube_sample_pkg::CfgAddrW;
-  localparam int unsigned SmInW    = gicube_sample_pkg::in_w(VoxelW);
+  localparam int unsigned SmCfgAW  = gicube_sample_pkg::cfg_addr_w(Shade);
+  localparam int unsigned CfgAW    = 2 + SmCfgAW;
+  localparam int unsigned SmShW    = gicube_sample_pkg::shade_in_w(Shade, GradIdxW, TagW);
+  localparam int unsigned SmInW    = gicube_sample_pkg::in_w(VoxelW) + SmShW;
   localparam int unsigned SmOutW   = gicube_sample_pkg::OutW;        // colour, opacity, terminated
   localparam int unsigned StInW    = 3 * PosW + 3 * 16 + QueueW + 1;
   localparam int unsigned KW       = BlockLog2 + 9;
@@ -178,6 +204,12 @@ module gicube_processor #(
   end
   if (Scatter > 1 || (Scatter != 0 && Light == 0)) begin : gen_bad_scatter
     $fatal(1, "gicube_processor: Scatter must be 0 or 1, and 1 only with Light");
+  end
+  if (Jitter > 1) begin : gen_bad_jitter
+    $fatal(1, "gicube_processor: Jitter must be 0 or 1");
+  end
+  if (Shade > 1 || (Shade != 0 && Light != 0) || (Shade == 0 && TagW != 0)) begin : gen_bad_shade
+    $fatal(1, "gicube_processor: Shade must be 0 or 1, 1 only without Light, TagW 0 without it");
   end
 
   // ---------------------------------------------------------------------------
@@ -651,14 +683,31 @@ module gicube_processor #(
   assign go        = f_v_q && f_ray_q;
   assign go_sample = ca_out_valid && !cell_flush;
   assign of_push_flush = ca_out_valid && cell_flush;
-  // voxels, weights (the start's fraction bits), irradiance, colour and opacity, lighting.
-  assign sm_in = {cell_q[CellW-2 -: 49], irrs, irr_en, cell_q[0 +: 3 * PosFracW], voxels};
+  // voxels, weights (the start's fraction bits), irradiance, colour and opacity, lighting;
+  // Shade: the corners' gradient indices, then their tags, the fields above each word's
+  // density.
+  if (Shade != 0) begin : gen_sm_in_shade
+    logic [SmShW-1:0] shades;
+    for (genvar c = 0; c < 8; c++) begin : gen_corner
+      assign shades[c * GradIdxW +: GradIdxW] = ca_out[c * WordW + GradLsb +: GradIdxW];
+      if (TagW != 0) begin : gen_tag
+        assign shades[8 * GradIdxW + c * TagW +: TagW] = ca_out[c * WordW + TagLsb +: TagW];
+      end
+    end
+    assign sm_in = {shades, cell_q[CellW-2 -: 49], irrs, irr_en, cell_q[0 +: 3 * PosFracW],
+                    voxels};
+  end else begin : gen_sm_in
+    assign sm_in = {cell_q[CellW-2 -: 49], irrs, irr_en, cell_q[0 +: 3 * PosFracW], voxels};
+  end
   // start, dir, queue, leap.
   assign st_in = {f_leap_q, f_q_q, f_pkt_q[DirLsb +: 48], f_pkt_q[StartLsb +: 3 * PosW]};
 
   gicube_sample #(
-    .VoxelW (VoxelW),
-    .Jitter (0)
+    .VoxelW   (VoxelW),
+    .Jitter   (Jitter),
+    .Shade    (Shade),
+    .GradIdxW (GradIdxW),
+    .TagW     (TagW)
   ) u_sample (
     .clk_i       (clk_i),
     .rst_ni      (rst_ni),
@@ -669,7 +718,7 @@ module gicube_processor #(
     .out_ready_i (1'b1),
     .out_data_o  (sm_out),
     .cfg_valid_i (cfg_sample),
-    .cfg_addr_i  (cfg_addr_i[gicube_sample_pkg::CfgAddrW-1:0]),
+    .cfg_addr_i  (cfg_addr_i[SmCfgAW-1:0]),
     .cfg_data_i  (cfg_data_i)
   );
 

@@ -17,12 +17,13 @@ use cube5_model::phantom::head_phantom;
 use cube5_model::phantom::sphere_floor_phantom;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::units::cube5_axi_rd::Burst;
+use cube5_model::units::cube5_shader::Phong;
 use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
+use cube5_model::units::gicube_processor::{half_tags, interaction_draw, ray_bits};
 use cube5_model::units::gicube_processor::{
     host_rays, light_rays, shadow_scene, GiLight, GiMode, Processor, ProcessorFrame, ProcessorOut,
     ProcessorRtlConfig, Projection,
 };
-use cube5_model::units::gicube_processor::{interaction_draw, ray_bits};
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
@@ -33,7 +34,8 @@ use support::{axi, axi_mem_setup, compare_bursts, configs, seed};
 type Bits = [u32; PACKET_WORDS];
 
 /// A scene: the head phantom at the RTL's side and voxel width, seen from azimuth 65, elevation
-/// 20, `px` pixels a side.
+/// 20, `px` pixels a side; with `Shade` lit by two lights (the viewer's map) and tagged in two
+/// halves (`half_tags`: the tag's colour in the half `x >= N/2`).
 struct Scene {
     proc: Processor,
     cam: Camera,
@@ -48,7 +50,15 @@ impl Scene {
         let dir = [-e.cos() * a.cos(), -e.cos() * a.sin(), -e.sin()];
         let cam = Camera::new(dir.into(), vol.dims, vol.spacing, px, px);
         let tf = TransferFunction::head_default();
-        let proc = Processor::new(rtl.processor_config(), &vol, &tf).unwrap();
+        let mut proc = Processor::new(rtl.processor_config(), &vol, &tf).unwrap();
+        if rtl.shade == 1 {
+            let phong = Phong {
+                view: dir.map(|c| -c),
+                ..Phong::two_lights()
+            };
+            let tags = (rtl.tag_w > 0).then(|| half_tags(&vol));
+            proc.set_shading(&phong, tags).unwrap();
+        }
         Self { proc, cam, proj }
     }
 
@@ -602,23 +612,28 @@ fn high_albedo_photons_scatter_in_the_ring_like_the_model() {
         // GICUBE_GI_PNG=<file>: the two images (equal to the RTL's), low albedo left, each pixel
         // 8 x 8 (docs/img/gicube-processor-gi-albedo.png).
         if let Ok(path) = std::env::var("GICUBE_GI_PNG") {
-            let (w, h, k) = (lo.width, lo.height, 8);
-            let (lo, hi) = (lo.to_f64(), hi.to_f64());
-            let rgb = (0..h * k)
-                .flat_map(|y| (0..2 * w * k).map(move |x| (x / k, y / k)))
-                .map(|(x, y)| {
-                    let f = if x < w { &lo } else { &hi };
-                    f[(y * w + x % w) as usize]
-                })
-                .collect();
-            let img = cube5_model::render::ImageF64 {
-                width: 2 * w * k,
-                height: h * k,
-                rgb,
-            };
-            img.to_rgb8().save(&path).unwrap();
+            save_side_by_side(&path, &lo, &hi, 8);
         }
     }
+}
+
+/// A PNG of two frames of one size side by side, `left` on the left, each pixel `k x k`.
+fn save_side_by_side(path: &str, left: &ProcessorFrame, right: &ProcessorFrame, k: u32) {
+    let (w, h) = (left.width, left.height);
+    let (l, r) = (left.to_f64(), right.to_f64());
+    let rgb = (0..h * k)
+        .flat_map(|y| (0..2 * w * k).map(move |x| (x / k, y / k)))
+        .map(|(x, y)| {
+            let f = if x < w { &l } else { &r };
+            f[(y * w + x % w) as usize]
+        })
+        .collect();
+    let img = cube5_model::render::ImageF64 {
+        width: 2 * w * k,
+        height: h * k,
+        rgb,
+    };
+    img.to_rgb8().save(path).unwrap();
 }
 
 /// A reset in the middle of a high-albedo lighting pass (photons and bursts in flight, some
@@ -763,6 +778,44 @@ fn forced_overflow_loses_no_ray() {
         got.last.rays_overflowed,
         got.outputs
     );
+}
+
+/// Shading and jitter (`Shade = 1`, `Jitter = 1`): the frames of the tests above are the
+/// model's bit for bit; here the shaded, jittered image differs from the same processor's
+/// without them (the map and the tags light and colour it). `GICUBE_SHADE_PNG=<file>` writes the
+/// model's unshaded image (left) and the RTL's shaded, jittered one (right), `4 N` pixels a side
+/// (docs/img/gicube-processor-shaded.png).
+#[test]
+fn shaded_jittered_frame_is_lit_and_equals_the_model() {
+    for (variant, rtl) in ci_configs().into_iter().filter(|(_, c)| c.shade == 1) {
+        let png = std::env::var("GICUBE_SHADE_PNG").ok();
+        let px = if png.is_some() { 4 } else { 1 } * rtl.side();
+        let proj = Projection::Perspective { fov_deg: 30.0 };
+        let (got, want) = exact_frame(variant, rtl, px, proj, None, seed(1915));
+        frame_line(variant, "shaded, jittered", &got, &want);
+        let plain = ProcessorRtlConfig {
+            shade: 0,
+            tag_w: 0,
+            jitter: 0,
+            ..rtl
+        };
+        let (flat, _) = Scene::new(&plain, px, proj).model();
+        let differ = want
+            .rgb
+            .iter()
+            .zip(&flat.rgb)
+            .filter(|(a, b)| a != b)
+            .count();
+        let rays = want.counts.rays_made as usize;
+        eprintln!("{variant}: {differ} of {rays} rays' pixels differ from the unshaded image");
+        assert!(
+            differ * 4 > rays,
+            "{variant}: shading changes the image ({differ} of {rays} rays' pixels)"
+        );
+        if let Some(path) = png {
+            save_side_by_side(&path, &flat, &want, 2);
+        }
+    }
 }
 
 /// The host idle and the output stalled at random: the image is exact and no ray is lost (the

@@ -19,13 +19,15 @@ use crate::error::{ModelError, Result};
 use crate::transfer::TransferFunction;
 use crate::units::cube5_axi_rd::{AxiMemImage, Burst};
 use crate::units::cube5_compos::corrected_alpha;
-use crate::units::cube5_shader::ClassLut;
+use crate::units::cube5_shader::{ClassLut, Phong, ReflectanceMap, Rgba};
 use crate::units::gicube_bucket::{BucketConfig, BucketUnit, Distribution, Position};
 use crate::units::gicube_cache::{CacheConfig, CacheItem, CacheReq, VolumeCache};
 use crate::units::gicube_deposit as deposit;
 use crate::units::gicube_packet_loop::{flag, RayPacket, RayReal, RayType, POS_FRAC_W};
 use crate::units::gicube_queue_front::{Chooser, FrontTraffic, QueueFront};
-use crate::units::gicube_sample::{jitter_index, Jitter, SampleConfig, SampleIn, Sampler};
+use crate::units::gicube_sample::{
+    jitter_index, shader_config_for, GradLut, Jitter, SampleConfig, SampleIn, Sampler, ShadeConfig,
+};
 use crate::units::gicube_scatter::{jenkins_hash, Scatter, ScatterConfig, ScatterIn};
 use crate::units::gicube_step::{StepConfig, Stepper};
 use crate::volume::Volume;
@@ -94,6 +96,11 @@ pub struct ProcessorConfig {
     /// Jitter ([353], [380], `gicube_sample`): each sample's opacity for a step `r dr`, `r` in
     /// `[1/2, 1)` from the random LUT at the position's fraction bits (the advance stays `dr`).
     pub jitter: bool,
+    /// Shading ([352], [378], [379], [383]; contract *Shading and jitter in the processor*): the
+    /// volume's gradient indices and tags in the voxel words, the gradient LUT, the 2-D
+    /// classification by density and the nearest tag, the reflectance map lighting rendering rays
+    /// without irradiance. `None`: unlit.
+    pub shade: Option<ShadeConfig>,
     pub order: QueueOrder,
     pub host_order: HostOrder,
     /// Ring latency `L` in processor cycles (contract, *The ring*): the ray popped in cycle `t`
@@ -117,6 +124,7 @@ impl ProcessorConfig {
         et_threshold: Some(CHAN_MAX + 1 - 16),
         space_leap: true,
         jitter: false,
+        shade: None,
         order: QueueOrder::Sorter,
         host_order: HostOrder::RowMajor,
         ring_latency: 0,
@@ -408,8 +416,6 @@ struct FrameCache {
     /// The words hold the irradiance field above the voxel (contract, *Splatting through the
     /// cache*): a lighting sample is a deposit item.
     splats: bool,
-    /// The voxel's bits of a word.
-    voxel_mask: u32,
     trace: Option<CacheTrace>,
 }
 
@@ -424,7 +430,7 @@ pub struct CacheTrace {
 }
 
 impl FrameCache {
-    /// The eight corner voxels of the cell at `base` through the cache: a read, or, for a
+    /// The eight corner words of the cell at `base` through the cache: a read, or, for a
     /// lighting sample when the words hold the field, a deposit of `energies` (the same voxels:
     /// a deposit adds above them); the corners found and not found are counted.
     fn sample(
@@ -444,7 +450,7 @@ impl FrameCache {
         counts.cache_hits += found;
         counts.cache_misses += 8 - found;
         self.record(step.reads, step.writes);
-        step.out.vox.map(|v| v & self.voxel_mask)
+        step.out.vox
     }
 
     fn record(&mut self, reads: Vec<Burst>, writes: Vec<Burst>) {
@@ -502,6 +508,79 @@ pub struct Processor {
     stepper: Stepper,
     /// The volume cache after reset over the padded volume (`None`: samples read the volume).
     cache: Option<VolumeCache>,
+    /// Shading on: the host's per-voxel fields and lights (contract, *Shading and jitter in the
+    /// processor*).
+    shading: Option<Shading>,
+}
+
+/// What the host computed for a shaded volume: every voxel's gradient index and tag (the fields
+/// of its word), the directions the f64 reference interpolates, and the lights of the map.
+#[derive(Debug, Clone)]
+struct Shading {
+    widths: ShadeConfig,
+    phong: Phong,
+    /// `GradLut::index_of` of the voxel's central differences, x fastest.
+    grad_idx: Vec<u16>,
+    /// The voxel's tag (`< 2^TagW`), x fastest.
+    tags: Vec<u8>,
+    /// The unit direction of the voxel's central differences (0 for a zero gradient).
+    dirs: Vec<DVec3>,
+}
+
+/// The host's gradient of voxel `v` (contract, *Shading and jitter in the processor*): central
+/// differences `vol(v + e_a) - vol(v - e_a)` per axis, 0 outside the volume.
+pub fn voxel_gradient(vol: &Volume, v: [i64; 3]) -> [f64; 3] {
+    std::array::from_fn(|a| {
+        let mut hi = v;
+        let mut lo = v;
+        hi[a] += 1;
+        lo[a] -= 1;
+        f64::from(vol.get(hi[0], hi[1], hi[2])) - f64::from(vol.get(lo[0], lo[1], lo[2]))
+    })
+}
+
+/// An example segmentation for the tests and figures: tag 1 in the half `x >= dims.x / 2`, 0
+/// elsewhere (one per voxel, x fastest).
+pub fn half_tags(vol: &Volume) -> Vec<u8> {
+    let nx = vol.dims[0];
+    (0..vol.len()).map(|i| u8::from(i % nx >= nx / 2)).collect()
+}
+
+/// The colour of tag `t` (contract, *Shading and jitter in the processor*): the transfer
+/// function's colour with its channels rotated `t mod 3` places (tag 1: `(b, r, g)`).
+pub fn tag_rgb(rgb: [f64; 3], t: u32) -> [f64; 3] {
+    let k = (t % 3) as usize;
+    std::array::from_fn(|i| rgb[(i + 3 - k) % 3])
+}
+
+/// The host's classification table (contract, *Shading and jitter in the processor*): without
+/// tags `ClassLut::from_transfer`; with `TagW` tag bits the 2-D table density-major, entry
+/// `(den, t)` the transfer function at the centre of density bin `den` (`ClassIdxW - TagW` bits)
+/// in the colour of tag `t` ([`tag_rgb`]), its alpha unchanged.
+pub fn class_lut(
+    voxel_w: u32,
+    shade: Option<ShadeConfig>,
+    tf: &TransferFunction,
+) -> Result<ClassLut> {
+    let cfg = shader_config_for(voxel_w, shade);
+    let tag_w = shade.map_or(0, |s| s.tag_w);
+    if tag_w == 0 {
+        return ClassLut::from_transfer(&cfg, tf);
+    }
+    tf.validate()?;
+    let den_n = f64::from(1u32 << (cfg.class_idx_w - tag_w));
+    let q = |x: f64, max: u32| (x.clamp(0.0, 1.0) * f64::from(max)).round() as u32;
+    ClassLut::from_fn(&cfg, |idx| {
+        let (den, t) = (idx >> tag_w, (idx & ((1 << tag_w) - 1)) as u32);
+        let v = tf.lookup((den as f64 + 0.5) / den_n);
+        let [r, g, b] = tag_rgb([v[0], v[1], v[2]], t);
+        Rgba {
+            r: q(r, cfg.color_max()),
+            g: q(g, cfg.color_max()),
+            b: q(b, cfg.color_max()),
+            a: q(v[3], cfg.alpha_max()),
+        }
+    })
 }
 
 impl Processor {
@@ -516,17 +595,47 @@ impl Processor {
             )));
         }
         let (blocks, side) = domain(vol, cfg.block_log2)?;
-        let class = ClassLut::from_transfer(&shader_config(vol.bits), tf)?;
-        let sampler = Sampler::new(
+        let class = class_lut(vol.bits, cfg.shade, tf)?;
+        let mut sampler = Sampler::new(
             SampleConfig {
                 voxel_w: vol.bits,
                 step: cfg.step,
                 et_threshold: cfg.et_threshold,
                 jitter: cfg.jitter,
-                shade: None,
+                shade: cfg.shade,
             },
             class,
         )?;
+        // Shading: the LUT of uniform directions the host bins into, the map of two lights.
+        let shading = match cfg.shade {
+            Some(widths) => {
+                let lut = GradLut::directions(widths.grad_idx_w)?;
+                let phong = Phong::two_lights();
+                let rmap =
+                    ReflectanceMap::from_lights(&shader_config_for(vol.bits, cfg.shade), &phong)?;
+                sampler = sampler.with_shading(rmap, lut.clone())?;
+                let mut grad_idx = Vec::with_capacity(vol.len());
+                let mut dirs = Vec::with_capacity(vol.len());
+                let [nx, ny, nz] = vol.dims.map(|d| d as i64);
+                for z in 0..nz {
+                    for y in 0..ny {
+                        for x in 0..nx {
+                            let g = voxel_gradient(vol, [x, y, z]);
+                            grad_idx.push(lut.index_of(g) as u16);
+                            dirs.push(DVec3::from(g).normalize_or_zero());
+                        }
+                    }
+                }
+                Some(Shading {
+                    widths,
+                    phong,
+                    grad_idx,
+                    tags: vec![0; vol.len()],
+                    dirs,
+                })
+            }
+            None => None,
+        };
         let bucket = BucketUnit::new(BucketConfig {
             block_log2: cfg.block_log2,
             vol_blocks: blocks,
@@ -551,6 +660,7 @@ impl Processor {
                 step: cfg.step,
             })?,
             cache: None,
+            shading,
         };
         p.load_cache()?;
         p.empty = (0..blocks * blocks * blocks)
@@ -563,21 +673,85 @@ impl Processor {
         self.cfg
     }
 
+    /// Shading (`cfg.shade`): the reflectance map of `phong`'s lights and the volume's tags
+    /// (`None`: every tag 0; else one per voxel, x fastest, each below `2^TagW`), which the
+    /// host writes into the voxel words. Refused without shading, or with tags of another
+    /// length or width.
+    pub fn set_shading(&mut self, phong: &Phong, tags: Option<Vec<u8>>) -> Result<()> {
+        let Some(sh) = self.shading.as_mut() else {
+            return Err(ModelError::Config(
+                "gicube processor: shading tables for a processor without shading".into(),
+            ));
+        };
+        let tags = tags.unwrap_or_else(|| vec![0; self.vol.len()]);
+        if tags.len() != self.vol.len()
+            || tags.iter().any(|&t| u32::from(t) >> sh.widths.tag_w != 0)
+        {
+            return Err(ModelError::Config(format!(
+                "gicube processor: {} tags for {} voxels, each below 2^{}",
+                tags.len(),
+                self.vol.len(),
+                sh.widths.tag_w
+            )));
+        }
+        let rmap = ReflectanceMap::from_lights(&self.sampler.shader().config(), phong)?;
+        let lut = self
+            .sampler
+            .grad_lut()
+            .cloned()
+            .unwrap_or(GradLut::zero(2)?);
+        self.sampler = self.sampler.clone().with_shading(rmap, lut)?;
+        sh.phong = phong.clone();
+        sh.tags = tags;
+        self.load_cache()?;
+        self.empty = (0..self.queues()).map(|q| self.block_is_empty(q)).collect();
+        Ok(())
+    }
+
+    /// Bits of a voxel word's fields: the density, and with shading the tag and the gradient
+    /// index above it.
+    fn fields_w(&self) -> u32 {
+        self.vol.bits + self.cfg.shade.map_or(0, |s| s.tag_w + s.grad_idx_w)
+    }
+
+    /// The voxel word of `v` (contract, *Shading and jitter in the processor*): the density in
+    /// bits `0 .. VoxelW`; with shading the tag in `VoxelW .. VoxelW + TagW` and the gradient
+    /// index above it; 0 outside the volume.
+    fn word_of(&self, v: [i64; 3]) -> u32 {
+        let d = self.vol.get(v[0], v[1], v[2]);
+        match (&self.shading, voxel_index(self.vol.dims, v)) {
+            (Some(sh), Some(i)) => {
+                let w = self.vol.bits;
+                d | u32::from(sh.tags[i]) << w | u32::from(sh.grad_idx[i]) << (w + sh.widths.tag_w)
+            }
+            _ => d,
+        }
+    }
+
     /// The volume cache's configuration (contract, *The volume cache*): `cfg.cache`, or the
     /// default at the smallest `MaxDim > N` of at least 16 (`None` beyond
     /// [`MAX_DEFAULT_CACHE_DIM`]). Refused: a `MaxDim` not above `N`, a word narrower than a voxel.
     pub fn cache_config(&self) -> Result<Option<CacheConfig>> {
         let Some(c) = self.cfg.cache else {
             let m = (self.side + 1).next_power_of_two().max(16);
+            let word_w = if self.fields_w() > CacheConfig::DEFAULT.word_w {
+                32
+            } else {
+                CacheConfig::DEFAULT.word_w
+            };
             return Ok((m <= MAX_DEFAULT_CACHE_DIM).then_some(CacheConfig {
                 max_dim: m,
+                word_w,
                 ..CacheConfig::DEFAULT
             }));
         };
-        if c.max_dim <= self.side || c.word_w < self.vol.bits {
+        if c.max_dim <= self.side
+            || c.word_w < self.fields_w()
+            || (self.shading.is_some() && c.splat == 1)
+        {
             return Err(ModelError::Config(format!(
-                "gicube processor: a volume cache of MaxDim {} and WordW {} for a domain of {} voxels a side of {} bits (need MaxDim above the side, WordW at least the voxel)",
-                c.max_dim, c.word_w, self.side, self.vol.bits
+                "gicube processor: a volume cache of MaxDim {} and WordW {} (Splat {}) for a domain of {} voxels a side of {}-bit words (need MaxDim above the side, WordW at least the word's fields, no splatting with shading)",
+                c.max_dim, c.word_w, c.splat, self.side, self.fields_w()
             )));
         }
         Ok(Some(c))
@@ -612,7 +786,7 @@ impl Processor {
                 let irr = field
                     .and_then(|f| voxel_index(self.vol.dims, v).map(|k| u32::from(f[k])))
                     .unwrap_or(0);
-                self.vol.get(v[0], v[1], v[2]) | irr << c.irr_shift()
+                self.word_of(v) | irr << c.irr_shift()
             })
             .collect()
     }
@@ -660,8 +834,10 @@ impl Processor {
                 }
             }
         }
-        let idx = |v: u32| self.sampler.class_index_of_voxel(v);
-        self.sampler.shader().tables().class.entries()[idx(lo)..=idx(hi)]
+        // With tags the 2-D index is density-major: every tag's entry of the density bins.
+        let tw = self.cfg.shade.map_or(0, |s| s.tag_w);
+        let idx = |v: u32| self.sampler.class_index_of_voxel(v) >> tw << tw;
+        self.sampler.shader().tables().class.entries()[idx(lo)..=idx(hi) | ((1 << tw) - 1)]
             .iter()
             .all(|e| e.a == 0)
     }
@@ -694,13 +870,14 @@ impl Processor {
         self.stepper.delta(ray.dir)
     }
 
-    /// The classified, composited sample at the ray's position (the pipeline's datapath). A
+    /// The classified, composited sample at the ray's position (the pipeline's datapath) from
+    /// the cell's eight voxel words (the density, with shading the tag and gradient index). A
     /// lighting ray adds its `energies` into `irr` first; a rendering ray is lit by the loaded
     /// irradiance.
     fn sample(
         &self,
         ray: &mut RayPacket,
-        voxels: [u32; 8],
+        words: [u32; 8],
         energies: Option<[u32; 8]>,
         irr: Option<&mut [u16]>,
     ) -> bool {
@@ -709,6 +886,10 @@ impl Processor {
         let mask = (1u32 << POS_FRAC_W) - 1;
         let weights = p.map(|c| c & mask);
         let lighting = ray.ray_type == RayType::Lighting;
+        let vw = self.vol.bits;
+        let field = |sh: u32, w: u32| words.map(|x| (x >> sh) & ((1 << w) - 1));
+        let (tag_w, grad_w) = self.cfg.shade.map_or((0, 0), |s| (s.tag_w, s.grad_idx_w));
+        let voxels = field(0, vw);
         if let (Some(irr), Some(e)) = (irr, energies) {
             for (c, &ec) in e.iter().enumerate() {
                 if let Some(i) = voxel_index(self.vol.dims, corner(base, c)) {
@@ -734,8 +915,8 @@ impl Processor {
             color: ray.color,
             opacity: ray.opacity,
             lighting,
-            grad_idx: [0; 8],
-            tags: [0; 8],
+            grad_idx: field(vw + tag_w, grad_w),
+            tags: field(vw, tag_w),
         });
         ray.color = out.color;
         ray.opacity = out.opacity;
@@ -778,17 +959,14 @@ impl Processor {
             // this sample (contract, *Global illumination*).
             let energies = (irr.is_some() && ray.ray_type == RayType::Lighting)
                 .then(|| self.deposit_energies(&ray));
-            // The cell's eight voxels, through the volume cache (contract, *The volume cache*):
+            // The cell's eight words, through the volume cache (contract, *The volume cache*):
             // a read, or the deposit itself when the words hold the field.
             let base = ray.start.map(|c| i64::from(c >> POS_FRAC_W));
-            let voxels = match cache {
+            let words = match cache {
                 Some(cache) => cache.sample(base, energies, counts),
-                None => std::array::from_fn(|c| {
-                    let [x, y, z] = corner(base, c);
-                    self.vol.get(x, y, z)
-                }),
+                None => std::array::from_fn(|c| self.word_of(corner(base, c))),
             };
-            let terminated = self.sample(&mut ray, voxels, energies, irr);
+            let terminated = self.sample(&mut ray, words, energies, irr);
             if let Some(albedo) = self.photon_albedo {
                 // A photon interacts when its opacity reaches its interaction value [364].
                 if u32::from(ray.opacity) << 4 >= u32::from(ray.interaction) {
@@ -1001,7 +1179,6 @@ impl Processor {
         let mut cache = self.cache.as_ref().map(|c| FrameCache {
             cache: c.clone(),
             splats: self.field_in_words(&c.config()),
-            voxel_mask: (1 << self.vol.bits) - 1,
             trace: cache_trace.is_some().then(CacheTrace::default),
         });
         let mut last_active: Option<u32> = None;
@@ -1160,8 +1337,12 @@ impl Processor {
                 });
                 let w = (1.0 - a) * corrected_alpha(rgba[3], r_j * dr);
                 let light = irr.map_or(1.0, |f| field_f64(f, self.vol.dims, p));
+                let rgb = match &self.shading {
+                    Some(sh) => self.shade_f64(sh, [rgba[0], rgba[1], rgba[2]], p, irr.is_some()),
+                    None => [rgba[0], rgba[1], rgba[2]],
+                };
                 for i in 0..3 {
-                    c[i] += w * (rgba[i] * light).min(1.0);
+                    c[i] += w * (rgb[i] * light).min(1.0);
                 }
                 a += w;
                 if thr.is_some_and(|t| a >= t) {
@@ -1171,6 +1352,39 @@ impl Processor {
             img[(r.py * cam.width + r.px) as usize] = c;
         }
         Ok(img)
+    }
+}
+
+impl Processor {
+    /// The f64 reference's shading of a sample at `p` (contract, *Shading and jitter in the
+    /// processor*): the colour of the nearest voxel's tag; unless the ray is lit by irradiance,
+    /// Phong with the map's lights at the tri-linear interpolation of the voxels' unit gradient
+    /// directions (the ambient term alone where it is zero), `rgb d + sp 256/255`, the
+    /// intensities capped at the texels' largest codes.
+    fn shade_f64(&self, sh: &Shading, rgb: [f64; 3], p: DVec3, lit: bool) -> [f64; 3] {
+        let near = (p + DVec3::splat(0.5)).floor().as_i64vec3().to_array();
+        let t = voxel_index(self.vol.dims, near).map_or(0, |i| u32::from(sh.tags[i]));
+        let rgb = tag_rgb(rgb, t);
+        if lit {
+            return rgb;
+        }
+        let f = p.floor();
+        let mut g = DVec3::ZERO;
+        for (c, w) in corner_weights(p - f) {
+            if let Some(i) = voxel_index(self.vol.dims, corner(f.as_i64vec3().to_array(), c)) {
+                g += w * sh.dirs[i];
+            }
+        }
+        let scfg = self.sampler.shader().config();
+        let (d, sp) = if g == DVec3::ZERO {
+            (sh.phong.ambient, 0.0)
+        } else {
+            sh.phong.intensities(g.to_array())
+        };
+        let d = d.min(f64::from(scfg.diff_max()) / f64::from(1u32 << (scfg.diff_w - 1)));
+        let sp = sp.min(f64::from(scfg.spec_max()) / f64::from(1u32 << scfg.spec_w));
+        let k = f64::from(1u32 << scfg.color_w) / f64::from(scfg.color_max());
+        rgb.map(|c| c * d + sp * k)
     }
 }
 
@@ -1552,6 +1766,15 @@ pub struct ProcessorRtlConfig {
     /// 1 (with `light`): high-albedo photons scatter in the ring (contract, *Photons in the
     /// ring*): the scattering unit, the photon registers, the scatterings count in the output.
     pub scatter: u32,
+    /// 1: jitter (the model's `jitter`: `gicube_sample`'s random, log and power LUTs).
+    pub jitter: u32,
+    /// 1 (`light = 0`): shading (contract, *Shading and jitter in the processor*): voxel words
+    /// of density, tag and gradient index, `gicube_sample`'s `Shade = 1`.
+    pub shade: u32,
+    /// Gradient index bits of a voxel word (`shade`), 2..=11.
+    pub grad_idx_w: u32,
+    /// Tag bits of a voxel word (`shade`), 0..=4; 0 without `shade`.
+    pub tag_w: u32,
 }
 
 /// Region of a configuration address (its top two bits): `gicube_sample`'s tables, the empty
@@ -1600,10 +1823,29 @@ impl ProcessorRtlConfig {
         prefetch: 0,
         light: 0,
         scatter: 0,
+        jitter: 0,
+        shade: 0,
+        grad_idx_w: 11,
+        tag_w: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(ModelError::Config(format!("gicube_processor: {m}")));
+        if self.jitter > 1 {
+            return bad(format!("Jitter {} is not 0 or 1", self.jitter));
+        }
+        if self.shade > 1
+            || (self.shade == 1 && self.light == 1)
+            || (self.shade == 0 && self.tag_w != 0)
+        {
+            return bad(format!(
+                "Shade {} is not 0 or 1, or with Light {}, or TagW {} without it",
+                self.shade, self.light, self.tag_w
+            ));
+        }
+        if let Some(sh) = self.shade_config() {
+            sh.validate(self.voxel_w)?;
+        }
         if self.light > 1 {
             return bad(format!("Light {} is not 0 or 1", self.light));
         }
@@ -1648,15 +1890,29 @@ impl ProcessorRtlConfig {
         self.cache_config().validate()
     }
 
+    /// The shading widths (`shade`).
+    pub fn shade_config(&self) -> Option<ShadeConfig> {
+        (self.shade == 1).then_some(ShadeConfig {
+            grad_idx_w: self.grad_idx_w,
+            tag_w: self.tag_w,
+        })
+    }
+
+    /// Bits of a voxel word's fields: `VoxelW`, with `shade` plus `TagW + GradIdxW`.
+    pub fn fields_w(&self) -> u32 {
+        self.voxel_w + self.shade * (self.tag_w + self.grad_idx_w)
+    }
+
     /// The volume cache (contract, *The RTL*): `MaxDim` the smallest power of two above `N` (at
-    /// least 4), `WordW` 8 for voxels of up to 8 bits, else 16 (32 and `Splat = 1` with
-    /// `Light`), `AddrW = 32`, the rest the RTL's.
+    /// least 4), `WordW` the smallest of 8, 16, 32 that holds the word's fields (the voxel;
+    /// with `Shade` its tag and gradient index too; 32 and `Splat = 1` with `Light`), `AddrW =
+    /// 32`, the rest the RTL's.
     pub fn cache_config(&self) -> CacheConfig {
         CacheConfig {
             max_dim: (self.side() + 1).next_power_of_two().max(4),
-            word_w: if self.light == 1 {
+            word_w: if self.light == 1 || self.fields_w() > 16 {
                 32
-            } else if self.voxel_w <= 8 {
+            } else if self.fields_w() <= 8 {
                 8
             } else {
                 16
@@ -1684,14 +1940,15 @@ impl ProcessorRtlConfig {
             .max(1)
     }
 
-    /// Configuration address bits: two region bits over `gicube_sample`'s address.
+    /// Configuration address bits: two region bits over `gicube_sample`'s address (one more
+    /// with `Shade`: its shading tables at bit 14).
     pub fn cfg_addr_w(&self) -> u32 {
-        2 + SAMPLE_CFG_ADDR_W
+        2 + SAMPLE_CFG_ADDR_W + self.shade
     }
 
     /// The model's configuration that this RTL renders exactly (frames and counts): the RTL's
-    /// front end, step, ring latency and volume cache, the model's defaults otherwise
-    /// (termination at `1 - 2^-8`, space leaping, the sorter, no jitter).
+    /// front end, step, ring latency, volume cache, jitter and shading, the model's defaults
+    /// otherwise (termination at `1 - 2^-8`, space leaping, the sorter).
     pub fn processor_config(&self) -> ProcessorConfig {
         ProcessorConfig {
             block_log2: self.block_log2,
@@ -1700,6 +1957,8 @@ impl ProcessorRtlConfig {
             step: self.step,
             ring_latency: self.ring_lat,
             cache: Some(self.cache_config()),
+            jitter: self.jitter == 1,
+            shade: self.shade_config(),
             ..ProcessorConfig::DEFAULT
         }
     }
@@ -1720,6 +1979,10 @@ crate::unit_config!(ProcessorRtlConfig, "gicube_processor", DEFAULT, {
     "Prefetch" => prefetch,
     "Light" => light,
     "Scatter" => scatter,
+    "Jitter" => jitter,
+    "Shade" => shade,
+    "GradIdxW" => grad_idx_w,
+    "TagW" => tag_w,
 });
 
 /// One output item of the RTL: a finished or an overflowed ray, and the counts after it.
@@ -1800,6 +2063,8 @@ impl Processor {
             || self.cfg.block_log2 != rtl.block_log2
             || self.blocks != rtl.vol_blocks
             || self.cache_config()? != Some(rtl.cache_config())
+            || self.cfg.jitter != (rtl.jitter == 1)
+            || self.cfg.shade != rtl.shade_config()
         {
             return Err(ModelError::Config(format!(
                 "gicube_processor: a {}-bit volume of {} blocks of 2^{} at step {} does not fit {rtl:?}",
@@ -1819,7 +2084,7 @@ impl Processor {
             .into_iter()
             .map(|(a, d)| (region(CFG_REGION_SAMPLE, a), d))
             .collect();
-        debug_assert!(writes.iter().all(|(a, _)| *a < 1 << SAMPLE_CFG_ADDR_W));
+        debug_assert!(writes.iter().all(|(a, _)| *a < 1 << top));
         for q in 0..1u32 << rtl.queue_w() {
             let e = self.cfg.space_leap && self.empty.get(q as usize).copied().unwrap_or(false);
             writes.push((region(CFG_REGION_EMPTY, q), word(u32::from(e))));
