@@ -403,7 +403,7 @@ pub fn interaction_draw(bits: u32) -> u16 {
 /// The volume cache of one frame (contract, *The volume cache*): the samples' items, in order,
 /// and, when traced, the bursts of their misses and write-backs.
 #[derive(Debug, Clone)]
-struct FrameCache {
+pub(crate) struct FrameCache {
     cache: VolumeCache,
     /// The words hold the irradiance field above the voxel (contract, *Splatting through the
     /// cache*): a lighting sample is a deposit item.
@@ -471,7 +471,7 @@ pub type QueueOp = crate::units::gicube_queue_front::QueueOp<RayPacket>;
 type FrontTrace = crate::units::gicube_queue_front::FrontTrace<RayPacket>;
 
 /// What one pipeline cycle did to a ray.
-enum Outcome {
+pub(crate) enum Outcome {
     /// Still in the volume: re-queued through the ring to the block it is in now (the front
     /// end buckets it: the same queue, or the one it entered).
     Next(RayPacket),
@@ -998,12 +998,7 @@ impl Processor {
         let mut rgb = vec![[0u16; 3]; (w * h) as usize];
         let mut done = vec![false; (w * h) as usize];
         // The volume cache from reset (contract, *The volume cache*).
-        let mut cache = self.cache.as_ref().map(|c| FrameCache {
-            cache: c.clone(),
-            splats: self.field_in_words(&c.config()),
-            voxel_mask: (1 << self.vol.bits) - 1,
-            trace: cache_trace.is_some().then(CacheTrace::default),
-        });
+        let mut cache = self.frame_cache(cache_trace.is_some());
         let mut last_active: Option<u32> = None;
         // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
         // Per ray and life: at most 2 N 256 / step samples along a path (sqrt 3 N < 2 N), plus
@@ -1514,6 +1509,52 @@ pub fn shadow_scene(n: usize) -> Result<(Volume, TransferFunction, GiLight)> {
         mode: GiMode::LowAlbedo,
     };
     Ok((vol, tf, light))
+}
+
+/// What a ring of processors (`gicube_ring`, docs/numerics/gicube_ring.md) uses of one: each
+/// of its processors is this one, its cycle's parts called by the ring's cycle loop.
+impl Processor {
+    /// The volume cache of a frame from reset (contract, *The volume cache*); `traced`: it
+    /// records its bursts.
+    pub(crate) fn frame_cache(&self, traced: bool) -> Option<FrameCache> {
+        self.cache.as_ref().map(|c| FrameCache {
+            cache: c.clone(),
+            splats: self.field_in_words(&c.config()),
+            voxel_mask: (1 << self.vol.bits) - 1,
+            trace: traced.then(CacheTrace::default),
+        })
+    }
+
+    /// The AR bursts a traced frame cache recorded, in order.
+    pub(crate) fn frame_cache_reads(cache: FrameCache) -> Vec<Burst> {
+        cache.trace.map(|t| t.reads).unwrap_or_default()
+    }
+
+    /// One pipeline cycle on a ray of queue `q` of a rendering frame (no lighting pass).
+    pub(crate) fn ring_advance(
+        &self,
+        ray: RayPacket,
+        q: u32,
+        counts: &mut ProcessorCounts,
+        cache: Option<&mut FrameCache>,
+    ) -> Outcome {
+        self.advance(ray, q, counts, cache, None)
+    }
+
+    /// The host's packets of a frame, in its order.
+    pub(crate) fn ring_packets(&self, cam: &Camera, proj: Projection) -> Result<Vec<RayPacket>> {
+        self.frame_packets(cam, proj)
+    }
+
+    /// Blocks a side `B`.
+    pub fn blocks(&self) -> u32 {
+        self.blocks
+    }
+
+    /// The queue of a position inside the volume (`None` outside).
+    pub(crate) fn ring_queue_of(&self, pos: [u32; 3]) -> Option<u32> {
+        self.queue_of(pos)
+    }
 }
 
 /// The RTL top `gicube_processor`'s parameters (contract, *The RTL*): the front end's, the voxel
