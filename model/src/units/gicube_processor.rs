@@ -1593,6 +1593,10 @@ pub struct ProcessorRtlConfig {
     /// 1 (with `light`): high-albedo photons scatter in the ring (contract, *Photons in the
     /// ring*): the scattering unit, the photon registers, the scatterings count in the output.
     pub scatter: u32,
+    /// Processors of the ring this one is in (docs/numerics/gicube_ring.md: 1 alone, 2 or 4 in
+    /// `gicube_ring`) and its index there; a processor's own lines are 1 and 0.
+    pub procs: u32,
+    pub proc_id: u32,
 }
 
 /// Region of a configuration address (its top two bits): `gicube_sample`'s tables, the empty
@@ -1641,10 +1645,22 @@ impl ProcessorRtlConfig {
         prefetch: 0,
         light: 0,
         scatter: 0,
+        procs: 1,
+        proc_id: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(ModelError::Config(format!("gicube_processor: {m}")));
+        if ![1, 2, 4].contains(&self.procs)
+            || self.proc_id >= self.procs
+            || self.vol_blocks % self.procs != 0
+            || (self.procs > 1 && self.light != 0)
+        {
+            return bad(format!(
+                "Procs {} (1, 2 or 4, dividing VolBlocks, Light 0) or ProcId {} (below it)",
+                self.procs, self.proc_id
+            ));
+        }
         if self.light > 1 {
             return bad(format!("Light {} is not 0 or 1", self.light));
         }
@@ -1761,6 +1777,8 @@ crate::unit_config!(ProcessorRtlConfig, "gicube_processor", DEFAULT, {
     "Prefetch" => prefetch,
     "Light" => light,
     "Scatter" => scatter,
+    "Procs" => procs,
+    "ProcId" => proc_id,
 });
 
 /// One output item of the RTL: a finished or an overflowed ray, and the counts after it.

@@ -377,6 +377,8 @@ impl RingRtlConfig {
             prefetch: self.prefetch,
             light: 0,
             scatter: 0,
+            procs: 1,
+            proc_id: 0,
         }
     }
 
