@@ -1653,7 +1653,7 @@ impl ProcessorRtlConfig {
         let bad = |m: String| Err(ModelError::Config(format!("gicube_processor: {m}")));
         if ![1, 2, 4].contains(&self.procs)
             || self.proc_id >= self.procs
-            || self.vol_blocks % self.procs != 0
+            || !self.vol_blocks.is_multiple_of(self.procs)
             || (self.procs > 1 && self.light != 0)
         {
             return bad(format!(

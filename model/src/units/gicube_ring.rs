@@ -86,7 +86,8 @@ impl Ring {
     pub fn new(proc: Processor, procs: u32) -> Result<Self> {
         let b = proc.blocks();
         let cfg = proc.config();
-        if !(1..=MAX_PROCS).contains(&procs) || !procs.is_power_of_two() || b % procs != 0 {
+        if !(1..=MAX_PROCS).contains(&procs) || !procs.is_power_of_two() || !b.is_multiple_of(procs)
+        {
             return Err(ModelError::Config(format!(
                 "gicube ring: {procs} processors (1, 2 or 4, dividing the {b} blocks a side)"
             )));
@@ -387,7 +388,7 @@ impl RingRtlConfig {
     }
 
     pub fn validate(&self) -> Result<()> {
-        if self.proc_log2 > 2 || self.vol_blocks % self.procs() != 0 {
+        if self.proc_log2 > 2 || !self.vol_blocks.is_multiple_of(self.procs()) {
             return Err(ModelError::Config(format!(
                 "gicube_ring: ProcLog2 {} outside 0..=2 or VolBlocks {} not a multiple of {}",
                 self.proc_log2,
