@@ -95,7 +95,12 @@ module gicube_processor #(
   /// Gradient index bits of a voxel word (Shade = 1), 2..11.
   parameter int unsigned GradIdxW    = 11,
   /// Tag bits of a voxel word (Shade = 1), 0..4; 0 with Shade = 0.
-  parameter int unsigned TagW        = 0
+  parameter int unsigned TagW        = 0,
+  /// Processors of the ring this one is in (docs/numerics/gicube_ring.md): 1 (alone: the
+  /// ring ports are not read), 2 or 4 (slabs along x; Light = 0).
+  parameter int unsigned Procs       = 1,
+  /// This processor's index in the ring, 0..Procs-1: it owns slab ProcId.
+  parameter int unsigned ProcId      = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -129,6 +134,28 @@ module gicube_processor #(
   /// Sticky: some volume read (or write-back) since reset came back with RRESP (BRESP) != OKAY
   /// (gicube_cache's).
   output logic err_o,
+
+  // The ring (Procs > 1; docs/numerics/gicube_ring.md): lockstep cycles and the neighbour port.
+  /// Issue the processor cycle now (the ring's go: every processor could, some has work).
+  input  logic go_i,
+  /// This processor could issue a cycle (its front end, output and ring's head are ready).
+  output logic can_o,
+  /// It has work: an offer on in_*, a ray in its queues or in its ring.
+  output logic busy_o,
+  /// A cycle is between its issue and its dispatch.
+  output logic waiting_o,
+  /// The offer on in_* is a neighbour's ray (its link), not the host's.
+  input  logic in_nb_i,
+  /// The ring's ray belongs to processor nb_dest_o: at go it is sent if nb_grant_i, else it is
+  /// returned to the host through the output (OVERFLOW set).
+  output logic nb_req_o,
+  output logic [1:0] nb_dest_o,
+  output logic [gicube_pkg::PacketW-1:0] nb_data_o,
+  /// The link to nb_dest_o takes the ray.
+  input  logic nb_grant_i,
+  /// The counts (rays_in, finished, overflowed, samples, leaps, cycles, cache hits, misses,
+  /// nb_in, nb_out; 32 bits each, LSB first).
+  output logic [gicube_pkg::RingCounts*32-1:0] cnt_o,
 
   // AXI4 channels (gicube_cache's): the volume in memory (AR, R); Light: the cache's
   // write-back of dirty lines (AW, W, B), else idle.
@@ -210,6 +237,10 @@ module gicube_processor #(
   end
   if (Shade > 1 || (Shade != 0 && Light != 0) || (Shade == 0 && TagW != 0)) begin : gen_bad_shade
     $fatal(1, "gicube_processor: Shade must be 0 or 1, 1 only without Light, TagW 0 without it");
+  end
+  if (!(Procs == 1 || Procs == 2 || Procs == 4) || VolBlocks % Procs != 0 || ProcId >= Procs
+      || (Procs > 1 && Light != 0)) begin : gen_bad_procs
+    $fatal(1, "gicube_processor: Procs must be 1, 2 or 4 dividing VolBlocks, ProcId below it, Light 0");
   end
 
   // ---------------------------------------------------------------------------
@@ -343,7 +374,10 @@ module gicube_processor #(
   // does not see.
   // While a flush is in the cache, no cycle is issued (its output item has the output alone).
   logic flush_fly_q;
-  assign issue      = !waiting_q && fe_in_ready && of_empty && head_ready && busy && !flush_fly_q;
+  logic can_issue;
+  assign can_issue  = !waiting_q && fe_in_ready && of_empty && head_ready && !flush_fly_q;
+  // In a ring (Procs > 1) every processor issues at the ring's go (lockstep cycles).
+  assign issue      = (Procs == 1) ? (can_issue && busy) : go_i;
   // A sampling ray's cell goes to the cache (Light: to gicube_deposit) in the dispatch clock: the
   // dispatch waits while the cache (or the deposit pipeline) cannot take it.
   logic smp_req, fetch_ready;
@@ -351,8 +385,17 @@ module gicube_processor #(
   assign dispatch   = waiting_q && fe_out_valid && (!smp_req || fetch_ready);
 
   // The front end's item: take, ring, host, ring ray, host ray.
-  logic ring_v;
-  assign ring_v       = (lead_q == '0) && h_ray && !h_done;
+  // The ring's ray in a ring of processors: it belongs to slab h_owner; another's is sent to its
+  // link (granted) or returned to the host (nb_ret), and does not enter this front end.
+  logic       ring_v, nb_req, nb_ret, offer_nb_q, offer_nb;
+  logic [1:0] h_owner;
+  assign h_owner      = gicube_pkg::ring_owner(h_out[StartLsb + PosFracW +: gicube_pkg::PosIntW],
+                                               BlockLog2, VolBlocks / Procs, Procs);
+  assign nb_req       = (Procs > 1) && (lead_q == '0) && h_ray && !h_done
+                        && (h_owner != 2'(ProcId));
+  assign nb_ret       = issue && nb_req && !nb_grant_i;
+  assign offer_nb     = (Procs > 1) && offer_nb_q;
+  assign ring_v       = (lead_q == '0) && h_ray && !h_done && !nb_req;
   assign fe_in_valid  = issue;
   assign fe_in        = {in_data_i, h_out, in_valid_i, ring_v, 1'b1};
   assign fe_out_ready = dispatch;
@@ -365,13 +408,15 @@ module gicube_processor #(
   // Counts.
   logic [CntW-1:0] c_in_q, c_fin_q, c_ovf_q, c_smp_q, c_leap_q, c_cyc_q, c_hit_q, c_mis_q;
   logic [CntW-1:0] c_in_d, c_fin_d, c_ovf_d, c_smp_d, c_leap_d, c_cyc_d, c_hit_d, c_mis_d;
-  logic [CntW-1:0] c_sct_q, c_sct_d;
+  logic [CntW-1:0] c_sct_q, c_sct_d, c_nbi_q, c_nbi_d, c_nbo_q, c_nbo_d;
   logic              ca_out_valid;
   logic [CaOutW-1:0] ca_out;
 
   always_comb begin
-    c_in_d   = c_in_q   + CntW'(dispatch && o_host_taken);
-    c_ovf_d  = c_ovf_q  + CntW'(dispatch && o_ring_ovf);
+    c_in_d   = c_in_q   + CntW'(dispatch && o_host_taken && !offer_nb);
+    c_nbi_d  = c_nbi_q  + CntW'(dispatch && o_host_taken && offer_nb);
+    c_nbo_d  = c_nbo_q  + CntW'(issue && nb_req && nb_grant_i);
+    c_ovf_d  = c_ovf_q  + CntW'(dispatch && o_ring_ovf) + CntW'(nb_ret);
     c_smp_d  = c_smp_q  + CntW'(dispatch && o_popped && !rec_leap);
     c_leap_d = c_leap_q + CntW'(dispatch && o_popped && rec_leap);
     c_fin_d  = c_fin_q  + CntW'(issue && (lead_q == '0) && h_ray && h_done);
@@ -384,12 +429,19 @@ module gicube_processor #(
 
   assign of_push_fin = issue && (lead_q == '0) && h_ray && h_done;
   assign of_push_ovf = dispatch && o_ring_ovf;
-  assign of_push     = of_push_fin || of_push_ovf || of_push_flush;
+  assign of_push     = of_push_fin || of_push_ovf || of_push_flush || nb_ret;
   logic of_push_flush;
+  // A ray the link refused goes back to the host with OVERFLOW set.
+  logic [PacketW-1:0] h_ret;
+  always_comb begin
+    h_ret = h_out;
+    h_ret[gicube_pkg::PacketFlagsLsb + gicube_pkg::FlagOverflow] = 1'b1;
+  end
   logic [OutW-CntW*Scatter-1:0] of_base;
   assign of_base     = {of_push_flush, c_mis_d, c_hit_d, c_cyc_d, c_leap_d, c_smp_d, c_ovf_d,
                         c_fin_d, c_in_d,
-                        of_push_fin ? h_out : of_push_flush ? PacketW'(0) : o_ovf_ray,
+                        of_push_fin ? h_out : nb_ret ? h_ret
+                                    : of_push_flush ? PacketW'(0) : o_ovf_ray,
                         of_push_fin};
   // Scatter: the scatterings above the flush bit.
   if (Scatter != 0) begin : gen_out_sct
@@ -414,7 +466,13 @@ module gicube_processor #(
       c_hit_q     <= '0;
       c_mis_q     <= '0;
       c_sct_q     <= '0;
+      c_nbi_q     <= '0;
+      c_nbo_q     <= '0;
+      offer_nb_q  <= 1'b0;
     end else begin
+      if (issue) begin
+        offer_nb_q <= in_nb_i;
+      end
       if (issue) begin
         waiting_q <= 1'b1;
       end else if (dispatch) begin
@@ -440,8 +498,20 @@ module gicube_processor #(
       c_hit_q  <= c_hit_d;
       c_mis_q  <= c_mis_d;
       c_sct_q  <= c_sct_d;
+      c_nbi_q  <= c_nbi_d;
+      c_nbo_q  <= c_nbo_d;
     end
   end
+
+  // The ring's view of this processor (read only with Procs > 1).
+  assign can_o     = can_issue;
+  assign busy_o    = busy;
+  assign waiting_o = waiting_q;
+  assign nb_req_o  = nb_req;
+  assign nb_dest_o = h_owner;
+  assign nb_data_o = h_out;
+  assign cnt_o     = {c_nbo_q, c_nbi_q, c_mis_q, c_hit_q, c_cyc_q, c_leap_q, c_smp_q, c_ovf_q,
+                      c_fin_q, c_in_q};
 
   gicube_queue_front #(
     .BlockLog2 (BlockLog2),

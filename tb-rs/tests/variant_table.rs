@@ -20,6 +20,7 @@ use cube5_model::units::gicube_deposit::DepositConfig;
 use cube5_model::units::gicube_processor::ProcessorRtlConfig;
 use cube5_model::units::gicube_queue_front::QueueFrontConfig;
 use cube5_model::units::gicube_ray_queues::RayQueuesConfig;
+use cube5_model::units::gicube_ring::RingRtlConfig;
 use cube5_model::units::gicube_sample::SampleRtlConfig;
 use cube5_model::units::gicube_step::StepConfig;
 use cube5_model::units::{
@@ -84,6 +85,7 @@ fn check(v: &Variant) -> Result<(), String> {
         t if t == RayQueuesConfig::TOP => agree::<RayQueuesConfig>(v),
         t if t == QueueFrontConfig::TOP => agree::<QueueFrontConfig>(v),
         t if t == ProcessorRtlConfig::TOP => agree::<ProcessorRtlConfig>(v),
+        t if t == RingRtlConfig::TOP => agree::<RingRtlConfig>(v),
         t if t == SectionBufConfig::TOP => agree::<SectionBufConfig>(v),
         t if t == StepConfig::TOP => agree::<StepConfig>(v),
         t if t == DepositConfig::TOP => agree::<DepositConfig>(v),

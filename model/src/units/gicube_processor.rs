@@ -411,7 +411,7 @@ pub fn interaction_draw(bits: u32) -> u16 {
 /// The volume cache of one frame (contract, *The volume cache*): the samples' items, in order,
 /// and, when traced, the bursts of their misses and write-backs.
 #[derive(Debug, Clone)]
-struct FrameCache {
+pub(crate) struct FrameCache {
     cache: VolumeCache,
     /// The words hold the irradiance field above the voxel (contract, *Splatting through the
     /// cache*): a lighting sample is a deposit item.
@@ -477,7 +477,7 @@ pub type QueueOp = crate::units::gicube_queue_front::QueueOp<RayPacket>;
 type FrontTrace = crate::units::gicube_queue_front::FrontTrace<RayPacket>;
 
 /// What one pipeline cycle did to a ray.
-enum Outcome {
+pub(crate) enum Outcome {
     /// Still in the volume: re-queued through the ring to the block it is in now (the front
     /// end buckets it: the same queue, or the one it entered).
     Next(RayPacket),
@@ -1176,11 +1176,7 @@ impl Processor {
         let mut rgb = vec![[0u16; 3]; (w * h) as usize];
         let mut done = vec![false; (w * h) as usize];
         // The volume cache from reset (contract, *The volume cache*).
-        let mut cache = self.cache.as_ref().map(|c| FrameCache {
-            cache: c.clone(),
-            splats: self.field_in_words(&c.config()),
-            trace: cache_trace.is_some().then(CacheTrace::default),
-        });
+        let mut cache = self.frame_cache(cache_trace.is_some());
         let mut last_active: Option<u32> = None;
         // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
         // Per ray and life: at most 2 N 256 / step samples along a path (sqrt 3 N < 2 N), plus
@@ -1730,6 +1726,51 @@ pub fn shadow_scene(n: usize) -> Result<(Volume, TransferFunction, GiLight)> {
     Ok((vol, tf, light))
 }
 
+/// What a ring of processors (`gicube_ring`, docs/numerics/gicube_ring.md) uses of one: each
+/// of its processors is this one, its cycle's parts called by the ring's cycle loop.
+impl Processor {
+    /// The volume cache of a frame from reset (contract, *The volume cache*); `traced`: it
+    /// records its bursts.
+    pub(crate) fn frame_cache(&self, traced: bool) -> Option<FrameCache> {
+        self.cache.as_ref().map(|c| FrameCache {
+            cache: c.clone(),
+            splats: self.field_in_words(&c.config()),
+            trace: traced.then(CacheTrace::default),
+        })
+    }
+
+    /// The AR bursts a traced frame cache recorded, in order.
+    pub(crate) fn frame_cache_reads(cache: FrameCache) -> Vec<Burst> {
+        cache.trace.map(|t| t.reads).unwrap_or_default()
+    }
+
+    /// One pipeline cycle on a ray of queue `q` of a rendering frame (no lighting pass).
+    pub(crate) fn ring_advance(
+        &self,
+        ray: RayPacket,
+        q: u32,
+        counts: &mut ProcessorCounts,
+        cache: Option<&mut FrameCache>,
+    ) -> Outcome {
+        self.advance(ray, q, counts, cache, None)
+    }
+
+    /// The host's packets of a frame, in its order.
+    pub(crate) fn ring_packets(&self, cam: &Camera, proj: Projection) -> Result<Vec<RayPacket>> {
+        self.frame_packets(cam, proj)
+    }
+
+    /// Blocks a side `B`.
+    pub fn blocks(&self) -> u32 {
+        self.blocks
+    }
+
+    /// The queue of a position inside the volume (`None` outside).
+    pub(crate) fn ring_queue_of(&self, pos: [u32; 3]) -> Option<u32> {
+        self.queue_of(pos)
+    }
+}
+
 /// The RTL top `gicube_processor`'s parameters (contract, *The RTL*): the front end's, the voxel
 /// width, the sample distance, the ring latency and the volume cache's. Every parameter is a
 /// field of the model ([`ProcessorRtlConfig::processor_config`]).
@@ -1775,6 +1816,10 @@ pub struct ProcessorRtlConfig {
     pub grad_idx_w: u32,
     /// Tag bits of a voxel word (`shade`), 0..=4; 0 without `shade`.
     pub tag_w: u32,
+    /// Processors of the ring this one is in (docs/numerics/gicube_ring.md: 1 alone, 2 or 4 in
+    /// `gicube_ring`) and its index there; a processor's own lines are 1 and 0.
+    pub procs: u32,
+    pub proc_id: u32,
 }
 
 /// Region of a configuration address (its top two bits): `gicube_sample`'s tables, the empty
@@ -1827,6 +1872,8 @@ impl ProcessorRtlConfig {
         shade: 0,
         grad_idx_w: 11,
         tag_w: 0,
+        procs: 1,
+        proc_id: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
@@ -1845,6 +1892,16 @@ impl ProcessorRtlConfig {
         }
         if let Some(sh) = self.shade_config() {
             sh.validate(self.voxel_w)?;
+        }
+        if ![1, 2, 4].contains(&self.procs)
+            || self.proc_id >= self.procs
+            || !self.vol_blocks.is_multiple_of(self.procs)
+            || (self.procs > 1 && self.light != 0)
+        {
+            return bad(format!(
+                "Procs {} (1, 2 or 4, dividing VolBlocks, Light 0) or ProcId {} (below it)",
+                self.procs, self.proc_id
+            ));
         }
         if self.light > 1 {
             return bad(format!("Light {} is not 0 or 1", self.light));
@@ -1983,6 +2040,8 @@ crate::unit_config!(ProcessorRtlConfig, "gicube_processor", DEFAULT, {
     "Shade" => shade,
     "GradIdxW" => grad_idx_w,
     "TagW" => tag_w,
+    "Procs" => procs,
+    "ProcId" => proc_id,
 });
 
 /// One output item of the RTL: a finished or an overflowed ray, and the counts after it.

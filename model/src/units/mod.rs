@@ -31,6 +31,7 @@ pub mod gicube_packet_loop;
 pub mod gicube_processor;
 pub mod gicube_queue_front;
 pub mod gicube_ray_queues;
+pub mod gicube_ring;
 pub mod gicube_sample;
 pub mod gicube_scatter;
 pub mod gicube_sorter;
