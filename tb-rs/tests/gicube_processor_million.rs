@@ -16,8 +16,10 @@ mod support;
 
 use cube5_model::camera::Camera;
 use cube5_model::transfer::{TfPoint, TransferFunction};
-use cube5_model::units::gicube_packet_loop::{RayPacket, RayReal, RayType};
-use cube5_model::units::gicube_processor::{host_rays, Processor, ProcessorRtlConfig, Projection};
+use cube5_model::units::gicube_packet_loop::RayPacket;
+use cube5_model::units::gicube_processor::{
+    host_rays, HostRay, Processor, ProcessorRtlConfig, Projection,
+};
 use cube5_model::volume::Volume;
 use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
@@ -152,21 +154,14 @@ fn random_rays(
                 if rng.random_range(0..3) == 0 {
                     start[rng.random_range(0..3)] = if rng.random_bool(0.5) { 0.0 } else { hi };
                 }
-                RayPacket::from_real(&RayReal {
-                    u: (i % 64) as u16,
-                    v: (i / 64) as u16,
-                    start,
-                    dir: random_dir(rng),
-                    color: [0.0; 3],
-                    opacity: 0.0,
-                    contribution: 1.0,
-                    interaction: 0.0,
-                    lifetime: 0,
-                    generation: 0,
-                    ray_type: RayType::Rendering,
-                    flags: 0,
-                })
-                .unwrap()
+                // The host's packet (`Processor::packet`) of a ray from `start`.
+                let ray = HostRay {
+                    px: i % 64,
+                    py: i / 64,
+                    entry: start.into(),
+                    dir: random_dir(rng).into(),
+                };
+                Processor::packet(&ray).unwrap()
             })
             .collect();
         (packets, (64, n.div_ceil(64)), format!("{n} random packets"))
