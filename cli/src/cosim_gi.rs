@@ -185,7 +185,17 @@ impl GiBench {
         let (mut finished, mut clocks) = (0usize, 0u64);
         let mut last = ProcessorOut::default();
         let limit = 100_000 + 40_000 * rays.len() as u64;
+        let mut shown = std::time::Instant::now();
         while finished < rays.len() {
+            // Progress on stderr every few seconds (a 64^3 pass runs for minutes).
+            if clocks % 4096 == 0 && shown.elapsed().as_secs_f64() > 5.0 {
+                eprintln!(
+                    "{name}: {finished} of {} rays finished, {} overflowed, after {clocks} clocks",
+                    rays.len(),
+                    last.rays_overflowed
+                );
+                shown = std::time::Instant::now();
+            }
             if clocks >= limit {
                 bail!(
                     "{name}: no progress after {clocks} clocks ({finished} of {} rays finished)",

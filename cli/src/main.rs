@@ -435,6 +435,9 @@ fn render(args: RenderArgs) -> Result<()> {
 /// f64 reference. The plan line follows the run, with the passes' counts.
 fn render_gi(scene: &Scene, vol: &cube5_model::volume::Volume, args: &RenderArgs) -> Result<()> {
     use cube5_model::scene_gi::{compare, run_counts_text, GiJob};
+    if scene.run.target.uses_rtl() && cosim_for_render(scene, args)? {
+        return Ok(());
+    }
     let mut plan = Plan::new(scene, vol)?;
     let mut job = GiJob::new(scene, vol)?;
     let repeat = args.repeat.max(1);
@@ -508,32 +511,41 @@ fn render_gi(scene: &Scene, vol: &cube5_model::volume::Volume, args: &RenderArgs
     Ok(())
 }
 
-/// `run.target = "rtl"` or `"both"`: the RTL frame (P = 4) against the model, images beside the
-/// output. True when the scene asks for the RTL only (nothing more to render).
+/// `run.target = "rtl"` or `"both"`: the RTL frame (P = 4) against the model, or for a `[gi]`
+/// scene both passes on the `gicube_processor` line of its size (`cube5 cosim`'s run, the DDR-like
+/// memory), images beside the output. True when the scene asks for the RTL only (nothing more to
+/// render).
 #[cfg(feature = "rtl")]
 fn cosim_for_render(scene: &Scene, args: &RenderArgs) -> Result<bool> {
-    // The RTL frame the scene elaborates to (`cube5 elaborate`) against the model, images beside
-    // the output.
     let origin = args
         .scene
         .as_ref()
         .map_or("the default scene".to_string(), |p| p.display().to_string());
-    let rtl = cosim::variant_for(scene, &origin, None)?;
-    say!(
-        "rtl: {} (the only RTL variant this scene needs; `make cosim SCENE=...` builds just it)",
-        rtl.variant
-    );
     let stem = args
         .output
         .file_stem()
         .map_or("cube5".into(), |s| s.to_string_lossy().into_owned());
     let dir = args.output.with_file_name(format!("{stem}-cosim"));
+    let target = scene.run.target.name();
+    if scene.gi.is_some() {
+        let memory = cosim_gi::MemoryKind::Ddr;
+        let matched = cosim_gi::run(scene, &origin, &dir, 1, memory)
+            .with_context(|| format!("run.target = \"{target}\""))?;
+        if !matched {
+            bail!("run.target = \"{target}\": the RTL GI-Cube processor differs from the model (report above)");
+        }
+        return Ok(scene.run.target == Target::Rtl);
+    }
+    // The RTL frame the scene elaborates to (`cube5 elaborate`) against the model, images beside
+    // the output.
+    let rtl = cosim::variant_for(scene, &origin, None)?;
+    say!(
+        "rtl: {} (the only RTL variant this scene needs; `make cosim SCENE=...` builds just it)",
+        rtl.variant
+    );
     let r = cosim::cosim_scene(scene, &origin, rtl, &dir, 1)?;
     if !r.matched {
-        bail!(
-            "run.target = \"{}\": the RTL frame differs from the model (report above)",
-            scene.run.target.name()
-        );
+        bail!("run.target = \"{target}\": the RTL frame differs from the model (report above)");
     }
     Ok(scene.run.target == Target::Rtl)
 }

@@ -1,8 +1,8 @@
 //! GI scenes (`[gi]`) on the command line: `cube5 render` runs them on the GI-Cube processor model
 //! (the plan line names it and gives the counts of both passes), `--compare` measures them against
 //! the processor's f64 reference, the light's shadow shows in the image; `cube5 cosim` runs them
-//! on the RTL block processor (`gicube_processor`) bit for bit, and `run.target = "rtl"`/`"both"`
-//! refuse them in one line.
+//! on the RTL block processor (`gicube_processor`) bit for bit, and so does `cube5 render` with
+//! `run.target = "rtl"`/`"both"` (a line not built is named in one line with its build).
 
 mod support;
 
@@ -110,25 +110,99 @@ fn gi_reference_renders() {
     assert!(img.pixels().any(|p| p.0.iter().any(|&c| c > 60)));
 }
 
+/// The 16^3 GI scene, a quarter of its lighting rays and 16 x 16 pixels (seconds on the RTL).
+fn short_gi_16() -> String {
+    let path = cube5_model::repo_root().join("scenes/gi-shadow-16.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let short = text
+        .replace("width = 32", "width = 16")
+        .replace("height = 32", "height = 16")
+        .replace("albedo = 0.0 ", "light_rays = 28\nalbedo = 0.0 ");
+    assert!(short.contains("light_rays = 28"), "{short}");
+    short
+}
+
+/// `cube5 render --target both` of the 16^3 GI scene: both passes on `gicube_processor` (its
+/// `Light = 1` line, in every cube5) MATCH the model at the line's configuration, their images
+/// beside the output, and the model's image at the scene's configuration is written; `--target rtl` co-simulates only (no output image). A 24^3 volume
+/// (no line) and the 32^3 and 64^3 scenes (lines built only by `CUBE5_FULL=1`) are refused in
+/// one line naming what would run them, or (when built) MATCH.
+#[cfg(feature = "rtl")]
 #[test]
-fn gi_scenes_refuse_the_rtl_in_one_line() {
-    let png = scratch("gi-rtl.png");
-    for target in ["rtl", "both"] {
-        let out = cube5(&["render", s(&example()), "-o", s(&png), "--target", target]);
-        assert_refused(&out, &["run.target", "processor model only"]);
+fn gi_scenes_render_on_the_processor_rtl_with_run_target() {
+    let scene = scratch_file("gi-render-16.toml", short_gi_16());
+    for target in ["both", "rtl"] {
+        let png = scratch(&format!("gi-render-16-{target}.png"));
+        let dir = scratch(&format!("gi-render-16-{target}-cosim"));
+        let _ = std::fs::remove_file(&png);
+        let _ = std::fs::remove_dir_all(&dir);
+        let out = cube5(&["render", s(&scene), "-o", s(&png), "--target", target]);
+        let stdout = succeeded(&out, "render on the RTL");
+        for pass in ["MATCH: lighting pass", "MATCH: rendering pass"] {
+            assert!(
+                stdout.lines().any(|l| l.starts_with(pass)),
+                "{target}: no `{pass}`: {stdout}"
+            );
+        }
+        for who in ["model-gi.png", "rtl-gi.png"] {
+            let img = image::open(dir.join(who)).unwrap().to_rgb8();
+            assert_eq!(img.dimensions(), (16, 16));
+        }
+        assert_eq!(png.exists(), target == "both", "{target}: {stdout}");
+        if target == "both" {
+            // The model at the scene's own voxel width (12 bits; the line's is 8).
+            let img = image::open(&png).unwrap().to_rgb8();
+            assert_eq!(img.dimensions(), (16, 16));
+            assert!(stdout.contains("plan: "), "{stdout}");
+        }
+    }
+    let png = scratch("gi-render-rtl.png");
+    let _ = std::fs::remove_file(&png);
+    let text = std::fs::read_to_string(example()).unwrap();
+    let odd = scratch_file("gi-render-24.toml", text.replace("size = 64", "size = 24"));
+    let out = cube5(&["render", s(&odd), "-o", s(&png), "--target", "rtl"]);
+    assert_refused(
+        &out,
+        &[
+            "run.target = \"rtl\"",
+            "gi-render-24.toml",
+            "no gicube_processor configuration",
+            "24^3",
+        ],
+    );
+    for size in [32, 64] {
+        let small = text
+            .replace("size = 64", &format!("size = {size}"))
+            .replace("# light_rays = 222", "light_rays = 8");
+        assert!(small.contains("light_rays = 8"), "{small}");
+        let scene = scratch_file(&format!("gi-render-{size}.toml"), small);
+        let out = cube5(&[
+            "render",
+            s(&scene),
+            "-o",
+            s(&png),
+            "--target",
+            "rtl",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ]);
+        if out.status.success() {
+            let stdout = String::from_utf8_lossy(&out.stdout);
+            assert!(stdout.contains("MATCH: rendering pass"), "{stdout}");
+        } else {
+            assert_refused(
+                &out,
+                &[
+                    "run.target = \"rtl\"",
+                    "is not built",
+                    "CUBE5_FULL=1 CUBE5_TOPS=",
+                ],
+            );
+        }
     }
     assert!(!png.exists());
-    #[cfg(feature = "rtl")]
-    {
-        // No gicube_processor line has a 24^3 volume.
-        let text = std::fs::read_to_string(example()).unwrap();
-        let odd = scratch_file("gi-24.toml", text.replace("size = 64", "size = 24"));
-        let out = cube5(&["cosim", s(&odd), "-o", s(&scratch("gi-cosim"))]);
-        assert_refused(
-            &out,
-            &["gi-24.toml", "no gicube_processor configuration", "24^3"],
-        );
-    }
 }
 
 /// `cube5 cosim` of the 16^3 GI scene on `gicube_processor` (its `Light = 1` line, in every
@@ -137,14 +211,7 @@ fn gi_scenes_refuse_the_rtl_in_one_line() {
 #[cfg(feature = "rtl")]
 #[test]
 fn gi_scene_cosimulates_on_the_processor_rtl() {
-    let path = cube5_model::repo_root().join("scenes/gi-shadow-16.toml");
-    let text = std::fs::read_to_string(path).unwrap();
-    let short = text
-        .replace("width = 32", "width = 16")
-        .replace("height = 32", "height = 16")
-        .replace("albedo = 0.0 ", "light_rays = 28\nalbedo = 0.0 ");
-    assert!(short.contains("light_rays = 28"), "{short}");
-    let scene = scratch_file("gi-cosim-16.toml", short);
+    let scene = scratch_file("gi-cosim-16.toml", short_gi_16());
     let dir = scratch("gi-cosim-16");
     let _ = std::fs::remove_dir_all(&dir);
     let out = cube5(&["cosim", s(&scene), "-o", s(&dir), "--memory", "random"]);

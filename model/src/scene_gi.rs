@@ -5,13 +5,13 @@
 //! This module reads the section (`GiSpec`), checks what a GI scene may say, makes the plan, and
 //! runs the two passes (`GiJob`); `--compare` is against the processor's f64 reference.
 //!
-//! `cube5 render` runs a GI scene on the processor model only (`run.target = "model"`);
-//! `cube5 cosim` co-simulates it on the `gicube_processor` RTL (cli/src/cosim_gi.rs).
+//! `cube5 cosim`, and `cube5 render` with `run.target = "rtl"` or `"both"`, co-simulate it on the
+//! `gicube_processor` RTL (cli/src/cosim_gi.rs).
 
 use crate::camera::Camera;
 use crate::error::{ModelError, Result};
 use crate::render::{CompositeMode, ImageF64, Material, Quality};
-use crate::scene::{Plan, PlanEntry, Renderer, Scene, Target, Unit};
+use crate::scene::{Plan, PlanEntry, Renderer, Scene, Unit};
 use crate::transfer::TransferFunction;
 use crate::units::gicube_processor::{
     psnr, GiLight, GiMode, Processor, ProcessorConfig, ProcessorCounts, Projection, CHAN_MAX,
@@ -127,15 +127,6 @@ pub fn validate(scene: &Scene, gi: &GiSpec) -> std::result::Result<(), (String, 
         );
     }
     // The rest of the scene, as the processor reads it.
-    if scene.run.target != Target::Model {
-        return bad(
-            "run.target",
-            format!(
-                "\"{}\": a [gi] scene renders on the GI-Cube processor model only (`cube5 cosim` runs it on the gicube_processor RTL)",
-                scene.run.target.name()
-            ),
-        );
-    }
     if scene.render.mode != CompositeMode::Composite {
         return bad(
             "render.mode",
@@ -580,7 +571,6 @@ mod tests {
             ("[gi]\nblock_size = 6\n", "gi.block_size"),
             ("[gi]\nqueue_length = 70000\n", "gi.queue_length"),
             ("[gi]\ncolour = 1\n", "colour"),
-            ("[gi]\n[run]\ntarget = \"both\"\n", "run.target"),
             ("[gi]\n[render]\nmode = \"xray\"\n", "render.mode"),
             ("[gi]\n[render]\nstep = 0.05\n", "render.step"),
             ("[gi]\n[image]\nwidth = 5000\n", "image.width"),

@@ -169,7 +169,7 @@ fn cases() -> Vec<Case> {
         c("shading.ambient", GI, "[shading]\nambient = 0.5\n", Refused),
         c("light", GI, "[[light]]\ndirection = [0.0, 0.0, -1.0]\n", Refused),
         c("quality.supersampling", GI, "[quality]\nsupersampling = 2\n", Refused),
-        c("run.target", GI, "[run]\ntarget = \"rtl\"\n", Refused),
+        c("run.target", GI, "[run]\ntarget = \"rtl\"\n", Run),
         c("run.renderer", GI, "[run]\nrenderer = \"reference\"\n", Processor),
         // [geometry]: opaque boxes and spheres, rasterized into the depth test's RGBA-Z table.
         c("geometry.box", "", BOX, Frame),

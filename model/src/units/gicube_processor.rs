@@ -427,6 +427,9 @@ pub struct CacheTrace {
     pub writes: Vec<Burst>,
     /// `M^3` words, x fastest (`VolumeCache::memory_words`) at the end of the pass.
     pub memory: Vec<u32>,
+    /// The rays that left the processor, in order: finished (`true`) or overflowed to the host
+    /// (`false`, OVERFLOW set), one a cycle at most (the processor's output port).
+    pub outputs: Vec<(bool, RayPacket)>,
 }
 
 impl FrameCache {
@@ -1062,6 +1065,31 @@ impl Processor {
         Ok((f, t.reads))
     }
 
+    /// The frame loop over the host's `packets` (rendering rays made by any host, not only
+    /// `host_rays`: each starts inside the volume, its pixel `(u, v)` inside `w x h` and its own),
+    /// the bursts of its cache's misses and every ray that left the processor, in order
+    /// (`CacheTrace::outputs`): the million-ray co-simulation's reference.
+    pub fn run_packets_traced(
+        &self,
+        packets: Vec<RayPacket>,
+        w: u32,
+        h: u32,
+    ) -> Result<(ProcessorFrame, CacheTrace)> {
+        let mut seen = vec![false; (w as usize) * (h as usize)];
+        for p in &packets {
+            let (u, v) = (u32::from(p.u), u32::from(p.v));
+            let i = (v as usize) * (w as usize) + u as usize;
+            if u >= w || v >= h || std::mem::replace(&mut seen[i], true) {
+                return Err(ModelError::Config(format!(
+                    "gicube processor: packet pixel ({u}, {v}) outside {w}x{h} or given twice"
+                )));
+            }
+        }
+        let mut t = CacheTrace::default();
+        let f = self.run(packets, w, h, None, None, Some(&mut t))?;
+        Ok((f, t))
+    }
+
     /// The lighting pass of volumetric GI ([358]-[363], low albedo, single scattering): lighting
     /// rays from `light` through the same queues and pipeline, each splatting into a fresh
     /// irradiance field, which then lights every rendering ray of `render` (until the next
@@ -1177,6 +1205,7 @@ impl Processor {
         let mut done = vec![false; (w * h) as usize];
         // The volume cache from reset (contract, *The volume cache*).
         let mut cache = self.frame_cache(cache_trace.is_some());
+        let mut outputs = cache_trace.is_some().then(Vec::new);
         let mut last_active: Option<u32> = None;
         // A cycle bound far above any frame: a livelock is a model bug, reported, not a hang.
         // Per ray and life: at most 2 N 256 / step samples along a path (sqrt 3 N < 2 N), plus
@@ -1237,6 +1266,9 @@ impl Processor {
                             }
                             done[i] = true;
                             rgb[i] = ray.color;
+                            if let Some(o) = outputs.as_mut() {
+                                o.push((true, ray));
+                            }
                             Ok(None)
                         }
                     }
@@ -1253,6 +1285,9 @@ impl Processor {
             if let Some(ray) = c.ring_ovf {
                 // Returned with OVERFLOW set; the host offers it again after the rays it holds.
                 counts.rays_overflowed += 1;
+                if let Some(o) = outputs.as_mut() {
+                    o.push((false, ray));
+                }
                 feed.push_back(ray);
             }
             if c.host_taken {
@@ -1277,6 +1312,7 @@ impl Processor {
         if let (Some(t), Some(c)) = (cache_trace, cache) {
             *t = CacheTrace {
                 memory: c.cache.memory_words().to_vec(),
+                outputs: outputs.unwrap_or_default(),
                 ..c.trace.unwrap_or_default()
             };
         }

@@ -12,6 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use std::fmt::Debug;
 
 pub mod axi;
+pub mod processor;
 pub mod warp;
 
 /// Random items per configuration in the long co-simulation runs (the acceptance figure).
