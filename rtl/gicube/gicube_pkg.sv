@@ -136,23 +136,4 @@ package gicube_pkg;
     rq_out_w = 4 + 2 * rq_len_w(queue_len) + rq_tot_w(queue_w, queue_len) + 2 * data_w;
   endfunction
 
-  // ---------------------------------------------------------------------------
-  // A ring of processors (docs/numerics/gicube_ring.md)
-  // ---------------------------------------------------------------------------
-
-  /// Counts per processor a ring reports (rays_in ... cache_misses, nb_in, nb_out).
-  localparam int unsigned RingCounts = 10;
-
-  /// The processor that owns the block of integer x coordinate ix: slabs of `slab` blocks of
-  /// 2^block_log2 voxels along x, `procs` (1..4) processors; floor((ix >> block_log2) / slab).
-  function automatic logic [1:0] ring_owner(logic [PosIntW-1:0] ix, int unsigned block_log2,
-                                            int unsigned slab, int unsigned procs);
-    ring_owner = 2'd0;
-    for (int unsigned k = 1; k < 4; k++) begin
-      if (k < procs && 32'(ix) >= ((k * slab) << block_log2)) begin
-        ring_owner = ring_owner + 2'd1;
-      end
-    end
-  endfunction
-
 endpackage

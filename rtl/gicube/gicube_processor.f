@@ -3,6 +3,7 @@
 -f rtl/gicube/gicube_sample.f
 -f rtl/gicube/gicube_cache.f
 -f rtl/gicube/gicube_scatter.f
+rtl/gicube/gicube_ring_pkg.sv
 rtl/gicube/gicube_step_div.sv
 rtl/gicube/gicube_step.sv
 rtl/gicube/gicube_deposit.sv

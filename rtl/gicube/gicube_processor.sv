@@ -155,7 +155,7 @@ module gicube_processor #(
   input  logic nb_grant_i,
   /// The counts (rays_in, finished, overflowed, samples, leaps, cycles, cache hits, misses,
   /// nb_in, nb_out; 32 bits each, LSB first).
-  output logic [gicube_pkg::RingCounts*32-1:0] cnt_o,
+  output logic [gicube_ring_pkg::RingCounts*32-1:0] cnt_o,
 
   // AXI4 channels (gicube_cache's): the volume in memory (AR, R); Light: the cache's
   // write-back of dirty lines (AW, W, B), else idle.
@@ -389,7 +389,7 @@ module gicube_processor #(
   // link (granted) or returned to the host (nb_ret), and does not enter this front end.
   logic       ring_v, nb_req, nb_ret, offer_nb_q, offer_nb;
   logic [1:0] h_owner;
-  assign h_owner      = gicube_pkg::ring_owner(h_out[StartLsb + PosFracW +: gicube_pkg::PosIntW],
+  assign h_owner      = gicube_ring_pkg::ring_owner(h_out[StartLsb + PosFracW +: gicube_pkg::PosIntW],
                                                BlockLog2, VolBlocks / Procs, Procs);
   assign nb_req       = (Procs > 1) && (lead_q == '0) && h_ray && !h_done
                         && (h_owner != 2'(ProcId));

@@ -54,7 +54,7 @@ module gicube_ring #(
   /// done (1), ray (256), proc (2), then per processor (0 first) its ten counts, 32 bits each
   /// (rays_in, finished, overflowed, samples, leaps, cycles, cache hits, misses, nb_in,
   /// nb_out) as the item entered the output register; LSB first.
-  output logic [1+gicube_pkg::PacketW+2+(1<<ProcLog2)*gicube_pkg::RingCounts*32-1:0] out_data_o,
+  output logic [1+gicube_pkg::PacketW+2+(1<<ProcLog2)*gicube_ring_pkg::RingCounts*32-1:0] out_data_o,
 
   /// Configuration write (broadcast: every processor holds every table and empty flag).
   input  logic cfg_valid_i,
@@ -70,7 +70,7 @@ module gicube_ring #(
 
   localparam int unsigned Procs    = 1 << ProcLog2;
   localparam int unsigned PacketW  = gicube_pkg::PacketW;
-  localparam int unsigned CntsW    = gicube_pkg::RingCounts * 32;
+  localparam int unsigned CntsW    = gicube_ring_pkg::RingCounts * 32;
   localparam int unsigned POutW    = 1 + PacketW + 8 * 32 + 1;   // the processor's item
   localparam int unsigned OutW     = 1 + PacketW + 2 + Procs * CntsW;
   localparam int unsigned ArW      = 32 + 8 + 3 + 2;            // addr, len, size, burst
@@ -104,7 +104,7 @@ module gicube_ring #(
 
   // The host's ray goes to the processor that owns its start.
   logic [1:0] host_owner;
-  assign host_owner = gicube_pkg::ring_owner(in_data_i[StartLsb + PosFracW +: gicube_pkg::PosIntW],
+  assign host_owner = gicube_ring_pkg::ring_owner(in_data_i[StartLsb + PosFracW +: gicube_pkg::PosIntW],
                                              BlockLog2, VolBlocks / Procs, Procs);
 
   for (genvar p = 0; p < Procs; p++) begin : gen_proc
