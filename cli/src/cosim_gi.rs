@@ -474,11 +474,12 @@ pub fn overflow_rate(c: &ProcessorCounts) -> f64 {
 
 /// The built `gicube_processor` configuration a GI scene runs on: side `N` equal to the volume's,
 /// `Light = 1` for a lighting pass, `Scatter = 1` for photons (`gi.albedo > 0`); of those, the one
-/// with the fewest units (no photon path when not needed). Refused in one line naming what would
-/// run it.
+/// with the fewest units (no photon path when not needed), the scene's step first; never a shaded
+/// or jittered line (a `[gi]` scene is unshaded). Refused in one line naming what would run it.
 fn variant_for(
     gi: &GiSpec,
     side: usize,
+    step: u32,
     origin: &str,
 ) -> Result<(&'static Variant, ProcessorRtlConfig)> {
     let lit = gi.passes == 2;
@@ -494,7 +495,12 @@ fn variant_for(
         if (!lit || rtl.light == 1) && !sides.contains(&rtl.side()) {
             sides.push(rtl.side());
         }
-        if rtl.side() as usize != side || (lit && rtl.light == 0) || (photons && rtl.scatter == 0) {
+        if rtl.side() as usize != side
+            || (lit && rtl.light == 0)
+            || (photons && rtl.scatter == 0)
+            || rtl.shade != 0
+            || rtl.jitter != 0
+        {
             continue;
         }
         if v.built {
@@ -503,7 +509,7 @@ fn variant_for(
             near.push(v.config);
         }
     }
-    fits.sort_by_key(|(_, r)| (r.scatter, r.light));
+    fits.sort_by_key(|(_, r)| (r.step != step, r.scatter, r.light));
     fits.into_iter().next().ok_or_else(|| {
         let what = format!(
             "{side}^3{}{}",
@@ -544,12 +550,12 @@ pub fn run(
             raw.dims
         );
     }
-    let (variant, rtl) = variant_for(gi, side, origin)?;
+    let wanted = cube5_model::scene_gi::processor_config(scene)?;
+    let (variant, rtl) = variant_for(gi, side, wanted.step, origin)?;
     let vol: Volume = at_voxel_width(&raw, rtl.voxel_w)?;
     let tf = scene.transfer_function();
     let mut proc =
         Processor::new(rtl.processor_config(), &vol, &tf).map_err(|e| anyhow!("{origin}: {e}"))?;
-    let wanted = cube5_model::scene_gi::processor_config(scene)?;
     let cfg = proc.config();
     if (wanted.step, wanted.et_threshold) != (cfg.step, cfg.et_threshold) {
         bail!(
