@@ -13,29 +13,25 @@
 mod support;
 
 use cube5_model::camera::Camera;
-use cube5_model::phantom::head_phantom;
 use cube5_model::phantom::sphere_floor_phantom;
-use cube5_model::transfer::TransferFunction;
 use cube5_model::units::cube5_axi_rd::Burst;
-use cube5_model::units::cube5_shader::Phong;
-use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
-use cube5_model::units::gicube_processor::{half_tags, interaction_draw, ray_bits};
+use cube5_model::units::gicube_processor::{interaction_draw, ray_bits};
 use cube5_model::units::gicube_processor::{
-    host_rays, light_rays, shadow_scene, GiLight, GiMode, Processor, ProcessorFrame, ProcessorOut,
+    light_rays, shadow_scene, GiLight, GiMode, Processor, ProcessorFrame, ProcessorOut,
     ProcessorRtlConfig, Projection,
 };
-use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
+use cube5_tb::rtl::{RtlStream, Traffic};
 use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::collections::VecDeque;
-use support::{axi, axi_mem_setup, compare_bursts, configs, seed};
+use support::processor::{
+    check_bursts, check_frame, head_scene, host_packets, load_config, open_proc, random_memory,
+    run_host, view_dir, Behaviour, Bits, Memory, RtlFrame,
+};
+use support::{axi, compare_bursts, configs, seed};
 
-type Bits = [u32; PACKET_WORDS];
-
-/// A scene: the head phantom at the RTL's side and voxel width, seen from azimuth 65, elevation
-/// 20, `px` pixels a side; with `Shade` lit by two lights (the viewer's map) and tagged in two
-/// halves (`half_tags`: the tag's colour in the half `x >= N/2`).
+/// A scene: the head phantom in the RTL's processor seen from azimuth 65, elevation 20
+/// (`head_scene`: with `Shade` lit and tagged), and the projection.
 struct Scene {
     proc: Processor,
     cam: Camera,
@@ -44,59 +40,18 @@ struct Scene {
 
 impl Scene {
     fn new(rtl: &ProcessorRtlConfig, px: u32, proj: Projection) -> Self {
-        let side = rtl.side() as usize;
-        let vol = head_phantom(side, rtl.voxel_w).unwrap();
-        let (a, e) = (65f64.to_radians(), 20f64.to_radians());
-        let dir = [-e.cos() * a.cos(), -e.cos() * a.sin(), -e.sin()];
-        let cam = Camera::new(dir.into(), vol.dims, vol.spacing, px, px);
-        let tf = TransferFunction::head_default();
-        let mut proc = Processor::new(rtl.processor_config(), &vol, &tf).unwrap();
-        if rtl.shade == 1 {
-            let phong = Phong {
-                view: dir.map(|c| -c),
-                ..Phong::two_lights()
-            };
-            let tags = (rtl.tag_w > 0).then(|| half_tags(&vol));
-            proc.set_shading(&phong, tags).unwrap();
-        }
+        let (proc, cam) = head_scene(rtl, px);
         Self { proc, cam, proj }
     }
 
     /// The host's packets, in its order.
     fn packets(&self) -> Vec<Bits> {
-        let cfg = self.proc.config();
-        host_rays(self.proc_volume(), &self.cam, self.proj, cfg.host_order)
-            .unwrap()
-            .iter()
-            .map(|r| Processor::packet(r).unwrap().to_bits().unwrap())
-            .collect()
-    }
-
-    fn proc_volume(&self) -> &cube5_model::volume::Volume {
-        self.proc.volume()
+        host_packets(&self.proc, &self.cam, self.proj)
     }
 
     /// The model's frame and the bursts of its cache's misses.
     fn model(&self) -> (ProcessorFrame, Vec<Burst>) {
         self.proc.render_cache_traced(&self.cam, self.proj).unwrap()
-    }
-}
-
-/// How the memory answers: latency `fixed + U(0..random)` cycles, AR and R gaps (per mille), a
-/// bandwidth limit of `num / den` bytes per cycle (0: none).
-#[derive(Clone, Copy, Debug)]
-struct Memory {
-    lat: (u32, u32),
-    gaps: (u32, u32),
-    bw: (u32, u32),
-}
-
-/// Random conditions: latency 10-200, gaps of up to 30 %, a bandwidth limit on half the seeds.
-fn random_memory(rng: &mut ChaCha8Rng, rtl: &ProcessorRtlConfig) -> Memory {
-    Memory {
-        lat: (10, 190),
-        gaps: (rng.random_range(0..300), rng.random_range(0..300)),
-        bw: axi::random_bandwidth(rng, rtl.data_w / 8),
     }
 }
 
@@ -107,233 +62,10 @@ const DDR_LIKE: Memory = Memory {
     bw: (12, 1),
 };
 
-/// What the RTL rendered: the pixels, the last output's counts, the clocks from the first offer
-/// to the last output, the AR bursts.
-struct RtlFrame {
-    rgb: Vec<[u16; 3]>,
-    last: ProcessorOut,
-    outputs: u64,
-    clocks: u64,
-    ars: Vec<cube5_tb::rtl::ArHandshake>,
-}
-
-/// How the host and the consumer behave: the probability that the host, having a ray, does not
-/// offer it yet in a clock, and that the output is not taken.
-#[derive(Clone, Copy)]
-struct Behaviour {
-    idle: f64,
-    stall: f64,
-}
-
 const FULL_SPEED: Behaviour = Behaviour {
     idle: 0.0,
     stall: 0.0,
 };
-
-/// The host loop, one clock per call of the RTL: offers the head of its list (held until
-/// taken), collects finished rays into the image and appends overflowed rays to its list; stops
-/// after `stop_after` clocks if given, else when every ray has finished.
-fn run_host(
-    dut: &mut RtlStream<ProcessorRtlConfig>,
-    rays: &[Bits],
-    px: u32,
-    b: Behaviour,
-    rng: &mut ChaCha8Rng,
-    stop_after: Option<u64>,
-) -> RtlFrame {
-    let name = dut.name();
-    let mut list: VecDeque<Bits> = rays.iter().copied().collect();
-    let mut rgb = vec![[0u16; 3]; (px * px) as usize];
-    let mut seen = vec![false; (px * px) as usize];
-    let (mut finished, mut outputs, mut clocks) = (0usize, 0u64, 0u64);
-    let mut offering = false;
-    let mut last = ProcessorOut::default();
-    let limit = 100_000 + 40_000 * rays.len() as u64;
-    while finished < rays.len() && stop_after.is_none_or(|s| clocks < s) {
-        assert!(clocks < limit, "{name}: no progress after {clocks} clocks");
-        if !list.is_empty() && !offering {
-            offering = !rng.random_bool(b.idle);
-        }
-        let items: Vec<Bits> = if offering { vec![list[0]] } else { Vec::new() };
-        let traffic = Traffic {
-            idle: vec![0],
-            stall: vec![u8::from(rng.random_bool(b.stall))],
-        };
-        let expect = u64::from(items.is_empty());
-        let d = dut.drive(&items, &traffic, expect, 1).unwrap();
-        clocks += 1;
-        assert_eq!(
-            d.stats.protocol_errors, 0,
-            "{name}: a stalled output changed at clock {clocks}"
-        );
-        if d.stats.consumed == 1 {
-            list.pop_front();
-            offering = false;
-        }
-        for o in d.outputs {
-            let o = o.value;
-            assert!(!o.flush, "{name}: a flush item without a flush");
-            outputs += 1;
-            last = o;
-            if o.done {
-                let r = RayPacket::from_bits(&o.ray);
-                let i = (u32::from(r.v) * px + u32::from(r.u)) as usize;
-                assert!(!seen[i], "{name}: pixel ({}, {}) finished twice", r.u, r.v);
-                seen[i] = true;
-                rgb[i] = r.color;
-                finished += 1;
-            } else {
-                let r = RayPacket::from_bits(&o.ray);
-                assert!(
-                    r.flags & 4 != 0,
-                    "{name}: an overflowed ray has OVERFLOW set"
-                );
-                list.push_back(o.ray);
-            }
-        }
-    }
-    let c = dut.axi_counters();
-    assert_eq!(
-        c.protocol_errors,
-        0,
-        "{name}: AXI checker: {}",
-        dut.axi_first_error()
-    );
-    RtlFrame {
-        rgb,
-        last,
-        outputs,
-        clocks,
-        ars: dut.axi_take_ar().unwrap(),
-    }
-}
-
-/// Opens `variant` with the scene's volume in its subordinate's memory (answering as `mem`
-/// says) and loads the tables and empty flags.
-fn open(
-    variant: &'static Variant,
-    rtl: ProcessorRtlConfig,
-    scene: &Scene,
-    mem: Memory,
-    s: u64,
-) -> RtlStream<ProcessorRtlConfig> {
-    open_proc(variant, rtl, &scene.proc, mem, s)
-}
-
-/// The subordinate as `mem` says, the write channels' gaps as the read channels' (AW and B as
-/// AR, W as R).
-fn mem_setup(
-    rtl: &ProcessorRtlConfig,
-    img: &cube5_model::units::cube5_axi_rd::AxiMemImage,
-    mem: Memory,
-    s: u64,
-) -> AxiMemSetup {
-    AxiMemSetup {
-        declared_outstanding: rtl.outstanding,
-        aw_gap_permille: mem.gaps.0,
-        w_gap_permille: mem.gaps.1,
-        b_gap_permille: mem.gaps.0,
-        ..axi_mem_setup((rtl.data_w / 8, 32), img, mem.lat, mem.gaps, mem.bw, s)
-    }
-}
-
-/// Opens `variant` over `proc`'s memory image (`Processor::rtl_memory`) and loads its tables,
-/// flags and (`Light`) GI registers.
-fn open_proc(
-    variant: &'static Variant,
-    rtl: ProcessorRtlConfig,
-    proc: &Processor,
-    mem: Memory,
-    s: u64,
-) -> RtlStream<ProcessorRtlConfig> {
-    let img = proc.rtl_memory().unwrap().expect("the RTL's cache");
-    let setup = mem_setup(&rtl, &img, mem, s);
-    let mut dut = RtlStream::new(variant, rtl, s as u32).unwrap();
-    dut.axi_setup(&setup).unwrap();
-    dut.axi_load(img.base, &img.bytes).unwrap();
-    load_config(&mut dut, &rtl, proc);
-    dut
-}
-
-fn load_config(
-    dut: &mut RtlStream<ProcessorRtlConfig>,
-    rtl: &ProcessorRtlConfig,
-    proc: &Processor,
-) {
-    for (a, d) in proc.rtl_config_writes(rtl).unwrap() {
-        dut.write_config(a, &d).unwrap();
-    }
-}
-
-/// The image and the conservation of rays; with `exact_counts` every count equals the model's.
-fn check_frame(name: &str, what: &str, got: &RtlFrame, want: &ProcessorFrame, exact_counts: bool) {
-    let c = &want.counts;
-    let l = &got.last;
-    let differ = cube5_tb::harness::count_differing(&got.rgb, &want.rgb);
-    assert_eq!(
-        differ, 0,
-        "{name} {what}: {differ} pixels differ from the model"
-    );
-    assert_eq!(
-        u64::from(l.rays_in),
-        u64::from(l.rays_finished) + u64::from(l.rays_overflowed),
-        "{name} {what}: RTL rays in = finished + overflowed ({l:?})"
-    );
-    assert_eq!(
-        c.rays_in,
-        c.rays_finished + c.rays_overflowed,
-        "{name} {what}: model rays in = finished + overflowed"
-    );
-    assert_eq!(
-        u64::from(l.rays_finished),
-        c.rays_made,
-        "{name} {what}: every ray finished"
-    );
-    // A ray's samples and leaps do not depend on the order.
-    assert_eq!(
-        (u64::from(l.samples), u64::from(l.leaps)),
-        (c.samples, c.leaps),
-        "{name} {what}: samples and leaps"
-    );
-    if exact_counts {
-        assert_eq!(
-            (
-                u64::from(l.rays_in),
-                u64::from(l.rays_overflowed),
-                u64::from(l.cycles)
-            ),
-            (c.rays_in, c.rays_overflowed, c.cycles),
-            "{name} {what}: rays in, overflowed and processor cycles equal the model's"
-        );
-        assert_eq!(
-            (u64::from(l.cache_hits), u64::from(l.cache_misses)),
-            (c.cache_hits, c.cache_misses),
-            "{name} {what}: cache hits and misses equal the model's"
-        );
-    }
-    // Photons scattered (Scatter = 1; a function of each ray's packets, whatever the order).
-    assert_eq!(
-        u64::from(l.scatterings),
-        c.scatterings,
-        "{name} {what}: scatterings equal the model's"
-    );
-}
-
-/// The AR bursts of a frame from reset equal the model cache's, in order.
-fn check_bursts(
-    variant: &'static Variant,
-    rtl: &ProcessorRtlConfig,
-    got: &RtlFrame,
-    want: &[Burst],
-    s: u64,
-) {
-    let size = (rtl.data_w / 8).trailing_zeros();
-    let n = compare_bursts(&got.ars, "AR", want, size, variant, s, |k| {
-        format!("the frame's burst #{k}")
-    })
-    .unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(n, want.len(), "{variant}: every missed line read once");
-}
 
 /// One frame from reset with the host always offering and the output taken at random with
 /// probability `1 - stall`, the memory as `mem` (random when `None`): every pixel, every count
@@ -348,21 +80,17 @@ fn exact_frame(
 ) -> (RtlFrame, ProcessorFrame) {
     let scene = Scene::new(&rtl, px, proj);
     let (want, bursts) = scene.model();
+    let packets = scene.packets();
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let mem = mem.unwrap_or_else(|| random_memory(&mut rng, &rtl));
-    let mut dut = open(variant, rtl, &scene, mem, s);
+    let mut dut = open_proc(variant, rtl, &scene.proc, mem, s);
     let b = Behaviour {
         idle: 0.0,
         stall: if mem.lat.1 > 20 { 0.3 } else { 0.0 },
     };
-    let got = run_host(&mut dut, &scene.packets(), px, b, &mut rng, None);
-    check_frame(
-        variant.name,
-        &format!("{proj:?} ({mem:?})"),
-        &got,
-        &want,
-        true,
-    );
+    let what = format!("{variant} seed {s} ({proj:?}, {mem:?}, {b:?})");
+    let got = run_host(&mut dut, &packets, (px, px), b, &mut rng, None, &what);
+    check_frame(&what, &got, &want, true);
     check_bursts(variant, &rtl, &got, &bursts, s);
     (got, want)
 }
@@ -446,8 +174,10 @@ fn two_pass_gi(
         let (a, d) = Processor::rtl_photon_write(&rtl, Some(&light));
         dut.write_config(a, &d).unwrap();
     }
-    let got = run_host(&mut dut, &packets, light.grid, b, &mut rng, None);
-    check_frame(variant.name, "lighting pass", &got, &want, true);
+    let what = format!("{variant} seed {s} lighting pass ({mode:?}, {mem:?}, {b:?})");
+    let grid = (light.grid, light.grid);
+    let got = run_host(&mut dut, &packets, grid, b, &mut rng, None, &what);
+    check_frame(&what, &got, &want, true);
     let f = flush(&mut dut, &rtl, 0.3, &mut rng);
     assert_eq!(
         (
@@ -522,13 +252,10 @@ fn two_pass_gi(
     let cam = gi_camera(&vol, px);
     let proj = Projection::Parallel;
     let (want, bursts) = proc.render_cache_traced(&cam, proj).unwrap();
-    let packets: Vec<Bits> = host_rays(&vol, &cam, proj, proc.config().host_order)
-        .unwrap()
-        .iter()
-        .map(|r| Processor::packet(r).unwrap().to_bits().unwrap())
-        .collect();
-    let got = run_host(&mut dut, &packets, px, b, &mut rng, None);
-    check_frame(variant.name, "GI rendering pass", &got, &want, true);
+    let packets = host_packets(&proc, &cam, proj);
+    let what = format!("{variant} seed {s} GI rendering pass ({mode:?}, {mem:?}, {b:?})");
+    let got = run_host(&mut dut, &packets, (px, px), b, &mut rng, None, &what);
+    check_frame(&what, &got, &want, true);
     check_bursts(variant, &rtl, &got, &bursts, s);
     assert!(
         want.rgb.iter().any(|p| p.iter().any(|&c| c > 0)),
@@ -584,8 +311,7 @@ const HIGH_ALBEDO: GiMode = GiMode::HighAlbedo {
 
 /// The GI scene's camera: azimuth 30, elevation 25 (the floor and the sphere's shadow in view).
 fn gi_camera(vol: &cube5_model::volume::Volume, px: u32) -> Camera {
-    let (a, e) = (30f64.to_radians(), 25f64.to_radians());
-    let dir = [-e.cos() * a.cos(), -e.cos() * a.sin(), -e.sin()];
+    let dir = view_dir(30.0, 25.0);
     Camera::new(dir.into(), vol.dims, vol.spacing, px, px)
 }
 
@@ -660,14 +386,10 @@ fn mid_pass_reset_then_an_exact_high_albedo_pass() {
             idle: 0.2,
             stall: 0.2,
         };
-        let part = run_host(
-            &mut dut,
-            &packets,
-            light.grid,
-            b,
-            &mut rng,
-            Some(60 * want.counts.cycles),
-        );
+        let what = format!("{variant} seed {s} high albedo ({mem:?}, {b:?})");
+        let grid = (light.grid, light.grid);
+        let cut = Some(60 * want.counts.cycles);
+        let part = run_host(&mut dut, &packets, grid, b, &mut rng, cut, &what);
         assert!(
             part.last.scatterings > 0 && u64::from(part.last.rays_finished) < want.counts.rays_made,
             "{variant}: the reset falls mid-pass, after some scatterings ({:?})",
@@ -683,8 +405,10 @@ fn mid_pass_reset_then_an_exact_high_albedo_pass() {
         dut.axi_load(img.base, &img.bytes).unwrap();
         load_config(&mut dut, &rtl, &proc);
         dut.write_config(photons.0, &photons.1).unwrap();
-        let got = run_host(&mut dut, &packets, light.grid, FULL_SPEED, &mut rng, None);
-        check_frame(variant.name, "high albedo after a reset", &got, &want, true);
+        let what =
+            format!("{variant} seed {s} high albedo after a reset ({mem:?}, {FULL_SPEED:?})");
+        let got = run_host(&mut dut, &packets, grid, FULL_SPEED, &mut rng, None, &what);
+        check_frame(&what, &got, &want, true);
         let size = (rtl.data_w / 8).trailing_zeros();
         compare_bursts(&got.ars, "AR", &trace.reads, size, variant, s, |k| {
             format!("burst #{k}")
@@ -731,27 +455,33 @@ fn scatter_configs() -> Vec<(&'static Variant, ProcessorRtlConfig)> {
         .collect()
 }
 
+/// Parallel and perspective frames of `px = N` (`exact_frame`), each with random memory (seed
+/// `seed(s0)`) and a DDR-like one (`seed(s0 + 1)`), and their lines.
+fn projections_and_memories(variant: &'static Variant, rtl: ProcessorRtlConfig, s0: u64) {
+    let px = rtl.side();
+    for proj in [
+        Projection::Parallel,
+        Projection::Perspective { fov_deg: 30.0 },
+    ] {
+        for (k, mem) in [None, Some(DDR_LIKE)].into_iter().enumerate() {
+            let (got, want) = exact_frame(variant, rtl, px, proj, mem, seed(s0 + k as u64));
+            let what = if mem.is_some() {
+                "DDR-like"
+            } else {
+                "random memory"
+            };
+            frame_line(variant, &format!("{proj:?}, {what}"), &got, &want);
+        }
+    }
+}
+
 /// Parallel and perspective frames under random memory latency (10-200), gaps, bandwidth limits
 /// and output back-pressure, then with a DDR-like memory at full speed (the figures of
 /// docs/measurements.md).
 #[test]
 fn parallel_and_perspective_frames_equal_the_model_with_every_count() {
     for (variant, rtl) in ci_configs() {
-        let px = rtl.side();
-        for proj in [
-            Projection::Parallel,
-            Projection::Perspective { fov_deg: 30.0 },
-        ] {
-            for (k, mem) in [None, Some(DDR_LIKE)].into_iter().enumerate() {
-                let (got, want) = exact_frame(variant, rtl, px, proj, mem, seed(1900 + k as u64));
-                let what = if mem.is_some() {
-                    "DDR-like"
-                } else {
-                    "random memory"
-                };
-                frame_line(variant, &format!("{proj:?}, {what}"), &got, &want);
-            }
-        }
+        projections_and_memories(variant, rtl, 1900);
     }
 }
 
@@ -826,10 +556,11 @@ fn idle_host_and_stalled_output_keep_the_image() {
         let px = rtl.side();
         let scene = Scene::new(&rtl, px, Projection::Perspective { fov_deg: 30.0 });
         let (want, _) = scene.model();
+        let packets = scene.packets();
         let s = seed(1920);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let mem = random_memory(&mut rng, &rtl);
-        let mut dut = open(variant, rtl, &scene, mem, s);
+        let mut dut = open_proc(variant, rtl, &scene.proc, mem, s);
         for (b, exact) in [
             (
                 Behaviour {
@@ -847,8 +578,9 @@ fn idle_host_and_stalled_output_keep_the_image() {
             ),
         ] {
             dut.reset();
-            let got = run_host(&mut dut, &scene.packets(), px, b, &mut rng, None);
-            check_frame(variant.name, "idle/stall", &got, &want, exact);
+            let what = format!("{variant} seed {s} idle/stall ({mem:?}, {b:?})");
+            let got = run_host(&mut dut, &packets, (px, px), b, &mut rng, None, &what);
+            check_frame(&what, &got, &want, exact);
         }
     }
 }
@@ -863,21 +595,18 @@ fn mid_frame_reset_then_an_exact_frame() {
         let px = rtl.side();
         let scene = Scene::new(&rtl, px, Projection::Parallel);
         let (want, bursts) = scene.model();
+        let packets = scene.packets();
         let s = seed(1930);
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let mem = random_memory(&mut rng, &rtl);
-        let mut dut = open(variant, rtl, &scene, mem, s);
-        let part = run_host(
-            &mut dut,
-            &scene.packets(),
-            px,
-            Behaviour {
-                idle: 0.2,
-                stall: 0.2,
-            },
-            &mut rng,
-            Some(3 * want.counts.cycles),
-        );
+        let mut dut = open_proc(variant, rtl, &scene.proc, mem, s);
+        let b = Behaviour {
+            idle: 0.2,
+            stall: 0.2,
+        };
+        let what = format!("{variant} seed {s} before a reset ({mem:?}, {b:?})");
+        let cut = Some(3 * want.counts.cycles);
+        let part = run_host(&mut dut, &packets, (px, px), b, &mut rng, cut, &what);
         assert!(
             part.outputs > 0 && (part.last.rays_finished as u64) < want.counts.rays_made,
             "{variant}: the reset falls mid-frame"
@@ -887,8 +616,10 @@ fn mid_frame_reset_then_an_exact_frame() {
             "{variant}: reset after {} clocks, {} of {} rays finished, {} bursts in flight dropped",
             part.clocks, part.last.rays_finished, want.counts.rays_made, dropped
         );
-        let got = run_host(&mut dut, &scene.packets(), px, FULL_SPEED, &mut rng, None);
-        check_frame(variant.name, "after a reset", &got, &want, true);
+        let b = FULL_SPEED;
+        let what = format!("{variant} seed {s} after a reset ({mem:?}, {b:?})");
+        let got = run_host(&mut dut, &packets, (px, px), b, &mut rng, None, &what);
+        check_frame(&what, &got, &want, true);
         check_bursts(variant, &rtl, &got, &bursts, s);
     }
 }
@@ -900,6 +631,7 @@ fn a_model_with_another_ring_latency_counts_other_cycles() {
     let (variant, rtl) = ci_configs()[0];
     let px = rtl.side();
     let scene = Scene::new(&rtl, px, Projection::Parallel);
+    let packets = scene.packets();
     let other = ProcessorRtlConfig {
         ring_lat: rtl.ring_lat + 1,
         ..rtl
@@ -908,9 +640,11 @@ fn a_model_with_another_ring_latency_counts_other_cycles() {
     let s = seed(1940);
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let mem = random_memory(&mut rng, &rtl);
-    let mut dut = open(variant, rtl, &scene, mem, s);
-    let got = run_host(&mut dut, &scene.packets(), px, FULL_SPEED, &mut rng, None);
-    check_frame(variant.name, "other latency: image", &got, &want, false);
+    let mut dut = open_proc(variant, rtl, &scene.proc, mem, s);
+    let b = FULL_SPEED;
+    let what = format!("{variant} seed {s} other latency: image ({mem:?}, {b:?})");
+    let got = run_host(&mut dut, &packets, (px, px), b, &mut rng, None, &what);
+    check_frame(&what, &got, &want, false);
     assert_ne!(
         u64::from(got.last.cycles),
         want.counts.cycles,
@@ -926,21 +660,7 @@ fn large_frames_equal_the_model_with_every_count() {
         if rtl.side() <= 16 || rtl.light == 1 {
             continue;
         }
-        let px = rtl.side();
-        for proj in [
-            Projection::Parallel,
-            Projection::Perspective { fov_deg: 30.0 },
-        ] {
-            for (k, mem) in [None, Some(DDR_LIKE)].into_iter().enumerate() {
-                let (got, want) = exact_frame(variant, rtl, px, proj, mem, seed(1950 + k as u64));
-                let what = if mem.is_some() {
-                    "DDR-like"
-                } else {
-                    "random memory"
-                };
-                frame_line(variant, &format!("{proj:?}, {what}"), &got, &want);
-            }
-        }
+        projections_and_memories(variant, rtl, 1950);
     }
 }
 

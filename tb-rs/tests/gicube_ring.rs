@@ -13,21 +13,20 @@
 mod support;
 
 use cube5_model::camera::Camera;
-use cube5_model::phantom::head_phantom;
-use cube5_model::transfer::TransferFunction;
-use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
-use cube5_model::units::gicube_processor::{host_rays, Processor, Projection};
+use cube5_model::units::gicube_processor::Projection;
 use cube5_model::units::gicube_ring::{Ring, RingFrame, RingOut, RingOutCounts, RingRtlConfig};
-use cube5_tb::rtl::{ArHandshake, RtlStream, Traffic};
+use cube5_tb::harness::count_differing;
+use cube5_tb::rtl::ArHandshake;
 use cube5_tb::Variant;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use std::collections::VecDeque;
-use support::{axi, axi_mem_setup, compare_bursts, configs, seed};
+use support::processor::{
+    head_scene, host_packets, open_over, random_memory, run_eager_host, Bits, RtlFrame,
+};
+use support::{compare_bursts, configs, seed};
 
-type Bits = [u32; PACKET_WORDS];
-
-/// The head phantom at the RTL's side and voxel width, azimuth 65, elevation 20, `px` a side.
+/// The head phantom at the RTL's side and voxel width, azimuth 65, elevation 20, `px` a side
+/// (`head_scene`), in a ring of the RTL's processors.
 struct Scene {
     ring: Ring,
     cam: Camera,
@@ -36,102 +35,13 @@ struct Scene {
 
 impl Scene {
     fn new(rtl: &RingRtlConfig, px: u32, proj: Projection) -> Self {
-        let p = rtl.processor();
-        let vol = head_phantom(p.side() as usize, p.voxel_w).unwrap();
-        let (a, e) = (65f64.to_radians(), 20f64.to_radians());
-        let dir = [-e.cos() * a.cos(), -e.cos() * a.sin(), -e.sin()];
-        let cam = Camera::new(dir.into(), vol.dims, vol.spacing, px, px);
-        let proc = Processor::new(
-            p.processor_config(),
-            &vol,
-            &TransferFunction::head_default(),
-        )
-        .unwrap();
+        let (proc, cam) = head_scene(&rtl.processor(), px);
         let ring = Ring::new(proc, rtl.procs()).unwrap();
         Self { ring, cam, proj }
     }
 
     fn packets(&self) -> Vec<Bits> {
-        let p = self.ring.processor();
-        host_rays(p.volume(), &self.cam, self.proj, p.config().host_order)
-            .unwrap()
-            .iter()
-            .map(|r| Processor::packet(r).unwrap().to_bits().unwrap())
-            .collect()
-    }
-}
-
-/// What the RTL rendered: the pixels, the last output item, the clocks, the AR bursts.
-struct RtlFrame {
-    rgb: Vec<[u16; 3]>,
-    last: RingOut,
-    clocks: u64,
-    ars: Vec<ArHandshake>,
-}
-
-/// The host loop, one clock per call: offers the head of its list (held until taken), collects
-/// finished rays into the image and appends returned rays to its list, until every ray
-/// finished.
-fn run_host(
-    dut: &mut RtlStream<RingRtlConfig>,
-    rays: &[Bits],
-    px: u32,
-    stall: f64,
-    rng: &mut ChaCha8Rng,
-) -> RtlFrame {
-    let name = dut.name();
-    let mut list: VecDeque<Bits> = rays.iter().copied().collect();
-    let mut rgb = vec![[0u16; 3]; (px * px) as usize];
-    let mut seen = vec![false; (px * px) as usize];
-    let (mut finished, mut clocks) = (0usize, 0u64);
-    let mut last = RingOut::default();
-    let limit = 100_000 + 40_000 * rays.len() as u64;
-    while finished < rays.len() {
-        assert!(clocks < limit, "{name}: no progress after {clocks} clocks");
-        let items: Vec<Bits> = list.front().copied().into_iter().collect();
-        let traffic = Traffic {
-            idle: vec![0],
-            stall: vec![u8::from(rng.random_bool(stall))],
-        };
-        let d = dut
-            .drive(&items, &traffic, u64::from(items.is_empty()), 1)
-            .unwrap();
-        clocks += 1;
-        assert_eq!(
-            d.stats.protocol_errors, 0,
-            "{name}: a stalled output changed at clock {clocks}"
-        );
-        if d.stats.consumed == 1 {
-            list.pop_front();
-        }
-        for o in d.outputs {
-            let o = o.value;
-            let r = RayPacket::from_bits(&o.ray);
-            if o.done {
-                let i = (u32::from(r.v) * px + u32::from(r.u)) as usize;
-                assert!(!seen[i], "{name}: pixel ({}, {}) finished twice", r.u, r.v);
-                seen[i] = true;
-                rgb[i] = r.color;
-                finished += 1;
-            } else {
-                assert!(r.flags & 4 != 0, "{name}: a returned ray has OVERFLOW set");
-                list.push_back(o.ray);
-            }
-            last = o;
-        }
-    }
-    let c = dut.axi_counters();
-    assert_eq!(
-        c.protocol_errors,
-        0,
-        "{name}: AXI: {}",
-        dut.axi_first_error()
-    );
-    RtlFrame {
-        rgb,
-        last,
-        clocks,
-        ars: dut.axi_take_ar().unwrap(),
+        host_packets(self.ring.processor(), &self.cam, self.proj)
     }
 }
 
@@ -143,7 +53,7 @@ fn exact_frame(
     px: u32,
     proj: Projection,
     s: u64,
-) -> (RtlFrame, RingFrame) {
+) -> (RtlFrame<RingOut>, RingFrame) {
     let scene = Scene::new(&rtl, px, proj);
     let (want, bursts) = scene.ring.render_cache_traced(&scene.cam, proj).unwrap();
     want.check_conservation().unwrap();
@@ -155,39 +65,16 @@ fn exact_frame(
 
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let p = rtl.processor();
-    let img = scene
-        .ring
-        .processor()
-        .rtl_memory()
-        .unwrap()
-        .expect("a cache");
-    let setup = axi_mem_setup(
-        (p.data_w / 8, 32),
-        &img,
-        (10, 190),
-        (rng.random_range(0..300), rng.random_range(0..300)),
-        axi::random_bandwidth(&mut rng, p.data_w / 8),
-        s,
-    );
-    let mut dut = RtlStream::new(variant, rtl, s as u32).unwrap();
-    dut.axi_setup(&setup).unwrap();
-    dut.axi_load(img.base, &img.bytes).unwrap();
-    for (a, d) in scene.ring.processor().rtl_config_writes(&p).unwrap() {
-        dut.write_config(a, &d).unwrap();
-    }
-    let got = run_host(&mut dut, &scene.packets(), px, 0.3, &mut rng);
+    let mem = random_memory(&mut rng, &p);
+    let proc = scene.ring.processor();
+    let setup = |img: &_| mem.read_setup(p.data_w / 8, img, s);
+    let mut dut = open_over(variant, rtl, &p, proc, setup, s);
+    let what = format!("{variant} seed {s} ({proj:?}, {mem:?}, stall 0.3)");
+    let got = run_eager_host(&mut dut, &scene.packets(), (px, px), 0.3, &mut rng, &what);
 
     let name = variant.name;
-    let differ = got
-        .rgb
-        .iter()
-        .zip(&want.rgb)
-        .filter(|(a, b)| a != b)
-        .count();
-    assert_eq!(
-        differ, 0,
-        "{name} {proj:?} seed {s}: {differ} pixels differ"
-    );
+    let differ = count_differing(&got.rgb, &want.rgb);
+    assert_eq!(differ, 0, "{what}: {differ} pixels differ");
     let wanted: Vec<RingOutCounts> = want
         .counts
         .iter()
@@ -196,7 +83,7 @@ fn exact_frame(
         .collect();
     assert_eq!(
         got.last.counts, wanted,
-        "{name} {proj:?} seed {s}: every processor's counts equal the model's"
+        "{what}: every processor's counts equal the model's"
     );
     let sum = |f: fn(&RingOutCounts) -> u32| got.last.counts.iter().map(f).sum::<u32>();
     assert_eq!(
@@ -232,7 +119,7 @@ fn exact_frame(
     (got, want)
 }
 
-fn frame_line(variant: &'static Variant, what: &str, got: &RtlFrame, want: &RingFrame) {
+fn frame_line(variant: &'static Variant, what: &str, got: &RtlFrame<RingOut>, want: &RingFrame) {
     let per: Vec<String> = want
         .counts
         .iter()

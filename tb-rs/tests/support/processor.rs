@@ -1,14 +1,22 @@
-//! The host of gicube_processor's co-simulations: the subordinate's memory conditions, opening a
-//! processor over a model's memory image with its tables loaded, the host loop (offers its list,
-//! collects finished rays, re-offers overflowed ones) and the checks of a pass against the model
-//! (the pixels, rays in = finished + overflowed, the counts, the AR bursts).
+//! The host of gicube_processor's and gicube_ring's co-simulations: the head scene, the
+//! subordinate's memory conditions, opening a processor (or a ring of them) over a model's memory
+//! image with its tables loaded, the host loop (offers its list, collects finished rays, re-offers
+//! returned ones) and the checks of a processor's pass against the model (the pixels, rays in =
+//! finished + overflowed, the counts, the AR bursts).
 
 use super::{axi, axi_mem_setup, compare_bursts};
+use cube5_model::camera::Camera;
+use cube5_model::phantom::head_phantom;
+use cube5_model::transfer::TransferFunction;
+use cube5_model::unit::StreamCodec;
 use cube5_model::units::cube5_axi_rd::{AxiMemImage, Burst};
+use cube5_model::units::cube5_shader::Phong;
 use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
 use cube5_model::units::gicube_processor::{
-    Processor, ProcessorFrame, ProcessorOut, ProcessorRtlConfig,
+    half_tags, host_rays, Processor, ProcessorFrame, ProcessorOut, ProcessorRtlConfig, Projection,
 };
+use cube5_model::units::gicube_ring::RingOut;
+use cube5_tb::harness::count_differing;
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::Variant;
 use rand::Rng;
@@ -17,6 +25,41 @@ use std::collections::VecDeque;
 
 pub type Bits = [u32; PACKET_WORDS];
 
+/// The direction from the eye into the scene at `azimuth` and `elevation` (degrees).
+pub fn view_dir(azimuth: f64, elevation: f64) -> [f64; 3] {
+    let (a, e) = (azimuth.to_radians(), elevation.to_radians());
+    [-e.cos() * a.cos(), -e.cos() * a.sin(), -e.sin()]
+}
+
+/// The head phantom at `rtl`'s side and voxel width in `rtl`'s processor, seen from azimuth 65,
+/// elevation 20, `px` pixels a side; with `Shade` lit by two lights (the viewer's map) and tagged
+/// in two halves (`half_tags`: the tag's colour in the half `x >= N/2`).
+pub fn head_scene(rtl: &ProcessorRtlConfig, px: u32) -> (Processor, Camera) {
+    let vol = head_phantom(rtl.side() as usize, rtl.voxel_w).unwrap();
+    let dir = view_dir(65.0, 20.0);
+    let cam = Camera::new(dir.into(), vol.dims, vol.spacing, px, px);
+    let tf = TransferFunction::head_default();
+    let mut proc = Processor::new(rtl.processor_config(), &vol, &tf).unwrap();
+    if rtl.shade == 1 {
+        let phong = Phong {
+            view: dir.map(|c| -c),
+            ..Phong::two_lights()
+        };
+        let tags = (rtl.tag_w > 0).then(|| half_tags(&vol));
+        proc.set_shading(&phong, tags).unwrap();
+    }
+    (proc, cam)
+}
+
+/// The host's packets of `cam`'s rays through `proc`'s volume, in the host's order.
+pub fn host_packets(proc: &Processor, cam: &Camera, proj: Projection) -> Vec<Bits> {
+    host_rays(proc.volume(), cam, proj, proc.config().host_order)
+        .unwrap()
+        .iter()
+        .map(|r| Processor::packet(r).unwrap().to_bits().unwrap())
+        .collect()
+}
+
 /// How the memory answers: latency `fixed + U(0..random)` cycles, AR and R gaps (per mille), a
 /// bandwidth limit of `num / den` bytes per cycle (0: none).
 #[derive(Clone, Copy, Debug)]
@@ -24,6 +67,14 @@ pub struct Memory {
     pub lat: (u32, u32),
     pub gaps: (u32, u32),
     pub bw: (u32, u32),
+}
+
+impl Memory {
+    /// The subordinate of `data_bytes`-wide beats over `img` answering reads as `self` says (no
+    /// write gaps, no declared outstanding count).
+    pub fn read_setup(self, data_bytes: u32, img: &AxiMemImage, s: u64) -> AxiMemSetup {
+        axi_mem_setup((data_bytes, 32), img, self.lat, self.gaps, self.bw, s)
+    }
 }
 
 /// Random conditions: latency 10-200, gaps of up to 30 %, a bandwidth limit on half the seeds.
@@ -35,11 +86,43 @@ pub fn random_memory(rng: &mut ChaCha8Rng, rtl: &ProcessorRtlConfig) -> Memory {
     }
 }
 
-/// What the RTL did in a pass: the pixels, the last output's counts, every output ray in order
-/// (finished: `true`), the clocks from the first offer to the last output, the AR bursts.
-pub struct RtlFrame {
+/// An output item of the host's unit (a processor, a ring): a finished ray or one returned with
+/// OVERFLOW set, or (a processor's, `Light`) a flush's item.
+pub trait HostOut: Default {
+    fn done(&self) -> bool;
+    fn ray(&self) -> &Bits;
+    fn flush(&self) -> bool;
+}
+
+impl HostOut for ProcessorOut {
+    fn done(&self) -> bool {
+        self.done
+    }
+    fn ray(&self) -> &Bits {
+        &self.ray
+    }
+    fn flush(&self) -> bool {
+        self.flush
+    }
+}
+
+impl HostOut for RingOut {
+    fn done(&self) -> bool {
+        self.done
+    }
+    fn ray(&self) -> &Bits {
+        &self.ray
+    }
+    fn flush(&self) -> bool {
+        false
+    }
+}
+
+/// What the RTL did in a pass: the pixels, the last output (its counts), every output ray in
+/// order (finished: `true`), the clocks from the first offer to the last output, the AR bursts.
+pub struct RtlFrame<O = ProcessorOut> {
     pub rgb: Vec<[u16; 3]>,
-    pub last: ProcessorOut,
+    pub last: O,
     pub outputs: u64,
     pub rays: Vec<(bool, Bits)>,
     pub clocks: u64,
@@ -62,7 +145,7 @@ pub fn mem_setup(rtl: &ProcessorRtlConfig, img: &AxiMemImage, mem: Memory, s: u6
         aw_gap_permille: mem.gaps.0,
         w_gap_permille: mem.gaps.1,
         b_gap_permille: mem.gaps.0,
-        ..axi_mem_setup((rtl.data_w / 8, 32), img, mem.lat, mem.gaps, mem.bw, s)
+        ..mem.read_setup(rtl.data_w / 8, img, s)
     }
 }
 
@@ -75,18 +158,39 @@ pub fn open_proc(
     mem: Memory,
     s: u64,
 ) -> RtlStream<ProcessorRtlConfig> {
+    open_over(
+        variant,
+        rtl,
+        &rtl,
+        proc,
+        |img| mem_setup(&rtl, img, mem, s),
+        s,
+    )
+}
+
+/// Opens `variant` (`codec`: a processor's or a ring's) over `proc`'s memory image, the
+/// subordinate as `setup` makes it for the image, and loads `proc`'s registers at `rtl` (the
+/// processor's configuration, each of a ring's).
+pub fn open_over<C: StreamCodec>(
+    variant: &'static Variant,
+    codec: C,
+    rtl: &ProcessorRtlConfig,
+    proc: &Processor,
+    setup: impl FnOnce(&AxiMemImage) -> AxiMemSetup,
+    s: u64,
+) -> RtlStream<C> {
     let img = proc.rtl_memory().unwrap().expect("the RTL's cache");
-    let setup = mem_setup(&rtl, &img, mem, s);
-    let mut dut = RtlStream::new(variant, rtl, s as u32).unwrap();
+    let setup = setup(&img);
+    let mut dut = RtlStream::new(variant, codec, s as u32).unwrap();
     dut.axi_setup(&setup).unwrap();
     dut.axi_load(img.base, &img.bytes).unwrap();
-    load_config(&mut dut, &rtl, proc);
+    load_config(&mut dut, rtl, proc);
     dut
 }
 
 /// The tables, empty flags and GI registers of `proc` written to the processor's registers.
-pub fn load_config(
-    dut: &mut RtlStream<ProcessorRtlConfig>,
+pub fn load_config<C: StreamCodec>(
+    dut: &mut RtlStream<C>,
     rtl: &ProcessorRtlConfig,
     proc: &Processor,
 ) {
@@ -100,32 +204,69 @@ pub fn load_config(
 /// to its list; stops after `stop_after` clocks if given, else when every ray has finished.
 /// `what` names the pass in every failure (variant, seed).
 #[allow(clippy::too_many_arguments)]
-pub fn run_host(
-    dut: &mut RtlStream<ProcessorRtlConfig>,
+pub fn run_host<C: StreamCodec<In = Bits, Out: HostOut>>(
+    dut: &mut RtlStream<C>,
     rays: &[Bits],
     (w, h): (u32, u32),
     b: Behaviour,
     rng: &mut ChaCha8Rng,
     stop_after: Option<u64>,
     what: &str,
-) -> RtlFrame {
+) -> RtlFrame<C::Out> {
+    host_loop(
+        dut,
+        rays,
+        (w, h),
+        Some(b.idle),
+        b.stall,
+        rng,
+        stop_after,
+        what,
+    )
+}
+
+/// The host loop of `run_host` with a host that offers its head at once, never idle (and draws
+/// nothing for it), until every ray has finished.
+pub fn run_eager_host<C: StreamCodec<In = Bits, Out: HostOut>>(
+    dut: &mut RtlStream<C>,
+    rays: &[Bits],
+    (w, h): (u32, u32),
+    stall: f64,
+    rng: &mut ChaCha8Rng,
+    what: &str,
+) -> RtlFrame<C::Out> {
+    host_loop(dut, rays, (w, h), None, stall, rng, None, what)
+}
+
+/// `run_host`; `idle: None`, the host offers its head at once without a draw.
+#[allow(clippy::too_many_arguments)]
+fn host_loop<C: StreamCodec<In = Bits, Out: HostOut>>(
+    dut: &mut RtlStream<C>,
+    rays: &[Bits],
+    (w, h): (u32, u32),
+    idle: Option<f64>,
+    stall: f64,
+    rng: &mut ChaCha8Rng,
+    stop_after: Option<u64>,
+    what: &str,
+) -> RtlFrame<C::Out> {
     let mut list: VecDeque<Bits> = rays.iter().copied().collect();
     let mut rgb = vec![[0u16; 3]; (w * h) as usize];
     let mut seen = vec![false; (w * h) as usize];
     let (mut finished, mut outputs, mut clocks) = (0usize, 0u64, 0u64);
     let mut out = Vec::new();
     let mut offering = false;
-    let mut last = ProcessorOut::default();
+    let mut last = C::Out::default();
     let limit = 100_000 + 40_000 * rays.len() as u64;
     while finished < rays.len() && stop_after.is_none_or(|s| clocks < s) {
         assert!(clocks < limit, "{what}: no progress after {clocks} clocks");
         if !list.is_empty() && !offering {
-            offering = !rng.random_bool(b.idle);
+            offering = idle.is_none_or(|p| !rng.random_bool(p));
         }
         let items: Vec<Bits> = if offering { vec![list[0]] } else { Vec::new() };
         let traffic = Traffic {
             idle: vec![0],
-            stall: vec![u8::from(rng.random_bool(b.stall))],
+            stall: vec![u8::from(rng.random_bool(stall))],
         };
         let expect = u64::from(items.is_empty());
         let d = dut.drive(&items, &traffic, expect, 1).unwrap();
@@ -140,12 +281,12 @@ pub fn run_host(
         }
         for o in d.outputs {
             let o = o.value;
-            assert!(!o.flush, "{what}: a flush item without a flush");
+            assert!(!o.flush(), "{what}: a flush item without a flush");
             outputs += 1;
-            last = o;
-            out.push((o.done, o.ray));
-            let r = RayPacket::from_bits(&o.ray);
-            if o.done {
+            let (done, ray) = (o.done(), *o.ray());
+            out.push((done, ray));
+            let r = RayPacket::from_bits(&ray);
+            if done {
                 let i = (u32::from(r.v) * w + u32::from(r.u)) as usize;
                 assert!(!seen[i], "{what}: pixel ({}, {}) finished twice", r.u, r.v);
                 seen[i] = true;
@@ -156,8 +297,9 @@ pub fn run_host(
                     r.flags & 4 != 0,
                     "{what}: an overflowed ray has OVERFLOW set"
                 );
-                list.push_back(o.ray);
+                list.push_back(ray);
             }
+            last = o;
         }
     }
     let c = dut.axi_counters();
@@ -181,12 +323,7 @@ pub fn run_host(
 pub fn check_frame(what: &str, got: &RtlFrame, want: &ProcessorFrame, exact_counts: bool) {
     let c = &want.counts;
     let l = &got.last;
-    let differ = got
-        .rgb
-        .iter()
-        .zip(&want.rgb)
-        .filter(|(a, b)| a != b)
-        .count();
+    let differ = count_differing(&got.rgb, &want.rgb);
     assert_eq!(differ, 0, "{what}: {differ} pixels differ from the model");
     assert_eq!(
         u64::from(l.rays_in),
