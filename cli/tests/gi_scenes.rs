@@ -7,8 +7,11 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use support::{assert_refused, cube5, render_at, render_scene, scratch, scratch_file, succeeded};
+#[cfg(feature = "rtl")]
+use support::cube5;
+use support::{assert_refused, render_at, render_scene, scratch, scratch_file, succeeded};
 
+#[cfg(feature = "rtl")]
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
@@ -111,6 +114,7 @@ fn gi_reference_renders() {
 }
 
 /// The 16^3 GI scene, a quarter of its lighting rays and 16 x 16 pixels (seconds on the RTL).
+#[cfg(feature = "rtl")]
 fn short_gi_16() -> String {
     let path = cube5_model::repo_root().join("scenes/gi-shadow-16.toml");
     let text = std::fs::read_to_string(path).unwrap();
