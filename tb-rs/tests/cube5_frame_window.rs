@@ -211,7 +211,10 @@ fn run(
 
 /// 32^3 frames at P = 4 in sections of 8 and 16 (and 4 at P = 1 below): faces, 45 degrees,
 /// obliques, MIP and composite; 30 % idle beats and back-pressure, the DRAM slow and stalling.
+/// `w1p4` is a `full` line (CI's build budget): the accelerator's CI line `w1v8p4s8` runs the
+/// window at P = 4 in CI.
 #[test]
+#[ignore = "sim-full: the P = 4 window build (w1p4) is not in CI's build budget"]
 fn window_frames_bit_exact_p4() {
     let s = seed(11);
     let rtl = window(4);
@@ -279,15 +282,15 @@ fn window_frames_bit_exact_p1() {
 #[test]
 fn window_reset_mid_frame() {
     let s = seed(13);
-    let rtl = window(4);
-    let vol = Rc::new(head_phantom(32, 12).unwrap());
+    let rtl = window(1);
+    let vol = Rc::new(head_phantom(16, 12).unwrap());
     let mut bench = must(StreamBench::new(rtl, s as u32));
     let mut rng = ChaCha8Rng::seed_from_u64(s);
     let traffic = Traffic::random(&mut rng, 0.2, 0.2);
-    let c = case(&rtl, &vol, VIEWS[4], Render::Composite, 8);
+    let c = case(&rtl, &vol, VIEWS[4], Render::Composite, 4);
     assert!(c.t.parked > 0);
     must(bench.load(&c.e));
-    let order = section_order(&c.e.params, 8, rtl.p).unwrap();
+    let order = section_order(&c.e.params, 4, rtl.p).unwrap();
     let (items, _) = items_of(&rtl, &c.e, &order, true);
     must(bench.dut.win_setup(&dram(&mut rng, true)));
     let _ = must(
@@ -303,21 +306,22 @@ fn window_reset_mid_frame() {
 
 /// Throughput: a 45-degree and an oblique frame at full speed (no idle, no stall, DRAM at once
 /// and at 40 cycles), against the same frame through the whole-plane build (`Window = 0`) with
-/// the same P: the sweep's samples per clock per pipeline.
+/// the same P: the sweep's samples per clock per pipeline. P = 1 on 16^3 in CI (`w1p1`).
 #[test]
 fn window_throughput_against_the_whole_plane() {
     let s = seed(14);
-    let rtl = window(4);
+    let rtl = window(1);
     let whole = FrameRtl::streams()
         .into_iter()
-        .filter(|r| r.p == 4 && r.default_widths())
+        .filter(|r| r.p == rtl.p && r.default_widths())
         .min_by_key(|r| r.max_dim_log2)
-        .expect("a Window = 0 stream frame at P = 4");
-    let vol = Rc::new(head_phantom(32, 12).unwrap());
+        .expect("a Window = 0 stream frame with the window's P");
+    let n = 1 << rtl.max_dim_log2;
+    let vol = Rc::new(head_phantom(n, 12).unwrap());
     let mut bench = must(StreamBench::new(rtl, s as u32));
     let mut wbench = must(StreamBench::new(whole, s as u32));
     for view in [VIEWS[2], VIEWS[5]] {
-        for width in [8, 16] {
+        for width in [4, 8] {
             let c = case(&rtl, &vol, view, Render::Composite, width);
             let samples = (c.e.params.ni * c.e.params.nj * c.e.params.nk) as f64;
             let fast = must(run(
@@ -340,7 +344,7 @@ fn window_throughput_against_the_whole_plane() {
             let (w0, _) = must(wbench.check(&c.e, width, &Traffic::full_speed(), s));
             let per = |cy: u64| samples / rtl.p as f64 / cy as f64;
             eprintln!(
-                "MEASURE {} 32^3 {} S = {width}: window {fast} cycles ({:.3} samples/clock/pipeline), DRAM latency 40: {slow} ({:.3}); whole plane {} with read-out: {w0} ({:.3}); parked {}",
+                "MEASURE {} {n}^3 {} S = {width}: window {fast} cycles ({:.3} samples/clock/pipeline), DRAM latency 40: {slow} ({:.3}); whole plane {} with read-out: {w0} ({:.3}); parked {}",
                 rtl.variant,
                 view.0,
                 per(fast),
