@@ -79,6 +79,10 @@ module cube5_accel #(
   /// park order*); 0: a slot per pixel, a burst per park and per restore.
   parameter int unsigned WinRing     = 0,
   parameter int unsigned WinRingBurst = 16,
+  /// Window = 1: 0 writes each final pixel beat as a single-beat burst; else the final items'
+  /// consecutive beats go out as bursts of up to WinFinBurst beats (cube5_accel_win FinBurst;
+  /// docs/numerics/compos_window.md, *Final pixels in bursts*). The image is the same.
+  parameter int unsigned WinFinBurst = 0,
   /// Window = 1: while the window's write beats wait, the fetch keeps at most FetchHold (+ 1)
   /// read bursts granted and not yet returned; 0: it starts none (docs/accel.md, *The
   /// compositing window in the top*).
@@ -655,7 +659,8 @@ module cube5_accel #(
     cube5_accel_win #(
       .P(P), .DimW(M + 1), .AddrW(AddrW), .DataW(DataW), .IdW(IdW), .AccW(AccW),
       .ColorW(ColorW), .Outstanding(WinOutstanding), .WDepth(WinWDepth),
-      .ZeroDepth(WinZeroDepth), .Ring(WinRing), .RingBurst(WinRingBurst)
+      .ZeroDepth(WinZeroDepth), .Ring(WinRing), .RingBurst(WinRingBurst),
+      .FinBurst(WinFinBurst)
     ) u_win (
       .clk_i, .rst_ni(unit_rst_n),
       .img_base_i(img_base), .row_step_i(row_step), .park_base_i(park_base),

@@ -38,6 +38,13 @@
 // nothing else is on its way) writes the beats held, the last padded with zeros; the pad's place
 // (the count of coxels before it) goes to the reader through a small FIFO. A beat is read only
 // after its write's B and rewritten only after its read's data is back.
+//
+// Finals in bursts (FinBurst > 0; docs/numerics/compos_window.md, *Final pixels in bursts*): the
+// final items' beats (as above: the bus beats their pixels touch, with strobes) join a *run*
+// while each is the run's last beat (strobes merged) or the beat after it, inside one aligned
+// block of FinBurst beats; any other beat, or FinWait cycles with no final beat, closes the run:
+// its beats (a FIFO) go out as one INCR burst (ID IdFin). Each image byte is written once, as
+// before; only the bursts change.
 module cube5_accel_win #(
   parameter int unsigned P           = 4,
   /// Bits of a key coordinate (log2(MaxDim) + 1).
@@ -60,7 +67,11 @@ module cube5_accel_win #(
   /// pixel, one burst per park and per restore.
   parameter int unsigned Ring        = 0,
   /// Ring = 1: the longest burst in beats (a power of two, at most 256 and 4 KB).
-  parameter int unsigned RingBurst   = 16
+  parameter int unsigned RingBurst   = 16,
+  /// 0: each final beat is a single-beat burst; else the final items' beats that follow each
+  /// other in the image go out as INCR bursts of up to FinBurst beats (a power of two, at most
+  /// 256 and 4 KB; docs/numerics/compos_window.md, *Final pixels in bursts*).
+  parameter int unsigned FinBurst    = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -282,6 +293,15 @@ module cube5_accel_win #(
   logic               rg_w;       // Ring = 1: a ring burst's beat into the W FIFO
   logic [AwW-1:0]     rg_aw_d;
   logic [WW-1:0]      rg_w_d;
+  logic               fc_in;      // FinBurst > 0: a final's beat (a strobe set) into its run
+  logic               fc_ok;      // FinBurst > 0: the run's FIFOs take a beat and a burst
+  logic               fm_use;     // FinBurst > 0: a finals burst's AW or beats go into the FIFOs
+  logic               fm_busy;    // FinBurst > 0: a finals burst's beats are moving
+  logic               fm_aw;      // FinBurst > 0: a finals burst starts (its AW pushed)
+  logic               fm_w;       // FinBurst > 0: a finals burst's beat into the W FIFO
+  logic [AwW-1:0]     fm_aw_d;
+  logic [WW-1:0]      fm_w_d;
+  logic               fm_idle;    // FinBurst > 0: no run open, nothing queued
 
   always_comb begin
     beat      = s2_line_q[0 +: DataW];
@@ -295,10 +315,14 @@ module cube5_accel_win #(
   end
 
   assign t_last  = s2_park_q ? (t_q == TW'(PkBeats - 1)) : (t_q == TW'(FinBeats - 1));
-  assign need_aw = s2_park_q ? (t_q == '0) : |beat_strb;
-  assign push_w  = s2_park_q || |beat_strb;
-  assign can     = (!need_aw || (!aw_full && out_q < OutW'(Outstanding))) && (!push_w || !w_full);
-  assign step    = s2_v_q && can && !rg_use;
+  assign need_aw = s2_park_q ? (t_q == '0) : (FinBurst == 0 && |beat_strb);
+  assign push_w  = s2_park_q || (FinBurst == 0 && |beat_strb);
+  assign fc_in   = !s2_park_q && FinBurst != 0 && |beat_strb;
+  assign can     = (!need_aw || (!aw_full && out_q < OutW'(Outstanding))) && (!push_w || !w_full)
+                   && (!fc_in || fc_ok);
+  // A beat into the AW/W FIFOs waits while a ring or finals burst moves into them.
+  assign step    = s2_v_q && can && ((FinBurst == 0) ? !rg_use
+                                      : (!(need_aw || push_w) || (!rg_use && !fm_use)));
   assign push_aw = step && need_aw;
   assign s3_done = step && t_last;
 
@@ -318,11 +342,13 @@ module cube5_accel_win #(
 
   cube5_frame_fifo #(.Width(AwW), .Depth(WDepth)) u_aw (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i(push_aw || rg_aw), .d_i(rg_use ? rg_aw_d : aw_d), .pop_i(aw_pop), .q_o(aw_q), .empty_o(aw_empty), .full_o(aw_full)
+    .push_i(push_aw || rg_aw || fm_aw), .d_i(rg_use ? rg_aw_d : fm_use ? fm_aw_d : aw_d),
+    .pop_i(aw_pop), .q_o(aw_q), .empty_o(aw_empty), .full_o(aw_full)
   );
   cube5_frame_fifo #(.Width(WW), .Depth(WDepth)) u_w (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i((step && push_w) || rg_w), .d_i(rg_use ? rg_w_d : w_d), .pop_i(w_pop), .q_o(w_q), .empty_o(w_empty), .full_o(w_full)
+    .push_i((step && push_w) || rg_w || fm_w), .d_i(rg_use ? rg_w_d : fm_use ? fm_w_d : w_d),
+    .pop_i(w_pop), .q_o(w_q), .empty_o(w_empty), .full_o(w_full)
   );
 
   assign {awid_o, awlen_o, awaddr_o} = aw_q;
@@ -337,7 +363,7 @@ module cube5_accel_win #(
     if (!rst_ni) begin
       out_q <= '0;
     end else begin
-      out_q <= out_q + OutW'(push_aw || rg_aw) - OutW'(b_fire);
+      out_q <= out_q + OutW'(push_aw || rg_aw || fm_aw) - OutW'(b_fire);
     end
   end
 
@@ -612,7 +638,7 @@ module cube5_accel_win #(
     assign w_len  = min2(CntW'(bq_n_q), w_lim);
     assign w_room = ring_n_q - (w_iss_q - r_ret_q);
     assign rg_aw  = mv_q == '0 && w_len != '0 && (CntW'(bq_n_q) >= w_lim || flush_q)
-                    && w_len <= w_room && !aw_full && out_q < OutW'(Outstanding);
+                    && w_len <= w_room && !aw_full && out_q < OutW'(Outstanding) && !fm_busy;
     assign rg_w   = mv_q != '0 && !w_full;
     assign rg_use = rg_aw || mv_q != '0;
     assign rg_aw_d = {IdPark, 8'(w_len - CntW'(1)), base + (AddrW'(wpos_q) << LogBus)};
@@ -763,7 +789,130 @@ module cube5_accel_win #(
     assign rg_araddr  = '0;
     assign rg_arlen   = '0;
     logic unused_rows;
-    assign unused_rows = ^park_rows_i;
+    assign unused_rows = ^{park_rows_i, fm_busy};
+  end
+
+  // ---------------------------------------------------------------------------
+  // FinBurst > 0: the final items' beats gathered into runs of consecutive beats (the *run*:
+  // its first beat's address and length; its last beat, cur, held in registers while later
+  // beats may merge into it; the earlier ones in a FIFO), each closed run one INCR burst
+  // (docs/numerics/compos_window.md, *Final pixels in bursts*).
+  // ---------------------------------------------------------------------------
+  if (FinBurst != 0) begin : gen_fin
+    localparam int unsigned FLog    = $clog2(FinBurst);
+    localparam int unsigned FnW     = $clog2(FinBurst + 1);
+    localparam int unsigned FqDepth = 2 * FinBurst;    // beats of closed runs and the open one
+    localparam int unsigned FdDepth = 4;               // closed runs waiting for the port
+    localparam int unsigned FinWait = 16;              // idle cycles that close a run
+    localparam int unsigned WaitW   = $clog2(FinWait);
+    localparam int unsigned FdW     = AddrW + 8;
+
+    if (FinBurst < 2 || (1 << FLog) != FinBurst || FinBurst > 256 || FinBurst * Bbus > 4096)
+    begin : gen_bad_fin
+      $fatal(1, "cube5_accel_win: FinBurst must be 0 or a power of two, 2 to 256 beats, <= 4 KB");
+    end
+
+    logic               fc_v_q;        // a run is open (cur holds its last beat)
+    logic [AddrW-1:0]   fc_first_q, fc_addr_q, ba;
+    logic [DataW-1:0]   fc_data_q, fc_merged;
+    logic [Bbus-1:0]    fc_strb_q;
+    logic [FnW-1:0]     fc_n_q;        // the run's beats, cur included
+    logic [WaitW-1:0]   fc_wait_q;     // cycles with the run open and no final beat
+    logic               j_same, j_next, close_in, close_t, fq_push, fd_push;
+    logic               fq_full, fq_empty, fd_full, fd_empty;
+    logic [WW-2:0]      fq_q;
+    logic [FdW-1:0]     fd_q;
+    logic [8:0]         fm_mv_q;       // beats of the moving burst still to go
+
+    assign ba      = s2_addr_q + (AddrW'(t_q) << LogBus);
+    assign j_same  = fc_v_q && ba == fc_addr_q;
+    assign j_next  = fc_v_q && ba == fc_addr_q + AddrW'(Bbus) && FLog'(ba >> LogBus) != '0;
+    assign fc_ok   = !fq_full && !fd_full;
+    assign close_in = step && fc_in && fc_v_q && !j_same && !j_next;
+    assign close_t  = fc_v_q && !(step && fc_in) && fc_wait_q == WaitW'(FinWait - 1) && fc_ok;
+    // cur leaves for the FIFO when the next beat follows it or the run closes.
+    assign fq_push = (step && fc_in && fc_v_q && !j_same) || close_t;
+    assign fd_push = close_in || close_t;
+    for (genvar b = 0; b < Bbus; b++) begin : gen_merge
+      assign fc_merged[8*b +: 8] = beat_strb[b] ? beat[8*b +: 8] : fc_data_q[8*b +: 8];
+    end
+
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni) begin
+        fc_v_q    <= 1'b0;
+        fc_wait_q <= '0;
+      end else begin
+        if (step && fc_in) fc_v_q <= 1'b1;
+        else if (close_t)  fc_v_q <= 1'b0;
+        if ((step && fc_in) || !fc_v_q)        fc_wait_q <= '0;
+        else if (fc_wait_q != WaitW'(FinWait - 1)) fc_wait_q <= fc_wait_q + WaitW'(1);
+      end
+    end
+
+    always_ff @(posedge clk_i) begin
+      if (step && fc_in) begin
+        if (j_same) begin
+          fc_data_q <= fc_merged;
+          fc_strb_q <= fc_strb_q | beat_strb;
+        end else begin
+          fc_data_q <= beat;
+          fc_strb_q <= beat_strb;
+          fc_addr_q <= ba;
+        end
+        if (!fc_v_q || !(j_same || j_next)) begin
+          fc_first_q <= ba;
+          fc_n_q     <= FnW'(1);
+        end else if (j_next) begin
+          fc_n_q <= fc_n_q + FnW'(1);
+        end
+      end
+    end
+
+    cube5_frame_fifo #(.Width(WW - 1), .Depth(FqDepth)) u_fq (
+      .clk_i, .rst_ni, .clear_i(1'b0),
+      .push_i(fq_push), .d_i({fc_strb_q, fc_data_q}), .pop_i(fm_w), .q_o(fq_q),
+      .empty_o(fq_empty), .full_o(fq_full)
+    );
+    cube5_frame_fifo #(.Width(FdW), .Depth(FdDepth)) u_fd (
+      .clk_i, .rst_ni, .clear_i(1'b0),
+      .push_i(fd_push), .d_i({8'(fc_n_q) - 8'd1, fc_first_q}), .pop_i(fm_aw), .q_o(fd_q),
+      .empty_o(fd_empty), .full_o(fd_full)
+    );
+
+    // The mover: a closed run's AW, then its beats, while no ring burst moves.
+    assign fm_aw   = fm_mv_q == '0 && !fd_empty && !rg_use && !aw_full
+                     && out_q < OutW'(Outstanding);
+    assign fm_w    = fm_mv_q != '0 && !w_full;
+    assign fm_busy = fm_mv_q != '0;
+    assign fm_use  = fm_aw || fm_busy;
+    assign fm_aw_d = {IdFin, fd_q};
+    assign fm_w_d  = {fm_mv_q == 9'd1, fq_q};
+    assign fm_idle = !fc_v_q && fd_empty && fm_mv_q == '0;
+
+    always_ff @(posedge clk_i) begin
+      if (!rst_ni) begin
+        fm_mv_q <= '0;
+      end else if (fm_aw) begin
+        fm_mv_q <= 9'(fd_q[AddrW +: 8]) + 9'd1;
+      end else if (fm_w) begin
+        fm_mv_q <= fm_mv_q - 9'd1;
+      end
+    end
+
+`ifndef SYNTHESIS
+    WinFinRun: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        fm_w |-> !fq_empty)
+      else $error("cube5_accel_win: a finals burst's beat before it was gathered");
+`endif
+  end else begin : gen_no_fin
+    assign fc_ok   = 1'b1;
+    assign fm_aw   = 1'b0;
+    assign fm_w    = 1'b0;
+    assign fm_busy = 1'b0;
+    assign fm_use  = 1'b0;
+    assign fm_aw_d = '0;
+    assign fm_w_d  = '0;
+    assign fm_idle = 1'b1;
   end
 
   // ---------------------------------------------------------------------------
@@ -780,7 +929,7 @@ module cube5_accel_win #(
   assign err_o  = err_q;
   assign wr_wait_o = !w_empty;
   assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && rq_empty
-                  && !hd_v_q && rs_out_q == '0 && !rs_v_q && ord_empty && rg_idle;
+                  && !hd_v_q && rs_out_q == '0 && !rs_v_q && ord_empty && rg_idle && fm_idle;
   logic unused_ord;
   assign unused_ord = ord_full;
 

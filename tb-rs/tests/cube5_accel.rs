@@ -804,3 +804,289 @@ fn window_full(p: usize) -> AccelRtl {
         .max_by_key(|r| r.frame.max_dim_log2)
         .unwrap_or_else(|| panic!("no cube5_accel variant with Window = 1 and P = {p}"))
 }
+
+// ---------------------------------------------------------------------------------------------
+// The window's bursts by AXI ID against the contract (docs/numerics/compos_window.md, *The ring
+// in park order*, *Final pixels in bursts*): the memory logs every AR and AW handshake with its
+// ID (`axi_take_ar`, `axi_take_aw`); the model's window streams give what they must be.
+// ---------------------------------------------------------------------------------------------
+
+/// Bursts and beats of one AXI ID.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct IdCount {
+    bursts: u64,
+    beats: u64,
+}
+
+/// The bursts of ID `id` in `hs`.
+fn of_id(hs: &[cube5_tb::rtl::ArHandshake], id: u32) -> Vec<(u64, u64)> {
+    hs.iter()
+        .filter(|h| h.id == id)
+        .map(|h| (h.addr, u64::from(h.len) + 1))
+        .collect()
+}
+
+fn count(bursts: &[(u64, u64)]) -> IdCount {
+    IdCount {
+        bursts: bursts.len() as u64,
+        beats: bursts.iter().map(|b| b.1).sum(),
+    }
+}
+
+/// The contract's final bursts: the final pixels' bus beats in stream order, a run continuing
+/// while each beat is the run's last or the next one inside an aligned block of `fin_burst`
+/// beats; (bursts, beats) with no run closed by the idle wait.
+fn final_runs(finals: &[(u64, u64)], fin_burst: u64) -> IdCount {
+    let mut n = IdCount::default();
+    let mut prev: Option<u64> = None;
+    for &(addr, len) in finals {
+        for b in addr..addr + len {
+            match prev {
+                Some(p) if b == p => {}
+                Some(p) if b == p + 1 && b % fin_burst != 0 => n.beats += 1,
+                _ => {
+                    n.bursts += 1;
+                    n.beats += 1;
+                }
+            }
+            prev = Some(b);
+        }
+    }
+    n
+}
+
+/// What the window's IDs did in one frame, against the contract.
+struct WindowBursts {
+    /// ID 1 writes and reads (the ring's), ID 2 writes (the final pixels).
+    ring_w: IdCount,
+    ring_r: IdCount,
+    fin: IdCount,
+    /// The contract: ring beats `ceil(Wn StoreW / DataW)` (exact when the zero-park FIFO never
+    /// fills), its bursts cut at `RingBurst` beats and the ring's end; the finals' runs.
+    ring_beats: u64,
+    ring_segments: u64,
+    fin_runs: IdCount,
+    run: FrameRun,
+}
+
+/// One 45-degree composite frame of `c` under `env` (packed rows), its bursts by ID checked
+/// against the contract's rules: every ring burst continues the previous one in the ring and
+/// crosses no `RingBurst` boundary nor the ring's end; reads the same beats as writes; every
+/// final burst inside an aligned block of `WinFinBurst` beats; the final beats and bursts at
+/// least the contract's runs, and each run the idle wait closed early costs one burst and at
+/// most one beat.
+fn window_bursts(c: &mut Case, view: View, env: &MemEnv) -> WindowBursts {
+    use cube5_model::units::cube5_accel::{AccelConfig, ID_FINAL, ID_PARK};
+    use cube5_model::units::cube5_frame::sections::section_order;
+    use cube5_model::units::cube5_frame::window::render_window;
+    let rtl = c.bench.rtl;
+    let ac: AccelConfig = rtl.variant.config().unwrap();
+    assert!(
+        ac.win_ring && ac.win_fin_burst != 0,
+        "{}: no ring",
+        rtl.variant
+    );
+    let e = c.expect(view, Composite);
+    let look = Look::default();
+    let (_, fu) = Expected::model_units(&rtl.frame, &e.seen, e.dir, Composite, &look).unwrap();
+    let order = section_order(&e.params, rtl.section, rtl.p).unwrap();
+    let (_, t) = render_window(&e.params, &e.seen, &fu, &order, rtl.p).unwrap();
+    c.bench.pitch = 0;
+    must(c.bench.dut.axi_take_ar());
+    must(c.bench.dut.axi_take_aw());
+    let mem_seed = c.rng.random();
+    let img_base = must(c.bench.start(&e, &c.vol, &c.lut, env, mem_seed));
+    let run = must(c.bench.finish(&e, img_base, mem_seed));
+    let (ars, aws) = (
+        must(c.bench.dut.axi_take_ar()),
+        must(c.bench.dut.axi_take_aw()),
+    );
+    let bus = u64::from(rtl.fetch.data_w / 8);
+    let store_w = 4 * (u64::from(rtl.frame.compos.acc_w) + 1) + 1;
+    // The ring: beats at ParkBase' + (m mod RB) bytes-per-beat, RB = Wp nj PkBeats.
+    let base = c.bench.park.0 / rtl.park_slot * rtl.park_slot / bus;
+    let rb = u64::from(rtl.ctrl.row_pixels(e.w as u32)) * e.params.nj as u64 * rtl.park_slot / bus;
+    let rburst = u64::from(ac.win_ring_burst);
+    let cut = |pos: u64| pos == 0 || (base + pos) % rburst == 0;
+    let check_ring = |bursts: &[(u64, u64)], what: &str| -> u64 {
+        let mut pos = 0u64;
+        let mut short = 0;
+        for (k, &(addr, len)) in bursts.iter().enumerate() {
+            assert_eq!(
+                addr / bus,
+                base + pos,
+                "{}: ring {what} burst {k}",
+                rtl.variant
+            );
+            let end = pos + len;
+            assert!(
+                end <= rb && (base + pos) % rburst + len <= rburst,
+                "{}: ring {what} burst {k} crosses a {rburst}-beat boundary",
+                rtl.variant
+            );
+            pos = end % rb;
+            if !cut(pos) && k + 1 < bursts.len() {
+                short += 1;
+            }
+        }
+        short
+    };
+    let (w1, r1) = (of_id(&aws, ID_PARK), of_id(&ars, ID_PARK));
+    let short_w = check_ring(&w1, "write");
+    check_ring(&r1, "read");
+    let zero = |x: &cube5_model::units::cube5_compos::Coxel| {
+        !x.terminated && x.rgba.iter().all(|&v| v == 0)
+    };
+    let wn = t.streams.parked.iter().filter(|p| !zero(&p.2)).count() as u64;
+    let ring_beats = (wn * store_w).div_ceil(8 * bus);
+    let segments = |beats: u64| (0..beats).filter(|&m| cut(m % rb)).count() as u64;
+    let ring_segments = segments(ring_beats);
+    let (ring_w, ring_r) = (count(&w1), count(&r1));
+    assert_eq!(
+        ring_w.beats, ring_r.beats,
+        "{}: ring beats written and read",
+        rtl.variant
+    );
+    // Every burst ends at a cut but those a flush ended.
+    assert_eq!(
+        ring_w.bursts,
+        segments(ring_w.beats) + short_w,
+        "{}: ring write bursts against the segments of its beats ({short_w} cut short)",
+        rtl.variant
+    );
+    // The final pixels: each pixel's bytes as (first beat, beats) in stream order.
+    let pitch = c.bench.pitch_bytes(&e) as u64;
+    let finals: Vec<(u64, u64)> = t
+        .streams
+        .finals
+        .iter()
+        .map(|&(r, q, _)| {
+            let a = img_base + q as u64 * pitch + 4 * r as u64;
+            (a / bus, (a + 3) / bus - a / bus + 1)
+        })
+        .collect();
+    let fb = u64::from(ac.win_fin_burst);
+    let fin_runs = final_runs(&finals, fb);
+    let f2 = of_id(&aws, ID_FINAL);
+    for (k, &(addr, len)) in f2.iter().enumerate() {
+        assert!(
+            (addr / bus) % fb + len <= fb,
+            "{}: final burst {k} ({addr:#x}, {len} beats) crosses a {fb}-beat block",
+            rtl.variant
+        );
+    }
+    let fin = count(&f2);
+    let split = fin.bursts.checked_sub(fin_runs.bursts).unwrap_or_else(|| {
+        panic!(
+            "{}: {fin:?} final bursts, fewer than the contract's runs {fin_runs:?}",
+            rtl.variant
+        )
+    });
+    assert!(
+        fin.beats >= fin_runs.beats && fin.beats - fin_runs.beats <= split,
+        "{}: final {fin:?} against the runs {fin_runs:?}",
+        rtl.variant
+    );
+    // Where the channel is busy: beats per 2,048-cycle window (by their address handshake),
+    // against the memory's limit (bytes per cycle / bytes per beat).
+    if env.bw.0 != 0 {
+        let win = 2048u64;
+        let t0 = ars.iter().chain(&aws).map(|h| h.cycle).min().unwrap_or(0);
+        let t1 = ars.iter().chain(&aws).map(|h| h.cycle).max().unwrap_or(0);
+        let nw = ((t1 - t0) / win + 1) as usize;
+        let (mut rd, mut wr) = (vec![0u64; nw], vec![0u64; nw]);
+        for h in &ars {
+            rd[((h.cycle - t0) / win) as usize] += u64::from(h.len) + 1;
+        }
+        for h in &aws {
+            wr[((h.cycle - t0) / win) as usize] += u64::from(h.len) + 1;
+        }
+        let cap = win as f64 * env.bw.0 as f64 / env.bw.1.max(1) as f64 / bus as f64;
+        let busy: Vec<usize> = (0..nw)
+            .filter(|&k| (rd[k] + wr[k]) as f64 >= 0.9 * cap)
+            .collect();
+        let sum = |v: &[u64]| busy.iter().map(|&k| v[k]).sum::<u64>() as f64;
+        let per = (busy.len() as u64 * win).max(1) as f64;
+        eprintln!(
+            "{}: {} windows of {win} cycles, {} with the channel at >= 90 % of {cap:.0} beats: read {:.3}, write {:.3} beats/clock there",
+            rtl.variant,
+            nw,
+            busy.len(),
+            sum(&rd) / per,
+            sum(&wr) / per
+        );
+    }
+    eprintln!(
+        "{}: {} {}: {} cycles ({:.3} samples/clock/pipeline); ring: written {ring_w:?}, read {ring_r:?}, contract {ring_beats} beats in {ring_segments} segments ({wn} written parks, {short_w} bursts cut short); finals {fin:?}, contract runs {fin_runs:?}; volume reads {:?}; clear {:?}",
+        rtl.variant,
+        e.view,
+        c.vol.dims[0],
+        run.cycles,
+        run.rate(rtl.p),
+        count(&of_id(&ars, 0)),
+        count(&of_id(&aws, 0)),
+    );
+    WindowBursts {
+        ring_w,
+        ring_r,
+        fin,
+        ring_beats,
+        ring_segments,
+        fin_runs,
+        run,
+    }
+}
+
+/// CI's window build (`w1v8p4s8`: the ring, bursts of up to 8 beats, a 16-bit zero-park FIFO
+/// that fills, so the written parks depend on timing): the 16^3 head at 45 degrees and the
+/// blob under the DDR-like memory and a random one: every ring and final burst by the
+/// contract's rules, the ring's beats read back as written, the final bursts the contract's
+/// runs (plus the runs the idle wait closed).
+#[test]
+fn window_16_bursts_by_id_follow_the_contract() {
+    let s = seed(0xacce28);
+    let rtl = window_rtl(4);
+    let n = 1usize << rtl.frame.max_dim_log2;
+    let mut c = Case::new(rtl, head_phantom(n, 8).unwrap(), s);
+    for env in [ddr(100, 12), MemEnv::random(&mut c.rng)] {
+        for v in ["45 xz", "oblique x"] {
+            let b = window_bursts(&mut c, view(v), &env);
+            assert!(b.ring_w.beats >= b.ring_beats, "{b:?}", b = b.ring_w);
+        }
+    }
+}
+
+/// The 256^3 P = 4 line (`w1p4m256s16d128a16c10`: the ring, finals in bursts of 16 beats) on
+/// the 128^3 head at 45 degrees under the DDR-like memory: the ring's beats exactly
+/// `ceil(Wn StoreW / DataW)` each way (its zero-park FIFO never fills), its bursts the contract's
+/// segments (+ the flushes' short ones), the final bursts exactly the contract's runs.
+#[test]
+#[ignore = "sim-full: a 128^3 frame on a `full` 256^3 line"]
+fn window_128_bursts_by_id_equal_the_contract() {
+    let s = seed(0xacce29);
+    let rtl = AccelRtl::windows()
+        .into_iter()
+        .filter(|r| {
+            r.p == 4
+                && r.variant
+                    .config::<cube5_model::units::cube5_accel::AccelConfig>()
+                    .is_ok_and(|a| a.win_fin_burst != 0 && a.win_ring)
+                && r.frame.max_dim_log2 == 8
+        })
+        .last()
+        .expect("the w1p4m256s16d128a16c10 build (CUBE5_FULL=1)");
+    let mut c = Case::new(rtl, head_phantom(128, 12).unwrap(), s);
+    let b = window_bursts(&mut c, view("45 xz"), &ddr(100, 12));
+    assert_eq!(b.ring_w.beats, b.ring_beats, "ring beats written");
+    assert_eq!(b.ring_r.beats, b.ring_beats, "ring beats read");
+    assert_eq!(
+        b.ring_w.bursts, b.ring_segments,
+        "ring write bursts: no flush cut one short"
+    );
+    assert_eq!(b.ring_r.bursts, b.ring_segments, "ring read bursts");
+    assert_eq!(
+        b.fin, b.fin_runs,
+        "final bursts and beats: the contract's runs"
+    );
+    assert!(b.run.cycles > 0);
+}

@@ -39,6 +39,7 @@ const OWN_PARAMS: &[(&str, i64)] = &[
     ("WinZeroDepth", 0),
     ("WinRing", 0),
     ("WinRingBurst", 16),
+    ("WinFinBurst", 0),
 ];
 
 /// The defaults of the parameters the top passes on, where the top's default differs from (or
@@ -109,6 +110,10 @@ pub struct AccelConfig {
     /// *The ring in park order*). Timing and scratch layout only: the image is the same.
     pub win_ring: bool,
     pub win_ring_burst: u32,
+    /// With the window: the final pixels' consecutive beats as bursts of up to this many beats
+    /// (`WinFinBurst`; 0: single-beat bursts; docs/numerics/compos_window.md, *Final pixels in
+    /// bursts*). Timing only: the image is the same.
+    pub win_fin_burst: u32,
 }
 
 /// Bytes per base-plane pixel in memory (the top's `PixelBytes`: R, G, B, A codes).
@@ -215,17 +220,21 @@ impl UnitConfig for AccelConfig {
             win_zero_depth: own("WinZeroDepth")?,
             win_ring: own("WinRing")? == 1,
             win_ring_burst: own("WinRingBurst")?,
+            win_fin_burst: own("WinFinBurst")?,
         };
         let pow2 = |v: u32| v.is_power_of_two();
         if own("WinRing")? > 1
             || !pow2(c.win_ring_burst)
             || !(2..=256).contains(&c.win_ring_burst)
             || (c.win_zero_depth != 0 && (!pow2(c.win_zero_depth) || c.win_zero_depth < 2))
+            || (c.win_fin_burst != 0
+                && (!pow2(c.win_fin_burst) || !(2..=256).contains(&c.win_fin_burst)))
         {
             return Err(ModelError::Config(format!(
                 "cube5_accel: WinRing must be 0 or 1, WinRingBurst = {} a power of two from 2 to \
-                 256, WinZeroDepth = {} 0 or a power of two of at least 2",
-                c.win_ring_burst, c.win_zero_depth
+                 256, WinZeroDepth = {} 0 or a power of two of at least 2, WinFinBurst = {} 0 or \
+                 a power of two from 2 to 256",
+                c.win_ring_burst, c.win_zero_depth, c.win_fin_burst
             )));
         }
         if !c.win_w_depth.is_power_of_two() || c.win_w_depth < 2 {
@@ -278,6 +287,7 @@ impl UnitConfig for AccelConfig {
             ("WinZeroDepth", i64::from(self.win_zero_depth)),
             ("WinRing", i64::from(self.win_ring)),
             ("WinRingBurst", i64::from(self.win_ring_burst)),
+            ("WinFinBurst", i64::from(self.win_fin_burst)),
         ]);
         out
     }
