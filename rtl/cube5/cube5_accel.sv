@@ -189,8 +189,10 @@ module cube5_accel #(
   logic [SweepW-1:0] fc_data;
   logic              sc_valid, sc_ready;   // buffer section
   logic [SbCmdW-1:0] sc_data;
-  logic              rc_valid, rc_ready;   // frame section
+  logic              rc_valid, rc_ready;   // frame section (out of the slice below)
   logic [FrCmdW-1:0] rc_data;
+  logic              cc_valid, cc_ready;   // frame section (the core's port)
+  logic [FrCmdW-1:0] cc_data;
   logic              wc_valid, wc_ready;   // writer row
   logic [AddrW+LenW-1:0] wc_data;
   logic              done_valid, done_error;
@@ -214,7 +216,7 @@ module cube5_accel #(
     .s_axil_rdata_o, .s_axil_rresp_o, .irq_o,
     .fetch_cmd_valid_o(fc_valid), .fetch_cmd_ready_i(fc_ready), .fetch_cmd_data_o(fc_data),
     .sbuf_cmd_valid_o(sc_valid), .sbuf_cmd_ready_i(sc_ready), .sbuf_cmd_data_o(sc_data),
-    .frame_cmd_valid_o(rc_valid), .frame_cmd_ready_i(rc_ready), .frame_cmd_data_o(rc_data),
+    .frame_cmd_valid_o(cc_valid), .frame_cmd_ready_i(cc_ready), .frame_cmd_data_o(cc_data),
     .wr_cmd_valid_o(wc_valid), .wr_cmd_ready_i(wc_ready), .wr_cmd_data_o(wc_data),
     .frame_done_valid_i(done_valid), .frame_done_error_i(done_error),
     .wr_cpl_valid_i(cpl_valid), .wr_cpl_resp_i(cpl_data[1:0]),
@@ -223,6 +225,17 @@ module cube5_accel #(
     .table_data_o(tbl_data),
     .img_base_o(img_base), .row_step_o(row_step), .park_base_o(park_base),
     .row_pixels_o(row_pixels)
+  );
+
+  // The frame's section commands pass a two-entry register slice (valid, data and ready from
+  // flip-flops): the frame's input ready, which follows the compositing window's admission and
+  // the section buffer's beams, reaches the core's hold and section count only through a
+  // register (docs/accel.md, *Synthesis*). One cycle of latency per command, while the frame
+  // still sweeps the section before. Reset with the units (a drain drops what it holds).
+  cube5_axi_slice #(.Width(FrCmdW)) u_rc_slice (
+    .clk_i, .rst_ni(unit_rst_n),
+    .in_valid_i(cc_valid), .in_ready_o(cc_ready), .in_data_i(cc_data),
+    .out_valid_o(rc_valid), .out_ready_i(rc_ready), .out_data_o(rc_data)
   );
 
   // ---------------------------------------------------------------------------
@@ -613,16 +626,26 @@ module cube5_accel #(
   // ---------------------------------------------------------------------------
   // The image writer: the core's row commands {addr, pixels} in writer items.
   // ---------------------------------------------------------------------------
+  // Window = 0: a row goes to the writer only once the frame has taken the frame's last section.
+  // The core's `gidx == nsec` counts the slice's takes (u_rc_slice), so the row waits while the
+  // slice still holds a section: once the core has offered them all no command enters it again,
+  // and the first cycle it is empty is the one the core saw before the slice. (Without this, a
+  // frame of one or two sections commands its rows while the slice holds them and the frame has
+  // not taken its first, so an error flush left over from a refused frame fills them with zeros.)
   logic wr_err;
+  logic wc_open, wc_in_valid, wc_in_ready;
   logic [AddrW+LenW-1:0] wr_cmd;
-  assign wr_cmd = {wc_items, wc_data[AddrW-1:0]};
+  assign wr_cmd      = {wc_items, wc_data[AddrW-1:0]};
+  assign wc_open     = Window != 0 || !rc_valid;
+  assign wc_in_valid = wc_valid && wc_open;
+  assign wc_ready    = wc_in_ready && wc_open;
 
   cube5_axi_wr #(
     .AddrW(AddrW), .DataW(DataW), .ItemW(ItemW), .LenW(LenW), .MaxBurst(MaxBurst),
     .Outstanding(WrOutstanding), .IdW(IdW)
   ) u_wr (
     .clk_i, .rst_ni(unit_rst_n),
-    .in_valid_i(wc_valid), .in_ready_o(wc_ready), .in_data_i(wr_cmd),
+    .in_valid_i(wc_in_valid), .in_ready_o(wc_in_ready), .in_data_i(wr_cmd),
     .dat_valid_i(wr_dat_valid), .dat_ready_o(wr_dat_ready), .dat_data_i(wr_dat),
     .out_valid_o(cpl_valid), .out_ready_i(1'b1), .out_data_o(cpl_data),
     .err_o(wr_err),
