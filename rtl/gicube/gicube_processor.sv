@@ -503,15 +503,26 @@ module gicube_processor #(
     end
   end
 
-  // The ring's view of this processor (read only with Procs > 1).
-  assign can_o     = can_issue;
-  assign busy_o    = busy;
-  assign waiting_o = waiting_q;
-  assign nb_req_o  = nb_req;
-  assign nb_dest_o = h_owner;
-  assign nb_data_o = h_out;
-  assign cnt_o     = {c_nbo_q, c_nbi_q, c_mis_q, c_hit_q, c_cyc_q, c_leap_q, c_smp_q, c_ovf_q,
-                      c_fin_q, c_in_q};
+  // The ring's view of this processor (Procs > 1; with one processor the ports are tied off, so
+  // a processor on its own spends no logic on them).
+  if (Procs > 1) begin : gen_ring_view
+    assign can_o     = can_issue;
+    assign busy_o    = busy;
+    assign waiting_o = waiting_q;
+    assign nb_req_o  = nb_req;
+    assign nb_dest_o = h_owner;
+    assign nb_data_o = h_out;
+    assign cnt_o     = {c_nbo_q, c_nbi_q, c_mis_q, c_hit_q, c_cyc_q, c_leap_q, c_smp_q, c_ovf_q,
+                        c_fin_q, c_in_q};
+  end else begin : gen_no_ring_view
+    assign can_o     = 1'b0;
+    assign busy_o    = 1'b0;
+    assign waiting_o = 1'b0;
+    assign nb_req_o  = 1'b0;
+    assign nb_dest_o = 2'd0;
+    assign nb_data_o = '0;
+    assign cnt_o     = '0;
+  end
 
   gicube_queue_front #(
     .BlockLog2 (BlockLog2),

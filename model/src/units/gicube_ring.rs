@@ -26,6 +26,9 @@ pub struct LinkCounts {
     pub nb_in: u64,
     /// Rays it sent to a neighbour's link.
     pub nb_out: u64,
+    /// Rays a neighbour's link refused (full, or taken by a lower processor in the cycle): back
+    /// to the host with `OVERFLOW` set, counted in its `rays_overflowed` too (not an RTL count).
+    pub nb_refused: u64,
 }
 
 /// A frame rendered by the ring: the pixels, and the counts of every processor.
@@ -67,6 +70,16 @@ impl RingFrame {
         }
         Ok(())
     }
+}
+
+/// What a ring did besides its frame: each processor's AR bursts (its cache's misses) in order,
+/// and every ray that left the ring in output order (per cycle, processor 0's first; each
+/// processor at most one a cycle): finished (`true`) or returned to the host (`false`,
+/// OVERFLOW set), and the processor it came from.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RingTrace {
+    pub reads: Vec<Vec<Burst>>,
+    pub outputs: Vec<(bool, RayPacket, u32)>,
 }
 
 /// `p` block processors in lockstep (contract, *Lockstep*, *One ring cycle*).
@@ -140,11 +153,44 @@ impl Ring {
         proj: Projection,
         traced: bool,
     ) -> Result<(RingFrame, Vec<Vec<Burst>>)> {
+        let packets = self.proc.ring_packets(cam, proj)?;
+        let (f, t) = self.run_packets(packets, cam.width, cam.height, traced)?;
+        Ok((f, t.reads))
+    }
+
+    /// The frame loop over the host's `packets` (rendering rays made by any host: each starts
+    /// inside the volume, its pixel `(u, v)` inside `w x h` and its own), each processor's
+    /// bursts and every ray that left the ring in the order of its output (`RingTrace`): the
+    /// million-ray co-simulation's reference.
+    pub fn run_packets_traced(
+        &self,
+        packets: Vec<RayPacket>,
+        w: u32,
+        h: u32,
+    ) -> Result<(RingFrame, RingTrace)> {
+        if let Some(p) = packets
+            .iter()
+            .find(|p| u32::from(p.u) >= w || u32::from(p.v) >= h)
+        {
+            return Err(ModelError::Config(format!(
+                "gicube ring: packet pixel ({}, {}) outside {w}x{h}",
+                p.u, p.v
+            )));
+        }
+        self.run_packets(packets, w, h, true)
+    }
+
+    fn run_packets(
+        &self,
+        packets: Vec<RayPacket>,
+        w: u32,
+        h: u32,
+        traced: bool,
+    ) -> Result<(RingFrame, RingTrace)> {
         let p = self.procs as usize;
         let cfg = self.proc.config();
-        let packets = self.proc.ring_packets(cam, proj)?;
         let rays = packets.len();
-        let (w, h) = (cam.width, cam.height);
+        let mut outputs: Vec<(bool, RayPacket, u32)> = Vec::new();
         let mut feed: VecDeque<RayPacket> = packets.into();
         let mut fronts = (0..p)
             .map(|_| {
@@ -216,6 +262,7 @@ impl Ring {
                 };
                 let (ring, cache) = (&mut rings[i], caches[i].as_mut());
                 let mut sent_or_returned: Option<(Option<usize>, RayPacket)> = None;
+                let mut finished: Option<RayPacket> = None;
                 let c = fronts[i].cycle(
                     true,
                     |popped| {
@@ -252,6 +299,7 @@ impl Ring {
                                 }
                                 done[k] = true;
                                 rgb[k] = ray.color;
+                                finished = Some(ray);
                                 Ok(None)
                             }
                         }
@@ -263,9 +311,14 @@ impl Ring {
                     Some((Some(_), _)) => lc[i].nb_out += 1,
                     Some((None, r)) => {
                         c_i.rays_overflowed += 1;
+                        lc[i].nb_refused += 1;
                         returned.push(r);
+                        outputs.push((false, r, i as u32));
                     }
                     None => {}
+                }
+                if let Some(ray) = finished {
+                    outputs.push((true, ray, i as u32));
                 }
                 if c.active.is_some() && c.active != last_active[i] {
                     c_i.activations += 1;
@@ -277,6 +330,7 @@ impl Ring {
                 if let Some(ray) = c.ring_ovf {
                     c_i.rays_overflowed += 1;
                     returned.push(ray);
+                    outputs.push((false, ray, i as u32));
                 }
                 if c.host_taken {
                     if from_link {
@@ -314,7 +368,7 @@ impl Ring {
                 counts,
                 links: lc,
             },
-            reads,
+            RingTrace { reads, outputs },
         ))
     }
 }
