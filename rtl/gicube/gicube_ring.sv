@@ -21,7 +21,7 @@
 `include "cube5_axi_ports.svh"
 
 module gicube_ring #(
-  /// Processors 2^ProcLog2, 0..2 (0: one processor, its ring ports unused).
+  /// Processors 2^ProcLog2, 1..2 (0: one processor, its ring ports unused).
   parameter int unsigned ProcLog2    = 1,
   /// The processors' parameters (gicube_processor's; Light = 0).
   parameter int unsigned BlockLog2   = 2,
@@ -78,8 +78,8 @@ module gicube_ring #(
   localparam int unsigned PosFracW = gicube_pkg::PosFracW;
   localparam int unsigned PW       = (ProcLog2 == 0) ? 1 : ProcLog2;
 
-  if (ProcLog2 > 2) begin : gen_bad_procs
-    $fatal(1, "gicube_ring: ProcLog2 must be 0, 1 or 2 (up to four processors)");
+  if (ProcLog2 > 1) begin : gen_bad_procs
+    $fatal(1, "gicube_ring: ProcLog2 must be 0 or 1 (the verified ring has two processors)");
   end
   if (VolBlocks % Procs != 0) begin : gen_bad_slabs
     $fatal(1, "gicube_ring: VolBlocks must be a multiple of 2^ProcLog2 (slabs)");
