@@ -110,7 +110,10 @@ fn full_links_return_rays_to_the_host_and_lose_none() {
     f.check_conservation().unwrap();
     assert_eq!(f.rgb, single.rgb);
     assert!(f.counts.iter().all(|c| c.rays_overflowed > 0), "{f:?}");
-    assert!(f.links.iter().any(|l| l.nb_refused > 0), "a full link: {f:?}");
+    assert!(
+        f.links.iter().any(|l| l.nb_refused > 0),
+        "a full link: {f:?}"
+    );
 }
 
 #[test]

@@ -694,13 +694,15 @@ fn random_frame(
     t.clocks += got.clocks;
 }
 
-/// Random frames on every built ring configuration up to `rays` rays each (seeds from 8000 +
-/// 10,000 x the configuration's index; the third frame across a reset); the totals.
+/// Random frames on the first two built ring configurations of 16^3 and below, up to `rays` rays
+/// each (seeds from 8000 + 10,000 x the configuration's index; the third frame across a reset);
+/// the totals.
 fn random_frames(rays: u64) {
-    for (i, (variant, rtl)) in configs::<RingRtlConfig>().into_iter().enumerate() {
-        if rtl.processor().side() > 16 {
-            continue;
-        }
+    let small = configs::<RingRtlConfig>()
+        .into_iter()
+        .filter(|(_, c)| c.processor().side() <= 16)
+        .take(2);
+    for (i, (variant, rtl)) in small.enumerate() {
         let start = Instant::now();
         let mut t = Totals::default();
         let mut k = 0u64;
@@ -740,4 +742,20 @@ fn a_million_random_rays_per_config() {
 #[ignore = "sim-full: the million's first 10,000 rays (its time estimate)"]
 fn ten_thousand_random_rays_per_config() {
     random_frames(10_000);
+}
+
+/// The gate-level netlist (Yosys) of the smallest ring renders an exact frame: every pixel,
+/// every processor's counts and bursts, rays sent between the processors.
+#[test]
+#[ignore = "sim-full: the ring's gate-level netlist is a `full` build (many minutes of Yosys and Verilator)"]
+fn gate_level_netlist_renders_an_exact_frame() {
+    for (v, rtl) in support::gate_configs::<RingRtlConfig>() {
+        let t = Instant::now();
+        let (got, want) = exact_frame(v, rtl, 12, Projection::Parallel, seed(0x61_7275));
+        frame_line(v, "gate level", &got, &want);
+        eprintln!(
+            "{v}: the frame on the netlist in {:.1} s",
+            t.elapsed().as_secs_f64()
+        );
+    }
 }
