@@ -843,7 +843,7 @@ fn final_runs(finals: &[(u64, u64)], fin_burst: u64) -> IdCount {
         for b in addr..addr + len {
             match prev {
                 Some(p) if b == p => {}
-                Some(p) if b == p + 1 && b % fin_burst != 0 => n.beats += 1,
+                Some(p) if b == p + 1 && !b.is_multiple_of(fin_burst) => n.beats += 1,
                 _ => {
                     n.bursts += 1;
                     n.beats += 1;
@@ -907,7 +907,7 @@ fn window_bursts(c: &mut Case, view: View, env: &MemEnv) -> WindowBursts {
     let base = c.bench.park.0 / rtl.park_slot * rtl.park_slot / bus;
     let rb = u64::from(rtl.ctrl.row_pixels(e.w as u32)) * e.params.nj as u64 * rtl.park_slot / bus;
     let rburst = u64::from(ac.win_ring_burst);
-    let cut = |pos: u64| pos == 0 || (base + pos) % rburst == 0;
+    let cut = |pos: u64| pos == 0 || (base + pos).is_multiple_of(rburst);
     let check_ring = |bursts: &[(u64, u64)], what: &str| -> u64 {
         let mut pos = 0u64;
         let mut short = 0;
@@ -965,6 +965,18 @@ fn window_bursts(c: &mut Case, view: View, env: &MemEnv) -> WindowBursts {
             (a / bus, (a + 3) / bus - a / bus + 1)
         })
         .collect();
+    // Final pixels with neither stream neighbour next to them in memory (a run of one pixel).
+    let at: Vec<u64> = t
+        .streams
+        .finals
+        .iter()
+        .map(|&(r, q, _)| q as u64 * pitch + 4 * r as u64)
+        .collect();
+    let alone = (0..at.len())
+        .filter(|&i| {
+            (i == 0 || at[i - 1] + 4 != at[i]) && (i + 1 == at.len() || at[i] + 4 != at[i + 1])
+        })
+        .count();
     let fb = u64::from(ac.win_fin_burst);
     let fin_runs = final_runs(&finals, fb);
     let f2 = of_id(&aws, ID_FINAL);
@@ -1006,6 +1018,21 @@ fn window_bursts(c: &mut Case, view: View, env: &MemEnv) -> WindowBursts {
             .filter(|&k| (rd[k] + wr[k]) as f64 >= 0.9 * cap)
             .collect();
         let sum = |v: &[u64]| busy.iter().map(|&k| v[k]).sum::<u64>() as f64;
+        // The volume's reads against its present blocks (each block's bytes once).
+        let present = c
+            .lut
+            .entries
+            .iter()
+            .filter(|b| !b.empty && !b.masked)
+            .count() as u64;
+        let voxel = u64::from(rtl.fetch.voxel_w.div_ceil(8).next_power_of_two());
+        let block = u64::from(rtl.fetch.block_dim).pow(3) * voxel / bus;
+        let vol = count(&of_id(&ars, 0)).beats;
+        eprintln!(
+            "{}: volume reads {vol} beats for {present} present blocks of {block} beats: each read {:.2} times",
+            rtl.variant,
+            vol as f64 / (present * block).max(1) as f64
+        );
         let per = (busy.len() as u64 * win).max(1) as f64;
         eprintln!(
             "{}: {} windows of {win} cycles, {} with the channel at >= 90 % of {cap:.0} beats: read {:.3}, write {:.3} beats/clock there",
@@ -1017,12 +1044,13 @@ fn window_bursts(c: &mut Case, view: View, env: &MemEnv) -> WindowBursts {
         );
     }
     eprintln!(
-        "{}: {} {}: {} cycles ({:.3} samples/clock/pipeline); ring: written {ring_w:?}, read {ring_r:?}, contract {ring_beats} beats in {ring_segments} segments ({wn} written parks, {short_w} bursts cut short); finals {fin:?}, contract runs {fin_runs:?}; volume reads {:?}; clear {:?}",
+        "{}: {} {}: {} cycles ({:.3} samples/clock/pipeline); ring: written {ring_w:?}, read {ring_r:?}, contract {ring_beats} beats in {ring_segments} segments ({wn} written parks, {short_w} bursts cut short); finals {fin:?} ({} pixels, {alone} alone), contract runs {fin_runs:?}; volume reads {:?}; clear {:?}",
         rtl.variant,
         e.view,
         c.vol.dims[0],
         run.cycles,
         run.rate(rtl.p),
+        at.len(),
         count(&of_id(&ars, 0)),
         count(&of_id(&aws, 0)),
     );
@@ -1056,37 +1084,43 @@ fn window_16_bursts_by_id_follow_the_contract() {
     }
 }
 
-/// The 256^3 P = 4 line (`w1p4m256s16d128a16c10`: the ring, finals in bursts of 16 beats) on
-/// the 128^3 head at 45 degrees under the DDR-like memory: the ring's beats exactly
-/// `ceil(Wn StoreW / DataW)` each way (its zero-park FIFO never fills), its bursts the contract's
-/// segments (+ the flushes' short ones), the final bursts exactly the contract's runs.
+/// Every MaxDim 256 window line with the ring and the finals in bursts that this run built
+/// (`w1p*m256s16d128a16c10`, `w1p4m256s32d128`) on the 128^3 head at 45 degrees under the
+/// DDR-like memory: the ring's beats exactly `ceil(Wn StoreW / DataW)` each way (the zero-park
+/// FIFO never fills), its bursts the contract's segments, the final bursts exactly the
+/// contract's runs; where the channel is busy and how often the volume's blocks are read.
 #[test]
-#[ignore = "sim-full: a 128^3 frame on a `full` 256^3 line"]
+#[ignore = "sim-full: 128^3 frames on `full` MaxDim 256 lines"]
 fn window_128_bursts_by_id_equal_the_contract() {
     let s = seed(0xacce29);
-    let rtl = AccelRtl::windows()
+    let lines: Vec<AccelRtl> = AccelRtl::windows()
         .into_iter()
         .filter(|r| {
-            r.p == 4
+            r.frame.max_dim_log2 == 8
                 && r.variant
                     .config::<cube5_model::units::cube5_accel::AccelConfig>()
                     .is_ok_and(|a| a.win_fin_burst != 0 && a.win_ring)
-                && r.frame.max_dim_log2 == 8
         })
-        .last()
-        .expect("the w1p4m256s16d128a16c10 build (CUBE5_FULL=1)");
-    let mut c = Case::new(rtl, head_phantom(128, 12).unwrap(), s);
-    let b = window_bursts(&mut c, view("45 xz"), &ddr(100, 12));
-    assert_eq!(b.ring_w.beats, b.ring_beats, "ring beats written");
-    assert_eq!(b.ring_r.beats, b.ring_beats, "ring beats read");
-    assert_eq!(
-        b.ring_w.bursts, b.ring_segments,
-        "ring write bursts: no flush cut one short"
+        .collect();
+    assert!(
+        !lines.is_empty(),
+        "no MaxDim 256 line with the ring built (CUBE5_FULL=1)"
     );
-    assert_eq!(b.ring_r.bursts, b.ring_segments, "ring read bursts");
-    assert_eq!(
-        b.fin, b.fin_runs,
-        "final bursts and beats: the contract's runs"
-    );
-    assert!(b.run.cycles > 0);
+    for rtl in lines {
+        let mut c = Case::new(rtl, head_phantom(128, 12).unwrap(), s);
+        let b = window_bursts(&mut c, view("45 xz"), &ddr(100, 12));
+        let v = rtl.variant;
+        assert_eq!(b.ring_w.beats, b.ring_beats, "{v}: ring beats written");
+        assert_eq!(b.ring_r.beats, b.ring_beats, "{v}: ring beats read");
+        assert_eq!(
+            b.ring_w.bursts, b.ring_segments,
+            "{v}: ring write bursts (no flush cut one short)"
+        );
+        assert_eq!(b.ring_r.bursts, b.ring_segments, "{v}: ring read bursts");
+        assert_eq!(
+            b.fin, b.fin_runs,
+            "{v}: final bursts and beats: the contract's runs"
+        );
+        assert!(b.run.cycles > 0);
+    }
 }
