@@ -679,27 +679,44 @@ fn gate_level_netlist_renders_an_exact_frame() {
     }
 }
 
-/// The gate-level netlists of the `Light` configurations (`b2v2l1`): a short lighting pass (the
-/// shadow scene's grid halved: a quarter of its rays, the fewest its energy allows), its flush and the rendering pass lit by the field, every
-/// ray, count, burst and memory word after the flush and every pixel equal to the model's
-/// (`two_pass_gi`); high albedo on a `Scatter` netlist.
+/// The gate-level netlists of the `Light` configurations without the photon path (`b2v2l1`): a
+/// short lighting pass (the shadow scene's grid halved: a quarter of its rays, the fewest its
+/// energy allows), its flush and the rendering pass lit by the field, every ray, count, burst and
+/// memory word after the flush and every pixel equal to the model's (`two_pass_gi`).
 #[test]
 #[ignore = "sim-full: the gate-level netlist is a `full` build (minutes of Yosys and Verilator)"]
 fn gate_level_netlist_runs_an_exact_lighting_pass() {
-    let lit = support::gate_configs::<ProcessorRtlConfig>()
+    gate_level_gi_passes(0, GiMode::LowAlbedo, seed(1990));
+}
+
+/// Both GI passes (`two_pass_gi`, the lighting grid halved) in `mode` on every gate-level netlist
+/// of a `Light` configuration with `Scatter = scatter`, timed.
+fn gate_level_gi_passes(scatter: u32, mode: GiMode, s: u64) {
+    let lit: Vec<_> = support::gate_configs::<ProcessorRtlConfig>()
         .into_iter()
-        .filter(|(_, c)| c.light == 1);
+        .filter(|(_, c)| c.light == 1 && c.scatter == scatter)
+        .collect();
+    assert!(
+        !lit.is_empty(),
+        "a gate-level line with Light = 1, Scatter = {scatter}"
+    );
     for (variant, rtl) in lit {
         let t = std::time::Instant::now();
-        let mode = if rtl.scatter == 1 {
-            HIGH_ALBEDO
-        } else {
-            GiMode::LowAlbedo
-        };
-        two_pass_gi(variant, rtl, mode, 2, seed(1990));
+        two_pass_gi(variant, rtl, mode, 2, s);
         eprintln!(
-            "{variant}: both GI passes on the netlist in {:.1} s",
+            "{variant}: both GI passes ({mode:?}) on the netlist in {:.1} s",
             t.elapsed().as_secs_f64()
         );
     }
+}
+
+/// The gate-level netlist of the photon path (`b2v2s1`: `gicube_scatter`, the albedo and
+/// interaction draws, the second step unit): a high-albedo lighting pass (albedo 0.8, up to 8
+/// bounces; a quarter of the shadow scene's photons), its flush and the rendering pass lit by the
+/// field, every photon, count (scatterings too), burst, memory word and pixel equal to the
+/// model's (`two_pass_gi`).
+#[test]
+#[ignore = "sim-full: the gate-level netlist is a `full` build (minutes of Yosys and Verilator)"]
+fn gate_level_netlist_runs_an_exact_photon_pass() {
+    gate_level_gi_passes(1, HIGH_ALBEDO, seed(1995));
 }
