@@ -244,7 +244,10 @@ mod tests {
         assert_eq!(Outer::from_params(&[]).unwrap(), Outer::DEFAULT);
         // A parameter of the unit inside that the top does not pass through is unknown.
         let e = Outer::from_params(&[("B", 1)]).unwrap_err().to_string();
-        assert!(e.contains("outer: unknown parameter B (known: K, A)"), "{e}");
+        assert!(
+            e.contains("outer: unknown parameter B (known: K, A)"),
+            "{e}"
+        );
         // The unit inside checks its own.
         let e = Outer::from_params(&[("A", 10)]).unwrap_err().to_string();
         assert!(e.contains("A 10 outside 1..=9"), "{e}");
