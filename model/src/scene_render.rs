@@ -206,9 +206,9 @@ pub struct Look {
     /// Early termination (`Composite`) at accumulated opacity `termination_at` (0..1; >= 1: off).
     pub early_termination: bool,
     pub termination_at: f64,
-    /// First-opaque's threshold and the 2-D transfer function (`ModeOptions`).
-    pub threshold: f64,
+    /// The 2-D transfer function and first-opaque's threshold (`ModeOptions`).
     pub boundary: Option<f64>,
+    pub threshold: f64,
     /// X-ray: `XrayShift` in place of the set-up's (a sum that saturates, for the tests).
     pub xray_shift: Option<u32>,
     /// Opaque solids rasterized into the geometry table of a `DepthTest = 1` frame (none: every
