@@ -204,7 +204,7 @@ mod tests {
         const DEFAULT: Self = Self { a: 1, b: 2 };
 
         fn validate(&self) -> crate::Result<()> {
-            super::param_in("A", self.a, 1..=9).map_err(|m| crate::ModelError::Config(m))
+            super::param_in("A", self.a, 1..=9).map_err(crate::ModelError::Config)
         }
     }
 

@@ -11,7 +11,7 @@ use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{axi, axi_mem_setup, axi_random_image, configs, seed, with_waves};
+use support::{axi, axi_random_image, configs, seed, with_waves};
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
 /// optionally a reset after `reset_at` cycles followed by `after` commands.

@@ -14,8 +14,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts,
-    configs, seed, with_waves,
+    axi, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts, configs, seed,
+    with_waves,
 };
 
 /// Commands and the items they take.

@@ -10,7 +10,6 @@ mod support;
 use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
-use cube5_model::units::cube5_axi_rd::AxiMemImage;
 use cube5_model::units::gicube_cache::{
     CacheConfig, CacheItem, CacheReq, CacheTraffic, SplatCodec, VolumeCache, HIT_LATENCY,
 };
@@ -23,8 +22,7 @@ use rand_chacha::ChaCha8Rng;
 use std::collections::{HashMap, VecDeque};
 use std::path::PathBuf;
 use support::{
-    axi, axi_mem_setup, axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, seed,
-    with_waves,
+    axi, axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, seed, with_waves,
 };
 
 /// One run: the volume's words (`M^3`, x fastest), the items (reads, and with `Splat` deposits
