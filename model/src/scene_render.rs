@@ -12,6 +12,7 @@
 
 use crate::camera::Camera;
 use crate::error::{ModelError, Result};
+use crate::geometry::Solid;
 use crate::render::{
     CompositeMode, GradientScheme, ImageF64, Interpolation, Projection, RenderParams,
 };
@@ -195,13 +196,53 @@ pub fn params_phong(render: &RenderParams, params: &FrameParams) -> Phong {
     }
 }
 
-/// The look of a frame: transfer function, lighting (frame axes) and the early-termination
-/// threshold (accumulated opacity in 0..1; `None` or >= 1: off).
+/// The look of a frame: transfer function and lighting (frame axes), early termination, the
+/// first-opaque threshold and the 2-D transfer function ([`ModeOptions`]), X-ray's shift and the
+/// opaque geometry. A scene's frame ([`FrameJob`]) and the test bench's frames share it.
 #[derive(Debug, Clone)]
 pub struct Look {
     pub tf: TransferFunction,
     pub phong: Phong,
-    pub early_termination: Option<f64>,
+    /// Early termination (`Composite`) at accumulated opacity `termination_at` (0..1; >= 1: off).
+    pub early_termination: bool,
+    pub termination_at: f64,
+    /// The 2-D transfer function and first-opaque's threshold (`ModeOptions`).
+    pub boundary: Option<f64>,
+    pub threshold: f64,
+    /// X-ray: `XrayShift` in place of the set-up's (a sum that saturates, for the tests).
+    pub xray_shift: Option<u32>,
+    /// Opaque solids rasterized into the geometry table of a `DepthTest = 1` frame (none: every
+    /// pixel at `Znone`).
+    pub geometry: Vec<Solid>,
+}
+
+impl Default for Look {
+    /// The head phantom's transfer function, two lights, no early termination (at
+    /// `cube5_frame::ET_DEFAULT` when on), first-opaque at 0.5, the 1-D table.
+    fn default() -> Self {
+        let opts = ModeOptions::default();
+        Self {
+            tf: TransferFunction::head_default(),
+            phong: Phong::two_lights(),
+            early_termination: false,
+            termination_at: cube5_frame::ET_DEFAULT,
+            threshold: opts.threshold,
+            boundary: opts.boundary,
+            xray_shift: None,
+            geometry: Vec::new(),
+        }
+    }
+}
+
+impl Look {
+    /// The frame model's options of this look.
+    pub fn options(&self) -> ModeOptions {
+        ModeOptions {
+            early_termination: self.early_termination.then_some(self.termination_at),
+            threshold: self.threshold,
+            boundary: self.boundary,
+        }
+    }
 }
 
 /// One frame of a scene, set up as the host sets up the RTL: the volume at the frame's voxel
@@ -257,20 +298,24 @@ impl FrameJob {
         let look = Look {
             tf: scene.transfer_function(),
             phong: scene_phong(scene, &setup.params),
-            early_termination: (mode == FrameMode::Composite)
-                .then_some(scene.render.early_termination),
-        };
-        let opts = ModeOptions {
-            early_termination: look.early_termination,
+            early_termination: mode == FrameMode::Composite,
+            termination_at: scene.render.early_termination,
             threshold: scene.render.threshold,
             boundary: scene.boundary(),
+            xray_shift: None,
+            geometry: scene
+                .geometry
+                .as_ref()
+                .map(|g| g.solids())
+                .unwrap_or_default(),
         };
-        let mut units = FrameUnits::with_options(&cfg, mode, &setup, &look.tf, &look.phong, &opts)?;
+        let mut units =
+            FrameUnits::with_options(&cfg, mode, &setup, &look.tf, &look.phong, &look.options())?;
         // The depth test: the buffer is preloaded with the geometry's RGBA-Z image (none: every
         // pixel at Znone), rasterized by the host on this view's base plane.
         match (&scene.geometry, cfg.depth_test) {
-            (Some(g), true) => {
-                let img = crate::geometry::rasterize(&setup.params, &g.solids(), &cfg.compos);
+            (Some(_), true) => {
+                let img = crate::geometry::rasterize(&setup.params, &look.geometry, &cfg.compos);
                 units.set_geometry(&setup.params, img)?;
             }
             (None, true) => {

@@ -105,6 +105,71 @@ macro_rules! unit_config {
             }
         }
     };
+    // A top that wraps another unit's top: its own parameters as fields, and the listed parameters
+    // of the unit inside passed through to its configuration in field `$inner` (which keeps its
+    // own names, defaults and checks): `unit_config!(RingRtlConfig, "gicube_ring", DEFAULT,
+    // { "ProcLog2" => proc_log2 }, proc: ["BlockLog2", "VolBlocks", ...])`.
+    ($ty:ty, $top:literal, $default:ident, { $($name:literal => $field:ident),* $(,)? },
+     $inner:ident: [$($fwd:literal),+ $(,)?]) => {
+        impl $crate::unit::UnitConfig for $ty {
+            const TOP: &'static str = $top;
+
+            fn from_params(params: &[(&str, i64)]) -> $crate::Result<Self> {
+                let mut c = <$ty>::$default;
+                let own = $crate::unit::forward_params(
+                    $top,
+                    params,
+                    &[$($name),*],
+                    (&mut c.$inner, &[$($fwd),+]),
+                )?;
+                $crate::unit::set_params($top, &own, &mut [$(($name, &mut c.$field)),*])?;
+                c.validate()?;
+                Ok(c)
+            }
+
+            fn to_params(&self) -> Vec<(&'static str, i64)> {
+                let mut p = vec![$(($name, i64::from(self.$field))),*];
+                let fwd = [$($fwd),+];
+                p.extend(
+                    $crate::unit::UnitConfig::to_params(&self.$inner)
+                        .into_iter()
+                        .filter(|(n, _)| fwd.contains(n)),
+                );
+                p
+            }
+        }
+    };
+}
+
+/// For a top that wraps another unit's ([`unit_config!`]'s second form): sets the parameters of
+/// `params` named in `forwarded` on `inner` (through its own `from_params`, the others at their
+/// values in `inner`) and returns the rest, which must be among `own`.
+pub fn forward_params<'a, C: UnitConfig>(
+    top: &str,
+    params: &[(&'a str, i64)],
+    own: &[&str],
+    (inner, forwarded): (&mut C, &[&str]),
+) -> crate::Result<Vec<(&'a str, i64)>> {
+    let mut merged = inner.to_params();
+    let mut rest = Vec::new();
+    for &(name, value) in params {
+        if let Some(slot) = merged
+            .iter_mut()
+            .find(|(n, _)| *n == name && forwarded.contains(n))
+        {
+            slot.1 = value;
+        } else if own.contains(&name) {
+            rest.push((name, value));
+        } else {
+            return Err(crate::ModelError::Config(format!(
+                "{top}: unknown parameter {name} (known: {})",
+                [own, forwarded].concat().join(", ")
+            )));
+        }
+    }
+    // An error names the unit inside (its parameters keep their names).
+    *inner = C::from_params(&merged)?;
+    Ok(rest)
 }
 
 /// A unit parameter's range check, as every unit's `validate` words it: `Err("{name} {v} outside
@@ -122,5 +187,69 @@ pub fn param_in<T: PartialOrd + Display>(
             range.start(),
             range.end()
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::UnitConfig;
+
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    struct Inner {
+        a: u32,
+        b: u32,
+    }
+
+    impl Inner {
+        const DEFAULT: Self = Self { a: 1, b: 2 };
+
+        fn validate(&self) -> crate::Result<()> {
+            super::param_in("A", self.a, 1..=9).map_err(crate::ModelError::Config)
+        }
+    }
+
+    crate::unit_config!(Inner, "inner", DEFAULT, { "A" => a, "B" => b });
+
+    /// A top wrapping `Inner` with `B = 3` and only `A` passed through.
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    struct Outer {
+        k: u32,
+        inner: Inner,
+    }
+
+    impl Outer {
+        const DEFAULT: Self = Self {
+            k: 4,
+            inner: Inner { a: 1, b: 3 },
+        };
+
+        fn validate(&self) -> crate::Result<()> {
+            self.inner.validate()
+        }
+    }
+
+    crate::unit_config!(Outer, "outer", DEFAULT, { "K" => k }, inner: ["A"]);
+
+    #[test]
+    fn a_wrapping_top_passes_the_listed_parameters_through() {
+        let c = Outer::from_params(&[("A", 7), ("K", 5)]).unwrap();
+        assert_eq!(
+            c,
+            Outer {
+                k: 5,
+                inner: Inner { a: 7, b: 3 }
+            }
+        );
+        assert_eq!(c.to_params(), vec![("K", 5), ("A", 7)]);
+        assert_eq!(Outer::from_params(&[]).unwrap(), Outer::DEFAULT);
+        // A parameter of the unit inside that the top does not pass through is unknown.
+        let e = Outer::from_params(&[("B", 1)]).unwrap_err().to_string();
+        assert!(
+            e.contains("outer: unknown parameter B (known: K, A)"),
+            "{e}"
+        );
+        // The unit inside checks its own.
+        let e = Outer::from_params(&[("A", 10)]).unwrap_err().to_string();
+        assert!(e.contains("A 10 outside 1..=9"), "{e}");
     }
 }

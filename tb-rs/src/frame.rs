@@ -13,19 +13,18 @@ use crate::rtl::{RtlStream, Taken, Traffic};
 use crate::variants::{variants_of, Variant};
 use cube5_model::bits::BitWriter;
 use cube5_model::error::ModelError;
-use cube5_model::geometry::{self, Solid};
+use cube5_model::geometry;
 use cube5_model::scene_render::{FrameJob, FrameRun};
 use cube5_model::transfer::TransferFunction;
 use cube5_model::unit::StreamCodec;
 use cube5_model::unit::UnitConfig;
 use cube5_model::units::cube5_compos::{self, Compos, ComposConfig, ComposRegs, Coxel, OpacityLut};
 use cube5_model::units::cube5_frame::{
-    self, FrameConfig, FrameParams, FrameSetup, FrameUnits, GeometryImage, ModeOptions,
-    SweepAccesses,
+    self, FrameConfig, FrameParams, FrameSetup, FrameUnits, GeometryImage, SweepAccesses,
 };
 use cube5_model::units::cube5_gradient::{Gradient, GradientConfig};
 use cube5_model::units::cube5_shader::{
-    ClassLut, Phong, ReflectanceMap, Shader, ShaderConfig, ShaderMode, ShaderTables,
+    ClassLut, ReflectanceMap, Shader, ShaderConfig, ShaderMode, ShaderTables,
 };
 use cube5_model::units::cube5_skewmem::{BlockLut, SkewConfig, SkewDims, SkewMem};
 use cube5_model::units::cube5_trilin::{Trilin, TrilinConfig};
@@ -362,49 +361,8 @@ pub struct Units {
 
 pub use cube5_model::units::cube5_frame::density_ramp;
 
-/// The look of a rendering: transfer function and lighting (frame axes), opacity correction and
-/// early termination.
-#[derive(Debug, Clone)]
-pub struct Look {
-    pub tf: TransferFunction,
-    pub phong: Phong,
-    pub early_termination: bool,
-    /// First-opaque's threshold and the 2-D transfer function (`cube5_frame::ModeOptions`).
-    pub threshold: f64,
-    pub boundary: Option<f64>,
-    /// X-ray: `XrayShift` in place of the set-up's (a sum that saturates, for the tests).
-    pub xray_shift: Option<u32>,
-    /// Opaque solids rasterized into the geometry table of a `DepthTest = 1` frame (none: every
-    /// pixel at `Znone`).
-    pub geometry: Vec<Solid>,
-}
-
-impl Default for Look {
-    /// The head phantom's transfer function, two lights, no early termination, first-opaque at
-    /// 0.5, the 1-D table.
-    fn default() -> Self {
-        Self {
-            tf: TransferFunction::head_default(),
-            phong: Phong::two_lights(),
-            early_termination: false,
-            threshold: 0.5,
-            boundary: None,
-            xray_shift: None,
-            geometry: Vec::new(),
-        }
-    }
-}
-
-impl Look {
-    /// The model's options of this look.
-    pub fn options(&self) -> ModeOptions {
-        ModeOptions {
-            early_termination: self.early_termination.then_some(cube5_frame::ET_DEFAULT),
-            threshold: self.threshold,
-            boundary: self.boundary,
-        }
-    }
-}
+/// The look of a rendering: the model's, one description for scenes and the test bench.
+pub use cube5_model::scene_render::Look;
 
 impl Units {
     /// The units of `render` for the view of `setup`: the MIP and composite tables written out

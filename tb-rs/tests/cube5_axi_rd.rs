@@ -11,7 +11,7 @@ use cube5_tb::{TbError, Variant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
-use support::{axi, axi_mem_setup, axi_random_image, configs, seed, with_waves};
+use support::{axi, axi_random_image, configs, seed, with_waves};
 
 /// One run: commands, the memory, how the subordinate behaves, the output traffic, and
 /// optionally a reset after `reset_at` cycles followed by `after` commands.
@@ -37,22 +37,6 @@ struct Report {
 impl Report {
     fn beats_per_cycle(&self) -> f64 {
         self.beats as f64 / self.cycles.max(1) as f64
-    }
-}
-
-/// The subordinate: latency `fixed + U(0..random)`, ARREADY/RVALID gaps, bandwidth `bw` bytes
-/// per cycle as `(num, den)` (`num = 0`: unlimited), the unit's Outstanding as its declared limit.
-fn mem_setup(
-    cfg: AxiRdConfig,
-    mem: &AxiMemImage,
-    lat: (u32, u32),
-    gaps: (u32, u32),
-    bw: (u32, u32),
-    seed: u64,
-) -> AxiMemSetup {
-    AxiMemSetup {
-        declared_outstanding: cfg.outstanding,
-        ..axi_mem_setup((cfg.bytes(), cfg.addr_w), mem, lat, gaps, bw, seed)
     }
 }
 
@@ -204,7 +188,7 @@ fn random_case(cfg: AxiRdConfig, seed: u64, n: usize) -> Case {
     let cmds = random_cmds(cfg, &mem, n, &mut rng);
     let bw = axi::random_bandwidth(&mut rng, 2 * cfg.bytes());
     let gaps = (rng.random_range(0..500), rng.random_range(0..500));
-    let setup = mem_setup(cfg, &mem, (10, 190), gaps, bw, rng.random());
+    let setup = axi::mem_setup(cfg, &mem, (10, 190), gaps, bw, rng.random());
     let stall = rng.random_range(0.0..0.6);
     let traffic = Traffic::random(&mut rng, 0.3, stall);
     Case {
@@ -239,9 +223,9 @@ fn a_million_random_beats_per_config() {
     axi::a_million_per_config(|variant, cfg: AxiRdConfig, s, k| {
         let mut case = random_case(cfg, s, 2000);
         if k == 2 {
-            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let after = random_cmds(cfg, &case.mem, 2000, &mut rng);
-            case.reset = Some((rng.random_range(1000..100_000), after));
+            case.reset = axi::reset_after(s, 1000..100_000, |rng| {
+                random_cmds(cfg, &case.mem, 2000, rng)
+            });
         }
         let r = must(variant, cfg, s, &case);
         assert_eq!(
@@ -353,7 +337,7 @@ fn directed_extremes() {
         let cmds = directed_cmds(cfg, &mem);
         for (lat, gaps, stall) in [((10, 0), (0, 0), 0.0), ((10, 190), (300, 300), 0.4)] {
             let case = Case {
-                setup: mem_setup(cfg, &mem, lat, gaps, (0, 1), s),
+                setup: axi::mem_setup(cfg, &mem, lat, gaps, (0, 1), s),
                 traffic: Traffic::random(&mut rng, 0.3, stall),
                 cmds: cmds.clone(),
                 mem: mem.clone(),
@@ -368,10 +352,8 @@ fn directed_extremes() {
 fn reset_in_mid_stream_leaves_nothing_outstanding_and_the_next_commands_are_exact() {
     axi::resets_land_with_bursts_in_flight(|variant, cfg: AxiRdConfig, s| {
         let mut case = random_case(cfg, s, 100);
-        let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-        let after = random_cmds(cfg, &case.mem, 100, &mut rng);
         // Early enough that bursts are in flight (latency >= 10 cycles).
-        case.reset = Some((rng.random_range(30..3000), after));
+        case.reset = axi::reset_after(s, 30..3000, |rng| random_cmds(cfg, &case.mem, 100, rng));
         let r = must(variant, cfg, s, &case);
         assert!(r.beats > 0);
         r.dropped_at_reset
@@ -415,7 +397,7 @@ fn throughput(variant: &'static Variant, cfg: AxiRdConfig, lat: u32, bw: (u32, u
         .filter(|c| c.addr + u64::from(c.len) * b <= mem.base + mem.bytes.len() as u64)
         .collect();
     let case = Case {
-        setup: mem_setup(cfg, &mem, (lat, 0), (0, 0), bw, 1),
+        setup: axi::mem_setup(cfg, &mem, (lat, 0), (0, 0), bw, 1),
         traffic: Traffic::full_speed(),
         cmds,
         mem,
@@ -484,7 +466,7 @@ fn the_comparison_sees_a_wrong_beat_and_a_wrong_burst() {
         len: 3,
     }];
     let case = Case {
-        setup: mem_setup(cfg, &mem, (10, 0), (0, 0), (0, 1), 1),
+        setup: axi::mem_setup(cfg, &mem, (10, 0), (0, 0), (0, 1), 1),
         traffic: Traffic::full_speed(),
         cmds: cmds.clone(),
         mem: mem.clone(),
@@ -542,7 +524,7 @@ fn the_axi_checker_reports_a_violation() {
     let (variant, cfg) = configs::<AxiRdConfig>()[0];
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mem = random_image(cfg, &mut rng);
-    let good = mem_setup(cfg, &mem, (10, 0), (200, 0), (0, 1), 1);
+    let good = axi::mem_setup(cfg, &mem, (10, 0), (200, 0), (0, 1), 1);
     let cmds = vec![AxiRdCmd {
         addr: mem.base + 0x3000,
         len: 4 * cfg.max_burst,

@@ -14,8 +14,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use support::{
-    axi, axi_mem_setup, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts,
-    configs, seed, with_waves,
+    axi, axi_protocol_clean, axi_random_image, compare_axi_outputs, compare_bursts, configs, seed,
+    with_waves,
 };
 
 /// Commands and the items they take.
@@ -72,8 +72,7 @@ fn mem_setup(
         aw_gap_permille: gaps.0,
         w_gap_permille: gaps.1,
         b_gap_permille: gaps.2,
-        declared_outstanding: cfg.outstanding,
-        ..axi_mem_setup((cfg.bytes(), cfg.addr_w), mem, lat, (0, 0), bw, seed)
+        ..axi::mem_setup(cfg, mem, lat, (0, 0), bw, seed)
     }
 }
 
@@ -385,9 +384,9 @@ fn a_million_random_items_per_config() {
     axi::a_million_per_config(|variant, cfg: AxiWrConfig, s, k| {
         let mut case = random_case(cfg, s, 2000);
         if k == 2 {
-            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let after = random_work(cfg, &case.mem, 2000, &mut rng);
-            case.reset = Some((rng.random_range(1000..100_000), after));
+            case.reset = axi::reset_after(s, 1000..100_000, |rng| {
+                random_work(cfg, &case.mem, 2000, rng)
+            });
         }
         must(variant, cfg, s, &case).items
     });
@@ -533,10 +532,8 @@ fn directed_extremes() {
 fn reset_in_mid_stream_leaves_nothing_outstanding_and_the_next_commands_are_exact() {
     axi::resets_land_with_bursts_in_flight(|variant, cfg: AxiWrConfig, s| {
         let mut case = random_case(cfg, s, 100);
-        let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-        let after = random_work(cfg, &case.mem, 100, &mut rng);
         // Early enough that bursts are in flight (B latency >= 10 cycles).
-        case.reset = Some((rng.random_range(30..3000), after));
+        case.reset = axi::reset_after(s, 30..3000, |rng| random_work(cfg, &case.mem, 100, rng));
         let r = must(variant, cfg, s, &case);
         assert!(r.items > 0);
         r.dropped_at_reset

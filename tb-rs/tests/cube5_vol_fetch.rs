@@ -349,9 +349,7 @@ fn a_million_random_items_per_config() {
     axi::a_million_per_config(|variant, cfg: VolFetchConfig, s, k| {
         let mut case = random_case(cfg, s, 12, 128);
         if k % 3 == 2 {
-            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let after = random_after(cfg, &case, 6, &mut rng);
-            case.reset = Some((rng.random_range(100..20_000), after));
+            case.reset = axi::reset_after(s, 100..20_000, |rng| random_after(cfg, &case, 6, rng));
         }
         must(variant, cfg, s, &case).items
     });

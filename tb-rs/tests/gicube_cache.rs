@@ -10,7 +10,6 @@ mod support;
 use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
-use cube5_model::units::cube5_axi_rd::AxiMemImage;
 use cube5_model::units::gicube_cache::{
     CacheConfig, CacheItem, CacheReq, CacheTraffic, SplatCodec, VolumeCache, HIT_LATENCY,
 };
@@ -23,8 +22,7 @@ use rand_chacha::ChaCha8Rng;
 use std::collections::{HashMap, VecDeque};
 use std::path::PathBuf;
 use support::{
-    axi, axi_mem_setup, axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, seed,
-    with_waves,
+    axi, axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, seed, with_waves,
 };
 
 /// One run: the volume's words (`M^3`, x fastest), the items (reads, and with `Splat` deposits
@@ -66,22 +64,6 @@ fn reads(reqs: &[CacheReq]) -> Vec<CacheItem> {
     reqs.iter().map(|r| CacheItem::Read(*r)).collect()
 }
 
-/// The subordinate at latency `fixed + U(0..random)`, gaps, bandwidth, the unit's Outstanding as
-/// its declared limit.
-fn mem_setup(
-    cfg: CacheConfig,
-    mem: &AxiMemImage,
-    lat: (u32, u32),
-    gaps: (u32, u32),
-    bw: (u32, u32),
-    seed: u64,
-) -> AxiMemSetup {
-    AxiMemSetup {
-        declared_outstanding: cfg.outstanding,
-        ..axi_mem_setup((cfg.data_w / 8, cfg.addr_w), mem, lat, gaps, bw, seed)
-    }
-}
-
 /// Random words of `WordW` bits.
 fn random_words(cfg: CacheConfig, rng: &mut ChaCha8Rng) -> Vec<u32> {
     let n = (cfg.max_dim as usize).pow(3);
@@ -94,15 +76,11 @@ fn random_case(cfg: CacheConfig, s: u64, n: usize) -> Case {
     let words = random_words(cfg, &mut rng);
     let items = reads(&CacheTraffic::new(cfg).items(&mut rng, n));
     let img = cfg.image(&words).unwrap();
-    let bus = (cfg.data_w / 8, cfg.addr_w);
-    let (setup, traffic) = axi::random_conditions(&mut rng, bus, &img, cfg.data_w / 4);
+    let (setup, traffic) = axi::random_conditions(&mut rng, cfg, &img);
     Case {
         words,
         items,
-        setup: AxiMemSetup {
-            declared_outstanding: cfg.outstanding,
-            ..setup
-        },
+        setup,
         traffic,
         reset: None,
     }
@@ -126,9 +104,9 @@ fn a_million_random_requests_per_config() {
     axi::a_million_per_config(|variant, cfg: CacheConfig, s, k| {
         let mut case = random_case(cfg, s, 20_000);
         if k == 2 {
-            let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-            let after = reads(&CacheTraffic::new(cfg).items(&mut rng, 20_000));
-            case.reset = Some((rng.random_range(1000..100_000), after));
+            case.reset = axi::reset_after(s, 1000..100_000, |rng| {
+                reads(&CacheTraffic::new(cfg).items(rng, 20_000))
+            });
         }
         must(variant, cfg, s, &case).items
     });
@@ -209,7 +187,7 @@ fn directed_runs(
             aw_gap_permille: gaps.0,
             w_gap_permille: gaps.1,
             b_gap_permille: gaps.0,
-            ..mem_setup(cfg, &img, lat, gaps, (0, 1), s)
+            ..axi::mem_setup(cfg, &img, lat, gaps, (0, 1), s)
         };
         let case = Case {
             words: words.to_vec(),
@@ -230,9 +208,9 @@ fn directed_runs(
 fn reset_in_mid_stream_forgets_the_tags_and_the_next_requests_are_exact() {
     axi::resets_land_with_bursts_in_flight(|variant, cfg: CacheConfig, s| {
         let mut case = random_case(cfg, s, 300);
-        let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
-        let after = reads(&CacheTraffic::new(cfg).items(&mut rng, 300));
-        case.reset = Some((rng.random_range(30..3000), after));
+        case.reset = axi::reset_after(s, 30..3000, |rng| {
+            reads(&CacheTraffic::new(cfg).items(rng, 300))
+        });
         let r = must(variant, cfg, s, &case);
         assert!(r.items > 0);
         r.dropped_at_reset
@@ -253,7 +231,7 @@ fn throughput_one_request_per_clock_while_hitting_and_the_cycle_identity() {
         let case = Case {
             words: words.clone(),
             items: reads(&reqs),
-            setup: mem_setup(cfg, &img, (100, 0), (0, 0), (0, 1), 1),
+            setup: axi::mem_setup(cfg, &img, (100, 0), (0, 0), (0, 1), 1),
             traffic: Traffic::full_speed(),
             reset: None,
         };
@@ -266,7 +244,7 @@ fn throughput_one_request_per_clock_while_hitting_and_the_cycle_identity() {
             let case = Case {
                 words: words.clone(),
                 items: reads(&reqs),
-                setup: mem_setup(cfg, &img, (lat, 0), (0, 0), (0, 1), 2),
+                setup: axi::mem_setup(cfg, &img, (lat, 0), (0, 0), (0, 1), 2),
                 traffic: Traffic::full_speed(),
                 reset: None,
             };
@@ -354,7 +332,7 @@ fn processor_frame_sample_traffic_replays_on_the_rtl() {
         let case = Case {
             words,
             items: reads(&reqs),
-            setup: mem_setup(cfg, &img, (10, 190), (200, 200), (0, 1), s),
+            setup: axi::mem_setup(cfg, &img, (10, 190), (200, 200), (0, 1), s),
             traffic: Traffic::random(&mut rng, 0.2, 0.3),
             reset: None,
         };
@@ -404,7 +382,7 @@ fn the_comparison_sees_a_wrong_voxel_and_a_wrong_tag() {
     let mut rng = ChaCha8Rng::seed_from_u64(9);
     let words = random_words(cfg, &mut rng);
     let img = cfg.image(&words).unwrap();
-    let setup = mem_setup(cfg, &img, (10, 0), (0, 0), (0, 1), 1);
+    let setup = axi::mem_setup(cfg, &img, (10, 0), (0, 0), (0, 1), 1);
     let reqs = CacheTraffic::new(cfg).items(&mut rng, 300);
     let fails = |model: &mut VolumeCache| {
         let mut dut = axi::open(variant, SplatCodec(cfg), 1, (&setup, &img), &None).unwrap();
@@ -486,10 +464,8 @@ fn random_splat_case(cfg: CacheConfig, s: u64, n: usize) -> Case {
     let dep = rng.random_range(0.1..0.6);
     let items = splat_items(cfg, &mut rng, n, dep);
     let img = cfg.image(&words).unwrap();
-    let bus = (cfg.data_w / 8, cfg.addr_w);
-    let (setup, traffic) = axi::random_conditions(&mut rng, bus, &img, cfg.data_w / 4);
+    let (setup, traffic) = axi::random_conditions(&mut rng, cfg, &img);
     let setup = AxiMemSetup {
-        declared_outstanding: cfg.outstanding,
         aw_gap_permille: rng.random_range(0..400),
         w_gap_permille: rng.random_range(0..400),
         b_gap_permille: rng.random_range(0..400),
@@ -879,7 +855,7 @@ fn splat_throughput_two_clocks_per_hitting_deposit_and_the_cycle_identity() {
         let case = Case {
             words: words.clone(),
             items,
-            setup: mem_setup(cfg, &img, (100, 0), (0, 0), (0, 1), 1),
+            setup: axi::mem_setup(cfg, &img, (100, 0), (0, 0), (0, 1), 1),
             traffic: Traffic::full_speed(),
             reset: None,
         };
@@ -904,7 +880,7 @@ fn splat_throughput_two_clocks_per_hitting_deposit_and_the_cycle_identity() {
             let case = Case {
                 words: words.clone(),
                 items,
-                setup: mem_setup(cfg, &img, (lat, 0), (0, 0), (0, 1), 2),
+                setup: axi::mem_setup(cfg, &img, (lat, 0), (0, 0), (0, 1), 2),
                 traffic: Traffic::full_speed(),
                 reset: None,
             };

@@ -5,7 +5,9 @@
 
 use super::{axi_protocol_clean, compare_axi_outputs, compare_bursts, configs, gate_configs, seed};
 use cube5_model::unit::{StreamCodec, UnitConfig};
-use cube5_model::units::cube5_axi_rd::{AxiMemImage, Burst};
+use cube5_model::units::cube5_axi_rd::{AxiMemImage, AxiRdConfig, Burst};
+use cube5_model::units::cube5_axi_wr::AxiWrConfig;
+use cube5_model::units::gicube_cache::CacheConfig;
 use cube5_tb::rtl::{AxiMemSetup, Driven, RtlStream, Traffic};
 use cube5_tb::{Mismatch, TbError, Variant};
 use rand::{Rng, SeedableRng};
@@ -260,18 +262,80 @@ pub fn err_flag_matches<C: StreamCodec>(
     ))
 }
 
-/// A random subordinate and stream traffic, as the AXI tests' random cases draw them: latency
-/// 10..200, AR and R gaps up to 40 %, a bandwidth limit of up to `twice / 2` bytes per cycle on
-/// half the seeds, idle 30 % and back-pressure up to 60 %.
-pub fn random_conditions(
+/// A random subordinate of `cfg`'s port and stream traffic, as the AXI tests' random cases draw
+/// them: latency 10..200, AR and R gaps up to 40 %, a bandwidth limit of up to the bus width per
+/// cycle on half the seeds, idle 30 % and back-pressure up to 60 %.
+pub fn random_conditions<C: AxiPort>(
     rng: &mut ChaCha8Rng,
-    bus: (u32, u32),
+    cfg: C,
     mem: &AxiMemImage,
-    twice: u32,
 ) -> (AxiMemSetup, cube5_tb::rtl::Traffic) {
-    let bw = random_bandwidth(rng, twice);
+    let bw = random_bandwidth(rng, 2 * cfg.bus().0);
     let gaps = (rng.random_range(0..400), rng.random_range(0..400));
-    let setup = super::axi_mem_setup(bus, mem, (10, 190), gaps, bw, rng.random());
+    let setup = mem_setup(cfg, mem, (10, 190), gaps, bw, rng.random());
     let stall = rng.random_range(0.0..0.6);
     (setup, cube5_tb::rtl::Traffic::random(rng, 0.3, stall))
+}
+
+/// A unit with an AXI4 manager port: its bus as (data bytes, address bits) and the bursts it
+/// declares in flight (its Outstanding, the subordinate's checked limit).
+pub trait AxiPort {
+    fn bus(&self) -> (u32, u32);
+    fn outstanding(&self) -> u32;
+}
+
+impl AxiPort for AxiRdConfig {
+    fn bus(&self) -> (u32, u32) {
+        (self.bytes(), self.addr_w)
+    }
+    fn outstanding(&self) -> u32 {
+        self.outstanding
+    }
+}
+
+impl AxiPort for AxiWrConfig {
+    fn bus(&self) -> (u32, u32) {
+        (self.bytes(), self.addr_w)
+    }
+    fn outstanding(&self) -> u32 {
+        self.outstanding
+    }
+}
+
+impl AxiPort for CacheConfig {
+    fn bus(&self) -> (u32, u32) {
+        (self.data_w / 8, self.addr_w)
+    }
+    fn outstanding(&self) -> u32 {
+        self.outstanding
+    }
+}
+
+/// The subordinate of `cfg`'s port: latency `fixed + U(0..random)`, AR/R gaps (permille),
+/// bandwidth `bw` bytes per cycle as `(num, den)` (`num = 0`: unlimited), the unit's Outstanding
+/// as its declared limit.
+pub fn mem_setup<C: AxiPort>(
+    cfg: C,
+    mem: &AxiMemImage,
+    lat: (u32, u32),
+    gaps: (u32, u32),
+    bw: (u32, u32),
+    seed: u64,
+) -> AxiMemSetup {
+    AxiMemSetup {
+        declared_outstanding: cfg.outstanding(),
+        ..super::axi_mem_setup(cfg.bus(), mem, lat, gaps, bw, seed)
+    }
+}
+
+/// A reset in mid-stream: the items after it drawn by `after` from a generator seeded `s ^
+/// 0x5eed`, then the cycle it lands at, in `at` (the tests' one order of draws).
+pub fn reset_after<T>(
+    s: u64,
+    at: std::ops::Range<u64>,
+    after: impl FnOnce(&mut ChaCha8Rng) -> T,
+) -> Option<(u64, T)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(s ^ 0x5eed);
+    let after = after(&mut rng);
+    Some((rng.random_range(at), after))
 }
