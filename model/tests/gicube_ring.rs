@@ -6,7 +6,7 @@ use cube5_model::camera::Camera;
 use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::TransferFunction;
 use cube5_model::units::gicube_processor::{
-    Processor, ProcessorConfig, ProcessorCounts, Projection,
+    Processor, ProcessorConfig, ProcessorCounts, ProcessorRtlConfig, Projection,
 };
 use cube5_model::units::gicube_ring::{Ring, RingRtlConfig};
 use cube5_model::volume::Volume;
@@ -120,15 +120,21 @@ fn full_links_return_rays_to_the_host_and_lose_none() {
 fn the_ring_runs_at_every_rtl_configuration() {
     for cfg in [
         RingRtlConfig {
-            prefetch: 4,
-            data_w: 32,
-            line_vox: 8,
-            sets: 8,
+            proc: ProcessorRtlConfig {
+                prefetch: 4,
+                data_w: 32,
+                line_vox: 8,
+                sets: 8,
+                ..ProcessorRtlConfig::DEFAULT
+            },
             ..RingRtlConfig::DEFAULT
         },
         RingRtlConfig {
-            block_log2: 3,
-            voxel_w: 12,
+            proc: ProcessorRtlConfig {
+                block_log2: 3,
+                voxel_w: 12,
+                ..ProcessorRtlConfig::DEFAULT
+            },
             ..RingRtlConfig::DEFAULT
         },
     ] {
@@ -162,7 +168,10 @@ fn bad_rings_are_refused() {
         assert!(e.contains("processors") && !e.contains('\n'), "{e}");
     }
     let bad = RingRtlConfig {
-        vol_blocks: 3,
+        proc: ProcessorRtlConfig {
+            vol_blocks: 3,
+            ..ProcessorRtlConfig::DEFAULT
+        },
         ..RingRtlConfig::DEFAULT
     };
     assert!(bad.validate().is_err());

@@ -374,23 +374,13 @@ impl Ring {
 }
 
 /// The RTL top `gicube_ring`'s parameters (contract, *The RTL*): `ProcLog2` and one
-/// processor's (`gicube_processor`'s, `Light = 0`).
+/// processor's (`gicube_processor`'s, `Light = 0`, alone: `Procs = 1`, `ProcId = 0`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RingRtlConfig {
     /// `p = 2^proc_log2` processors, 1..=2.
     pub proc_log2: u32,
-    pub block_log2: u32,
-    pub vol_blocks: u32,
-    pub queue_len: u32,
-    pub ranks: u32,
-    pub voxel_w: u32,
-    pub step: u32,
-    pub ring_lat: u32,
-    pub data_w: u32,
-    pub line_vox: u32,
-    pub sets: u32,
-    pub outstanding: u32,
-    pub prefetch: u32,
+    /// The processor each of the ring's is.
+    pub proc: ProcessorRtlConfig,
 }
 
 /// Counts per processor in an output item.
@@ -401,39 +391,12 @@ pub const PROC_FIELD_W: u32 = 2;
 impl RingRtlConfig {
     pub const DEFAULT: Self = Self {
         proc_log2: 1,
-        block_log2: 2,
-        vol_blocks: 4,
-        queue_len: 16,
-        ranks: 8,
-        voxel_w: 8,
-        step: 256,
-        ring_lat: 8,
-        data_w: 64,
-        line_vox: 16,
-        sets: 32,
-        outstanding: 8,
-        prefetch: 0,
+        proc: ProcessorRtlConfig::DEFAULT,
     };
 
     /// The processor each of the ring's is.
     pub fn processor(&self) -> ProcessorRtlConfig {
-        ProcessorRtlConfig {
-            block_log2: self.block_log2,
-            vol_blocks: self.vol_blocks,
-            queue_len: self.queue_len,
-            ranks: self.ranks,
-            voxel_w: self.voxel_w,
-            step: self.step,
-            ring_lat: self.ring_lat,
-            data_w: self.data_w,
-            line_vox: self.line_vox,
-            sets: self.sets,
-            outstanding: self.outstanding,
-            prefetch: self.prefetch,
-            procs: 1,
-            proc_id: 0,
-            ..ProcessorRtlConfig::DEFAULT
-        }
+        self.proc
     }
 
     pub fn procs(&self) -> u32 {
@@ -441,33 +404,34 @@ impl RingRtlConfig {
     }
 
     pub fn validate(&self) -> Result<()> {
-        if self.proc_log2 > 2 || !self.vol_blocks.is_multiple_of(self.procs()) {
+        if self.proc_log2 > 2 || !self.proc.vol_blocks.is_multiple_of(self.procs()) {
             return Err(ModelError::Config(format!(
                 "gicube_ring: ProcLog2 {} outside 0..=2 or VolBlocks {} not a multiple of {}",
                 self.proc_log2,
-                self.vol_blocks,
+                self.proc.vol_blocks,
                 self.procs()
             )));
         }
-        self.processor().validate()
+        self.proc.validate()
     }
 }
 
-crate::unit_config!(RingRtlConfig, "gicube_ring", DEFAULT, {
-    "ProcLog2" => proc_log2,
-    "BlockLog2" => block_log2,
-    "VolBlocks" => vol_blocks,
-    "QueueLen" => queue_len,
-    "Ranks" => ranks,
-    "VoxelW" => voxel_w,
-    "Step" => step,
-    "RingLat" => ring_lat,
-    "DataW" => data_w,
-    "LineVox" => line_vox,
-    "Sets" => sets,
-    "Outstanding" => outstanding,
-    "Prefetch" => prefetch,
-});
+crate::unit_config!(RingRtlConfig, "gicube_ring", DEFAULT, { "ProcLog2" => proc_log2 },
+    proc: [
+        "BlockLog2",
+        "VolBlocks",
+        "QueueLen",
+        "Ranks",
+        "VoxelW",
+        "Step",
+        "RingLat",
+        "DataW",
+        "LineVox",
+        "Sets",
+        "Outstanding",
+        "Prefetch",
+    ]
+);
 
 /// One processor's counts in an output item (contract, *Output item*).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
