@@ -418,9 +418,19 @@ module cube5_frame_win #(
   logic [DimW-1:0]   g_r, g_q;
   logic signed [TW-1:0] g_sx, g_sy;
 
+  // The walker's slice steps in registers (for clock rate: step_of's carry chains end in a
+  // flip-flop instead of running on into g_go and rq_out_q): g_dsx_q = step_of(gtx_q, dx_i)
+  // always, loaded with the next slice's step when the walker moves to it.
+  logic signed [1:0] g_dsx_q, g_dsy_q, g_dsx_n, g_dsy_n, g_dsx0, g_dsy0;
+  logic              g_slice;   // the walker moves to the next slice this cycle
+  assign g_dsx_n = step_of(gtx_q + TW'(dx_i), dx_i);
+  assign g_dsy_n = step_of(gty_q + TW'(dy_i), dy_i);
+  assign g_dsx0  = step_of(TW'(dx_i), dx_i);
+  assign g_dsy0  = step_of(TW'(dy_i), dy_i);
+
   always_comb begin
-    g_dsx  = step_of(gtx_q, dx_i);
-    g_dsy  = step_of(gty_q, dy_i);
+    g_dsx  = g_dsx_q;
+    g_dsy  = g_dsy_q;
     g_sx   = gtx_q >>> StepW;
     g_sy   = gty_q >>> StepW;
     // The slice's entering column restores (from the section before it in sweep order).
@@ -439,6 +449,7 @@ module cube5_frame_win #(
     gty_d      = gty_q;
     rq_valid_d = rq_valid_q && !rq_ready_i;
     rq_key_d   = rq_key_q;
+    g_slice    = 1'b0;
     if (g_go) begin
       if (g_emit) begin
         rq_valid_d = 1'b1;
@@ -447,6 +458,7 @@ module cube5_frame_win #(
       if (g_col && gb_q != nj_i - DimW'(1)) begin
         gb_d = gb_q + DimW'(1);
       end else begin
+        g_slice = 1'b1;
         gb_d  = '0;
         gs_d  = gs_q + DimW'(1);
         gtx_d = gtx_q + TW'(dx_i);
@@ -489,6 +501,13 @@ module cube5_frame_win #(
     gtx_q    <= gtx_d;
     gty_q    <= gty_d;
     rq_key_q <= rq_key_d;
+    if (start_i) begin
+      g_dsx_q <= g_dsx0;
+      g_dsy_q <= g_dsy0;
+    end else if (g_slice) begin
+      g_dsx_q <= g_dsx_n;
+      g_dsy_q <= g_dsy_n;
+    end
   end
 
   assign rq_valid_o = rq_valid_q;
@@ -514,6 +533,9 @@ module cube5_frame_win #(
   WinDescriptorPresent: assert property (@(posedge clk_i) disable iff (!rst_ni)
       rd_i |-> !unused_d0)
     else $error("cube5_frame_win: a sample beat without its descriptor");
+  WinWalkerSteps: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      g_on_q |-> g_dsx_q == step_of(gtx_q, dx_i) && g_dsy_q == step_of(gty_q, dy_i))
+    else $error("cube5_frame_win: the walker's registered slice steps disagree with its position");
   WinRequestsHeld: assert property (@(posedge clk_i) disable iff (!rst_ni)
       rq_valid_o && !rq_ready_i |=> rq_valid_o && $stable(rq_key_o))
     else $error("cube5_frame_win: a stalled restore request changed");
