@@ -171,7 +171,7 @@ fn check_bursts(
     s: u64,
 ) {
     let name = variant.name;
-    let size = (rtl.data_w / 8).trailing_zeros();
+    let size = (rtl.proc.data_w / 8).trailing_zeros();
     for (i, want_i) in bursts.iter().enumerate() {
         let mine: Vec<ArHandshake> = got
             .ars
@@ -469,7 +469,7 @@ fn full_speed_clocks_within_the_lockstep_bound() {
         let p = rtl.processor();
         let cache = p.cache_config();
         let beats = u64::from(cache.line_vox * cache.word_w / cache.data_w);
-        let per_cycle = 1 + RING_TRIP.div_ceil(u64::from(rtl.ring_lat)).max(5);
+        let per_cycle = 1 + RING_TRIP.div_ceil(u64::from(rtl.proc.ring_lat)).max(5);
         let per_miss = u64::from(FAST.lat.0) + beats + 2;
         let transparent = Scene::with(
             &rtl,
