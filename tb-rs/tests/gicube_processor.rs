@@ -720,3 +720,54 @@ fn gate_level_gi_passes(scatter: u32, mode: GiMode, s: u64) {
 fn gate_level_netlist_runs_an_exact_photon_pass() {
     gate_level_gi_passes(1, HIGH_ALBEDO, seed(1995));
 }
+
+/// Throughput at full speed (the host never idle, the output never stalled, a memory answering
+/// after 2 clocks): every frame makes exactly the model's cycles (`check_frame`), and its clocks
+/// are within the contract's *Timing*: a cycle while the lines hit takes `max(5, trip / RingLat)`
+/// clocks, the trip being the front end's 3, the cache's 2 and the sample's latency (22; 28 with
+/// `Shade`, one more with `Jitter`; the deposit's 5 beside it with `Light`), and each line the
+/// cache misses holds the dispatch at most the memory's latency, the line's beats and two clocks
+/// more. A frame's clocks are at most the sum of both.
+#[test]
+fn full_speed_clocks_within_the_timing_bound() {
+    const FAST: Memory = Memory {
+        lat: (2, 0),
+        gaps: (0, 0),
+        bw: (0, 1),
+    };
+    for (variant, rtl) in ci_configs() {
+        let trip = 3
+            + 2
+            + 22
+            + 6 * u64::from(rtl.shade)
+            + u64::from(rtl.jitter)
+            + 5 * u64::from(rtl.light);
+        let per_cycle = trip.div_ceil(u64::from(rtl.ring_lat)).max(5);
+        let cache = rtl.cache_config();
+        let beats = u64::from(cache.line_vox * cache.word_w / cache.data_w);
+        let per_miss = u64::from(FAST.lat.0) + beats + 2;
+        for proj in [
+            Projection::Parallel,
+            Projection::Perspective { fov_deg: 40.0 },
+        ] {
+            let (got, want) = exact_frame(variant, rtl, rtl.side(), proj, Some(FAST), seed(0x7468));
+            let c = &want.counts;
+            let bound = c.cycles * per_cycle + c.cache_misses * per_miss;
+            eprintln!(
+                "{variant} {proj:?} at full speed: {} clocks for {} cycles ({:.2} a cycle) and {} lines missed; bound {bound} ({per_cycle} a cycle, {per_miss} a miss): {:.2} of it",
+                got.clocks,
+                c.cycles,
+                got.clocks as f64 / c.cycles as f64,
+                c.cache_misses,
+                got.clocks as f64 / bound as f64
+            );
+            assert!(
+                got.clocks <= bound,
+                "{variant} {proj:?}: {} clocks exceed the timing bound {bound} ({} cycles x {per_cycle} + {} misses x {per_miss})",
+                got.clocks,
+                c.cycles,
+                c.cache_misses
+            );
+        }
+    }
+}
