@@ -26,7 +26,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use support::processor::{
     check_bursts, check_frame, head_scene, host_packets, load_config, open_proc, random_memory,
-    run_host, view_dir, Behaviour, Bits, Memory, RtlFrame,
+    round_trip_clocks, run_host, view_dir, Behaviour, Bits, Memory, RtlFrame, FAST_MEMORY,
+    IDLE_AND_STALL,
 };
 use support::{axi, compare_bursts, configs, seed};
 
@@ -561,22 +562,7 @@ fn idle_host_and_stalled_output_keep_the_image() {
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let mem = random_memory(&mut rng, &rtl);
         let mut dut = open_proc(variant, rtl, &scene.proc, mem, s);
-        for (b, exact) in [
-            (
-                Behaviour {
-                    idle: 0.0,
-                    stall: 0.6,
-                },
-                true,
-            ),
-            (
-                Behaviour {
-                    idle: 0.5,
-                    stall: 0.3,
-                },
-                false,
-            ),
-        ] {
+        for (b, exact) in IDLE_AND_STALL {
             dut.reset();
             let what = format!("{variant} seed {s} idle/stall ({mem:?}, {b:?})");
             let got = run_host(&mut dut, &packets, (px, px), b, &mut rng, None, &what);
@@ -723,34 +709,31 @@ fn gate_level_netlist_runs_an_exact_photon_pass() {
 
 /// Throughput at full speed (the host never idle, the output never stalled, a memory answering
 /// after 2 clocks): every frame makes exactly the model's cycles (`check_frame`), and its clocks
-/// are within the contract's *Timing*: a cycle while the lines hit takes `max(5, trip / RingLat)`
-/// clocks, the trip being the front end's 3, the cache's 2 and the sample's latency (22; 28 with
-/// `Shade`, one more with `Jitter`; the deposit's 5 beside it with `Light`), and each line the
+/// are within the contract's *Timing*: a cycle while the lines hit takes `max(5, round trip /
+/// RingLat)` clocks (`round_trip_clocks`), and each line the
 /// cache misses holds the dispatch at most the memory's latency, the line's beats and two clocks
 /// more. A frame's clocks are at most the sum of both.
 #[test]
 fn full_speed_clocks_within_the_timing_bound() {
-    const FAST: Memory = Memory {
-        lat: (2, 0),
-        gaps: (0, 0),
-        bw: (0, 1),
-    };
     for (variant, rtl) in ci_configs() {
-        let trip = 3
-            + 2
-            + 22
-            + 6 * u64::from(rtl.shade)
-            + u64::from(rtl.jitter)
-            + 5 * u64::from(rtl.light);
-        let per_cycle = trip.div_ceil(u64::from(rtl.ring_lat)).max(5);
+        let per_cycle = round_trip_clocks(&rtl)
+            .div_ceil(u64::from(rtl.ring_lat))
+            .max(5);
         let cache = rtl.cache_config();
         let beats = u64::from(cache.line_vox * cache.word_w / cache.data_w);
-        let per_miss = u64::from(FAST.lat.0) + beats + 2;
+        let per_miss = u64::from(FAST_MEMORY.lat.0) + beats + 2;
         for proj in [
             Projection::Parallel,
             Projection::Perspective { fov_deg: 40.0 },
         ] {
-            let (got, want) = exact_frame(variant, rtl, rtl.side(), proj, Some(FAST), seed(0x7468));
+            let (got, want) = exact_frame(
+                variant,
+                rtl,
+                rtl.side(),
+                proj,
+                Some(FAST_MEMORY),
+                seed(0x7468),
+            );
             let c = &want.counts;
             let bound = c.cycles * per_cycle + c.cache_misses * per_miss;
             eprintln!(

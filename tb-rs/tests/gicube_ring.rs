@@ -26,8 +26,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
 use support::processor::{
-    head_scene, host_packets, open_over, random_memory, run_eager_host, run_host, view_dir,
-    Behaviour, Bits, Memory, RtlFrame,
+    head_scene, host_packets, open_over, random_memory, round_trip_clocks, run_eager_host,
+    run_host, view_dir, Behaviour, Bits, Memory, RtlFrame, FAST_MEMORY, IDLE_AND_STALL,
 };
 use support::{axi, compare_bursts, configs, seed};
 
@@ -94,13 +94,6 @@ impl Scene {
         open_over(variant, rtl, &p, self.ring.processor(), setup, s)
     }
 }
-
-/// A memory that answers at once: latency 2, no gaps, no bandwidth limit.
-const FAST: Memory = Memory {
-    lat: (2, 0),
-    gaps: (0, 0),
-    bw: (0, 1),
-};
 
 /// A transfer function of one colour and opacity `alpha` at every density.
 fn flat_tf(alpha: f64) -> TransferFunction {
@@ -378,22 +371,7 @@ fn idle_host_and_stalled_output_keep_the_image() {
         let mut rng = ChaCha8Rng::seed_from_u64(s);
         let mem = random_memory(&mut rng, &rtl.processor());
         let mut dut = scene.open(v, rtl, mem, s);
-        for (b, exact) in [
-            (
-                Behaviour {
-                    idle: 0.0,
-                    stall: 0.6,
-                },
-                true,
-            ),
-            (
-                Behaviour {
-                    idle: 0.5,
-                    stall: 0.3,
-                },
-                false,
-            ),
-        ] {
+        for (b, exact) in IDLE_AND_STALL {
             dut.reset();
             let what = format!("{v} seed {s} idle/stall ({mem:?}, {b:?})");
             let got = run_host(&mut dut, &packets, (12, 12), b, &mut rng, None, &what);
@@ -452,14 +430,10 @@ fn mid_frame_reset_then_an_exact_frame() {
     }
 }
 
-/// The clocks of a ray's round trip through a processor while its lines hit (gicube_processor.md,
-/// *Timing*: the front end's 3, the cache's 2, the sample's 22).
-const RING_TRIP: u64 = 3 + 2 + 22;
-
 /// Throughput at full speed (the host never idle, the output never stalled, a memory answering
 /// after 2 clocks): the ring makes exactly the model's cycles (the counts), and its clocks are
 /// within the contract's timing (*Lockstep*: a ring cycle is every processor's cycle): a cycle
-/// while the lines hit takes the processor's `max(5, RING_TRIP / RingLat)` clocks and one for the
+/// while the lines hit takes the processor's `max(5, round trip / RingLat)` clocks and one for the
 /// output merge, and each line a processor misses holds the cycle at most the memory's latency,
 /// the line's beats and two clocks more. The clocks of a frame are at most the sum of both.
 #[test]
@@ -469,8 +443,10 @@ fn full_speed_clocks_within_the_lockstep_bound() {
         let p = rtl.processor();
         let cache = p.cache_config();
         let beats = u64::from(cache.line_vox * cache.word_w / cache.data_w);
-        let per_cycle = 1 + RING_TRIP.div_ceil(u64::from(rtl.proc.ring_lat)).max(5);
-        let per_miss = u64::from(FAST.lat.0) + beats + 2;
+        let per_cycle = 1 + round_trip_clocks(&p)
+            .div_ceil(u64::from(rtl.proc.ring_lat))
+            .max(5);
+        let per_miss = u64::from(FAST_MEMORY.lat.0) + beats + 2;
         let transparent = Scene::with(
             &rtl,
             12,
@@ -487,7 +463,7 @@ fn full_speed_clocks_within_the_lockstep_bound() {
             ("transparent", transparent),
         ];
         for (name, scene) in scenes {
-            let (got, want) = exact_scene(v, rtl, &scene, Some(FAST), 0.0, s);
+            let (got, want) = exact_scene(v, rtl, &scene, Some(FAST_MEMORY), 0.0, s);
             let misses: u64 = want.counts.iter().map(|c| c.cache_misses).sum();
             let bound = want.cycles() * per_cycle + misses * per_miss;
             eprintln!(

@@ -77,6 +77,40 @@ impl Memory {
     }
 }
 
+/// A memory that answers at once: latency 2, no gaps, no bandwidth limit.
+pub const FAST_MEMORY: Memory = Memory {
+    lat: (2, 0),
+    gaps: (0, 0),
+    bw: (0, 1),
+};
+
+/// The clocks of a ray's round trip through a processor while its lines hit (gicube_processor.md,
+/// *Timing*): the front end's 3, the cache's 2 and the sample's latency (22; 28 with `Shade`, one
+/// more with `Jitter`; the deposit's 5 beside it with `Light`).
+pub fn round_trip_clocks(rtl: &ProcessorRtlConfig) -> u64 {
+    3 + 2 + 22 + 6 * u64::from(rtl.shade) + u64::from(rtl.jitter) + 5 * u64::from(rtl.light)
+}
+
+/// Two host behaviours and whether the counts stay exact under them: the output stalled 60 %
+/// (the host offering at once: every count), and the host idle half the time (only the image and
+/// the ray totals: idle cycles move the sorter).
+pub const IDLE_AND_STALL: [(Behaviour, bool); 2] = [
+    (
+        Behaviour {
+            idle: 0.0,
+            stall: 0.6,
+        },
+        true,
+    ),
+    (
+        Behaviour {
+            idle: 0.5,
+            stall: 0.3,
+        },
+        false,
+    ),
+];
+
 /// Random conditions: latency 10-200, gaps of up to 30 %, a bandwidth limit on half the seeds.
 pub fn random_memory(rng: &mut ChaCha8Rng, rtl: &ProcessorRtlConfig) -> Memory {
     Memory {
