@@ -429,9 +429,15 @@ fn discover_variants(repo: &Path) -> (Vec<cube5_gen::variants::Top>, Vec<Variant
                 });
             }
             if line.has_flag("gate") {
+                // `gatefull`: the netlist alone is a `full` build (`make sim-full`).
+                let mut flags = base.flags.clone();
+                if line.has_flag("gatefull") {
+                    flags.push("full".to_string());
+                }
                 out.push(Variant {
                     full_name: format!("{}_gate", base.full_name),
                     gate: true,
+                    flags,
                     ..base.clone()
                 });
             }

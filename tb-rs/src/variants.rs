@@ -100,11 +100,13 @@ pub fn variants_of(top: &str) -> Vec<&'static Variant> {
     found
 }
 
-/// The gate-level builds of `top`'s configurations (lines with the `gate` flag).
+/// The gate-level builds of `top`'s configurations (lines with the `gate` flag; a `gatefull`
+/// line's netlist only where built: `CUBE5_FULL=1`).
 pub fn gate_variants_of(top: &str) -> Vec<&'static Variant> {
     variants_of(top)
         .into_iter()
         .filter_map(Variant::gate)
+        .filter(|g| g.built || !g.flags.contains(&"full"))
         .collect()
 }
 

@@ -278,8 +278,11 @@ fn one_ray_per_cycle_when_never_stalled() {
 
 /// Yosys's gate-level netlists (lines flagged `gate`) through the same comparison.
 #[test]
+#[ignore = "sim-full: the gate-level netlist is `gatefull` (155 s of build; docs/ci.md)"]
 fn gate_level_netlist_smoke() {
-    for (variant, cfg) in gate_configs::<ScatterConfig>() {
+    let gates = gate_configs::<ScatterConfig>();
+    assert!(!gates.is_empty(), "no gate-level build of gicube_scatter");
+    for (variant, cfg) in gates {
         let (mut model, writes) = model_and_tables(cfg);
         let check = StreamCheck::gate_smoke(seed(51)).with_config_writes(writes);
         must_match(variant, cfg, &mut model, &mut gen(cfg), &check);

@@ -3,7 +3,9 @@
 //! `scripts/synth.sh` call `cube5-gen variants`, which prints the same list as text.
 //!
 //! A `.variants` line is `name [flag ...] Param=value ...` (`#` starts a comment). Flags:
-//! `gate` (also build Yosys's gate-level netlist for the smoke co-simulation), `mutant` (also a
+//! `gate` (also build Yosys's gate-level netlist for the smoke co-simulation), `gatefull` (with
+//! `gate`: that netlist is built and run only by `make sim-full`, the RTL line stays in CI),
+//! `mutant` (also a
 //! gate-level netlist with one injected fault, which the tests must catch), `fmax` / `fmax85`
 //! (`make synth` places and routes it on the ECP5 25k / 85k part), `ooc` (with `fmax`/`fmax85`:
 //! placed out of context, without I/O pads, for a unit whose ports outnumber the package's pins;
@@ -28,8 +30,11 @@ use std::path::{Path, PathBuf};
 /// The flags a `.variants` line may carry. `full`: a configuration only the runs too long for CI
 /// use (`make sim-full`); the test bench builds it only when `CUBE5_FULL=1`. `synthfull`: the
 /// synthesis counterpart, a configuration `make synth` skips unless `SYNTH_FULL=1` (`make synth-full`).
+/// `gatefull`: the line's gate-level netlist is `full` (minutes of Yosys, Verilator and g++ that
+/// CI's test budget cannot hold; docs/ci.md), its RTL build is not.
 pub const FLAGS: &[&str] = &[
     "gate",
+    "gatefull",
     "mutant",
     "fmax",
     "fmax85",
