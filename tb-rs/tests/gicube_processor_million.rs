@@ -14,12 +14,9 @@
 
 mod support;
 
-use cube5_model::camera::Camera;
 use cube5_model::transfer::{TfPoint, TransferFunction};
 use cube5_model::units::gicube_packet_loop::RayPacket;
-use cube5_model::units::gicube_processor::{
-    host_rays, HostRay, Processor, ProcessorRtlConfig, Projection,
-};
+use cube5_model::units::gicube_processor::{HostOrder, Processor, ProcessorRtlConfig};
 use cube5_model::volume::Volume;
 use cube5_tb::Variant;
 use rand::{Rng, SeedableRng};
@@ -27,6 +24,7 @@ use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
 use support::processor::{
     check_bursts, check_frame, open_proc, random_memory, run_host, Behaviour, Bits, Memory,
+    RandomRays,
 };
 use support::{axi, configs, seed};
 
@@ -118,55 +116,14 @@ fn random_dir(rng: &mut ChaCha8Rng) -> [f64; 3] {
     d.map(|c| c / l)
 }
 
-/// The host's rays of one frame and the image's side: a camera's (parallel or perspective, a
-/// random view, 8-48 pixels a side), or random packets (pixels in rows of 64) starting anywhere
-/// in the voxel-centre box (a third on one of its faces), the host's fields otherwise (colour and
-/// opacity 0, contribution 1).
-fn random_rays(
-    rng: &mut ChaCha8Rng,
-    vol: &Volume,
-    order: bool,
-) -> (Vec<RayPacket>, (u32, u32), String) {
-    if rng.random_bool(0.5) {
-        let px = rng.random_range(8..=48);
-        let proj = if rng.random_bool(0.5) {
-            Projection::Parallel
-        } else {
-            Projection::Perspective {
-                fov_deg: rng.random_range(10.0..150.0),
-            }
-        };
-        let cam = Camera::new(random_dir(rng).into(), vol.dims, vol.spacing, px, px);
-        let host = if order {
-            cube5_model::units::gicube_processor::HostOrder::RowMajor
-        } else {
-            cube5_model::units::gicube_processor::HostOrder::Reversed
-        };
-        let rays = host_rays(vol, &cam, proj, host).unwrap();
-        let packets = rays.iter().map(|r| Processor::packet(r).unwrap()).collect();
-        (packets, (px, px), format!("{proj:?} {px}x{px}"))
-    } else {
-        let hi = vol.dims[0] as f64 - 1.0;
-        let n: u32 = rng.random_range(256..=4096);
-        let packets = (0..n)
-            .map(|i| {
-                let mut start: [f64; 3] = std::array::from_fn(|_| rng.random_range(0.0..=hi));
-                if rng.random_range(0..3) == 0 {
-                    start[rng.random_range(0..3)] = if rng.random_bool(0.5) { 0.0 } else { hi };
-                }
-                // The host's packet (`Processor::packet`) of a ray from `start`.
-                let ray = HostRay {
-                    px: i % 64,
-                    py: i / 64,
-                    entry: start.into(),
-                    dir: random_dir(rng).into(),
-                };
-                Processor::packet(&ray).unwrap()
-            })
-            .collect();
-        (packets, (64, n.div_ceil(64)), format!("{n} random packets"))
-    }
-}
+/// The host's rays of one frame: a camera's (8-48 pixels a side, fields of view 10-150 degrees)
+/// or 256-4,096 random packets, in directions from `random_dir`.
+const RAYS: RandomRays = RandomRays {
+    px: 8..=48,
+    fov_deg: 10.0..150.0,
+    packets: 256..=4096,
+    dir: random_dir,
+};
 
 /// A ray's packet without the OVERFLOW flag (the one field the order may change).
 fn unflagged(bits: &Bits) -> RayPacket {
@@ -203,8 +160,12 @@ fn random_frame(
     let vol = random_volume(&mut rng, n, rtl.voxel_w);
     let tf = random_tf(&mut rng);
     let proc = Processor::new(rtl.processor_config(), &vol, &tf).unwrap();
-    let order = rng.random_bool(0.5);
-    let (packets, (w, h), kind) = random_rays(&mut rng, &vol, order);
+    let order = if rng.random_bool(0.5) {
+        HostOrder::RowMajor
+    } else {
+        HostOrder::Reversed
+    };
+    let (packets, (w, h), kind) = RAYS.draw(&mut rng, &vol, Some(order));
     if packets.is_empty() {
         return;
     }

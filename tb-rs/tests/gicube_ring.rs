@@ -17,7 +17,7 @@ use cube5_model::phantom::head_phantom;
 use cube5_model::transfer::{TfPoint, TransferFunction};
 use cube5_model::units::cube5_axi_rd::Burst;
 use cube5_model::units::gicube_packet_loop::RayPacket;
-use cube5_model::units::gicube_processor::{host_rays, HostOrder, HostRay, Processor, Projection};
+use cube5_model::units::gicube_processor::{Processor, Projection};
 use cube5_model::units::gicube_ring::{Ring, RingFrame, RingOut, RingOutCounts, RingRtlConfig};
 use cube5_tb::harness::count_differing;
 use cube5_tb::rtl::{ArHandshake, RtlStream};
@@ -27,7 +27,7 @@ use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
 use support::processor::{
     head_scene, host_packets, open_over, random_memory, round_trip_clocks, run_eager_host,
-    run_host, view_dir, Behaviour, Bits, Memory, RtlFrame, FAST_MEMORY, IDLE_AND_STALL,
+    run_host, view_dir, Behaviour, Bits, Memory, RandomRays, RtlFrame, FAST_MEMORY, IDLE_AND_STALL,
 };
 use support::{axi, compare_bursts, configs, seed};
 
@@ -514,50 +514,14 @@ fn random_view(rng: &mut ChaCha8Rng) -> [f64; 3] {
     }
 }
 
-/// The host's packets of one random frame and its image's side: a camera's (parallel or
-/// perspective, a random view, 8-32 pixels a side, either host order) or 256-2,048 packets from
-/// random starts in the voxel-centre box (a third on a face) in random directions (rows of 64).
-fn random_packets(rng: &mut ChaCha8Rng, proc: &Processor) -> (Vec<RayPacket>, (u32, u32), String) {
-    let vol = proc.volume();
-    if rng.random_bool(0.5) {
-        let px = rng.random_range(8..=32);
-        let proj = if rng.random_bool(0.5) {
-            Projection::Parallel
-        } else {
-            Projection::Perspective {
-                fov_deg: rng.random_range(10.0..120.0),
-            }
-        };
-        let cam = Camera::new(random_view(rng).into(), vol.dims, vol.spacing, px, px);
-        let order = if rng.random_bool(0.5) {
-            HostOrder::RowMajor
-        } else {
-            HostOrder::Reversed
-        };
-        let rays = host_rays(vol, &cam, proj, order).unwrap();
-        let packets = rays.iter().map(|r| Processor::packet(r).unwrap()).collect();
-        (packets, (px, px), format!("{proj:?} {px}x{px}"))
-    } else {
-        let hi = vol.dims[0] as f64 - 1.0;
-        let n: u32 = rng.random_range(256..=2048);
-        let packets = (0..n)
-            .map(|i| {
-                let mut entry: [f64; 3] = std::array::from_fn(|_| rng.random_range(0.0..=hi));
-                if rng.random_range(0..3) == 0 {
-                    entry[rng.random_range(0..3)] = if rng.random_bool(0.5) { 0.0 } else { hi };
-                }
-                let ray = HostRay {
-                    px: i % 64,
-                    py: i / 64,
-                    entry: entry.into(),
-                    dir: random_view(rng).into(),
-                };
-                Processor::packet(&ray).unwrap()
-            })
-            .collect();
-        (packets, (64, n.div_ceil(64)), format!("{n} random packets"))
-    }
-}
+/// The host's packets of one random frame: a camera's (8-32 pixels a side, fields of view 10-120
+/// degrees, either host order) or 256-2,048 random packets, in directions from `random_view`.
+const RAYS: RandomRays = RandomRays {
+    px: 8..=32,
+    fov_deg: 10.0..120.0,
+    packets: 256..=2048,
+    dir: random_view,
+};
 
 /// The totals of one configuration's random frames.
 #[derive(Default, Debug)]
@@ -588,7 +552,7 @@ fn random_frame(
     let p = rtl.processor();
     let vol = head_phantom(p.side() as usize, p.voxel_w).unwrap();
     let proc = Processor::new(p.processor_config(), &vol, &random_tf(&mut rng)).unwrap();
-    let (packets, (w, h), kind) = random_packets(&mut rng, &proc);
+    let (packets, (w, h), kind) = RAYS.draw(&mut rng, proc.volume(), None);
     if packets.is_empty() {
         return;
     }

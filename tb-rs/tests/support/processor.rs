@@ -13,9 +13,11 @@ use cube5_model::units::cube5_axi_rd::{AxiMemImage, Burst};
 use cube5_model::units::cube5_shader::Phong;
 use cube5_model::units::gicube_packet_loop::{RayPacket, PACKET_WORDS};
 use cube5_model::units::gicube_processor::{
-    half_tags, host_rays, Processor, ProcessorFrame, ProcessorOut, ProcessorRtlConfig, Projection,
+    half_tags, host_rays, HostOrder, HostRay, Processor, ProcessorFrame, ProcessorOut,
+    ProcessorRtlConfig, Projection,
 };
 use cube5_model::units::gicube_ring::RingOut;
+use cube5_model::volume::Volume;
 use cube5_tb::harness::count_differing;
 use cube5_tb::rtl::{AxiMemSetup, RtlStream, Traffic};
 use cube5_tb::Variant;
@@ -29,6 +31,70 @@ pub type Bits = [u32; PACKET_WORDS];
 pub fn view_dir(azimuth: f64, elevation: f64) -> [f64; 3] {
     let (a, e) = (azimuth.to_radians(), elevation.to_radians());
     [-e.cos() * a.cos(), -e.cos() * a.sin(), -e.sin()]
+}
+
+/// The host's packets of one random frame, drawn from `rng`: a camera's (half the frames: parallel
+/// or perspective, `px` pixels a side, a direction from `dir`) or `packets` rays from random starts
+/// in the voxel-centre box (a third on one of its faces) in directions from `dir`, pixels in rows
+/// of 64. The processor's and the ring's random tests each keep their own ranges (and so their own
+/// random streams).
+pub struct RandomRays {
+    pub px: std::ops::RangeInclusive<u32>,
+    pub fov_deg: std::ops::Range<f64>,
+    pub packets: std::ops::RangeInclusive<u32>,
+    pub dir: fn(&mut ChaCha8Rng) -> [f64; 3],
+}
+
+impl RandomRays {
+    /// The packets, the image's side and a description; `order`: the camera's host order, or
+    /// `None` to draw it after the camera.
+    pub fn draw(
+        &self,
+        rng: &mut ChaCha8Rng,
+        vol: &Volume,
+        order: Option<HostOrder>,
+    ) -> (Vec<RayPacket>, (u32, u32), String) {
+        if rng.random_bool(0.5) {
+            let px = rng.random_range(self.px.clone());
+            let proj = if rng.random_bool(0.5) {
+                Projection::Parallel
+            } else {
+                Projection::Perspective {
+                    fov_deg: rng.random_range(self.fov_deg.clone()),
+                }
+            };
+            let cam = Camera::new((self.dir)(rng).into(), vol.dims, vol.spacing, px, px);
+            let order = order.unwrap_or_else(|| {
+                if rng.random_bool(0.5) {
+                    HostOrder::RowMajor
+                } else {
+                    HostOrder::Reversed
+                }
+            });
+            let rays = host_rays(vol, &cam, proj, order).unwrap();
+            let packets = rays.iter().map(|r| Processor::packet(r).unwrap()).collect();
+            (packets, (px, px), format!("{proj:?} {px}x{px}"))
+        } else {
+            let hi = vol.dims[0] as f64 - 1.0;
+            let n: u32 = rng.random_range(self.packets.clone());
+            let packets = (0..n)
+                .map(|i| {
+                    let mut entry: [f64; 3] = std::array::from_fn(|_| rng.random_range(0.0..=hi));
+                    if rng.random_range(0..3) == 0 {
+                        entry[rng.random_range(0..3)] = if rng.random_bool(0.5) { 0.0 } else { hi };
+                    }
+                    let ray = HostRay {
+                        px: i % 64,
+                        py: i / 64,
+                        entry: entry.into(),
+                        dir: (self.dir)(rng).into(),
+                    };
+                    Processor::packet(&ray).unwrap()
+                })
+                .collect();
+            (packets, (64, n.div_ceil(64)), format!("{n} random packets"))
+        }
+    }
 }
 
 /// The head phantom at `rtl`'s side and voxel width in `rtl`'s processor, seen from azimuth 65,
