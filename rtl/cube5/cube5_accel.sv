@@ -72,6 +72,8 @@ module cube5_accel #(
   parameter int unsigned WinOutstanding = 16,
   /// Window = 1: the depth of the window's AW and W FIFOs (cube5_accel_win), a power of two.
   parameter int unsigned WinWDepth   = 8,
+  /// Window = 1: the frame's window descriptor FIFO depth (cube5_frame WinDescDepth).
+  parameter int unsigned WinDescDepth = 32,
   /// Window = 1: the zero-park bit FIFO's depth (cube5_accel_win ZeroDepth; 0: MaxDim^2).
   parameter int unsigned WinZeroDepth = 0,
   /// Window = 1: 1 parks into a packed ring in park order, written and read in bursts of up to
@@ -465,7 +467,7 @@ module cube5_accel #(
     .BlockDim(BlockDim), .ClassIdxW(ClassIdxW), .MagIdxW(MagIdxW), .MagShift(MagShift),
     .ColorW(ColorW), .AlphaW(AlphaW), .RmLog2(RmLog2), .RmFracW(RmFracW), .DiffW(DiffW),
     .SpecW(SpecW), .ExtraW(ExtraW), .AccW(AccW), .ZW(ZW), .Shade(1), .Source(1),
-    .OutLanes(FrLanes), .MaxSection(Section), .Window(Window)
+    .OutLanes(FrLanes), .MaxSection(Section), .Window(Window), .WinDescDepth(WinDescDepth)
   ) u_frame (
     .clk_i, .rst_ni(unit_rst_n),
     .in_valid_i(fr_in_valid), .in_ready_o(fr_in_ready), .in_data_i(fr_in_data),

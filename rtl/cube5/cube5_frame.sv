@@ -73,7 +73,11 @@ module cube5_frame #(
   /// stream (a later section samples them) or the final stream (the image's pixels), parked ones
   /// come back on the restore streams; no read-out (the output stream carries error items only).
   /// 0: the whole base plane in the buffer, the read-out after the last section.
-  parameter int unsigned Window     = 0
+  parameter int unsigned Window     = 0,
+  /// Window = 1: the window's descriptor FIFO depth (cube5_frame_win DescDepth, a power of two):
+  /// 32 admits at most 0.94 beats per clock, 64 one (docs/accel.md, *Throughput against memory
+  /// bandwidth*).
+  parameter int unsigned WinDescDepth = 32
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -1003,7 +1007,8 @@ module cube5_frame #(
       .CoxW    (StoreW),
       .TrigW   (LagW + 1),
       .Depth   (WinDepth),
-      .RsDepth (RsDepth)
+      .RsDepth (RsDepth),
+      .DescDepth (WinDescDepth)
     ) u_win (
       .clk_i        (clk_i),
       .rst_ni       (rst_ni),

@@ -37,11 +37,16 @@ module cube5_frame_win #(
   parameter int unsigned CoxW    = 85,
   /// Bits of Trig (the frame's flush count).
   parameter int unsigned TrigW   = 16,
-  /// Descriptor, park and final FIFO depth (a power of two): at least the beats between
-  /// admission and write-back for a sweep without stalls.
+  /// Park and final FIFO depth (a power of two): at least the beats between admission and
+  /// write-back for a sweep without stalls.
   parameter int unsigned Depth   = 32,
   /// Restore FIFO depth (a power of two): restores requested ahead.
-  parameter int unsigned RsDepth = 64
+  parameter int unsigned RsDepth = 64,
+  /// Descriptor FIFO depth (a power of two): the beats admitted and not yet read by the buffer.
+  /// The admission's round trip (admit -> the buffer's read of the beat -> the registered full
+  /// flag) is about 34 cycles, so 32 admits at most 32 beats per 34 cycles (0.94 beats per
+  /// clock); 64 never stops a sweep on it (docs/accel.md, *Throughput against memory bandwidth*).
+  parameter int unsigned DescDepth = 32
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -100,11 +105,13 @@ module cube5_frame_win #(
   localparam int unsigned KeyW  = 2 * DimW;
   localparam int unsigned CntW  = $clog2(Depth) + 1;
   localparam int unsigned RsCntW = $clog2(RsDepth) + 1;
+  localparam int unsigned DescCntW = $clog2(DescDepth) + 1;
   localparam int unsigned DescW = 4 * P + KeyW;     // enter, restore, leave, final, {Q, R0}
 
   if (Depth < 2 || (1 << $clog2(Depth)) != Depth || RsDepth < 2
-      || (1 << $clog2(RsDepth)) != RsDepth) begin : gen_bad_depth
-    $fatal(1, "cube5_frame_win: Depth and RsDepth must be powers of two >= 2");
+      || (1 << $clog2(RsDepth)) != RsDepth || DescDepth < 2
+      || (1 << $clog2(DescDepth)) != DescDepth) begin : gen_bad_depth
+    $fatal(1, "cube5_frame_win: Depth, RsDepth and DescDepth must be powers of two >= 2");
   end
 
   // ---------------------------------------------------------------------------
@@ -241,7 +248,8 @@ module cube5_frame_win #(
   // FIFOs not yet promised, free descriptors; beside each, whether none is left (a register
   // that follows the count: its next value from the count's compares and the cycle's events).
   logic [RsCntW-1:0] rs_avail_q;
-  logic [CntW-1:0]   park_free_q, fin_free_q, desc_cnt_q;
+  logic [CntW-1:0]   park_free_q, fin_free_q;
+  logic [DescCntW-1:0] desc_cnt_q;
   logic              rs_none_q, park_none_q, fin_none_q, desc_full_q;
   logic              admit, rs_push, park_pop, fin_pop, rd_pop, take_rs, take_park, take_fin;
 
@@ -272,14 +280,14 @@ module cube5_frame_win #(
       rs_avail_q  <= rs_avail_q + RsCntW'(rs_push) - RsCntW'(take_rs);
       park_free_q <= park_free_q + CntW'(park_pop) - CntW'(take_park);
       fin_free_q  <= fin_free_q + CntW'(fin_pop) - CntW'(take_fin);
-      desc_cnt_q  <= desc_cnt_q + CntW'(admit) - CntW'(rd_pop);
+      desc_cnt_q  <= desc_cnt_q + DescCntW'(admit) - DescCntW'(rd_pop);
       // A take needs a count of at least one, so with no increment the count ends at zero
       // (full) when it is zero (full) or one short and taken.
       rs_none_q   <= !rs_push && (rs_avail_q == '0 || (rs_avail_q == RsCntW'(1) && take_rs));
       park_none_q <= !park_pop && (park_free_q == '0 || (park_free_q == CntW'(1) && take_park));
       fin_none_q  <= !fin_pop && (fin_free_q == '0 || (fin_free_q == CntW'(1) && take_fin));
-      desc_full_q <= !rd_pop && (desc_cnt_q == CntW'(Depth)
-                                 || (desc_cnt_q == CntW'(Depth - 1) && admit));
+      desc_full_q <= !rd_pop && (desc_cnt_q == DescCntW'(DescDepth)
+                                 || (desc_cnt_q == DescCntW'(DescDepth - 1) && admit));
     end
   end
 
@@ -291,7 +299,7 @@ module cube5_frame_win #(
 
   cube5_frame_fifo #(
     .Width (DescW),
-    .Depth (Depth)
+    .Depth (DescDepth)
   ) u_desc (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),

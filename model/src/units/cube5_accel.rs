@@ -35,6 +35,7 @@ const OWN_PARAMS: &[(&str, i64)] = &[
     ("Window", 0),
     ("WinOutstanding", 16),
     ("WinWDepth", 8),
+    ("WinDescDepth", 32),
     ("FetchHold", 0),
     ("WinZeroDepth", 0),
     ("WinRing", 0),
@@ -193,6 +194,7 @@ impl UnitConfig for AccelConfig {
         // With the compositing window (`Window = 1`) the frame has no read-out: one lane.
         fp.push(("OutLanes", if get("Window") == 1 { 1 } else { get("P") }));
         fp.push(("Window", get("Window")));
+        fp.push(("WinDescDepth", get("WinDescDepth")));
         let own = |n: &str| {
             u32::try_from(get(n)).map_err(|_| {
                 ModelError::Config(format!("cube5_accel: {n} = {} is out of range", get(n)))
@@ -283,6 +285,7 @@ impl UnitConfig for AccelConfig {
             ("Window", i64::from(self.window)),
             ("WinOutstanding", i64::from(self.win_outstanding)),
             ("WinWDepth", i64::from(self.win_w_depth)),
+            ("WinDescDepth", i64::from(self.frame.win_desc_depth)),
             ("FetchHold", i64::from(self.fetch_hold)),
             ("WinZeroDepth", i64::from(self.win_zero_depth)),
             ("WinRing", i64::from(self.win_ring)),

@@ -96,6 +96,9 @@ pub struct FrameConfig {
     /// rays' coxels, the rest leave on the park and final streams and come back on the restore
     /// streams (docs/numerics/compos_window.md; the model: `window::render_window`).
     pub window: bool,
+    /// With the window: its descriptor FIFO's depth (`WinDescDepth`, a power of two; 32 admits
+    /// at most 0.94 beats per clock, 64 one). Timing only: the image is the same.
+    pub win_desc_depth: u32,
 }
 
 impl FrameConfig {
@@ -115,6 +118,7 @@ impl FrameConfig {
         out_lanes: 1,
         max_section: None,
         window: false,
+        win_desc_depth: 32,
     };
 
     /// The largest volume edge (`MaxDim`).
@@ -153,6 +157,7 @@ impl crate::unit::UnitConfig for FrameConfig {
         let mut out_lanes = d.out_lanes as u32;
         let mut max_section = 0u32; // 0: not given, MaxDim
         let mut window = 0u32;
+        let mut win_desc_depth = d.win_desc_depth;
         crate::unit::set_params(
             Self::TOP,
             params,
@@ -182,8 +187,14 @@ impl crate::unit::UnitConfig for FrameConfig {
                 ("OutLanes", &mut out_lanes),
                 ("MaxSection", &mut max_section),
                 ("Window", &mut window),
+                ("WinDescDepth", &mut win_desc_depth),
             ],
         )?;
+        if win_desc_depth < 2 || !win_desc_depth.is_power_of_two() {
+            return Err(ModelError::Config(format!(
+                "cube5_frame: WinDescDepth = {win_desc_depth} must be a power of two of at least 2"
+            )));
+        }
         if window > 1 || (window == 1 && (source != 1 || depth_test != 0 || out_lanes != 1)) {
             return Err(ModelError::Config(format!(
                 "cube5_frame: Window = {window} must be 0, or 1 with Source = 1, no depth test and OutLanes = 1"
@@ -247,6 +258,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             max_section: (max_section != 0 && max_section != max_dim)
                 .then_some(max_section as usize),
             window: window == 1,
+            win_desc_depth,
         })
     }
 
@@ -279,6 +291,7 @@ impl crate::unit::UnitConfig for FrameConfig {
             ("OutLanes", self.out_lanes as i64),
             ("MaxSection", self.max_section() as i64),
             ("Window", i64::from(self.window)),
+            ("WinDescDepth", i64::from(self.win_desc_depth)),
         ]
     }
 }
