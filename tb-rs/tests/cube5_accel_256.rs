@@ -208,3 +208,12 @@ fn synthesized_lines_256() {
 fn bandwidth_sweep_128() {
     head_45_ddr(128, seed(0xacce128), &[12, 16, 24]);
 }
+
+/// Every synthesized line at its size: the 256^3 head at 45 degrees, composite, under the
+/// DDR-like memory at 12, 16 and 24 bytes per cycle (the same memory seed as
+/// `synthesized_lines_256`; docs/accel.md, *Throughput against memory bandwidth*).
+#[test]
+#[ignore = "sim-full: 256^3 frames on the synthesized lines, minutes each"]
+fn bandwidth_sweep_256() {
+    head_45_ddr(256, seed(0xacce257), &[12, 16, 24]);
+}
