@@ -204,10 +204,11 @@ pub struct FrameRun {
     /// The core's cycle counter: start to end of frame.
     pub cycles: u64,
     pub samples: u64,
-    /// Read bursts and beats, write bursts of the frame.
+    /// Read bursts and beats, write bursts and beats of the frame.
     pub ar: u64,
     pub r_beats: u64,
     pub aw: u64,
+    pub w_beats: u64,
 }
 
 impl FrameRun {
@@ -227,8 +228,8 @@ pub struct AccelBench {
     /// What the tables hold: (volume LUT loaded, the frame's configuration writes).
     loaded: Option<Vec<(u32, Vec<u32>)>>,
     lut_loaded: Option<Vec<(u32, u32, Vec<u32>)>>,
-    /// The memory's AR, R and AW counters when the frame started.
-    at_start: (u64, u64, u64),
+    /// The memory's AR, R, AW and W counters when the frame started.
+    at_start: (u64, u64, u64, u64),
     /// The `ImgPitch` register the next frames are started with (0: the smallest pitch).
     pub pitch: u32,
     /// The window's scratch area of the frame being run (`Window = 1`): base and bytes.
@@ -260,7 +261,7 @@ impl AccelBench {
             host_stall: Vec::new(),
             loaded: None,
             lut_loaded: None,
-            at_start: (0, 0, 0),
+            at_start: (0, 0, 0, 0),
             pitch: 0,
             park: (0, 0),
         })
@@ -369,12 +370,8 @@ impl AccelBench {
         let rtl = self.rtl;
         let img_base = self.load_memory(e, vol, lut, env, mem_seed)?;
         self.host_stall = env.host_stall.clone();
-        let c = self.dut.axi_counters();
-        self.at_start = (
-            c.ar_accepted,
-            c.r_beats,
-            self.dut.axi_wr_counters().aw_accepted,
-        );
+        let (c, w) = (self.dut.axi_counters(), self.dut.axi_wr_counters());
+        self.at_start = (c.ar_accepted, c.r_beats, w.aw_accepted, w.w_beats);
         let pitch = self.pitch;
         let park = self.park.0;
         let mut host = AccelHost::new(&mut *self, 0);
@@ -393,13 +390,14 @@ impl AccelBench {
         if st.busy || !st.done {
             return Err(self.protocol(self.dut.cycle(), format!("status {st:?} after the irq")));
         }
-        let after = self.dut.axi_counters();
+        let (after, w) = (self.dut.axi_counters(), self.dut.axi_wr_counters());
         let run = FrameRun {
             cycles: c.cycles,
             samples: c.samples,
             ar: after.ar_accepted - self.at_start.0,
             r_beats: after.r_beats - self.at_start.1,
-            aw: self.dut.axi_wr_counters().aw_accepted - self.at_start.2,
+            aw: w.aw_accepted - self.at_start.2,
+            w_beats: w.w_beats - self.at_start.3,
         };
         self.compare(e, img_base, seed)?;
         Ok(run)
