@@ -578,3 +578,21 @@ impl RegBus for &mut AccelBench {
         Ok(())
     }
 }
+
+/// Bursts and beats of one AXI ID.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct IdCount {
+    pub bursts: u64,
+    pub beats: u64,
+}
+
+/// Bursts and beats per AXI ID of a memory's handshake log (`axi_take_ar`, `axi_take_aw`).
+pub fn count_by_id(hs: &[crate::rtl::ArHandshake]) -> std::collections::BTreeMap<u32, IdCount> {
+    let mut m = std::collections::BTreeMap::<u32, IdCount>::new();
+    for h in hs {
+        let e = m.entry(h.id).or_default();
+        e.bursts += 1;
+        e.beats += u64::from(h.len) + 1;
+    }
+    m
+}

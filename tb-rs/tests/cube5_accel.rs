@@ -811,12 +811,7 @@ fn window_full(p: usize) -> AccelRtl {
 // ID (`axi_take_ar`, `axi_take_aw`); the model's window streams give what they must be.
 // ---------------------------------------------------------------------------------------------
 
-/// Bursts and beats of one AXI ID.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-struct IdCount {
-    bursts: u64,
-    beats: u64,
-}
+use cube5_tb::accel::IdCount;
 
 /// The bursts of ID `id` in `hs`.
 fn of_id(hs: &[cube5_tb::rtl::ArHandshake], id: u32) -> Vec<(u64, u64)> {

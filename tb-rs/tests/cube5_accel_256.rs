@@ -15,9 +15,8 @@ mod support;
 
 use cube5_model::phantom::head_phantom;
 use cube5_model::units::cube5_skewmem::BlockLut;
-use cube5_tb::accel::{AccelBench, AccelRtl, FrameRun, MemEnv, TOP};
+use cube5_tb::accel::{count_by_id, AccelBench, AccelRtl, FrameRun, IdCount, MemEnv, TOP};
 use cube5_tb::frame::{Expected, Look, Render, OBLIQUE_Z, VIEWS};
-use cube5_tb::rtl::ArHandshake;
 use cube5_tb::variants::variants_of;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -50,17 +49,7 @@ fn view_45() -> View {
 }
 
 /// Bursts and beats per AXI4 ID, from the memory's handshake log.
-type ById = BTreeMap<u32, (u64, u64)>;
-
-fn by_id(hs: &[ArHandshake]) -> ById {
-    let mut m = ById::new();
-    for h in hs {
-        let e = m.entry(h.id).or_default();
-        e.0 += 1;
-        e.1 += u64::from(h.len) + 1;
-    }
-    m
-}
+type ById = BTreeMap<u32, IdCount>;
 
 /// What one frame of [`head_frames`] did: the run, and its read and write bursts and beats per
 /// ID (reads: 0 the volume, 1 the ring; writes: 0 the clear, 1 the ring, 2 the final pixels).
@@ -97,8 +86,8 @@ fn head_frames(
         let img_base = must(bench.start(&e, &vol, &lut, &env, mem_seed));
         let run = must(bench.finish(&e, img_base, mem_seed));
         let (reads, writes) = (
-            by_id(&must(bench.dut.axi_take_ar())),
-            by_id(&must(bench.dut.axi_take_aw())),
+            count_by_id(&must(bench.dut.axi_take_ar())),
+            count_by_id(&must(bench.dut.axi_take_aw())),
         );
         eprintln!(
             "{}: {n}^3 head {name} {render:?}, {what} (latency {:?}, bytes/cycle {:?}): {:.3} samples/clock/pipeline, {run:?}; by ID (bursts, beats): reads {reads:?}, writes {writes:?}",
@@ -169,8 +158,8 @@ fn head_45_ddr(n: usize, s: u64, bytes: &[u32]) {
                 r.r_beats,
                 r.aw,
                 r.w_beats,
-                fin.0,
-                fin.1,
+                fin.bursts,
+                fin.beats,
                 bytes_moved as f64 / r.cycles as f64,
                 100.0 * bytes_moved as f64 / (r.cycles as f64 * f64::from(b)),
             ));
