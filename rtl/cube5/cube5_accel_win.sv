@@ -178,6 +178,8 @@ module cube5_accel_win #(
   // Stage 1: the next item (a park before a final; a final once its row is cleared).
   // ---------------------------------------------------------------------------
   logic               s1_v_q, s1_park_q, s1_new_q;
+  logic               s1_zero_q;  // the park's stored coxel is all zero (found as it is taken)
+  logic [AddrW-1:0]   s1_rowoff_q; // a final's row times the row step (multiplied as it is taken)
   logic [KeyW-1:0]    s1_key_q;
   logic [P-1:0]       s1_mask_q;
   logic [P*StoreW-1:0] s1_cox_q;
@@ -210,16 +212,18 @@ module cube5_accel_win #(
       s1_key_q  <= park_key_i;
       s1_mask_q <= P'(1);
       s1_cox_q  <= (P*StoreW)'(park_cox_i);
+      s1_zero_q <= park_cox_i[StoreW-1:0] == '0;
     end else if (take_fin) begin
       s1_park_q <= 1'b0;
       s1_key_q  <= fin_key_i;
       s1_mask_q <= fin_mask_i;
       s1_cox_q  <= fin_cox_i;
+      s1_rowoff_q <= AddrW'(fin_key_i[DimW +: DimW]) * row_step_i;
     end
   end
 
   assign p_decide = s1_v_q && s1_new_q;   // s1_new_q: a park, loaded last cycle
-  assign p_drop   = p_decide && p_rec && s1_cox_q[StoreW-1:0] == '0;
+  assign p_drop   = p_decide && p_rec && s1_zero_q;
   assign p_write  = p_decide && !p_drop;
 
   // ---------------------------------------------------------------------------
@@ -241,8 +245,7 @@ module cube5_accel_win #(
     assign pix_strb[4*k +: 4] = {4{s1_mask_q[k]}};
   end
 
-  assign fin_addr = img_base_i + AddrW'(s1_key_q[DimW +: DimW]) * row_step_i
-                    + (AddrW'(s1_key_q[0 +: DimW]) << 2);
+  assign fin_addr = img_base_i + s1_rowoff_q + (AddrW'(s1_key_q[0 +: DimW]) << 2);
 
   always_comb begin
     if (s1_park_q) begin
@@ -288,7 +291,7 @@ module cube5_accel_win #(
   logic               aw_full, aw_empty, w_full, w_empty, aw_pop, w_pop;
   logic [OutW-1:0]    out_q;      // write bursts in the AW FIFO or in flight, B not yet in
   logic               b_fire;
-  logic               rg_use;     // Ring = 1: a ring burst's AW or beats go into the FIFOs
+  logic               rg_use;     // Ring = 1: the ring holds the FIFOs (a burst decided, or its beats)
   logic               rg_aw;      // Ring = 1: a ring burst starts (its AW pushed)
   logic               rg_w;       // Ring = 1: a ring burst's beat into the W FIFO
   logic [AwW-1:0]     rg_aw_d;
@@ -342,12 +345,12 @@ module cube5_accel_win #(
 
   cube5_frame_fifo #(.Width(AwW), .Depth(WDepth)) u_aw (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i(push_aw || rg_aw || fm_aw), .d_i(rg_use ? rg_aw_d : fm_use ? fm_aw_d : aw_d),
+    .push_i(push_aw || rg_aw || fm_aw), .d_i(rg_aw ? rg_aw_d : fm_use ? fm_aw_d : aw_d),
     .pop_i(aw_pop), .q_o(aw_q), .empty_o(aw_empty), .full_o(aw_full)
   );
   cube5_frame_fifo #(.Width(WW), .Depth(WDepth)) u_w (
     .clk_i, .rst_ni, .clear_i(1'b0),
-    .push_i((step && push_w) || rg_w || fm_w), .d_i(rg_use ? rg_w_d : fm_use ? fm_w_d : w_d),
+    .push_i((step && push_w) || rg_w || fm_w), .d_i(rg_w ? rg_w_d : fm_use ? fm_w_d : w_d),
     .pop_i(w_pop), .q_o(w_q), .empty_o(w_empty), .full_o(w_full)
   );
 
@@ -397,12 +400,17 @@ module cube5_accel_win #(
     logic           zh_bit;
     logic [UnW-1:0] unrec_q;        // parks written and recorded nowhere, not yet restored
     logic           z_push, z_re, z_pop, z_any, un_pop;
+    // The FIFO full and no park unrecorded, kept in registers so that a park's decision starts
+    // at flip-flops; each is set from the count's registered value and this cycle's push and pop
+    // (one LUT after them, not after an adder).
+    logic           z_full_q, unrec_zero_q, z_cnt_full, z_cnt_near, un_inc;
+    logic [ZPtrW:0] z_cnt;
 
     if (ZDepth < 2 || (1 << ZPtrW) != ZDepth) begin : gen_bad_zdepth
       $fatal(1, "cube5_accel_win: ZeroDepth must be 0 or a power of two >= 2");
     end
 
-    assign p_rec  = unrec_q == '0 && (zw_q - zr_q) != (ZPtrW+1)'(ZDepth);
+    assign p_rec  = unrec_zero_q && !z_full_q;
     assign z_push = p_decide && p_rec;
     // A request belongs to the FIFO's head while the FIFO holds a bit (the recorded parks are
     // older than the unrecorded ones), else to an unrecorded park: a read.
@@ -412,6 +420,10 @@ module cube5_accel_win #(
     assign z_pop  = rq_push && z_any;
     assign un_pop = rq_push && !z_any;
     assign z_re   = zw_q != zr_q && (!zh_v_q || z_pop);
+    assign z_cnt      = zw_q - zr_q;
+    assign z_cnt_full = z_cnt == (ZPtrW+1)'(ZDepth);
+    assign z_cnt_near = z_cnt == (ZPtrW+1)'(ZDepth - 1);
+    assign un_inc     = p_write && !p_rec;
 
     cube5_section_buf_ram #(.Depth(ZDepth), .Width(1), .AddrW(ZPtrW)) u_zbits (
       .clk_i,
@@ -425,16 +437,23 @@ module cube5_accel_win #(
         zr_q    <= '0;
         zh_v_q  <= 1'b0;
         unrec_q <= '0;
+        z_full_q     <= 1'b0;
+        unrec_zero_q <= 1'b1;
       end else begin
         zw_q    <= zw_q + (ZPtrW+1)'(z_push);
         zr_q    <= zr_q + (ZPtrW+1)'(z_re);
         if (z_re)       zh_v_q <= 1'b1;
         else if (z_pop) zh_v_q <= 1'b0;
-        unrec_q <= unrec_q + UnW'(p_write && !p_rec) - UnW'(un_pop);
+        unrec_q <= unrec_q + UnW'(un_inc) - UnW'(un_pop);
+        z_full_q     <= (z_push == z_re) ? z_cnt_full : (z_push && z_cnt_near);
+        unrec_zero_q <= (un_inc == un_pop) ? unrec_zero_q : (un_pop && unrec_q == UnW'(1));
       end
     end
 
 `ifndef SYNTHESIS
+    WinZeroFlags: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        z_full_q == (zw_q - zr_q == (ZPtrW+1)'(ZDepth)) && unrec_zero_q == (unrec_q == '0))
+      else $error("cube5_accel_win: the zero FIFO's registered flags disagree with its counts");
     WinZeroKnown: assert property (@(posedge clk_i) disable iff (!rst_ni)
         un_pop |-> unrec_q != '0)
       else $error("cube5_accel_win: a restore request before its park");
@@ -623,7 +642,12 @@ module cube5_accel_win #(
     logic [CntW-1:0] w_iss_q, w_ack_q;          // beats in write bursts; acknowledged (B)
     logic [CntW-1:0] r_iss_q, r_ret_q, r_pop_q; // beats read (AR), returned (R), unpacked
     logic [CntW-1:0] w_lim, w_len, w_room, w_end, r_lim, r_len, r_end, r_avail, r_cred;
+    logic [CntW-1:0] w_lim_q, w_room_q;         // w_lim, w_room a cycle late (see rg_go)
+    logic [CntW-1:0] r_lim_q, r_avail_q, r_cred_q;  // r_lim, r_avail, r_cred a cycle late
     logic [QW-1:0]   mv_q;                      // beats of the current burst still to move
+    logic            rg_go, rg_claim_q;         // a burst decided; it holds the AW/W FIFOs
+    logic [QW-1:0]   wb_len_q;                  // the decided burst's beats
+    logic [AddrW-1:0] wb_addr_q;                // and its address
     logic            bl_empty, bl_full, bl_pop, ar_go, rg_ar_v_q;
     logic [QW-1:0]   bl_q;
     logic [BLog-1:0] w_off, r_off;
@@ -632,30 +656,37 @@ module cube5_accel_win #(
       min2 = (a < b) ? a : b;
     endfunction
 
+    // A burst is decided (rg_go) a cycle before its AW enters the FIFO (rg_aw): the decision's
+    // carry chains end in registers, and the FIFOs' users (step, the finals' mover) see only
+    // registered state (rg_claim_q, mv_q). Its limit and the ring's room come from registers a
+    // cycle late: wpos_q and w_iss_q move only at rg_aw, at least two cycles before the next
+    // rg_go (mv_q counts the burst's beats down first), and r_ret_q only grows, so w_lim_q is
+    // w_lim and w_room_q at most w_room whenever rg_go can be true.
     assign w_off  = BLog'(base >> LogBus) + BLog'(wpos_q);
     assign w_end  = ring_n_q - wpos_q;
     assign w_lim  = min2(CntW'(RingBurst) - CntW'(w_off), w_end);
-    assign w_len  = min2(CntW'(bq_n_q), w_lim);
+    assign w_len  = min2(CntW'(bq_n_q), w_lim_q);
     assign w_room = ring_n_q - (w_iss_q - r_ret_q);
-    assign rg_aw  = mv_q == '0 && w_len != '0 && (CntW'(bq_n_q) >= w_lim || flush_q)
-                    && w_len <= w_room && !aw_full && out_q < OutW'(Outstanding) && !fm_busy;
+    assign rg_go  = !rg_claim_q && mv_q == '0 && w_len != '0
+                    && (CntW'(bq_n_q) >= w_lim_q || flush_q) && w_len <= w_room_q;
+    assign rg_aw  = rg_claim_q && mv_q == '0 && !aw_full && out_q < OutW'(Outstanding) && !fm_busy;
     assign rg_w   = mv_q != '0 && !w_full;
-    assign rg_use = rg_aw || mv_q != '0;
-    assign rg_aw_d = {IdPark, 8'(w_len - CntW'(1)), base + (AddrW'(wpos_q) << LogBus)};
+    assign rg_use = rg_claim_q || mv_q != '0;
+    assign rg_aw_d = {IdPark, 8'(wb_len_q) - 8'd1, wb_addr_q};
     assign rg_w_d  = {mv_q == QW'(1), {Bbus{1'b1}}, bq_q};
     assign bl_pop  = b_fire && bid_i == IdPark;
 
     cube5_frame_fifo #(.Width(QW), .Depth(BlDepth)) u_bl (
       .clk_i, .rst_ni, .clear_i(1'b0),
-      .push_i(rg_aw), .d_i(QW'(w_len)), .pop_i(bl_pop), .q_o(bl_q), .empty_o(bl_empty),
+      .push_i(rg_aw), .d_i(wb_len_q), .pop_i(bl_pop), .q_o(bl_q), .empty_o(bl_empty),
       .full_o(bl_full)
     );
 
     // ---- restore reads: the acknowledged beats in order, ahead, as the buffer has room ----
     logic [AddrW-1:0] rg_addr_q;
     logic [7:0]       rg_len_q;
-    logic             rb_empty, rb_full, rb_pop;
-    logic [DataW-1:0] rb_q;
+    logic             rb_empty, rb_full, rb_pop, hd_v, hd_take;
+    logic [DataW-1:0] rb_q, hd_beat;
     logic [OutW-1:0]  r_out_q;          // read bursts issued, last beat not yet in
 
     assign r_off   = BLog'(base >> LogBus) + BLog'(rpos_q);
@@ -663,10 +694,12 @@ module cube5_accel_win #(
     assign r_avail = w_ack_q - r_iss_q;
     assign r_cred  = CntW'(RdDepth) - (r_iss_q - r_pop_q);
     assign r_lim   = min2(CntW'(RingBurst) - CntW'(r_off), r_end);
-    // A read waits until the buffer has room for the whole burst (not a beat at a time).
-    assign r_len   = min2(r_avail, r_lim);
-    assign ar_go   = r_len != '0 && r_len <= r_cred && (!rg_ar_v_q || arready_i)
-                     && r_out_q < OutW'(Outstanding);
+    // A read waits until the buffer has room for the whole burst (not a beat at a time). As the
+    // writes' decision, it reads its limit, the acknowledged beats and the buffer's room from
+    // registers a cycle late: rpos_q and r_iss_q move only at ar_go, and the next ar_go waits
+    // until the AR register is free (at least two cycles), while w_ack_q and r_pop_q only grow.
+    assign r_len   = min2(r_avail_q, r_lim_q);
+    assign ar_go   = r_len != '0 && r_len <= r_cred_q && !rg_ar_v_q && r_out_q < OutW'(Outstanding);
 
     always_ff @(posedge clk_i) begin
       if (!rst_ni || frame_start_i) begin
@@ -679,15 +712,29 @@ module cube5_accel_win #(
         r_pop_q <= '0;
         bq_n_q <= '0;
         mv_q   <= '0;
+        rg_claim_q <= 1'b0;
+        // Nothing is decided in the cycle after: no room, no beats to read.
+        w_lim_q   <= '0;
+        w_room_q  <= '0;
+        r_lim_q   <= '0;
+        r_avail_q <= '0;
+        r_cred_q  <= '0;
         rg_ar_v_q <= 1'b0;
         flush_q <= 1'b0;
         r_out_q <= '0;
       end else begin
-        bq_n_q <= bq_n_q + QW'(emit || pad) - (rg_aw ? QW'(w_len) : QW'(0));
+        w_lim_q   <= w_lim;
+        w_room_q  <= w_room;
+        r_lim_q   <= r_lim;
+        r_avail_q <= r_avail;
+        r_cred_q  <= r_cred;
+        bq_n_q <= bq_n_q + QW'(emit || pad) - (rg_aw ? wb_len_q : QW'(0));
+        if (rg_go) rg_claim_q <= 1'b1;
         if (rg_aw) begin
-          mv_q    <= QW'(w_len);
-          w_iss_q <= w_iss_q + w_len;
-          wpos_q  <= (w_len == w_end) ? '0 : wpos_q + w_len;
+          rg_claim_q <= 1'b0;
+          mv_q    <= wb_len_q;
+          w_iss_q <= w_iss_q + CntW'(wb_len_q);
+          wpos_q  <= (CntW'(wb_len_q) == w_end) ? '0 : wpos_q + CntW'(wb_len_q);
         end else if (rg_w) begin
           mv_q <= mv_q - QW'(1);
         end
@@ -703,12 +750,16 @@ module cube5_accel_win #(
         r_out_q <= r_out_q + OutW'(ar_go) - OutW'(r_fire && rlast_i);
         r_pop_q <= r_pop_q + CntW'(rb_pop);
         // The frame waits for a restore whose bits are not on their way: write what is held.
-        flush_q <= !ord_empty && !ord_zero && !rg_cx_v && rb_empty && r_avail == '0
-                   && r_iss_q == r_ret_q && !rg_ar_v_q && bl_empty && mv_q == '0;
+        flush_q <= !ord_empty && !ord_zero && !rg_cx_v && rb_empty && !hd_v && r_avail == '0
+                   && r_iss_q == r_ret_q && !rg_ar_v_q && bl_empty && mv_q == '0 && !rg_claim_q;
       end
     end
 
     always_ff @(posedge clk_i) begin
+      if (rg_go) begin
+        wb_len_q  <= QW'(w_len);
+        wb_addr_q <= base + (AddrW'(wpos_q) << LogBus);
+      end
       if (ar_go) begin
         rg_addr_q <= base + (AddrW'(rpos_q) << LogBus);
         rg_len_q  <= 8'(r_len - CntW'(1));
@@ -735,9 +786,17 @@ module cube5_accel_win #(
     assign pad_hit = !pf_empty && pf_q == cout_q;
     assign drop    = DFillW'(dfill_q[LogW-1:0]);   // the rest of the beat under way
     assign ex      = !pad_hit && dfill_q >= DFillW'(StoreW) && !cx_full;
-    assign ap      = !pad_hit && dfill_q < DFillW'(StoreW) && !rb_empty;
+    assign ap      = !pad_hit && dfill_q < DFillW'(StoreW) && hd_v;
     assign pf_pop  = pad_hit;
-    assign rb_pop  = ap;
+
+    // The buffer's head beat through a register slice: the unpacker's shift starts at flip-flops,
+    // not at the block RAM's output (5.8 ns of clock-to-out on the ECP5 without its register).
+    cube5_axi_slice #(.Width(DataW)) u_hd (
+      .clk_i, .rst_ni(rst_ni && !frame_start_i),
+      .in_valid_i(!rb_empty), .in_ready_o(hd_take), .in_data_i(rb_q),
+      .out_valid_o(hd_v), .out_ready_i(ap), .out_data_o(hd_beat)
+    );
+    assign rb_pop = !rb_empty && hd_take;
 
     always_ff @(posedge clk_i) begin
       if (!rst_ni || frame_start_i) begin
@@ -752,7 +811,7 @@ module cube5_accel_win #(
         dfill_q <= dfill_q - DFillW'(StoreW);
         cout_q  <= cout_q + CntW'(1);
       end else if (ap) begin
-        dbuf_q  <= dbuf_q | (DBits'(rb_q) << dfill_q);
+        dbuf_q  <= dbuf_q | (DBits'(hd_beat) << dfill_q);
         dfill_q <= dfill_q + DFillW'(DataW);
       end
     end
@@ -763,12 +822,18 @@ module cube5_accel_win #(
       .empty_o(cx_empty), .full_o(cx_full)
     );
     assign rg_cx_v = !cx_empty;
-    assign rg_idle = mv_q == '0 && bl_empty && r_iss_q == r_ret_q && !rg_ar_v_q;
+    assign rg_idle = mv_q == '0 && !rg_claim_q && bl_empty && r_iss_q == r_ret_q && !rg_ar_v_q;
 
 `ifndef SYNTHESIS
     WinRingRoom: assert property (@(posedge clk_i) disable iff (!rst_ni)
         !(w_len != '0 && w_len > w_room))
       else $error("cube5_accel_win: the ring is full (docs/numerics/compos_window.md bound)");
+    WinRingLate: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        rg_go |-> w_lim_q == w_lim && w_room_q <= w_room)
+      else $error("cube5_accel_win: a ring burst decided on a stale limit or room");
+    WinRingReadLate: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        ar_go |-> r_lim_q == r_lim && r_avail_q <= r_avail && r_cred_q <= r_cred)
+      else $error("cube5_accel_win: a ring read decided on a stale limit, count or room");
     WinRingOrder: assert property (@(posedge clk_i) disable iff (!rst_ni)
         rs_take |-> !cx_empty)
       else $error("cube5_accel_win: a restore handed over before its coxel");
