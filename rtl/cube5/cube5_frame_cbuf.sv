@@ -255,7 +255,11 @@ module cube5_frame_cbuf #(
         // The word {Q, R div P}, or in the window {Q mod MaxDim, (R div P) mod WinCols}.
         sw_addr[j*AddrW +: AddrW] = (Window != 0) ? AddrW'({q_row[QW-2:0], col[WinColW-1:0]})
                                                   : AddrW'({q_row[QW-1:0], col[ColW-1:0]});
-        pay_rot[j*PayW +: PayW]   = in_pay_i[lane*PayW +: PayW];
+        // A P-way mux by lane (an indexed part-select `lane*PayW` becomes a multiplier in Yosys).
+        pay_rot[j*PayW +: PayW]   = in_pay_i[0 +: PayW];
+        for (int unsigned l = 1; l < P; l++) begin
+          if (lane == LaneW'(l)) pay_rot[j*PayW +: PayW] = in_pay_i[l*PayW +: PayW];
+        end
         past_rot[j]               = past[lane];
         unused_col ^= ^col;
       end
@@ -507,7 +511,12 @@ module cube5_frame_cbuf #(
 
   if (OutLanes == 1) begin : gen_ro_one
     logic [WordW-1:0] ro_word;
-    assign ro_word = rd_word[ro_bank_q*WordW +: WordW];
+    always_comb begin
+      ro_word = rd_word[0 +: WordW];
+      for (int unsigned k = 1; k < P; k++) begin
+        if (ro_bank_q == LaneW'(k)) ro_word = rd_word[k*WordW +: WordW];
+      end
+    end
     assign ro_cox  = ro_word[CoxW] ? ro_word[CoxW-1:0] : empty_cox_i;
   end else begin : gen_ro_lanes
     // Bank k holds pixel R + k (R a multiple of P).
@@ -523,7 +532,12 @@ module cube5_frame_cbuf #(
   if (GeoW > 0) begin : gen_out_geo
     // The read-out word's geometry travels with its coxel.
     logic [GeoW-1:0] ro_geo;
-    assign ro_geo = geo_word[ro_bank_q*GeoPW +: GeoPW];
+    always_comb begin
+      ro_geo = GeoW'(geo_word[0 +: GeoPW]);
+      for (int unsigned k = 1; k < P; k++) begin
+        if (ro_bank_q == LaneW'(k)) ro_geo = GeoW'(geo_word[k*GeoPW +: GeoPW]);
+      end
+    end
     cube5_frame_fifo #(
       .Width (CoxW + GeoW),
       .Depth (OutDepth)
