@@ -9,7 +9,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 3 ]; then
-  echo "usage: scripts/unit-fmax.sh TOP CONFIG UNIT... (e.g. cube5_accel w1p4m256s16d128a16c10 cube5_frame_cbuf)" >&2
+  echo "usage: scripts/unit-fmax.sh TOP CONFIG UNIT..." >&2
+  echo "  e.g. scripts/unit-fmax.sh cube5_accel w1p4m256s16d128a16c10 cube5_frame_cbuf" >&2
   exit 2
 fi
 top=$1 config=$2
