@@ -350,6 +350,8 @@ module cube5_accel #(
   logic             sb_items_q;     // passing the fetch's items
   logic             sb_in_valid, sb_in_ready;
   logic [SbInW-1:0] sb_in_data;
+  logic             sb_rs_valid, sb_rs_ready;   // the same items past the register slice
+  logic [SbInW-1:0] sb_rs_data;
   logic             sb_out_valid, sb_out_ready;
   logic [SbOutW-1:0] sb_out_data;
 
@@ -366,12 +368,22 @@ module cube5_accel #(
     end
   end
 
+  // The buffer's input passes a two-entry register slice: the fetch's items leave the AXI read
+  // FIFO's block RAM (whose unregistered output takes 5.6 ns on the ECP5) and its word mux, and
+  // the buffer's command arithmetic starts from flip-flops; the buffer's ready reaches the fetch
+  // through a register (docs/accel.md, *Synthesis*). One cycle of latency, full throughput.
+  cube5_axi_slice #(.Width(SbInW)) u_sb_slice (
+    .clk_i, .rst_ni(unit_rst_n),
+    .in_valid_i(sb_in_valid), .in_ready_o(sb_in_ready), .in_data_i(sb_in_data),
+    .out_valid_o(sb_rs_valid), .out_ready_i(sb_rs_ready), .out_data_o(sb_rs_data)
+  );
+
   cube5_section_buf #(
     .P(P), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim), .Section(Section),
     .ItemGroups(SbG)
   ) u_sbuf (
     .clk_i, .rst_ni(unit_rst_n),
-    .in_valid_i(sb_in_valid), .in_ready_o(sb_in_ready), .in_data_i(sb_in_data),
+    .in_valid_i(sb_rs_valid), .in_ready_o(sb_rs_ready), .in_data_i(sb_rs_data),
     .out_valid_o(sb_out_valid), .out_ready_i(sb_out_ready), .out_data_o(sb_out_data)
   );
 
@@ -384,6 +396,8 @@ module cube5_accel #(
   logic [2:0]         reg_q;        // the register being written
   logic               fr_in_valid, fr_in_ready;
   logic [FrInW-1:0]   fr_in_data;
+  logic               fr_rs_valid, fr_rs_ready;   // the same items past the register slice
+  logic [FrInW-1:0]   fr_rs_data;
   logic               fr_out_valid, fr_out_ready;
   logic [FrOutW-1:0]  fr_out_data;
   logic               fr_error;     // the frame's output item is its error item
@@ -462,6 +476,16 @@ module cube5_accel #(
   logic [P-1:0]         win_fin_mask;
   logic [P*WinCoxW-1:0] win_fin_cox;
 
+  // The frame's input passes a two-entry register slice: the section buffer's read-out and the
+  // frame's admission (its ready follows the compositing window's flags and its state) meet only
+  // at flip-flops, and the frame's beat take starts from a registered valid and beam
+  // (docs/accel.md, *Synthesis*). One cycle of latency, full throughput.
+  cube5_axi_slice #(.Width(FrInW)) u_fr_slice (
+    .clk_i, .rst_ni(unit_rst_n),
+    .in_valid_i(fr_in_valid), .in_ready_o(fr_in_ready), .in_data_i(fr_in_data),
+    .out_valid_o(fr_rs_valid), .out_ready_i(fr_rs_ready), .out_data_o(fr_rs_data)
+  );
+
   cube5_frame #(
     .P(P), .MaxDim(MaxDim), .VoxelW(VoxelW), .WeightW(WeightW), .FracW(FracW),
     .BlockDim(BlockDim), .ClassIdxW(ClassIdxW), .MagIdxW(MagIdxW), .MagShift(MagShift),
@@ -470,7 +494,7 @@ module cube5_accel #(
     .OutLanes(FrLanes), .MaxSection(Section), .Window(Window), .WinDescDepth(WinDescDepth)
   ) u_frame (
     .clk_i, .rst_ni(unit_rst_n),
-    .in_valid_i(fr_in_valid), .in_ready_o(fr_in_ready), .in_data_i(fr_in_data),
+    .in_valid_i(fr_rs_valid), .in_ready_o(fr_rs_ready), .in_data_i(fr_rs_data),
     .out_valid_o(fr_out_valid), .out_ready_i(fr_out_ready), .out_data_o(fr_out_data),
     .cfg_valid_i(cfg_valid), .cfg_addr_i(cfg_addr), .cfg_data_i(cfg_data),
     // The compositing-window streams: cube5_accel_win (Window = 1), else idle.
@@ -492,8 +516,10 @@ module cube5_accel #(
 
   // Window = 1: no read-out; the frame is done once its last section's sweep is over (the frame
   // idle again), the window's streams are empty and their traffic has drained (every B and R in).
-  assign win_end    = Window != 0 && readout_q && last_in_q && fr_q == FrIdle && fr_in_ready
-                      && !win_park_valid && !win_fin_valid && win_idle;
+  // The frame is idle when the slice is empty and the frame is ready: with every beat of the
+  // last section inside it, it is ready for a beat or a command only in its idle state.
+  assign win_end    = Window != 0 && readout_q && last_in_q && fr_q == FrIdle && !fr_rs_valid
+                      && fr_rs_ready && !win_park_valid && !win_fin_valid && win_idle;
   assign done_ev    = (fr_out_valid && fr_out_ready && readout_q) || win_end;
   assign done_valid = (done_ev || done_pend_q) && last_in_q && (Window == 0 || win_idle);
   assign done_error = done_pend_q ? done_err_q : fr_error && fr_out_valid;

@@ -778,6 +778,27 @@ module cube5_frame #(
   assign beat_valid = mem_beat || flush_beat;
   assign beat       = mem_beat ? mem_lanes : '0;
 
+  // The beat register (BeatLatency cycles): the interpolators' windows, whose every register and
+  // block RAM advances per beat, take the beat a cycle after it is taken, so that their enable is
+  // a flip-flop and not the take (the input's valid, the window's admission, the state), which
+  // would otherwise reach across the whole frame in one cycle (docs/accel.md, *Synthesis*). The
+  // window's admission counts the beat as it is taken.
+  if (cube5_frame_pkg::BeatLatency != 1) begin : gen_bad_beat_latency
+    $fatal(1, "cube5_frame: the beat register is one stage (BeatLatency = 1)");
+  end
+  logic                beat_valid_q;
+  logic [XBeatW-1:0]   beat_q;
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      beat_valid_q <= 1'b0;
+    end else begin
+      beat_valid_q <= beat_valid;
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    beat_q <= beat;
+  end
+
   // ---------------------------------------------------------------------------
   // The P pipelines
   // ---------------------------------------------------------------------------
@@ -823,8 +844,8 @@ module cube5_frame #(
     .lag_i        (lag),
     .edge_lo_on_i (edge_lo_on),
     .edge_hi_on_i (edge_hi_on),
-    .beat_valid_i (beat_valid),
-    .beat_i       (beat),
+    .beat_valid_i (beat_valid_q),
+    .beat_i       (beat_q),
     .smp_valid_o  (smp_valid),
     .smp_o        (smp)
   );
@@ -871,7 +892,8 @@ module cube5_frame #(
       .DiffW      (DiffW),
       .SpecW      (SpecW),
       .ShCfgAddrW (ShAddrW),
-      .ShCfgDataW (ShDataW)
+      .ShCfgDataW (ShDataW),
+      .ShaderPipe (cube5_frame_pkg::ShaderPipe)
     ) u_shade (
       .clk_i         (clk_i),
       .rst_ni        (rst_ni),

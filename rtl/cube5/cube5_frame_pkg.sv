@@ -12,6 +12,10 @@ package cube5_frame_pkg;
   /// Width of the status counters in every output item (memory beats read, sweep cycles).
   localparam int unsigned CntW = 32;
 
+  /// Cycles from a beat taken by the frame to its voxel window: the beat register, so that the
+  /// windows' enable is a flip-flop (docs/accel.md, *Synthesis*).
+  localparam int unsigned BeatLatency = 1;
+
   /// `Pipe` of the frame's interpolators (cube5_trilin): 1, per axis the difference, the product
   /// and the rounded sum each in a register, so that no multiplier of the frame has logic on either
   /// side (docs/numerics/trilin.md, "Timing"; docs/accel.md, *Synthesis*).
@@ -20,6 +24,11 @@ package cube5_frame_pkg;
   /// Latency of the frame's cube5_trilin in cycles: 3, or 9 with `TrilinPipe` = 1
   /// (docs/numerics/trilin.md, "Timing").
   localparam int unsigned TrilinLatency = 3 + 6 * TrilinPipe;
+
+  /// `Pipe` of the frame's shaders (cube5_shader): 1, the decode in three stages and the output's
+  /// products in a register of their own, three cycles more latency (`9 + QW + 3`;
+  /// docs/numerics/shader.md, "Timing"; docs/accel.md, *Synthesis*).
+  localparam int unsigned ShaderPipe = 1;
 
   /// Latency of cube5_gradient in cycles: five register stages (docs/numerics/gradient.md,
   /// "Timing").

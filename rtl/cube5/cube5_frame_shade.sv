@@ -21,7 +21,9 @@ module cube5_frame_shade #(
   parameter int unsigned SpecW     = 8,
   /// Shader configuration port widths (cube5_shader_pkg).
   parameter int unsigned ShCfgAddrW = 14,
-  parameter int unsigned ShCfgDataW = 36
+  parameter int unsigned ShCfgDataW = 36,
+  /// The shaders' `Pipe` (cube5_shader): cube5_frame's ShaderPipe; 0 in cube5_er.
+  parameter int unsigned ShaderPipe = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -155,7 +157,8 @@ module cube5_frame_shade #(
       .RmLog2    (RmLog2),
       .RmFracW   (RmFracW),
       .DiffW     (DiffW),
-      .SpecW     (SpecW)
+      .SpecW     (SpecW),
+      .Pipe      (ShaderPipe)
     ) u_shader (
       .clk_i       (clk_i),
       .rst_ni      (rst_ni),

@@ -297,9 +297,12 @@ module cube5_frame_win #(
   logic [DescW-1:0] desc_head, wb_desc;
   logic unused_d0, unused_d1, unused_d2, unused_d3;
 
+  // The head in a register: the buffer's read of a descriptor (enter, restore) starts from a
+  // flip-flop, not from the RAM's read mux (docs/accel.md, *Synthesis*).
   cube5_frame_fifo #(
-    .Width (DescW),
-    .Depth (DescDepth)
+    .Width  (DescW),
+    .Depth  (DescDepth),
+    .OutReg (1)
   ) u_desc (
     .clk_i   (clk_i),
     .rst_ni  (rst_ni),

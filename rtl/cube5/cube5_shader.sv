@@ -32,7 +32,12 @@ module cube5_shader #(
   /// Diffuse intensity width, U(1.(DiffW-1)).
   parameter int unsigned DiffW     = 9,
   /// Specular intensity width, U(0.SpecW).
-  parameter int unsigned SpecW     = 8
+  parameter int unsigned SpecW     = 8,
+  /// 0: the stages below; 1 (for clock rate, the frame's shaders): the decode in three stages
+  /// (|g|; the major axis and the minor components; the dividends) and the output's products in
+  /// a register of their own, three cycles more latency, the same bits (docs/numerics/shader.md,
+  /// "Timing").
+  parameter int unsigned Pipe      = 0
 ) (
   input  logic clk_i,
   input  logic rst_ni,
@@ -91,18 +96,20 @@ module cube5_shader #(
   localparam int unsigned MagLsb  = SampleW + 3 * GradW;
   localparam int unsigned ModeLsb = SampleW + 4 * GradW;
 
-  // Stages: decode, the divider, bank addresses, texel reads (block RAM output registers), the
-  // texels in fabric registers in cell order, bilinear U (prep, product), bilinear V (prep with
-  // the classification read, product), output.
-  localparam int unsigned StAdr = DivStages + 1;
-  localparam int unsigned StRd  = DivStages + 2;
-  localparam int unsigned StRq  = DivStages + 3;
-  localparam int unsigned StUd  = DivStages + 4;
-  localparam int unsigned StBu  = DivStages + 5;
-  localparam int unsigned StVd  = DivStages + 6;
-  localparam int unsigned StBv  = DivStages + 7;
-  localparam int unsigned StOut = DivStages + 8;
-  localparam int unsigned NSt   = DivStages + 9;
+  // Stages: decode (1 + 2 Pipe), the divider, bank addresses, texel reads (block RAM output
+  // registers), the texels in fabric registers in cell order, bilinear U (prep, product),
+  // bilinear V (prep with the classification read, product), the output's products (Pipe = 1),
+  // output.
+  localparam int unsigned DecSt = 1 + 2 * Pipe;
+  localparam int unsigned StAdr = DecSt + DivStages;
+  localparam int unsigned StRd  = StAdr + 1;
+  localparam int unsigned StRq  = StAdr + 2;
+  localparam int unsigned StUd  = StAdr + 3;
+  localparam int unsigned StBu  = StAdr + 4;
+  localparam int unsigned StVd  = StAdr + 5;
+  localparam int unsigned StBv  = StAdr + 6;
+  localparam int unsigned StOut = StBv + 1 + Pipe;
+  localparam int unsigned NSt   = StOut + 1;
 
   // Elaboration checks mirror ShaderConfig::validate in the model.
   if (VoxelW < 4 || VoxelW > 16) begin : gen_bad_voxel_w
@@ -137,6 +144,9 @@ module cube5_shader #(
   end
   if (SpecW < 1 || SpecW > 12) begin : gen_bad_spec_w
     $fatal(1, "cube5_shader: SpecW must be 1..12");
+  end
+  if (Pipe > 1) begin : gen_bad_pipe
+    $fatal(1, "cube5_shader: Pipe must be 0 or 1");
   end
 
   /// x * M with M = 2^(RmLog2-1) + 1, as a shift and an add (no multiplier).
@@ -224,6 +234,7 @@ module cube5_shader #(
   logic [RemW-1:0]      dec_rem_u_d, dec_rem_v_d, dec_rem_u_q, dec_rem_v_q;
   logic [SideW-1:0]     dec_side_d, dec_side_q;
 
+  // Part 1: |g| and the classification index.
   always_comb begin
     sample = in_data_i[0 +: SampleW];
     gx     = in_data_i[GxLsb +: GradW];
@@ -236,34 +247,77 @@ module cube5_shader #(
     ax = gx[GradW-1] ? ~gx + GradW'(1) : gx;
     ay = gy[GradW-1] ? ~gy + GradW'(1) : gy;
     az = gz[GradW-1] ? ~gz + GradW'(1) : gz;
-    zero    = (ax | ay | az) == '0;
-    x_major = ax >= ay && ax >= az;
-    y_major = !x_major && ay >= az;
-    // Minor axes are cyclic: x -> (y, z), y -> (z, x), z -> (x, y).
-    if (x_major) begin
-      axis = 2'd0; m = ax; neg = gx[GradW-1]; gu = gy; gv = gz;
-    end else if (y_major) begin
-      axis = 2'd1; m = ay; neg = gy[GradW-1]; gu = gz; gv = gx;
-    end else begin
-      axis = 2'd2; m = az; neg = gz[GradW-1]; gu = gx; gv = gy;
-    end
-    // g + m lies in [0, 2m]: nonnegative, EW bits.
-    num_u = EW'($signed({gu[GradW-1], gu}) + $signed({1'b0, m}));
-    num_v = EW'($signed({gv[GradW-1], gv}) + $signed({1'b0, m}));
-    // q = floor(((g + m) * 2^(QW-1) + m) / (2m)): round half up of (g + m) * 2^(QW-2) / m.
-    dec_rem_u_d = (RemW'(num_u) << (QW - 1)) + RemW'(m);
-    dec_rem_v_d = (RemW'(num_v) << (QW - 1)) + RemW'(m);
 
     // Classification index: the top bits of the sample, or density bits over magnitude bins.
     mag_bin = ((mag >> MagShift) >> MagIdxW) != '0 ? '1 : MagIdxW'(mag >> MagShift);
     cidx    = mode[cube5_shader_pkg::ModeTf2d] ? {sample[SampleW-1 -: DenW], mag_bin}
                                                : sample[SampleW-1 -: ClassIdxW];
+  end
 
-    dec_side_d = {cidx, mode[cube5_shader_pkg::ModeUnlit], zero, axis, neg, m, 1'b0};
+  // Part 2 reads part 1's values, through a register with Pipe = 1: |g|, g, the index, unlit.
+  localparam int unsigned P1W = 6 * GradW + ClassIdxW + 1;
+  logic [P1W-1:0] p1_d, p1;
+  logic [GradW-1:0] ax2, ay2, az2, gx2, gy2, gz2;
+  logic [ClassIdxW-1:0] cidx2;
+  logic unlit2;
+  assign p1_d = {mode[cube5_shader_pkg::ModeUnlit], cidx, gz, gy, gx, az, ay, ax};
+  if (Pipe != 0) begin : gen_dec1_q
+    logic [P1W-1:0] p1_q;
+    always_ff @(posedge clk_i) begin
+      if (en[0]) p1_q <= p1_d;
+    end
+    assign p1 = p1_q;
+  end else begin : gen_dec1_w
+    assign p1 = p1_d;
+  end
+  assign {unlit2, cidx2, gz2, gy2, gx2, az2, ay2, ax2} = p1;
+
+  // Part 2: the major axis, its sign and |g| (m), the minor components (g_U, g_V), zero.
+  localparam int unsigned P2W = 3 * GradW + ClassIdxW + 5;
+  logic [P2W-1:0] p2_d, p2;
+  logic [GradW-1:0] m3, gu3, gv3;
+  logic [ClassIdxW-1:0] cidx3;
+  logic [1:0] axis3;
+  logic unlit3, zero3, neg3;
+
+  always_comb begin
+    zero    = (ax2 | ay2 | az2) == '0;
+    x_major = ax2 >= ay2 && ax2 >= az2;
+    y_major = !x_major && ay2 >= az2;
+    // Minor axes are cyclic: x -> (y, z), y -> (z, x), z -> (x, y).
+    if (x_major) begin
+      axis = 2'd0; m = ax2; neg = gx2[GradW-1]; gu = gy2; gv = gz2;
+    end else if (y_major) begin
+      axis = 2'd1; m = ay2; neg = gy2[GradW-1]; gu = gz2; gv = gx2;
+    end else begin
+      axis = 2'd2; m = az2; neg = gz2[GradW-1]; gu = gx2; gv = gy2;
+    end
+  end
+  assign p2_d = {unlit2, cidx2, zero, axis, neg, gv, gu, m};
+  if (Pipe != 0) begin : gen_dec2_q
+    logic [P2W-1:0] p2_q;
+    always_ff @(posedge clk_i) begin
+      if (en[1]) p2_q <= p2_d;
+    end
+    assign p2 = p2_q;
+  end else begin : gen_dec2_w
+    assign p2 = p2_d;
+  end
+  assign {unlit3, cidx3, zero3, axis3, neg3, gv3, gu3, m3} = p2;
+
+  // Part 3: the dividends.
+  always_comb begin
+    // g + m lies in [0, 2m]: nonnegative, EW bits.
+    num_u = EW'($signed({gu3[GradW-1], gu3}) + $signed({1'b0, m3}));
+    num_v = EW'($signed({gv3[GradW-1], gv3}) + $signed({1'b0, m3}));
+    // q = floor(((g + m) * 2^(QW-1) + m) / (2m)): round half up of (g + m) * 2^(QW-2) / m.
+    dec_rem_u_d = (RemW'(num_u) << (QW - 1)) + RemW'(m3);
+    dec_rem_v_d = (RemW'(num_v) << (QW - 1)) + RemW'(m3);
+    dec_side_d  = {cidx3, unlit3, zero3, axis3, neg3, m3, 1'b0};
   end
 
   always_ff @(posedge clk_i) begin
-    if (en[0]) begin
+    if (en[DecSt - 1]) begin
       dec_rem_u_q <= dec_rem_u_d;
       dec_rem_v_q <= dec_rem_v_d;
       dec_side_q  <= dec_side_d;
@@ -322,7 +376,7 @@ module cube5_shader #(
 
   always_ff @(posedge clk_i) begin
     for (int s = 0; s < DivStages; s++) begin
-      if (en[1 + s]) begin
+      if (en[DecSt + s]) begin
         div_rem_u_q[s*RemW +: RemW]  <= div_rem_u_d[s*RemW +: RemW];
         div_rem_v_q[s*RemW +: RemW]  <= div_rem_v_d[s*RemW +: RemW];
         div_qu_q[s*QW +: QW]         <= div_qu_d[s*QW +: QW];
@@ -591,17 +645,43 @@ module cube5_shader #(
   // Output: c' = sat(rnd(c * d * 2^SpecW + sp * 2^(ColorW+DiffW-1), DiffW-1+SpecW)); alpha as is
   // ---------------------------------------------------------------------------
   logic [RgbaW-1:0] out_d, out_q;
+  // The colour products c * d of the three channels, the specular intensity, the entry and the
+  // unlit flag: as the V stages leave them, or (Pipe = 1) in a register of their own.
+  localparam int unsigned CdW = ColorW + DiffW;
+  localparam int unsigned PrW = 3 * CdW + SpecW + RgbaW + 1;
+  logic [PrW-1:0]   pr_d, pr;
+  logic [3*CdW-1:0] cd, cd_d;
+  logic [SpecW-1:0] pr_lit_s;
+  logic [RgbaW-1:0] pr_rgba;
+  logic             pr_unlit;
 
   always_comb begin
-    out_d = bv_rgba_q;  // alpha, and the colours when unlit
+    for (int ch = 0; ch < 3; ch++) begin
+      cd_d[ch*CdW +: CdW] = CdW'(bv_rgba_q[ch*ColorW +: ColorW]) * CdW'(lit_d);
+    end
+  end
+  assign pr_d = {bv_unlit_q, bv_rgba_q, lit_s, cd_d};
+  if (Pipe != 0) begin : gen_prod_q
+    logic [PrW-1:0] pr_q;
+    always_ff @(posedge clk_i) begin
+      if (en[StBv + 1]) pr_q <= pr_d;
+    end
+    assign pr = pr_q;
+  end else begin : gen_prod_w
+    assign pr = pr_d;
+  end
+  assign {pr_unlit, pr_rgba, pr_lit_s, cd} = pr;
+
+  always_comb begin
+    out_d = pr_rgba;  // alpha, and the colours when unlit
     for (int ch = 0; ch < 3; ch++) begin
       logic [ProdW-1:0]  sum;
       logic [ColorW+1:0] res;
-      sum = (ProdW'(bv_rgba_q[ch*ColorW +: ColorW]) * ProdW'(lit_d) << SpecW)
-          + (ProdW'(lit_s) << (ColorW + DiffW - 1))
+      sum = (ProdW'(cd[ch*CdW +: CdW]) << SpecW)
+          + (ProdW'(pr_lit_s) << (ColorW + DiffW - 1))
           + (ProdW'(1) << (OutShift - 1));
       res = (ColorW + 2)'(sum >> OutShift);
-      if (!bv_unlit_q) begin
+      if (!pr_unlit) begin
         out_d[ch*ColorW +: ColorW] = res[ColorW +: 2] != 2'b00 ? '1 : res[ColorW-1:0];
       end
     end

@@ -126,9 +126,10 @@ impl FrameRtl {
 /// description as `cube5_frame_pkg`. Only the cycle budget and the smallest-volume rule (compos)
 /// depend on the latencies.
 pub use cube5_model::regs::cube5_frame::{
-    CLASS_LATENCY, COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK, REGION_COMPOS,
-    REGION_FRAME, REGION_GEOMETRY, REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX, REG_DY, REG_MODE,
-    REG_MODE_RENDER, REG_MODE_TF2D, REG_SKIP, REG_VIEW, TRILIN_LATENCY,
+    BEAT_LATENCY, CLASS_LATENCY, COMPOS_LATENCY, GRADIENT_LATENCY, OP_RENDER, REGION_BLOCK,
+    REGION_COMPOS, REGION_FRAME, REGION_GEOMETRY, REGION_SHADER, REGION_VOXEL, REG_DIMS, REG_DX,
+    REG_DY, REG_MODE, REG_MODE_RENDER, REG_MODE_TF2D, REG_SKIP, REG_VIEW, SHADER_PIPE,
+    TRILIN_LATENCY,
 };
 
 /// The frame's renderings (docs/numerics/frame.md, "Render modes"): the model's modes.
@@ -306,10 +307,23 @@ impl FrameRtl {
     /// classification table alone without them (`Shade = 0`).
     pub fn shade_latency(&self) -> u64 {
         if self.shade {
-            GRADIENT_LATENCY + self.shader.latency()
+            // The frame's shaders have `Pipe = ShaderPipe` (cube5_frame.regs.toml).
+            let shader = ShaderConfig {
+                pipe: SHADER_PIPE,
+                ..self.shader
+            };
+            GRADIENT_LATENCY + shader.latency()
         } else {
             CLASS_LATENCY
         }
+    }
+
+    /// Cycles from a beat taken to its samples' write-back count in the compositing buffer: the
+    /// beat register, the corner register 1, trilin, the sample window's register 1, gradient and
+    /// shader (or the table), the buffer read 1, compos, the write-back count 1 (docs/frame-rtl.md,
+    /// "Cycle budget").
+    pub fn pipeline_latency(&self) -> u64 {
+        BEAT_LATENCY + 1 + TRILIN_LATENCY + 1 + self.shade_latency() + 1 + COMPOS_LATENCY + 1
     }
 
     /// The default unit widths, the only ones `cube5_model::units::cube5_frame::FrameUnits` builds.

@@ -442,16 +442,8 @@ fn sweep_and_readout_cycles_follow_the_budget() {
         .filter(|r| r.max_dim() >= 32);
     for rtl in [p(1), p(4), p(8)].into_iter().chain(bare) {
         let (mut bench, seen) = loaded(rtl, &vol, s);
-        // Memory L + 2, corner register 1, trilin, window register 1, gradient and shader (or
-        // the table), buffer read 1, compos, write-back count 1.
-        let pipeline = u64::from(rtl.skew().latency())
-            + 1
-            + TRILIN_LATENCY
-            + 1
-            + rtl.shade_latency()
-            + 1
-            + COMPOS_LATENCY
-            + 1;
+        // Memory L + 2, then the frame's pipeline from the beat taken.
+        let pipeline = u64::from(rtl.skew().latency()) + rtl.pipeline_latency();
         let render = if rtl.shade {
             Render::Composite
         } else {

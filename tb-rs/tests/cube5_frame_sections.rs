@@ -10,7 +10,7 @@ mod support;
 use cube5_model::phantom::head_phantom;
 use cube5_model::units::cube5_frame::sections::section_order;
 use cube5_model::volume::Volume;
-use cube5_tb::frame::{Expected, FrameRtl, Look, Render, COMPOS_LATENCY, TRILIN_LATENCY};
+use cube5_tb::frame::{Expected, FrameRtl, Look, Render};
 use cube5_tb::frame_stream::{items_of, StreamBench, StreamIn};
 use cube5_tb::rtl::Traffic;
 use rand::SeedableRng;
@@ -198,7 +198,7 @@ fn budget(
     let (items, beats) = items_of(rtl, &e, &order, true);
     let got = must(bench.drive(&e, &items, &traffic));
     let (_, sweep) = must(bench.compare(&e, &got, beats, &format!("S = {w}, idle {idle}"), s));
-    let pipeline = 1 + TRILIN_LATENCY + 1 + rtl.shade_latency() + 1 + COMPOS_LATENCY + 1;
+    let pipeline = rtl.pipeline_latency();
     let ideal: u64 = order
         .iter()
         .map(|sec| {

@@ -12,6 +12,10 @@ pub const STEP_W: u32 = 16;
 /// Width of the status counters in every output item (memory beats read, sweep cycles).
 pub const CNT_W: u32 = 32;
 
+/// Cycles from a beat taken by the frame to its voxel window: the beat register, so that the
+/// windows' enable is a flip-flop (docs/accel.md, *Synthesis*).
+pub const BEAT_LATENCY: u64 = 1;
+
 /// `Pipe` of the frame's interpolators (cube5_trilin): 1, per axis the difference, the product and
 /// the rounded sum each in a register, so that no multiplier of the frame has logic on either side
 /// (docs/numerics/trilin.md, "Timing"; docs/accel.md, *Synthesis*).
@@ -20,6 +24,11 @@ pub const TRILIN_PIPE: u32 = 1;
 /// Latency of the frame's cube5_trilin in cycles: 3, or 9 with `TrilinPipe` = 1
 /// (docs/numerics/trilin.md, "Timing").
 pub const TRILIN_LATENCY: u64 = 9;
+
+/// `Pipe` of the frame's shaders (cube5_shader): 1, the decode in three stages and the output's
+/// products in a register of their own, three cycles more latency (`9 + QW + 3`;
+/// docs/numerics/shader.md, "Timing"; docs/accel.md, *Synthesis*).
+pub const SHADER_PIPE: u32 = 1;
 
 /// Latency of cube5_gradient in cycles: five register stages (docs/numerics/gradient.md, "Timing").
 pub const GRADIENT_LATENCY: u64 = 5;

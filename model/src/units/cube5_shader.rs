@@ -24,6 +24,9 @@ pub struct ShaderConfig {
     pub rm_frac_w: u32,
     pub diff_w: u32,
     pub spec_w: u32,
+    /// Register stages for clock rate: 0, or 1 (the decode in three stages and the output's
+    /// products in a register of their own: three cycles more latency, the same bits).
+    pub pipe: u32,
 }
 
 impl ShaderConfig {
@@ -40,6 +43,7 @@ impl ShaderConfig {
         rm_frac_w: 3,
         diff_w: 6,
         spec_w: 5,
+        pipe: 0,
     };
     /// `v12`: VolumePro's 4096-entry 8-8-8-12 table on the U(12.4) sample, 8x8-cell faces.
     pub const DEFAULT: Self = Self {
@@ -54,6 +58,7 @@ impl ShaderConfig {
         rm_frac_w: 4,
         diff_w: 9,
         spec_w: 8,
+        pipe: 0,
     };
 
     pub fn validate(&self) -> Result<()> {
@@ -76,6 +81,7 @@ impl ShaderConfig {
         range("RmFracW", self.rm_frac_w, 1, 8)?;
         range("DiffW", self.diff_w, 2, 12)?;
         range("SpecW", self.spec_w, 1, 12)?;
+        range("Pipe", self.pipe, 0, 1)?;
         Ok(())
     }
 
@@ -123,7 +129,7 @@ impl ShaderConfig {
 
     /// Cycles from an input transfer to its output when never stalled.
     pub fn latency(&self) -> u64 {
-        9 + u64::from(self.quotient_w())
+        9 + u64::from(self.quotient_w()) + 3 * u64::from(self.pipe)
     }
 
     pub fn color_max(&self) -> u32 {
@@ -1209,6 +1215,7 @@ crate::unit_config!(ShaderConfig, "cube5_shader", DEFAULT, {
     "RmFracW" => rm_frac_w,
     "DiffW" => diff_w,
     "SpecW" => spec_w,
+    "Pipe" => pipe,
 });
 
 #[cfg(test)]
