@@ -199,7 +199,7 @@ module cube5_accel_ctrl #(
     word = v[i*32 +: 32];
   endfunction
 
-  typedef enum logic [2:0] {StIdle, StAxes, StSetup, StSize, StCheck, StRun} state_e;
+  typedef enum logic [2:0] {StIdle, StAxes, StSetup, StPlane, StSize, StCheck, StRun} state_e;
   state_e state_q, state_d;
 
   logic start_stb, abort_stb;
@@ -325,8 +325,19 @@ module cube5_accel_ctrl #(
   logic [2*M+1:0]     ninj_q, ni_nj1_q;
   logic [3:0]         code_a_q;
 
-  // Stage 2 (the Size cycle, t0 + 3): the base plane, a row's bytes, the samples and the rules
-  // that need the products, but for the pitch against a row's bytes (code_b).
+  // Stage 1.75 (the Plane cycle, t0 + 3): the base plane's size and the samples, from stage
+  // 1.5's registers (for clock rate: the shift's absolute value and the sum end in a register
+  // before the row's rounding and bytes; the product alone in its stage).
+  logic [M:0]     wpix_q, hpix_q;
+  logic [3*M+2:0] samples_q;
+  always_comb begin
+    wpix    = ni_q + M1'(abs_shift(sx_q));
+    hpix    = nj_q + M1'(abs_shift(sy_q));
+    samples = (3*M+3)'(ninj_q) * (3*M+3)'(swept_q);
+  end
+
+  // Stage 2 (the Size cycle, t0 + 4): a row's pixels and bytes, the rules that need the products,
+  // but for the pitch against a row's bytes (code_b).
   // A row as written: W rounded up to P pixels (the frame's read-out items), its bytes (the
   // pitch when ImgPitch is 0; a multiple of the row alignment, which divides P PixelBytes).
   localparam int unsigned RowBW = M + LogPix + 2;
@@ -334,11 +345,8 @@ module cube5_accel_ctrl #(
   logic [RowBW-1:0] row_bytes;
   logic [3:0]       code_b;
   always_comb begin
-    wpix = ni_q + M1'(abs_shift(sx_q));
-    wpad = ((M+2)'(wpix) + (M+2)'(P - 1)) >> LogP << LogP;
+    wpad = ((M+2)'(wpix_q) + (M+2)'(P - 1)) >> LogP << LogP;
     row_bytes = RowBW'(wpad) << LogPix;
-    hpix = nj_q + M1'(abs_shift(sy_q));
-    samples = (3*M+3)'(ninj_q) * (3*M+3)'(swept_q);
     if (code_a_q != cube5_accel_regs_pkg::CodeNone) code_b = code_a_q;
     else if (ni_q < M1'(2 * P) || (ni_nj1_q >> LogP) < (2*M+2)'(9)) code_b = cube5_accel_regs_pkg::CodeSmall;
     else if ((vbase_q & AddrW'(VolMask)) != '0) code_b = cube5_accel_regs_pkg::CodeVolAlign;
@@ -347,16 +355,15 @@ module cube5_accel_ctrl #(
     else code_b = cube5_accel_regs_pkg::CodeNone;
   end
 
-  // Stage 2's results: the row command's pixels and rows, the row step, the samples (held from
-  // here to the next start), a row's bytes and the codes so far.
+  // Stage 2's results: the row command's pixels and rows, the row step, a row's bytes and the
+  // codes so far (the samples, stage 1.75's, are held from there to the next start).
   logic [M:0]       h_q;
   logic [M+1:0]     w_q;           // pixels per row command: W rounded up to P
   logic [AddrW-1:0] row_step_q;
   logic [RowBW-1:0] row_bytes_q;
-  logic [3*M+2:0]   samples_q;
   logic [3:0]       code_b_q;
 
-  // Stage 3 (the Check cycle, t0 + 4): a nonzero pitch below a row's bytes, the verdict.
+  // Stage 3 (the Check cycle, t0 + 5): a nonzero pitch below a row's bytes, the verdict.
   always_comb begin
     if (code_b_q != cube5_accel_regs_pkg::CodeNone) code = code_b_q;
     else if (pitch_q != '0 && pitch_q < 32'(row_bytes_q)) code = cube5_accel_regs_pkg::CodePitch;
@@ -444,7 +451,8 @@ module cube5_accel_ctrl #(
         end
       end
       StAxes:  state_d = StSetup;
-      StSetup: state_d = StSize;
+      StSetup: state_d = StPlane;
+      StPlane: state_d = StSize;
       StSize:  state_d = StCheck;
       StCheck: begin
         fidx_d  = '0;
@@ -560,12 +568,16 @@ module cube5_accel_ctrl #(
       ninj_q   <= ninj;
       ni_nj1_q <= ni_nj1;
     end
+    if (state_q == StPlane) begin
+      wpix_q    <= wpix;
+      hpix_q    <= hpix;
+      samples_q <= samples;
+    end
     if (state_q == StSize) begin
       w_q         <= wpad;
-      h_q         <= hpix;
+      h_q         <= hpix_q;
       row_step_q  <= (pitch_q != '0) ? AddrW'(pitch_q) : AddrW'(row_bytes);
       row_bytes_q <= row_bytes;
-      samples_q   <= samples;
       code_b_q    <= code_b;
     end
     waddr_q <= waddr_d;

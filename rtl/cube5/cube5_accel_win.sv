@@ -259,26 +259,21 @@ module cube5_accel_win #(
     end
   end
 
-  assign s2_take = s1_v_q && !p_drop && (!s2_v_q || s3_done) && !(Ring != 0 && s1_park_q);
+  // Stage 2 is a two-entry register slice (cube5_axi_slice): stage 1 hands its item over when
+  // the slice has room, a register, so stage 1's ready never waits on stage 3's beat and the W
+  // FIFO's room (docs/accel.md, *Synthesis*). Items keep their order.
+  localparam int unsigned S2W = 1 + AddrW + LineW + LineW / 8;
+  logic           s2_in_valid, s2_in_ready;
+  assign s2_in_valid = s1_v_q && !p_drop && !(Ring != 0 && s1_park_q);
+  assign s2_take     = s2_in_valid && s2_in_ready;
 
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      s2_v_q <= 1'b0;
-    end else if (s2_take) begin
-      s2_v_q <= 1'b1;
-    end else if (s3_done) begin
-      s2_v_q <= 1'b0;
-    end
-  end
-
-  always_ff @(posedge clk_i) begin
-    if (s2_take) begin
-      s2_park_q <= s1_park_q;
-      s2_addr_q <= s2_addr;
-      s2_line_q <= s2_line;
-      s2_strb_q <= s2_strb;
-    end
-  end
+  cube5_axi_slice #(.Width(S2W)) u_s2 (
+    .clk_i, .rst_ni,
+    .in_valid_i(s2_in_valid), .in_ready_o(s2_in_ready),
+    .in_data_i({s1_park_q, s2_addr, s2_line, s2_strb}),
+    .out_valid_o(s2_v_q), .out_ready_i(s3_done),
+    .out_data_o({s2_park_q, s2_addr_q, s2_line_q, s2_strb_q})
+  );
 
   // ---------------------------------------------------------------------------
   // Stage 3: one beat per cycle into the W FIFO, and a burst's address into the AW FIFO (a park:

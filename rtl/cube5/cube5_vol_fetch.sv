@@ -434,7 +434,14 @@ module cube5_vol_fetch #(
   logic [TagW-1:0]    head;
   logic               head_valid, head_skip, head_last, head_err, head_data;
   logic [BlkW-1:0]    head_blk;
-  assign head       = tag_mem[tag_rd_q];
+  // The head in a register (for clock rate: the gearbox's pop and the reader's ready start from a
+  // flip-flop, not from the tag RAM's read mux): after a pop the word after it, read at a
+  // registered address (tag_rd1_q = tag_rd_q + 1), or the word pushed this cycle when that is
+  // the one; into an empty FIFO the pushed word.
+  logic [TagPtrW-1:0] tag_rd1_q;
+  logic [TagW-1:0]    head_q, tag_word;
+  assign tag_word = {err2_q, last2_q, skip2, blk2_q};
+  assign head     = head_q;
   assign head_valid = (tag_count_q != '0);
   assign head_blk   = head[BlkW-1:0];
   assign head_skip  = head[BlkW];
@@ -482,8 +489,31 @@ module cube5_vol_fetch #(
   end
 
   always_ff @(posedge clk_i) begin
-    if (s2_fire) tag_mem[tag_wr_q] <= {err2_q, last2_q, skip2, blk2_q};
+    if (s2_fire) tag_mem[tag_wr_q] <= tag_word;
   end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      tag_rd1_q <= TagPtrW'(1);
+    end else begin
+      tag_rd1_q <= tag_rd_d + TagPtrW'(1);
+    end
+  end
+  always_ff @(posedge clk_i) begin
+    if (pop) begin
+      head_q <= (s2_fire && tag_wr_q == tag_rd1_q) ? tag_word : tag_mem[tag_rd1_q];
+    end else if (s2_fire && tag_count_q == '0) begin
+      head_q <= tag_word;
+    end
+  end
+`ifndef SYNTHESIS
+  // (The RAM's head word through a wire: Verilator 5 cannot read an array inside a property.)
+  logic [TagW-1:0] tag_ram_head;
+  assign tag_ram_head = tag_mem[tag_rd_q];
+  TagHeadAsRam: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      head_valid |-> head_q == tag_ram_head)
+    else $error("cube5_vol_fetch: the tag head register is not the tag RAM's head word");
+`endif
 
   // The item: the sub-th group of P voxels of the reader's beat (low VoxelW bits of each 16-bit
   // word), or zeros for a skip or error item.

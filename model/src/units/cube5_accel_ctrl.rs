@@ -31,7 +31,7 @@ const STEP_W: u32 = 16;
 /// checks"): a refused frame ends in `te = t0 + CHECK_CYCLES` (`Cycle` reads `CHECK_CYCLES`), an
 /// accepted frame's ports offer their first commands from `t0 + CHECK_CYCLES + 1`, and `Sample`
 /// is set in `t0 + CHECK_CYCLES`.
-pub const CHECK_CYCLES: u64 = 4;
+pub const CHECK_CYCLES: u64 = 5;
 
 /// The RTL parameters of one `cube5_accel_ctrl` configuration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
