@@ -259,20 +259,42 @@ module cube5_accel_win #(
     end
   end
 
-  // Stage 2 is a two-entry register slice (cube5_axi_slice): stage 1 hands its item over when
-  // the slice has room, a register, so stage 1's ready never waits on stage 3's beat and the W
-  // FIFO's room (docs/accel.md, *Synthesis*). Items keep their order.
-  localparam int unsigned S2W = 1 + AddrW + LineW + LineW / 8;
-  logic           s2_in_valid, s2_in_ready;
-  assign s2_in_valid = s1_v_q && !p_drop && !(Ring != 0 && s1_park_q);
-  assign s2_take     = s2_in_valid && s2_in_ready;
+  // Stage 2's register hands its item to a two-entry register slice (cube5_axi_slice), from
+  // which stage 3 takes it: stage 2 moves on when the slice has room, a register, so stage 1's
+  // and 2's readies never wait on stage 3's beat and the W FIFO's room (docs/accel.md,
+  // *Synthesis*). Items keep their order.
+  logic               s2_move, s3_in_ready, s3_v_q, s3_park_q;
+  logic [AddrW-1:0]   s3_addr_q;
+  logic [LineW-1:0]   s3_line_q;
+  logic [LineW/8-1:0] s3_strb_q;
+  assign s2_move = s2_v_q && s3_in_ready;
+  assign s2_take = s1_v_q && !p_drop && (!s2_v_q || s3_in_ready) && !(Ring != 0 && s1_park_q);
 
-  cube5_axi_slice #(.Width(S2W)) u_s2 (
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      s2_v_q <= 1'b0;
+    end else if (s2_take) begin
+      s2_v_q <= 1'b1;
+    end else if (s2_move) begin
+      s2_v_q <= 1'b0;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (s2_take) begin
+      s2_park_q <= s1_park_q;
+      s2_addr_q <= s2_addr;
+      s2_line_q <= s2_line;
+      s2_strb_q <= s2_strb;
+    end
+  end
+
+  cube5_axi_slice #(.Width(1 + AddrW + LineW + LineW / 8)) u_s3 (
     .clk_i, .rst_ni,
-    .in_valid_i(s2_in_valid), .in_ready_o(s2_in_ready),
-    .in_data_i({s1_park_q, s2_addr, s2_line, s2_strb}),
-    .out_valid_o(s2_v_q), .out_ready_i(s3_done),
-    .out_data_o({s2_park_q, s2_addr_q, s2_line_q, s2_strb_q})
+    .in_valid_i(s2_v_q), .in_ready_o(s3_in_ready),
+    .in_data_i({s2_park_q, s2_addr_q, s2_line_q, s2_strb_q}),
+    .out_valid_o(s3_v_q), .out_ready_i(s3_done),
+    .out_data_o({s3_park_q, s3_addr_q, s3_line_q, s3_strb_q})
   );
 
   // ---------------------------------------------------------------------------
@@ -302,24 +324,24 @@ module cube5_accel_win #(
   logic               fm_idle;    // FinBurst > 0: no run open, nothing queued
 
   always_comb begin
-    beat      = s2_line_q[0 +: DataW];
-    beat_strb = s2_strb_q[0 +: Bbus];
+    beat      = s3_line_q[0 +: DataW];
+    beat_strb = s3_strb_q[0 +: Bbus];
     for (int unsigned n = 1; n < LineBeats; n++) begin
       if (t_q == TW'(n)) begin
-        beat      = s2_line_q[n*DataW +: DataW];
-        beat_strb = s2_strb_q[n*Bbus +: Bbus];
+        beat      = s3_line_q[n*DataW +: DataW];
+        beat_strb = s3_strb_q[n*Bbus +: Bbus];
       end
     end
   end
 
-  assign t_last  = s2_park_q ? (t_q == TW'(PkBeats - 1)) : (t_q == TW'(FinBeats - 1));
-  assign need_aw = s2_park_q ? (t_q == '0) : (FinBurst == 0 && |beat_strb);
-  assign push_w  = s2_park_q || (FinBurst == 0 && |beat_strb);
-  assign fc_in   = !s2_park_q && FinBurst != 0 && |beat_strb;
+  assign t_last  = s3_park_q ? (t_q == TW'(PkBeats - 1)) : (t_q == TW'(FinBeats - 1));
+  assign need_aw = s3_park_q ? (t_q == '0) : (FinBurst == 0 && |beat_strb);
+  assign push_w  = s3_park_q || (FinBurst == 0 && |beat_strb);
+  assign fc_in   = !s3_park_q && FinBurst != 0 && |beat_strb;
   assign can     = (!need_aw || (!aw_full && out_q < OutW'(Outstanding))) && (!push_w || !w_full)
                    && (!fc_in || fc_ok);
   // A beat into the AW/W FIFOs waits while a ring or finals burst moves into them.
-  assign step    = s2_v_q && can && ((FinBurst == 0) ? !rg_use
+  assign step    = s3_v_q && can && ((FinBurst == 0) ? !rg_use
                                       : (!(need_aw || push_w) || (!rg_use && !fm_use)));
   assign push_aw = step && need_aw;
   assign s3_done = step && t_last;
@@ -334,9 +356,9 @@ module cube5_accel_win #(
 
   logic [AwW-1:0] aw_d, aw_q;
   logic [WW-1:0]  w_d, w_q;
-  assign aw_d = s2_park_q ? {IdPark, 8'(PkBeats - 1), s2_addr_q}
-                          : {IdFin, 8'd0, s2_addr_q + (AddrW'(t_q) << LogBus)};
-  assign w_d  = {s2_park_q ? t_last : 1'b1, s2_park_q ? {Bbus{1'b1}} : beat_strb, beat};
+  assign aw_d = s3_park_q ? {IdPark, 8'(PkBeats - 1), s3_addr_q}
+                          : {IdFin, 8'd0, s3_addr_q + (AddrW'(t_q) << LogBus)};
+  assign w_d  = {s3_park_q ? t_last : 1'b1, s3_park_q ? {Bbus{1'b1}} : beat_strb, beat};
 
   cube5_frame_fifo #(.Width(AwW), .Depth(WDepth)) u_aw (
     .clk_i, .rst_ni, .clear_i(1'b0),
@@ -884,7 +906,7 @@ module cube5_accel_win #(
     logic [FdW-1:0]     fd_q;
     logic [8:0]         fm_mv_q;       // beats of the moving burst still to go
 
-    assign ba      = s2_addr_q + (AddrW'(t_q) << LogBus);
+    assign ba      = s3_addr_q + (AddrW'(t_q) << LogBus);
     assign j_same  = fc_v_q && ba == fc_addr_q;
     assign j_next  = fc_v_q && ba == fc_addr_q + AddrW'(Bbus) && FLog'(ba >> LogBus) != '0;
     assign fc_ok   = !fq_full && !fd_full;
@@ -988,7 +1010,7 @@ module cube5_accel_win #(
   end
   assign err_o  = err_q;
   assign wr_wait_o = !w_empty;
-  assign idle_o = !s1_v_q && !s2_v_q && aw_empty && w_empty && out_q == '0 && rq_empty
+  assign idle_o = !s1_v_q && !s2_v_q && !s3_v_q && aw_empty && w_empty && out_q == '0 && rq_empty
                   && !hd_v_q && rs_out_q == '0 && !rs_v_q && ord_empty && rg_idle && fm_idle;
   logic unused_ord;
   assign unused_ord = ord_full;

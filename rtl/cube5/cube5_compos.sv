@@ -170,27 +170,24 @@ module cube5_compos #(
   assign in_ready_o = ready_1;
 
   // ---------------------------------------------------------------------------
-  // Stage 1, decode: depth test, early-termination compare, LUT read
+  // Stage 1, decode: depth test, LUT read
   // ---------------------------------------------------------------------------
-  logic [ChanW-1:0]    in_a;
   logic [ZW-1:0]       in_z, in_depth;
   logic [AlphaW-1:0]   in_alpha;
   logic [CorrW-1:0]    lut_rd_d;
-  logic                depth_pass_d1, et_hit_d1;
+  logic                depth_pass_d1;
 
-  assign in_a     = in_data_i[ALsb +: ChanW];
   assign in_z     = in_data_i[ZLsb +: ZW];
   assign in_depth = in_data_i[DepthLsb +: ZW];
   assign in_alpha = in_data_i[AlphaLsb +: AlphaW];
   assign lut_rd_d = lut_q[in_alpha];
   assign depth_pass_d1 = in_depth < in_z;   // in front of the geometry
-  assign et_hit_d1     = in_a >= et_q;
 
   logic [CoxelW-1:0]   coxel_q1;
   logic [3*ColorW-1:0] rgb_q1;
   logic [AlphaW-1:0]   alpha_q1;
   logic [2:0]          mode_q1;
-  logic                depth_pass_q1, et_hit_q1;
+  logic                depth_pass_q1;
   logic [CorrW-1:0]    lut_rd_q1;
 
   always_ff @(posedge clk_i) begin
@@ -200,21 +197,25 @@ module cube5_compos #(
       alpha_q1      <= in_alpha;
       mode_q1       <= in_data_i[ModeLsb +: 3];
       depth_pass_q1 <= depth_pass_d1;
-      et_hit_q1     <= et_hit_d1;
       lut_rd_q1     <= lut_rd_d;
     end
   end
 
   // ---------------------------------------------------------------------------
-  // Stage 2, alpha select: corrected alpha, transparency, colour codes, which case applies
+  // Stage 2, alpha select: the early-termination compare, corrected alpha, transparency, colour
+  // codes, which case applies (the compare reads the registered coxel: in a frame the coxel
+  // comes from the compositing buffer's block RAM, whose slow output then ends in stage 1's
+  // register; docs/accel.md, *Synthesis*)
   // ---------------------------------------------------------------------------
   logic [ChanW-1:0] a1;
+  logic             et_hit;
   logic [CorrW-1:0] a_bypass, a_corr_d2;
   logic [ChanW-1:0] t_d2;
   logic [3*VW-1:0]  c_p_d2, g_p_d2;
   logic             contrib_d2, flush_geo_d2, mark_term_d2;
 
-  assign a1 = coxel_q1[ALsb +: ChanW];
+  assign a1     = coxel_q1[ALsb +: ChanW];
+  assign et_hit = a1 >= et_q;
 
   cube5_compos_unorm #(
     .W (AlphaW),
@@ -259,7 +260,7 @@ module cube5_compos #(
       // 2. end of the ray: geometry (if any) under the coxel
       mark_term_d2 = 1'b1;
       flush_geo_d2 = coxel_q1[ZLsb +: ZW] != ZNone;
-    end else if (mode_q1 == cube5_compos_pkg::ModeFrontToBack && et_hit_q1) begin
+    end else if (mode_q1 == cube5_compos_pkg::ModeFrontToBack && et_hit) begin
       // 3. early termination
       mark_term_d2 = 1'b1;
     end else begin

@@ -491,11 +491,15 @@ module cube5_frame #(
   logic [CntW-1:0] reads_q, reads_d, cycles_q, cycles_d;
   logic            mem_beat, mem_read, flush_beat, upd_done;
   logic            win_ok;     // Window = 1: the window can take the next beat's sample beat
+  // The sweep needs more beats (state_q == StSweep && recvd_q != total_q, as a register: the
+  // take's logic then has no counter compare in it), and the next beat is the last
+  // (recvd_q + 1 == total_q).
+  logic            more_q, more_d, last_beat_q, last_beat_d;
 
   // Commands while idle; beats (Source = 1) while the sweep still needs them, or while idle (a
   // stray beat after a reset: taken and dropped).
   assign cmd_ready  = (state_q == StIdle) && !cbuf_clear_busy;
-  assign beat_ready = (state_q == StIdle) || (state_q == StSweep && recvd_q != total_q && win_ok);
+  assign beat_ready = (state_q == StIdle) || (more_q && win_ok);
   assign in_ready_o = in_is_cmd ? cmd_ready : beat_ready;
   assign in_fire    = in_valid_i && in_ready_o;
   assign cmd_fire   = in_fire && in_is_cmd;
@@ -559,7 +563,36 @@ module cube5_frame #(
     endcase
   end
 
-  // Counters of the sweep.
+  // Counters of the sweep. A sweep has at least one beat (frame_ok: nbs and the slices swept are
+  // at least 1), so the start sets more_q.
+  always_comb begin
+    more_d      = more_q;
+    last_beat_d = last_beat_q;
+    if (start) begin
+      more_d      = 1'b1;
+      last_beat_d = 1'b0;   // total >= nbs >= nbr + 1 + ReuseMin > 1
+    end else if (mem_beat) begin
+      more_d      = !last_beat_q;
+      last_beat_d = recvd_q + TotW'(2) == total_q;
+    end
+  end
+
+  always_ff @(posedge clk_i) begin
+    if (!rst_ni) begin
+      more_q      <= 1'b0;
+      last_beat_q <= 1'b0;
+    end else begin
+      more_q      <= more_d;
+      last_beat_q <= last_beat_d;
+    end
+  end
+`ifndef SYNTHESIS
+  MoreAsCounted: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      more_q == (state_q == StSweep && recvd_q != total_q)
+      && (!more_q || last_beat_q == (recvd_q + TotW'(1) == total_q)))
+    else $error("cube5_frame: more_q or last_beat_q disagrees with the beat count");
+`endif
+
   always_comb begin
     recvd_d   = recvd_q;
     written_d = written_q;
@@ -770,13 +803,12 @@ module cube5_frame #(
   end
 
   // After the last memory beat: nbs + 2 nbr + 2 beats of zeros flush the windows.
-  assign flush_beat  = (state_q == StSweep) && (recvd_q == total_q) && (flushed_q != flush_q)
-                       && win_ok;
+  assign flush_beat  = (state_q == StSweep) && !more_q && (flushed_q != flush_q) && win_ok;
 
   logic                beat_valid;
   logic [XBeatW-1:0]   beat;
   assign beat_valid = mem_beat || flush_beat;
-  assign beat       = mem_beat ? mem_lanes : '0;
+  assign beat       = mem_lanes;
 
   // The beat register (BeatLatency cycles): the interpolators' windows, whose every register and
   // block RAM advances per beat, take the beat a cycle after it is taken, so that their enable is
@@ -786,18 +818,23 @@ module cube5_frame #(
   if (cube5_frame_pkg::BeatLatency != 1) begin : gen_bad_beat_latency
     $fatal(1, "cube5_frame: the beat register is one stage (BeatLatency = 1)");
   end
-  logic                beat_valid_q;
-  logic [XBeatW-1:0]   beat_q;
+  // The lanes are registered as they come and zeroed after the register for a flush beat, so
+  // that the take does not fan out to every lane's bit.
+  logic                beat_valid_q, beat_mem_q;
+  logic [XBeatW-1:0]   beat_q, beat_in;
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
       beat_valid_q <= 1'b0;
+      beat_mem_q   <= 1'b0;
     end else begin
       beat_valid_q <= beat_valid;
+      beat_mem_q   <= mem_beat;
     end
   end
   always_ff @(posedge clk_i) begin
     beat_q <= beat;
   end
+  assign beat_in = beat_mem_q ? beat_q : '0;
 
   // ---------------------------------------------------------------------------
   // The P pipelines
@@ -845,7 +882,7 @@ module cube5_frame #(
     .edge_lo_on_i (edge_lo_on),
     .edge_hi_on_i (edge_hi_on),
     .beat_valid_i (beat_valid_q),
-    .beat_i       (beat_q),
+    .beat_i       (beat_in),
     .smp_valid_o  (smp_valid),
     .smp_o        (smp)
   );

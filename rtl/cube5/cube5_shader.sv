@@ -261,15 +261,7 @@ module cube5_shader #(
   logic [ClassIdxW-1:0] cidx2;
   logic unlit2;
   assign p1_d = {mode[cube5_shader_pkg::ModeUnlit], cidx, gz, gy, gx, az, ay, ax};
-  if (Pipe != 0) begin : gen_dec1_q
-    logic [P1W-1:0] p1_q;
-    always_ff @(posedge clk_i) begin
-      if (en[0]) p1_q <= p1_d;
-    end
-    assign p1 = p1_q;
-  end else begin : gen_dec1_w
-    assign p1 = p1_d;
-  end
+  cube5_opt_reg #(.Width(P1W), .On(Pipe)) u_dec1 (.clk_i, .en_i(en[0]), .d_i(p1_d), .q_o(p1));
   assign {unlit2, cidx2, gz2, gy2, gx2, az2, ay2, ax2} = p1;
 
   // Part 2: the major axis, its sign and |g| (m), the minor components (g_U, g_V), zero.
@@ -294,15 +286,9 @@ module cube5_shader #(
     end
   end
   assign p2_d = {unlit2, cidx2, zero, axis, neg, gv, gu, m};
-  if (Pipe != 0) begin : gen_dec2_q
-    logic [P2W-1:0] p2_q;
-    always_ff @(posedge clk_i) begin
-      if (en[1]) p2_q <= p2_d;
-    end
-    assign p2 = p2_q;
-  end else begin : gen_dec2_w
-    assign p2 = p2_d;
-  end
+  cube5_opt_reg #(.Width(P2W), .On(Pipe)) u_dec2 (
+    .clk_i, .en_i(en[Pipe]), .d_i(p2_d), .q_o(p2)
+  );
   assign {unlit3, cidx3, zero3, axis3, neg3, gv3, gu3, m3} = p2;
 
   // Part 3: the dividends.
@@ -661,15 +647,9 @@ module cube5_shader #(
     end
   end
   assign pr_d = {bv_unlit_q, bv_rgba_q, lit_s, cd_d};
-  if (Pipe != 0) begin : gen_prod_q
-    logic [PrW-1:0] pr_q;
-    always_ff @(posedge clk_i) begin
-      if (en[StBv + 1]) pr_q <= pr_d;
-    end
-    assign pr = pr_q;
-  end else begin : gen_prod_w
-    assign pr = pr_d;
-  end
+  cube5_opt_reg #(.Width(PrW), .On(Pipe)) u_prod (
+    .clk_i, .en_i(en[StBv + Pipe]), .d_i(pr_d), .q_o(pr)
+  );
   assign {pr_unlit, pr_rgba, pr_lit_s, cd} = pr;
 
   always_comb begin
