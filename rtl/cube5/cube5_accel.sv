@@ -325,9 +325,20 @@ module cube5_accel #(
   logic [FeOutW-1:0] fe_out_data;
   logic              fe_err;
 
-  assign fe_in_valid = blk_pend_q || fc_valid;
-  assign fe_in_data  = blk_pend_q ? FeCmdW'({blk_q, 1'b0}) : FeCmdW'({fc_data, 1'b1});
-  assign fc_ready    = fe_in_ready && !blk_pend_q;
+  // The core's sweep commands pass a two-entry register slice: the core's section arithmetic
+  // (the anchor, the section's block range) and the fetch's sweep checks meet at flip-flops
+  // (docs/accel.md, *Synthesis*). One cycle of latency per command.
+  logic              fs_valid, fs_ready;
+  logic [SweepW-1:0] fs_data;
+  cube5_axi_slice #(.Width(SweepW)) u_fc_slice (
+    .clk_i, .rst_ni(unit_rst_n),
+    .in_valid_i(fc_valid), .in_ready_o(fc_ready), .in_data_i(fc_data),
+    .out_valid_o(fs_valid), .out_ready_i(fs_ready), .out_data_o(fs_data)
+  );
+
+  assign fe_in_valid = blk_pend_q || fs_valid;
+  assign fe_in_data  = blk_pend_q ? FeCmdW'({blk_q, 1'b0}) : FeCmdW'({fs_data, 1'b1});
+  assign fs_ready    = fe_in_ready && !blk_pend_q;
 
   cube5_vol_fetch #(
     .AddrW(AddrW), .DataW(DataW), .P(Q), .VoxelW(VoxelW), .MaxDim(MaxDim), .BlockDim(BlockDim),
