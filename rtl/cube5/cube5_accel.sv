@@ -894,25 +894,29 @@ module cube5_accel #(
   logic                     ar_block_q, aw_block_q, w_open, quiet;
   logic [RdOutW-1:0]        rd_out_q;   // read bursts accepted, last beat not yet in
   logic [WrOutW-1:0]        wr_out_q;   // write bursts accepted, B not yet in
-  logic signed [WOwedW-1:0] w_owed_q;   // beats of accepted write bursts not yet sent
+  logic signed [WOwedW-1:0] w_owed_q, w_owed_d;   // beats of accepted write bursts not yet sent
+  // w_owed_q > 0 in a flip-flop (for clock rate: the W channel's ready starts from a register,
+  // not from the count's compare; the routed line's critical path at 30d3a1b).
+  logic                     w_owed_pos_q;
 
   assign m_axi_arvalid_o = ar_valid && !ar_block_q;
   assign ar_ready        = m_axi_arready_i && !ar_block_q;
   assign m_axi_awvalid_o = aw_valid && !aw_block_q;
   assign aw_ready        = m_axi_awready_i && !aw_block_q;
-  assign w_open          = !aw_block_q || w_owed_q > 0;
+  assign w_open          = !aw_block_q || w_owed_pos_q;
   assign m_axi_wvalid_o  = w_valid && w_open;
   assign w_ready         = m_axi_wready_i && w_open;
   assign quiet = ar_block_q && aw_block_q && rd_out_q == '0 && wr_out_q == '0 && w_owed_q == '0;
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
-      drain_q    <= 1'b0;
-      ar_block_q <= 1'b0;
-      aw_block_q <= 1'b0;
-      rd_out_q   <= '0;
-      wr_out_q   <= '0;
-      w_owed_q   <= '0;
+      drain_q      <= 1'b0;
+      ar_block_q   <= 1'b0;
+      aw_block_q   <= 1'b0;
+      rd_out_q     <= '0;
+      wr_out_q     <= '0;
+      w_owed_q     <= '0;
+      w_owed_pos_q <= 1'b0;
     end else begin
       drain_q <= flush && quiet && !drain_q;
       if (drain_q) begin
@@ -926,11 +930,18 @@ module cube5_accel #(
                            - RdOutW'(m_axi_rvalid_i && m_axi_rready_o && m_axi_rlast_i);
       wr_out_q <= wr_out_q + WrOutW'(m_axi_awvalid_o && m_axi_awready_i)
                            - WrOutW'(m_axi_bvalid_i && m_axi_bready_o);
-      w_owed_q <= w_owed_q + ((m_axi_awvalid_o && m_axi_awready_i)
-                              ? WOwedW'(m_axi_awlen_o) + WOwedW'(1) : '0)
-                           - WOwedW'(m_axi_wvalid_o && m_axi_wready_i);
+      w_owed_q     <= w_owed_d;
+      w_owed_pos_q <= w_owed_d > 0;
     end
   end
+  assign w_owed_d = w_owed_q + ((m_axi_awvalid_o && m_axi_awready_i)
+                                ? WOwedW'(m_axi_awlen_o) + WOwedW'(1) : '0)
+                             - WOwedW'(m_axi_wvalid_o && m_axi_wready_i);
+`ifndef SYNTHESIS
+  WOwedPosAsCount: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      w_owed_pos_q == (w_owed_q > 0))
+    else $error("cube5_accel: the W channel's open flag is not the owed count's sign");
+`endif
 
   // The rest of the frame's output item (counters) and of the completion (its count).
   logic unused;

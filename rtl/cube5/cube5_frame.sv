@@ -806,9 +806,7 @@ module cube5_frame #(
   assign flush_beat  = (state_q == StSweep) && !more_q && (flushed_q != flush_q) && win_ok;
 
   logic                beat_valid;
-  logic [XBeatW-1:0]   beat;
   assign beat_valid = mem_beat || flush_beat;
-  assign beat       = mem_lanes;
 
   // The beat register (BeatLatency cycles): the interpolators' windows, whose every register and
   // block RAM advances per beat, take the beat a cycle after it is taken, so that their enable is
@@ -832,7 +830,7 @@ module cube5_frame #(
     end
   end
   always_ff @(posedge clk_i) begin
-    beat_q <= beat;
+    beat_q <= mem_lanes;
   end
   assign beat_in = beat_mem_q ? beat_q : '0;
 

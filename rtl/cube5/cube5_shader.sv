@@ -261,7 +261,9 @@ module cube5_shader #(
   logic [ClassIdxW-1:0] cidx2;
   logic unlit2;
   assign p1_d = {mode[cube5_shader_pkg::ModeUnlit], cidx, gz, gy, gx, az, ay, ax};
-  cube5_opt_reg #(.Width(P1W), .On(Pipe)) u_dec1 (.clk_i, .en_i(en[0]), .d_i(p1_d), .q_o(p1));
+  cube5_delay_regs #(.Width(P1W), .Stages(Pipe)) u_dec1 (
+    .clk_i, .en_i(en[0]), .d_i(p1_d), .q_o(p1)
+  );
   assign {unlit2, cidx2, gz2, gy2, gx2, az2, ay2, ax2} = p1;
 
   // Part 2: the major axis, its sign and |g| (m), the minor components (g_U, g_V), zero.
@@ -286,7 +288,7 @@ module cube5_shader #(
     end
   end
   assign p2_d = {unlit2, cidx2, zero, axis, neg, gv, gu, m};
-  cube5_opt_reg #(.Width(P2W), .On(Pipe)) u_dec2 (
+  cube5_delay_regs #(.Width(P2W), .Stages(Pipe)) u_dec2 (
     .clk_i, .en_i(en[Pipe]), .d_i(p2_d), .q_o(p2)
   );
   assign {unlit3, cidx3, zero3, axis3, neg3, gv3, gu3, m3} = p2;
@@ -647,7 +649,7 @@ module cube5_shader #(
     end
   end
   assign pr_d = {bv_unlit_q, bv_rgba_q, lit_s, cd_d};
-  cube5_opt_reg #(.Width(PrW), .On(Pipe)) u_prod (
+  cube5_delay_regs #(.Width(PrW), .Stages(Pipe)) u_prod (
     .clk_i, .en_i(en[StBv + Pipe]), .d_i(pr_d), .q_o(pr)
   );
   assign {pr_unlit, pr_rgba, pr_lit_s, cd} = pr;

@@ -74,8 +74,6 @@ module cube5_vol_fetch #(
   localparam int unsigned R             = DataW / (16 * P);
   localparam int unsigned RW            = (R > 2) ? $clog2(R) : 1;
   localparam int unsigned TagDepth      = 1 << $clog2(Outstanding * MaxBurst / BeatsPerBlock + 4);
-  localparam int unsigned TagPtrW       = $clog2(TagDepth);
-  localparam int unsigned TagCntW       = TagPtrW + 1;
   localparam int unsigned TagW          = BlkW + 3;
   localparam int unsigned LutW          = BlkW + 2;
   localparam int unsigned NbCW          = NbW + 1;
@@ -293,8 +291,6 @@ module cube5_vol_fetch #(
   assign ptr2  = lut2_q[BlkW-1:0];
   assign skip2 = !err2_q && (lut2_q[BlkW] || lut2_q[BlkW+1]);
 
-  logic [TagCntW-1:0] tag_count_q, tag_count_d;
-  assign tag_space   = (tag_count_q != TagCntW'(TagDepth));
   // A block to read hands its command to the command FIFO (cmd3, two entries) while it has room:
   // a registered condition, so the reader's acceptance (its splitter's last-burst compare) does
   // not reach back through stage 2 to the walker in the same cycle.
@@ -429,20 +425,12 @@ module cube5_vol_fetch #(
   // Tag FIFO (blocks in walk order) and the output gearbox
   // ==============================================================================================
 
-  logic [TagW-1:0]    tag_mem [TagDepth];
-  logic [TagPtrW-1:0] tag_wr_q, tag_wr_d, tag_rd_q, tag_rd_d;
-  logic [TagW-1:0]    head;
-  logic               head_valid, head_skip, head_last, head_err, head_data;
-  logic [BlkW-1:0]    head_blk;
-  // The head in a register (for clock rate: the gearbox's pop and the reader's ready start from a
-  // flip-flop, not from the tag RAM's read mux): after a pop the word after it, read at a
-  // registered address (tag_rd1_q = tag_rd_q + 1), or the word pushed this cycle when that is
-  // the one; into an empty FIFO the pushed word.
-  logic [TagPtrW-1:0] tag_rd1_q;
-  logic [TagW-1:0]    head_q, tag_word;
-  assign tag_word = {err2_q, last2_q, skip2, blk2_q};
-  assign head     = head_q;
-  assign head_valid = (tag_count_q != '0);
+  logic [TagW-1:0] head, tag_word;
+  logic            head_valid, head_skip, head_last, head_err, head_data, tag_empty, tag_full;
+  logic [BlkW-1:0] head_blk;
+  assign tag_word   = {err2_q, last2_q, skip2, blk2_q};
+  assign head_valid = !tag_empty;
+  assign tag_space  = !tag_full;
   assign head_blk   = head[BlkW-1:0];
   assign head_skip  = head[BlkW];
   assign head_last  = head[BlkW+1];
@@ -467,53 +455,31 @@ module cube5_vol_fetch #(
       word_d = word_end ? '0 : word_q + WordW'(1);
       sub_d  = sub_end ? '0 : sub_q + RW'(1);
     end
-    tag_wr_d    = s2_fire ? tag_wr_q + TagPtrW'(1) : tag_wr_q;
-    tag_rd_d    = pop ? tag_rd_q + TagPtrW'(1) : tag_rd_q;
-    tag_count_d = tag_count_q + TagCntW'(s2_fire) - TagCntW'(pop);
   end
 
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
-      word_q      <= '0;
-      sub_q       <= '0;
-      tag_wr_q    <= '0;
-      tag_rd_q    <= '0;
-      tag_count_q <= '0;
+      word_q <= '0;
+      sub_q  <= '0;
     end else begin
-      word_q      <= word_d;
-      sub_q       <= sub_d;
-      tag_wr_q    <= tag_wr_d;
-      tag_rd_q    <= tag_rd_d;
-      tag_count_q <= tag_count_d;
+      word_q <= word_d;
+      sub_q  <= sub_d;
     end
   end
 
-  always_ff @(posedge clk_i) begin
-    if (s2_fire) tag_mem[tag_wr_q] <= tag_word;
-  end
-
-  always_ff @(posedge clk_i) begin
-    if (!rst_ni) begin
-      tag_rd1_q <= TagPtrW'(1);
-    end else begin
-      tag_rd1_q <= tag_rd_d + TagPtrW'(1);
-    end
-  end
-  always_ff @(posedge clk_i) begin
-    if (pop) begin
-      head_q <= (s2_fire && tag_wr_q == tag_rd1_q) ? tag_word : tag_mem[tag_rd1_q];
-    end else if (s2_fire && tag_count_q == '0) begin
-      head_q <= tag_word;
-    end
-  end
-`ifndef SYNTHESIS
-  // (The RAM's head word through a wire: Verilator 5 cannot read an array inside a property.)
-  logic [TagW-1:0] tag_ram_head;
-  assign tag_ram_head = tag_mem[tag_rd_q];
-  TagHeadAsRam: assert property (@(posedge clk_i) disable iff (!rst_ni)
-      head_valid |-> head_q == tag_ram_head)
-    else $error("cube5_vol_fetch: the tag head register is not the tag RAM's head word");
-`endif
+  // The head in a register (OutReg = 1, for clock rate: the gearbox's pop and the reader's ready
+  // start from a flip-flop, not from the tag RAM's read mux).
+  cube5_frame_fifo #(.Width(TagW), .Depth(TagDepth), .OutReg(1)) u_tags (
+    .clk_i   (clk_i),
+    .rst_ni  (rst_ni),
+    .clear_i (1'b0),
+    .push_i  (s2_fire),
+    .d_i     (tag_word),
+    .pop_i   (pop),
+    .q_o     (head),
+    .empty_o (tag_empty),
+    .full_o  (tag_full)
+  );
 
   // The item: the sub-th group of P voxels of the reader's beat (low VoxelW bits of each 16-bit
   // word), or zeros for a skip or error item.

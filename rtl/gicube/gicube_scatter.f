@@ -1,5 +1,5 @@
 rtl/gicube/gicube_scatter_pkg.sv
-rtl/gicube/gicube_scatter_pipe.sv
+rtl/cube5_delay_regs.sv
 rtl/gicube/gicube_scatter_dot3.sv
 rtl/gicube/gicube_scatter_madd3.sv
 rtl/gicube/gicube_scatter_hash.sv

@@ -8,7 +8,7 @@
 // A 42-stage pipeline that advances as a whole (one enable), one ray per clock when never
 // stalled. This module holds the handshake, the configuration decode and the wiring; the stages
 // are modules of their own (the table in the contract's Timing section), and fields that only
-// wait for a later stage ride in gicube_scatter_pipe delay lines. Stage numbers in the banners and
+// wait for a later stage ride in cube5_delay_regs delay lines. Stage numbers in the banners and
 // the `_sNN` suffixes are the register stages of the contract's timing table.
 module gicube_scatter #(
   /// Direction fraction bits F: directions are S(2.F).
@@ -219,9 +219,9 @@ module gicube_scatter #(
   logic [I-1:0]    isoi_s18;
   logic            zg_s18;
 
-  gicube_scatter_pipe #(
-    .W (3*DW + L2W + ETW),
-    .N (NormL)
+  cube5_delay_regs #(
+    .Width  (3*DW + L2W + ETW),
+    .Stages (NormL)
   ) u_geo_wait (
     .clk_i (clk_i),
     .en_i  (en),
@@ -229,9 +229,9 @@ module gicube_scatter #(
     .q_o   ({eta_s7, l2_s7, d_s7})
   );
 
-  gicube_scatter_pipe #(
-    .W (E2W),
-    .N (NormL + SurfL)
+  cube5_delay_regs #(
+    .Width  (E2W),
+    .Stages (NormL + SurfL)
   ) u_e2_wait (
     .clk_i (clk_i),
     .en_i  (en),
@@ -239,9 +239,9 @@ module gicube_scatter #(
     .q_o   (e2_s11)
   );
 
-  gicube_scatter_pipe #(
-    .W (RndW),
-    .N (NormL - gicube_scatter_pkg::DrawLatency + SurfL + RefrL)
+  cube5_delay_regs #(
+    .Width  (RndW),
+    .Stages (NormL - gicube_scatter_pkg::DrawLatency + SurfL + RefrL)
   ) u_rnd_wait (
     .clk_i (clk_i),
     .en_i  (en),
@@ -249,9 +249,9 @@ module gicube_scatter #(
     .q_o   ({isoi_s18, phi_s18, theta_s18, drawn_s18})
   );
 
-  gicube_scatter_pipe #(
-    .W (1),
-    .N (SurfL + RefrL)
+  cube5_delay_regs #(
+    .Width  (1),
+    .Stages (SurfL + RefrL)
   ) u_zg_wait (
     .clk_i (clk_i),
     .en_i  (en),
@@ -288,9 +288,9 @@ module gicube_scatter #(
   );
 
   // The vectors of the event selection wait beside the refraction's square root.
-  gicube_scatter_pipe #(
-    .W (3*DW + 3*EdW + 3*DW + 3*EW),
-    .N (RefrL)
+  cube5_delay_regs #(
+    .Width  (3*DW + 3*EdW + 3*DW + 3*EW),
+    .Stages (RefrL)
   ) u_vec_wait (
     .clk_i (clk_i),
     .en_i  (en),
@@ -372,9 +372,9 @@ module gicube_scatter #(
     .zero_o    (ez_unused)
   );
 
-  gicube_scatter_pipe #(
-    .W (A + PhiW),
-    .N (NormL)
+  cube5_delay_regs #(
+    .Width  (A + PhiW),
+    .Stages (NormL)
   ) u_ang_wait (
     .clk_i (clk_i),
     .en_i  (en),
@@ -382,9 +382,9 @@ module gicube_scatter #(
     .q_o   ({phi_s27, theta_s27})
   );
 
-  gicube_scatter_pipe #(
-    .W (4),
-    .N (NormL + FrmL + RotL + NormL)
+  cube5_delay_regs #(
+    .Width  (4),
+    .Stages (NormL + FrmL + RotL + NormL)
   ) u_flags_wait (
     .clk_i (clk_i),
     .en_i  (en),

@@ -57,9 +57,9 @@ module gicube_scatter_draw #(
     end
   end
 
-  gicube_scatter_pipe #(
-    .W (4*MW1),
-    .N (gicube_scatter_pkg::HashLatency)
+  cube5_delay_regs #(
+    .Width  (4*MW1),
+    .Stages (gicube_scatter_pkg::HashLatency)
   ) u_mat_wait (
     .clk_i (clk_i),
     .en_i  (en_i),
@@ -96,9 +96,9 @@ module gicube_scatter_draw #(
   end
 
   // The event, phi and the ISO index wait one stage beside theta.
-  gicube_scatter_pipe #(
-    .W (2 + PhiW + I),
-    .N (2)
+  cube5_delay_regs #(
+    .Width  (2 + PhiW + I),
+    .Stages (2)
   ) u_side_wait (
     .clk_i (clk_i),
     .en_i  (en_i),

@@ -105,9 +105,9 @@ module gicube_scatter_frame #(
   end
 
   // The angles, the axis and Ê wait one stage beside w, V, U.
-  gicube_scatter_pipe #(
-    .W (2*(F+1) + 2*DW + 2 + 3*DW),
-    .N (2)
+  cube5_delay_regs #(
+    .Width  (2*(F+1) + 2*DW + 2 + 3*DW),
+    .Stages (2)
   ) u_side_wait (
     .clk_i (clk_i),
     .en_i  (en_i),

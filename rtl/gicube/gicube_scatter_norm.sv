@@ -76,9 +76,9 @@ module gicube_scatter_norm #(
     .m_o       (m_unused)
   );
 
-  gicube_scatter_pipe #(
-    .W (3*VW + 1),
-    .N (gicube_scatter_pkg::RsqLatency)
+  cube5_delay_regs #(
+    .Width  (3*VW + 1),
+    .Stages (gicube_scatter_pkg::RsqLatency)
   ) u_wait (
     .clk_i (clk_i),
     .en_i  (en_i),

@@ -60,9 +60,9 @@ module gicube_scatter_refract #(
   logic           tir_s17;
   logic [EcW-1:0] ec_s17;
 
-  gicube_scatter_pipe #(
-    .W (1 + EcW),
-    .N (gicube_scatter_pkg::RsqLatency + 2)
+  cube5_delay_regs #(
+    .Width  (1 + EcW),
+    .Stages (gicube_scatter_pkg::RsqLatency + 2)
   ) u_side_wait (
     .clk_i (clk_i),
     .en_i  (en_i),

@@ -100,9 +100,9 @@ module gicube_scatter_rotate #(
   logic [F:0]      ct_q, ct_s33, ct_q2, st_q, st_s33;
   logic [3*DW-1:0] eh_q, eh_s33, eh_q2;
 
-  gicube_scatter_pipe #(
-    .W (SideW),
-    .N (gicube_scatter_pkg::RsqLatency - 1)
+  cube5_delay_regs #(
+    .Width  (SideW),
+    .Stages (gicube_scatter_pkg::RsqLatency - 1)
   ) u_side_wait (
     .clk_i (clk_i),
     .en_i  (en_i),

@@ -82,9 +82,9 @@ module gicube_scatter_rsqrt #(
   end
 
   // m and kk leave the unit beside y: stages B, C, D carry them unchanged.
-  gicube_scatter_pipe #(
-    .W (MW + KW),
-    .N (3)
+  cube5_delay_regs #(
+    .Width  (MW + KW),
+    .Stages (3)
   ) u_m_kk_wait (
     .clk_i (clk_i),
     .en_i  (en_i),

@@ -228,22 +228,24 @@ fn one_item_per_cycle_when_never_stalled() {
 
 #[test]
 fn gate_level_netlist_smoke() {
-    let (variant, cfg) = gate_configs::<ShaderConfig>()[0];
-    let tables = random_tables(&cfg, 21);
-    must_match(
-        variant,
-        cfg,
-        &mut shader(cfg, &tables),
-        &mut random_item(cfg),
-        &StreamCheck::gate_smoke(seed(21)).with_config_writes(tables.config_writes(&cfg)),
-    );
-    must_match_items(
-        variant,
-        cfg,
-        &mut shader(cfg, &tables),
-        directed_items(cfg),
-        &StreamCheck::directed(seed(22)).with_config_writes(tables.config_writes(&cfg)),
-    );
+    // Every `gate` line: v8 (Pipe = 0) and v8p1 (the pipelined decode and products).
+    for (variant, cfg) in gate_configs::<ShaderConfig>() {
+        let tables = random_tables(&cfg, 21);
+        must_match(
+            variant,
+            cfg,
+            &mut shader(cfg, &tables),
+            &mut random_item(cfg),
+            &StreamCheck::gate_smoke(seed(21)).with_config_writes(tables.config_writes(&cfg)),
+        );
+        must_match_items(
+            variant,
+            cfg,
+            &mut shader(cfg, &tables),
+            directed_items(cfg),
+            &StreamCheck::directed(seed(22)).with_config_writes(tables.config_writes(&cfg)),
+        );
+    }
 }
 
 /// Drives `items` under `traffic` and compares every output with `gold`; with `cut`, stops after
