@@ -7,6 +7,7 @@
 rtl/cube5/cube5_frame_pkg.sv
 rtl/cube5/cube5_frame_delay.sv
 rtl/cube5/cube5_frame_fifo.sv
+rtl/cube5/cube5_axi_slice.sv
 rtl/cube5/cube5_frame_pos.sv
 rtl/cube5/cube5_frame_agen.sv
 rtl/cube5/cube5_frame_vwin.sv

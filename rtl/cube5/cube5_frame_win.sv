@@ -422,8 +422,12 @@ module cube5_frame_win #(
   logic              g_on_q, g_on_d;
   logic [DimW-1:0]   gs_q, gs_d, gb_q, gb_d;
   logic signed [TW-1:0] gtx_q, gtx_d, gty_q, gty_d;
-  logic              rq_valid_q, rq_valid_d;
-  logic [KeyW-1:0]   rq_key_q, rq_key_d;
+  // rq_out_q != RsDepth in a flip-flop, and the requests through a register slice whose ready is
+  // a flip-flop (for clock rate: the walker's step no longer waits on the request's consumer nor
+  // on the count's compare; the frame's critical path alone at 30d3a1b, rq_out_q -> g_go ->
+  // rq_out_q through rq_ready_i).
+  logic              rq_room_q, rq_in_ready;
+  logic [RsCntW-1:0] rq_out_d;
   logic              g_go, g_col, g_emit;
   logic signed [1:0] g_dsx, g_dsy;
   logic [DimW-1:0]   g_r, g_q;
@@ -450,22 +454,15 @@ module cube5_frame_win #(
     g_emit = g_col && !((g_dsy == 2'sd1 && gb_q == '0) || (g_dsy == -2'sd1 && gb_q == nj_i - DimW'(1)));
     g_r    = ((g_dsx == 2'sd1) ? DimW'(0) : DimW'(nbr_i << LogP) - DimW'(1)) + max_sx_i - DimW'(g_sx);
     g_q    = gb_q + max_sy_i - DimW'(g_sy);
-    g_go   = g_on_q && (old_parks_q == '0) && (!rq_valid_q || rq_ready_i)
-             && (!g_emit || rq_out_q != RsCntW'(RsDepth));
+    g_go   = g_on_q && (old_parks_q == '0) && (!g_emit || (rq_in_ready && rq_room_q));
 
     g_on_d     = g_on_q;
     gs_d       = gs_q;
     gb_d       = gb_q;
     gtx_d      = gtx_q;
     gty_d      = gty_q;
-    rq_valid_d = rq_valid_q && !rq_ready_i;
-    rq_key_d   = rq_key_q;
     g_slice    = 1'b0;
     if (g_go) begin
-      if (g_emit) begin
-        rq_valid_d = 1'b1;
-        rq_key_d   = {g_q, g_r};
-      end
       if (g_col && gb_q != nj_i - DimW'(1)) begin
         gb_d = gb_q + DimW'(1);
       end else begin
@@ -489,13 +486,13 @@ module cube5_frame_win #(
   always_ff @(posedge clk_i) begin
     if (!rst_ni) begin
       g_on_q      <= 1'b0;
-      rq_valid_q  <= 1'b0;
       rq_out_q    <= '0;
+      rq_room_q   <= 1'b1;
       old_parks_q <= '0;
     end else begin
       g_on_q      <= g_on_d;
-      rq_valid_q  <= rq_valid_d;
-      rq_out_q    <= rq_out_q + RsCntW'(g_go && g_emit) - RsCntW'(rs_pop);
+      rq_out_q    <= rq_out_d;
+      rq_room_q   <= rq_out_d != RsCntW'(RsDepth);
       if (start_i) begin
         // The parks reserved or queued at the end of this cycle: a pop (or a reservation) in
         // the start cycle itself counts (else the walker waits for a park that already left).
@@ -511,7 +508,6 @@ module cube5_frame_win #(
     gb_q     <= gb_d;
     gtx_q    <= gtx_d;
     gty_q    <= gty_d;
-    rq_key_q <= rq_key_d;
     if (start_i) begin
       g_dsx_q <= g_dsx0;
       g_dsy_q <= g_dsy0;
@@ -521,8 +517,20 @@ module cube5_frame_win #(
     end
   end
 
-  assign rq_valid_o = rq_valid_q;
-  assign rq_key_o   = rq_key_q;
+  assign rq_out_d = rq_out_q + RsCntW'(g_go && g_emit) - RsCntW'(rs_pop);
+
+  cube5_axi_slice #(
+    .Width (KeyW)
+  ) u_rq (
+    .clk_i       (clk_i),
+    .rst_ni      (rst_ni),
+    .in_valid_i  (g_go && g_emit),
+    .in_ready_o  (rq_in_ready),
+    .in_data_i   ({g_q, g_r}),
+    .out_valid_o (rq_valid_o),
+    .out_ready_i (rq_ready_i),
+    .out_data_o  (rq_key_o)
+  );
 
   logic unused_win;
   assign unused_win = ^{unused_d0, unused_d1, unused_d2, unused_d3, unused_pf, unused_ff,
@@ -547,6 +555,9 @@ module cube5_frame_win #(
   WinWalkerSteps: assert property (@(posedge clk_i) disable iff (!rst_ni)
       g_on_q |-> g_dsx_q == step_of(gtx_q, dx_i) && g_dsy_q == step_of(gty_q, dy_i))
     else $error("cube5_frame_win: the walker's registered slice steps disagree with its position");
+  WinRequestRoomAsCount: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      rq_room_q == (rq_out_q != RsCntW'(RsDepth)))
+    else $error("cube5_frame_win: the request room flag disagrees with the requests' count");
   WinRequestsHeld: assert property (@(posedge clk_i) disable iff (!rst_ni)
       rq_valid_o && !rq_ready_i |=> rq_valid_o && $stable(rq_key_o))
     else $error("cube5_frame_win: a stalled restore request changed");
