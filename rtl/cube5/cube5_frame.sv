@@ -750,7 +750,15 @@ module cube5_frame #(
     // counts positions itself; the marks are checked against its count in simulation.
     logic beat_take, beat_err;
     logic [4:0] beat_marks;
-    assign beat_take  = in_fire && !in_is_cmd && state_q == StSweep;
+    // in_fire && !in_is_cmd in the sweep, written out so that the command side's ready (the
+    // compositing buffer's clear) is no input of the take (for clock rate: the routed line's
+    // critical path at d5c8287 ran from that clear through in_ready_o into the window's admission).
+    assign beat_take  = in_valid_i && !in_is_cmd && state_q == StSweep && more_q && win_ok;
+`ifndef SYNTHESIS
+    BeatTakeAsFire: assert property (@(posedge clk_i) disable iff (!rst_ni)
+        beat_take == (in_fire && !in_is_cmd && state_q == StSweep))
+      else $error("cube5_frame: the beat take disagrees with the input's handshake");
+`endif
     assign beat_err   = in_data_i[1 + XBeatW + 4];
     assign beat_marks = in_data_i[1 + XBeatW +: 5];
     assign mem_lanes  = in_data_i[1 +: XBeatW];
