@@ -896,8 +896,12 @@ module cube5_accel #(
   logic [WrOutW-1:0]        wr_out_q;   // write bursts accepted, B not yet in
   logic signed [WOwedW-1:0] w_owed_q, w_owed_d;   // beats of accepted write bursts not yet sent
   // w_owed_q > 0 in a flip-flop (for clock rate: the W channel's ready starts from a register,
-  // not from the count's compare; the routed line's critical path at 30d3a1b).
-  logic                     w_owed_pos_q;
+  // not from the count's compare; the routed line's critical path at 30d3a1b). The count after
+  // this cycle's AW (w_owed_aw) and both its compares are formed beside the W beat's handshake,
+  // which then only selects (the W valid comes late, through the window's W FIFO and the
+  // arbiter: the routed P = 1 and 2 lines' critical path at d5c8287).
+  logic                     w_owed_pos_q, w_owed_pos_d, w_fire;
+  logic signed [WOwedW-1:0] w_owed_aw;
 
   assign m_axi_arvalid_o = ar_valid && !ar_block_q;
   assign ar_ready        = m_axi_arready_i && !ar_block_q;
@@ -931,12 +935,14 @@ module cube5_accel #(
       wr_out_q <= wr_out_q + WrOutW'(m_axi_awvalid_o && m_axi_awready_i)
                            - WrOutW'(m_axi_bvalid_i && m_axi_bready_o);
       w_owed_q     <= w_owed_d;
-      w_owed_pos_q <= w_owed_d > 0;
+      w_owed_pos_q <= w_owed_pos_d;
     end
   end
-  assign w_owed_d = w_owed_q + ((m_axi_awvalid_o && m_axi_awready_i)
-                                ? WOwedW'(m_axi_awlen_o) + WOwedW'(1) : '0)
-                             - WOwedW'(m_axi_wvalid_o && m_axi_wready_i);
+  assign w_fire       = m_axi_wvalid_o && m_axi_wready_i;
+  assign w_owed_aw    = w_owed_q + ((m_axi_awvalid_o && m_axi_awready_i)
+                                    ? WOwedW'(m_axi_awlen_o) + WOwedW'(1) : '0);
+  assign w_owed_d     = w_fire ? w_owed_aw - WOwedW'(1) : w_owed_aw;
+  assign w_owed_pos_d = w_fire ? w_owed_aw > 1 : w_owed_aw > 0;
 `ifndef SYNTHESIS
   WOwedPosAsCount: assert property (@(posedge clk_i) disable iff (!rst_ni)
       w_owed_pos_q == (w_owed_q > 0))
