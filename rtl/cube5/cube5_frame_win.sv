@@ -426,8 +426,13 @@ module cube5_frame_win #(
   // a flip-flop (for clock rate: the walker's step no longer waits on the request's consumer nor
   // on the count's compare; the frame's critical path alone at 30d3a1b, rq_out_q -> g_go ->
   // rq_out_q through rq_ready_i).
-  logic              rq_room_q, rq_in_ready;
+  // The room's next value is formed from compares of the count beside the walker's step and
+  // the pop, which only select (the line's critical path at 63ba58f ran through the count's adder
+  // into that compare). The walker's "last row" (gb_q == nj_i - 1) is a flip-flop too, loaded
+  // from compares of registers (that path began at nj_i's decrement).
+  logic              rq_room_q, rq_room_d, rq_in_ready, rq_inc;
   logic [RsCntW-1:0] rq_out_d;
+  logic              g_last_row_q, g_last_row_d;
   logic              g_go, g_col, g_emit;
   logic signed [1:0] g_dsx, g_dsy;
   logic [DimW-1:0]   g_r, g_q;
@@ -451,7 +456,7 @@ module cube5_frame_win #(
     // The slice's entering column restores (from the section before it in sweep order).
     g_col  = (g_dsx == 2'sd1 && !lo_edge_i) || (g_dsx == -2'sd1 && !hi_edge_i);
     // Its row gb: not the entering row.
-    g_emit = g_col && !((g_dsy == 2'sd1 && gb_q == '0) || (g_dsy == -2'sd1 && gb_q == nj_i - DimW'(1)));
+    g_emit = g_col && !((g_dsy == 2'sd1 && gb_q == '0) || (g_dsy == -2'sd1 && g_last_row_q));
     g_r    = ((g_dsx == 2'sd1) ? DimW'(0) : DimW'(nbr_i << LogP) - DimW'(1)) + max_sx_i - DimW'(g_sx);
     g_q    = gb_q + max_sy_i - DimW'(g_sy);
     g_go   = g_on_q && (old_parks_q == '0) && (!g_emit || (rq_in_ready && rq_room_q));
@@ -462,12 +467,15 @@ module cube5_frame_win #(
     gtx_d      = gtx_q;
     gty_d      = gty_q;
     g_slice    = 1'b0;
+    g_last_row_d = g_last_row_q;
     if (g_go) begin
-      if (g_col && gb_q != nj_i - DimW'(1)) begin
+      if (g_col && !g_last_row_q) begin
         gb_d = gb_q + DimW'(1);
+        g_last_row_d = (gb_q == nj_i - DimW'(2));
       end else begin
         g_slice = 1'b1;
         gb_d  = '0;
+        g_last_row_d = (nj_i == DimW'(1));
         gs_d  = gs_q + DimW'(1);
         gtx_d = gtx_q + TW'(dx_i);
         gty_d = gty_q + TW'(dy_i);
@@ -478,6 +486,7 @@ module cube5_frame_win #(
       g_on_d = nk_i != DimW'(1);
       gs_d   = DimW'(1);
       gb_d   = '0;
+      g_last_row_d = (nj_i == DimW'(1));
       gtx_d  = TW'(dx_i);
       gty_d  = TW'(dy_i);
     end
@@ -492,7 +501,7 @@ module cube5_frame_win #(
     end else begin
       g_on_q      <= g_on_d;
       rq_out_q    <= rq_out_d;
-      rq_room_q   <= rq_out_d != RsCntW'(RsDepth);
+      rq_room_q   <= rq_room_d;
       if (start_i) begin
         // The parks reserved or queued at the end of this cycle: a pop (or a reservation) in
         // the start cycle itself counts (else the walker waits for a park that already left).
@@ -506,6 +515,7 @@ module cube5_frame_win #(
   always_ff @(posedge clk_i) begin
     gs_q     <= gs_d;
     gb_q     <= gb_d;
+    g_last_row_q <= g_last_row_d;
     gtx_q    <= gtx_d;
     gty_q    <= gty_d;
     if (start_i) begin
@@ -517,14 +527,18 @@ module cube5_frame_win #(
     end
   end
 
-  assign rq_out_d = rq_out_q + RsCntW'(g_go && g_emit) - RsCntW'(rs_pop);
+  assign rq_inc    = g_go && g_emit;
+  assign rq_out_d  = rq_out_q + RsCntW'(rq_inc) - RsCntW'(rs_pop);
+  // rq_out_d != RsDepth (the count never exceeds RsDepth).
+  assign rq_room_d = !((rq_inc && !rs_pop && rq_out_q == RsCntW'(RsDepth - 1))
+                       || (rq_inc == rs_pop && rq_out_q == RsCntW'(RsDepth)));
 
   cube5_axi_slice #(
     .Width (KeyW)
   ) u_rq (
     .clk_i       (clk_i),
     .rst_ni      (rst_ni),
-    .in_valid_i  (g_go && g_emit),
+    .in_valid_i  (rq_inc),
     .in_ready_o  (rq_in_ready),
     .in_data_i   ({g_q, g_r}),
     .out_valid_o (rq_valid_o),
@@ -558,6 +572,9 @@ module cube5_frame_win #(
   WinRequestRoomAsCount: assert property (@(posedge clk_i) disable iff (!rst_ni)
       rq_room_q == (rq_out_q != RsCntW'(RsDepth)))
     else $error("cube5_frame_win: the request room flag disagrees with the requests' count");
+  WinLastRowAsCount: assert property (@(posedge clk_i) disable iff (!rst_ni)
+      g_on_q |-> g_last_row_q == (gb_q == nj_i - DimW'(1)))
+    else $error("cube5_frame_win: the walker's last-row flag disagrees with its row");
   WinRequestsHeld: assert property (@(posedge clk_i) disable iff (!rst_ni)
       rq_valid_o && !rq_ready_i |=> rq_valid_o && $stable(rq_key_o))
     else $error("cube5_frame_win: a stalled restore request changed");
